@@ -1,0 +1,128 @@
+"""Pieces shared by the subcommands: parameter options, JSON output, errors."""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import math
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+
+class CommandError(Exception):
+    """A user-facing error of a subcommand (one line, exit status 2)."""
+
+
+@dataclass
+class Result:
+    """What a subcommand hands back: JSON-able ``data``, human ``text``, an exit ``status``."""
+
+    data: dict[str, Any]
+    text: str = ""
+    status: int = 0
+    extra: dict[str, Any] = field(default_factory=dict)
+
+
+def to_jsonable(obj: Any) -> Any:
+    """Convert numpy scalars/arrays, paths and non-finite floats (-> null) for JSON."""
+    if isinstance(obj, dict):
+        return {str(k): to_jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [to_jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return [to_jsonable(v) for v in obj.tolist()]
+    if isinstance(obj, (np.bool_, bool)):
+        return bool(obj)
+    if isinstance(obj, (np.integer,)):
+        return int(obj)
+    if isinstance(obj, (float, np.floating)):
+        value = float(obj)
+        return value if math.isfinite(value) else None
+    if isinstance(obj, Path):
+        return str(obj)
+    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        return to_jsonable(dataclasses.asdict(obj))
+    return obj
+
+
+def dumps(data: Any) -> str:
+    """One JSON document (strict: NaN and inf become null)."""
+    return json.dumps(to_jsonable(data), indent=2, allow_nan=False)
+
+
+def emit(result: Result, *, as_json: bool) -> int:
+    """Print a result (JSON or text) and return its exit status."""
+    if as_json:
+        sys.stdout.write(dumps(result.data) + "\n")
+    elif result.text:
+        sys.stdout.write(result.text.rstrip("\n") + "\n")
+    sys.stdout.flush()
+    return result.status
+
+
+def add_json_option(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--json", action="store_true", help="print one JSON document on stdout")
+
+
+def add_param_options(parser: argparse.ArgumentParser, params_cls: type, skip: tuple[str, ...] = ()) -> None:
+    """One ``--NAME`` option per field of a parameter dataclass (default: the dataclass's)."""
+    docs = params_cls.field_docs()
+    group = parser.add_argument_group("model parameters")
+    for f in dataclasses.fields(params_cls):
+        if f.name in skip:
+            continue
+        kind = int if f.metadata.get("integer") else float
+        group.add_argument(
+            f"--{f.name}",
+            dest=f"param_{f.name}",
+            type=_number(kind, f.name),
+            default=None,
+            metavar=f.name,
+            help=f"{docs[f.name]} (default {f.default})",
+        )
+
+
+def params_from_args(params_cls: type, args: argparse.Namespace, **overrides: Any):
+    """Build (and so validate) a parameter dataclass from the ``--NAME`` options."""
+    values = {}
+    for f in dataclasses.fields(params_cls):
+        value = getattr(args, f"param_{f.name}", None)
+        if value is not None:
+            values[f.name] = value
+    values.update(overrides)
+    return params_cls(**values)
+
+
+def _number(kind: type, name: str):
+    """An argparse type that accepts any number text and leaves range checks to the dataclass."""
+
+    def convert(text: str):
+        try:
+            return kind(text) if kind is int else float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{name} must be a number (got {text!r})") from None
+
+    convert.__name__ = name
+    return convert
+
+
+def float_arg(name: str):
+    """An argparse type for a plain float option (range checked by the command)."""
+    return _number(float, name)
+
+
+def prepare_out_dir(path: str | Path | None) -> Path | None:
+    """Create the output directory (after all validation has passed)."""
+    if path is None:
+        return None
+    out = Path(path)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise CommandError(f"cannot create output directory {out}: {exc.strerror}") from None
+    return out

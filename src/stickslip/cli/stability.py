@@ -1,0 +1,7 @@
+"""`stickslip stability`: (to be filled in)."""
+
+from __future__ import annotations
+
+
+def register(sub) -> None:
+    """Add the subcommand(s) of this module to the parser."""

@@ -1,0 +1,92 @@
+"""Writing and reading results: JSON metadata, labelled arrays (NetCDF/HDF5), event tables (Parquet).
+
+Every write is atomic (written to a temporary file in the same directory, then renamed), so an
+interrupted run never leaves a half-written file under the final name.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import platform
+import tempfile
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any, Iterator
+
+import pandas as pd
+import xarray as xr
+
+from stickslip import __version__
+
+
+@contextmanager
+def atomic_path(path: str | Path) -> Iterator[Path]:
+    """Yield a temporary path next to ``path``; rename it onto ``path`` on success."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    os.close(fd)
+    tmp_path = Path(tmp)
+    try:
+        yield tmp_path
+        os.replace(tmp_path, path)
+    finally:
+        if tmp_path.exists():
+            tmp_path.unlink()
+
+
+def write_json(path: str | Path, data: Any) -> Path:
+    """Write one JSON document atomically (NaN and inf become null)."""
+    from stickslip.cli._common import to_jsonable
+
+    with atomic_path(path) as tmp:
+        tmp.write_text(json.dumps(to_jsonable(data), indent=2, allow_nan=False) + "\n")
+    return Path(path)
+
+
+def read_json(path: str | Path) -> Any:
+    return json.loads(Path(path).read_text())
+
+
+def write_dataset(path: str | Path, ds: xr.Dataset) -> Path:
+    """Write labelled arrays to NetCDF4/HDF5 (h5netcdf engine), atomically."""
+    with atomic_path(path) as tmp:
+        ds.to_netcdf(tmp, engine="h5netcdf")
+    return Path(path)
+
+
+def read_dataset(path: str | Path) -> xr.Dataset:
+    """Read a dataset written by :func:`write_dataset` fully into memory."""
+    with xr.open_dataset(path, engine="h5netcdf") as ds:
+        return ds.load()
+
+
+def write_table(path: str | Path, table: pd.DataFrame) -> Path:
+    """Write a table (events, sweep summaries) to Parquet, atomically."""
+    with atomic_path(path) as tmp:
+        table.to_parquet(tmp, engine="pyarrow", index=False)
+    return Path(path)
+
+
+def read_table(path: str | Path) -> pd.DataFrame:
+    return pd.read_parquet(path, engine="pyarrow")
+
+
+def run_metadata(params: Any, *, integrator: str, **extra: Any) -> dict[str, Any]:
+    """The record written next to every run's outputs: parameters, integrator, versions."""
+    import numba
+    import numpy
+
+    meta = {
+        "package": "stickslip",
+        "version": __version__,
+        "integrator": integrator,
+        "params": params.to_dict() if hasattr(params, "to_dict") else dict(params),
+        "params_type": type(params).__name__,
+        "python": platform.python_version(),
+        "numpy": numpy.__version__,
+        "numba": numba.__version__,
+    }
+    meta.update(extra)
+    return meta

@@ -1,0 +1,179 @@
+"""Model parameters: frozen dataclasses, validated when built.
+
+Every field carries the paper's symbol. Defaults are the paper's values (section 2 for the
+single block, section 3 for the chain). A bad value raises :class:`ParameterError` whose
+message names the parameter and the allowed range, in one line.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+
+class ParameterError(ValueError):
+    """A parameter is outside its allowed range; the message is one line."""
+
+
+def _range_text(low: float | None, high: float | None, low_open: bool, high_open: bool) -> str:
+    parts = []
+    if low is not None:
+        parts.append(f"{'>' if low_open else '>='} {low:g}")
+    if high is not None:
+        parts.append(f"{'<' if high_open else '<='} {high:g}")
+    return " and ".join(parts) if parts else "finite"
+
+
+def check_number(
+    name: str,
+    value: Any,
+    *,
+    low: float | None = None,
+    high: float | None = None,
+    low_open: bool = False,
+    high_open: bool = False,
+    integer: bool = False,
+) -> float | int:
+    """Return ``value`` as a float (or int) if it is finite and in range, else raise.
+
+    The error names ``name`` and the allowed range, e.g. ``K must be > 0 (got -1)``.
+    """
+    allowed = _range_text(low, high, low_open, high_open)
+    kind = "an integer" if integer else "a finite number"
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{name} must be {kind} {allowed} (got {value!r})") from None
+    if not math.isfinite(number):
+        raise ParameterError(f"{name} must be {kind} {allowed} (got {value!r})")
+    if integer:
+        if number != int(number):
+            raise ParameterError(f"{name} must be {kind} {allowed} (got {value!r})")
+        number = int(number)
+    too_low = low is not None and (number <= low if low_open else number < low)
+    too_high = high is not None and (number >= high if high_open else number > high)
+    if too_low or too_high:
+        raise ParameterError(f"{name} must be {allowed} (got {value!r})")
+    return number
+
+
+def _positive(default: float, doc: str) -> Any:
+    return field(default=default, metadata={"low": 0.0, "low_open": True, "doc": doc})
+
+
+def _nonnegative(default: float, doc: str) -> Any:
+    return field(default=default, metadata={"low": 0.0, "doc": doc})
+
+
+class _Validated:
+    """Mixin: validate every field from its metadata after construction."""
+
+    def __post_init__(self) -> None:
+        for f in dataclasses.fields(self):  # type: ignore[arg-type]
+            meta = f.metadata
+            value = check_number(
+                f.name,
+                getattr(self, f.name),
+                low=meta.get("low"),
+                high=meta.get("high"),
+                low_open=meta.get("low_open", False),
+                high_open=meta.get("high_open", False),
+                integer=meta.get("integer", False),
+            )
+            object.__setattr__(self, f.name, value)
+        self._check()
+
+    def _check(self) -> None:
+        """Cross-field checks; subclasses override."""
+
+    def to_dict(self) -> dict[str, float | int]:
+        """All fields as a plain dict (for JSON and run metadata)."""
+        return dataclasses.asdict(self)  # type: ignore[call-overload]
+
+    def replace(self, **changes: Any):
+        """A copy with some fields changed (validated again)."""
+        return dataclasses.replace(self, **changes)  # type: ignore[type-var]
+
+    @classmethod
+    def field_docs(cls) -> dict[str, str]:
+        """Field name -> one-line description (used for command-line help)."""
+        return {f.name: f.metadata.get("doc", "") for f in dataclasses.fields(cls)}  # type: ignore[arg-type]
+
+
+@dataclass(frozen=True)
+class BlockParams(_Validated):
+    """Parameters of the single block and spring, eq. (1).
+
+    M x'' = K (V t - x) - F(theta, v),  F = sigma theta + beta v,
+    theta' = theta (1 - theta) - alpha theta v, with static friction Fs.
+    Defaults are the paper's (section 2, Fig. 1): M = sigma = alpha = beta = 1, K = 10,
+    V = 0.001, Fs = 3, Heun step dt = 0.005.
+    """
+
+    K: float = _positive(10.0, "spring constant K")
+    V: float = _nonnegative(0.001, "pulling velocity V")
+    beta: float = _nonnegative(1.0, "viscous friction coefficient beta")
+    alpha: float = _nonnegative(1.0, "weakening coefficient alpha of the state variable")
+    Fs: float = _positive(3.0, "static friction limit Fs")
+    M: float = _positive(1.0, "block mass M")
+    sigma: float = _positive(1.0, "state-variable friction scale sigma")
+    dt: float = _positive(0.005, "Heun time step dt")
+
+    def scaled(self) -> "BlockParams":
+        """The same system in the units M = sigma = 1 of section 2 (see :func:`scale_block`)."""
+        return scale_block(self)
+
+
+def scale_block(p: BlockParams) -> BlockParams:
+    """Rescale eq. (1) to M = sigma = 1 (section 2 of the paper).
+
+    With x = (sigma/M) x~, v = (sigma/M) v~, V = (sigma/M) V~, K~ = K/M, beta~ = beta/M and
+    alpha~ = alpha sigma / M, eq. (1) divided by M reads
+    x~'' = K~ (V~ t - x~) - theta - beta~ v~,  theta' = theta (1 - theta) - alpha~ theta v~.
+    The static friction scales like a force per unit mass over sigma/M: Fs~ = Fs / sigma.
+    Time is not rescaled, so dt is unchanged.
+    """
+    return BlockParams(
+        K=p.K / p.M,
+        V=p.V * p.M / p.sigma,
+        beta=p.beta / p.M,
+        alpha=p.alpha * p.sigma / p.M,
+        Fs=p.Fs / p.sigma,
+        M=1.0,
+        sigma=1.0,
+        dt=p.dt,
+    )
+
+
+@dataclass(frozen=True)
+class ChainParams(_Validated):
+    """Parameters of the chain of eq. (4), pinned down in MODEL.md.
+
+    N blocks, only the first pulled (x_0 = V t) through a spring K; free end; state variable
+    with diffusion D and no-flux ends; static friction Fs. Defaults are the paper's run
+    (section 3): N = 399, K = 10, D = 5, V = 0.001, Fs = 3, dt = 0.005, alpha = 1, beta = 1.
+    """
+
+    N: int = field(default=399, metadata={"low": 1, "integer": True, "doc": "number of blocks N"})
+    K: float = _positive(10.0, "spring constant K")
+    D: float = _nonnegative(5.0, "diffusion constant D of the state variable")
+    V: float = _nonnegative(0.001, "pulling velocity V of the first spring")
+    beta: float = _nonnegative(1.0, "viscous friction coefficient beta")
+    alpha: float = _nonnegative(1.0, "weakening coefficient alpha of the state variable")
+    Fs: float = _positive(3.0, "static friction limit Fs")
+    dt: float = _positive(0.005, "Heun time step dt")
+
+    def _check(self) -> None:
+        # Heun's diffusion part is stable only for D dt <= 1/2 (explicit scheme).
+        if self.D * self.dt > 0.5:
+            raise ParameterError(
+                f"D*dt must be <= 0.5 for a stable explicit step (got D={self.D:g}, dt={self.dt:g})"
+            )
+
+
+def steps_for(t_end: float, dt: float, name: str = "t_end") -> int:
+    """Number of steps n with t_n = n dt reaching ``t_end`` (rounded to the nearest step)."""
+    t_end = check_number(name, t_end, low=0.0)
+    return int(round(t_end / dt))

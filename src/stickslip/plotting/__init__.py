@@ -1,0 +1,1 @@
+"""Figures of the paper. Every function takes results and returns a matplotlib Figure; none calls show()."""

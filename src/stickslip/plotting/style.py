@@ -1,0 +1,50 @@
+"""One shared look for every figure, and saving a figure with the data behind it."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg", force=False)
+import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.figure import Figure  # noqa: E402
+
+RC = {
+    "figure.dpi": 110,
+    "savefig.dpi": 150,
+    "font.size": 10,
+    "axes.grid": True,
+    "grid.alpha": 0.3,
+    "axes.spines.top": False,
+    "axes.spines.right": False,
+    "legend.frameon": False,
+}
+
+SIM = {"color": "C0", "lw": 1.2}          # simulation of the model: solid
+THEORY = {"color": "C3", "lw": 1.2, "ls": "--"}  # analytic/limit curves: dashed, as in the paper
+PAPER = {"color": "0.4", "lw": 1.0, "ls": ":"}   # the paper's own formula where it differs
+
+
+def new_figure(nrows: int = 1, ncols: int = 1, *, width: float = 5.0, height: float = 3.6, **kw):
+    """A Figure and its axes in the project style (no pyplot state is kept)."""
+    with matplotlib.rc_context(RC):
+        fig = Figure(figsize=(width * ncols, height * nrows), layout="constrained")
+        axes = fig.subplots(nrows, ncols, squeeze=True, **kw)
+    return fig, axes
+
+
+def save_figure(fig: Figure, path: str | Path, *, formats: tuple[str, ...] = ("png",)) -> list[Path]:
+    """Save ``fig`` as PATH.png (and other formats); returns the written paths."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    written = []
+    with matplotlib.rc_context(RC):
+        for fmt in formats:
+            out = path.with_suffix(f".{fmt}")
+            fig.savefig(out)
+            written.append(out)
+    return written
+
+
+__all__ = ["new_figure", "save_figure", "plt", "SIM", "THEORY", "PAPER", "RC"]
