@@ -1,0 +1,75 @@
+"""Model equations that have closed forms: steady sliding of the block and of the chain.
+
+Conventions (MODEL.md): blocks are numbered i = 1..N in the paper and in every output of this
+package; arrays hold block i at index i - 1. The pulling point is x_0 = V t.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from stickslip.params import BlockParams, ChainParams
+
+
+def sliding_friction(V: float, beta: float) -> float:
+    """Friction of steady sliding, c = theta_0 + beta v_0 = 1 - (1 - beta) V (sections 2, 3)."""
+    return 1.0 - (1.0 - beta) * V
+
+
+def block_steady_state(p: BlockParams) -> dict[str, float]:
+    """Steady sliding of the single block, section 2 (with general M, sigma, alpha).
+
+    v_0 = V; theta_0 solves theta (1 - theta) = alpha theta V, so theta_0 = 1 - alpha V;
+    the spring carries the friction: K (V t - x_0) = sigma theta_0 + beta V.
+    For M = sigma = alpha = 1 this is the paper's x_0 = V t - {1 - (1 - beta) V} / K.
+    Returns v, theta and the spring extension ``lag`` = V t - x_0.
+    """
+    theta0 = 1.0 - p.alpha * p.V
+    force = p.sigma * theta0 + p.beta * p.V
+    return {"v": p.V, "theta": theta0, "force": force, "lag": force / p.K}
+
+
+def chain_steady_state(p: ChainParams, t: float = 0.0) -> dict[str, np.ndarray]:
+    """Exact discrete steady sliding of the chain, eq. (4) with the ends of MODEL.md.
+
+    v_i = V, theta_i = 1 - alpha V (= 1 - V for alpha = 1), friction
+    c = theta_0 + beta V; every block is pulled by the spring behind it with the friction of all
+    blocks ahead, so x_{i-1} - x_i = (c / K) (N - i + 1), with x_0 = V t.
+    Returns x (length N), v, theta and the extensions ``ext`` (x_{i-1} - x_i, i = 1..N).
+    """
+    theta0 = 1.0 - p.alpha * p.V
+    c = theta0 + p.beta * p.V
+    i = np.arange(1, p.N + 1, dtype=np.float64)
+    ext = (c / p.K) * (p.N - i + 1.0)
+    x = p.V * t - np.cumsum(ext)
+    return {
+        "x": x,
+        "v": np.full(p.N, p.V),
+        "theta": np.full(p.N, theta0),
+        "ext": ext,
+        "friction": c,
+    }
+
+
+def chain_steady_length(p: ChainParams) -> float:
+    """Total length L = x_1 - x_N of steady sliding, exact discrete form (MODEL.md).
+
+    L_ss = (c / K) N (N - 1) / 2 with c = theta_0 + beta V; 7940.1 for the paper's chain.
+    """
+    c = (1.0 - p.alpha * p.V) + p.beta * p.V
+    return c / p.K * p.N * (p.N - 1) / 2.0
+
+
+def chain_steady_profile_paper(p: ChainParams, t: float = 0.0) -> np.ndarray:
+    """The paper's continuum form x_i = V t - c/K {N^2 - (i - N)^2} / 2 (section 3, Fig. 5a).
+
+    An approximation of :func:`chain_steady_state`; shown beside it where a figure compares.
+    """
+    c = sliding_friction(p.V, p.beta)
+    i = np.arange(1, p.N + 1, dtype=np.float64)
+    return p.V * t - c / p.K * (p.N**2 - (i - p.N) ** 2) / 2.0
+
+
+def chain_steady_length_paper(p: ChainParams) -> float:
+    """The paper's L = {1 - (1 - beta) V} N^2 / 2 as printed (it lacks the factor 1/K; MODEL.md)."""
+    return sliding_friction(p.V, p.beta) * p.N**2 / 2.0
