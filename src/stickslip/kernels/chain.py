@@ -1,0 +1,495 @@
+"""Numba kernels of the chain of eq. (4): the reference (`dense`) and the fast (`exact`) Heun.
+
+Layout. Blocks i = 1..N live at index i of arrays of length N + 2; index 0 and N + 1 are
+ghost cells: x[0] is the pulling point V t, x[N+1] = x[N] (free end), th[0] = th[1] and
+th[N+1] = th[N] (no-flux ends of the state variable; MODEL.md). ``mov`` holds 1.0 for a
+moving block and 0.0 for a stopped one, so a stopped block's acceleration is ``0 * (...)``.
+
+One Heun step from t_n = n dt to t_{n+1} (MODEL.md):
+
+1. start rule: a stopped block with f_i > Fs moves (with v = 0) for this step; ``mm`` is
+   this mid-step mask;
+2. stage 1 at t_n: f_i = K ((x_{i-1} - x_i) - (x_i - x_{i+1})), a_i = mm (f_i - th_i - beta v_i),
+   b_i = th_i (1 - th_i) - alpha th_i v_i + D ((th_{i-1} - th_i) - (th_i - th_{i+1}));
+   predictor xs = x + dt v, vs = v + dt a, ths = th + dt b;
+3. stage 2 at t_{n+1} on the predictor, with the same mask; corrector
+   x += dt/2 (v + vs), v += dt/2 (a + a2), th += dt/2 (b + b2);
+4. stop rule: a moving block whose new v <= 0 gets v = 0 and stops.
+
+Both integrators evaluate every quantity with the very same expressions (the ``_force``,
+``_accel``, ``_dtheta`` helpers below), so they agree bit for bit. ``exact`` only skips
+work whose result is known: one step of block i reads blocks i-2..i+2 (stage 2 reads the
+neighbours' predictors, which read theirs), and the step is time-independent except through
+the pulling point, which only block 1 sees. So a block none of whose neighbours out to two
+places changed in the last step cannot change now; the blocks to update form the changed
+set dilated by two (kept as one bounding interval, which is conservative), plus block 1
+whenever it moves or its start rule fires. When nothing is active, nothing can change until
+block 1's force exceeds Fs: the kernel jumps to that step, found with the step's own
+expression for the force (monotone in n), stopping on the way at sampling steps.
+
+Events (MODEL.md): an event starts with the first step in which any block moves after a
+step that ended with every block stopped, and ends with the first step that ends with every
+block stopped again; S = sum_i (x_i(end) - x_i(start)) over the blocks that moved, summed in
+block order.
+
+Kernels return a status code; the driver empties the output buffers and calls again. All
+state lives in the arrays passed in, so a run can stop and resume at any step boundary.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+# Indices into the int64 state vector ``ist``.
+STEP = 0           # n: the state held is at t_n = n dt
+N_MOVING = 1       # blocks moving at t_n
+EV_ACTIVE = 2      # 1 while an event is in progress
+EV_START_STEP = 3  # step in which the event's first block moved
+EV_START_BLOCK = 4
+EV_MAX_BLOCK = 5   # farthest block moved so far in the event
+EV_N_MOVED = 6     # blocks moved so far in the event
+ACT_LO = 7         # blocks that may change in the next step: [ACT_LO, ACT_HI] (empty if lo > hi)
+ACT_HI = 8
+N_EVENTS = 9       # events completed since the start of the run (the next event's id)
+EV_COUNT = 10      # rows filled in the event buffer
+FM_COUNT = 11      # rows filled in the first-move buffer
+S_COUNT = 12       # samples filled in the sample buffer
+P_COUNT = 13       # rows filled in the profile buffer
+EV_P_FIRST = 14    # first profile row of the current event in the buffer
+NEXT_PROFILE = 15  # next step at which a profile row is due
+BAD_BLOCK = 16     # block found non-finite (status NONFINITE)
+BLOCK_UPDATES = 17  # block updates performed (stage 2), for profiling
+STEPS_COMPUTED = 18  # steps actually computed (not jumped over)
+NEXT_SAMPLE = 19   # next step at which L = x_1 - x_N is sampled
+IST_SIZE = 20
+
+# Indices into the float64 parameter vector ``par``.
+P_K, P_D, P_V, P_BETA, P_ALPHA, P_FS, P_DT = range(7)
+PAR_SIZE = 7
+
+# Columns of the int64 event buffer ``ev_int``.
+E_ID, E_START_STEP, E_END_STEP, E_START_BLOCK, E_MAX_BLOCK, E_N_BLOCKS = range(6)
+EV_INT_COLS = 6
+
+# Status codes returned by the kernels.
+DONE = 0
+EVENTS_FULL = 1
+FIRST_MOVES_FULL = 2
+SAMPLES_FULL = 3
+PROFILES_FULL = 4
+NONFINITE = 5
+
+_BIG = np.float64(1.7976931348623157e308)
+
+
+@njit(cache=True, inline="always")
+def _force(xl, xc, xr, K):
+    """Spring force on a block from its neighbours, eq. (4): K (x_{i+1} - 2 x_i + x_{i-1})."""
+    return K * ((xl - xc) - (xc - xr))
+
+
+@njit(cache=True, inline="always")
+def _accel(f, th, v, beta, m):
+    """dv/dt of eq. (4) times the moving mask m (1.0 moving, 0.0 stopped)."""
+    return m * (f - th - beta * v)
+
+
+@njit(cache=True, inline="always")
+def _dtheta(thl, th, thr, v, alpha, D):
+    """dtheta/dt of eq. (4) with diffusion D, for moving and stopped blocks alike."""
+    return th * (1.0 - th) - alpha * th * v + D * ((thl - th) - (th - thr))
+
+
+@njit(cache=True, inline="always")
+def _pull(V, n, dt):
+    """Pulling point x_0 = V t_n with t_n = n dt from the integer step count (MODEL.md)."""
+    return V * (np.float64(n) * dt)
+
+
+@njit(cache=True, inline="always")
+def _service(n, x, N, ist, samp_L, samp_step, prof_x, prof_meta, sample_every, profile_every):
+    """Samples and profile rows due at step n (state at t_n). Returns a status code."""
+    if n == ist[NEXT_SAMPLE]:
+        k = ist[S_COUNT]
+        if k >= samp_L.shape[0]:
+            return SAMPLES_FULL
+        samp_L[k] = x[1] - x[N]
+        samp_step[k] = n
+        ist[S_COUNT] = k + 1
+        ist[NEXT_SAMPLE] = n + sample_every
+    if profile_every > 0 and ist[EV_ACTIVE] == 1 and n == ist[NEXT_PROFILE]:
+        r = ist[P_COUNT]
+        if r >= prof_x.shape[0]:
+            return PROFILES_FULL
+        for i in range(1, N + 1):
+            prof_x[r, i - 1] = x[i]
+        prof_meta[r, 0] = ist[N_EVENTS]
+        prof_meta[r, 1] = n
+        ist[P_COUNT] = r + 1
+        ist[NEXT_PROFILE] = n + profile_every
+    return DONE
+
+
+@njit(cache=True, inline="always")
+def _capacity(N, ist, ev_int, fm, prof_x, profile_every):
+    """Return a status if a buffer could overflow in the next step, else DONE."""
+    if ist[EV_COUNT] >= ev_int.shape[0]:
+        return EVENTS_FULL
+    if ist[FM_COUNT] + N > fm.shape[0]:
+        return FIRST_MOVES_FULL
+    if profile_every > 0 and ist[P_COUNT] + 2 > prof_x.shape[0]:
+        return PROFILES_FULL
+    return DONE
+
+
+@njit(cache=True)
+def _start_and_first_moves(n, lo, hi, x, mm, first_step, x0ev, ist, prof_x, prof_meta, N, profile_every):
+    """Event bookkeeping before stage 2 (x still holds t_n): event start and first moves."""
+    if ist[EV_ACTIVE] == 0:
+        if ist[N_MOVING] != 0:
+            return
+        first = -1
+        for i in range(lo, hi + 1):
+            if mm[i] != 0.0:
+                first = i
+                break
+        if first < 0:
+            return
+        ist[EV_ACTIVE] = 1
+        ist[EV_START_STEP] = n
+        ist[EV_START_BLOCK] = first
+        ist[EV_MAX_BLOCK] = 0
+        ist[EV_N_MOVED] = 0
+        if profile_every > 0:
+            r = ist[P_COUNT]
+            ist[EV_P_FIRST] = r
+            for i in range(1, N + 1):
+                prof_x[r, i - 1] = x[i]
+            prof_meta[r, 0] = ist[N_EVENTS]
+            prof_meta[r, 1] = n
+            ist[P_COUNT] = r + 1
+            ist[NEXT_PROFILE] = n + profile_every
+    for i in range(lo, hi + 1):
+        if mm[i] != 0.0 and first_step[i] < 0:
+            first_step[i] = n
+            x0ev[i] = x[i]
+            ist[EV_N_MOVED] += 1
+            if i > ist[EV_MAX_BLOCK]:
+                ist[EV_MAX_BLOCK] = i
+
+
+@njit(cache=True)
+def _end_event(n, x, first_step, x0ev, ist, ev_int, ev_S, fm, prof_x, prof_meta, N, profile_every,
+               profile_min_blocks):
+    """Close the event that ended in step n (x holds t_{n+1}): S, its row, first-move rows."""
+    eid = ist[N_EVENTS]
+    S = 0.0
+    k = ist[FM_COUNT]
+    for i in range(1, ist[EV_MAX_BLOCK] + 1):
+        if first_step[i] >= 0:
+            S += x[i] - x0ev[i]
+            fm[k, 0] = eid
+            fm[k, 1] = i
+            fm[k, 2] = first_step[i]
+            k += 1
+            first_step[i] = -1
+    ist[FM_COUNT] = k
+    r = ist[EV_COUNT]
+    ev_int[r, E_ID] = eid
+    ev_int[r, E_START_STEP] = ist[EV_START_STEP]
+    ev_int[r, E_END_STEP] = n
+    ev_int[r, E_START_BLOCK] = ist[EV_START_BLOCK]
+    ev_int[r, E_MAX_BLOCK] = ist[EV_MAX_BLOCK]
+    ev_int[r, E_N_BLOCKS] = ist[EV_N_MOVED]
+    ev_S[r] = S
+    ist[EV_COUNT] = r + 1
+    if profile_every > 0:
+        if ist[EV_N_MOVED] >= profile_min_blocks:
+            p = ist[P_COUNT]
+            for i in range(1, N + 1):
+                prof_x[p, i - 1] = x[i]
+            prof_meta[p, 0] = eid
+            prof_meta[p, 1] = n + 1
+            ist[P_COUNT] = p + 1
+        else:
+            ist[P_COUNT] = ist[EV_P_FIRST]  # too small to keep: drop its rows
+    ist[EV_ACTIVE] = 0
+    ist[N_EVENTS] = eid + 1
+
+
+@njit(cache=True, inline="always")
+def _set_ghosts(x, th, N, xp):
+    x[0] = xp
+    x[N + 1] = x[N]
+    th[0] = th[1]
+    th[N + 1] = th[N]
+
+
+@njit(cache=True)
+def _first_bad(x, v, th, N):
+    for i in range(1, N + 1):
+        if not (abs(x[i]) <= _BIG and abs(v[i]) <= _BIG and abs(th[i]) <= _BIG):
+            return i
+    return 0
+
+
+@njit(cache=True)
+def run_dense(x, v, th, mov, xs, vs, ths, mm, a1, b1, first_step, x0ev, ist, par,
+              ev_int, ev_S, fm, samp_L, samp_step, prof_x, prof_meta,
+              n_end, sample_every, profile_every, profile_min_blocks):
+    """Reference integrator of eq. (4): Heun over every block at every step, written plainly.
+
+    Advances the state arrays to step ``n_end`` or until an output buffer is full; returns a
+    status code (module constants). See the module docstring for the step and the events.
+    """
+    N = x.shape[0] - 2
+    K = par[P_K]
+    D = par[P_D]
+    V = par[P_V]
+    beta = par[P_BETA]
+    alpha = par[P_ALPHA]
+    Fs = par[P_FS]
+    dt = par[P_DT]
+    h2 = 0.5 * dt
+    while True:
+        n = ist[STEP]
+        st = _service(n, x, N, ist, samp_L, samp_step, prof_x, prof_meta, sample_every,
+                      profile_every)
+        if st != DONE:
+            return st
+        if n >= n_end:
+            return DONE
+        st = _capacity(N, ist, ev_int, fm, prof_x, profile_every)
+        if st != DONE:
+            return st
+        _set_ghosts(x, th, N, _pull(V, n, dt))
+        for i in range(1, N + 1):
+            f = _force(x[i - 1], x[i], x[i + 1], K)
+            if mov[i] != 0.0 or f > Fs:
+                mm[i] = 1.0
+            else:
+                mm[i] = 0.0
+            a1[i] = _accel(f, th[i], v[i], beta, mm[i])
+            b1[i] = _dtheta(th[i - 1], th[i], th[i + 1], v[i], alpha, D)
+            xs[i] = x[i] + dt * v[i]
+            vs[i] = v[i] + dt * a1[i]
+            ths[i] = th[i] + dt * b1[i]
+        _set_ghosts(xs, ths, N, _pull(V, n + 1, dt))
+        _start_and_first_moves(n, 1, N, x, mm, first_step, x0ev, ist, prof_x, prof_meta, N, profile_every)
+        n_moving = 0
+        bad = 0
+        for i in range(1, N + 1):
+            f2 = _force(xs[i - 1], xs[i], xs[i + 1], K)
+            a2 = _accel(f2, ths[i], vs[i], beta, mm[i])
+            b2 = _dtheta(ths[i - 1], ths[i], ths[i + 1], vs[i], alpha, D)
+            th[i] = th[i] + h2 * (b1[i] + b2)
+            if mm[i] != 0.0:
+                x[i] = x[i] + h2 * (v[i] + vs[i])
+                vn = v[i] + h2 * (a1[i] + a2)
+                if vn <= 0.0:
+                    v[i] = 0.0
+                    mov[i] = 0.0
+                else:
+                    v[i] = vn
+                    mov[i] = 1.0
+                    n_moving += 1
+            else:
+                v[i] = 0.0
+                mov[i] = 0.0
+            if bad == 0 and not (abs(x[i]) <= _BIG and abs(v[i]) <= _BIG and abs(th[i]) <= _BIG):
+                bad = i
+        ist[N_MOVING] = n_moving
+        ist[BLOCK_UPDATES] += N
+        ist[STEPS_COMPUTED] += 1
+        ist[STEP] = n + 1
+        if bad > 0:
+            ist[BAD_BLOCK] = bad
+            return NONFINITE
+        if ist[EV_ACTIVE] == 1 and n_moving == 0:
+            _end_event(n, x, first_step, x0ev, ist, ev_int, ev_S, fm, prof_x, prof_meta, N,
+                       profile_every, profile_min_blocks)
+
+
+@njit(cache=True)
+def _first_trigger(x, N, V, dt, K, Fs, n_lo, n_hi):
+    """First step m in [n_lo, n_hi) at which stopped block 1 starts (f_1 > Fs), else n_hi.
+
+    Uses the step's own expression for the force, which is non-decreasing in m for V >= 0.
+    """
+    x1 = x[1]
+    x2 = x[2] if N > 1 else x[1]
+    if n_lo >= n_hi or not (_force(_pull(V, n_hi - 1, dt), x1, x2, K) > Fs):
+        return n_hi
+    lo = n_lo
+    hi = n_hi - 1  # invariant: fires at hi
+    while lo < hi:
+        mid = lo + (hi - lo) // 2
+        if _force(_pull(V, mid, dt), x1, x2, K) > Fs:
+            hi = mid
+        else:
+            lo = mid + 1
+    return lo
+
+
+@njit(cache=True, inline="always")
+def _stage1(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, K, D, beta, alpha, Fs, dt):
+    """Start rule, stage-1 derivatives and predictor for blocks lo..hi (branch-free).
+
+    Works on views that begin at block lo - 1, so that every index is provably
+    non-negative: the compiler then drops the negative-index handling and vectorises.
+    Returns the first block that moves in this step (hi + 1 if none).
+    """
+    x = x[lo - 1:hi + 2]
+    v = v[lo - 1:hi + 2]
+    th = th[lo - 1:hi + 2]
+    mov = mov[lo - 1:hi + 2]
+    xs = xs[lo - 1:hi + 2]
+    vs = vs[lo - 1:hi + 2]
+    ths = ths[lo - 1:hi + 2]
+    mm = mm[lo - 1:hi + 2]
+    a1 = a1[lo - 1:hi + 2]
+    b1 = b1[lo - 1:hi + 2]
+    n = hi - lo + 1
+    first = n + 1
+    for j in range(1, n + 1):
+        f = _force(x[j - 1], x[j], x[j + 1], K)
+        m = 1.0 if f > Fs else mov[j]
+        mm[j] = m
+        first = min(first, j if m != 0.0 else n + 1)
+        a = _accel(f, th[j], v[j], beta, m)
+        b = _dtheta(th[j - 1], th[j], th[j + 1], v[j], alpha, D)
+        a1[j] = a
+        b1[j] = b
+        xs[j] = x[j] + dt * v[j]
+        vs[j] = v[j] + dt * a
+        ths[j] = th[j] + dt * b
+    return first + lo - 1
+
+
+@njit(cache=True, inline="always")
+def _stage2(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, K, D, beta, alpha, h2):
+    """Stage 2, corrector and stop rule for blocks lo..hi (branch-free, on views as _stage1).
+
+    Returns the first and last block that changed (lo > hi if none), the number of moving
+    blocks among lo..hi before and after, and the number of non-finite blocks.
+    """
+    x = x[lo - 1:hi + 2]
+    v = v[lo - 1:hi + 2]
+    th = th[lo - 1:hi + 2]
+    mov = mov[lo - 1:hi + 2]
+    xs = xs[lo - 1:hi + 2]
+    vs = vs[lo - 1:hi + 2]
+    ths = ths[lo - 1:hi + 2]
+    mm = mm[lo - 1:hi + 2]
+    a1 = a1[lo - 1:hi + 2]
+    b1 = b1[lo - 1:hi + 2]
+    n = hi - lo + 1
+    c_lo = n + 1
+    c_hi = 0
+    moved_before = 0
+    moved_after = 0
+    bad = 0
+    for j in range(1, n + 1):
+        m = mm[j]
+        f2 = _force(xs[j - 1], xs[j], xs[j + 1], K)
+        a2 = _accel(f2, ths[j], vs[j], beta, m)
+        b2 = _dtheta(ths[j - 1], ths[j], ths[j + 1], vs[j], alpha, D)
+        xo = x[j]
+        vo = v[j]
+        tho = th[j]
+        mo = mov[j]
+        xn = xo + h2 * (vo + vs[j])
+        vn = vo + h2 * (a1[j] + a2)
+        thn = tho + h2 * (b1[j] + b2)
+        keep = vn > 0.0
+        vn = vn if keep else 0.0
+        mn = m if keep else 0.0
+        x[j] = xn
+        v[j] = vn
+        th[j] = thn
+        mov[j] = mn
+        ch = (xn != xo) | (vn != vo) | (thn != tho) | (mn != mo)
+        c_lo = min(c_lo, j if ch else n + 1)
+        c_hi = max(c_hi, j if ch else 0)
+        moved_before += 1 if mo != 0.0 else 0
+        moved_after += 1 if mn != 0.0 else 0
+        ok = (abs(xn) <= _BIG) & (abs(vn) <= _BIG) & (abs(thn) <= _BIG)
+        bad += 0 if ok else 1
+    return c_lo + lo - 1, c_hi + lo - 1, moved_before, moved_after, bad
+
+
+@njit(cache=True)
+def run_exact(x, v, th, mov, xs, vs, ths, mm, a1, b1, first_step, x0ev, ist, par,
+              ev_int, ev_S, fm, samp_L, samp_step, prof_x, prof_meta,
+              n_end, sample_every, profile_every, profile_min_blocks):
+    """Fast integrator of eq. (4), bit for bit equal to :func:`run_dense`.
+
+    Updates only the blocks that can change (see the module docstring), in branch-free
+    loops over one contiguous interval, and jumps over steps in which nothing can change.
+    Same arguments, state layout and status codes as :func:`run_dense`.
+    """
+    N = x.shape[0] - 2
+    K = par[P_K]
+    D = par[P_D]
+    V = par[P_V]
+    beta = par[P_BETA]
+    alpha = par[P_ALPHA]
+    Fs = par[P_FS]
+    dt = par[P_DT]
+    h2 = 0.5 * dt
+    while True:
+        n = ist[STEP]
+        st = _service(n, x, N, ist, samp_L, samp_step, prof_x, prof_meta, sample_every,
+                      profile_every)
+        if st != DONE:
+            return st
+        if n >= n_end:
+            return DONE
+        st = _capacity(N, ist, ev_int, fm, prof_x, profile_every)
+        if st != DONE:
+            return st
+        lo = ist[ACT_LO]
+        hi = ist[ACT_HI]
+        x2 = x[2] if N > 1 else x[1]
+        if mov[1] != 0.0 or _force(_pull(V, n, dt), x[1], x2, K) > Fs:
+            lo = 1
+            if hi < 1:
+                hi = 1
+        if lo > hi:
+            # Nothing can change before block 1 starts: jump, but stop at due outputs.
+            target = n_end
+            if ist[NEXT_SAMPLE] < target:
+                target = ist[NEXT_SAMPLE]
+            if profile_every > 0 and ist[EV_ACTIVE] == 1 and ist[NEXT_PROFILE] < target:
+                target = ist[NEXT_PROFILE]
+            ist[STEP] = _first_trigger(x, N, V, dt, K, Fs, n + 1, target)
+            continue
+
+        _set_ghosts(x, th, N, _pull(V, n, dt))
+        l1 = lo - 1 if lo > 1 else 1
+        h1 = hi + 1 if hi < N else N
+        first = _stage1(x, v, th, mov, xs, vs, ths, mm, a1, b1, l1, h1, K, D, beta, alpha, Fs, dt)
+        _set_ghosts(xs, ths, N, _pull(V, n + 1, dt))
+        if ist[EV_ACTIVE] == 1 or (ist[N_MOVING] == 0 and first <= h1):
+            _start_and_first_moves(n, lo, hi, x, mm, first_step, x0ev, ist, prof_x, prof_meta, N,
+                                   profile_every)
+        c_lo, c_hi, moved_before, moved_after, bad = _stage2(
+            x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, K, D, beta, alpha, h2)
+        n_moving = ist[N_MOVING] + moved_after - moved_before
+        ist[N_MOVING] = n_moving
+        ist[BLOCK_UPDATES] += hi - lo + 1
+        ist[STEPS_COMPUTED] += 1
+        ist[STEP] = n + 1
+        if bad > 0:
+            ist[BAD_BLOCK] = _first_bad(x, v, th, N)
+            return NONFINITE
+        if c_lo <= c_hi:
+            ist[ACT_LO] = c_lo - 2 if c_lo > 2 else 1
+            ist[ACT_HI] = c_hi + 2 if c_hi < N - 2 else N
+        else:
+            ist[ACT_LO] = 1
+            ist[ACT_HI] = 0
+        if ist[EV_ACTIVE] == 1 and n_moving == 0:
+            _end_event(n, x, first_step, x0ev, ist, ev_int, ev_S, fm, prof_x, prof_meta, N,
+                       profile_every, profile_min_blocks)
