@@ -1,7 +1,181 @@
-"""`stickslip sweep`: (to be filled in)."""
+"""`stickslip sweep`: run the chain (eq. 4) or the single block (eq. 1) over a grid of parameters.
+
+    stickslip sweep chain --grid beta=0.8,0.9,1.0 --grid N=99,199 --set K=10 --t-end 1e5 --out DIR
+
+Every combination of the ``--grid`` values is one point, run as an independent Dask task (a
+local cluster, one worker per core, unless ``--scheduler ADDRESS``). ``--set NAME=VALUE`` fixes
+a parameter or run option for every point. Results: one directory per point under DIR plus
+``summary.parquet`` and ``summary.csv``; points already done are skipped on a second call.
+"""
 
 from __future__ import annotations
 
+import argparse
+import dataclasses
+import itertools
+from typing import Any
+
+from stickslip.cli._common import CommandError, Result, add_json_option, prepare_out_dir
+from stickslip.params import BlockParams, ChainParams, check_number
+
+# Run options a point may carry besides the model parameters, with their value types.
+_OPTIONS: dict[str, dict[str, type]] = {
+    "chain": {
+        "t_end": float,
+        "integrator": str,
+        "start": str,
+        "sample_interval": float,
+        "average_from": float,
+        "profile_window": float,
+        "profile_min_blocks": int,
+    },
+    "block": {"t_end": float, "every": int},
+}
+_PARAMS: dict[str, type] = {"chain": ChainParams, "block": BlockParams}
+
 
 def register(sub) -> None:
-    """Add the subcommand(s) of this module to the parser."""
+    """Add the ``sweep`` subcommand."""
+    parser = sub.add_parser(
+        "sweep",
+        help="run the chain or the block over a grid of parameters on Dask",
+        description=(
+            "Run the chain (eq. 4) or the single block (eq. 1) at every point of a parameter "
+            "grid, each point an independent task on a Dask cluster. One directory per point "
+            "under --out, a summary table (summary.parquet, summary.csv); finished points are "
+            "skipped when the command is run again; a failed point is reported and the others go on."
+        ),
+        epilog=(
+            "example: stickslip sweep chain --grid beta=0.2,0.6,1.0,1.2 --set N=99 "
+            "--t-end 20000 --set average_from=10000 --out sweeps/L-beta"
+        ),
+    )
+    parser.add_argument("model", choices=("chain", "block"), help="which system to run")
+    parser.add_argument(
+        "--grid",
+        action="append",
+        default=[],
+        metavar="NAME=V1,V2,...",
+        help="a parameter and its values; repeat for more parameters (all combinations are run)",
+    )
+    parser.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        dest="fixed",
+        metavar="NAME=VALUE",
+        help="a parameter or run option fixed for every point; repeatable",
+    )
+    parser.add_argument("--t-end", type=str, required=True, metavar="T", help="run length of every point")
+    parser.add_argument("--out", required=True, metavar="DIR", help="output directory of the sweep")
+    parser.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                        help="address of an existing Dask scheduler (default: start a local cluster)")
+    parser.add_argument("--workers", type=str, default=None, metavar="N",
+                        help="worker processes of the local cluster (default: one per core)")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
+    add_json_option(parser)
+    parser.set_defaults(handler=run)
+
+
+def _value(model: str, name: str, text: str) -> Any:
+    """Convert one value by the type of the parameter or option it belongs to."""
+    options = _OPTIONS[model]
+    if name in options:
+        kind = options[name]
+    else:
+        fields = {f.name: f for f in dataclasses.fields(_PARAMS[model])}
+        kind = int if fields[name].metadata.get("integer") else float
+    if kind is str:
+        return text
+    return check_number(name, text.strip(), integer=kind is int)
+
+
+def _check_name(model: str, name: str) -> None:
+    allowed = [f.name for f in dataclasses.fields(_PARAMS[model])] + list(_OPTIONS[model])
+    if name not in allowed:
+        raise CommandError(f"unknown parameter {name!r} for {model} (allowed: {', '.join(allowed)})")
+
+
+def _split_assignment(text: str, option: str) -> tuple[str, str]:
+    name, sep, values = text.partition("=")
+    name = name.strip()
+    if not sep or not name or not values.strip():
+        raise CommandError(f"{option} expects NAME=VALUE (got {text!r})")
+    return name, values
+
+
+def parse_grid(
+    model: str, grid: list[str], fixed: list[str], t_end: str
+) -> tuple[list[dict[str, Any]], dict[str, Any]]:
+    """The points (one dict per combination of ``--grid`` values) and the settings common to all.
+
+    Every point is validated by building its parameter dataclass, so a bad value is reported
+    before anything is written.
+    """
+    axes: dict[str, list[Any]] = {}
+    for text in grid:
+        name, values = _split_assignment(text, "--grid")
+        _check_name(model, name)
+        if name in axes:
+            raise CommandError(f"--grid gives {name} twice")
+        items = [v.strip() for v in values.split(",")]
+        if any(not v for v in items):
+            raise CommandError(f"--grid {name}: empty value in {values!r}")
+        converted = [_value(model, name, v) for v in items]
+        if len(set(map(repr, converted))) != len(converted):
+            raise CommandError(f"--grid {name}: repeated value in {values!r}")
+        axes[name] = converted
+    common: dict[str, Any] = {}
+    for text in fixed:
+        name, value = _split_assignment(text, "--set")
+        _check_name(model, name)
+        if name in axes or name in common:
+            raise CommandError(f"{name} is given more than once (--grid/--set)")
+        if name == "t_end":
+            raise CommandError("give the run length with --t-end, not --set t_end")
+        common[name] = _value(model, name, value)
+    if "t_end" in axes:
+        raise CommandError("give the run length with --t-end, not --grid t_end")
+    common["t_end"] = check_number("t_end", t_end, low=0.0, low_open=True)
+
+    names = list(axes)
+    points = [dict(zip(names, combo)) for combo in itertools.product(*axes.values())] if names else [{}]
+    params_cls = _PARAMS[model]
+    fields = {f.name for f in dataclasses.fields(params_cls)}
+    for point in points:
+        merged = {**common, **point}
+        params_cls(**{k: v for k, v in merged.items() if k in fields})  # raises ParameterError
+    return points, common
+
+
+def run(args: argparse.Namespace) -> Result:
+    """Handler of ``stickslip sweep``."""
+    from stickslip.sweep import block_task, chain_task, run_sweep
+
+    points, common = parse_grid(args.model, args.grid, args.fixed, args.t_end)
+    workers = None
+    if args.workers is not None:
+        workers = check_number("--workers", args.workers, low=1, integer=True)
+    out = prepare_out_dir(args.out)
+    task = chain_task if args.model == "chain" else block_task
+    try:
+        result = run_sweep(task, points, out, common=common, scheduler=args.scheduler,
+                           n_workers=workers, progress=not args.no_progress)
+    except OSError as exc:  # e.g. no scheduler at the given address
+        raise CommandError(f"cannot run the sweep: {exc}") from None
+    data = {"model": args.model, "common": common, **result.to_dict()}
+    return Result(data=data, text=_text(result), status=1 if result.n_failed else 0)
+
+
+def _text(result) -> str:
+    table = result.table
+    shown = [c for c in table.columns if c not in ("error", "wall_seconds")]
+    lines = [
+        f"{result.n_points} points in {result.out_dir}: {result.n_run} run, {result.n_reused} reused, "
+        f"{result.n_failed} failed ({result.wall_seconds:.1f} s)",
+        table[shown].to_string(index=False, max_colwidth=40),
+    ]
+    for _, row in table[table["status"] != "ok"].iterrows():
+        lines.append(f"failed: {row['point_dir']}: {row['error']}")
+    lines.append(f"summary: {result.out_dir / 'summary.parquet'} (and .csv)")
+    return "\n".join(lines)

@@ -1,0 +1,243 @@
+"""Figures 5-8 of the paper: the chain of eq. (4) (section 3).
+
+Each function takes results of a chain run (a snapshot of x_i, a table of <L> against beta, the
+``profiles``/``first_move``/``events`` tables) and analysis results from
+:mod:`stickslip.statistics`, and returns a matplotlib Figure. Blocks are numbered 1..N.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Sequence
+
+import numpy as np
+import pandas as pd
+import xarray as xr
+from matplotlib import cm
+from matplotlib.figure import Figure
+
+from stickslip.params import ChainParams
+from stickslip.physics import chain_steady_length, chain_steady_profile_paper, chain_steady_state
+from stickslip.plotting.style import PAPER, SIM, THEORY, new_figure
+from stickslip.statistics import FrontSpeed, PowerLawFit, size_distribution
+
+__all__ = ["fig5a_snapshot", "fig5b_length", "fig6_fronts", "fig7_8_sizes", "PAPER_FRONT_SPEED"]
+
+# The paper's rupture-front speed in large events at beta = 1 (section 3, Fig. 6).
+PAPER_FRONT_SPEED = 1.43
+
+
+def _param_text(p: ChainParams) -> str:
+    return f"N={p.N}, K={p.K:g}, D={p.D:g}, V={p.V:g}, Fs={p.Fs:g}"
+
+
+def _snapshot_array(x: Any, N: int) -> np.ndarray:
+    # a snapshot picked from a (time, block) array may keep a time axis of length 1
+    values = np.squeeze(np.asarray(x.values if isinstance(x, xr.DataArray) else x, dtype=np.float64))
+    if values.ndim != 1 or values.size != N:
+        raise ValueError(f"the snapshot must hold x_i for i = 1..N = {N} (got shape {values.shape})")
+    return values
+
+
+def fig5a_snapshot(x: Any, params: ChainParams, t: float) -> Figure:
+    """Fig. 5(a): snapshot of x_i at time t against the steady sliding profile.
+
+    Top: x_i - V t of the run (solid), of the exact discrete steady sliding solution
+    (:func:`~stickslip.physics.chain_steady_state`, dashed) and of the paper's continuum form
+    x_i = V t - c/K {N^2 - (i - N)^2}/2 (dotted), all in the frame moving with the pulling point
+    x_0 = V t. Bottom: the run's departure from the exact steady profile, and the continuum
+    form's, which lies c i / (2K) above it (c N / (2K), about 20, at the free end of the paper's chain).
+    ``x`` is x_1..x_N (an array or a DataArray over ``block``).
+    """
+    xs = _snapshot_array(x, params.N)
+    i = np.arange(1, params.N + 1)
+    shift = params.V * t
+    exact = chain_steady_state(params, t)["x"]
+    paper = chain_steady_profile_paper(params, t)
+    fig, (ax, ax_r) = new_figure(2, 1, width=6.0, height=2.4, sharex=True,
+                                 gridspec_kw={"height_ratios": [2.2, 1.0]})
+    ax.plot(i, xs - shift, **SIM, label=f"$x_i$ at t = {t:.4g}")
+    ax.plot(i, exact - shift, **THEORY, label="steady sliding, exact discrete")
+    ax.plot(i, paper - shift, **PAPER, label="steady sliding, paper's continuum form")
+    ax.set_ylabel(r"$x_i - Vt$")
+    ax.set_title("(a)", loc="left")
+    ax.legend(loc="upper right", fontsize=8)
+    ax_r.axhline(0.0, color="0.6", lw=0.6)
+    ax_r.plot(i, xs - exact, **SIM, label="run - exact")
+    ax_r.plot(i, paper - exact, **PAPER, label="continuum - exact")
+    ax_r.set_xlabel("i")
+    ax_r.set_ylabel(r"$x_i - x_i^{ss}$")
+    ax_r.set_xlim(1, params.N)
+    ax_r.legend(loc="lower left", fontsize=8)
+    fig.suptitle(f"Fig. 5(a): snapshot and steady sliding, beta={params.beta:g}, {_param_text(params)}",
+                 fontsize=9)
+    return fig
+
+
+def fig5b_length(table: pd.DataFrame, params: ChainParams, *, beta_c: float = 1.0) -> Figure:
+    """Fig. 5(b): average total length <L> = <x_1 - x_N> against beta, with steady sliding.
+
+    ``table`` has columns ``beta`` and ``L_mean`` (and optionally ``L_err``, drawn as error
+    bars), e.g. a sweep's summary. The dashed line is the exact discrete steady sliding length
+    L = c N (N - 1) / (2K), c = 1 - (1 - beta) V (:func:`~stickslip.physics.chain_steady_length`)
+    for the other parameters of ``params``; the paper's printed L = c N^2 / 2 lacks the factor
+    1/K (MODEL.md) and is not drawn. The dotted vertical line marks beta_c = 1, where the
+    long-wave instability sets in (Fig. 4).
+    """
+    data = table.sort_values("beta")
+    beta = data["beta"].to_numpy(dtype=np.float64)
+    L = data["L_mean"].to_numpy(dtype=np.float64)
+    err = data["L_err"].to_numpy(dtype=np.float64) if "L_err" in data else None
+    fig, ax = new_figure(width=5.6, height=3.8)
+    lo, hi = (float(beta.min()), float(beta.max())) if beta.size else (0.0, 2.0)
+    pad = 0.05 * max(hi - lo, 0.1)
+    grid = np.linspace(max(lo - pad, 0.0), hi + pad, 200)
+    steady = np.array([chain_steady_length(params.replace(beta=float(b))) for b in grid])
+    ax.plot(grid, steady, **THEORY,
+            label="steady sliding, L = cN(N-1)/(2K)\n(paper prints cN²/2, without 1/K)")
+    ax.errorbar(beta, L, yerr=err, fmt="o-", color=SIM["color"], lw=SIM["lw"], ms=4, capsize=2,
+                label=r"$\langle L\rangle$, run")
+    ax.axvline(beta_c, color="0.5", lw=0.8, ls=":")
+    ax.set_xlabel(r"$\beta$")
+    ax.set_ylabel(r"$L = \langle x_1 - x_N \rangle$")
+    ax.set_title("(b)", loc="left")
+    ax.legend(loc="lower right", fontsize=8)
+    fig.suptitle(f"Fig. 5(b): average length against beta, {_param_text(params)}", fontsize=9)
+    return fig
+
+
+def _event_profiles(profiles: xr.Dataset, event: int) -> xr.Dataset:
+    rows = np.flatnonzero(profiles["event"].values == event)
+    if rows.size == 0:
+        raise ValueError(f"no displacement profiles stored for event {event}")
+    sub = profiles.isel(row=rows)
+    return sub.isel(row=np.argsort(sub["t"].values, kind="stable"))
+
+
+def _waterfall(ax, sub: xr.Dataset, window: float | None) -> None:
+    """Delta x_i over successive windows, each curve lifted by its window index (Fig. 6)."""
+    dx = sub["dx"].transpose("row", "block").values
+    blocks = sub["block"].values if "block" in sub.coords else np.arange(1, dx.shape[1] + 1)
+    t = sub["t"].values
+    n = dx.shape[0]
+    peak = float(np.nanmax(np.abs(dx))) if np.isfinite(dx).any() else 1.0
+    step = 0.6 * peak if peak > 0 else 1.0
+    colors = cm.viridis(np.linspace(0.0, 0.9, max(n, 1)))
+    for k in range(n):
+        ax.plot(blocks, dx[k] + k * step, color=colors[k], lw=0.9)
+    ticks = np.arange(n) * step
+    stride = max(1, int(math.ceil(n / 8)))
+    ax.set_yticks(ticks[::stride])
+    ax.set_yticklabels([f"{t[k] - t[0]:.0f}" for k in range(0, n, stride)])
+    w = f"{window:g}" if window else "W"
+    ax.set_ylabel(f"window start t - t_s\n(Δx_i over Δt = {w}; curves {step:.3g} apart)", fontsize=9)
+    ax.set_xlabel("i")
+    ax.set_xlim(blocks.min(), blocks.max())
+
+
+def _arrivals(ax, first_move: pd.DataFrame, front: FrontSpeed, K: float) -> None:
+    """First-move time against block, the fitted front, the paper's c and the sound speed."""
+    rows = first_move[(first_move["event"] == front.event) & np.isfinite(first_move["t_first"])]
+    i = rows["block"].to_numpy()
+    t = rows["t_first"].to_numpy() - front.t_start
+    used = (i >= front.i_min) & (i <= front.i_max)
+    ax.plot(i[~used], t[~used], ".", color="0.6", ms=2.5, label="first motion")
+    ax.plot(i[used], t[used], ".", color=SIM["color"], ms=2.5, label="first motion (fitted)")
+    line_i = np.array([front.i_min, front.i_max], dtype=np.float64)
+    t_anchor = float(front.arrival_time(front.i_min)) - front.t_start
+    ax.plot(line_i, front.arrival_time(line_i) - front.t_start, **THEORY,
+            label=f"fit: c = {front.speed:.3g} ± {front.speed_err:.2g}")
+    ax.plot(line_i, t_anchor + (line_i - front.i_min) / PAPER_FRONT_SPEED, **PAPER,
+            label=f"paper: c = {PAPER_FRONT_SPEED}")
+    sound = math.sqrt(K)
+    ax.plot(line_i, t_anchor + (line_i - front.i_min) / sound, color="0.2", lw=0.9, ls="-.",
+            label=f"sound speed √K = {sound:.3g}")
+    ax.set_xlabel("i")
+    ax.set_ylabel("first-move time t - t_s")
+    ax.legend(loc="upper left", fontsize=7)
+
+
+def fig6_fronts(
+    profiles: xr.Dataset,
+    first_move: pd.DataFrame,
+    fronts: Sequence[FrontSpeed],
+    params: ChainParams,
+    *,
+    labels: Sequence[str] | None = None,
+    window: float | None = 20.0,
+) -> Figure:
+    """Fig. 6: rupture fronts, one row per event (the paper: (a) a large, (b) an intermediate event).
+
+    Left: the displacement Delta x_i = x_i(t + Delta t) - x_i(t) over successive windows of
+    Delta t = ``window`` (20 in the paper) from the event's start, stacked upwards in time like
+    the paper's plot (``profiles``: dim ``row`` with ``event``, ``t`` and ``dx(row, block)``).
+    Right: the time each block first moved against i, the front speed fitted over the far part
+    of the chain (:func:`~stickslip.statistics.front_speed`), the paper's c = 1.43 and the sound
+    speed sqrt(K) = 3.16 (for K = 10) as slopes from the same point.
+    """
+    fronts = list(fronts)
+    if not fronts:
+        raise ValueError("give at least one fitted front")
+    if labels is None:
+        labels = [f"event {f.event}" for f in fronts]
+    fig, axes = new_figure(len(fronts), 2, width=4.8, height=3.8)
+    axes = np.asarray(axes).reshape(len(fronts), 2)
+    for row, (front, label) in enumerate(zip(fronts, labels)):
+        ax_w, ax_t = axes[row]
+        sub = _event_profiles(profiles, front.event)
+        _waterfall(ax_w, sub, window)
+        letter = "abcdefgh"[row] if row < 8 else str(row)
+        t0 = float(sub["t"].values[0])
+        ax_w.set_title(f"({letter}) {label}, t ≈ {t0:.6g}", loc="left", fontsize=9)
+        _arrivals(ax_t, first_move, front, params.K)
+        ax_t.set_title(f"front: blocks {front.i_min}-{front.i_max}", loc="left", fontsize=9)
+    fig.suptitle(f"Fig. 6: rupture fronts, beta={params.beta:g}, {_param_text(params)}", fontsize=9)
+    return fig
+
+
+def fig7_8_sizes(
+    events: pd.DataFrame,
+    fit: PowerLawFit,
+    beta: float,
+    *,
+    bins: int | Any = 30,
+    paper_tau: float | None = None,
+) -> Figure:
+    """Figs. 7 (beta = 1) and 8 (beta = 0.2): (a) slip-size distribution, (b) S against event time.
+
+    (a): the density of S on logarithmic bins (:func:`~stickslip.statistics.size_distribution`,
+    normalised for bin width) with the fitted power law p ~ S^-tau over [s_min, s_max]
+    (scaled by the share of events in that range); ``paper_tau`` adds the paper's exponent
+    (1.5 at beta = 1, about 1.6 at beta = 0.2) as a dotted guide. (b): S of every event against
+    its start time ``t_start``.
+    """
+    S = events["S"].to_numpy(dtype=np.float64)
+    dist = size_distribution(S, bins)
+    fig, (ax_a, ax_b) = new_figure(1, 2, width=4.8, height=3.8)
+    filled = dist["count"].values > 0
+    ax_a.loglog(dist["S"].values[filled], dist["density"].values[filled], "o", color=SIM["color"],
+                ms=4, label=f"simulation ({dist.attrs['n_binned']} events)")
+    share = fit.n / dist.attrs["n_binned"] if dist.attrs["n_binned"] else 1.0
+    s_line = np.geomspace(fit.s_min, fit.s_max, 100)
+    err = f" ± {fit.tau_err:.2f}" if math.isfinite(fit.tau_err) else ""
+    ax_a.loglog(s_line, share * fit.pdf(s_line), **THEORY,
+                label=f"fit: τ = {fit.tau:.2f}{err}\n(S in [{fit.s_min:.3g}, {fit.s_max:.3g}], {fit.n} events)")
+    if paper_tau is not None:
+        s_mid = math.sqrt(fit.s_min * fit.s_max)
+        anchor = share * float(fit.pdf(s_mid))
+        ax_a.loglog(s_line, anchor * (s_line / s_mid) ** (-paper_tau), **PAPER,
+                    label=f"paper: slope -{paper_tau:g}")
+    ax_a.set_xlabel("S")
+    ax_a.set_ylabel("p(S)")
+    ax_a.set_title("(a)", loc="left")
+    ax_a.legend(loc="lower left", fontsize=8)
+
+    t = events["t_start"].to_numpy(dtype=np.float64)
+    positive = S > 0
+    ax_b.semilogy(t[positive], S[positive], ".", color=SIM["color"], ms=2.0)
+    ax_b.set_xlabel("event time t")
+    ax_b.set_ylabel("S")
+    ax_b.set_title("(b)", loc="left")
+    number = {1.0: "Fig. 7", 0.2: "Fig. 8"}.get(round(float(beta), 6), "Figs. 7, 8")
+    fig.suptitle(f"{number}: slip sizes S = Σ Δx_i at beta = {beta:g}", fontsize=9)
+    return fig

@@ -1,0 +1,297 @@
+"""The reproduction report: ``report.json`` and a self-contained ``report.html``.
+
+The report holds the figures of a reproduction run (each panel's image, with links to its
+PDF and data) and a table with one row per number the paper states (MODEL.md, last table):
+where the paper states it, the quantity, the paper's value, this run's value, whether they
+agree within the stated tolerance, and the command that reproduces the row. A row whose
+number is not settled at the run's length (a quick run) says so ("n/a (...)") rather than
+claiming agreement or disagreement.
+"""
+
+from __future__ import annotations
+
+import base64
+import datetime as _dt
+import html
+import math
+from dataclasses import asdict, dataclass, field, fields
+from pathlib import Path
+from typing import Any, Iterable, Mapping
+
+from stickslip import __version__
+from stickslip.io import atomic_path, read_json, write_json
+
+__all__ = ["ReportRow", "ReportFigure", "Report", "write_report", "read_report", "agreement_text"]
+
+
+@dataclass(frozen=True)
+class ReportRow:
+    """One number the paper states (MODEL.md, last table) and how this run compares.
+
+    - ``where``: the place in the paper ("sec. 2", "eq. 3", "Fig. 6");
+    - ``quantity``: what is measured ("rupture front speed in large events, beta = 1");
+    - ``paper``: the paper's value as printed ("c = 1.43"); ``value``: this run's value
+      (text or a number; None when not computed);
+    - ``agrees``: True / False, or None when the comparison is not settled at this run length;
+    - ``tolerance``: the tolerance used ("|c - 1.43| <= 0.15"); ``na_reason``: why ``agrees`` is
+      None ("quick run"); ``command``: the shell command that reproduces the row;
+    - ``note``: anything a reader needs to judge the row (e.g. a slip of the paper).
+    """
+
+    where: str
+    quantity: str
+    paper: str
+    value: str | float | int | None
+    agrees: bool | None
+    tolerance: str
+    command: str
+    na_reason: str = ""
+    note: str = ""
+
+    @property
+    def agreement(self) -> str:
+        """``yes (tolerance)``, ``no (tolerance)`` or ``n/a (reason)``."""
+        return agreement_text(self.agrees, self.tolerance, self.na_reason)
+
+    def to_dict(self) -> dict[str, Any]:
+        data = asdict(self)
+        data["agreement"] = self.agreement
+        return data
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> "ReportRow":
+        names = {f.name for f in fields(cls)}
+        return cls(**{k: v for k, v in data.items() if k in names})
+
+
+@dataclass(frozen=True)
+class ReportFigure:
+    """One figure panel: its PNG (path relative to the report), caption, PDF and data files."""
+
+    figure: str
+    image: str
+    caption: str
+    pdf: str | None = None
+    data: tuple[str, ...] = ()
+    command: str = ""
+
+    def to_dict(self) -> dict[str, Any]:
+        data = asdict(self)
+        data["data"] = list(self.data)
+        return data
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> "ReportFigure":
+        names = {f.name for f in fields(cls)}
+        values = {k: v for k, v in data.items() if k in names}
+        values["data"] = tuple(values.get("data") or ())
+        return cls(**values)
+
+
+@dataclass(frozen=True)
+class Report:
+    """What ``report.json`` holds: ``meta`` (version, mode, times, ...), ``rows``, ``figures``."""
+
+    meta: dict[str, Any]
+    rows: tuple[ReportRow, ...]
+    figures: tuple[ReportFigure, ...] = field(default_factory=tuple)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "meta": self.meta,
+            "rows": [r.to_dict() for r in self.rows],
+            "figures": [f.to_dict() for f in self.figures],
+        }
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> "Report":
+        return cls(
+            meta=dict(data.get("meta") or {}),
+            rows=tuple(ReportRow.from_dict(r) for r in data.get("rows") or ()),
+            figures=tuple(ReportFigure.from_dict(f) for f in data.get("figures") or ()),
+        )
+
+
+def agreement_text(agrees: bool | None, tolerance: str, na_reason: str = "") -> str:
+    """The agreement column: ``yes (tol)``, ``no (tol)`` or ``n/a (reason)``."""
+    if agrees is None:
+        return f"n/a ({na_reason})" if na_reason else "n/a"
+    word = "yes" if agrees else "no"
+    return f"{word} ({tolerance})" if tolerance else word
+
+
+def _as_row(row: ReportRow | Mapping[str, Any]) -> ReportRow:
+    return row if isinstance(row, ReportRow) else ReportRow.from_dict(row)
+
+
+def _as_figure(figure: ReportFigure | Mapping[str, Any]) -> ReportFigure:
+    return figure if isinstance(figure, ReportFigure) else ReportFigure.from_dict(figure)
+
+
+def write_report(
+    out_dir: str | Path,
+    rows: Iterable[ReportRow | Mapping[str, Any]],
+    figures: Iterable[ReportFigure | Mapping[str, Any]],
+    meta: Mapping[str, Any] | None = None,
+    *,
+    embed: bool = True,
+    title: str = "Reproduction of Sakaguchi, Stick-Slip Motion and Phase Transition in a Block-Spring System",
+) -> dict[str, Path]:
+    """Write ``report.json`` and ``report.html`` into ``out_dir`` (the report of ``stickslip reproduce``).
+
+    Figure paths are relative to ``out_dir``. With ``embed`` (default) each PNG is embedded in
+    the HTML, so the page stands alone; otherwise it is linked by its relative path. PDF and
+    data files are always linked. ``meta`` gets the package version and the time written if
+    it lacks them. Returns the paths written.
+    """
+    out = Path(out_dir)
+    meta = dict(meta or {})
+    meta.setdefault("package", "stickslip")
+    meta.setdefault("version", __version__)
+    meta.setdefault("written", _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"))
+    report = Report(
+        meta=meta,
+        rows=tuple(_as_row(r) for r in rows),
+        figures=tuple(_as_figure(f) for f in figures),
+    )
+    json_path = write_json(out / "report.json", report.to_dict())
+    html_path = out / "report.html"
+    with atomic_path(html_path) as tmp:
+        tmp.write_text(render_html(report, out, embed=embed, title=title), encoding="utf-8")
+    return {"json": json_path, "html": html_path}
+
+
+def read_report(path: str | Path) -> Report:
+    """Read ``report.json`` (a file, or the directory holding it) back into a :class:`Report`."""
+    path = Path(path)
+    if path.is_dir():
+        path = path / "report.json"
+    return Report.from_dict(read_json(path))
+
+
+# ---------------------------------------------------------------------------------------------
+# HTML
+
+_CSS = """
+body { font-family: system-ui, sans-serif; margin: 2em auto; max-width: 72em; padding: 0 1em; color: #222; }
+h1 { font-size: 1.4em; } h2 { font-size: 1.15em; margin-top: 2em; }
+table { border-collapse: collapse; width: 100%; font-size: 0.92em; }
+th, td { border: 1px solid #ccc; padding: 0.35em 0.5em; text-align: left; vertical-align: top; }
+th { background: #f3f3f3; }
+td.yes { background: #e6f4e6; } td.no { background: #f9e0e0; } td.na { background: #f4f4f4; color: #555; }
+code { font-size: 0.9em; word-break: break-all; }
+figure { display: inline-block; vertical-align: top; margin: 0.8em; max-width: 46em; }
+figure img { max-width: 100%; border: 1px solid #ddd; }
+figcaption { font-size: 0.9em; }
+dl.meta { display: grid; grid-template-columns: max-content auto; gap: 0.2em 1em; font-size: 0.9em; }
+dl.meta dt { font-weight: 600; } dl.meta dd { margin: 0; }
+"""
+
+
+def _format_value(value: Any) -> str:
+    if value is None:
+        return "not computed"
+    if isinstance(value, bool):
+        return str(value)
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        return "n/a" if not math.isfinite(value) else f"{value:.4g}"
+    return str(value)
+
+
+def _agreement_class(agrees: bool | None) -> str:
+    return "na" if agrees is None else ("yes" if agrees else "no")
+
+
+def _image_src(image: str, out: Path, embed: bool) -> str:
+    path = out / image
+    if embed and path.is_file() and path.suffix.lower() == ".png":
+        encoded = base64.b64encode(path.read_bytes()).decode("ascii")
+        return f"data:image/png;base64,{encoded}"
+    return image
+
+
+def _meta_html(meta: Mapping[str, Any]) -> str:
+    items = []
+    for key, value in meta.items():
+        text = value if isinstance(value, str) else _json_text(value)
+        items.append(f"<dt>{html.escape(str(key))}</dt><dd>{html.escape(text)}</dd>")
+    return '<dl class="meta">' + "".join(items) + "</dl>"
+
+
+def _json_text(value: Any) -> str:
+    import json
+
+    from stickslip.cli._common import to_jsonable
+
+    return json.dumps(to_jsonable(value), allow_nan=False)
+
+
+def _rows_html(rows: Iterable[ReportRow]) -> str:
+    head = ("where", "quantity", "paper", "this run", "agreement", "command")
+    out = ["<table>", "<thead><tr>" + "".join(f"<th>{h}</th>" for h in head) + "</tr></thead>", "<tbody>"]
+    for row in rows:
+        quantity = html.escape(row.quantity)
+        if row.note:
+            quantity += f"<br><small>{html.escape(row.note)}</small>"
+        out.append(
+            "<tr>"
+            f"<td>{html.escape(row.where)}</td>"
+            f"<td>{quantity}</td>"
+            f"<td>{html.escape(row.paper)}</td>"
+            f"<td>{html.escape(_format_value(row.value))}</td>"
+            f'<td class="{_agreement_class(row.agrees)}">{html.escape(row.agreement)}</td>'
+            f"<td><code>{html.escape(row.command)}</code></td>"
+            "</tr>"
+        )
+    out.append("</tbody></table>")
+    return "\n".join(out)
+
+
+def _figures_html(figures: Iterable[ReportFigure], out: Path, embed: bool) -> str:
+    parts = []
+    for fig in figures:
+        links = []
+        if fig.pdf:
+            links.append(f'<a href="{html.escape(fig.pdf, quote=True)}">PDF</a>')
+        links.extend(f'<a href="{html.escape(d, quote=True)}">{html.escape(Path(d).name)}</a>' for d in fig.data)
+        extra = f"<br>files: {', '.join(links)}" if links else ""
+        command = f"<br><code>{html.escape(fig.command)}</code>" if fig.command else ""
+        parts.append(
+            "<figure>"
+            f'<img src="{html.escape(_image_src(fig.image, out, embed), quote=True)}" '
+            f'alt="{html.escape(fig.figure, quote=True)}">'
+            f"<figcaption><b>{html.escape(fig.figure)}.</b> {html.escape(fig.caption)}{extra}{command}"
+            "</figcaption></figure>"
+        )
+    return "\n".join(parts)
+
+
+def render_html(report: Report, out_dir: str | Path, *, embed: bool = True, title: str = "Report") -> str:
+    """The report as one HTML page (no scripts, no external resources when ``embed``)."""
+    out = Path(out_dir)
+    counts = {"yes": 0, "no": 0, "na": 0}
+    for row in report.rows:
+        counts[_agreement_class(row.agrees)] += 1
+    verdict = (
+        f"{len(report.rows)} stated numbers: {counts['yes']} agree, {counts['no']} disagree, "
+        f"{counts['na']} not settled at this run length."
+    )
+    return "\n".join(
+        [
+            "<!DOCTYPE html>",
+            '<html lang="en"><head><meta charset="utf-8">',
+            f"<title>{html.escape(title)}</title>",
+            f"<style>{_CSS}</style></head><body>",
+            f"<h1>{html.escape(title)}</h1>",
+            _meta_html(report.meta),
+            "<h2>Numbers the paper states</h2>",
+            f"<p>{html.escape(verdict)}</p>",
+            _rows_html(report.rows),
+            "<h2>Figures</h2>",
+            _figures_html(report.figures, out, embed),
+            "</body></html>",
+            "",
+        ]
+    )

@@ -1,0 +1,500 @@
+"""Analysis of chain runs: slip-size statistics (Figs. 7, 8), rupture fronts (Fig. 6), time averages (Fig. 5b).
+
+Conventions (MODEL.md): a slip event's size is S = sum_i (x_i(end) - x_i(start)); blocks are
+numbered 1..N. The functions here take the labelled tables of a chain run (``events``,
+``first_move``, ``samples``) and return labelled results: xarray Datasets and frozen dataclasses.
+
+Power-law fit. The paper quotes p(S) ~ S^-tau with tau about 1.5 at beta = 1 (Fig. 7) and
+about 1.6 for small S at beta = 0.2 (Fig. 8). A finite chain cuts the distribution off near
+the largest possible event, so the fit is the maximum-likelihood estimate for a power law
+*truncated* to [s_min, s_max],
+
+    p(S) = S^-tau / Z(tau),   Z(tau) = (s_min^(1-tau) - s_max^(1-tau)) / (tau - 1),
+
+computed here in closed form (the score equation is solved by bracketing). The ``powerlaw``
+package (2.0) was checked and is not used for the estimate: ``powerlaw.Fit(..., xmax=...)``
+keeps the untruncated closed-form estimate 1 + n / sum log(S / s_min) whenever that estimate
+lies in (1.5, 3], i.e. it ignores ``xmax`` exactly in the range of exponents the paper reports
+(for tau = 1.5, s_max / s_min = 1e3 it returns about 1.57). Its truncated likelihood is only
+maximised with ``Power_Law(..., force_numerical_fit=True)``, a Nelder-Mead search with
+tolerance 1e-4; the tests use that as an independent check of this module.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+from typing import Any
+
+import numpy as np
+import pandas as pd
+import xarray as xr
+from scipy import optimize
+
+__all__ = [
+    "size_distribution",
+    "fit_power_law",
+    "PowerLawFit",
+    "truncated_power_law_pdf",
+    "front_speed",
+    "FrontSpeed",
+    "pick_front_events",
+    "time_average",
+    "TimeAverage",
+]
+
+
+# ---------------------------------------------------------------------------------------------
+# Size distribution (Figs. 7a, 8a)
+
+
+def _positive_finite(S: Any) -> tuple[np.ndarray, int]:
+    """The finite, positive sizes as float64, and how many entries were dropped."""
+    values = np.asarray(S, dtype=np.float64).ravel()
+    keep = np.isfinite(values) & (values > 0.0)
+    return values[keep], int(values.size - keep.sum())
+
+
+def size_distribution(
+    S: Any,
+    bins: int | Any = 30,
+    *,
+    s_min: float | None = None,
+    s_max: float | None = None,
+) -> xr.Dataset:
+    """Histogram of slip sizes on logarithmic bins as a probability density (Figs. 7a, 8a).
+
+    ``bins`` is a number of logarithmically equal bins spanning [s_min, s_max] (default: the
+    smallest and the largest positive S), or an increasing array of bin edges. Sizes that are
+    not positive and finite cannot sit on a log axis and are left out (counted in the attrs).
+
+    The density is count / (n_binned * width), so sum(density * width) = 1 over the binned
+    events: it estimates p(S) itself, and a power law p ~ S^-tau appears with slope -tau. (A
+    plain count per log bin would have slope 1 - tau.)
+
+    Returns a Dataset on dim ``bin`` with coordinate ``S`` (geometric bin centre) and variables
+    ``density``, ``count``, ``width``, ``lower``, ``upper``; attrs ``n_binned``, ``n_total``,
+    ``n_dropped`` (non-positive or non-finite), ``n_outside`` (outside the edges).
+    """
+    values, n_dropped = _positive_finite(S)
+    if np.ndim(bins) == 0:
+        n_bins = int(bins)
+        if n_bins < 1:
+            raise ValueError(f"bins must be >= 1 (got {bins!r})")
+        if values.size == 0 and (s_min is None or s_max is None):
+            raise ValueError("no positive sizes to bin and no explicit s_min, s_max")
+        lo = float(values.min()) if s_min is None else float(s_min)
+        hi = float(values.max()) if s_max is None else float(s_max)
+        if not (0.0 < lo < hi):
+            # a single distinct size still gets one finite bin around it
+            if lo == hi and lo > 0.0:
+                lo, hi = lo / 1.05, hi * 1.05
+            else:
+                raise ValueError(f"need 0 < s_min < s_max (got {lo!r}, {hi!r})")
+        edges = np.geomspace(lo, hi, n_bins + 1)
+    else:
+        edges = np.asarray(bins, dtype=np.float64)
+        if edges.ndim != 1 or edges.size < 2 or edges[0] <= 0.0 or np.any(np.diff(edges) <= 0.0):
+            raise ValueError("bin edges must be a 1-d, strictly increasing, positive array")
+
+    # np.histogram closes the last bin on the right, so S = s_max is counted.
+    counts, _ = np.histogram(values, bins=edges)
+    n_binned = int(counts.sum())
+    width = np.diff(edges)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        density = counts / (n_binned * width) if n_binned else np.full(width.shape, np.nan)
+    centre = np.sqrt(edges[:-1] * edges[1:])
+    return xr.Dataset(
+        {
+            "density": ("bin", density, {"long_name": "probability density of S", "units": "1/S"}),
+            "count": ("bin", counts.astype(np.int64), {"long_name": "events in bin"}),
+            "width": ("bin", width, {"long_name": "bin width"}),
+            "lower": ("bin", edges[:-1], {"long_name": "lower bin edge"}),
+            "upper": ("bin", edges[1:], {"long_name": "upper bin edge"}),
+        },
+        coords={"S": ("bin", centre, {"long_name": "slip size S (geometric bin centre)"})},
+        attrs={
+            "n_binned": n_binned,
+            "n_total": int(np.asarray(S).size),
+            "n_dropped": n_dropped,
+            "n_outside": int(values.size - n_binned),
+            "normalisation": "sum(density * width) = 1 over the binned events",
+        },
+    )
+
+
+# ---------------------------------------------------------------------------------------------
+# Truncated power-law fit (Figs. 7a, 8a)
+
+# |(1 - tau) log(s_max/s_min)| below this: use the series of the mean of log(S/s_min).
+_SERIES = 1e-6
+# exp() of more than this overflows a float64.
+_EXP_LIMIT = 700.0
+
+
+def _mean_log_ratio(e: float, span: float) -> float:
+    """E[log(S/s_min)] for p(S) ~ S^-tau on [s_min, s_max], e = 1 - tau, span = log(s_max/s_min).
+
+    u = log(S/s_min) has density proportional to exp(e u) on [0, span] (a truncated
+    exponential), whose mean is span / (1 - exp(-e span)) - 1/e, span/2 at e = 0.
+    """
+    x = e * span
+    if abs(x) < _SERIES:
+        return span / 2.0 + e * span * span / 12.0
+    x = min(max(x, -_EXP_LIMIT), _EXP_LIMIT)
+    return span / (-math.expm1(-x)) - 1.0 / e
+
+
+def _var_log_ratio(e: float, span: float) -> float:
+    """Var[log(S/s_min)] under the truncated power law: the Fisher information per event in tau.
+
+    For the truncated exponential density of u on [0, span]: 1/e^2 - span^2 e^{x} / (e^{x} - 1)^2
+    with x = e span, span^2/12 at e = 0.
+    """
+    x = e * span
+    if abs(x) < 1e-4:
+        return span * span / 12.0 * (1.0 - x * x / 60.0)
+    x = min(max(x, -_EXP_LIMIT), _EXP_LIMIT)
+    # span^2 e^x / (e^x - 1)^2 = span^2 / (4 sinh^2(x/2))
+    return 1.0 / (e * e) - span * span / (4.0 * math.sinh(x / 2.0) ** 2)
+
+
+def _log_normaliser(tau: float, s_min: float, s_max: float) -> float:
+    """log Z(tau), Z = integral of S^-tau over [s_min, s_max] (s_max may be inf for tau > 1)."""
+    e = 1.0 - tau
+    if math.isinf(s_max):
+        return e * math.log(s_min) - math.log(-e)
+    span = math.log(s_max / s_min)
+    x = e * span
+    if abs(x) < _SERIES:
+        return math.log(span) + x / 2.0
+    # Z = s_min^e (exp(x) - 1) / e, written to stay finite for large |x|
+    if x > 0:
+        return e * math.log(s_min) + x + math.log(-math.expm1(-x) / e)
+    return e * math.log(s_min) + math.log(math.expm1(x) / e)
+
+
+def _truncated_mle(mean_log: float, span: float) -> float:
+    """The tau solving the likelihood equation E_tau[log(S/s_min)] = mean of log(S/s_min).
+
+    The truncated power law is an exponential family in tau, so the log-likelihood is concave
+    and this root is its unique maximum. The mean is increasing in e = 1 - tau, from 0 (e -> -inf)
+    to span (e -> +inf); the root is bracketed by doubling.
+    """
+    if not 0.0 < mean_log < span:
+        # all events at one end of the range: the likelihood has no interior maximum
+        return math.inf if mean_log <= 0.0 else -math.inf
+
+    def score(e: float) -> float:
+        return _mean_log_ratio(e, span) - mean_log
+
+    lo, hi = -1.0, 1.0
+    while score(lo) > 0.0:
+        lo *= 2.0
+    while score(hi) < 0.0:
+        hi *= 2.0
+    e = optimize.brentq(score, lo, hi, xtol=1e-14, rtol=4 * np.finfo(float).eps, maxiter=200)
+    return 1.0 - e
+
+
+def _fit_tau(log_ratio: np.ndarray, span: float) -> float:
+    """tau from log(S/s_min) of the events in range: truncated MLE, or the closed form if span = inf."""
+    mean_log = float(log_ratio.mean())
+    if math.isinf(span):
+        # untruncated continuous power law: tau = 1 + n / sum log(S/s_min)
+        return 1.0 + 1.0 / mean_log if mean_log > 0.0 else math.inf
+    return _truncated_mle(mean_log, span)
+
+
+@dataclass(frozen=True)
+class PowerLawFit:
+    """Maximum-likelihood exponent of p(S) ~ S^-tau on [s_min, s_max] (Figs. 7a, 8a).
+
+    ``tau``: the exponent; ``tau_err``: its bootstrap standard error (NaN without bootstrap);
+    ``tau_err_fisher``: the asymptotic error 1 / sqrt(n I(tau)) from the Fisher information;
+    ``n``: events in [s_min, s_max] used for the fit, ``n_total``: all finite positive events;
+    ``truncated``: whether the upper cut-off enters the likelihood (False: s_max = inf, the
+    classic estimator); ``loglikelihood``: the maximised log-likelihood; ``ks_distance``: the
+    Kolmogorov-Smirnov distance between the fitted and the empirical CDF on the range.
+    """
+
+    tau: float
+    tau_err: float
+    tau_err_fisher: float
+    s_min: float
+    s_max: float
+    n: int
+    n_total: int
+    bootstrap: int
+    seed: int
+    truncated: bool
+    method: str
+    loglikelihood: float
+    ks_distance: float
+
+    def pdf(self, s: Any) -> np.ndarray:
+        """The fitted density p(S) on [s_min, s_max] (zero outside), integrating to 1."""
+        return truncated_power_law_pdf(s, self.tau, self.s_min, self.s_max)
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+def truncated_power_law_pdf(s: Any, tau: float, s_min: float, s_max: float = math.inf) -> np.ndarray:
+    """p(S) = S^-tau / Z(tau) on [s_min, s_max], zero outside; the model of :func:`fit_power_law`."""
+    s = np.asarray(s, dtype=np.float64)
+    log_z = _log_normaliser(tau, s_min, s_max)
+    inside = (s >= s_min) & (s <= s_max)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        out = np.exp(-tau * np.log(s) - log_z)
+    return np.where(inside, out, 0.0)
+
+
+def _truncated_cdf(s: np.ndarray, tau: float, s_min: float, s_max: float) -> np.ndarray:
+    e = 1.0 - tau
+    if abs(e) < 1e-12:
+        return np.log(s / s_min) / math.log(s_max / s_min)
+    if math.isinf(s_max):
+        return 1.0 - (s / s_min) ** e
+    return np.expm1(e * np.log(s / s_min)) / math.expm1(e * math.log(s_max / s_min))
+
+
+def fit_power_law(
+    S: Any,
+    s_min: float | None = None,
+    s_max: float | None = None,
+    *,
+    bootstrap: int = 200,
+    seed: int = 0,
+    truncated: bool = True,
+) -> PowerLawFit:
+    """Exponent tau of the slip-size distribution p(S) ~ S^-tau by maximum likelihood (Figs. 7, 8).
+
+    The fit uses the events with s_min <= S <= s_max and maximises the likelihood of the power
+    law truncated to that range (module docstring). Defaults: s_min = the smallest positive S,
+    s_max = the largest S (the maximum-likelihood estimate of an upper cut-off). With
+    ``truncated=False`` the upper cut-off is ignored in the likelihood (s_max = inf, the classic
+    estimator tau = 1 + n / sum log(S/s_min)) but events above ``s_max`` are still left out;
+    that estimate is biased upwards for a cut-off distribution.
+
+    The error ``tau_err`` is the standard deviation of the estimate over ``bootstrap``
+    resamples (with replacement) of the events in range, drawn with
+    ``numpy.random.default_rng(seed)``; ``bootstrap=0`` skips it.
+    """
+    values, _ = _positive_finite(S)
+    n_total = int(values.size)
+    if n_total == 0:
+        raise ValueError("no positive, finite slip sizes to fit")
+    lo = float(values.min()) if s_min is None else float(s_min)
+    hi = float(values.max()) if s_max is None else float(s_max)
+    if not (lo > 0.0 and hi > lo):
+        raise ValueError(f"need 0 < s_min < s_max (got s_min={lo!r}, s_max={hi!r})")
+    if bootstrap < 0:
+        raise ValueError(f"bootstrap must be >= 0 (got {bootstrap!r})")
+
+    x = values[(values >= lo) & (values <= hi)]
+    n = int(x.size)
+    if n < 2:
+        raise ValueError(f"need at least 2 events in [s_min, s_max] (got {n})")
+    span = math.log(hi / lo) if truncated else math.inf
+    log_ratio = np.log(x / lo)
+    tau = _fit_tau(log_ratio, span)
+
+    tau_err = math.nan
+    if bootstrap > 0:
+        rng = np.random.default_rng(seed)
+        estimates = np.empty(bootstrap)
+        for k in range(bootstrap):
+            estimates[k] = _fit_tau(log_ratio[rng.integers(0, n, size=n)], span)
+        finite = estimates[np.isfinite(estimates)]
+        tau_err = float(finite.std(ddof=1)) if finite.size > 1 else math.nan
+
+    if math.isfinite(tau):
+        s_hi = math.inf if not truncated else hi
+        info = _var_log_ratio(1.0 - tau, span) if truncated else 1.0 / (tau - 1.0) ** 2
+        tau_err_fisher = 1.0 / math.sqrt(n * info) if info > 0 else math.nan
+        loglik = float(-tau * np.log(x).sum() - n * _log_normaliser(tau, lo, s_hi))
+        xs = np.sort(x)
+        model = _truncated_cdf(xs, tau, lo, s_hi)
+        upper = np.arange(1, n + 1) / n
+        ks = float(max(np.max(upper - model), np.max(model - (upper - 1.0 / n))))
+    else:
+        tau_err_fisher = loglik = ks = math.nan
+
+    method = (
+        "maximum likelihood, continuous power law truncated to [s_min, s_max]"
+        if truncated
+        else "maximum likelihood, continuous power law on [s_min, inf) (upper cut-off ignored)"
+    )
+    return PowerLawFit(
+        tau=float(tau),
+        tau_err=tau_err,
+        tau_err_fisher=float(tau_err_fisher),
+        s_min=lo,
+        s_max=hi,
+        n=n,
+        n_total=n_total,
+        bootstrap=int(bootstrap),
+        seed=int(seed),
+        truncated=bool(truncated),
+        method=method,
+        loglikelihood=loglik,
+        ks_distance=ks,
+    )
+
+
+# ---------------------------------------------------------------------------------------------
+# Rupture fronts (Fig. 6)
+
+
+@dataclass(frozen=True)
+class FrontSpeed:
+    """Speed of a rupture front fitted from first-motion times (Fig. 6).
+
+    Least squares of block index i against first-move time t over blocks i_min..i_max:
+    i = i_0 + speed (t - t_start). ``speed`` is in blocks per time unit (the paper: c = 1.43 in
+    large events at beta = 1, below the sound speed sqrt(K) = 3.16); ``speed_err`` is the
+    standard error of the slope; ``t_start`` the event's first first-move time; ``intercept``
+    is i_0; ``rms`` the residual root mean square in blocks; ``n_blocks`` the blocks fitted.
+    """
+
+    event: int
+    speed: float
+    speed_err: float
+    intercept: float
+    t_start: float
+    i_min: int
+    i_max: int
+    n_blocks: int
+    rms: float
+
+    def arrival_time(self, i: Any) -> np.ndarray:
+        """First-move time of block i on the fitted line (absolute time)."""
+        return self.t_start + (np.asarray(i, dtype=np.float64) - self.intercept) / self.speed
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+def front_speed(
+    first_move: pd.DataFrame,
+    event: int,
+    *,
+    i_min: int | None = None,
+    i_max: int | None = None,
+) -> FrontSpeed:
+    """Rupture-front speed of one event from the time each block first moved (Fig. 6).
+
+    ``first_move`` is the run's long table (event, block, t_first), blocks numbered 1..N;
+    blocks that did not move are absent or have NaN ``t_first``. The paper measures the leading
+    edge "for large i", away from the pulled end where the rupture starts, so by default the
+    fit uses the far half of the blocks the event reached: i_min = ceil(i_far / 2),
+    i_max = i_far, with i_far the farthest block that moved.
+    """
+    rows = first_move[(first_move["event"] == event) & np.isfinite(first_move["t_first"])]
+    if rows.empty:
+        raise ValueError(f"event {event} has no first-move times")
+    blocks = rows["block"].to_numpy(dtype=np.int64)
+    times = rows["t_first"].to_numpy(dtype=np.float64)
+    i_far = int(blocks.max())
+    lo = int(math.ceil(i_far / 2)) if i_min is None else int(i_min)
+    hi = i_far if i_max is None else int(i_max)
+    use = (blocks >= lo) & (blocks <= hi)
+    n = int(use.sum())
+    if n < 3:
+        raise ValueError(f"event {event}: need at least 3 moved blocks in [{lo}, {hi}] (got {n})")
+    t0 = float(times.min())
+    t = times[use] - t0
+    i = blocks[use].astype(np.float64)
+    design = np.column_stack([np.ones(n), t])
+    coef, *_ = np.linalg.lstsq(design, i, rcond=None)
+    residual = i - design @ coef
+    dof = n - 2
+    s2 = float(residual @ residual) / dof if dof > 0 else math.nan
+    t_centred = t - t.mean()
+    sxx = float(t_centred @ t_centred)
+    slope_err = math.sqrt(s2 / sxx) if sxx > 0 and dof > 0 else math.nan
+    return FrontSpeed(
+        event=int(event),
+        speed=float(coef[1]),
+        speed_err=slope_err,
+        intercept=float(coef[0]),
+        t_start=t0,
+        i_min=lo,
+        i_max=hi,
+        n_blocks=n,
+        rms=float(np.sqrt(np.mean(residual**2))),
+    )
+
+
+def pick_front_events(events: pd.DataFrame, N: int, *, intermediate: tuple[float, float] = (0.3, 0.7)) -> pd.DataFrame:
+    """One large and one intermediate event for the rupture-front figure (Fig. 6).
+
+    Large: the largest-S event whose rupture reached block N (the paper's event near t = 19100).
+    Intermediate: among events whose farthest moved block lies in ``intermediate`` * N, the one
+    closest to N/2 (the paper's event near t = 40400). Returns the chosen rows of ``events``
+    with a ``kind`` column ("large", "intermediate"); a kind with no candidate is left out.
+    """
+    chosen = []
+    reached = events[events["max_block"] >= N]
+    if not reached.empty:
+        chosen.append(reached.loc[[reached["S"].idxmax()]].assign(kind="large"))
+    lo, hi = intermediate[0] * N, intermediate[1] * N
+    middle = events[(events["max_block"] >= lo) & (events["max_block"] <= hi)]
+    if not middle.empty:
+        distance = (middle["max_block"] - N / 2.0).abs()
+        chosen.append(middle.loc[[distance.idxmin()]].assign(kind="intermediate"))
+    if not chosen:
+        return events.iloc[0:0].assign(kind=pd.Series(dtype=str))
+    return pd.concat(chosen).reset_index(drop=True)
+
+
+# ---------------------------------------------------------------------------------------------
+# Time averages (Fig. 5b)
+
+
+@dataclass(frozen=True)
+class TimeAverage:
+    """Time average of a sampled series with a batch-means standard error (Fig. 5b).
+
+    ``mean`` over samples with t >= t_from; ``stderr``: the standard deviation of the means of
+    ``n_batches`` consecutive equal batches over sqrt(n_batches) (stick-slip samples are
+    correlated, so the naive error would be too small); ``n_samples`` used.
+    """
+
+    mean: float
+    stderr: float
+    t_from: float
+    t_to: float
+    n_samples: int
+    n_batches: int
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+def time_average(series: xr.DataArray, t_from: float | None = None, *, n_batches: int = 10) -> TimeAverage:
+    """<L> = time average of L(t) = x_1 - x_N (or any series on coord ``t``) for Fig. 5b."""
+    if "t" not in series.coords:
+        raise ValueError("series needs a coordinate 't'")
+    t = series["t"].to_numpy()
+    values = series.to_numpy().astype(np.float64)
+    start = float(t.min()) if t_from is None else float(t_from)
+    keep = (t >= start) & np.isfinite(values)
+    y = values[keep]
+    n = int(y.size)
+    if n == 0:
+        raise ValueError(f"no samples at t >= {start:g}")
+    stderr = math.nan
+    if n_batches >= 2 and n >= n_batches:
+        size = n // n_batches
+        means = y[: size * n_batches].reshape(n_batches, size).mean(axis=1)
+        stderr = float(means.std(ddof=1) / math.sqrt(n_batches))
+    return TimeAverage(
+        mean=float(y.mean()),
+        stderr=stderr,
+        t_from=start,
+        t_to=float(t[keep].max()),
+        n_samples=n,
+        n_batches=int(n_batches),
+    )

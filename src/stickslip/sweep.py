@@ -1,0 +1,405 @@
+"""Parameter sweeps on Dask: one independent task per grid point (e.g. <L> against beta, Fig. 5b).
+
+A sweep is a task function and a list of points. Each point gets its own directory under the
+sweep's output directory, named from its parameters (``beta=0.9_N=399``); the task writes its
+outputs there and returns a summary dict. When a point finishes, ``done.json`` is written into
+its directory atomically; a later sweep over the same points finds it and skips the point, so
+an interrupted sweep resumes where it stopped. A point whose task raises gets ``error.json``
+(message and traceback), is reported in the summary table and does not stop the others; it is
+run again by the next sweep.
+
+The points run on ``dask.distributed``: a local cluster of worker processes (one per core,
+one thread each) by default, or an existing cluster given by its scheduler address. With a
+remote cluster the output directory must be on a file system the workers share.
+
+A task is a plain top-level function ``task(point: dict, point_dir: Path) -> dict`` so that it
+pickles by reference; :func:`chain_task` and :func:`block_task` run the model, :func:`demo_task`
+is a cheap stand-in for tests and for checking a cluster.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import logging
+import math
+import os
+import re
+import sys
+import time
+import traceback
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Callable, Iterable
+
+import numpy as np
+import pandas as pd
+
+from stickslip import __version__
+from stickslip.io import read_json, run_metadata, write_dataset, write_json, write_table
+from stickslip.params import BlockParams, ChainParams
+
+__all__ = [
+    "run_sweep",
+    "SweepResult",
+    "point_name",
+    "chain_task",
+    "block_task",
+    "demo_task",
+    "CHAIN_RUN_OPTIONS",
+    "BLOCK_RUN_OPTIONS",
+    "DONE_FILE",
+    "ERROR_FILE",
+]
+
+DONE_FILE = "done.json"
+ERROR_FILE = "error.json"
+SUMMARY_NAME = "summary"
+
+# Keys of a point that are options of the run rather than model parameters.
+CHAIN_RUN_OPTIONS = ("t_end", "integrator", "start", "sample_interval", "average_from",
+                     "profile_window", "profile_min_blocks")
+BLOCK_RUN_OPTIONS = ("t_end", "every")
+
+# Columns of the summary table that are not parameters or task results.
+_STATUS_COLUMNS = ("point_dir", "status", "reused", "error", "wall_seconds")
+
+Task = Callable[[dict[str, Any], Path], dict[str, Any]]
+
+
+# ---------------------------------------------------------------------------------------------
+# Naming and bookkeeping
+
+
+def _format_value(value: Any) -> str:
+    if isinstance(value, (bool, np.bool_)):
+        return str(bool(value))
+    if isinstance(value, (int, np.integer)):
+        return str(int(value))
+    if isinstance(value, (float, np.floating)):
+        value = float(value)
+        return str(int(value)) if value.is_integer() and abs(value) < 1e15 else f"{value:.10g}"
+    return str(value)
+
+
+def point_name(point: dict[str, Any]) -> str:
+    """Directory name of a point: ``key=value`` pairs joined by ``_``, keys in case-blind order.
+
+    The name depends only on the point's keys and values, so the same point always lands in
+    the same directory (``{"N": 399, "beta": 0.9}`` -> ``beta=0.9_N=399``). Characters that do
+    not belong in a file name become ``-``.
+    """
+    if not point:
+        return "point"
+    parts = [f"{key}={_format_value(point[key])}" for key in sorted(point, key=lambda k: (k.lower(), k))]
+    return re.sub(r"[^A-Za-z0-9._=+-]", "-", "_".join(parts))
+
+
+def _jsonable(value: Any) -> Any:
+    """A JSON round trip, so that stored and requested specs compare equal (tuples -> lists, ...)."""
+    from stickslip.cli._common import to_jsonable
+
+    return json.loads(json.dumps(to_jsonable(value)))
+
+
+def _task_name(task: Task) -> str:
+    return f"{task.__module__}.{task.__qualname__}"
+
+
+def _spec(task: Task, point: dict[str, Any], common: dict[str, Any]) -> dict[str, Any]:
+    """What a point's result depends on; a stored result is reused only if this matches."""
+    return _jsonable({"task": _task_name(task), "point": point, "common": common, "version": __version__})
+
+
+def _read_done(point_dir: Path, spec: dict[str, Any]) -> dict[str, Any] | None:
+    """The stored record of a finished point with this spec, or None."""
+    path = point_dir / DONE_FILE
+    if not path.is_file():
+        return None
+    try:
+        record = read_json(path)
+    except (OSError, ValueError):
+        return None
+    return record if record.get("spec") == spec else None
+
+
+def _run_point(task: Task, point: dict[str, Any], common: dict[str, Any], point_dir: str,
+               spec: dict[str, Any]) -> dict[str, Any]:
+    """Run one point on a worker: call the task, record done.json or error.json, never raise."""
+    directory = Path(point_dir)
+    directory.mkdir(parents=True, exist_ok=True)
+    for stale in (DONE_FILE, ERROR_FILE):
+        (directory / stale).unlink(missing_ok=True)
+    write_json(directory / "point.json", {"spec": spec})
+    start = time.perf_counter()
+    try:
+        summary = task({**common, **point}, directory)
+        summary = {} if summary is None else dict(summary)
+    except Exception as exc:  # a failing point is data, not a reason to stop the sweep
+        record = {
+            "spec": spec,
+            "status": "failed",
+            "error": f"{type(exc).__name__}: {exc}",
+            "traceback": traceback.format_exc(),
+            "wall_seconds": time.perf_counter() - start,
+        }
+        write_json(directory / ERROR_FILE, record)
+        return record
+    record = {
+        "spec": spec,
+        "status": "ok",
+        "error": None,
+        "wall_seconds": time.perf_counter() - start,
+        "summary": _jsonable(summary),
+    }
+    write_json(directory / DONE_FILE, record)
+    return record
+
+
+def _row(point: dict[str, Any], name: str, record: dict[str, Any], reused: bool) -> dict[str, Any]:
+    row: dict[str, Any] = dict(point)
+    row.update(point_dir=name, status=record.get("status", "failed"), reused=reused,
+               error=record.get("error"), wall_seconds=record.get("wall_seconds", math.nan))
+    for key, value in (record.get("summary") or {}).items():
+        # a result named like a parameter or a status column keeps both, prefixed
+        row[f"result_{key}" if key in row else key] = value
+    return row
+
+
+def _table(rows: list[dict[str, Any]], points: list[dict[str, Any]]) -> pd.DataFrame:
+    """The summary table: parameters, status columns, results.
+
+    Columns mixing text and numbers (or holding lists) become JSON text, so Parquet can store them.
+    """
+    params = list(dict.fromkeys(key for point in points for key in point))
+    table = pd.DataFrame(rows)
+    leading = params + [c for c in _STATUS_COLUMNS if c in table.columns]
+    table = table[leading + [c for c in table.columns if c not in leading]]
+    for column in table.columns:
+        if table[column].dtype != object:
+            continue
+        values = [v for v in table[column] if v is not None and not (isinstance(v, float) and math.isnan(v))]
+        kinds = {type(v) for v in values}
+        if kinds and not (kinds <= {str} or kinds <= {bool}):
+            table[column] = [None if v is None or (isinstance(v, float) and math.isnan(v))
+                             else (v if isinstance(v, str) else json.dumps(v)) for v in table[column]]
+    return table
+
+
+@dataclass(frozen=True)
+class SweepResult:
+    """Outcome of :func:`run_sweep`: the summary ``table`` (one row per point) and counts."""
+
+    table: pd.DataFrame
+    out_dir: Path
+    n_points: int
+    n_run: int
+    n_reused: int
+    n_failed: int
+    wall_seconds: float
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-able form (the table as a list of records)."""
+        data = {f.name: getattr(self, f.name) for f in dataclasses.fields(self) if f.name != "table"}
+        data["points"] = _jsonable(self.table.astype(object).where(self.table.notna(), None).to_dict(orient="records"))
+        return data
+
+
+# ---------------------------------------------------------------------------------------------
+# The driver
+
+
+def run_sweep(
+    task: Task,
+    points: Iterable[dict[str, Any]],
+    out_dir: str | Path,
+    *,
+    common: dict[str, Any] | None = None,
+    scheduler: str | None = None,
+    n_workers: int | None = None,
+    progress: bool = True,
+) -> SweepResult:
+    """Run ``task`` at every point of a parameter grid, each point an independent Dask task.
+
+    ``points`` are dicts of the varying parameters; each names its directory under ``out_dir``
+    (:func:`point_name`). ``common`` holds settings shared by every point (fixed parameters,
+    run length); the task receives ``{**common, **point}``. A point whose directory holds a
+    ``done.json`` for the same task, point, common settings and package version is not run
+    again. Points run on a new local cluster (``n_workers`` processes, default one per core,
+    one thread each) or, with ``scheduler`` = address, on an existing cluster. Progress
+    (points done / total, time left) goes to stderr. Writes ``summary.parquet`` and
+    ``summary.csv`` in ``out_dir``: one row per point with its parameters, ``status``
+    ("ok"/"failed"), ``reused``, ``error``, ``wall_seconds`` and the task's summary fields.
+    """
+    start = time.perf_counter()
+    points = [dict(p) for p in points]
+    common = dict(common or {})
+    out = Path(out_dir)
+    names = [point_name(p) for p in points]
+    duplicates = sorted({n for n in names if names.count(n) > 1})
+    if duplicates:
+        raise ValueError(f"points repeat: {', '.join(duplicates)}")
+    if n_workers is not None and n_workers < 1:
+        raise ValueError(f"n_workers must be >= 1 (got {n_workers})")
+    out.mkdir(parents=True, exist_ok=True)
+
+    specs = [_spec(task, p, common) for p in points]
+    records: list[dict[str, Any] | None] = [_read_done(out / n, s) for n, s in zip(names, specs)]
+    reused = [r is not None for r in records]
+    pending = [k for k, r in enumerate(records) if r is None]
+
+    if pending:
+        _compute(task, points, common, out, names, specs, pending, records,
+                 scheduler=scheduler, n_workers=n_workers, progress=progress)
+
+    rows = [_row(p, n, r, u) for p, n, r, u in zip(points, names, records, reused)]  # type: ignore[arg-type]
+    table = _table(rows, points)
+    write_table(out / f"{SUMMARY_NAME}.parquet", table)
+    _write_csv(out / f"{SUMMARY_NAME}.csv", table)
+    n_failed = int((table["status"] != "ok").sum()) if len(table) else 0
+    return SweepResult(
+        table=table,
+        out_dir=out,
+        n_points=len(points),
+        n_run=len(pending),
+        n_reused=sum(reused),
+        n_failed=n_failed,
+        wall_seconds=time.perf_counter() - start,
+    )
+
+
+def _write_csv(path: Path, table: pd.DataFrame) -> None:
+    from stickslip.io import atomic_path
+
+    with atomic_path(path) as tmp:
+        table.to_csv(tmp, index=False)
+
+
+def _compute(task, points, common, out, names, specs, pending, records, *, scheduler, n_workers, progress):
+    """Submit the pending points and collect their records as they finish (fills ``records``)."""
+    from dask.distributed import Client, LocalCluster, as_completed
+
+    cluster = None
+    if scheduler is None:
+        workers = n_workers or os.cpu_count() or 1
+        cluster = LocalCluster(
+            n_workers=min(workers, len(pending)),
+            threads_per_worker=1,
+            processes=True,
+            dashboard_address=":0",  # any free port: never clash with another cluster
+            silence_logs=logging.ERROR,
+        )
+        client = Client(cluster)
+    else:
+        client = Client(scheduler)
+    bar = _progress_bar(len(points), len(points) - len(pending), progress)
+    try:
+        futures = {}
+        for k in pending:
+            future = client.submit(_run_point, task, points[k], common, str(out / names[k]), specs[k],
+                                   key=f"sweep-{names[k]}-{os.getpid()}-{time.time_ns()}", pure=False)
+            futures[future] = k
+        for future in as_completed(futures):
+            k = futures[future]
+            try:
+                records[k] = future.result()
+            except Exception as exc:  # the worker itself died (memory, signal): record it here
+                records[k] = {
+                    "spec": specs[k],
+                    "status": "failed",
+                    "error": f"{type(exc).__name__}: {exc}",
+                    "traceback": traceback.format_exc(),
+                    "wall_seconds": math.nan,
+                }
+                write_json(out / names[k] / ERROR_FILE, records[k])
+            if bar is not None:
+                bar.update(1)
+                if records[k]["status"] != "ok":
+                    bar.write(f"point {names[k]} failed: {records[k]['error']}", file=sys.stderr)
+    finally:
+        if bar is not None:
+            bar.close()
+        client.close()
+        if cluster is not None:
+            cluster.close()
+
+
+def _progress_bar(total: int, done: int, enabled: bool):
+    if not enabled:
+        return None
+    from tqdm import tqdm
+
+    return tqdm(total=total, initial=done, desc="points", unit="point", file=sys.stderr,
+                dynamic_ncols=True, smoothing=0.1)
+
+
+# ---------------------------------------------------------------------------------------------
+# Tasks
+
+
+def _split(point: dict[str, Any], params_cls: type, options: tuple[str, ...]) -> tuple[Any, dict[str, Any]]:
+    fields = {f.name for f in dataclasses.fields(params_cls)}
+    unknown = sorted(set(point) - fields - set(options))
+    if unknown:
+        raise ValueError(f"unknown keys for {params_cls.__name__}: {', '.join(unknown)}")
+    params = params_cls(**{k: v for k, v in point.items() if k in fields})
+    run_options = {k: v for k, v in point.items() if k in options}
+    if "t_end" not in run_options:
+        raise ValueError("a sweep point needs t_end")
+    return params, run_options
+
+
+def chain_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
+    """Run the chain of eq. (4) at one point; its outputs go to ``point_dir``; returns its summary.
+
+    ``point`` holds :class:`~stickslip.params.ChainParams` fields, ``t_end`` and optionally the
+    run options in :data:`CHAIN_RUN_OPTIONS`.
+    """
+    from stickslip import chain  # imported here: workers load the simulator only when needed
+
+    params, options = _split(point, ChainParams, CHAIN_RUN_OPTIONS)
+    t_end = options.pop("t_end")
+    run = chain.run_chain(params, t_end, out_dir=point_dir, **options)
+    if not (Path(point_dir) / "run.json").exists():
+        chain.write_run(run, point_dir)
+    return dict(run.summary)
+
+
+def block_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
+    """Run the single block of eq. (1) at one point and return its summary.
+
+    ``point`` holds :class:`~stickslip.params.BlockParams` fields, ``t_end`` and optionally
+    ``every`` (the sampling stride). Writes ``series.nc`` (x, v, theta, f over t),
+    ``slips.parquet`` (one row per slip) and ``run.json`` (parameters, versions, summary).
+    """
+    from stickslip import block  # imported here: workers load the simulator only when needed
+
+    params, options = _split(point, BlockParams, BLOCK_RUN_OPTIONS)
+    t_end = options.pop("t_end")
+    run = block.simulate_block(params, t_end, **options)
+    summary = dict(run.summary())
+    directory = Path(point_dir)
+    write_dataset(directory / "series.nc", run.series)
+    write_table(directory / "slips.parquet", run.slips)
+    write_json(directory / "run.json", run_metadata(params, integrator="heun", t_end=t_end,
+                                                    summary=summary, **options))
+    return summary
+
+
+def demo_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
+    """A cheap stand-in task with a checkable result, for tests and for trying a cluster.
+
+    Returns ``value`` = sum_{k=1}^{n} k^2 * x (n = ``n``, default 10; x = ``x``, default 1)
+    and the worker's process id; sleeps ``sleep`` seconds first; raises ``ValueError`` when
+    ``fail`` is true; ends its worker process abruptly when ``crash`` is true (as a worker killed
+    for memory would). Writes ``value.txt`` into its directory.
+    """
+    time.sleep(float(point.get("sleep", 0.0)))
+    if point.get("crash", False):
+        os._exit(3)
+    if point.get("fail", False):
+        raise ValueError(f"demo point asked to fail (x={point.get('x')})")
+    n = int(point.get("n", 10))
+    value = float(sum(k * k for k in range(1, n + 1)) * float(point.get("x", 1.0)))
+    (Path(point_dir) / "value.txt").write_text(f"{value!r}\n")
+    return {"value": value, "pid": os.getpid()}
