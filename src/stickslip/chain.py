@@ -109,6 +109,7 @@ class ChainState:
         ist = np.zeros(K.IST_SIZE, dtype=np.int64)
         ist[K.N_MOVING] = int(np.count_nonzero(~stopped))
         ist[K.ACT_LO], ist[K.ACT_HI] = 1, N
+        ist[K.MECH_LO], ist[K.MECH_HI] = 1, N
         return cls(
             first_step=np.full(N + 2, -1, dtype=np.int64), x0ev=np.zeros(N + 2), mov=mov,
             ist=ist, **arrays,

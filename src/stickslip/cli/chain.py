@@ -1,7 +1,161 @@
-"""`stickslip chain`: (to be filled in)."""
+"""`stickslip chain` (run the chain of eq. 4) and `stickslip bench` (dense against exact)."""
 
 from __future__ import annotations
 
+import argparse
+import sys
+import time
+from pathlib import Path
+
+from stickslip.cli._common import (
+    CommandError,
+    Result,
+    add_json_option,
+    add_param_options,
+    float_arg,
+    params_from_args,
+    prepare_out_dir,
+)
+from stickslip.params import ChainParams, ParameterError, check_number
+
 
 def register(sub) -> None:
-    """Add the subcommand(s) of this module to the parser."""
+    """Add the `chain` and `bench` subcommands."""
+    p = sub.add_parser(
+        "chain",
+        help="run the chain of N blocks pulled at one end (eq. 4)",
+        description="Integrate the chain of eq. (4) (MODEL.md) and record its slip events.",
+    )
+    add_param_options(p, ChainParams)
+    _add_run_options(p)
+    p.add_argument("--integrator", choices=("exact", "dense"), default="exact",
+                   help="exact (default, fast) or dense (reference); both give the same answer bit for bit")
+    p.add_argument("--out", metavar="DIR", help="run directory: results, checkpoints, run.json")
+    p.add_argument("--resume", metavar="DIR", help="continue the run in DIR from its checkpoint")
+    p.add_argument("--checkpoint-interval", type=float_arg("checkpoint-interval"), default=300.0,
+                   metavar="SECONDS", help="wall-clock seconds between checkpoints (default 300; needs --out)")
+    p.add_argument("--sample-interval", type=float_arg("sample-interval"), default=10.0, metavar="T",
+                   help="sample L = x_1 - x_N every T time units (default 10)")
+    p.add_argument("--average-from", type=float_arg("average-from"), default=None, metavar="T",
+                   help="<L> averages the samples with t >= T (default t_end / 2)")
+    p.add_argument("--snapshot", type=float_arg("snapshot"), action="append", default=[], metavar="T",
+                   help="store all x_i at time T (repeatable; Fig. 5a)")
+    p.add_argument("--profile-window", type=float_arg("profile-window"), default=None, metavar="W",
+                   help="store the displacement over windows of W during events (Fig. 6 uses 20)")
+    p.add_argument("--profile-min-blocks", type=int, default=0, metavar="M",
+                   help="keep profiles only of events with at least M moved blocks")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
+    add_json_option(p)
+    p.set_defaults(handler=run_chain_command)
+
+    b = sub.add_parser(
+        "bench",
+        help="time dense against exact on the same workload, in one process",
+        description="Run the same chain workload with the dense and the exact integrator and compare.",
+    )
+    b.add_argument("--beta", type=float_arg("beta"), default=1.0, help="beta (default 1)")
+    b.add_argument("--N", type=int, default=399, help="number of blocks (default 399)")
+    b.add_argument("--t-end", type=float_arg("t-end"), default=2e5, help="end time (default 2e5)")
+    b.add_argument("--start", choices=("paper", "steady"), default="paper",
+                   help="initial state: the paper's (default) or exact steady sliding")
+    b.add_argument("--repeat", type=int, default=1, help="time each integrator this many times, keep the fastest")
+    add_json_option(b)
+    b.set_defaults(handler=run_bench_command)
+
+
+def _add_run_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--t-end", type=float_arg("t-end"), default=None, metavar="T",
+                   help="end time (default 2e4; the paper's runs use 2e7)")
+    p.add_argument("--start", choices=("paper", "steady"), default="paper",
+                   help="initial state: the paper's (x=0, v=0.1, theta=0.1) or exact steady sliding")
+    p.add_argument("--perturbation", type=float_arg("perturbation"), default=0.0, metavar="A",
+                   help="with --start steady: uniform perturbation of x and v in [-A, A]")
+    p.add_argument("--seed", type=int, default=0, help="seed of the perturbation (default 0)")
+
+
+def _summary_text(summary: dict, out: Path | None) -> str:
+    lines = [
+        f"t_end          {summary['t_end']:g}  ({summary['steps']} steps, {summary['integrator']})",
+        f"events         {summary['n_events']}" + ("  (one in progress)" if summary["event_in_progress"] else ""),
+        f"L_final        {summary['L_final']:.6g}   (steady sliding {summary['L_steady']:.6g})",
+        f"L_mean         {summary['L_mean']:.6g}   (t >= {summary['L_mean_from']:g})",
+        f"moving blocks  {summary['n_moving']}",
+        f"wall time      {summary['wall_seconds']:.3g} s",
+        f"state sha256   {summary['state_sha256']}",
+    ]
+    if out is not None:
+        lines.append(f"written to     {out}")
+    return "\n".join(lines)
+
+
+def _json_summary(summary: dict, out: Path | None) -> dict:
+    data = dict(summary)
+    data["events"] = summary["n_events"]
+    if out is not None:
+        data["out"] = str(out)
+    return data
+
+
+def run_chain_command(args: argparse.Namespace) -> Result:
+    """Handler of `stickslip chain`."""
+    from stickslip import chain
+
+    progress = not args.no_progress
+    if args.resume:
+        if args.out and Path(args.out) != Path(args.resume):
+            raise CommandError("--out and --resume name different directories; give only --resume")
+        check_number("checkpoint-interval", args.checkpoint_interval, low=0.0, low_open=True)
+        try:
+            run = chain.resume_chain(args.resume, t_end=args.t_end, checkpoint_interval=args.checkpoint_interval,
+                                     progress=progress, handle_signals=True)
+        except chain.ChainRunError as exc:
+            raise CommandError(str(exc)) from None
+        except chain.Interrupted as exc:
+            return _interrupted(exc, Path(args.resume))
+        return Result(_json_summary(run.summary, Path(args.resume)), _summary_text(run.summary, Path(args.resume)))
+
+    params = params_from_args(ChainParams, args)
+    t_end = 2e4 if args.t_end is None else args.t_end
+    check_number("t-end", t_end, low=0.0)
+    check_number("checkpoint-interval", args.checkpoint_interval, low=0.0, low_open=True)
+    check_number("profile-min-blocks", args.profile_min_blocks, low=0, integer=True)
+    # Validate every option before anything is written.
+    chain.RunOptions(t_end=t_end, sample_interval=args.sample_interval, average_from=args.average_from,
+                     snapshot_times=tuple(args.snapshot), profile_window=args.profile_window,
+                     profile_min_blocks=args.profile_min_blocks).validated(params.dt)
+    check_number("perturbation", args.perturbation, low=0.0)
+    out = prepare_out_dir(args.out)
+    if out is not None and (out / "checkpoint" / "state.npz").exists():
+        raise CommandError(f"{out} already holds a run; continue it with --resume {out} or choose another --out")
+    try:
+        run = chain.run_chain(
+            params, t_end, integrator=args.integrator, start=args.start, perturbation=args.perturbation,
+            seed=args.seed, sample_interval=args.sample_interval, average_from=args.average_from,
+            snapshot_times=args.snapshot, profile_window=args.profile_window,
+            profile_min_blocks=args.profile_min_blocks, out_dir=out,
+            checkpoint_interval=args.checkpoint_interval if out else None, progress=progress,
+            handle_signals=out is not None,
+        )
+    except chain.ChainRunError as exc:
+        sys.stderr.write(f"stickslip chain: error: {exc}\n")
+        return Result({"error": str(exc)}, "", status=1)
+    except chain.Interrupted as exc:
+        return _interrupted(exc, out)
+    return Result(_json_summary(run.summary, out), _summary_text(run.summary, out))
+
+
+def _interrupted(exc, out: Path | None) -> Result:
+    sys.stderr.write(f"stickslip chain: {exc}; continue with: stickslip chain --resume {out}\n")
+    return Result({"interrupted": True, "t": exc.t, "checkpoint": str(exc.checkpoint)}, "", status=130)
+
+
+def run_bench_command(args: argparse.Namespace) -> Result:
+    """Handler of `stickslip bench`: the same workload with dense and exact, one process."""
+    from stickslip import bench
+
+    check_number("N", args.N, low=1, integer=True)
+    check_number("t-end", args.t_end, low=0.0)
+    check_number("repeat", args.repeat, low=1, integer=True)
+    params = ChainParams(N=args.N, beta=args.beta)
+    result = bench.compare(params, args.t_end, start=args.start, repeat=args.repeat)
+    return Result(result, bench.format_result(result))

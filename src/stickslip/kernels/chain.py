@@ -62,7 +62,9 @@ BAD_BLOCK = 16     # block found non-finite (status NONFINITE)
 BLOCK_UPDATES = 17  # block updates performed (stage 2), for profiling
 STEPS_COMPUTED = 18  # steps actually computed (not jumped over)
 NEXT_SAMPLE = 19   # next step at which L = x_1 - x_N is sampled
-IST_SIZE = 20
+MECH_LO = 20       # blocks that may move in the next step: [MECH_LO, MECH_HI] (exact only)
+MECH_HI = 21
+IST_SIZE = 22
 
 # Indices into the float64 parameter vector ``par``.
 P_K, P_D, P_V, P_BETA, P_ALPHA, P_FS, P_DT = range(7)
@@ -338,7 +340,7 @@ def _stage1(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, K, D, beta, alpha, F
 
     Works on views that begin at block lo - 1, so that every index is provably
     non-negative: the compiler then drops the negative-index handling and vectorises.
-    Returns the first block that moves in this step (hi + 1 if none).
+    Returns the first and the last block that move in this step (lo > hi if none).
     """
     x = x[lo - 1:hi + 2]
     v = v[lo - 1:hi + 2]
@@ -352,11 +354,13 @@ def _stage1(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, K, D, beta, alpha, F
     b1 = b1[lo - 1:hi + 2]
     n = hi - lo + 1
     first = n + 1
+    last = 0
     for j in range(1, n + 1):
         f = _force(x[j - 1], x[j], x[j + 1], K)
         m = 1.0 if f > Fs else mov[j]
         mm[j] = m
         first = min(first, j if m != 0.0 else n + 1)
+        last = max(last, j if m != 0.0 else 0)
         a = _accel(f, th[j], v[j], beta, m)
         b = _dtheta(th[j - 1], th[j], th[j + 1], v[j], alpha, D)
         a1[j] = a
@@ -364,15 +368,65 @@ def _stage1(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, K, D, beta, alpha, F
         xs[j] = x[j] + dt * v[j]
         vs[j] = v[j] + dt * a
         ths[j] = th[j] + dt * b
-    return first + lo - 1
+    return first + lo - 1, last + lo - 1
+
+
+@njit(cache=True, inline="always")
+def _stage1_theta(x, v, th, xs, vs, ths, mm, b1, lo, hi, alpha, D, dt):
+    """Stage 1 for blocks lo..hi known to stay stopped in this step (mid-step mask 0).
+
+    For such a block v = 0 and the acceleration is 0 * (...), so the full stage gives
+    xs = x, vs = v exactly; only the state variable needs its derivative.
+    """
+    x = x[lo - 1:hi + 2]
+    v = v[lo - 1:hi + 2]
+    th = th[lo - 1:hi + 2]
+    xs = xs[lo - 1:hi + 2]
+    vs = vs[lo - 1:hi + 2]
+    ths = ths[lo - 1:hi + 2]
+    mm = mm[lo - 1:hi + 2]
+    b1 = b1[lo - 1:hi + 2]
+    for j in range(1, hi - lo + 2):
+        b = _dtheta(th[j - 1], th[j], th[j + 1], v[j], alpha, D)
+        b1[j] = b
+        xs[j] = x[j] + dt * v[j]
+        vs[j] = v[j]
+        ths[j] = th[j] + dt * b
+        mm[j] = 0.0
+
+
+@njit(cache=True, inline="always")
+def _stage2_theta(th, ths, vs, b1, lo, hi, alpha, D, h2):
+    """Stage 2 and corrector of the state variable alone, for blocks lo..hi that stay stopped.
+
+    Their x, v and stopped flag provably keep every bit (see _stage1_theta). Returns the
+    first and last block whose state variable changed (lo > hi if none).
+    """
+    th = th[lo - 1:hi + 2]
+    ths = ths[lo - 1:hi + 2]
+    vs = vs[lo - 1:hi + 2]
+    b1 = b1[lo - 1:hi + 2]
+    n = hi - lo + 1
+    c_lo = n + 1
+    c_hi = 0
+    for j in range(1, n + 1):
+        b2 = _dtheta(ths[j - 1], ths[j], ths[j + 1], vs[j], alpha, D)
+        tho = th[j]
+        thn = tho + h2 * (b1[j] + b2)
+        th[j] = thn
+        ch = thn != tho
+        c_lo = min(c_lo, j if ch else n + 1)
+        c_hi = max(c_hi, j if ch else 0)
+    return c_lo + lo - 1, c_hi + lo - 1
 
 
 @njit(cache=True, inline="always")
 def _stage2(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, K, D, beta, alpha, h2):
     """Stage 2, corrector and stop rule for blocks lo..hi (branch-free, on views as _stage1).
 
-    Returns the first and last block that changed (lo > hi if none), the number of moving
-    blocks among lo..hi before and after, and the number of non-finite blocks.
+    Returns the first and last block that changed (lo > hi if none), the same for x alone,
+    the number of moving blocks among lo..hi before and after, and the number of
+    non-finite blocks.
     """
     x = x[lo - 1:hi + 2]
     v = v[lo - 1:hi + 2]
@@ -387,6 +441,8 @@ def _stage2(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, K, D, beta, alpha, h
     n = hi - lo + 1
     c_lo = n + 1
     c_hi = 0
+    x_lo = n + 1
+    x_hi = 0
     moved_before = 0
     moved_after = 0
     bad = 0
@@ -412,11 +468,15 @@ def _stage2(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, K, D, beta, alpha, h
         ch = (xn != xo) | (vn != vo) | (thn != tho) | (mn != mo)
         c_lo = min(c_lo, j if ch else n + 1)
         c_hi = max(c_hi, j if ch else 0)
+        xch = xn != xo
+        x_lo = min(x_lo, j if xch else n + 1)
+        x_hi = max(x_hi, j if xch else 0)
         moved_before += 1 if mo != 0.0 else 0
         moved_after += 1 if mn != 0.0 else 0
         ok = (abs(xn) <= _BIG) & (abs(vn) <= _BIG) & (abs(thn) <= _BIG)
         bad += 0 if ok else 1
-    return c_lo + lo - 1, c_hi + lo - 1, moved_before, moved_after, bad
+    return (c_lo + lo - 1, c_hi + lo - 1, x_lo + lo - 1, x_hi + lo - 1, moved_before, moved_after,
+            bad)
 
 
 @njit(cache=True)
@@ -466,16 +526,62 @@ def run_exact(x, v, th, mov, xs, vs, ths, mm, a1, b1, first_step, x0ev, ist, par
             ist[STEP] = _first_trigger(x, N, V, dt, K, Fs, n + 1, target)
             continue
 
+        # Blocks that may move in this step: those that could last step, plus block 1.
+        ml = ist[MECH_LO]
+        mh = ist[MECH_HI]
+        if lo == 1 and (mov[1] != 0.0 or _force(_pull(V, n, dt), x[1], x2, K) > Fs):
+            ml = 1
+            if mh < 1:
+                mh = 1
         _set_ghosts(x, th, N, _pull(V, n, dt))
         l1 = lo - 1 if lo > 1 else 1
         h1 = hi + 1 if hi < N else N
-        first = _stage1(x, v, th, mov, xs, vs, ths, mm, a1, b1, l1, h1, K, D, beta, alpha, Fs, dt)
+        # Stage 1: full over [ml, mh] within [l1, h1], state variable alone elsewhere.
+        fl = ml if ml > l1 else l1
+        fh = mh if mh < h1 else h1
+        first = h1 + 1
+        last = l1 - 1
+        if fl <= fh:
+            first, last = _stage1(x, v, th, mov, xs, vs, ths, mm, a1, b1, fl, fh, K, D, beta, alpha, Fs, dt)
+            if l1 < fl:
+                _stage1_theta(x, v, th, xs, vs, ths, mm, b1, l1, fl - 1, alpha, D, dt)
+            if fh < h1:
+                _stage1_theta(x, v, th, xs, vs, ths, mm, b1, fh + 1, h1, alpha, D, dt)
+        else:
+            _stage1_theta(x, v, th, xs, vs, ths, mm, b1, l1, h1, alpha, D, dt)
         _set_ghosts(xs, ths, N, _pull(V, n + 1, dt))
-        if ist[EV_ACTIVE] == 1 or (ist[N_MOVING] == 0 and first <= h1):
+        if ist[EV_ACTIVE] == 1 or (ist[N_MOVING] == 0 and first <= last):
             _start_and_first_moves(n, lo, hi, x, mm, first_step, x0ev, ist, prof_x, prof_meta, N,
                                    profile_every)
-        c_lo, c_hi, moved_before, moved_after, bad = _stage2(
-            x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, K, D, beta, alpha, h2)
+        # Stage 2: full over the blocks that move, state variable alone elsewhere.
+        sl = first if first > lo else lo
+        sh = last if last < hi else hi
+        c_lo = hi + 1
+        c_hi = lo - 1
+        x_lo = hi + 1
+        x_hi = lo - 1
+        moved_before = 0
+        moved_after = 0
+        bad = 0
+        if sl <= sh:
+            c_lo, c_hi, x_lo, x_hi, moved_before, moved_after, bad = _stage2(
+                x, v, th, mov, xs, vs, ths, mm, a1, b1, sl, sh, K, D, beta, alpha, h2)
+            if lo < sl:
+                t_lo, t_hi = _stage2_theta(th, ths, vs, b1, lo, sl - 1, alpha, D, h2)
+                c_lo = min(c_lo, t_lo)
+                c_hi = max(c_hi, t_hi)
+            if sh < hi:
+                t_lo, t_hi = _stage2_theta(th, ths, vs, b1, sh + 1, hi, alpha, D, h2)
+                c_lo = min(c_lo, t_lo)
+                c_hi = max(c_hi, t_hi)
+        else:
+            c_lo, c_hi = _stage2_theta(th, ths, vs, b1, lo, hi, alpha, D, h2)
+        # Next step's movers: this step's, and neighbours of blocks whose x changed.
+        if x_lo <= x_hi:
+            first = min(first, x_lo - 1 if x_lo > 1 else 1)
+            last = max(last, x_hi + 1 if x_hi < N else N)
+        ist[MECH_LO] = first
+        ist[MECH_HI] = last
         n_moving = ist[N_MOVING] + moved_after - moved_before
         ist[N_MOVING] = n_moving
         ist[BLOCK_UPDATES] += hi - lo + 1
