@@ -166,6 +166,26 @@ def initial_state(p: ChainParams, start: str = "paper", *, amplitude: float = 0.
     raise ParameterError(f"start must be one of {', '.join(STARTS)} (got {start!r})")
 
 
+def steady_deviation(state: ChainState, p: ChainParams) -> float:
+    """Distance of a state from steady sliding of the chain (MODEL.md), in the frame moving with V.
+
+    The largest of |v_i - V|, |theta_i - theta_0| and |e_i - e_i^ss| over all blocks, where
+    e_i = x_{i-1} - x_i are the spring extensions (x_0 = V t_n) and e_i^ss = (c/K)(N - i + 1)
+    those of steady sliding. Infinite unless every block is moving.
+    """
+    if np.any(state.mov[1:-1] == 0.0):
+        return float("inf")
+    ss = physics.chain_steady_state(p)
+    x = state.x[1:-1]
+    x0 = p.V * (np.float64(state.step) * p.dt)
+    ext = np.diff(np.concatenate(([x0], x))) * -1.0
+    return float(max(
+        np.max(np.abs(state.v[1:-1] - ss["v"])),
+        np.max(np.abs(state.th[1:-1] - ss["theta"])),
+        np.max(np.abs(ext - ss["ext"])),
+    ))
+
+
 # --------------------------------------------------------------------------------------
 # Options and results
 
@@ -178,7 +198,9 @@ class RunOptions:
     average_from: <L> is the mean of the samples with t >= average_from (default t_end / 2);
     snapshot_times: times at which all x_i are stored (Fig. 5a); the final state is always kept;
     profile_window: if set, x_i is stored every this long during each event, for the
-    displacement over windows of Fig. 6, for events with >= profile_min_blocks moved blocks.
+    displacement over windows of Fig. 6, for events with >= profile_min_blocks moved blocks;
+    until_steady: if set, the run stops at the first sampling time at which every block slides
+    and the state is within this tolerance of steady sliding (:func:`steady_deviation`).
     """
 
     t_end: float
@@ -187,6 +209,7 @@ class RunOptions:
     snapshot_times: tuple[float, ...] = ()
     profile_window: float | None = None
     profile_min_blocks: int = 0
+    until_steady: float | None = None
 
     def validated(self, dt: float) -> "RunOptions":
         check_number("t_end", self.t_end, low=0.0)
@@ -202,6 +225,8 @@ class RunOptions:
             if round(self.profile_window / dt) < 1:
                 raise ParameterError(f"profile_window must be >= dt = {dt:g} (got {self.profile_window!r})")
         check_number("profile_min_blocks", self.profile_min_blocks, low=0, integer=True)
+        if self.until_steady is not None:
+            check_number("until_steady", self.until_steady, low=0.0, low_open=True)
         return self
 
     def to_dict(self) -> dict[str, Any]:
@@ -212,6 +237,7 @@ class RunOptions:
             "snapshot_times": list(self.snapshot_times),
             "profile_window": self.profile_window,
             "profile_min_blocks": self.profile_min_blocks,
+            "until_steady": self.until_steady,
         }
 
     @classmethod
@@ -503,6 +529,7 @@ def run_chain(
     snapshot_times: Sequence[float] = (),
     profile_window: float | None = None,
     profile_min_blocks: int = 0,
+    until_steady: float | None = None,
     out_dir: str | Path | None = None,
     checkpoint_interval: float | None = None,
     progress: bool = False,
@@ -513,6 +540,8 @@ def run_chain(
     ``integrator`` is 'exact' (default) or 'dense'; both give the same result bit for bit.
     ``start`` is 'paper' (x = 0, v = 0.1, theta = 0.1, all moving), 'steady' (exact steady
     sliding, optionally perturbed by ``perturbation`` with ``seed``) or a :class:`ChainState`.
+    With ``until_steady`` = TOL the run stops at the first sampling time at which every block
+    slides within TOL of steady sliding; L is then taken from the steady solution up to t_end.
     With ``out_dir``, checkpoints are written there every ``checkpoint_interval`` wall-clock
     seconds and on SIGINT/SIGTERM (``handle_signals``), and the results at the end.
     """
@@ -525,6 +554,7 @@ def run_chain(
         snapshot_times=tuple(float(t) for t in snapshot_times),
         profile_window=profile_window,
         profile_min_blocks=int(profile_min_blocks),
+        until_steady=until_steady,
     ).validated(params.dt)
     if checkpoint_interval is not None:
         check_number("checkpoint_interval", checkpoint_interval, low=0.0, low_open=True)
@@ -595,6 +625,7 @@ def _drive(params, options, integrator, start_info, state, outputs, *, out_dir, 
     profile_every = int(round(options.profile_window / params.dt)) if options.profile_window else 0
     stops = sorted({steps_for(t, params.dt) for t in options.snapshot_times} | {n_end})
     done_snaps = set(int(s) for a in outputs.parts["snap_step"] for s in a)
+    steady_at: dict[str, float] = {}
     header = {
         "params": params.to_dict(), "options": options.to_dict(), "integrator": integrator,
         "start": start_info,
@@ -612,7 +643,15 @@ def _drive(params, options, integrator, start_info, state, outputs, *, out_dir, 
                 if n in stops and n not in done_snaps and n != n_end:
                     outputs.add_snapshot(n, state.x)
                     done_snaps.add(n)
+                if options.until_steady is not None and n % sample_every == 0:
+                    dev = steady_deviation(state, params)
+                    if dev <= options.until_steady:
+                        steady_at = {"t_steady": n * params.dt, "deviation": dev}
+                        break
                 next_stop = min((s for s in stops if s > n), default=n_end)
+                if options.until_steady is not None:
+                    # Check on a fixed grid of steps, so the stop does not depend on timing.
+                    next_stop = min(next_stop, (n // sample_every + 1) * sample_every)
                 if n >= n_end:
                     # One more call services outputs due at the final step (its sample).
                     status = kernel(state.x, state.v, state.th, state.mov, *scratch, state.first_step,
@@ -653,7 +692,7 @@ def _drive(params, options, integrator, start_info, state, outputs, *, out_dir, 
             bar.close()
     outputs.flush(state.ist)
     wall = wall_before + time.perf_counter() - t0
-    run = _assemble(params, options, integrator, start_info, state, outputs, wall)
+    run = _assemble(params, options, integrator, start_info, state, outputs, wall, steady_at)
     if out_dir is not None:
         if checkpointer is not None:
             checkpointer.write(state, outputs, dict(header, wall_seconds=wall))
@@ -665,7 +704,7 @@ def _drive(params, options, integrator, start_info, state, outputs, *, out_dir, 
 # Results
 
 
-def _assemble(params, options, integrator, start_info, state, outputs, wall) -> ChainRun:
+def _assemble(params, options, integrator, start_info, state, outputs, wall, steady_at=None) -> ChainRun:
     dt = params.dt
     parts = outputs.all()
     ev = parts["ev_int"]
@@ -701,7 +740,28 @@ def _assemble(params, options, integrator, start_info, state, outputs, wall) -> 
     L_final = float(state.x[1] - state.x[-2])
     avg_from = options.average_from if options.average_from is not None else options.t_end / 2
     sel = t_samples >= avg_from - 0.5 * dt
-    L_mean = float(np.mean(parts["samp_L"][sel])) if np.any(sel) else float("nan")
+    L_values = parts["samp_L"][sel]
+    early: dict[str, Any] = {"stopped_early": False}
+    if steady_at:
+        # From the stop on, the chain is taken to slide steadily: L = L_ss at the remaining samples.
+        L_ss = physics.chain_steady_length(params)
+        sample_every = int(round(options.sample_interval / dt))
+        n_end = steps_for(options.t_end, dt)
+        later = np.arange((state.step // sample_every + 1) * sample_every, n_end + 1, sample_every) * dt
+        n_virtual = int(np.count_nonzero(later >= avg_from - 0.5 * dt))
+        L_values = np.concatenate([L_values, np.full(n_virtual, L_ss)])
+        L_final = L_ss
+        early = {
+            "stopped_early": True,
+            "reason": (f"steady sliding reached at t = {steady_at['t_steady']:g}: every block slides "
+                       f"within {options.until_steady:g} of the steady state (deviation "
+                       f"{steady_at['deviation']:.3g}); L taken from the steady solution from then on"),
+            "t_steady": steady_at["t_steady"],
+            "steady_deviation": steady_at["deviation"],
+            "until_steady": options.until_steady,
+            "L_final_simulated": float(state.x[1] - state.x[-2]),
+        }
+    L_mean = float(np.mean(L_values)) if len(L_values) else float("nan")
     summary = {
         "n_events": int(len(events)),
         "event_in_progress": bool(state.ist[K.EV_ACTIVE]),
@@ -709,7 +769,8 @@ def _assemble(params, options, integrator, start_info, state, outputs, wall) -> 
         "L_mean": L_mean,
         "L_mean_from": avg_from,
         "L_steady": physics.chain_steady_length(params),
-        "t_end": state.step * dt,
+        "t_end": options.t_end if steady_at else state.step * dt,
+        "t_reached": state.step * dt,
         "steps": state.step,
         "steps_computed": int(state.ist[K.STEPS_COMPUTED]),
         "block_updates": int(state.ist[K.BLOCK_UPDATES]),
@@ -717,6 +778,7 @@ def _assemble(params, options, integrator, start_info, state, outputs, wall) -> 
         "wall_seconds": wall,
         "integrator": integrator,
         "state_sha256": state.sha256(),
+        **early,
     }
     return ChainRun(params, options, integrator, start_info, state, events, first_move, samples,
                     snapshots, profiles, summary)

@@ -44,6 +44,9 @@ def register(sub) -> None:
                    help="store the displacement over windows of W during events (Fig. 6 uses 20)")
     p.add_argument("--profile-min-blocks", type=int, default=0, metavar="M",
                    help="keep profiles only of events with at least M moved blocks")
+    p.add_argument("--until-steady", type=float_arg("until-steady"), default=None, metavar="TOL",
+                   help="stop once every block slides within TOL of steady sliding (velocities, state "
+                        "variables, spring extensions); L is taken from the steady solution from then on")
     p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     add_json_option(p)
     p.set_defaults(handler=run_chain_command)
@@ -83,6 +86,8 @@ def _summary_text(summary: dict, out: Path | None) -> str:
         f"wall time      {summary['wall_seconds']:.3g} s",
         f"state sha256   {summary['state_sha256']}",
     ]
+    if summary.get("stopped_early"):
+        lines.append(f"stopped early  {summary['reason']}")
     if out is not None:
         lines.append(f"written to     {out}")
     return "\n".join(lines)
@@ -122,7 +127,8 @@ def run_chain_command(args: argparse.Namespace) -> Result:
     # Validate every option before anything is written.
     chain.RunOptions(t_end=t_end, sample_interval=args.sample_interval, average_from=args.average_from,
                      snapshot_times=tuple(args.snapshot), profile_window=args.profile_window,
-                     profile_min_blocks=args.profile_min_blocks).validated(params.dt)
+                     profile_min_blocks=args.profile_min_blocks,
+                     until_steady=args.until_steady).validated(params.dt)
     check_number("perturbation", args.perturbation, low=0.0)
     out = prepare_out_dir(args.out)
     if out is not None and (out / "checkpoint" / "state.npz").exists():
@@ -132,7 +138,7 @@ def run_chain_command(args: argparse.Namespace) -> Result:
             params, t_end, integrator=args.integrator, start=args.start, perturbation=args.perturbation,
             seed=args.seed, sample_interval=args.sample_interval, average_from=args.average_from,
             snapshot_times=args.snapshot, profile_window=args.profile_window,
-            profile_min_blocks=args.profile_min_blocks, out_dir=out,
+            profile_min_blocks=args.profile_min_blocks, until_steady=args.until_steady, out_dir=out,
             checkpoint_interval=args.checkpoint_interval if out else None, progress=progress,
             handle_signals=out is not None,
         )
