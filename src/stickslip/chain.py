@@ -504,6 +504,10 @@ def _in_main_thread() -> bool:
     return threading.current_thread() is threading.main_thread()
 
 
+def _finite(state: ChainState) -> bool:
+    return bool(np.isfinite(state.x).all() and np.isfinite(state.v).all() and np.isfinite(state.th).all())
+
+
 def _par(p: ChainParams) -> np.ndarray:
     par = np.zeros(K.PAR_SIZE)
     par[K.P_K], par[K.P_D], par[K.P_V] = p.K, p.D, p.V
@@ -662,11 +666,19 @@ def _drive(params, options, integrator, start_info, state, outputs, *, out_dir, 
                         continue
                     break
                 target = min(next_stop, n + chunk)
+                before = state.copy() if integrator == "exact" else None
                 c0 = time.perf_counter()
                 status = kernel(state.x, state.v, state.th, state.mov, *scratch, state.first_step,
                                 state.x0ev, state.ist, par, *outputs.kernel_args(), target,
                                 sample_every, profile_every, options.profile_min_blocks)
                 elapsed = time.perf_counter() - c0
+                if before is not None and not _finite(state):
+                    # The fast kernel does not look for non-finite values; replay this call
+                    # with the reference, which follows the same arithmetic and checks each step.
+                    state = before
+                    status = K.run_dense(state.x, state.v, state.th, state.mov, *scratch, state.first_step,
+                                         state.x0ev, state.ist, par, *outputs.kernel_args(), target,
+                                         sample_every, profile_every, options.profile_min_blocks)
                 if status == K.NONFINITE:
                     bad = int(state.ist[K.BAD_BLOCK])
                     raise ChainRunError(
@@ -774,6 +786,7 @@ def _assemble(params, options, integrator, start_info, state, outputs, wall, ste
         "steps": state.step,
         "steps_computed": int(state.ist[K.STEPS_COMPUTED]),
         "block_updates": int(state.ist[K.BLOCK_UPDATES]),
+        "full_block_updates": int(state.ist[K.FULL_UPDATES]) if integrator == "exact" else int(state.ist[K.BLOCK_UPDATES]),
         "n_moving": int(state.ist[K.N_MOVING]),
         "wall_seconds": wall,
         "integrator": integrator,

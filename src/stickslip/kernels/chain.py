@@ -64,7 +64,8 @@ STEPS_COMPUTED = 18  # steps actually computed (not jumped over)
 NEXT_SAMPLE = 19   # next step at which L = x_1 - x_N is sampled
 MECH_LO = 20       # blocks that may move in the next step: [MECH_LO, MECH_HI] (exact only)
 MECH_HI = 21
-IST_SIZE = 22
+FULL_UPDATES = 22  # block updates of exact that were full (the rest updated the state variable alone)
+IST_SIZE = 23
 
 # Indices into the float64 parameter vector ``par``.
 P_K, P_D, P_V, P_BETA, P_ALPHA, P_FS, P_DT = range(7)
@@ -229,14 +230,6 @@ def _set_ghosts(x, th, N, xp):
 
 
 @njit(cache=True)
-def _first_bad(x, v, th, N):
-    for i in range(1, N + 1):
-        if not (abs(x[i]) <= _BIG and abs(v[i]) <= _BIG and abs(th[i]) <= _BIG):
-            return i
-    return 0
-
-
-@njit(cache=True)
 def run_dense(x, v, th, mov, xs, vs, ths, mm, a1, b1, first_step, x0ev, ist, par,
               ev_int, ev_S, fm, samp_L, samp_step, prof_x, prof_meta,
               n_end, sample_every, profile_every, profile_min_blocks):
@@ -340,7 +333,8 @@ def _stage1(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, K, D, beta, alpha, F
 
     Works on views that begin at block lo - 1, so that every index is provably
     non-negative: the compiler then drops the negative-index handling and vectorises.
-    Returns the first and the last block that move in this step (lo > hi if none).
+    Returns the first and the last block that move in this step (lo > hi if none) and
+    whether a stopped block starts.
     """
     x = x[lo - 1:hi + 2]
     v = v[lo - 1:hi + 2]
@@ -355,12 +349,15 @@ def _stage1(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, K, D, beta, alpha, F
     n = hi - lo + 1
     first = n + 1
     last = 0
+    starts = False
     for j in range(1, n + 1):
         f = _force(x[j - 1], x[j], x[j + 1], K)
-        m = 1.0 if f > Fs else mov[j]
+        mo = mov[j]
+        m = 1.0 if f > Fs else mo
         mm[j] = m
         first = min(first, j if m != 0.0 else n + 1)
         last = max(last, j if m != 0.0 else 0)
+        starts |= m != mo
         a = _accel(f, th[j], v[j], beta, m)
         b = _dtheta(th[j - 1], th[j], th[j + 1], v[j], alpha, D)
         a1[j] = a
@@ -368,7 +365,44 @@ def _stage1(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, K, D, beta, alpha, F
         xs[j] = x[j] + dt * v[j]
         vs[j] = v[j] + dt * a
         ths[j] = th[j] + dt * b
-    return first + lo - 1, last + lo - 1
+    return first + lo - 1, last + lo - 1, starts
+
+
+@njit(cache=True, inline="always")
+def _stage1_all(x, v, th, xs, vs, ths, mm, a1, b1, N, K, D, beta, alpha, dt):
+    """Stage 1 over the whole chain when every block moves: no start can happen, mm = 1."""
+    for i in range(1, N + 1):
+        f = _force(x[i - 1], x[i], x[i + 1], K)
+        a = _accel(f, th[i], v[i], beta, 1.0)
+        b = _dtheta(th[i - 1], th[i], th[i + 1], v[i], alpha, D)
+        mm[i] = 1.0
+        a1[i] = a
+        b1[i] = b
+        xs[i] = x[i] + dt * v[i]
+        vs[i] = v[i] + dt * a
+        ths[i] = th[i] + dt * b
+
+
+@njit(cache=True, inline="always")
+def _stage2_all(x, v, th, mov, xs, vs, ths, a1, b1, N, K, D, beta, alpha, h2):
+    """Stage 2, corrector and stop rule over the whole chain when every block moves.
+
+    Skips the bookkeeping of changes (every block is kept active) and returns only whether
+    some block stopped, in which case the caller recounts the moving blocks.
+    """
+    stops = False
+    for i in range(1, N + 1):
+        f2 = _force(xs[i - 1], xs[i], xs[i + 1], K)
+        a2 = _accel(f2, ths[i], vs[i], beta, 1.0)
+        b2 = _dtheta(ths[i - 1], ths[i], ths[i + 1], vs[i], alpha, D)
+        x[i] = x[i] + h2 * (v[i] + vs[i])
+        vn = v[i] + h2 * (a1[i] + a2)
+        th[i] = th[i] + h2 * (b1[i] + b2)
+        keep = vn > 0.0
+        v[i] = vn if keep else 0.0
+        mov[i] = 1.0 if keep else 0.0
+        stops |= not keep
+    return stops
 
 
 @njit(cache=True, inline="always")
@@ -424,9 +458,8 @@ def _stage2_theta(th, ths, vs, b1, lo, hi, alpha, D, h2):
 def _stage2(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, K, D, beta, alpha, h2):
     """Stage 2, corrector and stop rule for blocks lo..hi (branch-free, on views as _stage1).
 
-    Returns the first and last block that changed (lo > hi if none), the same for x alone,
-    the number of moving blocks among lo..hi before and after, and the number of
-    non-finite blocks.
+    Returns the first and last block that changed (lo > hi if none) and the number of
+    moving blocks among lo..hi before and after.
     """
     x = x[lo - 1:hi + 2]
     v = v[lo - 1:hi + 2]
@@ -441,11 +474,8 @@ def _stage2(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, K, D, beta, alpha, h
     n = hi - lo + 1
     c_lo = n + 1
     c_hi = 0
-    x_lo = n + 1
-    x_hi = 0
     moved_before = 0
     moved_after = 0
-    bad = 0
     for j in range(1, n + 1):
         m = mm[j]
         f2 = _force(xs[j - 1], xs[j], xs[j + 1], K)
@@ -468,15 +498,9 @@ def _stage2(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, K, D, beta, alpha, h
         ch = (xn != xo) | (vn != vo) | (thn != tho) | (mn != mo)
         c_lo = min(c_lo, j if ch else n + 1)
         c_hi = max(c_hi, j if ch else 0)
-        xch = xn != xo
-        x_lo = min(x_lo, j if xch else n + 1)
-        x_hi = max(x_hi, j if xch else 0)
         moved_before += 1 if mo != 0.0 else 0
         moved_after += 1 if mn != 0.0 else 0
-        ok = (abs(xn) <= _BIG) & (abs(vn) <= _BIG) & (abs(thn) <= _BIG)
-        bad += 0 if ok else 1
-    return (c_lo + lo - 1, c_hi + lo - 1, x_lo + lo - 1, x_hi + lo - 1, moved_before, moved_after,
-            bad)
+    return c_lo + lo - 1, c_hi + lo - 1, moved_before, moved_after
 
 
 @njit(cache=True)
@@ -487,7 +511,9 @@ def run_exact(x, v, th, mov, xs, vs, ths, mm, a1, b1, first_step, x0ev, ist, par
 
     Updates only the blocks that can change (see the module docstring), in branch-free
     loops over one contiguous interval, and jumps over steps in which nothing can change.
-    Same arguments, state layout and status codes as :func:`run_dense`.
+    Same arguments, state layout and status codes as :func:`run_dense`, except that it does
+    not look for non-finite values: the driver checks the state after each call and replays
+    the call with :func:`run_dense`, which does, to name the step and the block.
     """
     N = x.shape[0] - 2
     K = par[P_K]
@@ -526,6 +552,31 @@ def run_exact(x, v, th, mov, xs, vs, ths, mm, a1, b1, first_step, x0ev, ist, par
             ist[STEP] = _first_trigger(x, N, V, dt, K, Fs, n + 1, target)
             continue
 
+        if ist[N_MOVING] == N and lo == 1 and hi == N:
+            # Every block slides: no start, no first move, nothing to track but stops.
+            _set_ghosts(x, th, N, _pull(V, n, dt))
+            _stage1_all(x, v, th, xs, vs, ths, mm, a1, b1, N, K, D, beta, alpha, dt)
+            _set_ghosts(xs, ths, N, _pull(V, n + 1, dt))
+            stops = _stage2_all(x, v, th, mov, xs, vs, ths, a1, b1, N, K, D, beta, alpha, h2)
+            ist[BLOCK_UPDATES] += N
+            ist[FULL_UPDATES] += N
+            ist[STEPS_COMPUTED] += 1
+            ist[STEP] = n + 1
+            # Every block changed: all stay candidates for the next step.
+            ist[ACT_LO] = 1
+            ist[ACT_HI] = N
+            ist[MECH_LO] = 1
+            ist[MECH_HI] = N
+            if stops:
+                n_moving = 0
+                for i in range(1, N + 1):
+                    n_moving += 1 if mov[i] != 0.0 else 0
+                ist[N_MOVING] = n_moving
+                if ist[EV_ACTIVE] == 1 and n_moving == 0:
+                    _end_event(n, x, first_step, x0ev, ist, ev_int, ev_S, fm, prof_x, prof_meta, N,
+                               profile_every, profile_min_blocks)
+            continue
+
         # Blocks that may move in this step: those that could last step, plus block 1.
         ml = ist[MECH_LO]
         mh = ist[MECH_HI]
@@ -541,8 +592,10 @@ def run_exact(x, v, th, mov, xs, vs, ths, mm, a1, b1, first_step, x0ev, ist, par
         fh = mh if mh < h1 else h1
         first = h1 + 1
         last = l1 - 1
+        starts = False
         if fl <= fh:
-            first, last = _stage1(x, v, th, mov, xs, vs, ths, mm, a1, b1, fl, fh, K, D, beta, alpha, Fs, dt)
+            first, last, starts = _stage1(x, v, th, mov, xs, vs, ths, mm, a1, b1, fl, fh, K, D, beta, alpha,
+                                          Fs, dt)
             if l1 < fl:
                 _stage1_theta(x, v, th, xs, vs, ths, mm, b1, l1, fl - 1, alpha, D, dt)
             if fh < h1:
@@ -550,22 +603,21 @@ def run_exact(x, v, th, mov, xs, vs, ths, mm, a1, b1, first_step, x0ev, ist, par
         else:
             _stage1_theta(x, v, th, xs, vs, ths, mm, b1, l1, h1, alpha, D, dt)
         _set_ghosts(xs, ths, N, _pull(V, n + 1, dt))
-        if ist[EV_ACTIVE] == 1 or (ist[N_MOVING] == 0 and first <= last):
-            _start_and_first_moves(n, lo, hi, x, mm, first_step, x0ev, ist, prof_x, prof_meta, N,
-                                   profile_every)
+        # Only a block that starts in this step can move for the first time in an event.
+        if (ist[EV_ACTIVE] == 1 and starts) or (ist[N_MOVING] == 0 and first <= last):
+            _start_and_first_moves(n, max(first, lo), min(last, hi), x, mm, first_step, x0ev, ist,
+                                   prof_x, prof_meta, N, profile_every)
         # Stage 2: full over the blocks that move, state variable alone elsewhere.
         sl = first if first > lo else lo
         sh = last if last < hi else hi
         c_lo = hi + 1
         c_hi = lo - 1
-        x_lo = hi + 1
-        x_hi = lo - 1
         moved_before = 0
         moved_after = 0
-        bad = 0
         if sl <= sh:
-            c_lo, c_hi, x_lo, x_hi, moved_before, moved_after, bad = _stage2(
+            c_lo, c_hi, moved_before, moved_after = _stage2(
                 x, v, th, mov, xs, vs, ths, mm, a1, b1, sl, sh, K, D, beta, alpha, h2)
+            ist[FULL_UPDATES] += sh - sl + 1
             if lo < sl:
                 t_lo, t_hi = _stage2_theta(th, ths, vs, b1, lo, sl - 1, alpha, D, h2)
                 c_lo = min(c_lo, t_lo)
@@ -576,20 +628,19 @@ def run_exact(x, v, th, mov, xs, vs, ths, mm, a1, b1, first_step, x0ev, ist, par
                 c_hi = max(c_hi, t_hi)
         else:
             c_lo, c_hi = _stage2_theta(th, ths, vs, b1, lo, hi, alpha, D, h2)
-        # Next step's movers: this step's, and neighbours of blocks whose x changed.
-        if x_lo <= x_hi:
-            first = min(first, x_lo - 1 if x_lo > 1 else 1)
-            last = max(last, x_hi + 1 if x_hi < N else N)
-        ist[MECH_LO] = first
-        ist[MECH_HI] = last
+        # Next step's movers: a stopped block starts only if its force changed, that is if a
+        # neighbour's x changed, and only moving blocks change x. So: this step's movers +- 1.
+        if first <= last:
+            ist[MECH_LO] = first - 1 if first > 1 else 1
+            ist[MECH_HI] = last + 1 if last < N else N
+        else:
+            ist[MECH_LO] = 1
+            ist[MECH_HI] = 0
         n_moving = ist[N_MOVING] + moved_after - moved_before
         ist[N_MOVING] = n_moving
         ist[BLOCK_UPDATES] += hi - lo + 1
         ist[STEPS_COMPUTED] += 1
         ist[STEP] = n + 1
-        if bad > 0:
-            ist[BAD_BLOCK] = _first_bad(x, v, th, N)
-            return NONFINITE
         if c_lo <= c_hi:
             ist[ACT_LO] = c_lo - 2 if c_lo > 2 else 1
             ist[ACT_HI] = c_hi + 2 if c_hi < N - 2 else N
