@@ -82,6 +82,7 @@ FIRST_MOVES_FULL = 2
 SAMPLES_FULL = 3
 PROFILES_FULL = 4
 NONFINITE = 5
+GO = -1  # internal: nothing stops the next step
 
 _BIG = np.float64(1.7976931348623157e308)
 
@@ -136,14 +137,31 @@ def _service(n, x, N, ist, samp_L, samp_step, prof_x, prof_meta, sample_every, p
 
 @njit(cache=True, inline="always")
 def _capacity(N, ist, ev_int, fm, prof_x, profile_every):
-    """Return a status if a buffer could overflow in the next step, else DONE."""
+    """Return a status if a buffer could overflow in the next step, else GO."""
     if ist[EV_COUNT] >= ev_int.shape[0]:
         return EVENTS_FULL
     if ist[FM_COUNT] + N > fm.shape[0]:
         return FIRST_MOVES_FULL
     if profile_every > 0 and ist[P_COUNT] + 2 > prof_x.shape[0]:
         return PROFILES_FULL
-    return DONE
+    return GO
+
+
+@njit(cache=True, inline="always")
+def _unpack(par):
+    return par[P_K], par[P_D], par[P_V], par[P_BETA], par[P_ALPHA], par[P_FS], par[P_DT]
+
+
+@njit(cache=True, inline="always")
+def _before_step(n, n_end, x, N, ist, ev_int, fm, samp_L, samp_step, prof_x, prof_meta,
+                 sample_every, profile_every):
+    """Outputs due at step n; then DONE at n_end, a status if a buffer could overflow, else GO."""
+    st = _service(n, x, N, ist, samp_L, samp_step, prof_x, prof_meta, sample_every, profile_every)
+    if st != DONE:
+        return st
+    if n >= n_end:
+        return DONE
+    return _capacity(N, ist, ev_int, fm, prof_x, profile_every)
 
 
 @njit(cache=True)
@@ -239,24 +257,13 @@ def run_dense(x, v, th, mov, xs, vs, ths, mm, a1, b1, first_step, x0ev, ist, par
     status code (module constants). See the module docstring for the step and the events.
     """
     N = x.shape[0] - 2
-    K = par[P_K]
-    D = par[P_D]
-    V = par[P_V]
-    beta = par[P_BETA]
-    alpha = par[P_ALPHA]
-    Fs = par[P_FS]
-    dt = par[P_DT]
+    K, D, V, beta, alpha, Fs, dt = _unpack(par)
     h2 = 0.5 * dt
     while True:
         n = ist[STEP]
-        st = _service(n, x, N, ist, samp_L, samp_step, prof_x, prof_meta, sample_every,
-                      profile_every)
-        if st != DONE:
-            return st
-        if n >= n_end:
-            return DONE
-        st = _capacity(N, ist, ev_int, fm, prof_x, profile_every)
-        if st != DONE:
+        st = _before_step(n, n_end, x, N, ist, ev_int, fm, samp_L, samp_step, prof_x, prof_meta,
+                          sample_every, profile_every)
+        if st != GO:
             return st
         _set_ghosts(x, th, N, _pull(V, n, dt))
         for i in range(1, N + 1):
@@ -516,24 +523,13 @@ def run_exact(x, v, th, mov, xs, vs, ths, mm, a1, b1, first_step, x0ev, ist, par
     the call with :func:`run_dense`, which does, to name the step and the block.
     """
     N = x.shape[0] - 2
-    K = par[P_K]
-    D = par[P_D]
-    V = par[P_V]
-    beta = par[P_BETA]
-    alpha = par[P_ALPHA]
-    Fs = par[P_FS]
-    dt = par[P_DT]
+    K, D, V, beta, alpha, Fs, dt = _unpack(par)
     h2 = 0.5 * dt
     while True:
         n = ist[STEP]
-        st = _service(n, x, N, ist, samp_L, samp_step, prof_x, prof_meta, sample_every,
-                      profile_every)
-        if st != DONE:
-            return st
-        if n >= n_end:
-            return DONE
-        st = _capacity(N, ist, ev_int, fm, prof_x, profile_every)
-        if st != DONE:
+        st = _before_step(n, n_end, x, N, ist, ev_int, fm, samp_L, samp_step, prof_x, prof_meta,
+                          sample_every, profile_every)
+        if st != GO:
             return st
         lo = ist[ACT_LO]
         hi = ist[ACT_HI]
