@@ -42,13 +42,18 @@ from stickslip.params import ChainParams, ParameterError, check_number, steps_fo
 
 INTEGRATORS = ("exact", "dense")
 STARTS = ("paper", "steady")
-CHECKPOINT_FORMAT = 1
+# Bump whenever the layout of the state arrays (kernels.chain.IST_SIZE included) changes.
+CHECKPOINT_FORMAT = 2
 
 _KERNELS = {"dense": K.run_dense, "exact": K.run_exact}
 
 
 class ChainRunError(RuntimeError):
     """A chain run cannot go on (non-finite state, bad checkpoint)."""
+
+
+class NonFiniteState(ChainRunError):
+    """The state of the chain became non-finite; the message names the time and the block."""
 
 
 class Interrupted(Exception):
@@ -386,6 +391,26 @@ def _read_npz(path: Path) -> tuple[dict[str, np.ndarray], dict[str, Any], str]:
     return arrays, header, stored
 
 
+def _check_layout(arrays: dict[str, np.ndarray], header: dict[str, Any]) -> None:
+    """Refuse state arrays that do not fit the header's N or this version's layout."""
+    try:
+        N = int(header["params"]["N"])
+    except (KeyError, TypeError, ValueError):
+        raise ChainRunError("checkpoint header has no valid N") from None
+    expected = {
+        "x": (np.float64, (N + 2,)), "v": (np.float64, (N + 2,)), "th": (np.float64, (N + 2,)),
+        "mov": (np.float64, (N + 2,)), "x0ev": (np.float64, (N + 2,)),
+        "first_step": (np.int64, (N + 2,)), "ist": (np.int64, (K.IST_SIZE,)),
+    }
+    for name, (dtype, shape) in expected.items():
+        a = arrays[name]
+        if a.dtype != dtype or a.shape != shape:
+            raise ChainRunError(
+                f"checkpoint array {name} has shape {a.shape} and type {a.dtype}, "
+                f"expected {shape} and {np.dtype(dtype)} for N = {N}"
+            )
+
+
 class Checkpointer:
     """Checkpoints of one run directory: ``checkpoint/state.npz`` plus append-only output parts.
 
@@ -411,7 +436,8 @@ class Checkpointer:
         digest = _write_npz(self.dir / name, new, {"format": CHECKPOINT_FORMAT})
         self.parts.append({"file": name, "sha256": digest})
         arrays = {k: getattr(state, k) for k in ChainState.ARRAYS}
-        full_header = dict(header, format=CHECKPOINT_FORMAT, parts=self.parts, version=__version__)
+        full_header = dict(header, format=CHECKPOINT_FORMAT, parts=self.parts, version=__version__,
+                           ist_size=K.IST_SIZE)
         _write_npz(self.state_path, arrays, full_header)
         return self.state_path
 
@@ -426,6 +452,7 @@ class Checkpointer:
         missing = [k for k in ChainState.ARRAYS if k not in arrays]
         if missing:
             raise ChainRunError(f"checkpoint is missing arrays {missing}")
+        _check_layout(arrays, header)
         state = ChainState(**{k: arrays[k].copy() for k in ChainState.ARRAYS})
         parts: dict[str, list[np.ndarray]] = {k: [] for k in PART_KEYS}
         listed = header.get("parts", [])
@@ -440,6 +467,8 @@ class Checkpointer:
         for stray in self.dir.glob("part-*.npz"):
             if stray.name not in keep:
                 stray.unlink()
+        for tmp in self.dir.glob(".*.tmp"):  # left by a write that was killed
+            tmp.unlink()
         self.parts = list(listed)
         return state, header, parts
 
@@ -681,7 +710,7 @@ def _drive(params, options, integrator, start_info, state, outputs, *, out_dir, 
                                          sample_every, profile_every, options.profile_min_blocks)
                 if status == K.NONFINITE:
                     bad = int(state.ist[K.BAD_BLOCK])
-                    raise ChainRunError(
+                    raise NonFiniteState(
                         f"state became non-finite at t = {state.step * params.dt:.6g} (step {state.step}) "
                         f"in block {bad}"
                     )

@@ -28,21 +28,21 @@ def register(sub) -> None:
     )
     add_param_options(p, ChainParams)
     _add_run_options(p)
-    p.add_argument("--integrator", choices=("exact", "dense"), default="exact",
+    p.add_argument("--integrator", choices=("exact", "dense"), default=None,
                    help="exact (default, fast) or dense (reference); both give the same answer bit for bit")
     p.add_argument("--out", metavar="DIR", help="run directory: results, checkpoints, run.json")
     p.add_argument("--resume", metavar="DIR", help="continue the run in DIR from its checkpoint")
     p.add_argument("--checkpoint-interval", type=float_arg("checkpoint-interval"), default=300.0,
                    metavar="SECONDS", help="wall-clock seconds between checkpoints (default 300; needs --out)")
-    p.add_argument("--sample-interval", type=float_arg("sample-interval"), default=10.0, metavar="T",
+    p.add_argument("--sample-interval", type=float_arg("sample-interval"), default=None, metavar="T",
                    help="sample L = x_1 - x_N every T time units (default 10)")
     p.add_argument("--average-from", type=float_arg("average-from"), default=None, metavar="T",
                    help="<L> averages the samples with t >= T (default t_end / 2)")
-    p.add_argument("--snapshot", type=float_arg("snapshot"), action="append", default=[], metavar="T",
+    p.add_argument("--snapshot", type=float_arg("snapshot"), action="append", default=None, metavar="T",
                    help="store all x_i at time T (repeatable; Fig. 5a)")
     p.add_argument("--profile-window", type=float_arg("profile-window"), default=None, metavar="W",
                    help="store the displacement over windows of W during events (Fig. 6 uses 20)")
-    p.add_argument("--profile-min-blocks", type=int, default=0, metavar="M",
+    p.add_argument("--profile-min-blocks", type=int, default=None, metavar="M",
                    help="keep profiles only of events with at least M moved blocks")
     p.add_argument("--until-steady", type=float_arg("until-steady"), default=None, metavar="TOL",
                    help="stop once every block slides within TOL of steady sliding (velocities, state "
@@ -69,11 +69,11 @@ def register(sub) -> None:
 def _add_run_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--t-end", type=float_arg("t-end"), default=None, metavar="T",
                    help="end time (default 2e4; the paper's runs use 2e7)")
-    p.add_argument("--start", choices=("paper", "steady"), default="paper",
-                   help="initial state: the paper's (x=0, v=0.1, theta=0.1) or exact steady sliding")
-    p.add_argument("--perturbation", type=float_arg("perturbation"), default=0.0, metavar="A",
-                   help="with --start steady: uniform perturbation of x and v in [-A, A]")
-    p.add_argument("--seed", type=int, default=0, help="seed of the perturbation (default 0)")
+    p.add_argument("--start", choices=("paper", "steady"), default=None,
+                   help="initial state: the paper's (x=0, v=0.1, theta=0.1; default) or exact steady sliding")
+    p.add_argument("--perturbation", type=float_arg("perturbation"), default=None, metavar="A",
+                   help="with --start steady: uniform perturbation of x and v in [-A, A] (default 0)")
+    p.add_argument("--seed", type=int, default=None, help="seed of the perturbation (default 0)")
 
 
 def _summary_text(summary: dict, out: Path | None) -> str:
@@ -101,6 +101,10 @@ def _json_summary(summary: dict, out: Path | None) -> dict:
     return data
 
 
+_FIXED_BY_CHECKPOINT = ("integrator", "start", "perturbation", "seed", "sample_interval", "average_from",
+                        "snapshot", "profile_window", "profile_min_blocks", "until_steady")
+
+
 def run_chain_command(args: argparse.Namespace) -> Result:
     """Handler of `stickslip chain`."""
     from stickslip import chain
@@ -109,10 +113,20 @@ def run_chain_command(args: argparse.Namespace) -> Result:
     if args.resume:
         if args.out and Path(args.out) != Path(args.resume):
             raise CommandError("--out and --resume name different directories; give only --resume")
+        fixed = [f"--{k.removeprefix('param_').replace('_', '-')}" for k, v in vars(args).items()
+                 if v is not None and (k.startswith("param_") or k in _FIXED_BY_CHECKPOINT)]
+        if fixed:
+            raise CommandError(
+                f"{', '.join(fixed)} cannot be combined with --resume: a resumed run keeps the "
+                "parameters and options it was started with (only --t-end may be raised)"
+            )
         check_number("checkpoint-interval", args.checkpoint_interval, low=0.0, low_open=True)
         try:
             run = chain.resume_chain(args.resume, t_end=args.t_end, checkpoint_interval=args.checkpoint_interval,
                                      progress=progress, handle_signals=True)
+        except chain.NonFiniteState as exc:
+            sys.stderr.write(f"stickslip chain: error: {exc}\n")
+            return Result({"error": str(exc)}, "", status=1)
         except chain.ChainRunError as exc:
             raise CommandError(str(exc)) from None
         except chain.Interrupted as exc:
@@ -121,6 +135,10 @@ def run_chain_command(args: argparse.Namespace) -> Result:
 
     params = params_from_args(ChainParams, args)
     t_end = 2e4 if args.t_end is None else args.t_end
+    for name, default in (("integrator", "exact"), ("start", "paper"), ("perturbation", 0.0), ("seed", 0),
+                          ("sample_interval", 10.0), ("snapshot", []), ("profile_min_blocks", 0)):
+        if getattr(args, name) is None:
+            setattr(args, name, default)
     check_number("t-end", t_end, low=0.0)
     check_number("checkpoint-interval", args.checkpoint_interval, low=0.0, low_open=True)
     check_number("profile-min-blocks", args.profile_min_blocks, low=0, integer=True)

@@ -148,6 +148,16 @@ def _capacity(N, ist, ev_int, fm, prof_x, profile_every):
 
 
 @njit(cache=True, inline="always")
+def _merge(a_lo, a_hi, b_lo, b_hi):
+    """Hull of two intervals of blocks, either of which may be empty (lo > hi)."""
+    if b_lo > b_hi:
+        return a_lo, a_hi
+    if a_lo > a_hi:
+        return b_lo, b_hi
+    return min(a_lo, b_lo), max(a_hi, b_hi)
+
+
+@njit(cache=True, inline="always")
 def _unpack(par):
     return par[P_K], par[P_D], par[P_V], par[P_BETA], par[P_ALPHA], par[P_FS], par[P_DT]
 
@@ -616,12 +626,10 @@ def run_exact(x, v, th, mov, xs, vs, ths, mm, a1, b1, first_step, x0ev, ist, par
             ist[FULL_UPDATES] += sh - sl + 1
             if lo < sl:
                 t_lo, t_hi = _stage2_theta(th, ths, vs, b1, lo, sl - 1, alpha, D, h2)
-                c_lo = min(c_lo, t_lo)
-                c_hi = max(c_hi, t_hi)
+                c_lo, c_hi = _merge(c_lo, c_hi, t_lo, t_hi)
             if sh < hi:
                 t_lo, t_hi = _stage2_theta(th, ths, vs, b1, sh + 1, hi, alpha, D, h2)
-                c_lo = min(c_lo, t_lo)
-                c_hi = max(c_hi, t_hi)
+                c_lo, c_hi = _merge(c_lo, c_hi, t_lo, t_hi)
         else:
             c_lo, c_hi = _stage2_theta(th, ths, vs, b1, lo, hi, alpha, D, h2)
         # Next step's movers: a stopped block starts only if its force changed, that is if a
@@ -637,12 +645,12 @@ def run_exact(x, v, th, mov, xs, vs, ths, mm, a1, b1, first_step, x0ev, ist, par
         ist[BLOCK_UPDATES] += hi - lo + 1
         ist[STEPS_COMPUTED] += 1
         ist[STEP] = n + 1
+        # Next step's candidates: changes dilated by two, and every block that may move (a
+        # start rule that fires is an event's move even when it changes no bit).
         if c_lo <= c_hi:
-            ist[ACT_LO] = c_lo - 2 if c_lo > 2 else 1
-            ist[ACT_HI] = c_hi + 2 if c_hi < N - 2 else N
-        else:
-            ist[ACT_LO] = 1
-            ist[ACT_HI] = 0
+            c_lo = c_lo - 2 if c_lo > 2 else 1
+            c_hi = c_hi + 2 if c_hi < N - 2 else N
+        ist[ACT_LO], ist[ACT_HI] = _merge(c_lo, c_hi, ist[MECH_LO], ist[MECH_HI])
         if ist[EV_ACTIVE] == 1 and n_moving == 0:
             _end_event(n, x, first_step, x0ev, ist, ev_int, ev_S, fm, prof_x, prof_meta, N,
                        profile_every, profile_min_blocks)

@@ -1,0 +1,214 @@
+"""Shared pieces of the chain tests: an independent plain-Python Heun step of eq. (4) with
+its slip events (MODEL.md), bitwise comparison of two chain runs, and the command line."""
+
+from __future__ import annotations
+
+import math
+import os
+import subprocess
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from stickslip.kernels import chain as K
+
+# Integer state entries that describe the model (not how much work an integrator did).
+IST_MODEL = {
+    "STEP": K.STEP, "N_MOVING": K.N_MOVING, "EV_ACTIVE": K.EV_ACTIVE,
+    "EV_START_STEP": K.EV_START_STEP, "EV_START_BLOCK": K.EV_START_BLOCK,
+    "EV_MAX_BLOCK": K.EV_MAX_BLOCK, "EV_N_MOVED": K.EV_N_MOVED, "N_EVENTS": K.N_EVENTS,
+    "NEXT_SAMPLE": K.NEXT_SAMPLE, "NEXT_PROFILE": K.NEXT_PROFILE,
+}  # fmt: skip
+
+# Summary entries that depend on the integrator or the machine, not on the model.
+SUMMARY_WORK = {"wall_seconds", "steps_computed", "block_updates", "full_block_updates", "integrator"}
+
+
+def _is_work(key: str) -> bool:
+    return key in SUMMARY_WORK or key.endswith("_updates") or key.startswith("wall")
+
+
+def bits(a) -> np.ndarray:
+    """The float64 bit patterns of ``a`` (so that -0.0 != 0.0 and NaN == NaN when equal)."""
+    return np.ascontiguousarray(np.asarray(a, dtype=np.float64)).view(np.uint64)
+
+
+def assert_bits_equal(a, b, what: str) -> None:
+    a, b = np.asarray(a), np.asarray(b)
+    assert a.shape == b.shape, f"{what}: shapes {a.shape} != {b.shape}"
+    if a.dtype.kind == "f" or b.dtype.kind == "f":
+        diff = np.flatnonzero(bits(a).ravel() != bits(b).ravel())
+    else:
+        diff = np.flatnonzero(a.ravel() != b.ravel())
+    assert diff.size == 0, f"{what}: {diff.size} entries differ, first at flat index {diff[0]}"
+
+
+def assert_same_state(a, b, skip: tuple[str, ...] = ()) -> None:
+    """Two ChainStates hold the same model state bit for bit (ghost cells excluded)."""
+    assert a.sha256() == b.sha256()
+    for name in ("x", "v", "th", "mov", "first_step", "x0ev"):
+        assert_bits_equal(getattr(a, name)[1:-1], getattr(b, name)[1:-1], f"state.{name}")
+    for name, idx in IST_MODEL.items():
+        if name in skip:
+            continue
+        assert a.ist[idx] == b.ist[idx], f"ist[{name}]: {a.ist[idx]} != {b.ist[idx]}"
+
+
+def assert_same_run(a, b, *, state: bool = True) -> None:
+    """Two ChainRuns are identical: final state, events, first moves, L samples, snapshots,
+    profiles and the model part of the summary."""
+    if state:
+        assert_same_state(a.state, b.state)
+    assert a.summary["state_sha256"] == b.summary["state_sha256"]
+    assert a.events.equals(b.events), "event tables differ"
+    for col in ("S", "t_start", "t_end", "duration"):
+        assert_bits_equal(a.events[col].to_numpy(), b.events[col].to_numpy(), f"events.{col}")
+    assert a.first_move.equals(b.first_move), "first-move tables differ"
+    assert_bits_equal(a.samples["t"].values, b.samples["t"].values, "sample times")
+    assert_bits_equal(a.samples["L"].values, b.samples["L"].values, "L samples")
+    assert_bits_equal(a.snapshots["time"].values, b.snapshots["time"].values, "snapshot times")
+    assert_bits_equal(a.snapshots.values, b.snapshots.values, "snapshots")
+    assert_bits_equal(a.profiles["dx"].values, b.profiles["dx"].values, "profiles dx")
+    for c in ("event", "t", "t_next"):
+        assert_bits_equal(a.profiles[c].values, b.profiles[c].values, f"profiles {c}")
+    for key in set(a.summary) | set(b.summary):
+        if _is_work(key):
+            continue
+        va, vb = a.summary.get(key), b.summary.get(key)
+        if isinstance(va, float) and isinstance(vb, float) and np.isnan(va) and np.isnan(vb):
+            continue
+        assert va == vb, f"summary[{key!r}]: {va!r} != {vb!r}"
+
+
+# --------------------------------------------------------------------------------------
+# Plain-Python Heun step of eq. (4), written from MODEL.md and the kernel module's docstring.
+
+
+def heun_step(x, v, th, moving, n, p):
+    """One Heun step of the chain from t_n = n dt; lists of blocks 1..N at index 0..N-1.
+
+    Returns (x, v, th, moving, mid) of the new state, with ``mid`` the blocks that moved
+    during the step (start rule applied). Ghost cells: pulling point V t, free end
+    x_{N+1} = x_N, no-flux ends of theta.
+    """
+    N = len(x)
+    dt, Kc, D, V, beta, alpha, Fs = p.dt, p.K, p.D, p.V, p.beta, p.alpha, p.Fs
+    h2 = 0.5 * dt
+
+    def padded(xa, tha, step):
+        return [V * (float(step) * dt)] + list(xa) + [xa[-1]], [tha[0]] + list(tha) + [tha[-1]]
+
+    X, TH = padded(x, th, n)
+    mid, a1, b1, xs, vs, ths = [], [], [], [], [], []
+    for i in range(1, N + 1):
+        f = Kc * ((X[i - 1] - X[i]) - (X[i] - X[i + 1]))
+        m = moving[i - 1] or f > Fs  # start rule, tested at the beginning of the step
+        a = (f - TH[i] - beta * v[i - 1]) if m else 0.0
+        b = TH[i] * (1.0 - TH[i]) - alpha * TH[i] * v[i - 1] + D * ((TH[i - 1] - TH[i]) - (TH[i] - TH[i + 1]))
+        mid.append(m)
+        a1.append(a)
+        b1.append(b)
+        xs.append(x[i - 1] + dt * v[i - 1])
+        vs.append(v[i - 1] + dt * a)
+        ths.append(th[i - 1] + dt * b)
+    XS, THS = padded(xs, ths, n + 1)
+    xn, vn, thn, mn = [], [], [], []
+    for i in range(1, N + 1):
+        f2 = Kc * ((XS[i - 1] - XS[i]) - (XS[i] - XS[i + 1]))
+        m = mid[i - 1]
+        a2 = (f2 - THS[i] - beta * vs[i - 1]) if m else 0.0
+        b2 = (THS[i] * (1.0 - THS[i]) - alpha * THS[i] * vs[i - 1]
+              + D * ((THS[i - 1] - THS[i]) - (THS[i] - THS[i + 1])))  # fmt: skip
+        thn.append(th[i - 1] + h2 * (b1[i - 1] + b2))
+        if m:
+            xn.append(x[i - 1] + h2 * (v[i - 1] + vs[i - 1]))
+            vel = v[i - 1] + h2 * (a1[i - 1] + a2)
+            if vel <= 0.0:  # stop rule, at the end of the step
+                vn.append(0.0)
+                mn.append(False)
+            else:
+                vn.append(vel)
+                mn.append(True)
+        else:  # stopped: x fixed, v = 0
+            xn.append(x[i - 1])
+            vn.append(0.0)
+            mn.append(False)
+    return xn, vn, thn, mn, mid
+
+
+@dataclass
+class OracleRun:
+    """The outcome of :func:`oracle_run`: final state, L after each step, events, first moves."""
+
+    x: list
+    v: list
+    th: list
+    moving: list
+    L: list = field(default_factory=list)  # L at t_0, t_1, ..., t_n_steps
+    events: list = field(default_factory=list)  # dicts with the event-table columns
+    first_moves: list = field(default_factory=list)  # (event, block, step)
+    nonfinite: tuple | None = None  # (step after which the state is non-finite, first bad block)
+
+
+def oracle_run(x, v, th, moving, p, n_steps: int) -> OracleRun:
+    """Step :func:`heun_step` n_steps times from step 0 and find the slip events (MODEL.md):
+    an event starts with the first step in which any block moves after a step that ended with
+    every block stopped (the initial state counts as such), and ends with the first step that
+    ends with every block stopped again; S = sum_i (x_i(end) - x_i(start))."""
+    x, v, th, moving = list(x), list(v), list(th), list(moving)
+    N = len(x)
+    out = OracleRun(x, v, th, moving, L=[x[0] - x[-1]])
+    in_event = False
+    for n in range(n_steps):
+        all_stopped_before = not any(moving)
+        x_before = list(x)
+        x, v, th, moving, mid = heun_step(x, v, th, moving, n, p)
+        if not in_event and all_stopped_before and any(mid):
+            in_event = True
+            ev = {"event": len(out.events), "step_start": n, "start_block": mid.index(True) + 1}
+            x_start = x_before
+            first = {}
+        if in_event:
+            for i in range(N):
+                if mid[i] and (i + 1) not in first:
+                    first[i + 1] = n
+        bad = [i + 1 for i in range(N) if not all(map(math.isfinite, (x[i], v[i], th[i])))]
+        if bad:
+            out.nonfinite = (n + 1, bad[0])
+            break
+        if in_event and not any(moving):
+            S = 0.0
+            for i in range(N):
+                S += x[i] - x_start[i]
+            ev.update(step_end=n, S=S, max_block=max(first), n_blocks=len(first))
+            out.events.append(ev)
+            out.first_moves += [(ev["event"], b, first[b]) for b in sorted(first)]
+            in_event = False
+        out.L.append(x[0] - x[-1])
+    out.x, out.v, out.th, out.moving = x, v, th, moving
+    return out
+
+
+# --------------------------------------------------------------------------------------
+# Command line in a subprocess
+
+
+def stickslip_cmd() -> list[str]:
+    """The installed ``stickslip`` entry point next to this interpreter, else ``-m stickslip.cli``."""
+    exe = Path(sys.executable).with_name("stickslip")
+    if exe.exists():
+        return [str(exe)]
+    return [sys.executable, "-m", "stickslip.cli"]
+
+
+def cli_env() -> dict[str, str]:
+    env = dict(os.environ)
+    env.pop("PYTHONWARNINGS", None)
+    return env
+
+
+def run_cli_subprocess(*argv: str, timeout: float = 120.0) -> subprocess.CompletedProcess:
+    return subprocess.run(stickslip_cmd() + list(argv), capture_output=True, text=True, timeout=timeout,
+                          env=cli_env())  # fmt: skip
