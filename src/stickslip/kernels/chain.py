@@ -386,13 +386,15 @@ def _stage1(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, K, D, beta, alpha, F
 
 
 @njit(cache=True, inline="always")
-def _stage1_all(x, v, th, xs, vs, ths, mm, a1, b1, N, K, D, beta, alpha, dt):
-    """Stage 1 over the whole chain when every block moves: no start can happen, mm = 1."""
+def _stage1_all(x, v, th, xs, vs, ths, a1, b1, N, K, D, beta, alpha, dt):
+    """Stage 1 over the whole chain when every block moves (no start can happen).
+
+    The mid-step mask is 1 everywhere and is not stored: no later use reads it.
+    """
     for i in range(1, N + 1):
         f = _force(x[i - 1], x[i], x[i + 1], K)
         a = _accel(f, th[i], v[i], beta, 1.0)
         b = _dtheta(th[i - 1], th[i], th[i + 1], v[i], alpha, D)
-        mm[i] = 1.0
         a1[i] = a
         b1[i] = b
         xs[i] = x[i] + dt * v[i]
@@ -401,11 +403,12 @@ def _stage1_all(x, v, th, xs, vs, ths, mm, a1, b1, N, K, D, beta, alpha, dt):
 
 
 @njit(cache=True, inline="always")
-def _stage2_all(x, v, th, mov, xs, vs, ths, a1, b1, N, K, D, beta, alpha, h2):
+def _stage2_all(x, v, th, xs, vs, ths, a1, b1, N, K, D, beta, alpha, h2):
     """Stage 2, corrector and stop rule over the whole chain when every block moves.
 
     Skips the bookkeeping of changes (every block is kept active) and returns only whether
-    some block stopped, in which case the caller recounts the moving blocks.
+    some block stopped. The moving flags are not written: after the step a block moves
+    exactly when its v > 0, and the caller rebuilds them from v when a block stopped.
     """
     stops = False
     for i in range(1, N + 1):
@@ -417,7 +420,6 @@ def _stage2_all(x, v, th, mov, xs, vs, ths, a1, b1, N, K, D, beta, alpha, h2):
         th[i] = th[i] + h2 * (b1[i] + b2)
         keep = vn > 0.0
         v[i] = vn if keep else 0.0
-        mov[i] = 1.0 if keep else 0.0
         stops |= not keep
     return stops
 
@@ -561,9 +563,9 @@ def run_exact(x, v, th, mov, xs, vs, ths, mm, a1, b1, first_step, x0ev, ist, par
         if ist[N_MOVING] == N and lo == 1 and hi == N:
             # Every block slides: no start, no first move, nothing to track but stops.
             _set_ghosts(x, th, N, _pull(V, n, dt))
-            _stage1_all(x, v, th, xs, vs, ths, mm, a1, b1, N, K, D, beta, alpha, dt)
+            _stage1_all(x, v, th, xs, vs, ths, a1, b1, N, K, D, beta, alpha, dt)
             _set_ghosts(xs, ths, N, _pull(V, n + 1, dt))
-            stops = _stage2_all(x, v, th, mov, xs, vs, ths, a1, b1, N, K, D, beta, alpha, h2)
+            stops = _stage2_all(x, v, th, xs, vs, ths, a1, b1, N, K, D, beta, alpha, h2)
             ist[BLOCK_UPDATES] += N
             ist[FULL_UPDATES] += N
             ist[STEPS_COMPUTED] += 1
@@ -576,7 +578,8 @@ def run_exact(x, v, th, mov, xs, vs, ths, mm, a1, b1, first_step, x0ev, ist, par
             if stops:
                 n_moving = 0
                 for i in range(1, N + 1):
-                    n_moving += 1 if mov[i] != 0.0 else 0
+                    mov[i] = 1.0 if v[i] > 0.0 else 0.0
+                    n_moving += 1 if v[i] > 0.0 else 0
                 ist[N_MOVING] = n_moving
                 if ist[EV_ACTIVE] == 1 and n_moving == 0:
                     _end_event(n, x, first_step, x0ev, ist, ev_int, ev_S, fm, prof_x, prof_meta, N,
