@@ -80,3 +80,93 @@ def format_result(r: dict[str, Any]) -> str:
         f"speedup    {r['speedup']:.1f}x",
         f"identical  {'yes' if r['identical'] else 'NO'}   sha256 {r['state_sha256'][:16]}...",
     ])
+
+
+def _unit_costs(params: ChainParams) -> dict[str, float]:
+    """Seconds per computed step (fixed part), per full block update and per state-variable update.
+
+    Measured in this process on three small workloads of the exact integrator: one sliding
+    block (the fixed cost of a step), the whole chain sliding (full updates), and the whole
+    chain stopped with its state variables relaxing (state-variable-only updates).
+    """
+    import numpy as np
+
+    from stickslip.chain import ChainState
+
+    def timed(p, t_end, start):
+        run_chain(p, 20 * p.dt, start=start)  # compile or load
+        best = float("inf")
+        for _ in range(3):
+            t0 = time.perf_counter()
+            run = run_chain(p, t_end, start=start)
+            best = min(best, time.perf_counter() - t0)
+        return best, run.summary
+
+    one = params.replace(N=1, beta=max(params.beta, 1.5))
+    t1, s1 = timed(one, 500.0, "steady")
+    per_step = t1 / s1["steps_computed"]
+    slide = params.replace(beta=max(params.beta, 1.5))
+    t2, s2 = timed(slide, 200.0, "steady")
+    per_full = max(t2 / s2["steps_computed"] - per_step, 0.0) / params.N
+    still = params.replace(V=0.0)
+    rng = np.random.default_rng(0)
+    relax = ChainState.from_blocks(np.zeros(params.N), np.zeros(params.N),
+                                   rng.uniform(0.2, 0.9, params.N), np.ones(params.N, bool))
+    t3, s3 = timed(still, 20.0, relax)
+    per_theta = max(t3 / s3["steps_computed"] - per_step, 0.0) / params.N
+    return {"step": per_step, "full_update": per_full, "theta_update": per_theta}
+
+
+def profile(params: ChainParams, t_end: float, *, start: str = "paper") -> dict[str, Any]:
+    """Where the exact integrator of eq. (4) spends its time on one workload.
+
+    Counts its work (steps computed and jumped over, full and state-variable-only block
+    updates) and splits the measured wall time with unit costs measured in this process.
+    """
+    costs = _unit_costs(params)
+    t0 = time.perf_counter()
+    run = run_chain(params, t_end, start=start)
+    wall = time.perf_counter() - t0
+    s = run.summary
+    theta_updates = s["block_updates"] - s["full_block_updates"]
+    parts = {
+        "fixed cost of computed steps": s["steps_computed"] * costs["step"],
+        "full block updates": s["full_block_updates"] * costs["full_update"],
+        "state-variable-only updates": theta_updates * costs["theta_update"],
+    }
+    parts["rest (jumps, events, driver)"] = max(wall - sum(parts.values()), 0.0)
+    return {
+        "workload": {"N": params.N, "beta": params.beta, "t_end": t_end, "start": start, "steps": s["steps"]},
+        "wall_seconds": wall,
+        "steps_computed": s["steps_computed"],
+        "steps_jumped": s["steps"] - s["steps_computed"],
+        "fraction_computed": s["steps_computed"] / s["steps"] if s["steps"] else 0.0,
+        "blocks_per_computed_step": s["block_updates"] / s["steps_computed"] if s["steps_computed"] else 0.0,
+        "full_block_updates": s["full_block_updates"],
+        "theta_only_updates": theta_updates,
+        "n_events": s["n_events"],
+        "unit_costs_ns": {k: 1e9 * v for k, v in costs.items()},
+        "seconds": parts,
+    }
+
+
+def format_profile(r: dict[str, Any]) -> str:
+    """Human-readable lines of :func:`profile`'s result."""
+    w = r["workload"]
+    u = r["unit_costs_ns"]
+    lines = [
+        f"workload   N={w['N']} beta={w['beta']:g} t_end={w['t_end']:g} start={w['start']} "
+        f"({w['steps']} steps, {r['n_events']} events)",
+        f"wall       {r['wall_seconds']:.3f} s (exact)",
+        f"steps      {r['steps_computed']} computed ({100 * r['fraction_computed']:.2f}%), "
+        f"{r['steps_jumped']} jumped over",
+        f"updates    {r['blocks_per_computed_step']:.1f} blocks per computed step: "
+        f"{r['full_block_updates']} full, {r['theta_only_updates']} state variable only",
+        f"unit cost  {u['step']:.0f} ns per computed step, {u['full_update']:.2f} ns per full update, "
+        f"{u['theta_update']:.2f} ns per state-variable update",
+        "time split",
+    ]
+    total = r["wall_seconds"]
+    for name, sec in r["seconds"].items():
+        lines.append(f"  {name:32s} {sec:8.3f} s  {100 * sec / total:5.1f}%")
+    return "\n".join(lines)

@@ -62,6 +62,8 @@ def register(sub) -> None:
     b.add_argument("--start", choices=("paper", "steady"), default="paper",
                    help="initial state: the paper's (default) or exact steady sliding")
     b.add_argument("--repeat", type=int, default=1, help="time each integrator this many times, keep the fastest")
+    b.add_argument("--profile", action="store_true",
+                   help="instead: where the exact integrator spends its time on this workload")
     add_json_option(b)
     b.set_defaults(handler=run_bench_command)
 
@@ -181,5 +183,8 @@ def run_bench_command(args: argparse.Namespace) -> Result:
     check_number("t-end", args.t_end, low=0.0)
     check_number("repeat", args.repeat, low=1, integer=True)
     params = ChainParams(N=args.N, beta=args.beta)
+    if args.profile:
+        result = bench.profile(params, args.t_end, start=args.start)
+        return Result(result, bench.format_profile(result))
     result = bench.compare(params, args.t_end, start=args.start, repeat=args.repeat)
     return Result(result, bench.format_result(result))

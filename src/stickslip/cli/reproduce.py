@@ -1,7 +1,91 @@
-"""`stickslip reproduce`: (to be filled in)."""
+"""`stickslip reproduce`: every figure and stated number of the paper, with a report.
+
+    stickslip reproduce [--quick | --full] [--out DIR] [--scheduler ADDRESS] [--workers N]
+
+``--quick`` (default) runs the pipeline on shorter chain runs in minutes; ``--full`` uses the
+paper's N = 399 and t = 2e7 (hours; resumable: run the same command again). Results already
+computed for the same spec and package version are reused, so a second call only redraws.
+Writes DIR/figures (PNG, PDF and data per figure), DIR/runs (the experiments), report.json and
+report.html. See docs/reproduce.md.
+"""
 
 from __future__ import annotations
 
+import argparse
+
+from stickslip.cli._common import CommandError, Result, add_json_option, prepare_out_dir
+from stickslip.params import check_number
+
+DEFAULT_OUT = "paper-reproduction"
+
 
 def register(sub) -> None:
-    """Add the subcommand(s) of this module to the parser."""
+    """Add the ``reproduce`` subcommand."""
+    p = sub.add_parser(
+        "reproduce",
+        help="reproduce every figure and stated number of the paper; writes report.html",
+        description=(
+            "Run the experiment behind each of the paper's figures (section 2: Figs. 1-3, the Hopf "
+            "point, the inverse transition; Fig. 4; section 3: chain runs on Dask for Figs. 5-8), draw "
+            "each figure (PNG, PDF and its data), and write report.json and report.html with one row "
+            "per number the paper states. Stored results of the same spec are reused."
+        ),
+    )
+    mode = p.add_mutually_exclusive_group()
+    mode.add_argument("--quick", dest="mode", action="store_const", const="quick",
+                      help="shorter chain runs (N = 99 and 199, t = 2e6 and 4e6): minutes on two cores (default)")
+    mode.add_argument("--full", dest="mode", action="store_const", const="full",
+                      help="the paper's chains (N = 399, t = 2e7): hours; run again to resume")
+    # A tiny spec set that exercises the whole pipeline in seconds; used by the tests.
+    mode.add_argument("--smoke", dest="mode", action="store_const", const="smoke", help=argparse.SUPPRESS)
+    p.set_defaults(mode="quick")
+    p.add_argument("--out", default=DEFAULT_OUT, metavar="DIR",
+                   help=f"output directory (default {DEFAULT_OUT}); stored results in it are reused")
+    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="address of an existing Dask scheduler for the chain runs (default: a local cluster)")
+    p.add_argument("--workers", default=None, metavar="N",
+                   help="worker processes of the local cluster (default: one per core)")
+    p.add_argument("--no-progress", action="store_true", help="no progress lines on stderr")
+    add_json_option(p)
+    p.set_defaults(handler=run)
+
+
+def run(args: argparse.Namespace) -> Result:
+    """Handler of ``stickslip reproduce``."""
+    from stickslip.reproduce import ReproduceError, reproduce
+
+    workers = None
+    if args.workers is not None:
+        workers = int(check_number("workers", args.workers, low=1, integer=True))
+    if args.scheduler is not None and not args.scheduler.strip():
+        raise CommandError("--scheduler needs an address, e.g. tcp://127.0.0.1:8786")
+    out = prepare_out_dir(args.out)
+    try:
+        result = reproduce(out, args.mode, scheduler=args.scheduler, n_workers=workers,
+                           progress=not args.no_progress)
+    except ReproduceError as exc:
+        return Result({"error": str(exc)}, f"stickslip reproduce: {exc}", status=1)
+    except KeyboardInterrupt:
+        import sys
+
+        sys.stderr.write(
+            f"stickslip reproduce: interrupted; run the same command again to continue (finished results in "
+            f"{out} are kept, chain runs continue from their last checkpoint)\n"
+        )
+        return Result({"interrupted": True, "out": str(out)}, "", status=130)
+    except OSError as exc:  # e.g. no scheduler at the given address
+        raise CommandError(f"cannot run the chain runs: {exc}") from None
+    return Result(result, _text(result))
+
+
+def _text(result: dict) -> str:
+    lines = [f"stickslip reproduce --{result['mode']}: {result['wall_seconds']:.1f} s"]
+    width = max(len(r["where"]) for r in result["rows"]) if result["rows"] else 0
+    for r in result["rows"]:
+        lines.append(f"  {r['where']:<{width}}  {r['agreement'][:60]:<60}  {r['quantity']}")
+    reused = sum(e["reused"] for e in result["experiments"])
+    lines.append(f"experiments: {len(result['experiments'])} ({reused} reused); figures: {len(result['figures'])}")
+    for name, why in result["figures_not_drawn"].items():
+        lines.append(f"  not drawn: {name}: {why}")
+    lines.append(f"report: {result['report_html']}")
+    return "\n".join(lines)

@@ -1,0 +1,267 @@
+"""`stickslip reproduce`: spec hashing and reuse, the report's rows and figures, the command line.
+
+The whole pipeline runs once per module on the tiny ``smoke`` spec set (chains of N = 19, a
+coarse hysteresis sweep) on a local Dask cluster of two workers: about 15 s.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from stickslip import experiments as ex
+from stickslip import reproduce as rp
+from stickslip.cli import main
+from stickslip.io import read_json
+
+#: MODEL.md, last table: (where, a word of the quantity) for every number the paper states;
+#: eq. 3 states two numbers and gets two rows.
+MODEL_ROWS = [
+    ("sec. 2", "Hopf point"),
+    ("sec. 2", "stable for all V"),
+    ("sec. 2", "inverse transition"),
+    ("eq. 3", "duration"),
+    ("eq. 3", "force"),
+    ("Fig. 3", "period"),
+    ("Fig. 4", "long-wave"),
+    ("sec. 3", "final state"),
+    ("Fig. 5(a)", "snapshot"),
+    ("Fig. 5(b)", "<L>"),
+    ("Fig. 6", "front speed"),
+    ("Fig. 7", "beta = 1"),
+    ("Fig. 8", "beta = 0.2"),
+]
+
+
+# ---------------------------------------------------------------------------------------------
+# Specs
+
+
+def test_spec_key_depends_on_what_the_result_depends_on_only():
+    e = ex.Experiment("a", "chain_modes", {"K": 10.0, "D": 5.0}, options={"betas": [0.5, 1.0]})
+    assert e.key() == ex.Experiment("b", "chain_modes", {"D": 5, "K": 10}, options={"betas": (0.5, 1.0)},
+                                    figures=("fig4",), note="label").key()
+    assert len(e.key()) == 12 and e.dirname == f"a-{e.key()}"
+    assert e.key() != ex.Experiment("a", "chain_modes", {"K": 10.0, "D": 4.0}, options={"betas": [0.5, 1.0]}).key()
+    assert e.key() != ex.Experiment("a", "chain_modes", {"K": 10.0, "D": 5.0}, options={"betas": [0.5]}).key()
+    assert e.key() != ex.Experiment("a", "chain_modes", {"K": 10.0, "D": 5.0}, t_end=1.0,
+                                    options={"betas": [0.5, 1.0]}).key()
+    assert e.key() != ex.Experiment("a", "block_run", {"K": 10.0, "D": 5.0}, options={"betas": [0.5, 1.0]}).key()
+
+
+def test_spec_key_includes_the_package_version(monkeypatch):
+    e = ex.Experiment("a", "slip_limit", {"K": 10.0})
+    before = e.key()
+    monkeypatch.setattr(ex, "__version__", "999.0")
+    assert e.key() != before and e.spec()["version"] == "999.0"
+
+
+def test_chain_points_are_left_out_of_the_directory_key_but_not_the_spec():
+    e1 = ex.Experiment("c", "chain_runs", {"K": 10.0}, options={"points": [{"N": 9, "beta": 1.0}], "x": 1})
+    e2 = ex.Experiment("c", "chain_runs", {"K": 10.0},
+                       options={"points": [{"N": 9, "beta": 1.0}, {"N": 9, "beta": 0.5}], "x": 1})
+    assert e1.key() == e2.key()
+    assert e1.spec() != e2.spec()
+
+
+def test_spec_sets_of_every_mode():
+    for mode in ex.MODES:
+        specs = ex.experiments(mode)
+        names = [e.name for e in specs]
+        assert len(set(names)) == len(names)
+        assert {e.kind for e in specs} == set(ex.KINDS)
+        drawn = {stem for e in specs for stem in e.figures}
+        assert drawn == {stem for stem, _ in ex.FIGURES}
+    full = ex.experiment("full", "chain-runs")
+    assert {p["N"] for p in full.options["points"]} == {399}
+    assert full.options["t_end_by_N"] == {"399": 2e7}
+    betas = sorted(p["beta"] for p in full.options["points"])
+    assert 0.2 in betas and 1.0 in betas and min(betas) <= 0.2 and max(betas) > 1.0
+    assert sum(0.9 <= b <= 1.1 for b in betas) >= 5  # enough points around the transition
+    quick = ex.experiment("quick", "chain-runs")
+    assert {"N": 199, "beta": 1.0} in quick.options["points"] and {"N": 199, "beta": 0.2} in quick.options["points"]
+    with pytest.raises(ValueError, match="mode"):
+        ex.experiments("medium")
+    with pytest.raises(ValueError, match="kind"):
+        ex.Experiment("x", "nonsense")
+
+
+# ---------------------------------------------------------------------------------------------
+# Reuse of a single experiment
+
+
+def test_run_experiment_computes_once_and_reuses(tmp_path, monkeypatch):
+    exp = ex.experiment("smoke", "chain-modes")
+    calls = []
+    runner = rp._RUNNERS["chain_modes"]
+
+    def counting(*args, **kw):
+        calls.append(1)
+        return runner.compute(*args, **kw)
+
+    monkeypatch.setitem(rp._RUNNERS, "chain_modes", rp._Runner(counting, runner.load))
+    first = rp.run_experiment(exp, tmp_path)
+    second = rp.run_experiment(exp, tmp_path)
+    assert len(calls) == 1 and not first.reused and second.reused
+    assert second.summary == first.summary
+    assert (tmp_path / exp.dirname / rp.RESULT_FILE).is_file()
+    changed = ex.Experiment(exp.name, exp.kind, exp.params, options={**exp.options, "n_k": 101})
+    third = rp.run_experiment(changed, tmp_path)
+    assert len(calls) == 2 and not third.reused and third.run_dir != first.run_dir
+
+
+def test_a_result_of_another_spec_in_the_same_directory_is_not_reused(tmp_path):
+    exp = ex.experiment("smoke", "slip-limit")
+    rp.run_experiment(exp, tmp_path)
+    record = read_json(tmp_path / exp.dirname / rp.RESULT_FILE)
+    record["spec"]["version"] = "0.0.0-other"
+    (tmp_path / exp.dirname / rp.RESULT_FILE).write_text(json.dumps(record))
+    assert not rp.run_experiment(exp, tmp_path).reused
+
+
+def test_chain_task_continues_from_a_checkpoint(tmp_path, monkeypatch):
+    from stickslip import chain
+
+    exp = ex.experiment("smoke", "chain-runs")
+    point = {**rp._chain_common(exp), "N": 19, "beta": 1.0}
+    first = rp.chain_point_task(point, tmp_path)
+    assert (tmp_path / "checkpoint" / "state.npz").is_file()
+    for name in ("run.json", "state.nc", "events.parquet"):
+        (tmp_path / name).unlink()
+
+    def no_fresh_run(*a, **k):
+        raise AssertionError("a run with a checkpoint must continue from it")
+
+    monkeypatch.setattr(chain, "run_chain", no_fresh_run)
+    again = rp.chain_point_task(point, tmp_path)
+    assert again["state_sha256"] == first["state_sha256"]
+    assert again["n_events"] == first["n_events"]
+    assert (tmp_path / "run.json").is_file()
+
+
+# ---------------------------------------------------------------------------------------------
+# The whole pipeline (smoke spec set)
+
+
+@pytest.fixture(scope="module")
+def smoke(tmp_path_factory):
+    out = tmp_path_factory.mktemp("repro")
+    import contextlib
+    import io as _io
+
+    buf = _io.StringIO()
+    with contextlib.redirect_stdout(buf):
+        status = main(["reproduce", "--smoke", "--out", str(out), "--workers", "2", "--no-progress", "--json"])
+    assert status == 0
+    return out, json.loads(buf.getvalue())
+
+
+def test_report_has_a_row_for_every_stated_number(smoke):
+    out, printed = smoke
+    report = read_json(out / "report.json")
+    rows = report["rows"]
+    assert len(rows) == len(MODEL_ROWS)
+    for (where, word), row in zip(MODEL_ROWS, rows):
+        assert row["where"] == where and word in row["quantity"], (where, word, row)
+        assert row["paper"] and row["value"] is not None
+        assert row["command"].startswith("stickslip ")
+        agreement = row["agreement"]
+        assert agreement.startswith(("yes (", "no (", "n/a ("))
+        if agreement.startswith("n/a"):
+            assert row["na_reason"]
+        else:
+            assert row["tolerance"]
+    # section 2, eq. 3, Fig. 4: the same numbers in every mode
+    by = {(r["where"], r["quantity"].split(",")[0]): r for r in rows}
+    assert by[("sec. 2", "Hopf point of steady sliding")]["agrees"] is True
+    assert by[("Fig. 4", "long-wave instability of steady sliding of the chain")]["agrees"] is True
+    # the smoke chains settle nothing
+    assert all(r["agrees"] is None for r in rows[7:])
+    assert printed["rows"] == rows
+    html = (out / "report.html").read_text()
+    for where, _ in MODEL_ROWS:
+        assert where in html
+
+
+def test_every_figure_is_drawn_with_png_pdf_and_data(smoke):
+    out, printed = smoke
+    report = read_json(out / "report.json")
+    assert not printed["figures_not_drawn"]
+    assert "figures_not_drawn" not in report["meta"]
+    images = {Path(f["image"]).stem for f in report["figures"]}
+    assert images == {stem for stem, _ in ex.FIGURES}
+    for f in report["figures"]:
+        assert (out / f["image"]).stat().st_size > 1000
+        assert (out / f["pdf"]).stat().st_size > 1000
+        assert f["data"], f["figure"]
+        for d in f["data"]:
+            assert (out / d).is_file(), d
+        assert f["command"].startswith("stickslip ")
+    html = (out / "report.html").read_text()
+    assert html.count("data:image/png;base64,") == len(report["figures"])
+
+
+def test_second_call_reuses_every_result_and_only_redraws(smoke, monkeypatch):
+    out, _ = smoke
+
+    def boom(*a, **k):
+        raise AssertionError("a stored result was computed again")
+
+    for kind, runner in list(rp._RUNNERS.items()):
+        monkeypatch.setitem(rp._RUNNERS, kind, rp._Runner(boom, runner.load))
+    import stickslip.sweep
+
+    monkeypatch.setattr(stickslip.sweep, "run_sweep", boom)
+    before = read_json(out / "report.json")
+    result = rp.reproduce(out, "smoke", progress=False)
+    assert all(e["reused"] for e in result["experiments"])
+    after = read_json(out / "report.json")
+    assert [r["value"] for r in after["rows"]] == [r["value"] for r in before["rows"]]
+    assert after["meta"]["wall_seconds"] < 30
+
+
+def test_chain_runs_of_the_smoke_set_are_on_disk_per_point(smoke):
+    out, _ = smoke
+    exp = ex.experiment("smoke", "chain-runs")
+    points = out / "runs" / exp.dirname / "points"
+    for p in exp.options["points"]:
+        d = points / f"beta={p['beta']:g}_N={p['N']}"
+        assert (d / "done.json").is_file() and (d / "run.json").is_file()
+    table = read_json(out / "runs" / exp.dirname / rp.RESULT_FILE)["summary"]["points"]
+    assert {(r["N"], r["beta"]) for r in table} == {(p["N"], p["beta"]) for p in exp.options["points"]}
+
+
+# ---------------------------------------------------------------------------------------------
+# Command line
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["--workers", "0"],
+        ["--workers", "two"],
+        ["--quick", "--full"],
+        ["--scheduler", " "],
+        ["--fast"],
+    ],
+)
+def test_bad_input_exits_2_and_writes_nothing(argv, tmp_path, capsys):
+    out = tmp_path / "never"
+    try:
+        status = main(["reproduce", "--out", str(out), *argv])
+    except SystemExit as exc:
+        status = exc.code
+    assert status == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "error" in err[0]
+    assert not out.exists()
+
+
+def test_help_lists_the_modes(capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["reproduce", "--help"])
+    assert exc.value.code == 0
+    text = capsys.readouterr().out
+    assert "--quick" in text and "--full" in text and "--scheduler" in text and "--smoke" not in text
