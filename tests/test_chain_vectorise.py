@@ -18,37 +18,71 @@ from stickslip.kernels import chain as K
 from stickslip.params import ChainParams
 
 
+# The block loops: separate compiled functions, and the all-moving ones inlined in run_exact.
+STAGES = ("_stage1", "_stage2", "_stage1_theta", "_stage1_theta_only", "_stage2_theta")
+
+
+def _fresh_ir(kernel, args=None) -> str:
+    """LLVM IR of a kernel compiled afresh with its own options (code loaded from numba's cache
+    cannot be inspected); ``args`` are example arguments when it has no recorded signature."""
+    options = {k: v for k, v in kernel.targetoptions.items() if k != "cache"}
+    fresh = numba.njit(**options)(kernel.py_func)
+    if args is None:
+        assert kernel.signatures, "kernel was not compiled by the workloads"
+        fresh.compile(kernel.signatures[0])
+    else:
+        fresh(*args)
+    return fresh.inspect_llvm(fresh.signatures[0])
+
+
+def _example_args(name: str) -> tuple:
+    a = [np.linspace(0.5, 1.5, 12) for _ in range(10)]
+    lo, hi = 1, 10
+    k, d, beta, alpha, fs, dt = 10.0, 5.0, 1.0, 1.0, 3.0, 0.005
+    return {
+        "_stage1": (*a, lo, hi, k, d, beta, alpha, fs, dt),
+        "_stage2": (*a, lo, hi, k, d, beta, alpha, 0.5 * dt),
+        "_stage1_theta": (*a[:8], lo, hi, alpha, d, dt),
+        "_stage1_theta_only": (*a[:4], lo, hi, alpha, d, dt),
+        "_stage2_theta": (*a[:4], lo, hi, alpha, d, 0.5 * dt),
+    }[name]
+
+
 @pytest.fixture(scope="module")
-def exact_ir() -> str:
-    """LLVM IR of run_exact, compiled afresh (code loaded from numba's cache cannot be inspected)."""
-    run_chain(ChainParams(N=4), 0.05, integrator="exact")
-    sig = K.run_exact.signatures[0]
-    fresh = numba.njit(K.run_exact.py_func)
-    fresh.compile(sig)
-    return fresh.inspect_llvm(sig)
+def irs() -> dict[str, str]:
+    run_chain(ChainParams(N=8), 1.0, integrator="exact")
+    run_chain(ChainParams(N=8), 1.0, integrator="dense")
+    out = {name: _fresh_ir(getattr(K, name), _example_args(name)) for name in STAGES}
+    out["run_exact"] = _fresh_ir(K.run_exact)
+    out["run_dense"] = _fresh_ir(K.run_dense)
+    return out
 
 
-def test_exact_kernel_uses_vector_arithmetic_on_doubles(exact_ir):
-    ir = exact_ir
-    ops = re.findall(r"= (fadd|fsub|fmul) <(\d+) x double>", ir)
-    assert ops, "no vector floating-point arithmetic in run_exact"
-    widths = {int(w) for _, w in ops}
-    assert max(widths) >= 2
-    # Every stage loop (full, state-variable-only, all-moving) contributes a dozen or more vector
-    # subtractions and multiplications; one loop falling back to scalar code drops below these.
-    assert sum(1 for op, _ in ops if op == "fsub") >= 70
-    assert sum(1 for op, _ in ops if op == "fmul") >= 70
+def _vector_ops(ir: str) -> list[tuple[str, int]]:
+    return [(op, int(w)) for op, w in re.findall(r"= (fadd|fsub|fmul) <(\d+) x double>", ir)]
 
 
-def test_vector_compare_and_select_for_the_stop_rule(exact_ir):
-    ir = exact_ir
-    # The stop rule and the start rule are selects on vectors, not branches.
+@pytest.mark.parametrize("name", STAGES + ("run_exact",))
+def test_block_loops_use_vector_arithmetic_on_doubles(irs, name):
+    ops = _vector_ops(irs[name])
+    assert ops, f"no vector floating-point arithmetic in {name}"
+    assert min(w for _, w in ops) >= 2
+    # Each loop evaluates the stencils with several subtractions and multiplications; a loop
+    # left scalar has none of them in vector form.
+    assert sum(1 for op, _ in ops if op == "fsub") >= 4
+    assert sum(1 for op, _ in ops if op == "fmul") >= 4
+
+
+@pytest.mark.parametrize("name", ("_stage1", "_stage2", "run_exact"))
+def test_start_and_stop_rules_are_vector_selects(irs, name):
+    ir = irs[name]
     assert re.search(r"fcmp \w+ <\d+ x double>", ir)
     assert re.search(r"select <\d+ x i1>", ir)
 
 
-def test_no_fast_math_flags(exact_ir):
-    ir = exact_ir
+@pytest.mark.parametrize("name", STAGES + ("run_exact", "run_dense"))
+def test_no_fast_math_flags(irs, name):
+    ir = irs[name]
     for flag in ("fast ", "reassoc", "contract", "nnan", "ninf"):
         assert not re.search(rf"= f(add|sub|mul|div) {flag}", ir), flag
     assert "llvm.fma" not in ir and "llvm.fmuladd" not in ir

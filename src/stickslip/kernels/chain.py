@@ -111,7 +111,7 @@ def _pull(V, n, dt):
     return V * (np.float64(n) * dt)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _service(n, x, N, ist, samp_L, samp_step, prof_x, prof_meta, sample_every, profile_every):
     """Samples and profile rows due at step n (state at t_n). Returns a status code."""
     if n == ist[NEXT_SAMPLE]:
@@ -136,18 +136,6 @@ def _service(n, x, N, ist, samp_L, samp_step, prof_x, prof_meta, sample_every, p
 
 
 @njit(cache=True, inline="always")
-def _capacity(N, ist, ev_int, fm, prof_x, profile_every):
-    """Return a status if a buffer could overflow in the next step, else GO."""
-    if ist[EV_COUNT] >= ev_int.shape[0]:
-        return EVENTS_FULL
-    if ist[FM_COUNT] + N > fm.shape[0]:
-        return FIRST_MOVES_FULL
-    if profile_every > 0 and ist[P_COUNT] + 2 > prof_x.shape[0]:
-        return PROFILES_FULL
-    return GO
-
-
-@njit(cache=True, inline="always")
 def _merge(a_lo, a_hi, b_lo, b_hi):
     """Hull of two intervals of blocks, either of which may be empty (lo > hi)."""
     if b_lo > b_hi:
@@ -165,13 +153,24 @@ def _unpack(par):
 @njit(cache=True, inline="always")
 def _before_step(n, n_end, x, N, ist, ev_int, fm, samp_L, samp_step, prof_x, prof_meta,
                  sample_every, profile_every):
-    """Outputs due at step n; then DONE at n_end, a status if a buffer could overflow, else GO."""
-    st = _service(n, x, N, ist, samp_L, samp_step, prof_x, prof_meta, sample_every, profile_every)
-    if st != DONE:
-        return st
+    """Outputs due at step n; then DONE at n_end, a status if a buffer could overflow, else GO.
+
+    Everything on the common path is a comparison of integers: the output routine, whose
+    array arguments cost far more than the step of a short chain, runs only when due.
+    """
+    if n == ist[NEXT_SAMPLE] or (profile_every > 0 and ist[EV_ACTIVE] == 1 and n == ist[NEXT_PROFILE]):
+        st = _service(n, x, N, ist, samp_L, samp_step, prof_x, prof_meta, sample_every, profile_every)
+        if st != DONE:
+            return st
     if n >= n_end:
         return DONE
-    return _capacity(N, ist, ev_int, fm, prof_x, profile_every)
+    if ist[EV_COUNT] >= ev_int.shape[0]:
+        return EVENTS_FULL
+    if ist[FM_COUNT] + N > fm.shape[0]:
+        return FIRST_MOVES_FULL
+    if profile_every > 0 and ist[P_COUNT] + 2 > prof_x.shape[0]:
+        return PROFILES_FULL
+    return GO
 
 
 @njit(cache=True)
@@ -344,7 +343,7 @@ def _first_trigger(x, N, V, dt, K, Fs, n_lo, n_hi):
     return lo
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False)
 def _stage1(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, K, D, beta, alpha, Fs, dt):
     """Start rule, stage-1 derivatives and predictor for blocks lo..hi (branch-free).
 
@@ -424,7 +423,7 @@ def _stage2_all(x, v, th, xs, vs, ths, a1, b1, N, K, D, beta, alpha, h2):
     return stops
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False)
 def _stage1_theta(x, v, th, xs, vs, ths, mm, b1, lo, hi, alpha, D, dt):
     """Stage 1 for blocks lo..hi known to stay stopped in this step (mid-step mask 0).
 
@@ -448,22 +447,40 @@ def _stage1_theta(x, v, th, xs, vs, ths, mm, b1, lo, hi, alpha, D, dt):
         mm[j] = 0.0
 
 
-@njit(cache=True, inline="always")
-def _stage2_theta(th, ths, vs, b1, lo, hi, alpha, D, h2):
+@njit(cache=True, _nrt=False)
+def _stage1_theta_only(v, th, ths, b1, lo, hi, alpha, D, dt):
+    """Stage 1 for blocks lo..hi in a step in which no block moves.
+
+    Then nothing reads the predictors of x and v or the mask, so only the state variable's
+    derivative and predictor are written (see _stage1_theta for why this is exact).
+    """
+    v = v[lo - 1:hi + 2]
+    th = th[lo - 1:hi + 2]
+    ths = ths[lo - 1:hi + 2]
+    b1 = b1[lo - 1:hi + 2]
+    for j in range(1, hi - lo + 2):
+        b = _dtheta(th[j - 1], th[j], th[j + 1], v[j], alpha, D)
+        b1[j] = b
+        ths[j] = th[j] + dt * b
+
+
+@njit(cache=True, _nrt=False)
+def _stage2_theta(th, ths, v, b1, lo, hi, alpha, D, h2):
     """Stage 2 and corrector of the state variable alone, for blocks lo..hi that stay stopped.
 
-    Their x, v and stopped flag provably keep every bit (see _stage1_theta). Returns the
-    first and last block whose state variable changed (lo > hi if none).
+    Their x, v and stopped flag provably keep every bit (see _stage1_theta), and their
+    predicted velocity equals v = 0, which is read instead. Returns the first and last block
+    whose state variable changed (lo > hi if none).
     """
     th = th[lo - 1:hi + 2]
     ths = ths[lo - 1:hi + 2]
-    vs = vs[lo - 1:hi + 2]
+    v = v[lo - 1:hi + 2]
     b1 = b1[lo - 1:hi + 2]
     n = hi - lo + 1
     c_lo = n + 1
     c_hi = 0
     for j in range(1, n + 1):
-        b2 = _dtheta(ths[j - 1], ths[j], ths[j + 1], vs[j], alpha, D)
+        b2 = _dtheta(ths[j - 1], ths[j], ths[j + 1], v[j], alpha, D)
         tho = th[j]
         thn = tho + h2 * (b1[j] + b2)
         th[j] = thn
@@ -473,7 +490,7 @@ def _stage2_theta(th, ths, vs, b1, lo, hi, alpha, D, h2):
     return c_lo + lo - 1, c_hi + lo - 1
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False)
 def _stage2(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, K, D, beta, alpha, h2):
     """Stage 2, corrector and stop rule for blocks lo..hi (branch-free, on views as _stage1).
 
@@ -610,7 +627,7 @@ def run_exact(x, v, th, mov, xs, vs, ths, mm, a1, b1, first_step, x0ev, ist, par
             if fh < h1:
                 _stage1_theta(x, v, th, xs, vs, ths, mm, b1, fh + 1, h1, alpha, D, dt)
         else:
-            _stage1_theta(x, v, th, xs, vs, ths, mm, b1, l1, h1, alpha, D, dt)
+            _stage1_theta_only(v, th, ths, b1, l1, h1, alpha, D, dt)
         _set_ghosts(xs, ths, N, _pull(V, n + 1, dt))
         # Only a block that starts in this step can move for the first time in an event.
         if (ist[EV_ACTIVE] == 1 and starts) or (ist[N_MOVING] == 0 and first <= last):
@@ -628,13 +645,13 @@ def run_exact(x, v, th, mov, xs, vs, ths, mm, a1, b1, first_step, x0ev, ist, par
                 x, v, th, mov, xs, vs, ths, mm, a1, b1, sl, sh, K, D, beta, alpha, h2)
             ist[FULL_UPDATES] += sh - sl + 1
             if lo < sl:
-                t_lo, t_hi = _stage2_theta(th, ths, vs, b1, lo, sl - 1, alpha, D, h2)
+                t_lo, t_hi = _stage2_theta(th, ths, v, b1, lo, sl - 1, alpha, D, h2)
                 c_lo, c_hi = _merge(c_lo, c_hi, t_lo, t_hi)
             if sh < hi:
-                t_lo, t_hi = _stage2_theta(th, ths, vs, b1, sh + 1, hi, alpha, D, h2)
+                t_lo, t_hi = _stage2_theta(th, ths, v, b1, sh + 1, hi, alpha, D, h2)
                 c_lo, c_hi = _merge(c_lo, c_hi, t_lo, t_hi)
         else:
-            c_lo, c_hi = _stage2_theta(th, ths, vs, b1, lo, hi, alpha, D, h2)
+            c_lo, c_hi = _stage2_theta(th, ths, v, b1, lo, hi, alpha, D, h2)
         # Next step's movers: a stopped block starts only if its force changed, that is if a
         # neighbour's x changed, and only moving blocks change x. So: this step's movers +- 1.
         if first <= last:
