@@ -20,7 +20,8 @@ options. Nothing else goes into its result, so the spec and the package version 
   tests to exercise the whole pipeline in seconds; its numbers mean nothing.
 
 Chain runs at beta > 1 stop once the chain slides steadily (``until_steady``): from then on
-every block moves every step and nothing changes but the position of the pulling point.
+every block moves every step and nothing changes but the position of the pulling point. In
+``full`` mode beta = 1.2 is the exception: it runs its whole length.
 """
 
 from __future__ import annotations
@@ -164,7 +165,10 @@ _BLOCK = {"K": 10.0, "V": 0.001, "beta": 1.0, "alpha": 1.0, "Fs": 3.0, "M": 1.0,
 #: Tolerance of the stop at steady sliding for beta > 1 (largest deviation of v, theta, springs).
 UNTIL_STEADY = 1e-6
 
-_FULL_BETAS = (0.2, 0.4, 0.6, 0.7, 0.8, 0.85, 0.9, 0.95, 0.975, 1.0, 1.025, 1.05, 1.1, 1.2, 1.5)
+# Just above beta = 1 (1.025 to 1.1) the chain stick-slips for a very long time: at N = 99 it
+# still does at t = 1e7, so such a point at N = 399 costs a whole run of the sliding regime
+# (an hour on one core) and ends without settling. The full set therefore jumps to 1.2.
+_FULL_BETAS = (0.2, 0.4, 0.6, 0.7, 0.8, 0.85, 0.9, 0.95, 0.975, 0.99, 1.0, 1.2, 1.5)
 _QUICK_BETAS = (0.2, 0.4, 0.6, 0.8, 0.9, 0.95, 1.0, 1.1, 1.2, 1.5)
 
 
@@ -222,17 +226,21 @@ def _chain(mode: str) -> Experiment:
         sweep_N = figure_N = 399
         t_sweep = t_fig = 2e7
         betas = _FULL_BETAS
-        note = ""
+        steady_above = 1.3
+        note = ("full: beta = 1.2 runs its whole length (the paper's run of the sliding regime); "
+                "beta = 1.5 stops at steady sliding")
     elif mode == "quick":
         sweep_N, figure_N = 99, 199
         t_sweep, t_fig = 2e6, 4e6
         betas = _QUICK_BETAS
+        steady_above = 1.0
         note = ("quick: Fig. 5(b) on N = 99 chains to t = 2e6, Figs. 5(a), 6, 7, 8 on N = 199 chains "
                 "to t = 4e6 (the paper: N = 399 to t = 2e7)")
     else:  # smoke
         sweep_N = figure_N = 19
         t_sweep = t_fig = 4e4
         betas = (0.2, 1.0, 1.5)
+        steady_above = 1.0
         note = "smoke: tiny chains for tests; the numbers mean nothing"
     points = chain_points(sweep_N, betas, figure_N)
     # A chain loads in about L_ss / V: average and count events over the second half only.
@@ -248,7 +256,7 @@ def _chain(mode: str) -> Experiment:
             "average_fraction": 0.5,
             "sample_interval": 100.0 if mode != "smoke" else 10.0,
             "until_steady": UNTIL_STEADY,
-            "until_steady_above": 1.0,
+            "until_steady_above": steady_above,
             "profile_betas": [1.0],
             "profile_N": figure_N,
             "profile_window": 20.0,

@@ -82,7 +82,6 @@ FIRST_MOVES_FULL = 2
 SAMPLES_FULL = 3
 PROFILES_FULL = 4
 NONFINITE = 5
-GO = -1  # internal: nothing stops the next step
 
 _BIG = np.float64(1.7976931348623157e308)
 
@@ -150,27 +149,14 @@ def _unpack(par):
     return par[P_K], par[P_D], par[P_V], par[P_BETA], par[P_ALPHA], par[P_FS], par[P_DT]
 
 
-@njit(cache=True, inline="always")
-def _before_step(n, n_end, x, N, ist, ev_int, fm, samp_L, samp_step, prof_x, prof_meta,
-                 sample_every, profile_every):
-    """Outputs due at step n; then DONE at n_end, a status if a buffer could overflow, else GO.
-
-    Everything on the common path is a comparison of integers: the output routine, whose
-    array arguments cost far more than the step of a short chain, runs only when due.
-    """
-    if n == ist[NEXT_SAMPLE] or (profile_every > 0 and ist[EV_ACTIVE] == 1 and n == ist[NEXT_PROFILE]):
-        st = _service(n, x, N, ist, samp_L, samp_step, prof_x, prof_meta, sample_every, profile_every)
-        if st != DONE:
-            return st
-    if n >= n_end:
-        return DONE
-    if ist[EV_COUNT] >= ev_int.shape[0]:
+@njit(cache=True)
+def _overflow(ist, N, cap_ev, cap_fm):
+    """Which output buffer could overflow in the next step."""
+    if ist[EV_COUNT] >= cap_ev:
         return EVENTS_FULL
-    if ist[FM_COUNT] + N > fm.shape[0]:
+    if ist[FM_COUNT] + N > cap_fm:
         return FIRST_MOVES_FULL
-    if profile_every > 0 and ist[P_COUNT] + 2 > prof_x.shape[0]:
-        return PROFILES_FULL
-    return GO
+    return PROFILES_FULL
 
 
 @njit(cache=True)
@@ -268,12 +254,19 @@ def run_dense(x, v, th, mov, xs, vs, ths, mm, a1, b1, first_step, x0ev, ist, par
     N = x.shape[0] - 2
     K, D, V, beta, alpha, Fs, dt = _unpack(par)
     h2 = 0.5 * dt
+    cap_ev, cap_fm, cap_p = ev_int.shape[0], fm.shape[0], prof_x.shape[0]
     while True:
         n = ist[STEP]
-        st = _before_step(n, n_end, x, N, ist, ev_int, fm, samp_L, samp_step, prof_x, prof_meta,
-                          sample_every, profile_every)
-        if st != GO:
-            return st
+        # Outputs due, the end, buffers that could overflow. Written out here rather than in a
+        # helper: as a function this costs several times a short step (measured).
+        if n == ist[NEXT_SAMPLE] or (profile_every > 0 and ist[EV_ACTIVE] == 1 and n == ist[NEXT_PROFILE]):
+            st = _service(n, x, N, ist, samp_L, samp_step, prof_x, prof_meta, sample_every, profile_every)
+            if st != DONE:
+                return st
+        if n >= n_end:
+            return DONE
+        if ist[EV_COUNT] >= cap_ev or ist[FM_COUNT] + N > cap_fm or (profile_every > 0 and ist[P_COUNT] + 2 > cap_p):
+            return _overflow(ist, N, cap_ev, cap_fm)
         _set_ghosts(x, th, N, _pull(V, n, dt))
         for i in range(1, N + 1):
             f = _force(x[i - 1], x[i], x[i + 1], K)
@@ -554,12 +547,19 @@ def run_exact(x, v, th, mov, xs, vs, ths, mm, a1, b1, first_step, x0ev, ist, par
     N = x.shape[0] - 2
     K, D, V, beta, alpha, Fs, dt = _unpack(par)
     h2 = 0.5 * dt
+    cap_ev, cap_fm, cap_p = ev_int.shape[0], fm.shape[0], prof_x.shape[0]
     while True:
         n = ist[STEP]
-        st = _before_step(n, n_end, x, N, ist, ev_int, fm, samp_L, samp_step, prof_x, prof_meta,
-                          sample_every, profile_every)
-        if st != GO:
-            return st
+        # Outputs due, the end, buffers that could overflow. Written out here rather than in a
+        # helper: as a function this costs several times a short step (measured).
+        if n == ist[NEXT_SAMPLE] or (profile_every > 0 and ist[EV_ACTIVE] == 1 and n == ist[NEXT_PROFILE]):
+            st = _service(n, x, N, ist, samp_L, samp_step, prof_x, prof_meta, sample_every, profile_every)
+            if st != DONE:
+                return st
+        if n >= n_end:
+            return DONE
+        if ist[EV_COUNT] >= cap_ev or ist[FM_COUNT] + N > cap_fm or (profile_every > 0 and ist[P_COUNT] + 2 > cap_p):
+            return _overflow(ist, N, cap_ev, cap_fm)
         lo = ist[ACT_LO]
         hi = ist[ACT_HI]
         x2 = x[2] if N > 1 else x[1]
