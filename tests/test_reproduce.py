@@ -219,7 +219,6 @@ def test_second_call_reuses_every_result_and_only_redraws(smoke, monkeypatch):
     assert all(e["reused"] for e in result["experiments"])
     after = read_json(out / "report.json")
     assert [r["value"] for r in after["rows"]] == [r["value"] for r in before["rows"]]
-    assert after["meta"]["wall_seconds"] < 30
 
 
 def test_chain_runs_of_the_smoke_set_are_on_disk_per_point(smoke):
