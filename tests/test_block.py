@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from stickslip.block import BlockState, period_sweep, simulate_block
-from stickslip.params import BlockParams, ParameterError, scale_block
-from stickslip.slip_limit import PAPER_DURATION, PAPER_FORCE_AT_STOP, solve_slip_limit
+from stickslip.analysis.slip_limit import PAPER_DURATION, PAPER_FORCE_AT_STOP, period_sweep, solve_slip_limit
+from stickslip.models.params import BlockParams, ParameterError, scale_block
+from stickslip.run.block import BlockState, simulate_block
 
 
 @pytest.fixture(scope="module")

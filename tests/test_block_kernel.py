@@ -7,9 +7,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from stickslip.block import BlockState, n_samples, simulate_block
 from stickslip.kernels.block import heun_block
-from stickslip.params import BlockParams
+from stickslip.models.params import BlockParams
+from stickslip.run.block import BlockState, n_samples, simulate_block
 
 
 def _buffers(n_steps, every, capacity=64):

@@ -14,9 +14,9 @@ from chain_helpers import assert_same_run, oracle_run
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from stickslip.chain import ChainRunError, ChainState, run_chain
 from stickslip.kernels import chain as K
-from stickslip.params import ChainParams
+from stickslip.models.params import ChainParams
+from stickslip.run.driver import ChainRunError, ChainState, run_chain
 
 BETAS = [0.2, 0.5, 1.0, 1.2]
 

@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 from chain_helpers import assert_bits_equal, oracle_run
 
-from stickslip.chain import ChainRunError, ChainState, run_chain
-from stickslip.params import ChainParams
+from stickslip.models.params import ChainParams
+from stickslip.run.driver import ChainRunError, ChainState, run_chain
 
 # (N, seed, steps, x amplitude, probability of a stopped block, parameters)
 CASES = {

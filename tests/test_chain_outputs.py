@@ -12,9 +12,9 @@ import xarray as xr
 from chain_helpers import assert_bits_equal, assert_same_run
 
 import stickslip
-from stickslip import physics
-from stickslip.chain import ChainRunError, load_run, run_chain, steady_deviation, write_run
-from stickslip.params import ChainParams
+from stickslip.models import physics
+from stickslip.models.params import ChainParams
+from stickslip.run.driver import ChainRunError, load_run, run_chain, steady_deviation, write_run
 
 P = ChainParams(N=6, V=0.01)
 SNAPS = (123.45, 400.0, 0.0)

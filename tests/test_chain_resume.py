@@ -16,11 +16,11 @@ import pandas as pd
 import pytest
 from chain_helpers import assert_bits_equal, assert_same_run, assert_same_state, run_cli_subprocess
 
-from stickslip import chain as C
-from stickslip.chain import ChainRunError, resume_chain, run_chain
 from stickslip.cli import main
 from stickslip.kernels import chain as K
-from stickslip.params import ChainParams, ParameterError
+from stickslip.models.params import ChainParams, ParameterError
+from stickslip.run import driver as C
+from stickslip.run.driver import ChainRunError, resume_chain, run_chain
 
 P = ChainParams(N=5)
 T2 = 3000.0

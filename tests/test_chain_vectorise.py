@@ -13,9 +13,9 @@ import numba
 import numpy as np
 import pytest
 
-from stickslip.chain import run_chain
 from stickslip.kernels import chain as K
-from stickslip.params import ChainParams
+from stickslip.models.params import ChainParams
+from stickslip.run.driver import run_chain
 
 
 # The block loops: separate compiled functions, and the all-moving ones inlined in run_exact.

@@ -8,9 +8,9 @@ import pandas as pd
 import pytest
 from chain_helpers import run_cli_subprocess
 
-from stickslip.chain import run_chain
 from stickslip.cli import main
-from stickslip.params import ChainParams
+from stickslip.models.params import ChainParams
+from stickslip.run.driver import run_chain
 
 
 def run_cli(capsys, *argv):

@@ -18,10 +18,10 @@ import pandas as pd
 import pytest
 from chain_helpers import assert_bits_equal, assert_same_run, cli_env, run_cli_subprocess, stickslip_cmd
 
-from stickslip import chain as C
 from stickslip import io
 from stickslip.kernels import chain as K
-from stickslip.params import ChainParams, steps_for
+from stickslip.models.params import ChainParams, steps_for
+from stickslip.run import driver as C
 
 T_END = 4000.0
 P = ChainParams()  # the paper's chain: N = 399, beta = 1

@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from stickslip.block import simulate_block
-from stickslip.hysteresis import SweepSettings, hysteresis_sweep
-from stickslip.params import BlockParams, ParameterError
+from stickslip.analysis.hysteresis import SweepSettings, hysteresis_sweep
+from stickslip.models.params import BlockParams, ParameterError
+from stickslip.run.block import simulate_block
 
 PAPER_V_UP = 0.345  # section 2: beta = 1, Fs = 3, K = 10
 

@@ -8,10 +8,10 @@ import pytest
 import xarray as xr
 from matplotlib.figure import Figure
 
-from stickslip.params import ChainParams
+from stickslip.analysis.statistics import fit_power_law, front_speed
+from stickslip.models.params import ChainParams
 from stickslip.plotting.chain import fig5a_snapshot, fig5b_length, fig6_fronts, fig7_8_sizes
 from stickslip.plotting.style import save_figure
-from stickslip.statistics import fit_power_law, front_speed
 
 P = ChainParams(N=99)
 

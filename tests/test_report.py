@@ -10,7 +10,7 @@ import pytest
 from matplotlib.figure import Figure
 
 from stickslip.plotting.style import save_figure
-from stickslip.report import ReportFigure, ReportRow, read_report, write_report
+from stickslip.report.writer import ReportFigure, ReportRow, read_report, write_report
 
 # The last table of MODEL.md, as the reproduction reports it (values of an imagined run).
 ROWS = [

@@ -11,9 +11,9 @@ from pathlib import Path
 
 import pytest
 
-from stickslip import experiments as ex
-from stickslip import reproduce as rp
 from stickslip.cli import main
+from stickslip.experiments import reproduce as rp
+from stickslip.experiments import specs as ex
 from stickslip.io import read_json
 
 #: MODEL.md, last table: (where, a word of the quantity) for every number the paper states;
@@ -122,7 +122,7 @@ def test_a_result_of_another_spec_in_the_same_directory_is_not_reused(tmp_path):
 
 
 def test_chain_task_continues_from_a_checkpoint(tmp_path, monkeypatch):
-    from stickslip import chain
+    from stickslip.run import driver as chain
 
     exp = ex.experiment("smoke", "chain-runs")
     point = {**rp._chain_common(exp), "N": 19, "beta": 1.0}
@@ -211,9 +211,9 @@ def test_second_call_reuses_every_result_and_only_redraws(smoke, monkeypatch):
 
     for kind, runner in list(rp._RUNNERS.items()):
         monkeypatch.setitem(rp._RUNNERS, kind, rp._Runner(boom, runner.load))
-    import stickslip.sweep
+    import stickslip.experiments.sweep
 
-    monkeypatch.setattr(stickslip.sweep, "run_sweep", boom)
+    monkeypatch.setattr(stickslip.experiments.sweep, "run_sweep", boom)
     before = read_json(out / "report.json")
     result = rp.reproduce(out, "smoke", progress=False)
     assert all(e["reused"] for e in result["experiments"])

@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from stickslip.block import simulate_block
-from stickslip.params import BlockParams, ParameterError
+from stickslip.analysis.slip_limit import NoStopError, heun_slip_limit, solve_slip_limit
+from stickslip.models.params import BlockParams, ParameterError
 from stickslip.plotting.block import slip_window
-from stickslip.slip_limit import NoStopError, heun_slip_limit, solve_slip_limit
+from stickslip.run.block import simulate_block
 
 PAPER_DT = 0.005
 

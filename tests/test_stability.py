@@ -15,9 +15,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as hs
 
-from stickslip import stability as st
-from stickslip.params import BlockParams, ChainParams, scale_block
-from stickslip.physics import chain_steady_state
+from stickslip.analysis import stability as st
+from stickslip.models.params import BlockParams, ChainParams, scale_block
+from stickslip.models.physics import chain_steady_state
 
 
 def _match(a: np.ndarray, b: np.ndarray) -> float:

@@ -17,7 +17,7 @@ import xarray as xr
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from stickslip.statistics import (
+from stickslip.analysis.statistics import (
     fit_power_law,
     front_speed,
     pick_front_events,

@@ -12,8 +12,8 @@ import pandas as pd
 import pytest
 
 from stickslip.cli import main
+from stickslip.experiments.sweep import chain_task, demo_task, point_name, run_sweep
 from stickslip.io import read_json
-from stickslip.sweep import chain_task, demo_task, point_name, run_sweep
 
 
 def sum_of_squares(n: int) -> float:
@@ -114,10 +114,10 @@ def test_chain_task_calls_the_simulator_with_the_point(tmp_path, monkeypatch):
     def write_run(run, out_dir):
         calls["written"] = Path(out_dir)
 
-    fake = types.ModuleType("stickslip.chain")
+    fake = types.ModuleType("stickslip.run.driver")
     fake.run_chain, fake.write_run = run_chain, write_run
-    monkeypatch.setitem(sys.modules, "stickslip.chain", fake)
-    monkeypatch.setattr("stickslip.chain", fake, raising=False)
+    monkeypatch.setitem(sys.modules, "stickslip.run.driver", fake)
+    monkeypatch.setattr("stickslip.run.driver", fake, raising=False)
     summary = chain_task({"beta": 0.9, "N": 19, "t_end": 100.0, "average_from": 50.0}, tmp_path)
     assert summary == {"n_events": 3, "L_mean": 12.5}
     assert calls["params"].beta == 0.9 and calls["params"].N == 19 and calls["params"].K == 10.0

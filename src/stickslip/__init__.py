@@ -4,8 +4,18 @@ Implements the model of H. Sakaguchi, "Stick-Slip Motion and Phase Transition in
 Block-Spring System": a single block with state-variable and static friction (eq. 1),
 its slip in the limit V -> 0 (eq. 3), the linear stability of steady sliding (eqs. 2, 5)
 and a chain of N blocks pulled at one end (eq. 4).
+
+Layout: :mod:`stickslip.models` (parameters, closed-form physics), :mod:`stickslip.kernels`
+(compiled integrators), :mod:`stickslip.run` (running the block and the chain, checkpoints,
+run directories), :mod:`stickslip.analysis` (stability, eq. (3), statistics, hysteresis),
+:mod:`stickslip.experiments` (the paper's experiments, sweeps on Dask, ``reproduce``),
+:mod:`stickslip.report`, :mod:`stickslip.plotting`, and the command line :mod:`stickslip.cli`.
+
+The main API is importable from here; the simulators load on first use, so that
+``import stickslip`` stays light.
 """
 
+from importlib import import_module
 from importlib.metadata import PackageNotFoundError, version as _version
 
 try:
@@ -13,6 +23,26 @@ try:
 except PackageNotFoundError:  # running from a source tree that is not installed
     __version__ = "0.0.0+unknown"
 
-from stickslip.params import BlockParams, ChainParams, ParameterError  # noqa: E402
+from stickslip.models.params import BlockParams, ChainParams, ParameterError  # noqa: E402
 
-__all__ = ["BlockParams", "ChainParams", "ParameterError", "__version__"]
+#: Names loaded on first use, and the module that holds each.
+_LAZY = {
+    "run_chain": "stickslip.run.driver",
+    "resume_chain": "stickslip.run.driver",
+    "load_run": "stickslip.run.rundir",
+    "simulate_block": "stickslip.run.block",
+}
+
+__all__ = ["BlockParams", "ChainParams", "ParameterError", "__version__", *_LAZY]
+
+
+def __getattr__(name: str):
+    if name in _LAZY:
+        value = getattr(import_module(_LAZY[name]), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'stickslip' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_LAZY))

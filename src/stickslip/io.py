@@ -18,6 +18,7 @@ import pandas as pd
 import xarray as xr
 
 from stickslip import __version__
+from stickslip.jsonable import to_jsonable
 
 
 @contextmanager
@@ -40,8 +41,6 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
 
 def write_json(path: str | Path, data: Any) -> Path:
     """Write one JSON document atomically (NaN and inf become null)."""
-    from stickslip.cli._common import to_jsonable
-
     with atomic_path(path) as tmp:
         tmp.write_text(json.dumps(to_jsonable(data), indent=2, allow_nan=False) + "\n")
     return Path(path)

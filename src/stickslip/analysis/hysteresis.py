@@ -6,11 +6,11 @@ goes over to steady sliding. This module raises V step by step from V_min to V_m
 it back, carrying the state over from one V to the next, and records at each V whether the
 block still sticks and the range of its velocity: a bifurcation diagram with its hysteresis.
 
-Carrying the state over. A run of :func:`stickslip.block.simulate_block` starts at t = 0 with
+Carrying the state over. A run of :func:`stickslip.run.block.simulate_block` starts at t = 0 with
 spring force f = K (V t - x). At the end of a segment of length t_seg the pulling point is at
 V_old t_seg; the next segment starts from x_new = x - V_old t_seg (with v, theta and the stick
 flag unchanged), so f, and with it the whole state, is continuous across the change of V
-(:meth:`stickslip.block.BlockRun.restart_state`).
+(:meth:`stickslip.run.block.BlockRun.restart_state`).
 """
 
 from __future__ import annotations
@@ -22,8 +22,8 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from stickslip.block import INTEGRATOR, BlockState, simulate_block
-from stickslip.params import BlockParams, ParameterError, check_number, steps_for
+from stickslip.models.params import BlockParams, ParameterError, check_number, steps_for
+from stickslip.run.block import INTEGRATOR, BlockState, simulate_block
 
 #: Defaults of the sweep. The range holds the paper's V = 0.345; 400 time units per value of
 #: V is about 160 stick-slip periods near V = 0.3 (T ~ 2.4), long enough for the transient

@@ -14,20 +14,23 @@ which grows at the rate K V until it reaches Fs again, so the period is
 the paper's T = 1.035 + 3.432 / (K V). :func:`solve_slip_limit` integrates eq. (3) with an
 adaptive high-order method and locates v = 0 as an event; :func:`heun_slip_limit` does the same
 slip with the fixed-step Heun scheme and stop rule of eq. (1), to show where the paper's third
-digit comes from.
+digit comes from. :func:`period_sweep` runs eq. (1) at several V and sets the simulated periods
+beside the law (Fig. 3).
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Iterable
 
 import numpy as np
+import pandas as pd
 import xarray as xr
 from scipy.integrate import solve_ivp
 
-from stickslip.params import BlockParams, ParameterError, check_number
+from stickslip.models.params import BlockParams, ParameterError, check_number, steps_for
+from stickslip.run.block import BlockState, first_start_time, simulate_block
 
 #: The paper's numbers for eq. (3) at K = 10, beta = 1, Fs = 3 (section 2), for comparison only.
 PAPER_DURATION = 1.035
@@ -170,8 +173,6 @@ def heun_slip_limit(
     (x = -Fs/K), run until the stop rule fires: what a fixed-step run of the paper reports for
     eq. (3). Its t_e is a whole number of steps.
     """
-    from stickslip.block import BlockState, simulate_block
-
     p = BlockParams() if params is None else params
     _check_can_slip(p)
     if dt is not None:
@@ -225,3 +226,48 @@ def matches_paper(params: BlockParams) -> bool:
     return all(
         math.isclose(getattr(params, k), getattr(d, k)) for k in ("K", "beta", "alpha", "Fs", "M", "sigma")
     )
+
+
+def period_sweep(
+    params: BlockParams,
+    V_values: Iterable[float],
+    *,
+    periods: int = 4,
+) -> pd.DataFrame:
+    """Simulated stick-slip period of eq. (1) at several pulling velocities V (Fig. 3).
+
+    Each V is run from the paper's initial state to the first slip plus ``periods`` + 1/2
+    periods of the law T(V) of eq. (3) (:func:`solve_slip_limit`); the period is the mean of
+    the slip table's ``period`` over the slips after the first. Returns one row per V with
+    the simulated period, its spread, the number of periods averaged and the law's T(V).
+    """
+    periods = int(check_number("periods", periods, low=1, integer=True))
+    V_values = [float(check_number("V", V, low=0.0, low_open=True)) for V in V_values]
+    law = solve_slip_limit(params, dense=False)
+    rows = []
+    for V in V_values:
+        p = params.replace(V=V)
+        T = law.period(V)
+        t_end = first_start_time(p) + (periods + 0.5) * T
+        steps = steps_for(t_end, p.dt)
+        run = simulate_block(p, t_end, every=max(1, steps))
+        s = run.summary()
+        rows.append(
+            {
+                "V": V,
+                "period": s["period"],
+                "period_std": s["period_std"],
+                "n_periods": max(0, s["events"] - 1),
+                "period_law": T,
+                "rel_dev": s["period"] / T - 1.0,
+                "slip_duration": s["slip_duration"],
+                "force_at_stop": s["force_at_stop"],
+            }
+        )
+    return pd.DataFrame(rows)
+
+
+def paper_V_values(n: int = 13, low: float = 1e-3, high: float = 1e-1) -> np.ndarray:
+    """Pulling velocities for Fig. 3: ``n`` values evenly spaced in log V from ``low`` to ``high``."""
+    n = int(check_number("n", n, low=2, integer=True))
+    return np.logspace(math.log10(low), math.log10(high), n)

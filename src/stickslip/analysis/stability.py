@@ -34,8 +34,8 @@ import pandas as pd
 import xarray as xr
 from scipy.optimize import brentq
 
-from stickslip.params import BlockParams, ChainParams
-from stickslip.physics import block_steady_state
+from stickslip.models.params import BlockParams, ChainParams
+from stickslip.models.physics import block_steady_state
 
 #: A growth rate below this (in absolute value) counts as zero: the round-off of a 3 x 3 or
 #: 3N x 3N eigenvalue problem with entries of order K is far below it.

@@ -12,7 +12,7 @@ import argparse
 import sys
 
 from stickslip.cli._common import CommandError, Result, emit
-from stickslip.params import ParameterError
+from stickslip.models.params import ParameterError
 
 __all__ = ["main", "build_parser", "Result", "CommandError"]
 

@@ -16,14 +16,16 @@ from typing import Any
 import xarray as xr
 
 from stickslip import io
-from stickslip.block import (
-    INTEGRATOR,
-    BlockRun,
-    first_start_time,
-    n_samples,
+from stickslip.analysis.slip_limit import (
+    PAPER_DURATION,
+    PAPER_FORCE_AT_STOP,
+    NoStopError,
+    SlipLimit,
+    heun_slip_limit,
+    matches_paper,
     paper_V_values,
     period_sweep,
-    simulate_block,
+    solve_slip_limit,
 )
 from stickslip.cli._common import (
     CommandError,
@@ -34,15 +36,13 @@ from stickslip.cli._common import (
     params_from_args,
     prepare_out_dir,
 )
-from stickslip.params import BlockParams, ParameterError, check_number, steps_for
-from stickslip.slip_limit import (
-    PAPER_DURATION,
-    PAPER_FORCE_AT_STOP,
-    NoStopError,
-    SlipLimit,
-    heun_slip_limit,
-    matches_paper,
-    solve_slip_limit,
+from stickslip.models.params import BlockParams, ParameterError, check_number, steps_for
+from stickslip.run.block import (
+    INTEGRATOR,
+    BlockRun,
+    first_start_time,
+    n_samples,
+    simulate_block,
 )
 
 #: Periods of the law simulated after the first slip when --t-end is not given.

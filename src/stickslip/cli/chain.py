@@ -16,7 +16,7 @@ from stickslip.cli._common import (
     params_from_args,
     prepare_out_dir,
 )
-from stickslip.params import ChainParams, ParameterError, check_number
+from stickslip.models.params import ChainParams, ParameterError, check_number
 
 
 def register(sub) -> None:
@@ -109,7 +109,7 @@ _FIXED_BY_CHECKPOINT = ("integrator", "start", "perturbation", "seed", "sample_i
 
 def run_chain_command(args: argparse.Namespace) -> Result:
     """Handler of `stickslip chain`."""
-    from stickslip import chain
+    from stickslip.run import driver as chain
 
     progress = not args.no_progress
     if args.resume:
@@ -177,7 +177,7 @@ def _interrupted(exc, out: Path | None) -> Result:
 
 def run_bench_command(args: argparse.Namespace) -> Result:
     """Handler of `stickslip bench`: the same workload with dense and exact, one process."""
-    from stickslip import bench
+    from stickslip.run import bench
 
     check_number("N", args.N, low=1, integer=True)
     check_number("t-end", args.t_end, low=0.0)

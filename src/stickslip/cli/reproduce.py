@@ -14,7 +14,7 @@ from __future__ import annotations
 import argparse
 
 from stickslip.cli._common import CommandError, Result, add_json_option, prepare_out_dir
-from stickslip.params import check_number
+from stickslip.models.params import check_number
 
 DEFAULT_OUT = "paper-reproduction"
 
@@ -52,7 +52,7 @@ def register(sub) -> None:
 
 def run(args: argparse.Namespace) -> Result:
     """Handler of ``stickslip reproduce``."""
-    from stickslip.reproduce import ReproduceError, reproduce
+    from stickslip.experiments.reproduce import ReproduceError, reproduce
 
     workers = None
     if args.workers is not None:

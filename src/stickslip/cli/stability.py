@@ -17,10 +17,9 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from stickslip import hysteresis as hy
 from stickslip import io
-from stickslip import stability as st
-from stickslip.block import INTEGRATOR
+from stickslip.analysis import hysteresis as hy
+from stickslip.analysis import stability as st
 from stickslip.cli._common import (
     Result,
     add_json_option,
@@ -29,7 +28,8 @@ from stickslip.cli._common import (
     params_from_args,
     prepare_out_dir,
 )
-from stickslip.params import BlockParams, ChainParams, check_number
+from stickslip.models.params import BlockParams, ChainParams, check_number
+from stickslip.run.block import INTEGRATOR
 
 #: Points of the stability map (beta x V) and of the Hopf curve.
 MAP_BETAS = 121

@@ -16,7 +16,7 @@ import itertools
 from typing import Any
 
 from stickslip.cli._common import CommandError, Result, add_json_option, prepare_out_dir
-from stickslip.params import BlockParams, ChainParams, check_number
+from stickslip.models.params import BlockParams, ChainParams, check_number
 
 # Run options a point may carry besides the model parameters, with their value types.
 _OPTIONS: dict[str, dict[str, type]] = {
@@ -150,7 +150,7 @@ def parse_grid(
 
 def run(args: argparse.Namespace) -> Result:
     """Handler of ``stickslip sweep``."""
-    from stickslip.sweep import block_task, chain_task, run_sweep
+    from stickslip.experiments.sweep import block_task, chain_task, run_sweep
 
     points, common = parse_grid(args.model, args.grid, args.fixed, args.t_end)
     workers = None

@@ -1,7 +1,7 @@
 """The experiments behind the paper's figures and stated numbers, as data (``stickslip reproduce``).
 
 Each :class:`Experiment` names one computation: its kind (which runner of
-:mod:`stickslip.reproduce` carries it out), the model parameters, the run length and the run
+:mod:`stickslip.experiments.reproduce` carries it out), the model parameters, the run length and the run
 options. Nothing else goes into its result, so the spec and the package version fix the result:
 :meth:`Experiment.key` hashes them, and ``reproduce`` stores the result under
 ``runs/<name>-<key>/`` and reuses it whenever the same spec comes round again.
@@ -28,10 +28,14 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any, Mapping
 
 from stickslip import __version__
+from stickslip.jsonable import to_jsonable
+from stickslip.models.params import ChainParams
 
 __all__ = [
     "Experiment",
@@ -41,11 +45,14 @@ __all__ = [
     "experiment",
     "chain_points",
     "FIGURES",
+    "Outcome",
+    "point_settings",
+    "chain_common",
 ]
 
 MODES = ("quick", "full", "smoke")
 
-#: The runners of :mod:`stickslip.reproduce`, one per kind of experiment.
+#: The runners of :mod:`stickslip.experiments.reproduce`, one per kind of experiment.
 KINDS = (
     "block_run",  # eq. (1) at the paper's parameters: Figs. 1, 2
     "slip_limit",  # eq. (3): duration, force at stop, the period law
@@ -77,7 +84,6 @@ def _canonical(value: Any) -> Any:
 
     So ``K = 10`` and ``K = 10.0``, or ``(0.5, 1.0)`` and ``[0.5, 1]``, give the same spec.
     """
-    from stickslip.cli._common import to_jsonable
 
     def whole(v: Any) -> Any:
         if isinstance(v, dict):
@@ -97,8 +103,8 @@ class Experiment:
 
     - ``name``: short name, the stem of its run directory (``block``, ``chain-runs``, ...);
     - ``kind``: one of :data:`KINDS`, the runner that computes it;
-    - ``params``: model parameters (fields of :class:`~stickslip.params.BlockParams` or
-      :class:`~stickslip.params.ChainParams`) shared by the whole experiment;
+    - ``params``: model parameters (fields of :class:`~stickslip.models.params.BlockParams` or
+      :class:`~stickslip.models.params.ChainParams`) shared by the whole experiment;
     - ``t_end``: run length in model time units (None where the kind has none);
     - ``options``: everything else the result depends on (grids, sweep protocol, points);
     - ``figures``: the figures (stems of :data:`FIGURES`) drawn from it, for the report;
@@ -134,7 +140,7 @@ class Experiment:
         """First 12 hex digits of the SHA-256 of :meth:`spec` as canonical JSON.
 
         ``options["points"]`` (the chain runs of a sweep) is left out of the key: each point is
-        stored and reused on its own (:func:`stickslip.sweep.run_sweep`), so adding a point to a
+        stored and reused on its own (:func:`stickslip.experiments.sweep.run_sweep`), so adding a point to a
         spec keeps the run directory and runs only the new point.
         """
         spec = self.spec()
@@ -282,3 +288,44 @@ def experiment(mode: str, name: str) -> Experiment:
         if exp.name == name:
             return exp
     raise KeyError(f"no experiment {name!r} in mode {mode!r}")
+
+
+# ---------------------------------------------------------------------------------------------
+# Outcomes, and the settings of one chain point
+
+
+@dataclass
+class Outcome:
+    """An experiment's loaded result: ``data`` (runner-specific), ``summary``, whether reused."""
+
+    experiment: Experiment
+    run_dir: Path
+    data: dict[str, Any]
+    summary: dict[str, Any]
+    reused: bool
+    wall_seconds: float
+
+
+_CHAIN_FIELDS = ("N", "K", "D", "V", "beta", "alpha", "Fs", "dt")
+
+
+def point_settings(cfg: dict[str, Any]) -> tuple[ChainParams, float, dict[str, Any]]:
+    """Parameters, t_end and run options of one chain point from its merged settings."""
+    params = ChainParams(**{k: cfg[k] for k in _CHAIN_FIELDS if k in cfg})
+    t_end = float(cfg["t_end_by_N"][str(params.N)])
+    options: dict[str, Any] = {
+        "sample_interval": float(cfg["sample_interval"]),
+        "average_from": float(cfg["average_fraction"]) * t_end,
+        "until_steady": float(cfg["until_steady"]) if params.beta > float(cfg["until_steady_above"]) else None,
+    }
+    if params.N == int(cfg["profile_N"]) and any(math.isclose(params.beta, float(b)) for b in cfg["profile_betas"]):
+        options["profile_window"] = float(cfg["profile_window"])
+        options["profile_min_blocks"] = int(float(cfg["profile_min_fraction"]) * params.N)
+    return params, t_end, options
+
+
+def chain_common(exp: Experiment) -> dict[str, Any]:
+    """The settings every chain point of ``exp`` shares: its parameters and options, less the point lists."""
+    common = dict(exp.params)
+    common.update({k: v for k, v in exp.options.items() if k not in ("points", "sweep_N", "figure_N")})
+    return common

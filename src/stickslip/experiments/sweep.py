@@ -37,7 +37,8 @@ import pandas as pd
 
 from stickslip import __version__
 from stickslip.io import read_json, run_metadata, write_dataset, write_json, write_table
-from stickslip.params import BlockParams, ChainParams
+from stickslip.jsonable import to_jsonable
+from stickslip.models.params import BlockParams, ChainParams
 
 __all__ = [
     "run_sweep",
@@ -97,8 +98,6 @@ def point_name(point: dict[str, Any]) -> str:
 
 def _jsonable(value: Any) -> Any:
     """A JSON round trip, so that stored and requested specs compare equal (tuples -> lists, ...)."""
-    from stickslip.cli._common import to_jsonable
-
     return json.loads(json.dumps(to_jsonable(value)))
 
 
@@ -352,10 +351,10 @@ def _split(point: dict[str, Any], params_cls: type, options: tuple[str, ...]) ->
 def chain_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     """Run the chain of eq. (4) at one point; its outputs go to ``point_dir``; returns its summary.
 
-    ``point`` holds :class:`~stickslip.params.ChainParams` fields, ``t_end`` and optionally the
+    ``point`` holds :class:`~stickslip.models.params.ChainParams` fields, ``t_end`` and optionally the
     run options in :data:`CHAIN_RUN_OPTIONS`.
     """
-    from stickslip import chain  # imported here: workers load the simulator only when needed
+    from stickslip.run import driver as chain  # imported here: workers load the simulator only when needed
 
     params, options = _split(point, ChainParams, CHAIN_RUN_OPTIONS)
     t_end = options.pop("t_end")
@@ -368,11 +367,11 @@ def chain_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
 def block_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     """Run the single block of eq. (1) at one point and return its summary.
 
-    ``point`` holds :class:`~stickslip.params.BlockParams` fields, ``t_end`` and optionally
+    ``point`` holds :class:`~stickslip.models.params.BlockParams` fields, ``t_end`` and optionally
     ``every`` (the sampling stride). Writes ``series.nc`` (x, v, theta, f over t),
     ``slips.parquet`` (one row per slip) and ``run.json`` (parameters, versions, summary).
     """
-    from stickslip import block  # imported here: workers load the simulator only when needed
+    from stickslip.run import block  # imported here: workers load the simulator only when needed
 
     params, options = _split(point, BlockParams, BLOCK_RUN_OPTIONS)
     t_end = options.pop("t_end")

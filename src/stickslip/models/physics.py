@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from stickslip.params import BlockParams, ChainParams
+from stickslip.models.params import BlockParams, ChainParams
 
 
 def sliding_friction(V: float, beta: float) -> float:

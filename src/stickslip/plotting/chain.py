@@ -2,7 +2,7 @@
 
 Each function takes results of a chain run (a snapshot of x_i, a table of <L> against beta, the
 ``profiles``/``first_move``/``events`` tables) and analysis results from
-:mod:`stickslip.statistics`, and returns a matplotlib Figure. Blocks are numbered 1..N.
+:mod:`stickslip.analysis.statistics`, and returns a matplotlib Figure. Blocks are numbered 1..N.
 """
 
 from __future__ import annotations
@@ -16,10 +16,10 @@ import xarray as xr
 from matplotlib import cm
 from matplotlib.figure import Figure
 
-from stickslip.params import ChainParams
-from stickslip.physics import chain_steady_length, chain_steady_profile_paper, chain_steady_state
+from stickslip.analysis.statistics import FrontSpeed, PowerLawFit, size_distribution
+from stickslip.models.params import ChainParams
+from stickslip.models.physics import chain_steady_length, chain_steady_profile_paper, chain_steady_state
 from stickslip.plotting.style import PAPER, SIM, THEORY, new_figure
-from stickslip.statistics import FrontSpeed, PowerLawFit, size_distribution
 
 __all__ = ["fig5a_snapshot", "fig5b_length", "fig6_fronts", "fig7_8_sizes", "PAPER_FRONT_SPEED"]
 
@@ -43,7 +43,7 @@ def fig5a_snapshot(x: Any, params: ChainParams, t: float) -> Figure:
     """Fig. 5(a): snapshot of x_i at time t against the steady sliding profile.
 
     Top: x_i - V t of the run (solid), of the exact discrete steady sliding solution
-    (:func:`~stickslip.physics.chain_steady_state`, dashed) and of the paper's continuum form
+    (:func:`~stickslip.models.physics.chain_steady_state`, dashed) and of the paper's continuum form
     x_i = V t - c/K {N^2 - (i - N)^2}/2 (dotted), all in the frame moving with the pulling point
     x_0 = V t. Bottom: the run's departure from the exact steady profile, and the continuum
     form's, which lies c i / (2K) above it (c N / (2K), about 20, at the free end of the paper's chain).
@@ -79,7 +79,7 @@ def fig5b_length(table: pd.DataFrame, params: ChainParams, *, beta_c: float = 1.
 
     ``table`` has columns ``beta`` and ``L_mean`` (and optionally ``L_err``, drawn as error
     bars), e.g. a sweep's summary. The dashed line is the exact discrete steady sliding length
-    L = c N (N - 1) / (2K), c = 1 - (1 - beta) V (:func:`~stickslip.physics.chain_steady_length`)
+    L = c N (N - 1) / (2K), c = 1 - (1 - beta) V (:func:`~stickslip.models.physics.chain_steady_length`)
     for the other parameters of ``params``; the paper's printed L = c N^2 / 2 lacks the factor
     1/K (MODEL.md) and is not drawn. The dotted vertical line marks beta_c = 1, where the
     long-wave instability sets in (Fig. 4).
@@ -172,7 +172,7 @@ def fig6_fronts(
     Delta t = ``window`` (20 in the paper) from the event's start, stacked upwards in time like
     the paper's plot (``profiles``: dim ``row`` with ``event``, ``t`` and ``dx(row, block)``).
     Right: the time each block first moved against i, the front speed fitted over the far part
-    of the chain (:func:`~stickslip.statistics.front_speed`), the paper's c = 1.43 and the sound
+    of the chain (:func:`~stickslip.analysis.statistics.front_speed`), the paper's c = 1.43 and the sound
     speed sqrt(K) = 3.16 (for K = 10) as slopes from the same point.
     """
     fronts = list(fronts)
@@ -205,7 +205,7 @@ def fig7_8_sizes(
 ) -> Figure:
     """Figs. 7 (beta = 1) and 8 (beta = 0.2): (a) slip-size distribution, (b) S against event time.
 
-    (a): the density of S on logarithmic bins (:func:`~stickslip.statistics.size_distribution`,
+    (a): the density of S on logarithmic bins (:func:`~stickslip.analysis.statistics.size_distribution`,
     normalised for bin width) with the fitted power law p ~ S^-tau over [s_min, s_max]
     (scaled by the share of events in that range); ``paper_tau`` adds the paper's exponent
     (1.5 at beta = 1, about 1.6 at beta = 0.2) as a dotted guide. (b): S of every event against

@@ -1,7 +1,7 @@
 """Figures of the linear stability (section 2, Fig. 4) and of the hysteresis loop (section 2).
 
-Each function takes results (the Datasets of :mod:`stickslip.stability` and
-:mod:`stickslip.hysteresis`) and returns a matplotlib Figure.
+Each function takes results (the Datasets of :mod:`stickslip.analysis.stability` and
+:mod:`stickslip.analysis.hysteresis`) and returns a matplotlib Figure.
 """
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ def plot_stability_map(
 ) -> Figure:
     """Stability map of steady sliding of the block (section 2, eq. 2): V_c(beta) at fixed K.
 
-    ``curve`` is :func:`stickslip.stability.hopf_curve`; ``growth`` (optional) the largest
+    ``curve`` is :func:`stickslip.analysis.stability.hopf_curve`; ``growth`` (optional) the largest
     Re(lambda) over (beta, V), shown as shading; ``mark`` an optional {"beta", "V"} point.
     """
     fig, ax = new_figure(width=5.6, height=4.0)
@@ -57,7 +57,7 @@ def plot_stability_map(
 def plot_fig4(ds: xr.Dataset, *, k_zoom: float = 0.3) -> Figure:
     """Fig. 4: real parts of the two largest eigenvalues of the Fourier modes of eq. (5).
 
-    ``ds`` is :func:`stickslip.stability.fig4_data`. Left: 0 <= k <= pi; right: the long
+    ``ds`` is :func:`stickslip.analysis.stability.fig4_data`. Left: 0 <= k <= pi; right: the long
     waves k <= ``k_zoom``, where the instability for beta < alpha lives. Solid: largest,
     dashed: second largest; one colour per beta.
     """
@@ -89,7 +89,7 @@ def plot_fig4(ds: xr.Dataset, *, k_zoom: float = 0.3) -> Figure:
 def plot_hysteresis(sweep: xr.Dataset) -> Figure:
     """Bifurcation diagram of the single block (section 2): max and min of v against V.
 
-    ``sweep`` is :func:`stickslip.hysteresis.hysteresis_sweep`'s ``data``: both sweeps, with
+    ``sweep`` is :func:`stickslip.analysis.hysteresis.hysteresis_sweep`'s ``data``: both sweeps, with
     the transitions V_up and V_down marked and the paper's V = 0.345 for comparison.
     """
     fig, ax = new_figure(width=6.0, height=4.0)

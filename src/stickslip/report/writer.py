@@ -20,6 +20,7 @@ from typing import Any, Iterable, Mapping
 
 from stickslip import __version__
 from stickslip.io import atomic_path, read_json, write_json
+from stickslip.jsonable import to_jsonable
 
 __all__ = ["ReportRow", "ReportFigure", "Report", "write_report", "read_report", "agreement_text"]
 
@@ -222,8 +223,6 @@ def _meta_html(meta: Mapping[str, Any]) -> str:
 
 def _json_text(value: Any) -> str:
     import json
-
-    from stickslip.cli._common import to_jsonable
 
     return json.dumps(to_jsonable(value), allow_nan=False)
 

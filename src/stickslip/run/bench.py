@@ -11,8 +11,8 @@ import platform
 import time
 from typing import Any
 
-from stickslip.chain import run_chain
-from stickslip.params import ChainParams
+from stickslip.models.params import ChainParams
+from stickslip.run.driver import run_chain
 
 
 def _warm(params: ChainParams, start: str) -> None:
@@ -91,7 +91,7 @@ def _unit_costs(params: ChainParams) -> dict[str, float]:
     """
     import numpy as np
 
-    from stickslip.chain import ChainState
+    from stickslip.run.state import ChainState
 
     def timed(p, t_end, start):
         """Best time of three runs, less that of a one-step run (the driver's fixed cost)."""

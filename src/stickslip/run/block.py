@@ -1,24 +1,24 @@
-"""The single block and spring of section 2: runs of eq. (1), their slips, the period sweep.
+"""The single block and spring of section 2: runs of eq. (1) and their slips.
 
 A run starts at t = 0 from a :class:`BlockState` and advances eq. (1) with the compiled Heun
 step of :mod:`stickslip.kernels.block` (start and stop rules of MODEL.md). It returns a
 :class:`BlockRun`: the time series as an xarray Dataset, the table of slips as a pandas
-DataFrame, the final state and a few statistics gathered over every step.
+DataFrame, the final state and a few statistics gathered over every step. The period sweep of
+Fig. 3 is :func:`stickslip.analysis.slip_limit.period_sweep`.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any, Iterable
+from typing import Any
 
 import numpy as np
 import pandas as pd
 import xarray as xr
 
 from stickslip.kernels.block import heun_block
-from stickslip.params import BlockParams, ParameterError, check_number, steps_for
-from stickslip.slip_limit import solve_slip_limit
+from stickslip.models.params import BlockParams, ParameterError, check_number, steps_for
 
 INTEGRATOR = "heun (explicit trapezoid, fixed dt) with the start/stop rules of MODEL.md"
 
@@ -237,48 +237,3 @@ def first_start_time(params: BlockParams, initial: BlockState | None = None) -> 
     if params.V <= 0.0:
         return math.inf
     return max(0.0, (params.Fs / params.K + initial.x) / params.V)
-
-
-def period_sweep(
-    params: BlockParams,
-    V_values: Iterable[float],
-    *,
-    periods: int = 4,
-) -> pd.DataFrame:
-    """Simulated stick-slip period of eq. (1) at several pulling velocities V (Fig. 3).
-
-    Each V is run from the paper's initial state to the first slip plus ``periods`` + 1/2
-    periods of the law T(V) of eq. (3) (:mod:`stickslip.slip_limit`); the period is the mean of
-    the slip table's ``period`` over the slips after the first. Returns one row per V with
-    the simulated period, its spread, the number of periods averaged and the law's T(V).
-    """
-    periods = int(check_number("periods", periods, low=1, integer=True))
-    V_values = [float(check_number("V", V, low=0.0, low_open=True)) for V in V_values]
-    law = solve_slip_limit(params, dense=False)
-    rows = []
-    for V in V_values:
-        p = params.replace(V=V)
-        T = law.period(V)
-        t_end = first_start_time(p) + (periods + 0.5) * T
-        steps = steps_for(t_end, p.dt)
-        run = simulate_block(p, t_end, every=max(1, steps))
-        s = run.summary()
-        rows.append(
-            {
-                "V": V,
-                "period": s["period"],
-                "period_std": s["period_std"],
-                "n_periods": max(0, s["events"] - 1),
-                "period_law": T,
-                "rel_dev": s["period"] / T - 1.0,
-                "slip_duration": s["slip_duration"],
-                "force_at_stop": s["force_at_stop"],
-            }
-        )
-    return pd.DataFrame(rows)
-
-
-def paper_V_values(n: int = 13, low: float = 1e-3, high: float = 1e-1) -> np.ndarray:
-    """Pulling velocities for Fig. 3: ``n`` values evenly spaced in log V from ``low`` to ``high``."""
-    n = int(check_number("n", n, low=2, integer=True))
-    return np.logspace(math.log10(low), math.log10(high), n)

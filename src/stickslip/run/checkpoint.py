@@ -1,0 +1,147 @@
+"""Checkpoints of a chain run (eq. 4): checksummed npz files and :class:`Checkpointer`.
+
+A checkpoint is the state file ``checkpoint/state.npz`` plus append-only part files of the
+outputs; every file is written atomically with a SHA-256 over its arrays and header.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from stickslip import __version__
+from stickslip.kernels import chain as K
+from stickslip.run.errors import ChainRunError
+from stickslip.run.outputs import PART_KEYS, _Outputs
+from stickslip.run.state import ChainState
+
+# Bump whenever the layout of the state arrays (kernels.chain.IST_SIZE included) changes.
+CHECKPOINT_FORMAT = 2
+
+
+def _checksum(arrays: dict[str, np.ndarray], header: dict[str, Any]) -> str:
+    h = hashlib.sha256(json.dumps(header, sort_keys=True).encode())
+    for key in sorted(arrays):
+        a = np.ascontiguousarray(arrays[key])
+        h.update(key.encode())
+        h.update(str(a.dtype).encode())
+        h.update(str(a.shape).encode())
+        h.update(a.tobytes())
+    return h.hexdigest()
+
+
+def _write_npz(path: Path, arrays: dict[str, np.ndarray], header: dict[str, Any]) -> str:
+    """Write arrays + a JSON header + their checksum to ``path`` atomically; returns the checksum."""
+    from stickslip.io import atomic_path
+
+    digest = _checksum(arrays, header)
+    payload = dict(arrays)
+    payload["__header__"] = np.frombuffer(json.dumps(header, sort_keys=True).encode(), dtype=np.uint8)
+    payload["__checksum__"] = np.frombuffer(digest.encode(), dtype=np.uint8)
+    with atomic_path(path) as tmp:
+        with open(tmp, "wb") as fh:
+            np.savez(fh, **payload)
+            fh.flush()
+            os.fsync(fh.fileno())
+    return digest
+
+
+def _read_npz(path: Path) -> tuple[dict[str, np.ndarray], dict[str, Any], str]:
+    """Read and verify a file written by :func:`_write_npz`; raises ChainRunError if corrupt."""
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            arrays = {k: z[k] for k in z.files}
+        header = json.loads(arrays.pop("__header__").tobytes().decode())
+        stored = arrays.pop("__checksum__").tobytes().decode()
+    except Exception as exc:  # any damage to the file: refuse it
+        raise ChainRunError(f"checkpoint file {path} is unreadable or corrupt ({type(exc).__name__})") from None
+    if _checksum(arrays, header) != stored:
+        raise ChainRunError(f"checkpoint file {path} is corrupt (checksum mismatch)")
+    return arrays, header, stored
+
+
+def _check_layout(arrays: dict[str, np.ndarray], header: dict[str, Any]) -> None:
+    """Refuse state arrays that do not fit the header's N or this version's layout."""
+    try:
+        N = int(header["params"]["N"])
+    except (KeyError, TypeError, ValueError):
+        raise ChainRunError("checkpoint header has no valid N") from None
+    expected = {
+        "x": (np.float64, (N + 2,)), "v": (np.float64, (N + 2,)), "th": (np.float64, (N + 2,)),
+        "mov": (np.float64, (N + 2,)), "x0ev": (np.float64, (N + 2,)),
+        "first_step": (np.int64, (N + 2,)), "ist": (np.int64, (K.IST_SIZE,)),
+    }
+    for name, (dtype, shape) in expected.items():
+        a = arrays[name]
+        if a.dtype != dtype or a.shape != shape:
+            raise ChainRunError(
+                f"checkpoint array {name} has shape {a.shape} and type {a.dtype}, "
+                f"expected {shape} and {np.dtype(dtype)} for N = {N}"
+            )
+
+
+class Checkpointer:
+    """Checkpoints of one run directory: ``checkpoint/state.npz`` plus append-only output parts.
+
+    Each checkpoint first writes the outputs produced since the last one as a new part file,
+    then atomically replaces the state file, which lists the parts (with their checksums)
+    that belong to it. A kill at any moment leaves the previous checkpoint intact; parts not
+    listed by the state file are ignored and removed on resume.
+    """
+
+    def __init__(self, run_dir: Path):
+        self.dir = Path(run_dir) / "checkpoint"
+        self.parts: list[dict[str, str]] = []
+        self.since: dict[str, int] = {}
+
+    @property
+    def state_path(self) -> Path:
+        return self.dir / "state.npz"
+
+    def write(self, state: ChainState, outputs: _Outputs, header: dict[str, Any]) -> Path:
+        self.dir.mkdir(parents=True, exist_ok=True)
+        new = outputs.take_new(self.since)
+        name = f"part-{len(self.parts):06d}.npz"
+        digest = _write_npz(self.dir / name, new, {"format": CHECKPOINT_FORMAT})
+        self.parts.append({"file": name, "sha256": digest})
+        arrays = {k: getattr(state, k) for k in ChainState.ARRAYS}
+        full_header = dict(header, format=CHECKPOINT_FORMAT, parts=self.parts, version=__version__,
+                           ist_size=K.IST_SIZE)
+        _write_npz(self.state_path, arrays, full_header)
+        return self.state_path
+
+    def load(self) -> tuple[ChainState, dict[str, Any], dict[str, list[np.ndarray]]]:
+        if not self.state_path.exists():
+            raise ChainRunError(f"no checkpoint in {self.dir.parent} (missing {self.state_path.name})")
+        arrays, header, _ = _read_npz(self.state_path)
+        if header.get("format") != CHECKPOINT_FORMAT:
+            raise ChainRunError(
+                f"checkpoint format {header.get('format')} is not supported (this version reads {CHECKPOINT_FORMAT})"
+            )
+        missing = [k for k in ChainState.ARRAYS if k not in arrays]
+        if missing:
+            raise ChainRunError(f"checkpoint is missing arrays {missing}")
+        _check_layout(arrays, header)
+        state = ChainState(**{k: arrays[k].copy() for k in ChainState.ARRAYS})
+        parts: dict[str, list[np.ndarray]] = {k: [] for k in PART_KEYS}
+        listed = header.get("parts", [])
+        for entry in listed:
+            part_arrays, _, digest = _read_npz(self.dir / entry["file"])
+            if digest != entry["sha256"]:
+                raise ChainRunError(f"checkpoint part {entry['file']} does not match the state file")
+            for key in PART_KEYS:
+                if key in part_arrays and part_arrays[key].shape[0]:
+                    parts[key].append(part_arrays[key])
+        keep = {entry["file"] for entry in listed}
+        for stray in self.dir.glob("part-*.npz"):
+            if stray.name not in keep:
+                stray.unlink()
+        for tmp in self.dir.glob(".*.tmp"):  # left by a write that was killed
+            tmp.unlink()
+        self.parts = list(listed)
+        return state, header, parts

@@ -1,0 +1,22 @@
+"""Errors of a chain run (eq. 4): a run that cannot go on, a non-finite state, a stop by a signal."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+
+class ChainRunError(RuntimeError):
+    """A chain run cannot go on (non-finite state, bad checkpoint)."""
+
+
+class NonFiniteState(ChainRunError):
+    """The state of the chain became non-finite; the message names the time and the block."""
+
+
+class Interrupted(Exception):
+    """A run was stopped by a signal after writing its checkpoint."""
+
+    def __init__(self, checkpoint: Path | None, t: float):
+        super().__init__(f"interrupted at t = {t:g}; checkpoint in {checkpoint}")
+        self.checkpoint = checkpoint
+        self.t = t

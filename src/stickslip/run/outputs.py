@@ -1,0 +1,279 @@
+"""What a chain run (eq. 4) records and returns: :class:`RunOptions`, :class:`ChainRun`, the output buffers.
+
+The kernels fill fixed-size buffers (:class:`_Outputs`) that are flushed into Python-side parts;
+:func:`_assemble` turns the parts into the event table (MODEL.md, "Slip events"), the first moves
+(rupture fronts, Fig. 6), L(t) (Fig. 5b), the snapshots (Fig. 5a), the displacement profiles
+(Fig. 6) and the run's summary.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import pandas as pd
+import xarray as xr
+
+from stickslip.kernels import chain as K
+from stickslip.models import physics
+from stickslip.models.params import ChainParams, ParameterError, check_number, steps_for
+from stickslip.run.state import ChainState
+
+
+@dataclass(frozen=True)
+class RunOptions:
+    """What a run records besides its state. Times are in the model's time units.
+
+    sample_interval: L = x_1 - x_N is sampled every this long (Fig. 5b);
+    average_from: <L> is the mean of the samples with t >= average_from (default t_end / 2);
+    snapshot_times: times at which all x_i are stored (Fig. 5a); the final state is always kept;
+    profile_window: if set, x_i is stored every this long during each event, for the
+    displacement over windows of Fig. 6, for events with >= profile_min_blocks moved blocks;
+    until_steady: if set, the run stops at the first sampling time at which every block slides
+    and the state is within this tolerance of steady sliding (:func:`steady_deviation`).
+    """
+
+    t_end: float
+    sample_interval: float = 10.0
+    average_from: float | None = None
+    snapshot_times: tuple[float, ...] = ()
+    profile_window: float | None = None
+    profile_min_blocks: int = 0
+    until_steady: float | None = None
+
+    def validated(self, dt: float) -> "RunOptions":
+        check_number("t_end", self.t_end, low=0.0)
+        check_number("sample_interval", self.sample_interval, low=0.0, low_open=True)
+        if round(self.sample_interval / dt) < 1:
+            raise ParameterError(f"sample_interval must be >= dt = {dt:g} (got {self.sample_interval!r})")
+        if self.average_from is not None:
+            check_number("average_from", self.average_from, low=0.0)
+        for t in self.snapshot_times:
+            check_number("snapshot time", t, low=0.0, high=self.t_end)
+        if self.profile_window is not None:
+            check_number("profile_window", self.profile_window, low=0.0, low_open=True)
+            if round(self.profile_window / dt) < 1:
+                raise ParameterError(f"profile_window must be >= dt = {dt:g} (got {self.profile_window!r})")
+        check_number("profile_min_blocks", self.profile_min_blocks, low=0, integer=True)
+        if self.until_steady is not None:
+            check_number("until_steady", self.until_steady, low=0.0, low_open=True)
+        return self
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "t_end": self.t_end,
+            "sample_interval": self.sample_interval,
+            "average_from": self.average_from,
+            "snapshot_times": list(self.snapshot_times),
+            "profile_window": self.profile_window,
+            "profile_min_blocks": self.profile_min_blocks,
+            "until_steady": self.until_steady,
+        }
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> "RunOptions":
+        d = dict(d)
+        d["snapshot_times"] = tuple(d.get("snapshot_times", ()))
+        return cls(**d)
+
+
+EVENT_COLUMNS = ["event", "step_start", "step_end", "t_start", "t_end", "duration", "S",
+                 "start_block", "max_block", "n_blocks"]
+
+
+@dataclass
+class ChainRun:
+    """The result of a chain run (eq. 4): events, first moves, L(t), snapshots, profiles, state."""
+
+    params: ChainParams
+    options: RunOptions
+    integrator: str
+    start: dict[str, Any]
+    state: ChainState
+    events: pd.DataFrame
+    first_move: pd.DataFrame
+    samples: xr.Dataset
+    snapshots: xr.DataArray
+    profiles: xr.Dataset
+    summary: dict[str, Any]
+
+    @property
+    def t_end(self) -> float:
+        return self.options.t_end
+
+    @property
+    def steps(self) -> int:
+        return self.state.step
+
+
+class _Outputs:
+    """Output buffers shared with the kernels, and what has been flushed from them."""
+
+    def __init__(self, N: int, profiling: bool):
+        self.ev_int = np.zeros((4096, K.EV_INT_COLS), dtype=np.int64)
+        self.ev_S = np.zeros(4096)
+        self.fm = np.zeros((max(65536, 4 * (N + 1)), 3), dtype=np.int64)
+        self.samp_L = np.zeros(65536)
+        self.samp_step = np.zeros(65536, dtype=np.int64)
+        rows = 256 if profiling else 2
+        self.prof_x = np.zeros((rows, N))
+        self.prof_meta = np.zeros((rows, 2), dtype=np.int64)
+        self.parts: dict[str, list[np.ndarray]] = {k: [] for k in PART_KEYS}
+
+    def kernel_args(self):
+        return (self.ev_int, self.ev_S, self.fm, self.samp_L, self.samp_step, self.prof_x, self.prof_meta)
+
+    def flush(self, ist: np.ndarray) -> None:
+        """Move filled buffer rows into Python-side lists and reset the counts."""
+        ne, nf, ns, npr = (int(ist[K.EV_COUNT]), int(ist[K.FM_COUNT]), int(ist[K.S_COUNT]), int(ist[K.P_COUNT]))
+        if ne:
+            self.parts["ev_int"].append(self.ev_int[:ne].copy())
+            self.parts["ev_S"].append(self.ev_S[:ne].copy())
+        if nf:
+            self.parts["fm"].append(self.fm[:nf].copy())
+        if ns:
+            self.parts["samp_L"].append(self.samp_L[:ns].copy())
+            self.parts["samp_step"].append(self.samp_step[:ns].copy())
+        if npr:
+            self.parts["prof_x"].append(self.prof_x[:npr].copy())
+            self.parts["prof_meta"].append(self.prof_meta[:npr].copy())
+        ist[K.EV_COUNT] = ist[K.FM_COUNT] = ist[K.S_COUNT] = ist[K.P_COUNT] = 0
+        ist[K.EV_P_FIRST] = 0
+
+    def add_snapshot(self, step: int, x: np.ndarray) -> None:
+        self.parts["snap_step"].append(np.array([step], dtype=np.int64))
+        self.parts["snap_x"].append(x[1:-1].copy()[None, :])
+
+    def take_new(self, since: dict[str, int]) -> dict[str, np.ndarray]:
+        """Concatenate the parts added since ``since`` (counts per key); updates ``since``."""
+        out = {}
+        for key in PART_KEYS:
+            new = self.parts[key][since.get(key, 0):]
+            since[key] = len(self.parts[key])
+            out[key] = _concat(key, new)
+        return out
+
+    def all(self) -> dict[str, np.ndarray]:
+        return {key: _concat(key, self.parts[key]) for key in PART_KEYS}
+
+
+PART_KEYS = ("ev_int", "ev_S", "fm", "samp_L", "samp_step", "prof_x", "prof_meta", "snap_step", "snap_x")
+_PART_SHAPES = {"ev_int": (0, K.EV_INT_COLS), "ev_S": (0,), "fm": (0, 3), "samp_L": (0,),
+                "samp_step": (0,), "prof_x": None, "prof_meta": (0, 2), "snap_step": (0,), "snap_x": None}
+_PART_DTYPES = {"ev_int": np.int64, "fm": np.int64, "samp_step": np.int64, "prof_meta": np.int64,
+                "snap_step": np.int64}
+
+
+def _concat(key: str, arrays: list[np.ndarray]) -> np.ndarray:
+    if arrays:
+        return np.concatenate(arrays, axis=0)
+    shape = _PART_SHAPES[key] or (0, 0)
+    return np.zeros(shape, dtype=_PART_DTYPES.get(key, np.float64))
+
+
+def _assemble(params, options, integrator, start_info, state, outputs, wall, steady_at=None) -> ChainRun:
+    dt = params.dt
+    parts = outputs.all()
+    ev = parts["ev_int"]
+    events = pd.DataFrame({
+        "event": ev[:, K.E_ID],
+        "step_start": ev[:, K.E_START_STEP],
+        "step_end": ev[:, K.E_END_STEP],
+        "t_start": ev[:, K.E_START_STEP] * dt,
+        "t_end": (ev[:, K.E_END_STEP] + 1) * dt,
+        "duration": (ev[:, K.E_END_STEP] + 1 - ev[:, K.E_START_STEP]) * dt,
+        "S": parts["ev_S"],
+        "start_block": ev[:, K.E_START_BLOCK],
+        "max_block": ev[:, K.E_MAX_BLOCK],
+        "n_blocks": ev[:, K.E_N_BLOCKS],
+    }, columns=EVENT_COLUMNS)
+    fm = parts["fm"]
+    first_move = pd.DataFrame({"event": fm[:, 0], "block": fm[:, 1], "step": fm[:, 2], "t_first": fm[:, 2] * dt})
+    t_samples = parts["samp_step"] * dt
+    samples = xr.Dataset(
+        {"L": ("t", parts["samp_L"], {"long_name": "total length x_1 - x_N"})},
+        coords={"t": ("t", t_samples, {"units": "model time"})},
+    )
+    blocks = np.arange(1, params.N + 1)
+    snap_steps = list(parts["snap_step"]) + [state.step]
+    snap_x = np.vstack([parts["snap_x"].reshape(-1, params.N), state.x[1:-1][None, :]])
+    order = np.argsort(snap_steps, kind="stable")
+    snapshots = xr.DataArray(
+        snap_x[order], dims=("time", "block"),
+        coords={"time": np.asarray(snap_steps)[order] * dt, "block": blocks}, name="x",
+        attrs={"long_name": "block positions x_i"},
+    )
+    profiles = _profiles(parts, events, options, params)
+    L_final = float(state.x[1] - state.x[-2])
+    avg_from = options.average_from if options.average_from is not None else options.t_end / 2
+    sel = t_samples >= avg_from - 0.5 * dt
+    L_values = parts["samp_L"][sel]
+    early: dict[str, Any] = {"stopped_early": False}
+    if steady_at:
+        # From the stop on, the chain is taken to slide steadily: L = L_ss at the remaining samples.
+        L_ss = physics.chain_steady_length(params)
+        sample_every = int(round(options.sample_interval / dt))
+        n_end = steps_for(options.t_end, dt)
+        later = np.arange((state.step // sample_every + 1) * sample_every, n_end + 1, sample_every) * dt
+        n_virtual = int(np.count_nonzero(later >= avg_from - 0.5 * dt))
+        L_values = np.concatenate([L_values, np.full(n_virtual, L_ss)])
+        L_final = L_ss
+        early = {
+            "stopped_early": True,
+            "reason": (f"steady sliding reached at t = {steady_at['t_steady']:g}: every block slides "
+                       f"within {options.until_steady:g} of the steady state (deviation "
+                       f"{steady_at['deviation']:.3g}); L taken from the steady solution from then on"),
+            "t_steady": steady_at["t_steady"],
+            "steady_deviation": steady_at["deviation"],
+            "until_steady": options.until_steady,
+            "L_final_simulated": float(state.x[1] - state.x[-2]),
+        }
+    L_mean = float(np.mean(L_values)) if len(L_values) else float("nan")
+    summary = {
+        "n_events": int(len(events)),
+        "event_in_progress": bool(state.ist[K.EV_ACTIVE]),
+        "L_final": L_final,
+        "L_mean": L_mean,
+        "L_mean_from": avg_from,
+        "L_steady": physics.chain_steady_length(params),
+        "t_end": options.t_end if steady_at else state.step * dt,
+        "t_reached": state.step * dt,
+        "steps": state.step,
+        "steps_computed": int(state.ist[K.STEPS_COMPUTED]),
+        "block_updates": int(state.ist[K.BLOCK_UPDATES]),
+        "full_block_updates": int(state.ist[K.FULL_UPDATES]) if integrator == "exact" else int(state.ist[K.BLOCK_UPDATES]),
+        "n_moving": int(state.ist[K.N_MOVING]),
+        "wall_seconds": wall,
+        "integrator": integrator,
+        "state_sha256": state.sha256(),
+        **early,
+    }
+    return ChainRun(params, options, integrator, start_info, state, events, first_move, samples,
+                    snapshots, profiles, summary)
+
+
+def _profiles(parts, events, options, params) -> xr.Dataset:
+    """Displacements dx_i = x_i(t + W) - x_i(t) over the stored windows of each event (Fig. 6)."""
+    px, pm = parts["prof_x"].reshape(-1, params.N), parts["prof_meta"]
+    keep_ids = set(events.loc[events["n_blocks"] >= options.profile_min_blocks, "event"].tolist())
+    rows_dx, rows_ev, rows_t0, rows_t1 = [], [], [], []
+    for eid in sorted(set(pm[:, 0].tolist()) & keep_ids) if len(pm) else []:
+        idx = np.flatnonzero(pm[:, 0] == eid)
+        idx = idx[np.argsort(pm[idx, 1], kind="stable")]
+        for a, b in zip(idx[:-1], idx[1:]):
+            rows_dx.append(px[b] - px[a])
+            rows_ev.append(eid)
+            rows_t0.append(pm[a, 1] * params.dt)
+            rows_t1.append(pm[b, 1] * params.dt)
+    dx = np.array(rows_dx).reshape(-1, params.N)
+    return xr.Dataset(
+        {"dx": (("row", "block"), dx, {"long_name": "displacement over the window"})},
+        coords={
+            "event": ("row", np.array(rows_ev, dtype=np.int64)),
+            "t": ("row", np.array(rows_t0, dtype=np.float64)),
+            "t_next": ("row", np.array(rows_t1, dtype=np.float64)),
+            "block": np.arange(1, params.N + 1),
+        },
+        attrs={"window": options.profile_window if options.profile_window else 0.0},
+    )

@@ -1,0 +1,140 @@
+"""The state of the chain of eq. (4): :class:`ChainState`, the initial states, the distance from steady sliding.
+
+The arrays carry ghost cells at index 0 and N + 1 (see :mod:`stickslip.kernels.chain`); the
+initial states are the paper's (section 3) and exact discrete steady sliding (MODEL.md).
+"""
+
+from __future__ import annotations
+
+import hashlib
+from dataclasses import dataclass
+
+import numpy as np
+
+from stickslip.kernels import chain as K
+from stickslip.models import physics
+from stickslip.models.params import ChainParams, ParameterError
+
+STARTS = ("paper", "steady")
+
+
+@dataclass
+class ChainState:
+    """Everything the kernels need to continue a run (arrays with ghost cells, see kernels).
+
+    x, v, th, mov: positions, velocities, state variables and moving mask (1.0/0.0) of
+    blocks 1..N at index 1..N; first_step, x0ev: per-block bookkeeping of the event in
+    progress; ist: the integer state vector (step count, event bookkeeping, active range).
+    """
+
+    x: np.ndarray
+    v: np.ndarray
+    th: np.ndarray
+    mov: np.ndarray
+    first_step: np.ndarray
+    x0ev: np.ndarray
+    ist: np.ndarray
+
+    ARRAYS = ("x", "v", "th", "mov", "first_step", "x0ev", "ist")
+
+    @property
+    def N(self) -> int:
+        return self.x.shape[0] - 2
+
+    @property
+    def step(self) -> int:
+        return int(self.ist[K.STEP])
+
+    @classmethod
+    def from_blocks(cls, x, v, theta, stopped) -> "ChainState":
+        """Build a state from per-block arrays (length N) of x, v, theta and stopped flags."""
+        x = np.asarray(x, dtype=np.float64)
+        N = x.shape[0]
+        arrays = {}
+        for name, values in (("x", x), ("v", v), ("th", theta)):
+            a = np.zeros(N + 2)
+            # Adding 0.0 turns -0.0 into +0.0, so "changed" (a float compare) sees every bit.
+            a[1:-1] = np.asarray(values, dtype=np.float64) + 0.0
+            arrays[name] = a
+        stopped = np.asarray(stopped, dtype=bool)
+        mov = np.zeros(N + 2)
+        mov[1:-1] = np.where(stopped, 0.0, 1.0)
+        arrays["v"][1:-1] = np.where(stopped, 0.0, arrays["v"][1:-1])
+        ist = np.zeros(K.IST_SIZE, dtype=np.int64)
+        ist[K.N_MOVING] = int(np.count_nonzero(~stopped))
+        ist[K.ACT_LO], ist[K.ACT_HI] = 1, N
+        ist[K.MECH_LO], ist[K.MECH_HI] = 1, N
+        return cls(
+            first_step=np.full(N + 2, -1, dtype=np.int64), x0ev=np.zeros(N + 2), mov=mov,
+            ist=ist, **arrays,
+        )
+
+    @classmethod
+    def paper(cls, p: ChainParams) -> "ChainState":
+        """The paper's initial state (section 3): x_i = 0, v_i = 0.1, theta_i = 0.1, all moving."""
+        N = p.N
+        return cls.from_blocks(np.zeros(N), np.full(N, 0.1), np.full(N, 0.1), np.zeros(N, bool))
+
+    @classmethod
+    def steady(cls, p: ChainParams, amplitude: float = 0.0, seed: int = 0) -> "ChainState":
+        """Exact discrete steady sliding (MODEL.md) at t = 0, all blocks moving.
+
+        With ``amplitude`` > 0, x_i and v_i get independent uniform perturbations in
+        [-amplitude, amplitude] drawn from numpy's default generator with ``seed``.
+        """
+        s = physics.chain_steady_state(p, 0.0)
+        x, v = s["x"].copy(), s["v"].copy()
+        if amplitude > 0:
+            rng = np.random.default_rng(seed)
+            x += rng.uniform(-amplitude, amplitude, p.N)
+            v += rng.uniform(-amplitude, amplitude, p.N)
+        return cls.from_blocks(x, v, s["theta"], np.zeros(p.N, bool))
+
+    def blocks(self) -> dict[str, np.ndarray]:
+        """Per-block copies: x, v, theta (float64) and stopped (bool), block i at index i - 1."""
+        return {
+            "x": self.x[1:-1].copy(),
+            "v": self.v[1:-1].copy(),
+            "theta": self.th[1:-1].copy(),
+            "stopped": self.mov[1:-1] == 0.0,
+        }
+
+    def sha256(self) -> str:
+        """SHA-256 of x, v, theta (float64 little-endian, block order) then stopped (1 byte each)."""
+        h = hashlib.sha256()
+        for a in (self.x, self.v, self.th):
+            h.update(np.ascontiguousarray(a[1:-1], dtype="<f8").tobytes())
+        h.update((self.mov[1:-1] == 0.0).astype(np.uint8).tobytes())
+        return h.hexdigest()
+
+    def copy(self) -> "ChainState":
+        return ChainState(**{k: getattr(self, k).copy() for k in self.ARRAYS})
+
+
+def initial_state(p: ChainParams, start: str = "paper", *, amplitude: float = 0.0, seed: int = 0) -> ChainState:
+    """The initial state named by ``start``: 'paper' (section 3) or 'steady' (MODEL.md)."""
+    if start == "paper":
+        return ChainState.paper(p)
+    if start == "steady":
+        return ChainState.steady(p, amplitude, seed)
+    raise ParameterError(f"start must be one of {', '.join(STARTS)} (got {start!r})")
+
+
+def steady_deviation(state: ChainState, p: ChainParams) -> float:
+    """Distance of a state from steady sliding of the chain (MODEL.md), in the frame moving with V.
+
+    The largest of |v_i - V|, |theta_i - theta_0| and |e_i - e_i^ss| over all blocks, where
+    e_i = x_{i-1} - x_i are the spring extensions (x_0 = V t_n) and e_i^ss = (c/K)(N - i + 1)
+    those of steady sliding. Infinite unless every block is moving.
+    """
+    if np.any(state.mov[1:-1] == 0.0):
+        return float("inf")
+    ss = physics.chain_steady_state(p)
+    x = state.x[1:-1]
+    x0 = p.V * (np.float64(state.step) * p.dt)
+    ext = np.diff(np.concatenate(([x0], x))) * -1.0
+    return float(max(
+        np.max(np.abs(state.v[1:-1] - ss["v"])),
+        np.max(np.abs(state.th[1:-1] - ss["theta"])),
+        np.max(np.abs(ext - ss["ext"])),
+    ))
