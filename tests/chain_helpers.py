@@ -152,7 +152,7 @@ class OracleRun:
     nonfinite: tuple | None = None  # (step after which the state is non-finite, first bad block)
 
 
-def oracle_run(x, v, th, moving, p, n_steps: int) -> OracleRun:
+def oracle_run(x, v, th, moving, p, n_steps: int, step=None) -> OracleRun:
     """Step :func:`heun_step` n_steps times from step 0 and find the slip events (MODEL.md):
     an event starts with the first step in which any block moves after a step that ended with
     every block stopped (the initial state counts as such), and ends with the first step that
@@ -164,7 +164,7 @@ def oracle_run(x, v, th, moving, p, n_steps: int) -> OracleRun:
     for n in range(n_steps):
         all_stopped_before = not any(moving)
         x_before = list(x)
-        x, v, th, moving, mid = heun_step(x, v, th, moving, n, p)
+        x, v, th, moving, mid = (step or heun_step)(x, v, th, moving, n, p)
         if not in_event and all_stopped_before and any(mid):
             in_event = True
             ev = {"event": len(out.events), "step_start": n, "start_block": mid.index(True) + 1}
@@ -212,3 +212,92 @@ def cli_env() -> dict[str, str]:
 def run_cli_subprocess(*argv: str, timeout: float = 120.0) -> subprocess.CompletedProcess:
     return subprocess.run(stickslip_cmd() + list(argv), capture_output=True, text=True, timeout=timeout,
                           env=cli_env())  # fmt: skip
+
+
+# --------------------------------------------------------------------------------------
+# Plain-Python Heun step of any model of the family (MODEL.md, "The family the paper
+# stands in"), written from its text: ghost cells from the drive and the ends, the force with
+# the plate's leaf spring, the three friction laws and the two thresholds.
+
+
+def _ghosts(xa, tha, step, p):
+    N = len(xa)
+    pull = p.V * (float(step) * p.dt)
+    periodic = p.ends == "periodic"
+    if p.drive == "end":
+        left = pull
+    elif periodic:
+        left = xa[N - 1]
+    elif p.ends == "fixed":
+        left = 0.0
+    else:
+        left = xa[0]
+    if periodic:
+        right, thl, thr = xa[0], tha[N - 1], tha[0]
+    else:
+        right = 0.0 if p.ends == "fixed" else xa[N - 1]
+        thl, thr = tha[0], tha[N - 1]
+    return [left] + list(xa) + [right], [thl] + list(tha) + [thr], pull
+
+
+def model_heun_step(x, v, th, moving, n, p):
+    """One Heun step of the model ``p`` (ChainParams with pieces) from t_n = n dt; lists of
+    blocks 1..N at index 0..N-1. Returns (x, v, th, moving, mid) as :func:`heun_step`."""
+    N = len(x)
+    dt, h2 = p.dt, 0.5 * p.dt
+
+    def force(X, i, plate):
+        f = p.K * ((X[i - 1] - X[i]) - (X[i] - X[i + 1]))
+        if p.drive == "plate":
+            f = f + p.Kp * (plate - X[i])
+        return f
+
+    def accel(f, thi, vi):
+        if p.friction == "state":
+            return f - thi - p.beta * vi
+        if p.friction == "weakening":
+            phi = (1 - p.sigma) / (1 + 2 * p.alpha * max(vi, 0.0) / (1 - p.sigma))
+            return f - phi
+        return f - p.F0 - p.beta * vi
+
+    def dtheta(TH, i, vi):
+        if p.friction != "state":
+            return 0.0
+        return (TH[i] * (1.0 - TH[i]) - p.alpha * TH[i] * vi
+                + p.D * ((TH[i - 1] - TH[i]) - (TH[i] - TH[i + 1])))  # fmt: skip
+
+    X, TH, plate = _ghosts(x, th, n, p)
+    mid, a1, b1, xs, vs, ths = [], [], [], [], [], []
+    for i in range(1, N + 1):
+        f = force(X, i, plate)
+        threshold = TH[i] if p.threshold == "state" else p.Fs
+        m = moving[i - 1] or f > threshold  # start rule, at the beginning of the step
+        a = accel(f, TH[i], v[i - 1]) if m else 0.0
+        b = dtheta(TH, i, v[i - 1])
+        mid.append(m)
+        a1.append(a)
+        b1.append(b)
+        xs.append(x[i - 1] + dt * v[i - 1])
+        vs.append(v[i - 1] + dt * a)
+        ths.append(th[i - 1] + dt * b)
+    XS, THS, plate2 = _ghosts(xs, ths, n + 1, p)
+    xn, vn, thn, mn = [], [], [], []
+    for i in range(1, N + 1):
+        m = mid[i - 1]
+        a2 = accel(force(XS, i, plate2), THS[i], vs[i - 1]) if m else 0.0
+        b2 = dtheta(THS, i, vs[i - 1])
+        thn.append(th[i - 1] + h2 * (b1[i - 1] + b2) if p.friction == "state" else th[i - 1])
+        if m:
+            xn.append(x[i - 1] + h2 * (v[i - 1] + vs[i - 1]))
+            vel = v[i - 1] + h2 * (a1[i - 1] + a2)
+            if vel <= 0.0:  # stop rule, at the end of the step
+                vn.append(0.0)
+                mn.append(False)
+            else:
+                vn.append(vel)
+                mn.append(True)
+        else:  # stuck: x fixed, v = 0
+            xn.append(x[i - 1])
+            vn.append(0.0)
+            mn.append(False)
+    return xn, vn, thn, mn, mid

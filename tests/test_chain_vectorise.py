@@ -31,20 +31,27 @@ def _fresh_ir(kernel, args=None) -> str:
         assert kernel.signatures, "kernel was not compiled by the workloads"
         fresh.compile(kernel.signatures[0])
     else:
-        fresh(*args)
+        # The model's pieces (trailing arguments) are compile-time literals in the engine.
+        n_pieces = 3 if kernel.py_func.__name__ == "_stage1" else 2 if kernel.py_func.__name__ == "_stage2" else 1
+        sig = tuple(numba.typeof(a) for a in args[:-n_pieces]) + tuple(
+            numba.types.literal(int(c)) for c in args[-n_pieces:])
+        fresh.compile(sig)
     return fresh.inspect_llvm(fresh.signatures[0])
 
 
 def _example_args(name: str) -> tuple:
     a = [np.linspace(0.5, 1.5, 12) for _ in range(10)]
     lo, hi = 1, 10
-    k, d, beta, alpha, fs, dt = 10.0, 5.0, 1.0, 1.0, 3.0, 0.005
+    dt, p = 0.005, 0.0
+    # The paper's model: K, Kp, beta, alpha, D, Fs, 1 - sigma, 2 alpha, F0; pieces as literals.
+    mp = (10.0, 1.0, 1.0, 1.0, 5.0, 3.0, 0.99, 2.0, 1.0)
+    end, state, constant = K.DRIVE_END, K.FRICTION_STATE, K.THRESHOLD_CONSTANT
     return {
-        "_stage1": (*a, lo, hi, k, d, beta, alpha, fs, dt),
-        "_stage2": (*a, lo, hi, k, d, beta, alpha, 0.5 * dt),
-        "_stage1_theta": (*a[:8], lo, hi, alpha, d, dt),
-        "_stage1_theta_only": (*a[:4], lo, hi, alpha, d, dt),
-        "_stage2_theta": (*a[:4], lo, hi, alpha, d, 0.5 * dt),
+        "_stage1": (*a, lo, hi, p, mp, dt, end, state, constant),
+        "_stage2": (*a, lo, hi, p, mp, 0.5 * dt, end, state),
+        "_stage1_theta": (*a[:8], lo, hi, mp, dt, state),
+        "_stage1_theta_only": (*a[:4], lo, hi, mp, dt, state),
+        "_stage2_theta": (*a[:4], lo, hi, mp, 0.5 * dt, state),
     }[name]
 
 

@@ -305,7 +305,7 @@ def chain_dispersion(p: ChainParams, k: np.ndarray) -> xr.Dataset:
             "k": ("k", k, {"long_name": "lattice wavenumber k"}),
             "branch": ("branch", np.arange(3)),
         },
-        attrs={name: float(v) for name, v in p.to_dict().items() if name not in ("N", "Fs", "dt")},
+        attrs={name: v if isinstance(v, str) else float(v) for name, v in p.to_dict().items() if name not in ("N", "Fs", "dt")},
     )
 
 

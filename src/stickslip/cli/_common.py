@@ -51,7 +51,7 @@ def add_param_options(parser: argparse.ArgumentParser, params_cls: type, skip: t
     docs = params_cls.field_docs()
     group = parser.add_argument_group("model parameters")
     for f in dataclasses.fields(params_cls):
-        if f.name in skip:
+        if f.name in skip or f.name not in docs:
             continue
         kind = int if f.metadata.get("integer") else float
         group.add_argument(
@@ -103,3 +103,57 @@ def prepare_out_dir(path: str | Path | None) -> Path | None:
     except OSError as exc:
         raise CommandError(f"cannot create output directory {out}: {exc.strerror}") from None
     return out
+
+
+def add_model_options(parser: argparse.ArgumentParser) -> None:
+    """``--model`` (a preset), the four pieces to compose a model, CL's own symbols, and one
+    ``--NAME`` per parameter of :class:`ChainParams`."""
+    from stickslip.models.params import ChainParams
+    from stickslip.models.pieces import names
+    from stickslip.models.presets import PRESETS
+
+    group = parser.add_argument_group("model (see `stickslip models`)")
+    group.add_argument("--model", choices=tuple(PRESETS), default=None,
+                       help="preset to start from (default sakaguchi: the paper's chain of eq. 4)")
+    for kind in ("drive", "friction", "threshold", "ends"):
+        group.add_argument(f"--{kind}", choices=names(kind), default=None,
+                           help=f"{kind} piece (default: the preset's)")
+    group.add_argument("--l", dest="param_l", type=_number(float, "l"), default=None,
+                       help="Carlson-Langer's spring ratio l (sets K = l^2)")
+    group.add_argument("--nu", dest="param_nu", type=_number(float, "nu"), default=None,
+                       help="Carlson-Langer's plate velocity nu (sets V)")
+    add_param_options(parser, ChainParams)
+
+
+def chain_params_from_args(args: argparse.Namespace, **overrides: Any):
+    """Validated ChainParams from ``--model``, the pieces and the parameter options.
+
+    An option the composition does not read (``--D`` with weakening friction, say) is refused
+    rather than silently ignored.
+    """
+    from stickslip.models.params import ChainParams, ParameterError
+    from stickslip.models.presets import chain_params
+
+    values: dict[str, Any] = {}
+    for kind in ("drive", "friction", "threshold", "ends"):
+        if getattr(args, kind, None) is not None:
+            values[kind] = getattr(args, kind)
+    for f in dataclasses.fields(ChainParams):
+        value = getattr(args, f"param_{f.name}", None)
+        if value is not None:
+            values[f.name] = value
+    for name in ("l", "nu"):
+        if getattr(args, f"param_{name}", None) is not None:
+            values[name] = getattr(args, f"param_{name}")
+    values.update(overrides)
+    params = chain_params(args.model or "sakaguchi", **values)
+    used = set(params.used()) | {"l", "nu"}
+    unused = [k for k in values if k not in used and k not in params.pieces]
+    if unused:
+        raise ParameterError(
+            f"--{unused[0]} is not a parameter of this model ({params.model}: "
+            f"{', '.join(f'{k} {v}' for k, v in params.pieces.items())}); it reads {', '.join(params.used())}"
+        )
+    if ("l" in values or "nu" in values) and params.drive != "plate":
+        raise ParameterError("--l and --nu are Carlson-Langer's symbols: they need drive plate")
+    return params

@@ -11,7 +11,8 @@ from stickslip.cli._common import (
     CommandError,
     Result,
     add_json_option,
-    add_param_options,
+    add_model_options,
+    chain_params_from_args,
     float_arg,
     params_from_args,
     prepare_out_dir,
@@ -23,10 +24,11 @@ def register(sub) -> None:
     """Add the `chain` and `bench` subcommands."""
     p = sub.add_parser(
         "chain",
-        help="run the chain of N blocks pulled at one end (eq. 4)",
-        description="Integrate the chain of eq. (4) (MODEL.md) and record its slip events.",
+        help="run the chain of eq. (4) or any model of its family (--model)",
+        description="Integrate the chain of eq. (4) (MODEL.md), or a relative chosen with --model or "
+                    "composed with --drive/--friction/--threshold/--ends, and record its slip events.",
     )
-    add_param_options(p, ChainParams)
+    add_model_options(p)
     _add_run_options(p)
     p.add_argument("--integrator", choices=("exact", "dense"), default=None,
                    help="exact (default, fast) or dense (reference); both give the same answer bit for bit")
@@ -56,11 +58,11 @@ def register(sub) -> None:
         help="time dense against exact on the same workload, in one process",
         description="Run the same chain workload with the dense and the exact integrator and compare.",
     )
-    b.add_argument("--beta", type=float_arg("beta"), default=1.0, help="beta (default 1)")
-    b.add_argument("--N", type=int, default=399, help="number of blocks (default 399)")
-    b.add_argument("--t-end", type=float_arg("t-end"), default=2e5, help="end time (default 2e5)")
-    b.add_argument("--start", choices=("paper", "steady"), default="paper",
-                   help="initial state: the paper's (default) or exact steady sliding")
+    add_model_options(b)
+    b.add_argument("--t-end", type=float_arg("t-end"), default=None,
+                   help="end time (default 2e5 for the paper's chain, 2e4 for the plate-driven models)")
+    b.add_argument("--start", choices=("paper", "steady", "rest"), default=None,
+                   help="initial state (default: the model's; the paper's x=0, v=0.1, theta=0.1 for sakaguchi)")
     b.add_argument("--repeat", type=int, default=1, help="time each integrator this many times, keep the fastest")
     b.add_argument("--profile", action="store_true",
                    help="instead: where the exact integrator spends its time on this workload")
@@ -71,11 +73,15 @@ def register(sub) -> None:
 def _add_run_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--t-end", type=float_arg("t-end"), default=None, metavar="T",
                    help="end time (default 2e4; the paper's runs use 2e7)")
-    p.add_argument("--start", choices=("paper", "steady"), default=None,
-                   help="initial state: the paper's (x=0, v=0.1, theta=0.1; default) or exact steady sliding")
+    p.add_argument("--start", choices=("paper", "steady", "rest"), default=None,
+                   help="initial state: the paper's (x=0, v=0.1, theta=0.1; default for sakaguchi), exact "
+                        "steady sliding, or every block stuck at x_i = -A u_i (Carlson-Langer's; default for "
+                        "the plate-driven models)")
     p.add_argument("--perturbation", type=float_arg("perturbation"), default=None, metavar="A",
                    help="with --start steady: uniform perturbation of x and v in [-A, A] (default 0)")
-    p.add_argument("--seed", type=int, default=None, help="seed of the perturbation (default 0)")
+    p.add_argument("--amplitude", type=float_arg("amplitude"), default=None, metavar="A",
+                   help="with --start rest: x_i = -A u_i, u_i uniform in [0, 1) (default the model's, 0.01 for CL)")
+    p.add_argument("--seed", type=int, default=None, help="seed of the perturbation or of u_i (default 0)")
 
 
 def _summary_text(summary: dict, out: Path | None) -> str:
@@ -135,8 +141,10 @@ def run_chain_command(args: argparse.Namespace) -> Result:
             return _interrupted(exc, Path(args.resume))
         return Result(_json_summary(run.summary, Path(args.resume)), _summary_text(run.summary, Path(args.resume)))
 
-    params = params_from_args(ChainParams, args)
+    params = chain_params_from_args(args)
     t_end = 2e4 if args.t_end is None else args.t_end
+    start, amplitude, seed = _start_of(params, args)
+    args.start, args.perturbation, args.seed = start, amplitude, seed
     for name, default in (("integrator", "exact"), ("start", "paper"), ("perturbation", 0.0), ("seed", 0),
                           ("sample_interval", 10.0), ("snapshot", []), ("profile_min_blocks", 0)):
         if getattr(args, name) is None:
@@ -170,6 +178,31 @@ def run_chain_command(args: argparse.Namespace) -> Result:
     return Result(_json_summary(run.summary, out), _summary_text(run.summary, out))
 
 
+def _start_of(params, args) -> tuple[str, float, int]:
+    """The initial state: the option, else the model's preset; its amplitude and seed."""
+    from stickslip.models.presets import PRESETS
+
+    preset = PRESETS[params.model]
+    start = args.start or preset.start
+    if args.amplitude is not None and start != "rest":
+        raise CommandError("--amplitude goes with --start rest (use --perturbation with --start steady)")
+    if args.perturbation is not None and start != "steady":
+        raise CommandError("--perturbation goes with --start steady (use --amplitude with --start rest)")
+    if start == "rest":
+        amplitude = args.amplitude if args.amplitude is not None else preset.start_options.get("amplitude", 0.0)
+        check_number("amplitude", amplitude, low=0.0)
+    else:
+        amplitude = args.perturbation if args.perturbation is not None else 0.0
+    seed = args.seed if args.seed is not None else preset.start_options.get("seed", 0)
+    check_number("seed", seed, low=0, integer=True)
+    if start == "steady":
+        from stickslip.models import physics
+
+        if not physics.has_steady_state(params):
+            raise CommandError(f"--start steady: the chain with ends {params.ends} has no steady sliding state")
+    return start, float(amplitude), int(seed)
+
+
 def _interrupted(exc, out: Path | None) -> Result:
     sys.stderr.write(f"stickslip chain: {exc}; continue with: stickslip chain --resume {out}\n")
     return Result({"interrupted": True, "t": exc.t, "checkpoint": str(exc.checkpoint)}, "", status=130)
@@ -179,12 +212,16 @@ def run_bench_command(args: argparse.Namespace) -> Result:
     """Handler of `stickslip bench`: the same workload with dense and exact, one process."""
     from stickslip.run import bench
 
-    check_number("N", args.N, low=1, integer=True)
-    check_number("t-end", args.t_end, low=0.0)
     check_number("repeat", args.repeat, low=1, integer=True)
-    params = ChainParams(N=args.N, beta=args.beta)
+    params = chain_params_from_args(args)
+    t_end = args.t_end if args.t_end is not None else (2e4 if params.drive == "plate" else 2e5)
+    check_number("t-end", t_end, low=0.0)
+    args.perturbation = getattr(args, "perturbation", None)
+    args.amplitude = None
+    args.seed = None
+    start, amplitude, seed = _start_of(params, args)
     if args.profile:
-        result = bench.profile(params, args.t_end, start=args.start)
+        result = bench.profile(params, t_end, start=start)
         return Result(result, bench.format_profile(result))
-    result = bench.compare(params, args.t_end, start=args.start, repeat=args.repeat)
+    result = bench.compare(params, t_end, start=start, repeat=args.repeat, perturbation=amplitude, seed=seed)
     return Result(result, bench.format_result(result))

@@ -73,6 +73,13 @@ class _Validated:
     def __post_init__(self) -> None:
         for f in dataclasses.fields(self):  # type: ignore[arg-type]
             meta = f.metadata
+            if meta.get("text"):
+                continue
+            if "choices" in meta:
+                value = getattr(self, f.name)
+                if value not in meta["choices"]:
+                    raise ParameterError(f"{f.name} must be one of {', '.join(meta['choices'])} (got {value!r})")
+                continue
             value = check_number(
                 f.name,
                 getattr(self, f.name),
@@ -147,13 +154,26 @@ def scale_block(p: BlockParams) -> BlockParams:
     )
 
 
+def _choice(default: str, kind: str, doc: str) -> Any:
+    from stickslip.models.pieces import names
+
+    return field(default=default, metadata={"choices": names(kind), "doc": doc})
+
+
 @dataclass(frozen=True)
 class ChainParams(_Validated):
-    """Parameters of the chain of eq. (4), pinned down in MODEL.md.
+    """Parameters of the chain of eq. (4) and of its relatives, pinned down in MODEL.md.
 
-    N blocks, only the first pulled (x_0 = V t) through a spring K; free end; state variable
-    with diffusion D and no-flux ends; static friction Fs. Defaults are the paper's run
-    (section 3): N = 399, K = 10, D = 5, V = 0.001, Fs = 3, dt = 0.005, alpha = 1, beta = 1.
+    N blocks on a line joined by springs K. The defaults are the paper's model and run
+    (section 3): the end drive (only the first block pulled, x_0 = V t), state friction with
+    diffusion D and no-flux ends, the constant threshold Fs, free end; N = 399, K = 10,
+    D = 5, V = 0.001, Fs = 3, dt = 0.005, alpha = 1, beta = 1. The pieces ``drive``,
+    ``friction``, ``threshold`` and ``ends`` (:mod:`stickslip.models.pieces`) select the
+    relatives: Carlson-Langer (plate drive with leaf spring Kp, velocity weakening with
+    alpha and sigma), the train model (strengthening friction F0 + beta v), the state
+    threshold of Batista-Carlson. ``model`` names the preset the parameters came from
+    (:mod:`stickslip.models.presets`). Parameters a composition does not read are kept at
+    their defaults and left out of :meth:`to_dict`.
     """
 
     N: int = field(default=399, metadata={"low": 1, "integer": True, "doc": "number of blocks N"})
@@ -164,13 +184,65 @@ class ChainParams(_Validated):
     alpha: float = _nonnegative(1.0, "weakening coefficient alpha of the state variable")
     Fs: float = _positive(3.0, "static friction limit Fs")
     dt: float = _positive(0.005, "Heun time step dt")
+    model: str = field(default="sakaguchi", metadata={"text": True, "doc": "preset the parameters came from"})
+    drive: str = _choice("end", "drive", "drive: end (pulling point at block 1) or plate (every block)")
+    friction: str = _choice("state", "friction", "friction of a moving block: state, weakening or strengthening")
+    threshold: str = _choice("constant", "threshold", "static threshold: constant (Fs) or state (theta_i)")
+    ends: str = _choice("free", "ends", "ends of the chain: free, fixed or periodic (plate drive only)")
+    Kp: float = _positive(1.0, "leaf spring Kp joining each block to the plate (plate drive)")
+    sigma: float = field(default=0.01, metadata={"low": 0.0, "high": 1.0, "high_open": True,
+                                                 "doc": "friction drop sigma of velocity weakening (CL)"})
+    F0: float = _nonnegative(1.0, "constant part F0 of strengthening friction (train model)")
+
+    def __post_init__(self) -> None:
+        from stickslip.models.presets import PRESETS
+
+        object.__setattr__(self, "model", str(self.model))
+        if self.model not in PRESETS:
+            raise ParameterError(f"model must be one of {', '.join(PRESETS)} (got {self.model!r})")
+        super().__post_init__()
 
     def _check(self) -> None:
+        from stickslip.models.pieces import CompositionError, check_composition
+
+        try:
+            check_composition(self.drive, self.friction, self.threshold, self.ends)
+        except CompositionError as exc:
+            raise ParameterError(str(exc)) from None
         # Heun's diffusion part is stable only for D dt <= 1/2 (explicit scheme).
-        if self.D * self.dt > 0.5:
+        if self.friction == "state" and self.D * self.dt > 0.5:
             raise ParameterError(
                 f"D*dt must be <= 0.5 for a stable explicit step (got D={self.D:g}, dt={self.dt:g})"
             )
+
+    @property
+    def pieces(self) -> dict[str, str]:
+        """The four pieces of the model."""
+        return {"drive": self.drive, "friction": self.friction, "threshold": self.threshold, "ends": self.ends}
+
+    @property
+    def codes(self) -> tuple[int, int, int, int]:
+        """The kernels' integer codes of the pieces (drive, friction, threshold, ends)."""
+        from stickslip.models.pieces import code
+
+        return tuple(code(k, v) for k, v in self.pieces.items())  # type: ignore[return-value]
+
+    def used(self) -> tuple[str, ...]:
+        """The numerical parameters this composition reads."""
+        from stickslip.models.pieces import reads
+
+        return ("N", "K", "V", "dt") + reads(**self.pieces)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The model (preset name and pieces) and every parameter it reads."""
+        d = dataclasses.asdict(self)
+        used = set(self.used())
+        return {k: v for k, v in d.items() if k in used or k in ("model", "drive", "friction", "threshold", "ends")}
+
+    @classmethod
+    def field_docs(cls) -> dict[str, str]:
+        return {k: v for k, v in super().field_docs().items() if k not in ("model", "drive", "friction",
+                                                                               "threshold", "ends")}
 
 
 def steps_for(t_end: float, dt: float, name: str = "t_end") -> int:

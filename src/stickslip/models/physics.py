@@ -29,19 +29,50 @@ def block_steady_state(p: BlockParams) -> dict[str, float]:
     return {"v": p.V, "theta": theta0, "force": force, "lag": force / p.K}
 
 
+def steady_friction(p: ChainParams) -> tuple[float, float]:
+    """Friction c of a block sliding steadily at v = V, and its state variable theta_0.
+
+    state (eq. 4): theta_0 = 1 - alpha V, c = theta_0 + beta V; weakening (Carlson-Langer):
+    c = phi(V) = (1 - sigma) / (1 + 2 alpha V / (1 - sigma)); strengthening: c = F0 + beta V.
+    Models without a state variable report theta_0 = 0 (the value their runs carry).
+    """
+    if p.friction == "state":
+        theta0 = 1.0 - p.alpha * p.V
+        return theta0 + p.beta * p.V, theta0
+    if p.friction == "weakening":
+        w = 1.0 - p.sigma
+        return w / (1.0 + 2.0 * p.alpha * p.V / w), 0.0
+    return p.F0 + p.beta * p.V, 0.0
+
+
+def has_steady_state(p: ChainParams) -> bool:
+    """Whether the chain can slide steadily with every block at v = V.
+
+    The end drive with a free end (eq. 4) and the plate drive with free or periodic ends can;
+    a fixed end holds a spring that stretches for ever, so those compositions cannot.
+    """
+    return p.ends != "fixed"
+
+
 def chain_steady_state(p: ChainParams, t: float = 0.0) -> dict[str, np.ndarray]:
     """Exact discrete steady sliding of the chain, eq. (4) with the ends of MODEL.md.
 
-    v_i = V, theta_i = 1 - alpha V (= 1 - V for alpha = 1), friction
+    End drive: v_i = V, theta_i = 1 - alpha V (= 1 - V for alpha = 1), friction
     c = theta_0 + beta V; every block is pulled by the spring behind it with the friction of all
     blocks ahead, so x_{i-1} - x_i = (c / K) (N - i + 1), with x_0 = V t.
+    Plate drive (free or periodic ends): every block lags the plate by c / Kp, springs K unstretched.
     Returns x (length N), v, theta and the extensions ``ext`` (x_{i-1} - x_i, i = 1..N).
     """
-    theta0 = 1.0 - p.alpha * p.V
-    c = theta0 + p.beta * p.V
-    i = np.arange(1, p.N + 1, dtype=np.float64)
-    ext = (c / p.K) * (p.N - i + 1.0)
-    x = p.V * t - np.cumsum(ext)
+    if not has_steady_state(p):
+        raise ValueError(f"the chain with ends {p.ends} has no steady sliding state")
+    c, theta0 = steady_friction(p)
+    if p.drive == "plate":
+        x = np.full(p.N, p.V * t - c / p.Kp)
+        ext = np.zeros(p.N)
+    else:
+        i = np.arange(1, p.N + 1, dtype=np.float64)
+        ext = (c / p.K) * (p.N - i + 1.0)
+        x = p.V * t - np.cumsum(ext)
     return {
         "x": x,
         "v": np.full(p.N, p.V),
@@ -54,9 +85,14 @@ def chain_steady_state(p: ChainParams, t: float = 0.0) -> dict[str, np.ndarray]:
 def chain_steady_length(p: ChainParams) -> float:
     """Total length L = x_1 - x_N of steady sliding, exact discrete form (MODEL.md).
 
-    L_ss = (c / K) N (N - 1) / 2 with c = theta_0 + beta V; 7940.1 for the paper's chain.
+    L_ss = (c / K) N (N - 1) / 2 with c = theta_0 + beta V; 7940.1 for the paper's chain. Zero for
+    the plate drive (every block lags the plate equally); NaN where there is no steady sliding.
     """
-    c = (1.0 - p.alpha * p.V) + p.beta * p.V
+    if not has_steady_state(p):
+        return float("nan")
+    if p.drive == "plate":
+        return 0.0
+    c = (1.0 - p.alpha * p.V) + p.beta * p.V if p.friction == "state" else steady_friction(p)[0]
     return c / p.K * p.N * (p.N - 1) / 2.0
 
 

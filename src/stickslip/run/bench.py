@@ -22,8 +22,10 @@ def _warm(params: ChainParams, start: str) -> None:
         run_chain(small, 20 * small.dt, integrator=integrator, start=start)
 
 
-def compare(params: ChainParams, t_end: float, *, start: str = "paper", repeat: int = 1) -> dict[str, Any]:
-    """Time ``dense`` and ``exact`` on the chain of eq. (4) from ``start`` to ``t_end``.
+def compare(params: ChainParams, t_end: float, *, start: str = "paper", repeat: int = 1,
+            perturbation: float = 0.0, seed: int = 0) -> dict[str, Any]:
+    """Time ``dense`` and ``exact`` on the chain of eq. (4), or any model of the family, from
+    ``start`` (with ``perturbation`` and ``seed``) to ``t_end``.
 
     Returns the times (fastest of ``repeat``), their ratio, ns per block-step of each,
     and whether the two runs are identical (state hash, event table and first moves).
@@ -34,7 +36,8 @@ def compare(params: ChainParams, t_end: float, *, start: str = "paper", repeat: 
     for integrator in ("dense", "exact"):
         for _ in range(repeat):
             t0 = time.perf_counter()
-            run = run_chain(params, t_end, integrator=integrator, start=start)
+            run = run_chain(params, t_end, integrator=integrator, start=start, perturbation=perturbation,
+                            seed=seed)
             elapsed = time.perf_counter() - t0
             best[integrator] = min(best.get(integrator, float("inf")), elapsed)
             runs[integrator] = run
@@ -47,8 +50,12 @@ def compare(params: ChainParams, t_end: float, *, start: str = "paper", repeat: 
     )
     block_steps = params.N * d.steps
     return {
-        "workload": {"N": params.N, "beta": params.beta, "t_end": t_end, "start": start,
-                     "steps": d.steps, "block_steps": block_steps},
+        "workload": {"model": params.model, "N": params.N, "beta": params.beta, "t_end": t_end,
+                     "start": start, "steps": d.steps, "block_steps": block_steps},
+        "params": params.to_dict(),
+        "skipped": {"steps_computed_fraction": e.summary["steps_computed"] / max(e.steps, 1),
+                    "block_updates_fraction": e.summary["block_updates"] / max(block_steps, 1),
+                    "full_block_updates_fraction": e.summary["full_block_updates"] / max(block_steps, 1)},
         "dense_seconds": best["dense"],
         "exact_seconds": best["exact"],
         "speedup": best["dense"] / best["exact"] if best["exact"] > 0 else float("inf"),
@@ -72,7 +79,7 @@ def format_result(r: dict[str, Any]) -> str:
     w = r["workload"]
     ns = r["ns_per_block_step"]
     return "\n".join([
-        f"workload   N={w['N']} beta={w['beta']:g} t_end={w['t_end']:g} start={w['start']} "
+        f"workload   {w['model']} N={w['N']} beta={w['beta']:g} t_end={w['t_end']:g} start={w['start']} "
         f"({w['steps']} steps, {r['n_events']} events)",
         f"dense      {r['dense_seconds']:.3f} s   {ns['dense']:.3g} ns/block-step",
         f"exact      {r['exact_seconds']:.3f} s   {ns['exact']:.3g} ns/block-step "
@@ -158,7 +165,7 @@ def format_profile(r: dict[str, Any]) -> str:
     w = r["workload"]
     u = r["unit_costs_ns"]
     lines = [
-        f"workload   N={w['N']} beta={w['beta']:g} t_end={w['t_end']:g} start={w['start']} "
+        f"workload   {w['model']} N={w['N']} beta={w['beta']:g} t_end={w['t_end']:g} start={w['start']} "
         f"({w['steps']} steps, {r['n_events']} events)",
         f"wall       {r['wall_seconds']:.3f} s (exact)",
         f"steps      {r['steps_computed']} computed ({100 * r['fraction_computed']:.2f}%), "

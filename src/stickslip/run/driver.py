@@ -132,7 +132,30 @@ def _par(p: ChainParams) -> np.ndarray:
     par = np.zeros(K.PAR_SIZE)
     par[K.P_K], par[K.P_D], par[K.P_V] = p.K, p.D, p.V
     par[K.P_BETA], par[K.P_ALPHA], par[K.P_FS], par[K.P_DT] = p.beta, p.alpha, p.Fs, p.dt
+    par[K.P_KP], par[K.P_SIGMA], par[K.P_F0] = p.Kp, p.sigma, p.F0
     return par
+
+
+class _Kernel:
+    """One integrator compiled for one model: ``kernel(state, target)`` advances the state.
+
+    The model's pieces are compile-time constants of the kernels (:func:`kernels.chain.specialise`).
+    """
+
+    def __init__(self, name, params, state, scratch, par, outputs, sample_every, profile_every, min_blocks):
+        self.scratch = tuple(scratch)
+        self.rest = (par, *outputs.kernel_args())
+        self.tail = (sample_every, profile_every, min_blocks)
+        self.pieces = params.codes
+        probe = self._args(state) + (np.int64(0),) + tuple(np.int64(t) for t in self.tail)
+        self.entry = K.specialise(_KERNELS[name], probe, self.pieces)
+
+    def _args(self, state):
+        return (state.x, state.v, state.th, state.mov, *self.scratch, state.first_step, state.x0ev,
+                state.ist, *self.rest)
+
+    def __call__(self, state, target):
+        return self.entry(*self._args(state), target, *self.tail, *self.pieces)
 
 
 def _check_state(state: ChainState, p: ChainParams) -> None:
@@ -240,13 +263,14 @@ def resume_chain(
 
 def _drive(params, options, integrator, start_info, state, outputs, *, out_dir, checkpointer,
            checkpoint_interval, progress, handle_signals, wall_before) -> ChainRun:
-    kernel = _KERNELS[integrator]
     par = _par(params)
     N = params.N
-    scratch = [np.zeros(N + 2) for _ in range(6)]
+    scratch = [np.zeros(N + 2) for _ in range(6)] + [np.zeros(N + 2, dtype=np.int64)]
     n_end = steps_for(options.t_end, params.dt)
     sample_every = int(round(options.sample_interval / params.dt))
     profile_every = int(round(options.profile_window / params.dt)) if options.profile_window else 0
+    kernel = _Kernel(integrator, params, state, scratch, par, outputs, sample_every, profile_every,
+                     options.profile_min_blocks)
     stops = sorted({steps_for(t, params.dt) for t in options.snapshot_times} | {n_end})
     done_snaps = set(int(s) for a in outputs.parts["snap_step"] for s in a)
     steady_at: dict[str, float] = {}
@@ -278,9 +302,7 @@ def _drive(params, options, integrator, start_info, state, outputs, *, out_dir, 
                     next_stop = min(next_stop, (n // sample_every + 1) * sample_every)
                 if n >= n_end:
                     # One more call services outputs due at the final step (its sample).
-                    status = kernel(state.x, state.v, state.th, state.mov, *scratch, state.first_step,
-                                    state.x0ev, state.ist, par, *outputs.kernel_args(), n_end,
-                                    sample_every, profile_every, options.profile_min_blocks)
+                    status = kernel(state, n_end)
                     if status != K.DONE and status != K.NONFINITE:
                         outputs.flush(state.ist)
                         continue
@@ -288,17 +310,15 @@ def _drive(params, options, integrator, start_info, state, outputs, *, out_dir, 
                 target = min(next_stop, n + chunk)
                 before = state.copy() if integrator == "exact" else None
                 c0 = time.perf_counter()
-                status = kernel(state.x, state.v, state.th, state.mov, *scratch, state.first_step,
-                                state.x0ev, state.ist, par, *outputs.kernel_args(), target,
-                                sample_every, profile_every, options.profile_min_blocks)
+                status = kernel(state, target)
                 elapsed = time.perf_counter() - c0
                 if before is not None and not _finite(state):
                     # The fast kernel does not look for non-finite values; replay this call
                     # with the reference, which follows the same arithmetic and checks each step.
                     state = before
-                    status = K.run_dense(state.x, state.v, state.th, state.mov, *scratch, state.first_step,
-                                         state.x0ev, state.ist, par, *outputs.kernel_args(), target,
-                                         sample_every, profile_every, options.profile_min_blocks)
+                    reference = _Kernel("dense", params, state, scratch, par, outputs, sample_every, profile_every,
+                                        options.profile_min_blocks)
+                    status = reference(state, target)
                 if status == K.NONFINITE:
                     bad = int(state.ist[K.BAD_BLOCK])
                     raise NonFiniteState(

@@ -231,6 +231,8 @@ def _assemble(params, options, integrator, start_info, state, outputs, wall, ste
         }
     L_mean = float(np.mean(L_values)) if len(L_values) else float("nan")
     summary = {
+        "model": params.model,
+        **params.pieces,
         "n_events": int(len(events)),
         "event_in_progress": bool(state.ist[K.EV_ACTIVE]),
         "L_final": L_final,

@@ -15,7 +15,7 @@ from stickslip.kernels import chain as K
 from stickslip.models import physics
 from stickslip.models.params import ChainParams, ParameterError
 
-STARTS = ("paper", "steady")
+STARTS = ("paper", "steady", "rest")
 
 
 @dataclass
@@ -73,7 +73,8 @@ class ChainState:
     def paper(cls, p: ChainParams) -> "ChainState":
         """The paper's initial state (section 3): x_i = 0, v_i = 0.1, theta_i = 0.1, all moving."""
         N = p.N
-        return cls.from_blocks(np.zeros(N), np.full(N, 0.1), np.full(N, 0.1), np.zeros(N, bool))
+        theta = np.full(N, 0.1 if p.friction == "state" else 0.0)
+        return cls.from_blocks(np.zeros(N), np.full(N, 0.1), theta, np.zeros(N, bool))
 
     @classmethod
     def steady(cls, p: ChainParams, amplitude: float = 0.0, seed: int = 0) -> "ChainState":
@@ -89,6 +90,14 @@ class ChainState:
             x += rng.uniform(-amplitude, amplitude, p.N)
             v += rng.uniform(-amplitude, amplitude, p.N)
         return cls.from_blocks(x, v, s["theta"], np.zeros(p.N, bool))
+
+    @classmethod
+    def rest(cls, p: ChainParams, amplitude: float = 0.01, seed: int = 0) -> "ChainState":
+        """Every block stuck: v_i = 0, x_i = -A u_i with u_i = ``default_rng(seed).random(N)``
+        (Carlson-Langer's start, MODEL.md), theta_i = 0.1 (the paper's) for state friction."""
+        x = -amplitude * np.random.default_rng(seed).random(p.N) if amplitude > 0 else np.zeros(p.N)
+        theta = np.full(p.N, 0.1 if p.friction == "state" else 0.0)
+        return cls.from_blocks(x, np.zeros(p.N), theta, np.ones(p.N, bool))
 
     def blocks(self) -> dict[str, np.ndarray]:
         """Per-block copies: x, v, theta (float64) and stopped (bool), block i at index i - 1."""
@@ -112,11 +121,14 @@ class ChainState:
 
 
 def initial_state(p: ChainParams, start: str = "paper", *, amplitude: float = 0.0, seed: int = 0) -> ChainState:
-    """The initial state named by ``start``: 'paper' (section 3) or 'steady' (MODEL.md)."""
+    """The initial state named by ``start``: 'paper' (section 3), 'steady' (MODEL.md) or 'rest'
+    (every block stuck, x_i = -A u_i: Carlson-Langer's start, MODEL.md)."""
     if start == "paper":
         return ChainState.paper(p)
     if start == "steady":
         return ChainState.steady(p, amplitude, seed)
+    if start == "rest":
+        return ChainState.rest(p, amplitude, seed)
     raise ParameterError(f"start must be one of {', '.join(STARTS)} (got {start!r})")
 
 
@@ -127,8 +139,13 @@ def steady_deviation(state: ChainState, p: ChainParams) -> float:
     e_i = x_{i-1} - x_i are the spring extensions (x_0 = V t_n) and e_i^ss = (c/K)(N - i + 1)
     those of steady sliding. Infinite unless every block is moving.
     """
-    if np.any(state.mov[1:-1] == 0.0):
+    if np.any(state.mov[1:-1] == 0.0) or not physics.has_steady_state(p):
         return float("inf")
+    if p.drive == "plate":
+        # Every block lags the plate by c / Kp: compare positions in the plate's frame.
+        ss = physics.chain_steady_state(p, float(np.float64(state.step) * p.dt))
+        return float(max(np.max(np.abs(state.v[1:-1] - ss["v"])),
+                         np.max(np.abs(state.x[1:-1] - ss["x"]))))
     ss = physics.chain_steady_state(p)
     x = state.x[1:-1]
     x0 = p.V * (np.float64(state.step) * p.dt)

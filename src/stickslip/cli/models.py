@@ -1,0 +1,49 @@
+"""`stickslip models`: the presets of the model family, their pieces, equations and parameters."""
+
+from __future__ import annotations
+
+import argparse
+
+from stickslip.cli._common import Result, add_json_option
+
+
+def register(sub) -> None:
+    """Add the `models` subcommand."""
+    p = sub.add_parser(
+        "models",
+        help="list the models: the paper's chain and its relatives (presets and pieces)",
+        description="The presets of MODEL.md's model family, and the pieces any composition is made of.",
+    )
+    add_json_option(p)
+    p.set_defaults(handler=run_models_command)
+
+
+def run_models_command(args: argparse.Namespace) -> Result:
+    """Handler of `stickslip models`."""
+    from stickslip.models.pieces import PIECES
+    from stickslip.models.presets import PRESETS
+
+    data = {
+        "presets": [p.describe() for p in PRESETS.values()],
+        "pieces": {kind: [{"name": p.name, "meaning": p.meaning, "reads": list(p.reads)} for p in choices]
+                   for kind, choices in PIECES.items()},
+        "rules": ["ends periodic needs drive plate", "threshold state needs friction state"],
+    }
+    lines = []
+    for pr in PRESETS.values():
+        lines.append(f"{pr.name}: {pr.title}")
+        lines.append("  pieces     " + ", ".join(f"{k} {v}" for k, v in pr.pieces.items()))
+        lines.append("  equations  " + pr.equations)
+        lines.append("  params     " + " ".join(f"{k}={v:g}" for k, v in pr.params.items()))
+        start = pr.start + ("".join(f" {k}={v:g}" for k, v in pr.start_options.items()))
+        lines.append(f"  start      {start}")
+        if pr.note:
+            lines.append("  note       " + pr.note)
+        lines.append("")
+    lines.append("pieces (compose any allowed choice with --drive --friction --threshold --ends):")
+    for kind, choices in PIECES.items():
+        for p in choices:
+            reads = f"  [reads {', '.join(p.reads)}]" if p.reads else ""
+            lines.append(f"  {kind:9s} {p.name:13s} {p.meaning}{reads}")
+    lines.append("rules: " + "; ".join(data["rules"]))
+    return Result(data, "\n".join(lines))

@@ -1,0 +1,104 @@
+"""The four pieces a block-spring model is made of (MODEL.md, "The family the paper stands in").
+
+The chain of eq. (4) and its relatives share blocks on a line, nearest-neighbour springs K,
+the start and stop rules and Heun with t_n = n dt. They differ in
+
+========== ==========================================================================
+drive      ``end``: a pulling point x_0 = V t joined to block 1 (eq. 4);
+           ``plate``: every block joined to a plate at V t by a leaf spring Kp (BK, CL)
+friction   ``state``: theta_i + beta v_i, theta from eq. (4);
+           ``weakening``: phi(v) = (1 - sigma) / (1 + 2 alpha max(v, 0) / (1 - sigma)) (CL);
+           ``strengthening``: F0 + beta v, no state variable (train model)
+threshold  ``constant``: Fs; ``state``: theta_i (the paper's reading of Batista-Carlson)
+ends       ``free``, ``fixed``, ``periodic`` (plate drive only)
+========== ==========================================================================
+
+A composition is valid when MODEL.md allows it: periodic ends need the plate drive (the end
+drive pulls block 1 only, so the ring has no place for the pulling point), and the state
+threshold needs the state friction (it reads theta). :func:`check_composition` says so in one
+line. Each piece lists the parameters it reads, so a run records exactly those.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+class CompositionError(ValueError):
+    """A choice of pieces that MODEL.md does not allow; the message is one line."""
+
+
+@dataclass(frozen=True)
+class Piece:
+    """One choice for one piece: its name, what it means, and the parameters it reads."""
+
+    kind: str
+    name: str
+    meaning: str
+    reads: tuple[str, ...] = ()
+
+
+PIECES: dict[str, tuple[Piece, ...]] = {
+    "drive": (
+        Piece("drive", "end", "pulling point x_0 = V t joined to block 1 by the spring K (eq. 4)"),
+        Piece("drive", "plate", "every block joined to a plate at V t by a leaf spring Kp: "
+              "f_i gains Kp (V t - x_i)", ("Kp",)),
+    ),
+    "friction": (
+        Piece("friction", "state", "theta_i + beta v_i while moving; dtheta_i/dt = theta_i (1 - theta_i) "
+              "- alpha theta_i v_i + D (theta_{i+1} - 2 theta_i + theta_{i-1}) (eq. 4)", ("beta", "alpha", "D")),
+        Piece("friction", "weakening", "phi(v) = (1 - sigma) / (1 + 2 alpha max(v, 0) / (1 - sigma)) "
+              "(Carlson-Langer)", ("alpha", "sigma")),
+        Piece("friction", "strengthening", "F0 + beta v, no state variable (train model)", ("beta", "F0")),
+    ),
+    "threshold": (
+        Piece("threshold", "constant", "a stuck block starts when f_i > Fs", ("Fs",)),
+        Piece("threshold", "state", "a stuck block starts when f_i > theta_i (the paper's reading of "
+              "Batista-Carlson)"),
+    ),
+    "ends": (
+        Piece("ends", "free", "x_{N+1} = x_N (plate drive: also x_0 = x_1)"),
+        Piece("ends", "fixed", "x_{N+1} = 0 (plate drive: also x_0 = 0)"),
+        Piece("ends", "periodic", "x_0 = x_N, x_{N+1} = x_1 (plate drive only)"),
+    ),
+}
+
+KINDS = tuple(PIECES)
+
+
+def names(kind: str) -> tuple[str, ...]:
+    """The allowed choices of one piece, in the order of their kernel codes."""
+    return tuple(p.name for p in PIECES[kind])
+
+
+def piece(kind: str, name: str) -> Piece:
+    """The piece ``name`` of ``kind``; a CompositionError names the allowed choices."""
+    for p in PIECES.get(kind, ()):
+        if p.name == name:
+            return p
+    raise CompositionError(f"{kind} must be one of {', '.join(names(kind))} (got {name!r})")
+
+
+def code(kind: str, name: str) -> int:
+    """The kernel's integer code of a piece (its position in :data:`PIECES`)."""
+    return names(kind).index(piece(kind, name).name)
+
+
+def check_composition(drive: str, friction: str, threshold: str, ends: str) -> None:
+    """Refuse a composition MODEL.md does not allow, in one line."""
+    for kind, name in zip(KINDS, (drive, friction, threshold, ends)):
+        piece(kind, name)
+    if ends == "periodic" and drive != "plate":
+        raise CompositionError("ends periodic needs drive plate (the end drive pulls block 1 only)")
+    if threshold == "state" and friction != "state":
+        raise CompositionError(f"threshold state needs friction state (friction {friction} has no theta)")
+
+
+def reads(drive: str, friction: str, threshold: str, ends: str) -> tuple[str, ...]:
+    """Parameters a composition reads, besides N, K, V and dt that every chain reads."""
+    out: list[str] = []
+    for kind, name in zip(KINDS, (drive, friction, threshold, ends)):
+        for r in piece(kind, name).reads:
+            if r not in out:
+                out.append(r)
+    return tuple(out)

@@ -1,0 +1,135 @@
+"""Named models: the paper's chain and the relatives it cites (MODEL.md, "Preset defaults").
+
+A preset is data: its four pieces (:mod:`stickslip.models.pieces`), its parameters, its start
+and the equations in words. :func:`chain_params` turns a preset plus overrides into validated
+:class:`~stickslip.models.params.ChainParams`; any composition MODEL.md allows can be built the
+same way by overriding the pieces. Adding a model means adding an entry here.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+
+@dataclass(frozen=True)
+class Preset:
+    """A named model: pieces, parameter defaults, start, and what it is in words."""
+
+    name: str
+    title: str
+    pieces: dict[str, str]
+    params: dict[str, Any]
+    start: str
+    start_options: dict[str, Any] = field(default_factory=dict)
+    equations: str = ""
+    source: str = ""
+    note: str = ""
+    symbols: dict[str, str] = field(default_factory=dict)  # the model's own names -> ChainParams fields
+
+    def describe(self) -> dict[str, Any]:
+        """Everything ``stickslip models`` prints about the preset (JSON-able)."""
+        return {
+            "name": self.name, "title": self.title, "pieces": dict(self.pieces),
+            "params": dict(self.params), "start": self.start, "start_options": dict(self.start_options),
+            "equations": self.equations, "source": self.source, "note": self.note,
+            "symbols": dict(self.symbols),
+        }
+
+
+_SAKAGUCHI = dict(drive="end", friction="state", threshold="constant", ends="free")
+_CL = dict(drive="plate", friction="weakening", threshold="constant", ends="periodic")
+_CL_PARAMS = dict(N=100, K=100.0, Kp=1.0, V=0.01, alpha=2.5, sigma=0.01, Fs=1.0, dt=0.005)
+_BC_NOTE = ("the paper's reading of Batista-Carlson (a stuck block starts when K (V t - x) > theta), "
+            "not Batista and Carlson's published model, which could not be consulted")
+
+PRESETS: dict[str, Preset] = {
+    "sakaguchi": Preset(
+        "sakaguchi", "the chain of eq. (4) (Sakaguchi)", _SAKAGUCHI,
+        dict(N=399, K=10.0, D=5.0, V=0.001, beta=1.0, alpha=1.0, Fs=3.0, dt=0.005),
+        "paper",
+        equations=("dv_i/dt = K (x_{i+1} - 2 x_i + x_{i-1}) - theta_i - beta v_i while moving, x_0 = V t, "
+                   "free end; dtheta_i/dt = theta_i (1 - theta_i) - alpha theta_i v_i + D (theta_{i+1} - "
+                   "2 theta_i + theta_{i-1}); a stuck block starts when its force exceeds Fs"),
+        source="H. Sakaguchi, Stick-Slip Motion and Phase Transition in a Block-Spring System, eq. (4)",
+    ),
+    "carlson-langer": Preset(
+        "carlson-langer", "Carlson-Langer (Burridge-Knopoff with velocity weakening)", _CL, _CL_PARAMS,
+        "rest", {"amplitude": 0.01, "seed": 0},
+        equations=("dv_i/dt = l^2 (x_{i+1} - 2 x_i + x_{i-1}) + (nu t - x_i) - phi(v_i) while moving, "
+                   "phi(v) = (1 - sigma) / (1 + 2 alpha v / (1 - sigma)); a stuck block starts when its "
+                   "force exceeds 1; periodic ends; start x_i = -A u_i, u_i uniform in [0, 1)"),
+        source="J. M. Carlson, J. S. Langer, B. E. Shaw and C. Tang, Phys. Rev. A 44, 884 (1991)",
+        note="units of the leaf spring and of the static friction: Kp = 1, Fs = 1; K = l^2, V = nu",
+        symbols={"l": "sqrt(K)", "nu": "V", "alpha": "alpha", "sigma": "sigma"},
+    ),
+    "train": Preset(
+        "train", "the train model (Elmer): the paper's chain with constant friction", 
+        dict(drive="end", friction="strengthening", threshold="constant", ends="free"),
+        dict(N=399, K=10.0, V=0.001, beta=1.0, F0=1.0, Fs=3.0, dt=0.005),
+        "paper",
+        equations=("dv_i/dt = K (x_{i+1} - 2 x_i + x_{i-1}) - F0 - beta v_i while moving, x_0 = V t, free "
+                   "end; a stuck block starts when its force exceeds Fs"),
+        source="F.-J. Elmer; here the paper's chain with alpha = 0 and theta = F0 = 1",
+        note="Elmer's own parametrisation was not available; this is one member of the model",
+    ),
+    "batista-carlson": Preset(
+        "batista-carlson", "a single block with a state-dependent threshold",
+        dict(drive="end", friction="state", threshold="state", ends="free"),
+        dict(N=1, K=10.0, D=0.0, V=0.05, beta=0.08, alpha=1.0, dt=0.005),
+        "rest", {"amplitude": 0.0, "seed": 0},
+        equations=("eq. (1) with M = sigma = 1: dv/dt = K (V t - x) - theta - beta v while moving; "
+                   "dtheta/dt = theta (1 - theta) - alpha theta v; a stuck block starts when "
+                   "K (V t - x) > theta"),
+        source="after A. A. Batista and J. M. Carlson, Phys. Rev. E 57, 4986 (1998)",
+        note=_BC_NOTE,
+    ),
+    "two-blocks": Preset(
+        "two-blocks", "two blocks (de Sousa Vieira): Carlson-Langer with N = 2, free ends",
+        dict(_CL, ends="free"), dict(_CL_PARAMS, N=2),
+        "rest", {"amplitude": 0.01, "seed": 0},
+        equations="as carlson-langer with N = 2 and free ends (x_0 = x_1, x_3 = x_2)",
+        source="M. de Sousa Vieira, Phys. Rev. A 46, 6288 (1992); H. Sakaguchi and T. Morita (2013)",
+        symbols={"l": "sqrt(K)", "nu": "V", "alpha": "alpha", "sigma": "sigma"},
+    ),
+}
+
+
+def preset(name: str) -> Preset:
+    """The preset called ``name``; a ValueError lists the presets."""
+    if name not in PRESETS:
+        raise ValueError(f"model must be one of {', '.join(PRESETS)} (got {name!r})")
+    return PRESETS[name]
+
+
+def chain_params(model: str = "sakaguchi", **overrides: Any):
+    """Validated parameters of preset ``model`` with ``overrides`` (pieces or parameters).
+
+    For the Carlson-Langer family ``l`` and ``nu`` are accepted in the model's own symbols
+    (K = l^2, V = nu).
+    """
+    from stickslip.models.params import ChainParams, ParameterError, check_number
+
+    try:
+        pr = preset(model)
+    except ValueError as exc:
+        raise ParameterError(str(exc)) from None
+    values: dict[str, Any] = {**pr.pieces, **pr.params}
+    if "l" in overrides:
+        values["K"] = check_number("l", overrides.pop("l"), low=0.0, low_open=True) ** 2
+    if "nu" in overrides:
+        values["V"] = overrides.pop("nu")
+    values.update(overrides)
+    return ChainParams(model=model, **values)
+
+
+def model_symbols(p) -> dict[str, float]:
+    """The parameters in the model's own symbols where they differ (l and nu of CL)."""
+    pr = PRESETS[p.model]
+    out: dict[str, float] = {}
+    if "l" in pr.symbols:
+        out["l"] = math.sqrt(p.K)
+    if "nu" in pr.symbols:
+        out["nu"] = p.V
+    return out
