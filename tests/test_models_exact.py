@@ -130,7 +130,7 @@ def test_plate_drive_exact_skips_stuck_blocks_and_jumps():
     s = run.summary
     assert len(run.events) > 10
     assert s["steps_computed"] < 0.8 * s["steps"]
-    assert s["block_updates"] < 0.2 * s["steps"] * p.N
+    assert s["block_updates"] < 0.4 * s["steps"] * p.N
 
 
 def test_train_model_is_the_paper_chain_with_alpha_zero_and_theta_one():

@@ -28,6 +28,8 @@ from stickslip.models.params import BlockParams, ChainParams, ParameterError  # 
 #: Names loaded on first use, and the module that holds each.
 _LAZY = {
     "run_chain": "stickslip.run.driver",
+    "chain_params": "stickslip.models.presets",
+    "largest_lyapunov": "stickslip.analysis.lyapunov",
     "resume_chain": "stickslip.run.driver",
     "load_run": "stickslip.run.rundir",
     "simulate_block": "stickslip.run.block",

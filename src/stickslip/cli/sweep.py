@@ -84,6 +84,8 @@ def _value(model: str, name: str, text: str) -> Any:
         kind = options[name]
     else:
         fields = {f.name: f for f in dataclasses.fields(_PARAMS[model])}
+        if "choices" in fields[name].metadata:  # a model name or a piece
+            return text.strip()
         kind = int if fields[name].metadata.get("integer") else float
     if kind is str:
         return text
@@ -140,11 +142,10 @@ def parse_grid(
 
     names = list(axes)
     points = [dict(zip(names, combo)) for combo in itertools.product(*axes.values())] if names else [{}]
-    params_cls = _PARAMS[model]
-    fields = {f.name for f in dataclasses.fields(params_cls)}
+    from stickslip.experiments.sweep import point_params
+
     for point in points:
-        merged = {**common, **point}
-        params_cls(**{k: v for k, v in merged.items() if k in fields})  # raises ParameterError
+        point_params(model, {**common, **point})  # raises ParameterError
     return points, common
 
 

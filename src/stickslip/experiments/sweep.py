@@ -336,12 +336,25 @@ def _progress_bar(total: int, done: int, enabled: bool):
 # Tasks
 
 
+def point_params(kind: str, point: dict[str, Any]):
+    """The parameters of one sweep point: BlockParams, or ChainParams of the point's ``model``
+    preset (default the paper's chain) with the point's other fields as overrides."""
+    params_cls = ChainParams if kind == "chain" else BlockParams
+    fields = {f.name for f in dataclasses.fields(params_cls)}
+    values = {k: v for k, v in point.items() if k in fields}
+    if params_cls is ChainParams:
+        from stickslip.models.presets import chain_params
+
+        return chain_params(values.pop("model", "sakaguchi"), **values)
+    return params_cls(**values)
+
+
 def _split(point: dict[str, Any], params_cls: type, options: tuple[str, ...]) -> tuple[Any, dict[str, Any]]:
     fields = {f.name for f in dataclasses.fields(params_cls)}
     unknown = sorted(set(point) - fields - set(options))
     if unknown:
         raise ValueError(f"unknown keys for {params_cls.__name__}: {', '.join(unknown)}")
-    params = params_cls(**{k: v for k, v in point.items() if k in fields})
+    params = point_params("chain" if params_cls is ChainParams else "block", point)
     run_options = {k: v for k, v in point.items() if k in options}
     if "t_end" not in run_options:
         raise ValueError("a sweep point needs t_end")
@@ -356,8 +369,15 @@ def chain_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     """
     from stickslip.run import driver as chain  # imported here: workers load the simulator only when needed
 
+    from stickslip.models.presets import PRESETS
+
     params, options = _split(point, ChainParams, CHAIN_RUN_OPTIONS)
     t_end = options.pop("t_end")
+    if "start" not in options:  # the model's own start (Carlson-Langer: every block stuck, seeded)
+        preset = PRESETS[params.model]
+        options["start"] = preset.start
+        options["perturbation"] = preset.start_options.get("amplitude", 0.0)
+        options["seed"] = preset.start_options.get("seed", 0)
     run = chain.run_chain(params, t_end, out_dir=point_dir, **options)
     if not (Path(point_dir) / "run.json").exists():
         chain.write_run(run, point_dir)

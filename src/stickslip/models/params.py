@@ -154,6 +154,10 @@ def scale_block(p: BlockParams) -> BlockParams:
     )
 
 
+# The named models (presets) of stickslip.models.presets, which checks that it defines these.
+MODELS = ("sakaguchi", "carlson-langer", "train", "batista-carlson", "two-blocks")
+
+
 def _choice(default: str, kind: str, doc: str) -> Any:
     from stickslip.models.pieces import names
 
@@ -184,7 +188,7 @@ class ChainParams(_Validated):
     alpha: float = _nonnegative(1.0, "weakening coefficient alpha of the state variable")
     Fs: float = _positive(3.0, "static friction limit Fs")
     dt: float = _positive(0.005, "Heun time step dt")
-    model: str = field(default="sakaguchi", metadata={"text": True, "doc": "preset the parameters came from"})
+    model: str = field(default="sakaguchi", metadata={"choices": MODELS, "doc": "preset the parameters came from"})
     drive: str = _choice("end", "drive", "drive: end (pulling point at block 1) or plate (every block)")
     friction: str = _choice("state", "friction", "friction of a moving block: state, weakening or strengthening")
     threshold: str = _choice("constant", "threshold", "static threshold: constant (Fs) or state (theta_i)")
@@ -194,13 +198,6 @@ class ChainParams(_Validated):
                                                  "doc": "friction drop sigma of velocity weakening (CL)"})
     F0: float = _nonnegative(1.0, "constant part F0 of strengthening friction (train model)")
 
-    def __post_init__(self) -> None:
-        from stickslip.models.presets import PRESETS
-
-        object.__setattr__(self, "model", str(self.model))
-        if self.model not in PRESETS:
-            raise ParameterError(f"model must be one of {', '.join(PRESETS)} (got {self.model!r})")
-        super().__post_init__()
 
     def _check(self) -> None:
         from stickslip.models.pieces import CompositionError, check_composition

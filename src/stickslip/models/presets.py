@@ -96,6 +96,12 @@ PRESETS: dict[str, Preset] = {
 }
 
 
+def _check_names() -> None:
+    from stickslip.models.params import MODELS
+
+    assert tuple(PRESETS) == MODELS, "ChainParams.model and the presets name the same models"
+
+
 def preset(name: str) -> Preset:
     """The preset called ``name``; a ValueError lists the presets."""
     if name not in PRESETS:
@@ -111,6 +117,7 @@ def chain_params(model: str = "sakaguchi", **overrides: Any):
     """
     from stickslip.models.params import ChainParams, ParameterError, check_number
 
+    _check_names()
     try:
         pr = preset(model)
     except ValueError as exc:

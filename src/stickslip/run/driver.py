@@ -350,3 +350,48 @@ def _drive(params, options, integrator, start_info, state, outputs, *, out_dir, 
             checkpointer.write(state, outputs, dict(header, wall_seconds=wall))
         write_run(run, out_dir)
     return run
+
+
+class Stepper:
+    """Advance chain states of one model to given steps with no outputs kept: the engine of
+    :func:`run_chain` without its tables, for methods that restart short runs many times
+    (Lyapunov exponents).
+
+    Same kernels, parameters and arrays as :func:`run_chain`, so a trajectory is the one
+    ``run_chain`` gives bit for bit; sampling is switched off (it decides only where a kernel
+    pauses, never what it computes) and the event buffers are emptied and dropped when full.
+    """
+
+    def __init__(self, params: ChainParams, integrator: str = "exact"):
+        if integrator not in INTEGRATORS:
+            raise ParameterError(f"integrator must be one of {', '.join(INTEGRATORS)} (got {integrator!r})")
+        self.params = params
+        self.integrator = integrator
+        self.par = _par(params)
+        self.scratch = [np.zeros(params.N + 2) for _ in range(6)] + [np.zeros(params.N + 2, dtype=np.int64)]
+        self.outputs = _Outputs(params.N, False)
+        self._kernels: dict[str, _Kernel] = {}
+
+    def _kernel(self, name: str, state: ChainState) -> "_Kernel":
+        if name not in self._kernels:
+            self._kernels[name] = _Kernel(name, self.params, state, self.scratch, self.par, self.outputs, 1, 0, 0)
+        return self._kernels[name]
+
+    def advance(self, state: ChainState, step: int) -> tuple[ChainState, int]:
+        """Advance ``state`` in place to ``step``; returns it and the slip events completed."""
+        ist = state.ist
+        events0 = int(ist[K.N_EVENTS])
+        ist[K.NEXT_SAMPLE] = np.iinfo(np.int64).max
+        while True:
+            before = state.copy() if self.integrator == "exact" else None
+            status = self._kernel(self.integrator, state)(state, step)
+            if before is not None and not _finite(state):
+                state.__dict__.update(before.__dict__)
+                status = self._kernel("dense", state)(state, step)
+            if status == K.NONFINITE:
+                raise NonFiniteState(f"state became non-finite at t = {state.step * self.params.dt:.6g} "
+                                     f"(step {state.step}) in block {int(ist[K.BAD_BLOCK])}")
+            ist[K.EV_COUNT] = ist[K.FM_COUNT] = ist[K.S_COUNT] = ist[K.P_COUNT] = 0
+            ist[K.EV_P_FIRST] = 0
+            if status == K.DONE:
+                return state, int(ist[K.N_EVENTS]) - events0

@@ -1,0 +1,408 @@
+"""The largest Lyapunov exponent of the chain of eq. (4) (and of eq. (1) as the chain with N = 1).
+
+Two-trajectory method of Benettin, Galgani, Giorgilli and Strelcyn (Meccanica 15, 9, 1980):
+a reference trajectory and a twin a distance d0 away are advanced side by side with the chain
+engine (:func:`stickslip.run.driver.run_chain`); every ``interval`` the distance d is measured and
+the twin is put back at distance d0 along the current separation. The exponent is the mean of
+ln(d / d0) per unit time over the renormalisations after a transient, and its error bar the
+standard error of the means of M independent segments of them.
+
+Separation. The state of block i is (x_i, v_i, theta_i, stopped_i). Forces depend on positions
+only through the spring extensions e_i = x_{i-1} - x_i (x_0 = V t_n, the pulling point), so the
+separation is measured in y = (sqrt(K) e_i, v_i, theta_i), i = 1..N, with the Euclidean norm.
+With unit mass, |(sqrt(K) de, dv)|^2 / 2 is the mechanical energy of the perturbation (springs
+plus motion): a harmonic oscillation of the perturbation does not make d oscillate, which would
+add noise to every ln(d / d0). The pulling point is the same for both trajectories, so the
+extensions carry the whole position information (no neutral translation direction).
+
+Stuck blocks. A stuck block lies on the constraint v_i = 0: its velocity is not a coordinate.
+The twin therefore has the reference's stopped flags, and the separation vector loses its
+velocity components on the blocks stuck in the reference before it is rescaled to d0 (it is
+projected onto the reference's current branch). A stuck block is perturbed in x_i and theta_i
+only; it starts when the start rule says so from its own force, as in the reference. The
+distance itself is measured from the continuous variables alone, so a twin block that is still
+sliding while the reference's has stopped counts with its velocity: flags never enter d.
+See docs/lyapunov.md for what the exponent means with these switching rules.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+from dataclasses import dataclass, field
+from typing import Any, Sequence
+
+import numpy as np
+import pandas as pd
+
+from stickslip.run.driver import ChainState, Stepper, run_chain
+from stickslip.models.params import ChainParams, ParameterError, check_number, steps_for
+
+#: Largest allowed initial separation: beyond it the twin is not a small perturbation.
+D0_MAX = 1e-3
+
+NORM = "Euclidean norm of (sqrt(K) e_i, v_i, theta_i), e_i = x_{i-1} - x_i, x_0 = V t"
+
+
+@dataclass(frozen=True)
+class LyapunovResult:
+    """The largest Lyapunov exponent of one run (Benettin et al. 1980, two trajectories).
+
+    lyapunov: sum of ln(d_k / d0_k) over the counted renormalisations divided by their total
+    time; lyapunov_err: standard error of the means of ``segments`` consecutive groups of them;
+    times, log_growth, durations: end time, ln(d / d0) and length of every renormalisation
+    interval (counted or not); counted: which enter the exponent (those ending after
+    transient + align).
+    """
+
+    lyapunov: float
+    lyapunov_err: float
+    t_end: float
+    transient: float
+    align: float
+    interval: float
+    d0: float
+    renormalisations: int
+    segments: int
+    segment_means: tuple[float, ...]
+    events: int
+    max_log_growth: float
+    reference_sha256: str
+    wall_seconds: float
+    params: ChainParams
+    start: str
+    times: np.ndarray = field(repr=False)
+    log_growth: np.ndarray = field(repr=False)
+    durations: np.ndarray = field(repr=False)
+    counted: np.ndarray = field(repr=False)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The scalars of the result, its parameters and the method, as a plain dict for JSON."""
+        return {
+            "lyapunov": self.lyapunov,
+            "lyapunov_err": self.lyapunov_err,
+            "t_end": self.t_end,
+            "transient": self.transient,
+            "align": self.align,
+            "interval": self.interval,
+            "d0": self.d0,
+            "renormalisations": self.renormalisations,
+            "segments": self.segments,
+            "segment_means": list(self.segment_means),
+            "events": self.events,
+            "max_log_growth": self.max_log_growth,
+            "reference_sha256": self.reference_sha256,
+            "wall_seconds": self.wall_seconds,
+            "params": self.params.to_dict(),
+            "start": self.start,
+            "method": "Benettin et al. (1980) two-trajectory method with renormalisation",
+            "norm": NORM,
+        }
+
+    def truncated(self, t_end: float) -> "LyapunovResult":
+        """The estimate a run to ``t_end`` (a renormalisation time of this run) would have given.
+
+        The twin's history does not depend on the run's end, so this equals the shorter run
+        apart from the reference's final state (its hash is left empty).
+        """
+        keep = self.times <= t_end + 0.5 * self.params.dt
+        lam, err, means = _estimate(self.log_growth[keep], self.durations[keep], self.counted[keep], self.segments)
+        return LyapunovResult(
+            lam, err, float(t_end), self.transient, self.align, self.interval, self.d0,
+            int(np.count_nonzero(self.counted[keep])), self.segments, means, -1,
+            float(np.max(self.log_growth[keep], initial=-np.inf)), "", float("nan"), self.params,
+            self.start, self.times[keep], self.log_growth[keep], self.durations[keep], self.counted[keep],
+        )
+
+
+def separation(ref: ChainState, twin: ChainState, params: ChainParams) -> np.ndarray:
+    """The separation twin - ref in the coordinates y = (sqrt(K) e, v, theta) (length 3N).
+
+    e_i = x_{i-1} - x_i with the same pulling point for both, so de_i = dx_{i-1} - dx_i, dx_0 = 0.
+    """
+    dx = twin.x[1:-1] - ref.x[1:-1]
+    de = np.concatenate(([0.0], dx[:-1])) - dx
+    dv = twin.v[1:-1] - ref.v[1:-1]
+    dth = twin.th[1:-1] - ref.th[1:-1]
+    return np.concatenate((math.sqrt(params.K) * de, dv, dth))
+
+
+def _project(dy: np.ndarray, stopped: np.ndarray) -> np.ndarray:
+    """Drop the velocity components of blocks stuck in the reference (the constraint v = 0)."""
+    N = stopped.shape[0]
+    out = dy.copy()
+    out[N:2 * N][stopped] = 0.0
+    return out
+
+
+ENGINES = ("lean", "run_chain")
+
+
+class _RunChainEngine:
+    """Advances a state with the public :func:`stickslip.run.driver.run_chain` (one call per interval).
+
+    Always right, but each call assembles the full run record (tables, xarray): some
+    milliseconds, a hundred times the cost of a short interval of the kernel itself.
+    """
+
+    def __init__(self, params: ChainParams):
+        self.params = params
+
+    def advance(self, state: ChainState, step: int) -> tuple[ChainState, int]:
+        """The state at ``step`` and the number of slip events completed on the way."""
+        run = run_chain(self.params, step * self.params.dt, start=state, sample_interval=self.params.dt)
+        return run.state, len(run.events)
+
+
+class _LeanEngine:
+    """Kernel calls to the target step with no outputs kept (:class:`stickslip.run.driver.Stepper`)."""
+
+    def __init__(self, params: ChainParams):
+        self.params = params
+        self.stepper = Stepper(params)
+
+    def advance(self, state: ChainState, step: int) -> tuple[ChainState, int]:
+        """The state at ``step`` (advanced in place) and the slip events completed on the way."""
+        return self.stepper.advance(state, step)
+
+
+def _with_step(state: ChainState, step: int) -> ChainState:
+    """``state`` (built by ChainState.from_blocks, at step 0) set to step ``step``.
+
+    from_blocks marks every block as possibly changing, so the fast integrator continues it
+    correctly; only the step count, which places the pulling point, has to be carried over.
+    """
+    from stickslip.kernels.chain import STEP
+
+    state.ist[STEP] = step
+    return state
+
+
+def twin_state(ref: ChainState, direction: np.ndarray, d0: float, params: ChainParams) -> ChainState:
+    """The twin ref + d0 * direction (direction in y coordinates, see :func:`separation`).
+
+    The twin takes the reference's stopped flags; ``direction`` is first projected onto the
+    reference's branch (no velocity on stuck blocks) and normalised. Positions follow from the
+    extensions: dx_i = -(de_1 + ... + de_i).
+    """
+    b = ref.blocks()
+    N = b["x"].shape[0]
+    u = _project(direction, b["stopped"])
+    norm = float(np.linalg.norm(u))
+    if not norm > 0.0:
+        raise ValueError("the separation vanished on the reference's branch; cannot renormalise")
+    u = u * (d0 / norm)
+    de = u[:N] / math.sqrt(params.K)
+    x = b["x"] - np.cumsum(de)
+    v = np.where(b["stopped"], 0.0, b["v"] + u[N:2 * N])
+    th = b["theta"] + u[2 * N:]
+    return _with_step(ChainState.from_blocks(x, v, th, b["stopped"]), ref.step)
+
+
+def _estimate(log_growth, durations, counted, segments):
+    """Exponent, standard error of the segment means, and the segment means."""
+    g = log_growth[counted]
+    tau = durations[counted]
+    if len(g) < segments:
+        return float("nan"), float("nan"), ()
+    lam = float(np.sum(g) / np.sum(tau))
+    parts = np.array_split(np.arange(len(g)), segments)
+    means = tuple(float(np.sum(g[p]) / np.sum(tau[p])) for p in parts)
+    err = float(np.std(means, ddof=1) / math.sqrt(segments))
+    return lam, err, means
+
+
+def _check_run(params: ChainParams, t_end, interval, d0, transient, align, segments):
+    """Validate the options; returns (t_end, interval, d0, transient, align, segments) as numbers."""
+    t_end = float(check_number("t_end", t_end, low=0.0, low_open=True))
+    interval = float(check_number("interval", interval, low=params.dt))
+    d0 = float(check_number("d0", d0, low=0.0, high=D0_MAX, low_open=True))
+    transient = float(check_number("transient", transient, low=0.0, high=t_end, high_open=True))
+    if align is None:
+        align = 0.1 * (t_end - transient)
+    align = float(check_number("align", align, low=0.0, high=t_end - transient, high_open=True))
+    segments = int(check_number("segments", segments, low=2, integer=True))
+    m = int(round(interval / params.dt))
+    n_lo = steps_for(transient + align, params.dt)
+    n_end = steps_for(t_end, params.dt)
+    counted = -(-(n_end - n_lo) // m) if n_end > n_lo else 0
+    if counted < segments:
+        need = transient + align + segments * m * params.dt
+        raise ParameterError(
+            f"t_end must be >= {need:g} for {segments} segments of one renormalisation each "
+            f"after transient + align (got {t_end:g})"
+        )
+    return t_end, interval, d0, transient, align, segments
+
+
+def largest_lyapunov(
+    params: ChainParams,
+    t_end: float,
+    *,
+    interval: float = 10.0,
+    d0: float = 1e-10,
+    transient: float = 0.0,
+    align: float | None = None,
+    start: str | ChainState = "paper",
+    perturbation: float = 0.0,
+    seed: int = 0,
+    direction_seed: int = 0,
+    segments: int = 10,
+    engine: str = "lean",
+    progress: bool = False,
+) -> LyapunovResult:
+    """Largest Lyapunov exponent of eq. (4) (eq. (1) for N = 1), Benettin et al. (1980).
+
+    The reference runs alone from ``start`` ('paper', 'steady' with ``perturbation`` and
+    ``seed``, or a ChainState) to ``transient``; there a twin is placed d0 away in a random
+    direction (numpy ``default_rng(direction_seed)``). Both advance with
+    the exact integrator of :func:`stickslip.run.driver.run_chain` in steps of ``interval`` up to
+    ``t_end`` (``engine`` 'lean': its kernel loop without the run record, a hundred times faster
+    for short intervals; 'run_chain': one public call per interval; both give the same numbers
+    bit for bit); after each
+    the distance d (:data:`NORM`) is recorded and the twin put back at d0 along the separation
+    (:func:`twin_state`). The renormalisations ending after transient + ``align`` (default a
+    tenth of t_end - transient, for the separation to turn into the most unstable direction)
+    give the exponent: sum of ln(d / d0) over their total time. The error bar is the standard
+    error of the exponents of ``segments`` consecutive groups of them.
+
+    The reference is continued exactly as one uninterrupted run: its final state is bit for bit
+    ``run_chain(params, t_end, start=start, ...).state``. d0 is the realised distance after
+    rounding, so ln(d / d0) is not biased by the rounding of the twin's positions.
+    """
+    t_end, interval, d0, transient, align, segments = _check_run(
+        params, t_end, interval, d0, transient, align, segments)
+    if engine not in ENGINES:
+        raise ParameterError(f"engine must be one of {', '.join(ENGINES)} (got {engine!r})")
+    stepper = _LeanEngine(params) if engine == "lean" else _RunChainEngine(params)
+    dt = params.dt
+    m = int(round(interval / dt))
+    n0 = steps_for(transient, dt)
+    n_end = steps_for(t_end, dt)
+    n_count = steps_for(transient + align, dt)
+    wall0 = time.perf_counter()
+
+    run = run_chain(params, n0 * dt, start=start, perturbation=perturbation, seed=seed,
+                    sample_interval=max(transient, dt))
+    ref = run.state
+    start_name = start if isinstance(start, str) else "state"
+    rng = np.random.default_rng(direction_seed)
+    twin = twin_state(ref, rng.standard_normal(3 * params.N), d0, params)
+    d_start = float(np.linalg.norm(separation(ref, twin, params)))
+
+    n_k = (n_end - n0 + m - 1) // m
+    times = np.zeros(n_k)
+    logs = np.zeros(n_k)
+    taus = np.zeros(n_k)
+    events = 0
+    bar = _bar(progress, t_end - transient)
+    try:
+        n = n0
+        for k in range(n_k):
+            n_next = min(n + m, n_end)
+            ref, n_events = stepper.advance(ref, n_next)
+            twin, _ = stepper.advance(twin, n_next)
+            if n_next > n_count:
+                events += n_events
+            dy = separation(ref, twin, params)
+            d = float(np.linalg.norm(dy))
+            times[k], taus[k] = n_next * dt, (n_next - n) * dt
+            logs[k] = math.log(d / d_start) if d > 0.0 else -math.inf
+            if d > 0.0 and np.any(_project(dy, ref.blocks()["stopped"]) != 0.0):
+                twin = twin_state(ref, dy, d0, params)
+            else:
+                # The twin fell onto the reference (sticking can merge them): start a fresh one.
+                twin = twin_state(ref, rng.standard_normal(3 * params.N), d0, params)
+            d_start = float(np.linalg.norm(separation(ref, twin, params)))
+            n = n_next
+            if bar is not None:
+                bar.update(taus[k])
+    finally:
+        if bar is not None:
+            bar.close()
+    counted = times > n_count * dt + 0.5 * dt
+    lam, err, means = _estimate(logs, taus, counted, segments)
+    return LyapunovResult(
+        lyapunov=lam, lyapunov_err=err, t_end=t_end, transient=transient, align=align,
+        interval=interval, d0=d0, renormalisations=int(np.count_nonzero(counted)), segments=segments,
+        segment_means=means, events=events, max_log_growth=float(np.max(logs[counted], initial=-np.inf)),
+        reference_sha256=ref.sha256(), wall_seconds=time.perf_counter() - wall0, params=params,
+        start=start_name, times=times, log_growth=logs, durations=taus, counted=counted,
+    )
+
+
+def _bar(progress: bool, total: float):
+    """A tqdm bar on stderr, only when asked and stderr is a terminal."""
+    if not (progress and sys.stderr.isatty()):
+        return None
+    from tqdm import tqdm
+
+    return tqdm(total=total, unit="t", unit_scale=True, dynamic_ncols=True, desc="lyapunov", file=sys.stderr)
+
+
+CONVERGENCE_COLUMNS = ["varied", "d0", "interval", "t_end", "lyapunov", "lyapunov_err", "renormalisations",
+                       "wall_seconds"]
+
+
+def lyapunov_convergence(
+    params: ChainParams,
+    t_end: float,
+    *,
+    d0s: Sequence[float] = (1e-8, 1e-10, 1e-12),
+    intervals: Sequence[float] | None = None,
+    t_ends: Sequence[float] | None = None,
+    interval: float = 10.0,
+    d0: float = 1e-10,
+    **kwargs: Any,
+) -> pd.DataFrame:
+    """The exponent of :func:`largest_lyapunov` against d0, the interval and the run length.
+
+    One quantity is varied at a time about (d0, interval, t_end). ``intervals`` defaults to
+    interval / 2, interval, 2 interval; ``t_ends`` to the quarter, half and whole of the counted
+    stretch, read off the base run (:meth:`LyapunovResult.truncated`, identical to shorter runs).
+    Other keyword arguments go to :func:`largest_lyapunov`.
+    """
+    rows = []
+
+    def add(varied, res, wall):
+        rows.append({"varied": varied, "d0": res.d0, "interval": res.interval, "t_end": res.t_end,
+                     "lyapunov": res.lyapunov, "lyapunov_err": res.lyapunov_err,
+                     "renormalisations": res.renormalisations, "wall_seconds": wall})
+
+    base = largest_lyapunov(params, t_end, interval=interval, d0=d0, **kwargs)
+    for value in d0s:
+        res = base if value == d0 else largest_lyapunov(params, t_end, interval=interval, d0=value, **kwargs)
+        add("d0", res, res.wall_seconds)
+    if intervals is None:
+        intervals = (interval / 2, interval, 2 * interval)
+    for value in intervals:
+        res = base if value == interval else largest_lyapunov(params, t_end, interval=value, d0=d0, **kwargs)
+        add("interval", res, res.wall_seconds)
+    if t_ends is None:
+        lo = base.transient + base.align
+        t_ends = [lo + f * (base.t_end - lo) for f in (0.25, 0.5, 1.0)]
+    for value in t_ends:
+        # Cut at the last renormalisation at or before value.
+        t_cut = float(base.times[base.times <= value + 0.5 * params.dt].max())
+        add("t_end", base.truncated(t_cut), float("nan"))
+    return pd.DataFrame(rows, columns=CONVERGENCE_COLUMNS)
+
+
+BETA_COLUMNS = ["beta", "lyapunov", "lyapunov_err", "renormalisations", "events", "max_log_growth",
+                "wall_seconds"]
+
+
+def lyapunov_vs_beta(params: ChainParams, betas: Sequence[float], t_end: float, **kwargs: Any) -> pd.DataFrame:
+    """The largest exponent of eq. (4) at each beta (other parameters from ``params``).
+
+    Keyword arguments go to :func:`largest_lyapunov`. Only a params object describes the
+    model, so a model with other parameters needs nothing else here.
+    """
+    rows = []
+    for beta in betas:
+        res = largest_lyapunov(params.replace(beta=float(beta)), t_end, **kwargs)
+        rows.append({"beta": float(beta), "lyapunov": res.lyapunov, "lyapunov_err": res.lyapunov_err,
+                     "renormalisations": res.renormalisations, "events": res.events,
+                     "max_log_growth": res.max_log_growth, "wall_seconds": res.wall_seconds})
+    return pd.DataFrame(rows, columns=BETA_COLUMNS)

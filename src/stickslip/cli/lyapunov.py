@@ -1,0 +1,128 @@
+"""`stickslip lyapunov`: the largest Lyapunov exponent of the chain of eq. (4) (eq. (1) at N = 1).
+
+Benettin et al. (1980) two-trajectory method (:mod:`stickslip.analysis.lyapunov`). ``--convergence``
+tabulates the exponent against d0, the renormalisation interval and the run length;
+``--betas`` tabulates it against beta, and ``--plot FILE`` draws that table.
+"""
+
+from __future__ import annotations
+
+import argparse
+
+from stickslip.cli._common import (
+    CommandError,
+    Result,
+    add_json_option,
+    add_param_options,
+    float_arg,
+    params_from_args,
+)
+from stickslip.models.params import ChainParams, ParameterError, check_number
+
+
+def register(sub) -> None:
+    """Add the `lyapunov` subcommand."""
+    p = sub.add_parser(
+        "lyapunov",
+        help="largest Lyapunov exponent of the chain (eq. 4; eq. 1 with --N 1)",
+        description=(
+            "Largest Lyapunov exponent of the chain of eq. (4) by the two-trajectory method of "
+            "Benettin et al. (1980): a reference run and a twin d0 away, renormalised every "
+            "interval; the exponent is the mean of ln(d/d0) per unit time after the transient, "
+            "with the standard error of the means of M segments. See docs/lyapunov.md."
+        ),
+    )
+    add_param_options(p, ChainParams)
+    p.add_argument("--start", choices=("paper", "steady"), default="paper",
+                   help="initial state: the paper's (default) or exact steady sliding")
+    p.add_argument("--perturbation", type=float_arg("perturbation"), default=0.0, metavar="A",
+                   help="with --start steady: uniform perturbation of x and v in [-A, A] (default 0)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the perturbation (default 0)")
+    p.add_argument("--t-end", type=float_arg("t-end"), default=2e4, metavar="T", help="end time (default 2e4)")
+    p.add_argument("--interval", type=float_arg("interval"), default=10.0, metavar="TAU",
+                   help="time between renormalisations (default 10)")
+    p.add_argument("--d0", type=float_arg("d0"), default=1e-10, metavar="D0",
+                   help="initial separation of the twin (default 1e-10)")
+    p.add_argument("--transient", type=float_arg("transient"), default=0.0, metavar="T0",
+                   help="the reference runs alone up to T0 before the twin is placed (default 0)")
+    p.add_argument("--align", type=float_arg("align"), default=None, metavar="TA",
+                   help="renormalisations ending before T0 + TA are not counted (default (T - T0) / 10)")
+    p.add_argument("--segments", type=int, default=10, metavar="M",
+                   help="independent segments for the error bar (default 10)")
+    p.add_argument("--direction-seed", type=int, default=0, help="seed of the twin's first direction (default 0)")
+    p.add_argument("--convergence", action="store_true",
+                   help="tabulate the exponent against d0 (1e-8, 1e-10, 1e-12), the interval (TAU/2, TAU, 2 TAU) "
+                        "and the run length")
+    p.add_argument("--betas", default=None, metavar="B1,B2,...",
+                   help="tabulate the exponent against these values of beta")
+    p.add_argument("--plot", default=None, metavar="FILE", help="with --betas: draw lambda(beta) to FILE (.png, .pdf)")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
+    add_json_option(p)
+    p.set_defaults(handler=run_lyapunov_command)
+
+
+def _betas(text: str) -> list[float]:
+    try:
+        values = [float(s) for s in text.split(",") if s.strip()]
+    except ValueError:
+        raise ParameterError(f"betas must be a comma-separated list of numbers >= 0 (got {text!r})") from None
+    if not values:
+        raise ParameterError(f"betas must be a comma-separated list of numbers >= 0 (got {text!r})")
+    for b in values:
+        check_number("beta", b, low=0.0)
+    return values
+
+
+def _result_text(d: dict) -> str:
+    return "\n".join([
+        f"lyapunov          {d['lyapunov']:.6g} +- {d['lyapunov_err']:.2g}   (per unit time)",
+        f"renormalisations  {d['renormalisations']} counted, interval {d['interval']:g}, d0 {d['d0']:g}",
+        f"window            t = {d['transient'] + d['align']:g} .. {d['t_end']:g}  (transient {d['transient']:g}, "
+        f"align {d['align']:g}); {d['events']} events in it",
+        f"segments          {d['segments']} (error bar: standard error of their means)",
+        f"max ln(d/d0)      {d['max_log_growth']:.3g} in one interval",
+        f"reference sha256  {d['reference_sha256']}",
+        f"wall time         {d['wall_seconds']:.3g} s",
+    ])
+
+
+def run_lyapunov_command(args: argparse.Namespace) -> Result:
+    """Handler of `stickslip lyapunov`."""
+    from stickslip.analysis import lyapunov as ly
+
+    params = params_from_args(ChainParams, args)
+    check_number("perturbation", args.perturbation, low=0.0)
+    if args.plot and not args.betas:
+        raise CommandError("--plot needs --betas")
+    if args.convergence and args.betas:
+        raise CommandError("give either --convergence or --betas, not both")
+    kw = dict(interval=args.interval, d0=args.d0, transient=args.transient, align=args.align,
+              start=args.start, perturbation=args.perturbation, seed=args.seed,
+              direction_seed=args.direction_seed, segments=args.segments)
+    # Validate every option before the first (possibly long) run.
+    ly._check_run(params, args.t_end, args.interval, args.d0, args.transient, args.align, args.segments)
+    if args.convergence:
+        table = ly.lyapunov_convergence(params, args.t_end, **kw)
+        data = {"params": params.to_dict(), "convergence": table.to_dict(orient="records"),
+                "method": "Benettin et al. (1980) two-trajectory method", "norm": ly.NORM}
+        return Result(data, table.to_string(index=False))
+    if args.betas:
+        betas = _betas(args.betas)
+        table = ly.lyapunov_vs_beta(params, betas, args.t_end, progress=not args.no_progress, **kw)
+        data = {"params": params.to_dict(), "t_end": args.t_end, "table": table.to_dict(orient="records"),
+                "method": "Benettin et al. (1980) two-trajectory method", "norm": ly.NORM}
+        text = table.to_string(index=False)
+        if args.plot:
+            from stickslip.plotting.lyapunov import plot_lyapunov_beta
+
+            fig = plot_lyapunov_beta(table, params)
+            try:
+                fig.savefig(args.plot)
+            except (OSError, ValueError) as exc:
+                raise CommandError(f"cannot write plot {args.plot}: {exc}") from None
+            data["plot"] = args.plot
+            text += f"\nplot written to {args.plot}"
+        return Result(data, text)
+    res = ly.largest_lyapunov(params, args.t_end, progress=not args.no_progress, **kw)
+    data = res.to_dict()
+    return Result(data, _result_text(data))
