@@ -4,7 +4,9 @@
 ``--V``, the eigenvalues there; ``--out DIR`` writes the stability map V_c(beta).
 ``stability chain`` gives the long-wave critical beta of the chain (eq. 5), the largest growth
 rate over Fourier modes and, with ``--N``, the check against the finite 3N x 3N chain;
-``--out DIR`` writes Fig. 4. ``hysteresis`` sweeps V up and down for the single block and gives
+``--out DIR`` writes Fig. 4. With ``--model`` (or the pieces) a chain without state variable, the
+plate drive of Carlson-Langer or the train model, gets its growth rates mode by mode
+(lambda^2 + phi'(V) lambda + w_k^2 = 0) and ``--out DIR`` the growth rate against k. ``hysteresis`` sweeps V up and down for the single block and gives
 V_up and V_down; ``--out DIR`` writes the bifurcation diagram.
 """
 
@@ -21,9 +23,12 @@ from stickslip import io
 from stickslip.analysis import hysteresis as hy
 from stickslip.analysis import stability as st
 from stickslip.cli._common import (
+    CommandError,
     Result,
     add_json_option,
+    add_model_options,
     add_param_options,
+    chain_params_from_args,
     float_arg,
     params_from_args,
     prepare_out_dir,
@@ -67,16 +72,20 @@ def register(sub) -> None:
 
     c = ss.add_parser(
         "chain",
-        help="long-wave instability of the chain (eq. 5, Fig. 4)",
+        help="long-wave instability of the chain (eq. 5, Fig. 4); growth rates of the relatives (--model)",
         description=(
             "Fourier modes of the linearised chain, eq. (5): critical beta (closed form and "
             "numerical), largest growth rate over 0 < k <= pi; with --N the eigenvalues of the "
-            "finite chain with the ends of MODEL.md. --out DIR writes Fig. 4."
+            "finite chain with the ends of MODEL.md. --out DIR writes Fig. 4. With --model "
+            "carlson-langer, train or two-blocks (or friction weakening/strengthening composed "
+            "with the pieces): the growth rate of each normal mode of the finite chain, "
+            "lambda^2 + phi'(V) lambda + w_k^2 = 0; --out DIR writes the growth rate against k."
         ),
     )
-    add_param_options(c, ChainParams, skip=("Fs", "dt"))
+    add_model_options(c)
     c.add_argument("--out", default=None, metavar="DIR",
-                   help="write fig4.png, fig4.nc and stability_chain.json to DIR")  # fmt: skip
+                   help="write fig4.png, fig4.nc and stability_chain.json to DIR (the relatives: "
+                        "mode_growth.png, mode_growth.nc, stability_chain.json)")  # fmt: skip
     add_json_option(c)
     c.set_defaults(handler=run_stability_chain)
 
@@ -196,12 +205,21 @@ def _block_text(d: dict[str, Any]) -> str:
 
 
 def run_stability_chain(args: argparse.Namespace) -> Result:
-    """Handler of ``stickslip stability chain``: Fourier modes of eq. (5), Fig. 4."""
+    """Handler of ``stickslip stability chain``: Fourier modes of eq. (5), Fig. 4; the relatives
+    without state variable mode by mode (:func:`run_stability_modes`)."""
+    for name in ("Fs", "dt"):
+        if getattr(args, f"param_{name}", None) is not None:
+            raise CommandError(f"--{name} is not read by the linear stability of steady sliding")
     with_N = args.param_N is not None
     D = args.param_D
     # dt is never read by the linear analysis; keep ChainParams' explicit-step check out of the way.
     overrides = {"dt": 0.5 / D} if D is not None and D > 0.0 and D * 0.005 > 0.5 else {}
-    p = params_from_args(ChainParams, args, **overrides)
+    p = chain_params_from_args(args, **overrides)
+    if p.friction != "state":
+        return run_stability_modes(args, p)
+    if p.drive != "end":
+        raise CommandError("friction state with drive plate is not covered: use friction weakening or "
+                           "strengthening with the plate drive")
     if with_N:
         check_number("N", p.N, low=1, high=MAX_FINITE_N, integer=True)
     out = prepare_out_dir(args.out)
@@ -263,6 +281,68 @@ def _chain_text(d: dict[str, Any]) -> str:
         f = d["finite_chain"]
         lines.append(f"finite chain N = {f['N']}: largest Re(lambda) {f['max_real']:.6g} "
                      f"(Fourier at k1 = {f['k1']:.4g}: {f['fourier_at_k1']:.6g})")  # fmt: skip
+    for path in d.get("outputs", []):
+        lines.append(f"wrote {path}")
+    return "\n".join(lines)
+
+
+def run_stability_modes(args: argparse.Namespace, p: ChainParams) -> Result:
+    """Growth rates of steady sliding mode by mode: plate drive (CL) or train model.
+
+    Each normal mode obeys lambda^2 + phi'(V) lambda + w_k^2 = 0 (analysis.stability).
+    """
+    if p.V <= 0.0:
+        raise CommandError(f"steady sliding needs V > 0 (got V={p.V:g})")
+    if p.ends == "fixed":
+        raise CommandError("ends fixed have no steady sliding (the springs to the walls stretch without bound)")
+    if p.N > MAX_FINITE_N:
+        raise CommandError(f"N must be <= {MAX_FINITE_N} for the mode table (got N={p.N})")
+    out = prepare_out_dir(args.out)
+
+    s = st.mode_stability(p)
+    data: dict[str, Any] = {
+        "params": {k: v for k, v in p.to_dict().items() if k not in ("Fs", "dt")},
+        "friction_slope": s.friction_slope,
+        "modes": s.modes,
+        "all_unstable": s.all_unstable,
+        "stable": s.stable,
+        "max_growth_rate": s.max_growth_rate,
+        "k_at_max": s.k_at_max,
+        "min_growth_rate": s.min_growth_rate,
+        "k_at_min": s.k_at_min,
+    }
+    if p.friction == "weakening":
+        data["alpha_g"] = p.alpha * st.weakening_g(p)
+    data["mode_table"] = s.growth.to_dict(orient="records")
+    if out is not None:
+        data["outputs"] = [str(path) for path in _write_mode_growth(out, p, data)]
+    return Result(data=data, text=_modes_text(data))
+
+
+def _write_mode_growth(out: Path, p: ChainParams, data: dict) -> list[Path]:
+    from stickslip.plotting.stability import plot_mode_growth
+    from stickslip.plotting.style import save_figure
+
+    ds = st.mode_dispersion(p)
+    written = [io.write_dataset(out / "mode_growth.nc", ds)]
+    written += save_figure(plot_mode_growth(ds, st.mode_growth_rates(p)), out / "mode_growth")
+    meta = io.run_metadata(p, integrator=_LINEAR, command="stability chain", result=data)
+    written.append(io.write_json(out / "stability_chain.json", meta))
+    return written
+
+
+def _modes_text(d: dict[str, Any]) -> str:
+    p = d["params"]
+    state = "every mode grows" if d["all_unstable"] else ("stable" if d["stable"] else "some modes grow")
+    lines = [
+        f"steady sliding of {p['model']} ({p['drive']} drive, {p['friction']} friction, {p['ends']} ends): "
+        + " ".join(f"{k}={v:g}" for k, v in p.items() if not isinstance(v, str)),
+        f"lambda^2 + phi'(V) lambda + w_k^2 = 0 with phi'(V) = {d['friction_slope']:.6g}"
+        + (f" (alpha g = {d['alpha_g']:.6g})" if "alpha_g" in d else ""),
+        f"modes: {d['modes']}",
+        f"growth rate over modes: max {d['max_growth_rate']:.6g} at k = {d['k_at_max']:.4g}, "
+        f"min {d['min_growth_rate']:.6g} at k = {d['k_at_min']:.4g}: {state}",
+    ]
     for path in d.get("outputs", []):
         lines.append(f"wrote {path}")
     return "\n".join(lines)

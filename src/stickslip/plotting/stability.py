@@ -128,3 +128,32 @@ def plot_hysteresis(sweep: xr.Dataset) -> Figure:
                  fontsize=9)
     ax.legend(fontsize=7, loc="best")
     return fig
+
+
+def plot_mode_growth(ds: xr.Dataset, modes=None) -> Figure:
+    """Growth rate of steady sliding against k for a chain without state variable (like Fig. 4).
+
+    ``ds`` is :func:`stickslip.analysis.stability.mode_dispersion`: Re of both roots of
+    lambda^2 + phi'(V) lambda + w_k^2 = 0 (plate drive of Carlson-Langer, or the train model);
+    ``modes`` (optional) :func:`~stickslip.analysis.stability.mode_growth_rates`, the finite
+    chain's modes, drawn as points (k folded into [0, pi]).
+    """
+    fig, ax = new_figure(width=5.6, height=4.0)
+    k = ds["k"].values
+    ax.plot(k, ds["real"].isel(branch=0), color="C0", lw=1.4, label=r"Re$\,\lambda$ (largest)")
+    ax.plot(k, ds["real"].isel(branch=1), color="C0", lw=1.0, ls="--", label=r"Re$\,\lambda$ (other root)")
+    if modes is not None:
+        km = np.asarray(modes["k"], dtype=float)
+        km = np.where(km > np.pi, 2.0 * np.pi - km, km)
+        ax.plot(km, modes["growth_rate"], "o", ms=3, mfc="none", color="C1",
+                label=f"modes of the chain (N = {len(km)})")
+    ax.axhline(0.0, color="k", lw=0.6)
+    ax.set_xlim(0.0, np.pi)
+    ax.set_xlabel(r"wavenumber $k$")
+    ax.set_ylabel(r"Re$\,\lambda$")
+    a = ds.attrs
+    names = [n for n in ("K", "Kp", "V", "alpha", "sigma", "beta") if n in a and not isinstance(a[n], str)]
+    ax.set_title(f"{a.get('model', '')}: {a.get('drive', '')} drive, {a.get('friction', '')} friction\n"
+                 + ", ".join(f"{n} = {a[n]:g}" for n in names), fontsize=8)
+    ax.legend(fontsize=8, loc="best")
+    return fig
