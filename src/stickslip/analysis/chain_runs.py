@@ -60,7 +60,8 @@ def choose_s_min(S: np.ndarray, s_max: float, *, max_quantile: float = 0.9, n_ca
     return best
 
 
-def size_statistics(events: pd.DataFrame, N: int, *, small_only: bool, seed: int = 0) -> dict[str, Any]:
+def size_statistics(events: pd.DataFrame, N: int, *, small_only: bool, seed: int = 0,
+                    spanning: str = "max_block", bootstrap: int = 200) -> dict[str, Any]:
     """Slip-size statistics of one chain run for Fig. 7 (beta = 1) or Fig. 8 (beta = 0.2).
 
     The events that reach block N ("system-spanning") set the largest sizes. With
@@ -69,15 +70,22 @@ def size_statistics(events: pd.DataFrame, N: int, *, small_only: bool, seed: int
     the likelihood. s_min is chosen by :func:`choose_s_min`. ``excess`` is the number of events
     with S >= s_span over the number the fitted power law, continued without cut-off beyond
     s_span, predicts for them (the paper's "excess of large events" at beta = 0.2 is > 1).
+
+    ``spanning`` says which events span the system: "max_block" (they reach block N: the
+    end-driven chain of eq. 4) or "n_blocks" (all N blocks moved: the periodic Carlson-Langer
+    chain, which has no far end). ``observed`` and ``expected`` are the two counts of the excess.
     """
+    if spanning not in ("max_block", "n_blocks"):
+        raise ValueError(f"spanning must be 'max_block' or 'n_blocks' (got {spanning!r})")
     S = events["S"].to_numpy(dtype=float)
     S = S[np.isfinite(S) & (S > 0)]
-    spanning = events[events["max_block"] >= N]
-    s_span = float(spanning["S"].min()) if len(spanning) else math.nan
+    span_rows = events[events[spanning] >= N]
+    s_span = float(span_rows["S"].min()) if len(span_rows) else math.nan
     s_max = s_span if (small_only and math.isfinite(s_span)) else float(S.max())
     s_min = choose_s_min(S, s_max)
-    fit = fit_power_law(S, s_min=s_min, s_max=s_max, bootstrap=200, seed=seed)
-    excess = math.nan
+    fit = fit_power_law(S, s_min=s_min, s_max=s_max, bootstrap=bootstrap, seed=seed)
+    excess = expected = math.nan
+    observed = 0
     if math.isfinite(s_span) and fit.tau > 1.0:
         n_above_min = np.count_nonzero(S >= s_min)
         expected = n_above_min * (s_span / s_min) ** (1.0 - fit.tau)
@@ -87,11 +95,13 @@ def size_statistics(events: pd.DataFrame, N: int, *, small_only: bool, seed: int
     return {
         "fit": fit,
         "n_events": int(len(events)),
-        "n_spanning": int(len(spanning)),
+        "n_spanning": int(len(span_rows)),
         "s_span": s_span,
         "S_max": float(S.max()) if S.size else math.nan,
-        "largest_reaches_N": bool(largest is not None and int(largest["max_block"]) >= N),
+        "largest_reaches_N": bool(largest is not None and int(largest[spanning]) >= N),
         "excess": excess,
+        "observed": int(observed),
+        "expected": float(expected),
     }
 
 
