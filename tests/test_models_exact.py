@@ -144,3 +144,15 @@ def test_train_model_is_the_paper_chain_with_alpha_zero_and_theta_one():
     assert len(a.events) > 3
     assert_bits_equal(a.state.x, b.state.x, "x")
     assert a.events[["step_start", "step_end", "n_blocks"]].equals(b.events[["step_start", "step_end", "n_blocks"]])
+
+
+def test_plate_drive_block_that_stops_while_all_slide_restarts_on_time():
+    # Found by hypothesis: a single block on a ring stops in a step in which every block slid;
+    # its first start step under the plate must be known before the next start.
+    p = ChainParams(N=1, drive="plate", friction="weakening", ends="periodic", K=1.0, V=0.5, Kp=1.0,
+                    beta=0.0, alpha=0.0, sigma=0.0, F0=0.0, D=0.0, Fs=1.0)
+    x, v, th, stopped = _state(p, 0)
+    runs = [run_chain(p, 40.0, integrator=i, start=ChainState.from_blocks(x, v, th, stopped),
+                      sample_interval=0.5) for i in ("dense", "exact")]
+    assert len(runs[0].events) >= 2
+    assert_same_run(*runs)

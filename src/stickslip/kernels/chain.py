@@ -813,6 +813,12 @@ def run_exact(x, v, th, mov, xs, vs, ths, mm, a1, b1, trig, first_step, x0ev, is
                     mov[i] = 1.0 if v[i] > 0.0 else 0.0
                     n_moving += 1 if v[i] > 0.0 else 0
                 ist[N_MOVING] = n_moving
+                if drive == DRIVE_PLATE:
+                    # The blocks that stopped need their first start step under the plate.
+                    _set_ghosts(x, th, N, 0.0, drive, ends)
+                    t = _plate_triggers(x, th, mov, mm, trig, 1, N, True, n + 1, n_end, mp, V, dt, threshold)
+                    if t < t_next:
+                        t_next = t
                 if ist[EV_ACTIVE] == 1 and n_moving == 0:
                     _end_event(n, x, first_step, x0ev, ist, ev_int, ev_S, fm, prof_x, prof_meta, N,
                                profile_every, profile_min_blocks)
