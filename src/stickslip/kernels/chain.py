@@ -51,7 +51,9 @@ Which stopped blocks can start:
   keeps the first step at which its force, evaluated with the step's own expression, exceeds
   its threshold (``trig``); it is recomputed whenever the block's neighbourhood changes, so a
   block that starts because of the plate alone is found by comparing the step with these
-  numbers. When nothing is active the kernel jumps to the smallest of them.
+  numbers. When nothing is active the kernel jumps to the smallest of them. Without a state
+  variable a stopped block never changes, so ``exact`` updates lists of blocks instead of an
+  interval (:mod:`stickslip.kernels.plate`).
 * state threshold: a block whose theta changes may start without any neighbour moving, so
   every block whose state variable may change is a candidate.
 
@@ -725,6 +727,13 @@ def run_exact(x, v, th, mov, xs, vs, ths, mm, a1, b1, trig, first_step, x0ev, is
     (int64, N + 2) is scratch: the plate drive's first start step of each stopped block,
     rebuilt on entry.
     """
+    if drive == DRIVE_PLATE:
+        if friction != FRICTION_STATE:
+            # No state variable: stopped blocks never change, so update a list, not an interval.
+            return _plate.run_sparse(x, v, th, mov, xs, vs, ths, mm, a1, b1, trig, first_step, x0ev, ist,
+                                     par, ev_int, ev_S, fm, samp_L, samp_step, prof_x, prof_meta, n_end,
+                                     sample_every, profile_every, profile_min_blocks, drive, friction,
+                                     threshold, ends)
     N = x.shape[0] - 2
     mp, V, dt = _unpack(par)
     K, Kp, Fs = mp[0], mp[1], mp[5]
@@ -936,3 +945,7 @@ def specialise(kernel, args, pieces):
 
 
 _ENTRIES: dict = {}
+
+# The plate drive's sparse steps use the helpers above (imported last: it imports this module).
+# numba's disk cache does not follow edits across modules: clear it after editing either file.
+from stickslip.kernels import plate as _plate  # noqa: E402
