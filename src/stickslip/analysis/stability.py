@@ -246,7 +246,7 @@ def hopf_curve(p: BlockParams, beta: np.ndarray) -> xr.Dataset:
             "V_c_closed_form": ("beta", np.array(closed), {"long_name": "Hopf point V_c (Routh-Hurwitz)"}),
         },
         coords={"beta": ("beta", beta, {"long_name": "viscous friction beta"})},
-        attrs={k: float(v) for k, v in p.to_dict().items() if k not in ("V", "beta", "Fs", "dt")},
+        attrs={k: v if isinstance(v, str) else float(v) for k, v in p.to_dict().items() if k not in ("V", "beta", "Fs", "dt")},
     )
 
 

@@ -51,7 +51,7 @@ def add_param_options(parser: argparse.ArgumentParser, params_cls: type, skip: t
     docs = params_cls.field_docs()
     group = parser.add_argument_group("model parameters")
     for f in dataclasses.fields(params_cls):
-        if f.name in skip or f.name not in docs:
+        if f.name in skip or f.name not in docs or "choices" in f.metadata:
             continue
         kind = int if f.metadata.get("integer") else float
         group.add_argument(
@@ -157,3 +157,29 @@ def chain_params_from_args(args: argparse.Namespace, **overrides: Any):
     if ("l" in values or "nu" in values) and params.drive != "plate":
         raise ParameterError("--l and --nu are Carlson-Langer's symbols: they need drive plate")
     return params
+
+
+def add_block_model_option(parser: argparse.ArgumentParser) -> None:
+    """``--model`` for the single block: the paper's (default) or the Batista-Carlson reading."""
+    from stickslip.models.presets import SINGLE_BLOCK
+
+    parser.add_argument("--model", choices=SINGLE_BLOCK, default=None,
+                        help="sakaguchi (default: eq. 1 with the constant threshold Fs) or batista-carlson "
+                             "(the paper's reading of Batista-Carlson: a stuck block starts when "
+                             "K (V t - x) > sigma theta)")
+
+
+def block_params_from_args(args: argparse.Namespace, **overrides: Any):
+    """Validated BlockParams of ``--model`` with the ``--NAME`` options as overrides."""
+    from stickslip.models.params import BlockParams
+    from stickslip.models.presets import block_params
+
+    values = {f.name: getattr(args, f"param_{f.name}") for f in dataclasses.fields(BlockParams)
+              if getattr(args, f"param_{f.name}", None) is not None}
+    values.update(overrides)
+    model = getattr(args, "model", None) or "sakaguchi"
+    if model == "batista-carlson" and "Fs" in values:
+        from stickslip.models.params import ParameterError
+
+        raise ParameterError("--Fs is not a parameter of batista-carlson (its threshold is sigma theta)")
+    return block_params(model, **values)

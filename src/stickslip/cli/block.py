@@ -31,7 +31,9 @@ from stickslip.cli._common import (
     CommandError,
     Result,
     add_json_option,
+    add_block_model_option,
     add_param_options,
+    block_params_from_args,
     float_arg,
     params_from_args,
     prepare_out_dir,
@@ -65,6 +67,7 @@ def register(sub) -> None:
             f"{DEFAULT_PERIODS:g} periods of the law T(V) of eq. (3)."
         ),
     )
+    add_block_model_option(p)
     add_param_options(p, BlockParams)
     p.add_argument("--t-end", type=float_arg("t_end"), default=None, metavar="T",
                    help="end time of the run (default: first slip + 3.5 periods of T(V))")  # fmt: skip
@@ -95,7 +98,10 @@ def register(sub) -> None:
 
 
 def _law_or_none(p: BlockParams) -> SlipLimit | None:
-    """The accurate eq. (3) at these parameters, or None where it has no slip that ends."""
+    """The accurate eq. (3) at these parameters, or None where it has no slip that ends (or where
+    the threshold is not the constant Fs that eq. (3) starts from)."""
+    if p.threshold != "constant":
+        return None
     try:
         return solve_slip_limit(p)
     except (ParameterError, NoStopError):
@@ -106,14 +112,19 @@ def default_t_end(p: BlockParams, law: SlipLimit | None) -> float:
     """First start plus 3.5 periods of the law (2 Fs / (K V) per period where eq. (3) has none)."""
     if p.V <= 0.0:
         raise ParameterError("t_end must be given when V = 0 (the block never starts)")
-    period = law.period(p.V) if law is not None else 2.0 * p.Fs / (p.K * p.V)
-    return first_start_time(p) + DEFAULT_PERIODS * float(period)
+    # Without eq. (3): the spring must be loaded by about twice the threshold per cycle.
+    threshold = p.Fs if p.threshold == "constant" else p.sigma
+    period = law.period(p.V) if law is not None else 2.0 * threshold / (p.K * p.V)
+    # A state threshold sigma theta is at most sigma: the first start comes no later than that.
+    if p.threshold == "constant":
+        return first_start_time(p) + DEFAULT_PERIODS * float(period)
+    return p.sigma / (p.K * p.V) + 20 * DEFAULT_PERIODS * float(period)
 
 
 def run_block(args: argparse.Namespace) -> Result:
     """Handler of ``stickslip block``: eq. (1), its slips, Figs. 1-3."""
     # Everything is validated before --out is created, so bad input writes nothing.
-    p = params_from_args(BlockParams, args)
+    p = block_params_from_args(args)
     every = int(check_number("every", args.every, low=1, integer=True))
     if args.t_end is not None:
         check_number("t_end", args.t_end, low=0.0)
@@ -143,6 +154,11 @@ def block_report(run: BlockRun, law: SlipLimit | None) -> dict[str, Any]:
     data: dict[str, Any] = run.summary()
     data["params"] = run.params.to_dict()
     data["integrator"] = INTEGRATOR
+    if run.params.threshold == "state":
+        from stickslip.models.presets import PRESETS
+
+        data["model"] = "batista-carlson"
+        data["note"] = PRESETS["batista-carlson"].note
     if law is not None and run.params.V > 0.0:
         T = float(law.period(run.params.V))
         data["period_law"] = {"a": law.law_a, "b": law.law_b, "T": T}
@@ -155,11 +171,14 @@ def block_text(d: dict[str, Any]) -> str:
     """The human summary of ``stickslip block``."""
     p = d["params"]
     lines = [
-        "single block, eq. (1): " + " ".join(f"{k}={v:g}" for k, v in p.items() if k != "dt"),
+        "single block, eq. (1): " + " ".join(f"{k}={v}" if isinstance(v, str) else f"{k}={v:g}"
+                                             for k, v in p.items() if k != "dt"),
         f"Heun dt={d['dt']:g}, t_end={d['t_end']:g} ({d['steps']} steps)",
         f"slips: {d['events']} (starts {d['n_starts']}, stops {d['n_stops']}); "
         f"v in [{d['v_min']:.4g}, {d['v_max']:.4g}]",
     ]
+    if d.get("note"):
+        lines.append(f"note: {d['model']} is {d['note']}")
     if d["events"] > 1:
         law = d.get("period_law")
         vs = f" (law {law['T']:.6g}, {100 * d['period_rel_dev']:+.3f}%)" if law else ""

@@ -27,7 +27,9 @@ from stickslip.cli._common import (
     Result,
     add_json_option,
     add_model_options,
+    add_block_model_option,
     add_param_options,
+    block_params_from_args,
     chain_params_from_args,
     float_arg,
     params_from_args,
@@ -99,6 +101,7 @@ def register(sub) -> None:
             "Fs = 3, K = 10), and V_down, where it starts again going down."
         ),
     )
+    add_block_model_option(h)
     add_param_options(h, BlockParams, skip=("V",))
     h.add_argument("--V-min", dest="V_min", type=float_arg("V_min"), default=hy.DEFAULT_V_MIN,
                    help=f"lowest V (default {hy.DEFAULT_V_MIN:g})")  # fmt: skip
@@ -355,7 +358,7 @@ def _modes_text(d: dict[str, Any]) -> str:
 
 def run_hysteresis(args: argparse.Namespace) -> Result:
     """Handler of ``stickslip hysteresis``: the adiabatic sweep of V of section 2."""
-    p = params_from_args(BlockParams, args)
+    p = block_params_from_args(args)
     settings = hy.SweepSettings(
         V_min=args.V_min, V_max=args.V_max, dV=args.dV,
         time_per_step=args.time_per_step, transient=args.transient,
@@ -390,7 +393,7 @@ def _hysteresis_text(d: dict[str, Any]) -> str:
 
     lines = [
         "single block, adiabatic sweep of V: "
-        + " ".join(f"{k}={v:g}" for k, v in d["params"].items() if k != "dt"),
+        + " ".join(f"{k}={v}" if isinstance(v, str) else f"{k}={v:g}" for k, v in d["params"].items() if k != "dt"),
         f"V from {s['V_min']:g} to {s['V_max']:g} and back, dV = {s['dV']:g}, "
         f"{s['time_per_step']:g} time units per V (first {s['transient']:g} discarded)",
         f"V_up (stick-slip ends going up) = {fmt(d['V_up'])}"

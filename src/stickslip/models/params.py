@@ -127,6 +127,18 @@ class BlockParams(_Validated):
     M: float = _positive(1.0, "block mass M")
     sigma: float = _positive(1.0, "state-variable friction scale sigma")
     dt: float = _positive(0.005, "Heun time step dt")
+    threshold: str = field(default="constant", metadata={
+        "choices": ("constant", "state"),
+        "doc": "static threshold: constant (Fs) or state (sigma theta: the paper's reading of Batista-Carlson)"})
+
+    def to_dict(self) -> dict[str, Any]:
+        """All parameters; the threshold only when it is not the paper's constant Fs."""
+        d = dataclasses.asdict(self)
+        if self.threshold == "constant":
+            d.pop("threshold")
+        else:
+            d.pop("Fs")
+        return d
 
     def scaled(self) -> "BlockParams":
         """The same system in the units M = sigma = 1 of section 2 (see :func:`scale_block`)."""

@@ -170,7 +170,7 @@ def simulate_block(
             params.K, params.V, params.beta, params.alpha, params.Fs, params.M, params.sigma,
             params.dt,
             out_t, out_x, out_v, out_theta, out_stopped,
-            slip_start, slip_end, slip_x_start, slip_x_end,
+            slip_start, slip_end, slip_x_start, slip_x_end, params.threshold == "state",
         )  # fmt: skip
         if n_slips <= capacity:
             break
@@ -198,7 +198,7 @@ def simulate_block(
 
 def _series(p: BlockParams, t, x, v, theta, stopped, every: int) -> xr.Dataset:
     f = p.K * (p.V * t - x)
-    attrs = {f"param_{k}": float(val) for k, val in p.to_dict().items()}
+    attrs = {f"param_{k}": val if isinstance(val, str) else float(val) for k, val in p.to_dict().items()}
     attrs.update(integrator=INTEGRATOR, every=int(every), model="eq. (1), single block")
     return xr.Dataset(
         {

@@ -233,6 +233,7 @@ def _assemble(params, options, integrator, start_info, state, outputs, wall, ste
     summary = {
         "model": params.model,
         **params.pieces,
+        **_model_note(params),
         "n_events": int(len(events)),
         "event_in_progress": bool(state.ist[K.EV_ACTIVE]),
         "L_final": L_final,
@@ -253,6 +254,14 @@ def _assemble(params, options, integrator, start_info, state, outputs, wall, ste
     }
     return ChainRun(params, options, integrator, start_info, state, events, first_move, samples,
                     snapshots, profiles, summary)
+
+
+def _model_note(params) -> dict[str, str]:
+    """The preset's caveat (Batista-Carlson: the paper's reading; train: one member), if any."""
+    from stickslip.models.presets import PRESETS
+
+    note = PRESETS[params.model].note
+    return {"model_note": note} if note and params.model in ("batista-carlson", "train") else {}
 
 
 def _profiles(parts, events, options, params) -> xr.Dataset:
