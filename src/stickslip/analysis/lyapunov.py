@@ -23,6 +23,11 @@ only; it starts when the start rule says so from its own force, as in the refere
 distance itself is measured from the continuous variables alone, so a twin block that is still
 sliding while the reference's has stopped counts with its velocity: flags never enter d.
 See docs/lyapunov.md for what the exponent means with these switching rules.
+
+Plate drive (Carlson-Langer, two blocks). Every block hangs on the plate by its own leaf spring
+Kp, which both trajectories share: positions relative to the plate are the displacements
+themselves, and y = (sqrt(Kp) dx_i, v_i, theta_i) weighs them with the leaf spring (the part of the
+perturbation's energy that every block has whatever its neighbours do).
 """
 
 from __future__ import annotations
@@ -120,8 +125,11 @@ def separation(ref: ChainState, twin: ChainState, params: ChainParams) -> np.nda
     """The separation twin - ref in the coordinates y = (sqrt(K) e, v, theta) (length 3N).
 
     e_i = x_{i-1} - x_i with the same pulling point for both, so de_i = dx_{i-1} - dx_i, dx_0 = 0.
+    With the plate drive y = (sqrt(Kp) dx, v, theta) (module docstring).
     """
     dx = twin.x[1:-1] - ref.x[1:-1]
+    if params.drive == "plate":
+        return np.concatenate((math.sqrt(params.Kp) * dx, twin.v[1:-1] - ref.v[1:-1], twin.th[1:-1] - ref.th[1:-1]))
     de = np.concatenate(([0.0], dx[:-1])) - dx
     dv = twin.v[1:-1] - ref.v[1:-1]
     dth = twin.th[1:-1] - ref.th[1:-1]
@@ -189,12 +197,16 @@ def twin_state(ref: ChainState, direction: np.ndarray, d0: float, params: ChainP
     b = ref.blocks()
     N = b["x"].shape[0]
     u = _project(direction, b["stopped"])
+    if params.friction != "state":
+        u[2 * N:] = 0.0  # no state variable: theta is not a coordinate of these models
     norm = float(np.linalg.norm(u))
     if not norm > 0.0:
         raise ValueError("the separation vanished on the reference's branch; cannot renormalise")
     u = u * (d0 / norm)
-    de = u[:N] / math.sqrt(params.K)
-    x = b["x"] - np.cumsum(de)
+    if params.drive == "plate":
+        x = b["x"] + u[:N] / math.sqrt(params.Kp)
+    else:
+        x = b["x"] - np.cumsum(u[:N] / math.sqrt(params.K))
     v = np.where(b["stopped"], 0.0, b["v"] + u[N:2 * N])
     th = b["theta"] + u[2 * N:]
     return _with_step(ChainState.from_blocks(x, v, th, b["stopped"]), ref.step)
