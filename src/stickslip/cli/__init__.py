@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import warnings
 
 from stickslip.cli._common import CommandError, Result, emit
 from stickslip.models.params import ParameterError
@@ -43,12 +44,23 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _one_line_warning(command: str):
+    """A ``warnings.showwarning`` that writes ``stickslip COMMAND: warning: MESSAGE`` on stderr."""
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        sys.stderr.write(f"stickslip {command}: warning: {message}\n")
+
+    return show
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``stickslip`` command; returns the exit status."""
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
-        result = args.handler(args)
+        with warnings.catch_warnings():
+            warnings.showwarning = _one_line_warning(args.command)
+            result = args.handler(args)
     except (ParameterError, CommandError) as exc:
         sys.stderr.write(f"stickslip {args.command}: error: {exc}\n")
         return 2

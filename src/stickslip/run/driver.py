@@ -28,6 +28,7 @@ from __future__ import annotations
 import signal
 import sys
 import time
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Sequence
@@ -38,10 +39,10 @@ from stickslip.kernels import chain as K
 from stickslip.models.params import ChainParams, ParameterError, check_number, steps_for
 # The checkpoint file helpers (_read_npz, _write_npz) are named here too, for checks of the files.
 from stickslip.run.checkpoint import CHECKPOINT_FORMAT, Checkpointer, _read_npz, _write_npz  # noqa: F401
-from stickslip.run.errors import ChainRunError, Interrupted, NonFiniteState
+from stickslip.run.errors import ChainRunError, Interrupted, NonFiniteState, ShortRunWarning
 from stickslip.run.outputs import EVENT_COLUMNS, ChainRun, RunOptions, _assemble, _Outputs
 from stickslip.run.rundir import load_run, write_run
-from stickslip.run.state import STARTS, ChainState, initial_state, steady_deviation
+from stickslip.run.state import STARTS, ChainState, initial_state, loading_warnings, steady_deviation
 
 __all__ = [
     "run_chain",
@@ -56,6 +57,7 @@ __all__ = [
     "Checkpointer",
     "ChainRunError",
     "NonFiniteState",
+    "ShortRunWarning",
     "Interrupted",
     "CHECKPOINT_FORMAT",
     "EVENT_COLUMNS",
@@ -213,6 +215,8 @@ def run_chain(
     else:
         state = initial_state(params, start, amplitude=perturbation, seed=seed)
         start_info = {"kind": start, "perturbation": perturbation, "seed": seed}
+        for message in loading_warnings(params, options.t_end, options.average_from, start):
+            warnings.warn(message, ShortRunWarning, stacklevel=2)
     state.ist[K.NEXT_SAMPLE] = state.step
     outputs = _Outputs(params.N, options.profile_window is not None)
     return _drive(params, options, integrator, start_info, state, outputs,
