@@ -18,7 +18,8 @@ def register(sub) -> None:
                     "run's data allow, from a directory written by `stickslip chain --out`.",
     )
     p.add_argument("run_dir", metavar="RUN_DIR", help="a run directory (run.json, state.nc, events.parquet)")
-    p.add_argument("--out", metavar="DIR", default=None, help="where the figures go (default RUN_DIR/figures)")
+    p.add_argument("--out", metavar="DIR", default=None,
+                   help="where the figures go (default RUN_DIR/figures)")
     p.add_argument("--format", action="append", choices=("png", "pdf", "svg"), default=None,
                    help="file format (repeatable; default png and pdf)")
     add_json_option(p)

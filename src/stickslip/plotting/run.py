@@ -71,7 +71,8 @@ def run_figures(run, *, max_snapshots: int = 4) -> list[RunFigure]:
             out.append(RunFigure(f"snapshot_t{float(t):.6g}", f"snapshot at t = {float(t):g}",
                                  fig5a_snapshot(run.snapshots.sel(time=t), p, float(t))))
     else:
-        out.append(RunFigure("snapshot_final", "final state", None, "no steady sliding profile for this model"))
+        out.append(RunFigure("snapshot_final", "final state", None,
+                             "no steady sliding profile for this model"))
     events = run.events
     n_pos = int(np.count_nonzero(events["S"].to_numpy(dtype=float) > 0)) if len(events) else 0
     if n_pos >= MIN_EVENTS_FOR_SIZES:
@@ -87,7 +88,8 @@ def run_figures(run, *, max_snapshots: int = 4) -> list[RunFigure]:
                               window=run.options.profile_window)
             out.append(RunFigure("fronts", "rupture fronts of the largest events", fig))
         else:
-            out.append(RunFigure("fronts", "rupture fronts", None, "no event with stored profiles could be fitted"))
+            out.append(RunFigure("fronts", "rupture fronts", None,
+                                 "no event with stored profiles could be fitted"))
     else:
         out.append(RunFigure("fronts", "rupture fronts", None,
                              "no displacement profiles stored (run with --profile-window 20)"))
@@ -102,6 +104,7 @@ def draw_run_figures(run, out_dir: str | Path, *, formats: tuple[str, ...] = ("p
         if item.figure is None:
             record["skipped"] = item.skipped
         else:
-            record["files"] = [str(f) for f in save_figure(item.figure, Path(out_dir) / item.stem, formats=formats)]
+            files = save_figure(item.figure, Path(out_dir) / item.stem, formats=formats)
+            record["files"] = [str(f) for f in files]
         records.append(record)
     return records
