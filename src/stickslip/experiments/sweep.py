@@ -157,8 +157,11 @@ def _run_point(task: Task, point: dict[str, Any], common: dict[str, Any], point_
     return record
 
 
-def _row(point: dict[str, Any], name: str, record: dict[str, Any], reused: bool) -> dict[str, Any]:
+def _row(point: dict[str, Any], name: str, record: dict[str, Any], reused: bool,
+         common: dict[str, Any] | None = None) -> dict[str, Any]:
     row: dict[str, Any] = dict(point)
+    for key, value in (common or {}).items():  # the fixed settings (--set, t_end) after the grid values
+        row.setdefault(key, value)
     row.update(point_dir=name, status=record.get("status", "failed"), reused=reused,
                error=record.get("error"), wall_seconds=record.get("wall_seconds", math.nan))
     for key, value in (record.get("summary") or {}).items():
@@ -229,7 +232,8 @@ def run_sweep(
     again. Points run on a new local cluster (``n_workers`` processes, default one per core,
     one thread each) or, with ``scheduler`` = address, on an existing cluster. Progress
     (points done / total, time left) goes to stderr. Writes ``summary.parquet`` and
-    ``summary.csv`` in ``out_dir``: one row per point with its parameters, ``status``
+    ``summary.csv`` in ``out_dir``: one row per point with its parameters, the fixed settings of
+    ``common``, ``status``
     ("ok"/"failed"), ``reused``, ``error``, ``wall_seconds`` and the task's summary fields.
     """
     start = time.perf_counter()
@@ -255,8 +259,8 @@ def run_sweep(
         _compute(task, points, common, out, names, specs, pending, records,
                  scheduler=scheduler, n_workers=n_workers, progress=progress)
 
-    rows = [_row(p, n, r, u) for p, n, r, u in zip(points, names, records, reused)]  # type: ignore[arg-type]
-    table = _table(rows, points)
+    rows = [_row(p, n, r, u, common) for p, n, r, u in zip(points, names, records, reused)]  # type: ignore[arg-type]
+    table = _table(rows, points + [common])
     write_table(out / f"{SUMMARY_NAME}.parquet", table)
     _write_csv(out / f"{SUMMARY_NAME}.csv", table)
     n_failed = int((table["status"] != "ok").sum()) if len(table) else 0
