@@ -83,8 +83,10 @@ class _Progress:
         if self.enabled:
             from tqdm import tqdm
 
-            self.bar = tqdm(total=self.t_end, unit="t", unit_scale=True, dynamic_ncols=True,
-                            desc="chain", file=sys.stderr, smoothing=0.1)
+            self.bar = tqdm(total=self.t_end, unit=" time units", unit_scale=False, dynamic_ncols=True,
+                            desc="chain", file=sys.stderr, smoothing=0.1,
+                            bar_format="{l_bar}{bar}| t = {n:.4g}/{total:.4g} [{elapsed}<{remaining}, "
+                                       "{rate_fmt}{postfix}]")
 
     def update(self, t: float, n_events: int) -> None:
         if self.bar is not None:
@@ -349,6 +351,9 @@ def _drive(params, options, integrator, start_info, state, outputs, *, out_dir, 
     outputs.flush(state.ist)
     wall = wall_before + time.perf_counter() - t0
     run = _assemble(params, options, integrator, start_info, state, outputs, wall, steady_at)
+    run.summary["wall_seconds_this_run"] = wall - wall_before  # wall_seconds counts every part of a resumed run
+    if run.summary["event_in_progress"]:  # the unfinished event began after the last finished one
+        run.summary["in_progress_since"] = float(run.events["t_end"].max()) if len(run.events) else 0.0
     if out_dir is not None:
         if checkpointer is not None:
             checkpointer.write(state, outputs, dict(header, wall_seconds=wall))
