@@ -4,7 +4,8 @@ from stickslip.cli import main
 
 
 def test_a_chain_with_every_block_moving_is_said_to_slide(capsys):
-    assert main(["chain", "--N", "20", "--beta", "1.5", "--start", "steady", "--t-end", "1e3", "--no-progress"]) == 0
+    args = ["chain", "--N", "20", "--beta", "1.5", "--start", "steady", "--t-end", "1e3", "--no-progress"]
+    assert main(args) == 0
     out = capsys.readouterr().out
     assert "the chain slides" in out and "--until-steady" in out
     assert "one in progress" not in out
