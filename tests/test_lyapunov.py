@@ -20,8 +20,6 @@ import numpy as np
 import pytest
 from matplotlib.figure import Figure
 
-from stickslip.run.driver import ChainState, run_chain
-from stickslip.cli import main
 from stickslip.analysis.lyapunov import (
     largest_lyapunov,
     lyapunov_convergence,
@@ -29,10 +27,12 @@ from stickslip.analysis.lyapunov import (
     separation,
     twin_state,
 )
-from stickslip.models.params import BlockParams, ChainParams, ParameterError
-from stickslip.plotting.lyapunov import plot_lyapunov_beta
 from stickslip.analysis.slip_limit import solve_slip_limit
 from stickslip.analysis.stability import block_eigenvalues, chain_finite_eigenvalues
+from stickslip.cli import main
+from stickslip.models.params import BlockParams, ChainParams, ParameterError
+from stickslip.plotting.lyapunov import plot_lyapunov_beta
+from stickslip.run.driver import run_chain
 
 PAPER_BLOCK = ChainParams(N=1, K=10.0, V=0.001, beta=1.0, Fs=3.0)
 

@@ -10,14 +10,14 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from chain_helpers import assert_bits_equal, assert_same_run, model_heun_step, oracle_run
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from stickslip.run.driver import ChainState, run_chain
+from chain_helpers import assert_bits_equal, assert_same_run, model_heun_step, oracle_run
+from stickslip.models.params import ChainParams
 from stickslip.models.pieces import CompositionError, check_composition, names
 from stickslip.models.presets import PRESETS, chain_params
-from stickslip.models.params import ChainParams
+from stickslip.run.driver import ChainState, run_chain
 
 ALL = [
     (d, f, t, e)

@@ -10,7 +10,7 @@ standard error of the means of M independent segments of them.
 Separation. The state of block i is (x_i, v_i, theta_i, stopped_i). Forces depend on positions
 only through the spring extensions e_i = x_{i-1} - x_i (x_0 = V t_n, the pulling point), so the
 separation is measured in y = (sqrt(K) e_i, v_i, theta_i), i = 1..N, with the Euclidean norm.
-With unit mass, |(sqrt(K) de, dv)|^2 / 2 is the mechanical energy of the perturbation (springs
+With unit mass, ``|(sqrt(K) de, dv)|^2 / 2`` is the mechanical energy of the perturbation (springs
 plus motion): a harmonic oscillation of the perturbation does not make d oscillate, which would
 add noise to every ln(d / d0). The pulling point is the same for both trajectories, so the
 extensions carry the whole position information (no neutral translation direction).
@@ -41,8 +41,8 @@ from typing import Any, Sequence
 import numpy as np
 import pandas as pd
 
-from stickslip.run.driver import ChainState, Stepper, run_chain
 from stickslip.models.params import ChainParams, ParameterError, check_number, steps_for
+from stickslip.run.driver import ChainState, Stepper, run_chain
 
 #: Largest allowed initial separation: beyond it the twin is not a small perturbation.
 D0_MAX = 1e-3

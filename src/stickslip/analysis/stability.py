@@ -563,7 +563,7 @@ def mode_growth_rates(p: ChainParams) -> pd.DataFrame:
 
     One row per normal mode of :func:`normal_modes`: ``j``, ``k``, ``omega2`` (w_k^2),
     ``growth_rate`` (largest Re lambda), ``growth_rate_2`` (the other root's) and ``frequency``
-    (|Im lambda|).
+    (``|Im lambda|``).
     """
     k, _ = normal_modes(p)
     roots = mode_roots(p, k)

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import warnings
 
 from stickslip.cli._common import CommandError, Result, emit
 from stickslip.models.params import ParameterError
@@ -27,7 +28,7 @@ class _Parser(argparse.ArgumentParser):
 
 def build_parser() -> argparse.ArgumentParser:
     """The full parser with every subcommand registered."""
-    from stickslip.cli import block, chain, lyapunov, models, reproduce, stability, sweep
+    from stickslip.cli import block, chain, lyapunov, models, plot, reproduce, stability, sweep
 
     parser = _Parser(
         prog="stickslip",
@@ -38,9 +39,18 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"stickslip {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
-    for module in (block, stability, chain, models, sweep, reproduce, lyapunov):
+    for module in (block, stability, chain, models, sweep, reproduce, lyapunov, plot):
         module.register(sub)
     return parser
+
+
+def _one_line_warning(command: str):
+    """A ``warnings.showwarning`` that writes ``stickslip COMMAND: warning: MESSAGE`` on stderr."""
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        sys.stderr.write(f"stickslip {command}: warning: {message}\n")
+
+    return show
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -48,7 +58,9 @@ def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
-        result = args.handler(args)
+        with warnings.catch_warnings():
+            warnings.showwarning = _one_line_warning(args.command)
+            result = args.handler(args)
     except (ParameterError, CommandError) as exc:
         sys.stderr.write(f"stickslip {args.command}: error: {exc}\n")
         return 2

@@ -84,14 +84,32 @@ def _add_run_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--seed", type=int, default=None, help="seed of the perturbation or of u_i (default 0)")
 
 
-def _summary_text(summary: dict, out: Path | None) -> str:
+def _events_text(summary: dict, N: int | None) -> str:
+    """The events line; a chain with every block moving in an unfinished event is said to slide."""
+    text = f"events         {summary['n_events']}"
+    if summary.get("stopped_early") and summary.get("t_steady") is not None:
+        return text + f"  (then steady sliding from t = {summary['t_steady']:g})"
+    if N is not None and summary["n_moving"] == N:
+        since = summary.get("in_progress_since") if summary["event_in_progress"] else None
+        when = f" since t = {since:g}" if since is not None else ""
+        return text + (f"  (every block moving{when}: the chain slides; --until-steady TOL stops a run "
+                       "once the sliding is steady)")
+    return text + ("  (one in progress)" if summary["event_in_progress"] else "")
+
+
+def _summary_text(summary: dict, out: Path | None, N: int | None = None) -> str:
+    wall = f"wall time      {summary['wall_seconds']:.3g} s"
+    this_run = summary.get("wall_seconds_this_run", summary["wall_seconds"])
+    if this_run < summary["wall_seconds"] - 1e-9:
+        wall = (f"wall time      {summary['wall_seconds_this_run']:.3g} s this run, "
+                f"{summary['wall_seconds']:.3g} s in all (resumed)")
     lines = [
         f"t_end          {summary['t_end']:g}  ({summary['steps']} steps, {summary['integrator']})",
-        f"events         {summary['n_events']}" + ("  (one in progress)" if summary["event_in_progress"] else ""),
+        _events_text(summary, N),
         f"L_final        {summary['L_final']:.6g}   (steady sliding {summary['L_steady']:.6g})",
         f"L_mean         {summary['L_mean']:.6g}   (t >= {summary['L_mean_from']:g})",
         f"moving blocks  {summary['n_moving']}",
-        f"wall time      {summary['wall_seconds']:.3g} s",
+        wall,
         f"state sha256   {summary['state_sha256']}",
     ]
     if summary.get("stopped_early"):
@@ -139,7 +157,8 @@ def run_chain_command(args: argparse.Namespace) -> Result:
             raise CommandError(str(exc)) from None
         except chain.Interrupted as exc:
             return _interrupted(exc, Path(args.resume))
-        return Result(_json_summary(run.summary, Path(args.resume)), _summary_text(run.summary, Path(args.resume)))
+        return Result(_json_summary(run.summary, Path(args.resume)),
+                      _summary_text(run.summary, Path(args.resume), run.params.N))
 
     params = chain_params_from_args(args)
     t_end = 2e4 if args.t_end is None else args.t_end
@@ -175,7 +194,7 @@ def run_chain_command(args: argparse.Namespace) -> Result:
         return Result({"error": str(exc)}, "", status=1)
     except chain.Interrupted as exc:
         return _interrupted(exc, out)
-    return Result(_json_summary(run.summary, out), _summary_text(run.summary, out))
+    return Result(_json_summary(run.summary, out), _summary_text(run.summary, out, params.N))
 
 
 def _start_of(params, args) -> tuple[str, float, int]:

@@ -46,8 +46,9 @@ def register(sub) -> None:
             "skipped when the command is run again; a failed point is reported and the others go on."
         ),
         epilog=(
-            "example: stickslip sweep chain --grid beta=0.2,0.6,1.0,1.2 --set N=99 "
-            "--t-end 20000 --set average_from=10000 --out sweeps/L-beta"
+            "example: stickslip sweep chain --grid beta=0.2,0.6,1.0,1.2 --set N=49 "
+            "--t-end 3e5 --set average_from=1.5e5 --out sweeps/L-beta (N = 49 loads until "
+            "L_ss / V ~ 1.2e5: run and average beyond that)"
         ),
     )
     parser.add_argument("model", choices=("chain", "block"), help="which system to run")

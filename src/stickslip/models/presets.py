@@ -65,7 +65,7 @@ PRESETS: dict[str, Preset] = {
         symbols={"l": "sqrt(K)", "nu": "V", "alpha": "alpha", "sigma": "sigma"},
     ),
     "train": Preset(
-        "train", "the train model (Elmer): the paper's chain with constant friction", 
+        "train", "the train model (Elmer): the paper's chain with constant friction",
         dict(drive="end", friction="strengthening", threshold="constant", ends="free"),
         dict(N=399, K=10.0, V=0.001, beta=1.0, F0=1.0, Fs=3.0, dt=0.005),
         "paper",

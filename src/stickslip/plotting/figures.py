@@ -22,7 +22,6 @@ from stickslip.models.params import ChainParams
 from stickslip.report.commands import block_command, chain_command, hysteresis_command, sweep_command
 from stickslip.report.writer import ReportFigure
 
-
 FORMATS = ("png", "pdf")
 
 
@@ -175,8 +174,8 @@ def _fig6(o: dict[str, Outcome], a: dict[str, Any], d: Path) -> list[ReportFigur
 
 def _fig7_8(o: dict[str, Outcome], a: dict[str, Any], d: Path, which: str) -> list[ReportFigure]:
     """Figs. 7 (beta = 1) and 8 (beta = 0.2): slip-size distribution and S against time."""
-    from stickslip.plotting.chain import fig7_8_sizes
     from stickslip.analysis.statistics import size_distribution
+    from stickslip.plotting.chain import fig7_8_sizes
 
     beta, stem, label, paper_tau = (1.0, "fig7", "Fig. 7", 1.5) if which == "7" else (0.2, "fig8", "Fig. 8", 1.6)
     events = a["events1"] if which == "7" else a["events02"]

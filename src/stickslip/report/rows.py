@@ -17,7 +17,8 @@ import pandas as pd
 from stickslip.analysis.chain_runs import sweep_table
 from stickslip.experiments.specs import Outcome
 from stickslip.models.physics import chain_steady_state
-from stickslip.report.commands import chain_command, g as _g, hysteresis_command, sweep_command
+from stickslip.report.commands import chain_command, hysteresis_command, sweep_command
+from stickslip.report.commands import g as _g
 from stickslip.report.writer import ReportRow
 
 #: The paper's stated numbers (MODEL.md, last table) that the report compares with.

@@ -28,6 +28,7 @@ from __future__ import annotations
 import signal
 import sys
 import time
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Sequence
@@ -38,10 +39,10 @@ from stickslip.kernels import chain as K
 from stickslip.models.params import ChainParams, ParameterError, check_number, steps_for
 # The checkpoint file helpers (_read_npz, _write_npz) are named here too, for checks of the files.
 from stickslip.run.checkpoint import CHECKPOINT_FORMAT, Checkpointer, _read_npz, _write_npz  # noqa: F401
-from stickslip.run.errors import ChainRunError, Interrupted, NonFiniteState
+from stickslip.run.errors import ChainRunError, Interrupted, NonFiniteState, ShortRunWarning
 from stickslip.run.outputs import EVENT_COLUMNS, ChainRun, RunOptions, _assemble, _Outputs
 from stickslip.run.rundir import load_run, write_run
-from stickslip.run.state import STARTS, ChainState, initial_state, steady_deviation
+from stickslip.run.state import STARTS, ChainState, initial_state, loading_warnings, steady_deviation
 
 __all__ = [
     "run_chain",
@@ -56,6 +57,7 @@ __all__ = [
     "Checkpointer",
     "ChainRunError",
     "NonFiniteState",
+    "ShortRunWarning",
     "Interrupted",
     "CHECKPOINT_FORMAT",
     "EVENT_COLUMNS",
@@ -81,8 +83,10 @@ class _Progress:
         if self.enabled:
             from tqdm import tqdm
 
-            self.bar = tqdm(total=self.t_end, unit="t", unit_scale=True, dynamic_ncols=True,
-                            desc="chain", file=sys.stderr, smoothing=0.1)
+            self.bar = tqdm(total=self.t_end, unit=" time units", unit_scale=False, dynamic_ncols=True,
+                            desc="chain", file=sys.stderr, smoothing=0.1,
+                            bar_format="{l_bar}{bar}| t = {n:.4g}/{total:.4g} [{elapsed}<{remaining}, "
+                                       "{rate_fmt}{postfix}]")
 
     def update(self, t: float, n_events: int) -> None:
         if self.bar is not None:
@@ -213,6 +217,8 @@ def run_chain(
     else:
         state = initial_state(params, start, amplitude=perturbation, seed=seed)
         start_info = {"kind": start, "perturbation": perturbation, "seed": seed}
+        for message in loading_warnings(params, options.t_end, options.average_from, start):
+            warnings.warn(message, ShortRunWarning, stacklevel=2)
     state.ist[K.NEXT_SAMPLE] = state.step
     outputs = _Outputs(params.N, options.profile_window is not None)
     return _drive(params, options, integrator, start_info, state, outputs,
@@ -345,6 +351,9 @@ def _drive(params, options, integrator, start_info, state, outputs, *, out_dir, 
     outputs.flush(state.ist)
     wall = wall_before + time.perf_counter() - t0
     run = _assemble(params, options, integrator, start_info, state, outputs, wall, steady_at)
+    run.summary["wall_seconds_this_run"] = wall - wall_before  # wall_seconds counts every part of a resumed run
+    if run.summary["event_in_progress"]:  # the unfinished event began after the last finished one
+        run.summary["in_progress_since"] = float(run.events["t_end"].max()) if len(run.events) else 0.0
     if out_dir is not None:
         if checkpointer is not None:
             checkpointer.write(state, outputs, dict(header, wall_seconds=wall))

@@ -20,3 +20,7 @@ class Interrupted(Exception):
         super().__init__(f"interrupted at t = {t:g}; checkpoint in {checkpoint}")
         self.checkpoint = checkpoint
         self.t = t
+
+
+class ShortRunWarning(UserWarning):
+    """A chain run with the end drive ends, or averages from, before the chain has loaded."""

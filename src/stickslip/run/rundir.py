@@ -18,6 +18,58 @@ from stickslip.models.params import ChainParams
 from stickslip.run.outputs import ChainRun, RunOptions
 from stickslip.run.state import ChainState
 
+UNITS = "model units"  # eq. (4) scaled to M = sigma = 1 (MODEL.md, "Units")
+
+#: long_name and units of the variables of state.nc (CF attributes).
+VARIABLE_ATTRS = {
+    "block": {"long_name": "block index i (1 = pulled end, N = free end)", "units": "1"},
+    "x": {"long_name": "block position x_i at the end of the run", "units": f"length ({UNITS})"},
+    "v": {"long_name": "block velocity v_i at the end of the run", "units": f"length/time ({UNITS})"},
+    "theta": {"long_name": "state variable theta_i of the friction at the end of the run",
+              "units": "1 (dimensionless)"},
+    "stopped": {"long_name": "block stuck (start and stop rules of eq. 4) at the end of the run",
+                "units": "1", "flag_values": np.array([0, 1], dtype=np.int8),
+                "flag_meanings": "moving stopped"},
+    "t_sample": {"long_name": "sampling time of L", "units": f"time ({UNITS})"},
+    "L": {"long_name": "chain length L = x_1 - x_N (Fig. 5b)", "units": f"length ({UNITS})"},
+    "snapshot_time": {"long_name": "time of the snapshot", "units": f"time ({UNITS})"},
+    "snapshot_x": {"long_name": "block positions x_i at the snapshot time (Fig. 5a)",
+                   "units": f"length ({UNITS})"},
+    "profile_dx": {"long_name": "displacement Delta x_i = x_i(t_next) - x_i(t) over one window (Fig. 6)",
+                   "units": f"length ({UNITS})"},
+    "profile_event": {"long_name": "slip event of the profile row (events.parquet column event)",
+                      "units": "1"},
+    "profile_t": {"long_name": "start of the profile window", "units": f"time ({UNITS})"},
+    "profile_t_next": {"long_name": "end of the profile window", "units": f"time ({UNITS})"},
+    "t": {"long_name": "start of the profile window", "units": f"time ({UNITS})"},
+}
+
+#: Descriptions of the columns of events.parquet and first_move.parquet (Parquet field metadata).
+EVENT_DOCS = {
+    "event": "event number, 0-based, in order of start",
+    "step_start": "first step n in which a block moved (t = n dt)",
+    "step_end": "first step that ended with every block stopped again",
+    "t_start": f"start time step_start * dt, {UNITS}",
+    "t_end": f"end time step_end * dt, {UNITS}",
+    "duration": f"t_end - t_start, {UNITS}",
+    "S": f"slip size S = sum_i (x_i(end) - x_i(start)), {UNITS} (Figs. 7, 8)",
+    "start_block": "block that moved first (1..N)",
+    "max_block": "farthest block that moved (1..N)",
+    "n_blocks": "number of blocks that moved",
+}
+FIRST_MOVE_DOCS = {
+    "event": "event number (events.parquet column event)",
+    "block": "block index i (1..N)",
+    "t_first": f"time at which block i first moved in the event, {UNITS} (Fig. 6)",
+    "step": "step at which block i first moved in the event",
+}
+
+
+def _param_attrs(params: ChainParams) -> dict[str, object]:
+    """The parameters as individual attributes ``param_<name>`` (bools as 0/1)."""
+    return {f"param_{k}": (int(v) if isinstance(v, bool) else v) for k, v in params.to_dict().items()
+            if isinstance(v, (int, float, str, bool))}
+
 
 def write_run(run: ChainRun, out_dir: str | Path) -> Path:
     """Write a run directory: run.json, state.nc (labelled arrays), events.parquet, first_move.parquet."""
@@ -39,13 +91,19 @@ def write_run(run: ChainRun, out_dir: str | Path) -> Path:
             "profile_t_next": ("profile_row", run.profiles["t_next"].values),
         },
         coords={"block": blocks},
-        attrs={"params": json.dumps(run.params.to_dict()), "integrator": run.integrator,
-               "version": __version__, "t": run.summary["t_end"]},
+        attrs={"Conventions": "CF-1.10", "title": "chain of eq. (4): final state, L(t), snapshots, profiles",
+               "source": f"stickslip {__version__}, {run.integrator} integrator", "units_note":
+               "model units: eq. (4) scaled to M = sigma = 1 (MODEL.md)",
+               "params": json.dumps(run.params.to_dict()), **_param_attrs(run.params),
+               "integrator": run.integrator, "version": __version__, "t": run.summary["t_end"]},
     )
     ds = ds.drop_vars([c for c in ("event", "t_next") if c in ds.coords], errors="ignore")
+    for name, attrs in VARIABLE_ATTRS.items():
+        if name in ds.variables:
+            ds[name].attrs.update(attrs)
     io.write_dataset(out / "state.nc", ds)
-    io.write_table(out / "events.parquet", run.events)
-    io.write_table(out / "first_move.parquet", run.first_move)
+    io.write_table(out / "events.parquet", run.events, EVENT_DOCS)
+    io.write_table(out / "first_move.parquet", run.first_move, FIRST_MOVE_DOCS)
     meta = io.run_metadata(run.params, integrator=run.integrator, options=run.options.to_dict(),
                            start=run.start, summary=run.summary)
     io.write_json(out / "run.json", meta)
