@@ -82,6 +82,13 @@ class LyapunovResult:
     durations: np.ndarray = field(repr=False)
     counted: np.ndarray = field(repr=False)
 
+    @property
+    def merges(self) -> int:
+        """Counted renormalisations after which the twin had fallen onto the reference (d = 0):
+        d0 at the rounding floor of the state, or a sticking phase that contracts to one point.
+        Any makes the exponent -inf; a larger d0 tells the two apart."""
+        return int(np.count_nonzero(np.isneginf(self.log_growth[self.counted])))
+
     def to_dict(self) -> dict[str, Any]:
         """The scalars of the result, its parameters and the method, as a plain dict for JSON."""
         return {
@@ -93,6 +100,7 @@ class LyapunovResult:
             "interval": self.interval,
             "d0": self.d0,
             "renormalisations": self.renormalisations,
+            "merges": self.merges,
             "segments": self.segments,
             "segment_means": list(self.segment_means),
             "events": self.events,

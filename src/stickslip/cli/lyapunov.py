@@ -136,4 +136,10 @@ def run_lyapunov_command(args: argparse.Namespace) -> Result:
         return Result(data, text)
     res = ly.largest_lyapunov(params, args.t_end, progress=not args.no_progress, **kw)
     data = res.to_dict()
+    if data["merges"]:
+        import sys
+
+        sys.stderr.write(f"stickslip lyapunov: warning: the twin fell onto the reference {data['merges']} times "
+                         f"(d0 = {args.d0:g} at the rounding floor, or sticking contracts to a point); "
+                         "try a larger --d0\n")
     return Result(data, _result_text(data))
