@@ -156,3 +156,24 @@ def test_plate_drive_block_that_stops_while_all_slide_restarts_on_time():
                       sample_interval=0.5) for i in ("dense", "exact")]
     assert len(runs[0].events) >= 2
     assert_same_run(*runs)
+
+
+def test_run_directory_records_the_model_everywhere(tmp_path):
+    import json
+
+    import pyarrow.parquet as pq
+
+    from stickslip import io
+
+    p = chain_params("carlson-langer", N=10)
+    run_chain(p, 300.0, start=ChainState.rest(p, 0.01, 0), out_dir=tmp_path / "run")
+    want = {"model": "carlson-langer", "drive": "plate", "friction": "weakening", "threshold": "constant",
+            "ends": "periodic", "K": 100.0, "Kp": 1.0, "V": 0.01, "alpha": 2.5, "sigma": 0.01, "Fs": 1.0, "N": 10}
+    meta = io.read_json(tmp_path / "run" / "run.json")
+    assert want.items() <= meta["params"].items()
+    ds = io.read_dataset(tmp_path / "run" / "state.nc")
+    assert want.items() <= json.loads(ds.attrs["params"]).items()
+    for table in ("events.parquet", "first_move.parquet"):
+        stored = json.loads(pq.read_schema(tmp_path / "run" / table).metadata[b"stickslip"])
+        assert want.items() <= stored["params"].items()
+    assert "D" not in meta["params"] and "beta" not in meta["params"]  # not read by CL

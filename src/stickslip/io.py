@@ -63,11 +63,13 @@ def read_dataset(path: str | Path) -> xr.Dataset:
         return ds.load()
 
 
-def write_table(path: str | Path, table: pd.DataFrame, descriptions: dict[str, str] | None = None) -> Path:
+def write_table(path: str | Path, table: pd.DataFrame, descriptions: dict[str, str] | None = None,
+                metadata: dict[str, Any] | None = None) -> Path:
     """Write a table (events, sweep summaries) to Parquet, atomically.
 
     ``descriptions`` (column -> text) go into the Parquet schema as each field's metadata
-    (key ``description``), readable with ``pyarrow.parquet.read_schema(path).field(name).metadata``.
+    (key ``description``), readable with ``pyarrow.parquet.read_schema(path).field(name).metadata``;
+    ``metadata`` (JSON-able) goes into the schema's own metadata under key ``stickslip``.
     """
     import pyarrow as pa
     import pyarrow.parquet as pq
@@ -77,6 +79,9 @@ def write_table(path: str | Path, table: pd.DataFrame, descriptions: dict[str, s
         fields = [f.with_metadata({**(f.metadata or {}), b"description": descriptions[f.name].encode()})
                   if f.name in descriptions else f for f in arrow.schema]
         arrow = arrow.cast(pa.schema(fields, metadata=arrow.schema.metadata))
+    if metadata:
+        arrow = arrow.replace_schema_metadata({**(arrow.schema.metadata or {}),
+                                               b"stickslip": json.dumps(to_jsonable(metadata)).encode()})
     with atomic_path(path) as tmp:
         pq.write_table(arrow, tmp)
     return Path(path)

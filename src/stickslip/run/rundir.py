@@ -102,8 +102,10 @@ def write_run(run: ChainRun, out_dir: str | Path) -> Path:
         if name in ds.variables:
             ds[name].attrs.update(attrs)
     io.write_dataset(out / "state.nc", ds)
-    io.write_table(out / "events.parquet", run.events, EVENT_DOCS)
-    io.write_table(out / "first_move.parquet", run.first_move, FIRST_MOVE_DOCS)
+    # The model, its pieces and every parameter travel with each table too.
+    model = {"params": run.params.to_dict(), "integrator": run.integrator}
+    io.write_table(out / "events.parquet", run.events, EVENT_DOCS, metadata=model)
+    io.write_table(out / "first_move.parquet", run.first_move, FIRST_MOVE_DOCS, metadata=model)
     meta = io.run_metadata(run.params, integrator=run.integrator, options=run.options.to_dict(),
                            start=run.start, summary=run.summary)
     io.write_json(out / "run.json", meta)
