@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import math
 import sys
+import warnings
 import time
 from dataclasses import dataclass, field
 from typing import Any, Sequence
@@ -42,7 +43,7 @@ import numpy as np
 import pandas as pd
 
 from stickslip.models.params import ChainParams, ParameterError, check_number, steps_for
-from stickslip.run.driver import ChainState, Stepper, run_chain
+from stickslip.run.driver import ChainState, ShortRunWarning, Stepper, run_chain
 
 #: Largest allowed initial separation: beyond it the twin is not a small perturbation.
 D0_MAX = 1e-3
@@ -303,8 +304,11 @@ def largest_lyapunov(
     n_count = steps_for(transient + align, dt)
     wall0 = time.perf_counter()
 
-    run = run_chain(params, n0 * dt, start=start, perturbation=perturbation, seed=seed,
-                    sample_interval=max(transient, dt))
+    with warnings.catch_warnings():
+        # Only the state at the transient's end is used, not <L>: loading is no concern here.
+        warnings.simplefilter("ignore", ShortRunWarning)
+        run = run_chain(params, n0 * dt, start=start, perturbation=perturbation, seed=seed,
+                        sample_interval=max(transient, dt))
     ref = run.state
     start_name = start if isinstance(start, str) else "state"
     rng = np.random.default_rng(direction_seed)
