@@ -213,7 +213,7 @@ def run_stability_chain(args: argparse.Namespace) -> Result:
     with_N = args.param_N is not None
     D = args.param_D
     # dt is never read by the linear analysis; keep ChainParams' explicit-step check out of the way.
-    overrides = {"dt": 0.5 / D} if D is not None and D > 0.0 and D * 0.005 > 0.5 else {}
+    overrides = {"dt": 1.0 / (2.0 * D + 1.0)} if D is not None and D > 0.0 and (2.0 * D + 1.0) * 0.005 > 1.0 else {}
     p = chain_params_from_args(args, **overrides)
     if p.friction != "state":
         return run_stability_modes(args, p)
