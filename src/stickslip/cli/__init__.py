@@ -55,15 +55,24 @@ def _one_line_warning(command: str):
 
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``stickslip`` command; returns the exit status."""
+    from stickslip.run.errors import NonFiniteBlock
+
     parser = build_parser()
+    argv = sys.argv[1:] if argv is None else list(argv)
+    if argv and argv[0].startswith("-") and argv[0] not in ("-h", "--help", "--version"):
+        parser.error(f"unrecognized argument {argv[0]} (options follow a COMMAND; see stickslip --help)")
     args = parser.parse_args(argv)
+    name = " ".join(v for v in (args.command, getattr(args, "stability_command", None)) if v)
     try:
         with warnings.catch_warnings():
             warnings.showwarning = _one_line_warning(args.command)
             result = args.handler(args)
     except (ParameterError, CommandError) as exc:
-        sys.stderr.write(f"stickslip {args.command}: error: {exc}\n")
+        sys.stderr.write(f"stickslip {name}: error: {exc}\n")
         return 2
+    except NonFiniteBlock as exc:
+        sys.stderr.write(f"stickslip {name}: error: {exc}\n")
+        return 1
     except KeyboardInterrupt:
         sys.stderr.write("stickslip: interrupted\n")
         return 130

@@ -36,9 +36,10 @@ from stickslip.cli._common import (
     block_params_from_args,
     float_arg,
     params_from_args,
+    check_out_owned,
     prepare_out_dir,
 )
-from stickslip.models.params import BlockParams, ParameterError, check_number, steps_for
+from stickslip.models.params import MAX_STEPS, BlockParams, ParameterError, check_number, steps_for
 from stickslip.run.block import (
     INTEGRATOR,
     BlockRun,
@@ -54,6 +55,11 @@ MAX_SAMPLES = 20_000_000
 #: Fig. 3: number of pulling velocities (log-spaced in [1e-3, 1e-1]) and periods per velocity.
 FIG3_POINTS = 13
 FIG3_PERIODS = 4
+#: Largest single-block run (steps); its slip table is sized for one slip per 1000 steps.
+MAX_BLOCK_STEPS = 10**10
+#: What ``block --out`` writes (its run directory may hold only these).
+BLOCK_FILES = frozenset({"series.nc", "slips.parquet", "run.json", "fig1.png", "fig1.pdf", "fig1.nc", "fig2.png",
+                         "fig2.pdf", "fig2.nc", "fig3.png", "fig3.pdf", "fig3.parquet"})
 
 
 def register(sub) -> None:
@@ -98,9 +104,10 @@ def register(sub) -> None:
 
 
 def _law_or_none(p: BlockParams) -> SlipLimit | None:
-    """The accurate eq. (3) at these parameters, or None where it has no slip that ends (or where
-    the threshold is not the constant Fs that eq. (3) starts from)."""
-    if p.threshold != "constant":
+    """The accurate eq. (3) at these parameters, or None where it has no slip that ends (or one
+    too stiff or too long to resolve: sqrt(K/M) > 1e4 or Fs > 1000 sigma; or where the threshold
+    is not the constant Fs that eq. (3) starts from)."""
+    if p.threshold != "constant" or math.sqrt(p.K / p.M) > 1e4 or p.Fs / p.sigma > 1e3:
         return None
     try:
         return solve_slip_limit(p)
@@ -125,7 +132,7 @@ def run_block(args: argparse.Namespace) -> Result:
     """Handler of ``stickslip block``: eq. (1), its slips, Figs. 1-3."""
     # Everything is validated before --out is created, so bad input writes nothing.
     p = block_params_from_args(args)
-    every = int(check_number("every", args.every, low=1, integer=True))
+    every = int(check_number("every", args.every, low=1, high=MAX_STEPS, integer=True))
     if args.t_end is not None:
         check_number("t_end", args.t_end, low=0.0)
     if args.fig3 and args.out is None:
@@ -133,6 +140,9 @@ def run_block(args: argparse.Namespace) -> Result:
     law = _law_or_none(p)
     t_end = float(args.t_end) if args.t_end is not None else default_t_end(p, law)
     steps = steps_for(t_end, p.dt)
+    if steps > MAX_BLOCK_STEPS:
+        raise CommandError(f"t_end must be <= {MAX_BLOCK_STEPS * p.dt:g} for the single block (at most "
+                           f"{MAX_BLOCK_STEPS:.0e} steps of dt = {p.dt:g}, for the memory of its slip table)")
     if n_samples(steps, every) > MAX_SAMPLES:
         raise CommandError(
             f"every must be >= {math.ceil(steps / MAX_SAMPLES)} for a run of {steps} steps "
@@ -140,6 +150,7 @@ def run_block(args: argparse.Namespace) -> Result:
         )
     if args.fig3 and law is None:
         raise CommandError("--fig3 needs the period law: eq. (3) has no slip that ends at these parameters")
+    check_out_owned(args.out, lambda n: n in BLOCK_FILES, "a block run")
     out = prepare_out_dir(args.out)
 
     run = simulate_block(p, t_end, every=every)
@@ -258,8 +269,15 @@ def write_block_outputs(out: Path, run: BlockRun, law: SlipLimit | None, *, fig3
 def run_slip_limit(args: argparse.Namespace) -> Result:
     """Handler of ``stickslip slip-limit``: eq. (3), the Heun comparison and the period law."""
     p = params_from_args(BlockParams, args)
-    rtol = check_number("rtol", args.rtol, low=0.0, low_open=True)
-    atol = check_number("atol", args.atol, low=0.0, low_open=True)
+    rtol = check_number("rtol", args.rtol, low=1e-13, high=1e-2)
+    atol = check_number("atol", args.atol, low=0.0, low_open=True, high=1e-2)
+    # Heun resolves the oscillation of the spring only for omega dt = dt sqrt(K/M) well below 1.
+    if p.dt * math.sqrt(p.K / p.M) > 0.5:
+        raise CommandError(f"dt must be <= 0.5 sqrt(M/K) = {0.5 * math.sqrt(p.M / p.K):.3g} for the Heun slip "
+                           f"(got dt={p.dt:g})")
+    # eq. (3) is solved for a slip of a few periods 2 pi sqrt(M/K); huge Fs/sigma slips for ever.
+    if p.Fs / p.sigma > 1e3:
+        raise CommandError(f"Fs must be <= 1000 sigma for eq. (3) (got Fs={p.Fs:g}, sigma={p.sigma:g})")
     try:
         law = solve_slip_limit(p, rtol=rtol, atol=atol)
         heun = heun_slip_limit(p)

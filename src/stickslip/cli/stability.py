@@ -33,9 +33,10 @@ from stickslip.cli._common import (
     chain_params_from_args,
     float_arg,
     params_from_args,
+    check_out_dir,
     prepare_out_dir,
 )
-from stickslip.models.params import BlockParams, ChainParams, check_number
+from stickslip.models.params import BlockParams, ChainParams, ParameterError, check_number
 from stickslip.run.block import INTEGRATOR
 
 #: Points of the stability map (beta x V) and of the Hopf curve.
@@ -138,9 +139,12 @@ def run_stability_block(args: argparse.Namespace) -> Result:
     """Handler of ``stickslip stability block``: Hopf point and eigenvalues of eq. (2)."""
     with_V = args.param_V is not None
     p = params_from_args(BlockParams, args)
-    out = prepare_out_dir(args.out)
-
-    hopf = st.hopf_point(p)
+    check_out_dir(args.out)
+    try:
+        hopf = st.hopf_point(p)
+    except ParameterError as exc:
+        raise CommandError(f"no Hopf point at K={p.K:g}, beta={p.beta:g}, alpha={p.alpha:g} "
+                           f"(steady sliding cannot be linearised there: {exc})") from None
     params = {k: v for k, v in p.to_dict().items() if k not in ("Fs", "dt") and (with_V or k != "V")}
     data: dict[str, Any] = {
         "params": params,
@@ -152,6 +156,7 @@ def run_stability_block(args: argparse.Namespace) -> Result:
     }
     if _is_paper_block(p):
         data["paper_hopf_V"] = 0.106
+    out = prepare_out_dir(args.out)
     if with_V:
         s = st.block_stability(p)
         data.update(V=p.V, theta0=s.theta0, eigenvalues=_eig_list(s.eigenvalues),
@@ -216,7 +221,7 @@ def run_stability_chain(args: argparse.Namespace) -> Result:
     with_N = args.param_N is not None
     D = args.param_D
     # dt is never read by the linear analysis; keep ChainParams' explicit-step check out of the way.
-    overrides = {"dt": 0.5 / D} if D is not None and D > 0.0 and D * 0.005 > 0.5 else {}
+    overrides = {"dt": 1.0 / (2.0 * D + 1.0)} if D is not None and D > 0.0 and (2.0 * D + 1.0) * 0.005 > 1.0 else {}
     p = chain_params_from_args(args, **overrides)
     if p.friction != "state":
         return run_stability_modes(args, p)
@@ -363,6 +368,11 @@ def run_hysteresis(args: argparse.Namespace) -> Result:
         V_min=args.V_min, V_max=args.V_max, dV=args.dV,
         time_per_step=args.time_per_step, transient=args.transient,
     )  # fmt: skip
+    from stickslip.cli.block import MAX_BLOCK_STEPS
+
+    if settings.time_per_step + settings.transient > MAX_BLOCK_STEPS * p.dt:
+        raise CommandError(f"time_per_step + transient must be <= {MAX_BLOCK_STEPS * p.dt:g} (at most "
+                           f"{MAX_BLOCK_STEPS:.0e} steps of dt = {p.dt:g} per value of V)")
     out = prepare_out_dir(args.out)
 
     result = hy.hysteresis_sweep(p, settings)

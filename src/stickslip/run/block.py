@@ -175,6 +175,8 @@ def simulate_block(
         if n_slips <= capacity:
             break
         capacity = n_slips
+    if not (np.isfinite(x) and np.isfinite(v) and np.isfinite(theta)):
+        _blow_up(params, out_t, out_x, out_v, out_theta, steps)
 
     series = _series(params, out_t, out_x, out_v, out_theta, out_stopped, every)
     slips = _slip_table(
@@ -194,6 +196,16 @@ def simulate_block(
         n_starts=int(n_starts),
         initial=initial,
     )
+
+
+def _blow_up(p: BlockParams, t, x, v, theta, steps: int) -> None:
+    """Raise NonFiniteBlock naming the first stored time with a non-finite state."""
+    from stickslip.run.errors import NonFiniteBlock
+
+    bad = ~(np.isfinite(x) & np.isfinite(v) & np.isfinite(theta))
+    when = f"t = {float(t[np.argmax(bad)]):.6g}" if bad.any() else f"t <= {steps * p.dt:.6g}"
+    raise NonFiniteBlock(f"the block's state became non-finite by {when} (blow-up; a smaller dt may help, "
+                         f"dt = {p.dt:g}, K/M = {p.K / p.M:g})")
 
 
 def _series(p: BlockParams, t, x, v, theta, stopped, every: int) -> xr.Dataset:

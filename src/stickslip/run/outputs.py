@@ -17,7 +17,7 @@ import xarray as xr
 
 from stickslip.kernels import chain as K
 from stickslip.models import physics
-from stickslip.models.params import ChainParams, ParameterError, check_number, steps_for
+from stickslip.models.params import MAX_STEPS, ChainParams, ParameterError, check_number, steps_for
 from stickslip.run.state import ChainState
 
 
@@ -43,16 +43,18 @@ class RunOptions:
     until_steady: float | None = None
 
     def validated(self, dt: float) -> "RunOptions":
-        check_number("t_end", self.t_end, low=0.0)
-        check_number("sample_interval", self.sample_interval, low=0.0, low_open=True)
+        """Check every option against the time step (ranges in docs/limits.md); returns self."""
+        steps_for(self.t_end, dt)
+        longest = MAX_STEPS * dt
+        check_number("sample_interval", self.sample_interval, low=0.0, low_open=True, high=longest)
         if round(self.sample_interval / dt) < 1:
             raise ParameterError(f"sample_interval must be >= dt = {dt:g} (got {self.sample_interval!r})")
         if self.average_from is not None:
-            check_number("average_from", self.average_from, low=0.0)
+            check_number("average_from", self.average_from, low=0.0, high=self.t_end)
         for t in self.snapshot_times:
             check_number("snapshot time", t, low=0.0, high=self.t_end)
         if self.profile_window is not None:
-            check_number("profile_window", self.profile_window, low=0.0, low_open=True)
+            check_number("profile_window", self.profile_window, low=0.0, low_open=True, high=longest)
             if round(self.profile_window / dt) < 1:
                 raise ParameterError(f"profile_window must be >= dt = {dt:g} (got {self.profile_window!r})")
         check_number("profile_min_blocks", self.profile_min_blocks, low=0, integer=True)
