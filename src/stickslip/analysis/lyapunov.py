@@ -362,7 +362,10 @@ def _bar(progress: bool, total: float):
         return None
     from tqdm import tqdm
 
-    return tqdm(total=total, unit="t", unit_scale=True, dynamic_ncols=True, desc="lyapunov", file=sys.stderr)
+    # rate in model time units per wall-clock second
+    return tqdm(total=total, unit=" time units", unit_scale=False, dynamic_ncols=True, desc="lyapunov",
+                file=sys.stderr, bar_format="{l_bar}{bar}| t = {n:.4g}/{total:.4g} [{elapsed}<{remaining}, "
+                                            "{rate_fmt}]")
 
 
 CONVERGENCE_COLUMNS = ["varied", "d0", "interval", "t_end", "lyapunov", "lyapunov_err", "renormalisations",

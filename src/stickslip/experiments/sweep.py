@@ -332,11 +332,12 @@ def _compute(task, points, common, out, names, specs, pending, records, *, sched
 
 
 def _progress_bar(total: int, done: int, enabled: bool):
-    if not enabled:
+    """A bar of finished points on stderr, only when asked and stderr is a terminal (not a log)."""
+    if not (enabled and sys.stderr.isatty()):
         return None
     from tqdm import tqdm
 
-    return tqdm(total=total, initial=done, desc="points", unit="point", file=sys.stderr,
+    return tqdm(total=total, initial=done, desc="points", unit=" points", file=sys.stderr,
                 dynamic_ncols=True, smoothing=0.1)
 
 
