@@ -13,6 +13,7 @@ V_up and V_down; ``--out DIR`` writes the bifurcation diagram.
 from __future__ import annotations
 
 import argparse
+import math
 from pathlib import Path
 from typing import Any
 
@@ -140,6 +141,12 @@ def run_stability_block(args: argparse.Namespace) -> Result:
     with_V = args.param_V is not None
     p = params_from_args(BlockParams, args)
     check_out_dir(args.out)
+    if args.out is not None:
+        with np.errstate(all="ignore"):
+            beta_limit = st.hopf_beta_limit(p)
+        if not math.isfinite(beta_limit):
+            raise CommandError(f"K must be small enough for the stability map's beta range to be finite "
+                               f"(got K={p.K:g}: the Hopf limit of beta overflows)")
     try:
         hopf = st.hopf_point(p)
     except ParameterError as exc:
