@@ -333,12 +333,17 @@ def _compute(task, points, common, out, names, specs, pending, records, *, sched
 
 def _progress_bar(total: int, done: int, enabled: bool):
     """A bar of finished points on stderr, only when asked and stderr is a terminal (not a log)."""
-    if not (enabled and sys.stderr.isatty()):
+    if not (enabled and _on_terminal()):
         return None
     from tqdm import tqdm
 
     return tqdm(total=total, initial=done, desc="points", unit=" points", file=sys.stderr,
                 dynamic_ncols=True, smoothing=0.1)
+
+
+def _on_terminal() -> bool:
+    """Whether stderr is a terminal: progress bars would garble a log file."""
+    return sys.stderr.isatty()
 
 
 # ---------------------------------------------------------------------------------------------
