@@ -16,8 +16,8 @@ so a mover's stage 2 reads its stopped neighbours' predictors without recomputin
 which it was a candidate and no neighbour moved); a block due in the next step goes on the
 queue, the others are found when the step reaches the smallest of their ``trig``.
 
-Every quantity uses the expressions of chain.py's helpers, so the result equals run_dense
-bit for bit.
+Every quantity uses the expressions of :mod:`stickslip.kernels.common`, so the result
+equals run_dense bit for bit.
 """
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from stickslip.kernels import chain as c
+from stickslip.kernels import common as c
 
 _QUEUED = np.int64(-1)  # trig of a stopped block queued as a candidate of the next step
 
@@ -147,7 +147,7 @@ def run_sparse(x, v, th, mov, xs, vs, ths, mm, a1, b1, trig, first_step, x0ev, i
             ths[i] = th[i] + dt * b
         p2 = c._pull(V, n + 1, dt)
         c._set_ghosts(xs, ths, N, p2, drive, ends)
-        # Event start and first moves (as chain._start_and_first_moves, on the list).
+        # Event start and first moves (as common._start_and_first_moves, on the list).
         if first <= N and (ist[c.EV_ACTIVE] == 1 or ist[c.N_MOVING] == 0) and (starts or ist[c.EV_ACTIVE] == 0):
             if ist[c.EV_ACTIVE] == 0:
                 ist[c.EV_ACTIVE] = 1
