@@ -59,7 +59,7 @@ def test_resume_in_pieces_equals_uninterrupted(tmp_path, full, full_dense, integ
         times = [_mid_event_time(full, -2)]
     else:
         times = [700.0, _mid_event_time(full, -1)]
-    first = run_chain(P, times[0], integrator=integrator, out_dir=tmp_path, **OPTS)
+    first = run_chain(P, times[0], integrator=integrator, out_dir=tmp_path, **OPTS, keep_checkpoint=True)
     if split == "mid-event":
         assert first.summary["event_in_progress"]
     for t in times[1:]:
@@ -75,7 +75,7 @@ def test_resume_in_pieces_equals_uninterrupted(tmp_path, full, full_dense, integ
 
 
 def test_resume_of_a_finished_run_changes_nothing(tmp_path, full):
-    run_chain(P, T2, out_dir=tmp_path, **OPTS)
+    run_chain(P, T2, out_dir=tmp_path, **OPTS, keep_checkpoint=True)
     again = resume_chain(tmp_path)
     assert_same_run(again, full)
     assert again.steps == full.steps
@@ -86,7 +86,7 @@ def test_frequent_checkpoints_do_not_change_the_result(tmp_path, full):
     times = tuple(float(t) for t in np.arange(50.0, T2, 50.0))
     opts = dict(OPTS, snapshot_times=times)
     ref = run_chain(P, T2, **opts)
-    run = run_chain(P, T2, out_dir=tmp_path, checkpoint_interval=1e-9, **opts)
+    run = run_chain(P, T2, out_dir=tmp_path, checkpoint_interval=1e-9, **opts, keep_checkpoint=True)
     assert_same_run(run, ref)
     assert len(list((tmp_path / "checkpoint").glob("part-*.npz"))) >= len(times)
     assert_same_run(resume_chain(tmp_path), ref)
@@ -127,7 +127,7 @@ def test_continue_from_a_state_inside_an_event(full):
 
 
 def test_resume_refuses_an_earlier_end_time(tmp_path):
-    run_chain(P, 100.0, out_dir=tmp_path)
+    run_chain(P, 100.0, out_dir=tmp_path, keep_checkpoint=True)
     with pytest.raises(ParameterError, match="t_end"):
         resume_chain(tmp_path, t_end=50.0)
 
@@ -150,9 +150,9 @@ def _digest_tree(d: Path) -> dict[str, str]:
 
 @pytest.fixture
 def run_dir(tmp_path):
-    """A finished run of 100 time units with slips, checkpointed in tmp_path/run."""
+    """A finished run of 100 time units with slips, its checkpoint kept in tmp_path/run."""
     d = tmp_path / "run"
-    run = run_chain(SMALL, 100.0, out_dir=d, profile_window=0.5)
+    run = run_chain(SMALL, 100.0, out_dir=d, profile_window=0.5, keep_checkpoint=True)
     assert run.summary["n_events"] > 0
     return d
 
@@ -250,7 +250,7 @@ def test_checkpoint_arrays_that_do_not_fit_are_refused(tmp_path, run_dir, mismat
     arrays, header, _ = C._read_npz(path)
     if mismatch == "arrays-of-N=4":
         other = tmp_path / "other"
-        run_chain(SMALL.replace(N=4), 100.0, out_dir=other)
+        run_chain(SMALL.replace(N=4), 100.0, out_dir=other, keep_checkpoint=True)
         arrays, _, _ = C._read_npz(other / "checkpoint" / "state.npz")
         C._write_npz(path, arrays, header)
         _refused(run_dir)

@@ -41,7 +41,7 @@ def test_chain_text_output_and_out_dir(capsys, tmp_path):
     out_dir = tmp_path / "run"
     status, out, _ = run_cli(capsys, "chain", "--N", "4", "--t-end", "800", "--V", "0.01", "--integrator", "dense",
                              "--snapshot", "100", "--profile-window", "0.5", "--out", str(out_dir),
-                             "--no-progress")  # fmt: skip
+                             "--keep-checkpoint", "--no-progress")  # fmt: skip
     assert status == 0
     ref = run_chain(ChainParams(N=4, V=0.01), 800.0, snapshot_times=(100.0,), profile_window=0.5)
     assert ref.summary["state_sha256"] in out and "events" in out

@@ -3,6 +3,7 @@ are owned by one run; checkpoints are validated before a kernel sees them; blow-
 
 from __future__ import annotations
 
+import json
 import os
 import shlex
 import subprocess
@@ -44,7 +45,26 @@ BAD = [
     ("sweep chain --t-end 10 --out o --set profile_window=0", "profile_window"),
     ("sweep chain --t-end 10 --out o --set profile_min_blocks=-1", "profile_min_blocks"),
     ("sweep block --t-end 10 --out o --set every=0", "every"),
-    ("sweep chain --t-end 10 --out o --set K=inf", "K"),
+    ("sweep chain --t-end 10 --out o --set K=inf", "K must be a finite number > 0"),
+    ("sweep chain --t-end 10 --out o --set K=nan", "K must be a finite number > 0"),
+    ("sweep chain --t-end 10 --out o --set N=inf", "N must be an integer >= 1"),
+    ("sweep chain --t-end 10 --out o --grid beta=1,nan", "beta must be a finite number >= 0"),
+    ("sweep chain --t-end 10 --out o --set sample_interval=inf",
+     "sample_interval must be a finite number > 0"),
+    ("sweep chain --t-end 10 --out o --set average_from=-inf", "average_from must be a finite number >= 0"),
+    ("sweep block --t-end 10 --out o --set every=inf", "every must be an integer >= 1"),
+    ("sweep block --t-end 10 --out o --set K=-inf", "K must be a finite number > 0"),
+    # --out holding somebody else's files; --overwrite or --keep-checkpoint without --out
+    ("block --t-end 10 --out foreign", "notes.txt"), ("stability block --out foreign", "notes.txt"),
+    ("stability chain --out foreign", "notes.txt"),
+    ("stability chain --model train --out foreign", "notes.txt"),
+    ("hysteresis --time-per-step 10 --out foreign", "notes.txt"),
+    ("sweep block --t-end 10 --out foreign", "notes.txt"), ("reproduce --smoke --out foreign", "notes.txt"),
+    ("chain --t-end 10 --out foreign", "notes.txt"),
+    ("block --t-end 10 --overwrite", "--overwrite"), ("stability block --overwrite", "--overwrite"),
+    ("stability chain --overwrite", "--overwrite"),
+    ("hysteresis --time-per-step 10 --overwrite", "--overwrite"),
+    ("chain --keep-checkpoint --t-end 10", "--keep-checkpoint"),
     ("models --bogus", "--bogus"), ("lyapunov --N 0", "N"), ("reproduce --bogus", "--bogus"), ("--bogus", "--bogus"),
 ]
 
@@ -56,6 +76,8 @@ def _tree(path):
 @pytest.mark.parametrize("argv,name", BAD, ids=[c for c, _ in BAD])
 def test_bad_input_one_line_exit_2(argv, name, tmp_path, monkeypatch, capsys):
     (tmp_path / "afile").write_text("")
+    (tmp_path / "foreign").mkdir()
+    (tmp_path / "foreign" / "notes.txt").write_text("mine")
     monkeypatch.chdir(tmp_path)
     before = _tree(tmp_path)
     try:
@@ -98,7 +120,8 @@ def test_foreign_folders_refused(tmp_path, capsys):
 
 
 def _finished_run(path):
-    assert main(["chain", "--N", "4", "--V", "0.01", "--t-end", "400", "--out", str(path), "--no-progress"]) == 0
+    assert main(["chain", "--N", "4", "--V", "0.01", "--t-end", "400", "--out", str(path),
+                 "--keep-checkpoint", "--no-progress"]) == 0
     return path
 
 
@@ -156,3 +179,160 @@ def test_second_writer_refused_while_first_runs(tmp_path):
     stdout, _ = first.communicate(timeout=300)
     assert first.returncode == 0 and (out / "run.json").exists() and not (out / ".lock").exists()
     assert '"events"' in stdout
+
+
+# Every command that writes into --out owns it as a chain run does: one writer at a time, no
+# foreign files, --overwrite removes only this package's files.
+
+WRITERS = [
+    "block --t-end 10 --out {out}", "stability block --out {out}", "stability chain --out {out}",
+    "stability chain --model train --out {out}", "hysteresis --time-per-step 10 --out {out}",
+    "sweep block --t-end 10 --out {out}", "plot {run} --out {out}", "reproduce --smoke --out {out}",
+    "chain --N 3 --t-end 10 --no-progress --out {out}",
+]
+
+
+@pytest.fixture(scope="module")
+def small_run(tmp_path_factory):
+    run = tmp_path_factory.mktemp("small") / "run"
+    assert main(["chain", "--N", "3", "--t-end", "10", "--out", str(run), "--no-progress"]) == 0
+    return run
+
+
+@pytest.fixture(scope="module")
+def held(tmp_path_factory):
+    """A directory whose lock another process holds; yields it and the holder's pid."""
+    import sys
+
+    d = tmp_path_factory.mktemp("held")
+    code = ("import sys, time\nfrom stickslip.run.rundir import owned_run_dir\n"
+            "with owned_run_dir(sys.argv[1], run_id=False):\n"
+            "    print('held', flush=True)\n    time.sleep(600)\n")
+    proc = subprocess.Popen([sys.executable, "-c", code, str(d)], stdout=subprocess.PIPE, text=True,
+                            env=cli_env())
+    try:
+        assert proc.stdout.readline().strip() == "held"
+        yield d, proc.pid
+    finally:
+        proc.kill()
+        proc.wait()
+
+
+@pytest.mark.parametrize("command", WRITERS, ids=[c.split(" --out")[0] for c in WRITERS])
+def test_second_writer_refused_at_once_naming_the_holder(command, held, small_run, capsys):
+    out, pid = held
+    before = _tree(out)
+    capsys.readouterr()
+    start = time.monotonic()
+    status = main(shlex.split(command.format(out=out, run=small_run)))
+    stdout, err = capsys.readouterr()
+    assert status == 2 and stdout == "", err
+    assert err.count("\n") == 1 and "in use by another run" in err and f"pid {pid}" in err, err
+    assert time.monotonic() - start < 30, "refused at once, not after waiting"
+    assert _tree(out) == before
+
+
+@pytest.mark.parametrize("command", ["block --t-end 10", "stability block", "hysteresis --time-per-step 10"])
+def test_finished_chain_run_is_not_overwritten(command, tmp_path, capsys):
+    """The issue's example: `block --out` on a finished chain run overwrote its run.json."""
+    run = tmp_path / "run"
+    assert main(["chain", "--N", "3", "--t-end", "10", "--out", str(run), "--no-progress"]) == 0
+    meta = (run / "run.json").read_bytes()
+    before = _tree(run)
+    capsys.readouterr()
+    assert main(shlex.split(command) + ["--out", str(run)]) == 2
+    stdout, err = capsys.readouterr()
+    assert stdout == "" and err.count("\n") == 1 and "events.parquet" in err and "--overwrite" in err, err
+    assert (run / "run.json").read_bytes() == meta and _tree(run) == before
+
+
+def test_overwrite_removes_only_this_packages_files(tmp_path, capsys):
+    run = tmp_path / "run"
+    assert main(["chain", "--N", "3", "--t-end", "10", "--out", str(run), "--no-progress"]) == 0
+    (run / "notes.txt").write_text("mine")
+    (run / "mine").mkdir()
+    capsys.readouterr()
+    assert main(["block", "--t-end", "10", "--out", str(run), "--overwrite", "--json"]) == 0
+    assert (run / "notes.txt").read_text() == "mine" and (run / "mine").is_dir()
+    for name in ("state.nc", "events.parquet", "first_move.parquet"):
+        assert not (run / name).exists(), f"the chain run's {name} was left beside the block's files"
+    assert (run / "series.nc").is_file() and json.loads((run / "run.json").read_text())["command"] == "block"
+    assert not (run / ".lock").exists() and not (run / ".lock.json").exists()
+
+
+def test_sweep_reuses_its_own_folder_and_refuses_others(tmp_path, capsys):
+    out = tmp_path / "sweep"
+    argv = ["sweep", "block", "--t-end", "10", "--grid", "K=8,10", "--out", str(out), "--workers", "1",
+            "--no-progress", "--json"]
+    assert main(argv) == 0
+    capsys.readouterr()
+    assert main(argv) == 0, "a sweep run again into its own folder reuses its points"
+    assert json.loads(capsys.readouterr().out)["n_reused"] == 2
+    (out / "K=8" / "point.json").unlink()  # a folder that is no longer the sweep's point
+    before = _tree(out)
+    assert main(argv) == 2
+    assert "K=8" in capsys.readouterr().err and _tree(out) == before
+
+
+# A finished chain run keeps only what it needs.
+
+
+def test_finished_run_drops_its_checkpoint_and_still_loads(tmp_path, capsys):
+    from stickslip.run.rundir import load_run
+
+    run = tmp_path / "run"
+    assert main(["chain", "--N", "4", "--V", "0.01", "--t-end", "400", "--out", str(run), "--no-progress",
+                 "--json"]) == 0
+    printed = json.loads(capsys.readouterr().out)
+    assert not (run / "checkpoint").exists()
+    assert sorted(p.name for p in run.iterdir()) == [".run_id", "events.parquet", "first_move.parquet",
+                                                     "run.json", "state.nc"]
+    loaded = load_run(run)
+    assert loaded.summary["state_sha256"] == printed["state_sha256"]
+    assert len(loaded.events) == printed["events"]
+    assert main(["plot", str(run), "--json"]) == 0
+    assert (run / "figures" / "length.png").is_file()
+    capsys.readouterr()
+    before = _tree(run)
+    assert main(["chain", "--resume", str(run), "--t-end", "800", "--no-progress"]) == 2
+    stdout, err = capsys.readouterr()
+    assert stdout == "" and err.count("\n") == 1 and "--keep-checkpoint" in err, err
+    assert _tree(run) == before
+
+
+def test_kept_checkpoint_stays_through_a_resume(tmp_path, capsys):
+    run = tmp_path / "run"
+    assert main(["chain", "--N", "4", "--V", "0.01", "--t-end", "400", "--out", str(run), "--no-progress",
+                 "--keep-checkpoint"]) == 0
+    assert (run / "checkpoint" / "state.npz").is_file()
+    capsys.readouterr()
+    assert main(["chain", "--resume", str(run), "--t-end", "800", "--no-progress", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["t_end"] == 800
+    assert (run / "checkpoint" / "state.npz").is_file(), "a run started with --keep-checkpoint keeps it"
+
+
+def test_results_killed_while_written_are_finished_by_resume(tmp_path, capsys):
+    """A kill during the final write of state.nc leaves the checkpoint and a .state.nc.*.tmp;
+    --resume removes the file of the killed write and finishes the run as one run."""
+    from stickslip.run.rundir import load_run
+
+    ref, run = tmp_path / "ref", tmp_path / "run"
+    for d in (ref, run):
+        assert main(["chain", "--N", "4", "--V", "0.01", "--t-end", "400", "--out", str(d), "--no-progress",
+                     "--keep-checkpoint"]) == 0
+    for name in ("state.nc", "run.json"):
+        (run / name).unlink()
+    stale = run / ".state.nc.k1ll3d.tmp"
+    stale.write_bytes(b"half a netCDF file")
+    capsys.readouterr()
+    assert main(["chain", "--resume", str(run), "--no-progress"]) == 0
+    assert not stale.exists() and not list(run.glob(".*.tmp"))
+    assert load_run(run).summary["state_sha256"] == load_run(ref).summary["state_sha256"]
+
+
+def test_start_removes_files_of_a_killed_write(tmp_path):
+    out = tmp_path / "run"
+    out.mkdir()
+    (out / ".state.nc.k1ll3d.tmp").write_bytes(b"half a netCDF file")
+    assert main(["chain", "--N", "3", "--t-end", "10", "--out", str(out), "--no-progress"]) == 0
+    assert not list(out.glob(".*.tmp")) and (out / "state.nc").is_file()

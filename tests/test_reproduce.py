@@ -126,7 +126,12 @@ def test_chain_task_continues_from_a_checkpoint(tmp_path, monkeypatch):
 
     exp = ex.experiment("smoke", "chain-runs")
     point = {**rp._chain_common(exp), "N": 19, "beta": 1.0}
-    first = rp.chain_point_task(point, tmp_path)
+    first = rp.chain_point_task(point, tmp_path / "done")
+    assert (tmp_path / "done" / "run.json").is_file()
+    assert not (tmp_path / "done" / "checkpoint").exists(), "a finished point keeps no checkpoint"
+    # A run killed while writing its results: the checkpoint is there, the results are not.
+    params, t_end, options = rp._point_settings(point)
+    chain.run_chain(params, t_end, out_dir=tmp_path, keep_checkpoint=True, **options)
     assert (tmp_path / "checkpoint" / "state.npz").is_file()
     for name in ("run.json", "state.nc", "events.parquet"):
         (tmp_path / name).unlink()

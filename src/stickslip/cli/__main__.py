@@ -2,4 +2,5 @@
 
 from stickslip.cli import main
 
-raise SystemExit(main())
+if __name__ == "__main__":  # not on import (the API reference imports every module)
+    raise SystemExit(main())

@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
 import json
 import os
 import sys
+from collections.abc import Callable, Collection, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -125,20 +127,92 @@ def check_out_dir(path: str | Path | None, option: str = "--out") -> Path | None
     return out
 
 
+def _figures(*stems: str) -> frozenset[str]:
+    """The files of figures saved by :func:`stickslip.plotting.style.save_figure` under these stems."""
+    return frozenset(f"{stem}.{fmt}" for stem in stems for fmt in ("png", "pdf", "svg"))
+
+
+#: What each command writes into its ``--out`` (a directory may hold only its command's files).
+OUT_FILES: dict[str, frozenset[str]] = {
+    "block": frozenset({"series.nc", "slips.parquet", "run.json", "fig1.nc", "fig2.nc", "fig3.parquet"})
+    | _figures("fig1", "fig2", "fig3"),
+    "stability block": frozenset({"stability_map.nc", "stability_block.json"}) | _figures("stability_map"),
+    "stability chain": frozenset({"fig4.nc", "mode_growth.nc", "stability_chain.json"})
+    | _figures("fig4", "mode_growth"),
+    "hysteresis": frozenset({"hysteresis.nc", "hysteresis.json"}) | _figures("hysteresis"),
+    "sweep": frozenset({"summary.parquet", "summary.csv"}),
+    "reproduce": frozenset({"runs", "figures", "report.json", "report.html", "experiments.json"}),
+}
+
+
+def package_files() -> frozenset[str]:
+    """What any command writes into a run directory (a chain run's files included, not the
+    folders of a sweep or of ``reproduce``); ``--overwrite`` removes these too, so that no
+    directory mixes the results of two commands (a block's run.json beside a chain's state.nc)."""
+    from stickslip.run.rundir import LOCK_FILES, OWN_FILES, RUN_ID_FILE
+
+    files = frozenset().union(*OUT_FILES.values()) - {"runs", "figures"}
+    return files | (OWN_FILES - LOCK_FILES - {RUN_ID_FILE})
+
+
+def _owner(own: Callable[[str], bool] | Collection[str]) -> Callable[[str], bool]:
+    """A test of names: ``own`` itself, or membership in it; the lock and files left by a killed
+    write always belong."""
+    from stickslip.run.rundir import LOCK_FILES, is_temporary
+
+    test = own if callable(own) else (lambda name: name in own)
+    return lambda name: name in LOCK_FILES or is_temporary(name) or test(name)
+
+
 def check_out_owned(path: str | Path | None, own, what: str, *, overwrite: bool = False,
                     option: str = "--out") -> Path | None:
-    """Refuse an output directory holding anything that is not ``own(name)`` (one of this
-    command's files); with ``overwrite`` the command's own files are removed instead."""
+    """Refuse an output directory holding anything that ``own`` (a set of names or a test of a
+    name) does not accept as written by the command ``what``; with ``overwrite`` the check is left out (the
+    command then removes only this package's files, :func:`owned_out_dir`)."""
     out = check_out_dir(path, option)
     if out is None or not out.is_dir():
         return out
-    names = sorted(p.name for p in out.iterdir())
+    names = sorted((p.name for p in out.iterdir()), key=lambda n: (n.startswith("."), n))  # hidden ones last
+    own = _owner(own)
     foreign = [n for n in names if not own(n)]
     if foreign and not overwrite:
         shown = ", ".join(foreign[:3]) + (", ..." if len(foreign) > 3 else "")
-        raise CommandError(f"{option} {out} holds files that are not {what}'s ({shown}); choose an empty "
-                           "directory, or --overwrite to replace this package's files there")
+        raise CommandError(f"{option} {out} holds files that `{what}` does not write ({shown}); choose an "
+                           "empty directory, or --overwrite to replace this package's files there")
     return out
+
+
+@contextlib.contextmanager
+def owned_out_dir(path: str | Path | None, own, what: str, *, overwrite: bool = False,
+                  run_id: bool = False) -> Iterator[Path | None]:
+    """Claim ``--out`` for one command: refuse foreign files (:func:`check_out_owned`), create the
+    directory, hold its lock while the command writes (a second writer is refused at once,
+    naming the holder; :func:`stickslip.run.rundir.owned_run_dir`) and, with ``overwrite``,
+    remove this command's and the package's files first. Yields the directory (None without
+    ``--out``). Call it after every other check, so that bad input writes nothing."""
+    from stickslip.run.rundir import RunDirBusy, owned_run_dir, remove_own_files
+
+    out = check_out_owned(path, own, what, overwrite=overwrite)
+    out = prepare_out_dir(out)
+    if out is None:
+        if overwrite:
+            raise CommandError("--overwrite needs --out")
+        yield None
+        return
+    test, package = _owner(own), package_files()
+    try:
+        with owned_run_dir(out, run_id=run_id):
+            if overwrite:
+                remove_own_files(out, lambda name: test(name) or name in package)
+            yield out
+    except RunDirBusy as exc:
+        raise CommandError(str(exc)) from None
+
+
+def add_overwrite_option(parser: argparse.ArgumentParser) -> None:
+    """``--overwrite``: replace this package's files in ``--out``; other files there stay."""
+    parser.add_argument("--overwrite", action="store_true",
+                        help="replace this package's files in --out (other files there are left alone)")
 
 
 def prepare_out_dir(path: str | Path | None) -> Path | None:

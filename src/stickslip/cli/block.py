@@ -31,13 +31,14 @@ from stickslip.cli._common import (
     CommandError,
     Result,
     add_json_option,
+    OUT_FILES,
     add_block_model_option,
+    add_overwrite_option,
     add_param_options,
     block_params_from_args,
     float_arg,
+    owned_out_dir,
     params_from_args,
-    check_out_owned,
-    prepare_out_dir,
 )
 from stickslip.models.params import MAX_STEPS, BlockParams, ParameterError, check_number, steps_for
 from stickslip.run.block import (
@@ -58,8 +59,7 @@ FIG3_PERIODS = 4
 #: Largest single-block run (steps); its slip table is sized for one slip per 1000 steps.
 MAX_BLOCK_STEPS = 10**10
 #: What ``block --out`` writes (its run directory may hold only these).
-BLOCK_FILES = frozenset({"series.nc", "slips.parquet", "run.json", "fig1.png", "fig1.pdf", "fig1.nc", "fig2.png",
-                         "fig2.pdf", "fig2.nc", "fig3.png", "fig3.pdf", "fig3.parquet"})
+BLOCK_FILES = OUT_FILES["block"]
 
 
 def register(sub) -> None:
@@ -84,6 +84,7 @@ def register(sub) -> None:
     p.add_argument("--fig3", action="store_true",
                    help=f"also simulate the period at {FIG3_POINTS} values of V in [1e-3, 1e-1] and "
                         "write fig3.png and fig3.parquet (needs --out)")  # fmt: skip
+    add_overwrite_option(p)
     add_json_option(p)
     p.set_defaults(handler=run_block)
 
@@ -150,13 +151,11 @@ def run_block(args: argparse.Namespace) -> Result:
         )
     if args.fig3 and law is None:
         raise CommandError("--fig3 needs the period law: eq. (3) has no slip that ends at these parameters")
-    check_out_owned(args.out, lambda n: n in BLOCK_FILES, "a block run")
-    out = prepare_out_dir(args.out)
-
-    run = simulate_block(p, t_end, every=every)
-    data = block_report(run, law)
-    if out is not None:
-        data["outputs"] = [str(path) for path in write_block_outputs(out, run, law, fig3=args.fig3)]
+    with owned_out_dir(args.out, BLOCK_FILES, "stickslip block", overwrite=args.overwrite) as out:
+        run = simulate_block(p, t_end, every=every)
+        data = block_report(run, law)
+        if out is not None:
+            data["outputs"] = [str(path) for path in write_block_outputs(out, run, law, fig3=args.fig3)]
     return Result(data=data, text=block_text(data))
 
 

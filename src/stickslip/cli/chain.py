@@ -15,13 +15,11 @@ from stickslip.cli._common import (
     chain_params_from_args,
     float_arg,
     int_arg,
-    params_from_args,
-    check_out_dir,
     check_out_owned,
-    prepare_out_dir,
+    owned_out_dir,
 )
-from stickslip.models.params import ChainParams, ParameterError, check_number, steps_for
-from stickslip.run.rundir import OWN_FILES, RunDirBusy, owned_run_dir, remove_own_files
+from stickslip.models.params import check_number, steps_for
+from stickslip.run.rundir import OWN_FILES, RunDirBusy, owned_run_dir, read_run_id
 
 
 def register(sub) -> None:
@@ -42,6 +40,9 @@ def register(sub) -> None:
                    metavar="SECONDS", help="wall-clock seconds between checkpoints (default 300; needs --out)")
     p.add_argument("--overwrite", action="store_true",
                    help="replace this package's files in --out (other files there are left alone)")
+    p.add_argument("--keep-checkpoint", action="store_true", default=None,
+                   help="keep the checkpoint (tens of MB for long chains) when the run finishes, so that "
+                        "--resume can continue it to a later --t-end (default: removed)")
     p.add_argument("--sample-interval", type=float_arg("sample-interval"), default=None, metavar="T",
                    help="sample L = x_1 - x_N every T time units (default 10)")
     p.add_argument("--average-from", type=float_arg("average-from"), default=None, metavar="T",
@@ -161,7 +162,8 @@ def run_chain_command(args: argparse.Namespace) -> Result:
         try:
             with owned_run_dir(args.resume):
                 run = chain.resume_chain(args.resume, t_end=args.t_end, checkpoint_interval=interval,
-                                         progress=progress, handle_signals=True)
+                                         progress=progress, handle_signals=True,
+                                         keep_checkpoint=args.keep_checkpoint)
         except RunDirBusy as exc:
             raise CommandError(str(exc)) from None
         except chain.NonFiniteState as exc:
@@ -186,7 +188,8 @@ def run_chain_command(args: argparse.Namespace) -> Result:
     steps_for(t_end, params.dt, "t-end")
     if args.out is None:
         for flag, value in (("--checkpoint-interval", args.checkpoint_interval),
-                            ("--overwrite", args.overwrite or None)):
+                            ("--overwrite", args.overwrite or None),
+                            ("--keep-checkpoint", args.keep_checkpoint)):
             if value is not None:
                 raise CommandError(f"{flag} needs --out (a run without a run directory writes no checkpoints)")
     interval = 300.0 if args.checkpoint_interval is None else args.checkpoint_interval
@@ -198,28 +201,25 @@ def run_chain_command(args: argparse.Namespace) -> Result:
                      profile_min_blocks=args.profile_min_blocks,
                      until_steady=args.until_steady).validated(params.dt)
     check_number("perturbation", args.perturbation, low=0.0)
-    out = check_out_dir(args.out)
+    out = check_out_owned(args.out, OWN_FILES, "stickslip chain", overwrite=args.overwrite)
     if out is not None and out.is_dir():
         if (out / "checkpoint" / "state.npz").exists() and not args.overwrite:
             raise CommandError(f"{out} already holds a run; continue it with --resume {out}, choose another "
                                "--out or give --overwrite")
-        check_out_owned(out, lambda n: n in OWN_FILES or (n.startswith(".") and n.endswith(".tmp")),
-                        "a chain run", overwrite=args.overwrite)
-    out = prepare_out_dir(out)
+        if (out / "run.json").exists() and not args.overwrite:
+            raise CommandError(f"{out} already holds a finished run; choose another --out or give "
+                               "--overwrite")
     try:
-        with owned_run_dir(out) as run_id:
-            if args.overwrite:
-                remove_own_files(out)
+        with owned_out_dir(out, OWN_FILES, "stickslip chain", overwrite=args.overwrite, run_id=True) as out:
             run = chain.run_chain(
                 params, t_end, integrator=args.integrator, start=args.start, perturbation=args.perturbation,
                 seed=args.seed, sample_interval=args.sample_interval, average_from=args.average_from,
                 snapshot_times=args.snapshot, profile_window=args.profile_window,
                 profile_min_blocks=args.profile_min_blocks, until_steady=args.until_steady, out_dir=out,
                 checkpoint_interval=interval if out else None, progress=progress,
-                handle_signals=out is not None, run_id=run_id,
+                handle_signals=out is not None, run_id=read_run_id(out) if out else None,
+                keep_checkpoint=bool(args.keep_checkpoint),
             )
-    except RunDirBusy as exc:
-        raise CommandError(str(exc)) from None
     except chain.ChainRunError as exc:
         sys.stderr.write(f"stickslip chain: error: {exc}\n")
         return Result({"error": str(exc)}, "", status=1)

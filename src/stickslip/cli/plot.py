@@ -3,9 +3,13 @@
 from __future__ import annotations
 
 import argparse
+import re
 from pathlib import Path
 
-from stickslip.cli._common import CommandError, Result, add_json_option
+from stickslip.cli._common import CommandError, Result, add_json_option, add_overwrite_option, owned_out_dir
+
+#: The figures `plot` draws (stickslip.plotting.run.run_figures); its --out may hold only these.
+_FIGURE = re.compile(r"(length|snapshot_final|snapshot_t[^/]*|sizes|fronts)\.(png|pdf|svg)")
 
 
 def register(sub) -> None:
@@ -22,6 +26,7 @@ def register(sub) -> None:
                    help="where the figures go (default RUN_DIR/figures)")
     p.add_argument("--format", action="append", choices=("png", "pdf", "svg"), default=None,
                    help="file format (repeatable; default png and pdf)")
+    add_overwrite_option(p)
     add_json_option(p)
     p.set_defaults(handler=run_plot_command)
 
@@ -35,8 +40,13 @@ def run_plot_command(args: argparse.Namespace) -> Result:
     if not (run_dir / "run.json").is_file() or not (run_dir / "state.nc").is_file():
         raise CommandError(f"{run_dir} is not a finished chain run directory (no run.json or state.nc)")
     out = Path(args.out) if args.out else run_dir / "figures"
+    if out.resolve() == run_dir.resolve():
+        raise CommandError(f"--out {out} is the run directory itself; the figures go into a folder of "
+                           "their own (default RUN_DIR/figures)")
     formats = tuple(dict.fromkeys(args.format or ("png", "pdf")))
-    records = draw_run_figures(load_run(run_dir), out, formats=formats)
+    run = load_run(run_dir)
+    with owned_out_dir(out, _FIGURE.fullmatch, "stickslip plot", overwrite=args.overwrite) as out:
+        records = draw_run_figures(run, out, formats=formats)
     lines = []
     for r in records:
         if "files" in r:

@@ -13,7 +13,14 @@ from __future__ import annotations
 
 import argparse
 
-from stickslip.cli._common import CommandError, Result, add_json_option, prepare_out_dir
+from stickslip.cli._common import (
+    OUT_FILES,
+    CommandError,
+    Result,
+    add_json_option,
+    add_overwrite_option,
+    owned_out_dir,
+)
 from stickslip.models.params import check_number
 
 DEFAULT_OUT = "paper-reproduction"
@@ -46,20 +53,27 @@ def register(sub) -> None:
     p.add_argument("--workers", default=None, metavar="N",
                    help="worker processes of the local cluster (default: one per core)")
     p.add_argument("--no-progress", action="store_true", help="no progress lines on stderr")
+    add_overwrite_option(p)
     add_json_option(p)
     p.set_defaults(handler=run)
 
 
 def run(args: argparse.Namespace) -> Result:
     """Handler of ``stickslip reproduce``."""
-    from stickslip.experiments.reproduce import ReproduceError, reproduce
-
     workers = None
     if args.workers is not None:
         workers = int(check_number("workers", args.workers, low=1, integer=True))
     if args.scheduler is not None and not args.scheduler.strip():
         raise CommandError("--scheduler needs an address, e.g. tcp://127.0.0.1:8786")
-    out = prepare_out_dir(args.out)
+    own = OUT_FILES["reproduce"]
+    with owned_out_dir(args.out, own, "stickslip reproduce", overwrite=args.overwrite) as out:
+        return _run(out, args, workers)
+
+
+def _run(out, args: argparse.Namespace, workers: int | None) -> Result:
+    """The pipeline into the claimed directory ``out``; its errors as results."""
+    from stickslip.experiments.reproduce import ReproduceError, reproduce
+
     try:
         result = reproduce(out, args.mode, scheduler=args.scheduler, n_workers=workers,
                            progress=not args.no_progress)

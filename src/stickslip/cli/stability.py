@@ -34,8 +34,10 @@ from stickslip.cli._common import (
     chain_params_from_args,
     float_arg,
     params_from_args,
-    check_out_dir,
-    prepare_out_dir,
+    OUT_FILES,
+    add_overwrite_option,
+    check_out_owned,
+    owned_out_dir,
 )
 from stickslip.models.params import BlockParams, ChainParams, ParameterError, check_number
 from stickslip.run.block import INTEGRATOR
@@ -46,6 +48,9 @@ MAP_VS = 200
 #: Largest N of the finite-chain check (a dense 3N x 3N eigenvalue problem).
 MAX_FINITE_N = 2000
 
+# What --out of each analysis may hold (stickslip.cli._common.OUT_FILES).
+_BLOCK_MAP = OUT_FILES["stability block"]
+_CHAIN_MAP = OUT_FILES["stability chain"]
 _LINEAR = "linearisation about steady sliding, numpy.linalg.eigvals; Hopf point by Brent's method"
 
 
@@ -71,6 +76,7 @@ def register(sub) -> None:
     add_param_options(b, BlockParams, skip=("Fs", "dt"))
     b.add_argument("--out", default=None, metavar="DIR",
                    help="write stability_map.png, .nc and stability_block.json to DIR")  # fmt: skip
+    add_overwrite_option(b)
     add_json_option(b)
     b.set_defaults(handler=run_stability_block)
 
@@ -90,6 +96,7 @@ def register(sub) -> None:
     c.add_argument("--out", default=None, metavar="DIR",
                    help="write fig4.png, fig4.nc and stability_chain.json to DIR (the relatives: "
                         "mode_growth.png, mode_growth.nc, stability_chain.json)")  # fmt: skip
+    add_overwrite_option(c)
     add_json_option(c)
     c.set_defaults(handler=run_stability_chain)
 
@@ -119,6 +126,7 @@ def register(sub) -> None:
                         f"(default {hy.DEFAULT_TRANSIENT:g})")  # fmt: skip
     h.add_argument("--out", default=None, metavar="DIR",
                    help="write hysteresis.png, hysteresis.nc and hysteresis.json to DIR")  # fmt: skip
+    add_overwrite_option(h)
     add_json_option(h)
     h.set_defaults(handler=run_hysteresis)
 
@@ -140,7 +148,7 @@ def run_stability_block(args: argparse.Namespace) -> Result:
     """Handler of ``stickslip stability block``: Hopf point and eigenvalues of eq. (2)."""
     with_V = args.param_V is not None
     p = params_from_args(BlockParams, args)
-    check_out_dir(args.out)
+    check_out_owned(args.out, _BLOCK_MAP, "stickslip stability block", overwrite=args.overwrite)
     if args.out is not None:
         with np.errstate(all="ignore"):
             beta_limit = st.hopf_beta_limit(p)
@@ -163,13 +171,13 @@ def run_stability_block(args: argparse.Namespace) -> Result:
     }
     if _is_paper_block(p):
         data["paper_hopf_V"] = 0.106
-    out = prepare_out_dir(args.out)
     if with_V:
         s = st.block_stability(p)
         data.update(V=p.V, theta0=s.theta0, eigenvalues=_eig_list(s.eigenvalues),
                     growth_rate=s.growth_rate, stable=s.stable)  # fmt: skip
-    if out is not None:
-        data["outputs"] = [str(path) for path in _write_block_map(out, p, data, with_V)]
+    with owned_out_dir(args.out, _BLOCK_MAP, "stickslip stability block", overwrite=args.overwrite) as out:
+        if out is not None:
+            data["outputs"] = [str(path) for path in _write_block_map(out, p, data, with_V)]
     return Result(data=data, text=_block_text(data))
 
 
@@ -237,7 +245,7 @@ def run_stability_chain(args: argparse.Namespace) -> Result:
                            "strengthening with the plate drive")
     if with_N:
         check_number("N", p.N, low=1, high=MAX_FINITE_N, integer=True)
-    out = prepare_out_dir(args.out)
+    check_out_owned(args.out, _CHAIN_MAP, "stickslip stability chain", overwrite=args.overwrite)
 
     s = st.chain_stability(p)
     long_wave = st.chain_long_wave(p)
@@ -263,8 +271,9 @@ def run_stability_chain(args: argparse.Namespace) -> Result:
             "k1": float(st.finite_chain_wavenumbers(p.N)[0]),
             "unstable": bool(row["finite_max_real"] > st.GROWTH_TOL),
         }
-    if out is not None:
-        data["outputs"] = [str(path) for path in _write_fig4(out, p, data)]
+    with owned_out_dir(args.out, _CHAIN_MAP, "stickslip stability chain", overwrite=args.overwrite) as out:
+        if out is not None:
+            data["outputs"] = [str(path) for path in _write_fig4(out, p, data)]
     return Result(data=data, text=_chain_text(data))
 
 
@@ -312,7 +321,7 @@ def run_stability_modes(args: argparse.Namespace, p: ChainParams) -> Result:
         raise CommandError("ends fixed have no steady sliding (the springs to the walls stretch without bound)")
     if p.N > MAX_FINITE_N:
         raise CommandError(f"N must be <= {MAX_FINITE_N} for the mode table (got N={p.N})")
-    out = prepare_out_dir(args.out)
+    check_out_owned(args.out, _CHAIN_MAP, "stickslip stability chain", overwrite=args.overwrite)
 
     s = st.mode_stability(p)
     data: dict[str, Any] = {
@@ -329,8 +338,9 @@ def run_stability_modes(args: argparse.Namespace, p: ChainParams) -> Result:
     if p.friction == "weakening":
         data["alpha_g"] = p.alpha * st.weakening_g(p)
     data["mode_table"] = s.growth.to_dict(orient="records")
-    if out is not None:
-        data["outputs"] = [str(path) for path in _write_mode_growth(out, p, data)]
+    with owned_out_dir(args.out, _CHAIN_MAP, "stickslip stability chain", overwrite=args.overwrite) as out:
+        if out is not None:
+            data["outputs"] = [str(path) for path in _write_mode_growth(out, p, data)]
     return Result(data=data, text=_modes_text(data))
 
 
@@ -380,14 +390,14 @@ def run_hysteresis(args: argparse.Namespace) -> Result:
     if settings.time_per_step + settings.transient > MAX_BLOCK_STEPS * p.dt:
         raise CommandError(f"time_per_step + transient must be <= {MAX_BLOCK_STEPS * p.dt:g} (at most "
                            f"{MAX_BLOCK_STEPS:.0e} steps of dt = {p.dt:g} per value of V)")
-    out = prepare_out_dir(args.out)
-
-    result = hy.hysteresis_sweep(p, settings)
-    data = result.summary()
-    if (p.K, p.beta, p.Fs, p.alpha, p.M, p.sigma) == (10.0, 1.0, 3.0, 1.0, 1.0, 1.0):
-        data["paper_V_up"] = 0.345
-    if out is not None:
-        data["outputs"] = [str(path) for path in _write_hysteresis(out, result, data)]
+    own = OUT_FILES["hysteresis"]
+    with owned_out_dir(args.out, own, "stickslip hysteresis", overwrite=args.overwrite) as out:
+        result = hy.hysteresis_sweep(p, settings)
+        data = result.summary()
+        if (p.K, p.beta, p.Fs, p.alpha, p.M, p.sigma) == (10.0, 1.0, 3.0, 1.0, 1.0, 1.0):
+            data["paper_V_up"] = 0.345
+        if out is not None:
+            data["outputs"] = [str(path) for path in _write_hysteresis(out, result, data)]
     return Result(data=data, text=_hysteresis_text(data))
 
 

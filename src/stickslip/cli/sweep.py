@@ -13,9 +13,17 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import itertools
+from pathlib import Path
 from typing import Any
 
-from stickslip.cli._common import CommandError, Result, add_json_option, prepare_out_dir
+from stickslip.cli._common import (
+    OUT_FILES,
+    CommandError,
+    Result,
+    add_json_option,
+    add_overwrite_option,
+    owned_out_dir,
+)
 from stickslip.models.params import MAX_STEPS, BlockParams, ChainParams, check_number
 
 # Run options a point may carry besides the model parameters, with their value types.
@@ -32,6 +40,11 @@ _OPTIONS: dict[str, dict[str, type]] = {
     "block": {"t_end": float, "every": int},
 }
 _PARAMS: dict[str, type] = {"chain": ChainParams, "block": BlockParams}
+# Lower ends of the numeric run options (their upper ends depend on dt: RunOptions.validated).
+_OPTION_RANGES: dict[str, dict[str, Any]] = {
+    "sample_interval": {"low": 0.0, "low_open": True}, "average_from": {"low": 0.0},
+    "profile_window": {"low": 0.0, "low_open": True}, "profile_min_blocks": {"low": 0}, "every": {"low": 1},
+}
 
 
 def register(sub) -> None:
@@ -74,6 +87,7 @@ def register(sub) -> None:
     parser.add_argument("--workers", type=str, default=None, metavar="N",
                         help="worker processes of the local cluster (default: one per core)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
+    add_overwrite_option(parser)
     add_json_option(parser)
     parser.set_defaults(handler=run)
 
@@ -83,14 +97,18 @@ def _value(model: str, name: str, text: str) -> Any:
     options = _OPTIONS[model]
     if name in options:
         kind = options[name]
+        allowed = _OPTION_RANGES.get(name, {})
     else:
         fields = {f.name: f for f in dataclasses.fields(_PARAMS[model])}
-        if "choices" in fields[name].metadata:  # a model name or a piece
+        meta = fields[name].metadata
+        if "choices" in meta:  # a model name or a piece
             return text.strip()
-        kind = int if fields[name].metadata.get("integer") else float
+        kind = int if meta.get("integer") else float
+        allowed = {k: meta[k] for k in ("low", "high", "low_open", "high_open") if k in meta}
     if kind is str:
         return text
-    return check_number(name, text.strip(), integer=kind is int)
+    # The range goes into the message, as for the options of the other commands.
+    return check_number(name, text.strip(), integer=kind is int, **allowed)
 
 
 def _check_name(model: str, name: str) -> None:
@@ -189,15 +207,24 @@ def run(args: argparse.Namespace) -> Result:
     if args.workers is not None:
         workers = check_number("--workers", args.workers, low=1, integer=True)
     _check_scheduler(args.scheduler)
-    out = prepare_out_dir(args.out)
+    own = _sweep_files(args.out)
     task = chain_task if args.model == "chain" else block_task
-    try:
-        result = run_sweep(task, points, out, common=common, scheduler=args.scheduler,
-                           n_workers=workers, progress=not args.no_progress)
-    except OSError as exc:  # e.g. no scheduler at the given address
-        raise CommandError(f"cannot run the sweep: {exc}") from None
+    with owned_out_dir(args.out, own, "stickslip sweep", overwrite=args.overwrite) as out:
+        try:
+            result = run_sweep(task, points, out, common=common, scheduler=args.scheduler,
+                               n_workers=workers, progress=not args.no_progress)
+        except OSError as exc:  # e.g. no scheduler at the given address
+            raise CommandError(f"cannot run the sweep: {exc}") from None
     data = {"model": args.model, "common": common, **result.to_dict()}
     return Result(data=data, text=_text(result), status=1 if result.n_failed else 0)
+
+
+def _sweep_files(out: str):
+    """What a sweep's directory may hold: its summary tables and the folders of its points
+    (each with its point.json); a sweep run again into it reuses the finished points."""
+    from stickslip.experiments.sweep import POINT_FILE
+
+    return lambda name: name in OUT_FILES["sweep"] or (Path(out) / name / POINT_FILE).is_file()
 
 
 def _text(result) -> str:

@@ -53,10 +53,12 @@ __all__ = [
     "BLOCK_RUN_OPTIONS",
     "DONE_FILE",
     "ERROR_FILE",
+    "POINT_FILE",
 ]
 
 DONE_FILE = "done.json"
 ERROR_FILE = "error.json"
+POINT_FILE = "point.json"  # a point's spec, written first: marks the folder as the sweep's
 SUMMARY_NAME = "summary"
 
 # Keys of a point that are options of the run rather than model parameters.
@@ -131,7 +133,7 @@ def _run_point(task: Task, point: dict[str, Any], common: dict[str, Any], point_
     directory.mkdir(parents=True, exist_ok=True)
     for stale in (DONE_FILE, ERROR_FILE):
         (directory / stale).unlink(missing_ok=True)
-    write_json(directory / "point.json", {"spec": spec})
+    write_json(directory / POINT_FILE, {"spec": spec})
     start = time.perf_counter()
     try:
         summary = task({**common, **point}, directory)

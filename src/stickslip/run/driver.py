@@ -187,6 +187,7 @@ def run_chain(
     progress: bool = False,
     handle_signals: bool = False,
     run_id: str | None = None,
+    keep_checkpoint: bool = False,
 ) -> ChainRun:
     """Integrate the chain of eq. (4) from ``start`` to ``t_end`` (MODEL.md, "Chain").
 
@@ -197,7 +198,9 @@ def run_chain(
     slides within TOL of steady sliding; L is then taken from the steady solution up to t_end.
     With ``out_dir``, checkpoints are written there every ``checkpoint_interval`` wall-clock
     seconds and on SIGINT/SIGTERM (``handle_signals``), and the results at the end; ``run_id``
-    (that of the run directory, :func:`rundir.owned_run_dir`) goes into every checkpoint.
+    (that of the run directory, :func:`rundir.owned_run_dir`) goes into every checkpoint. A
+    finished run removes its checkpoint unless ``keep_checkpoint`` (needed only to continue it to
+    a later t_end with :func:`resume_chain`).
     """
     if integrator not in INTEGRATORS:
         raise ParameterError(f"integrator must be one of {', '.join(INTEGRATORS)} (got {integrator!r})")
@@ -227,7 +230,7 @@ def run_chain(
     return _drive(params, options, integrator, start_info, state, outputs, run_id=run_id,
                   out_dir=out_dir, checkpointer=Checkpointer(Path(out_dir)) if out_dir else None,
                   checkpoint_interval=checkpoint_interval, progress=progress,
-                  handle_signals=handle_signals, wall_before=0.0)
+                  handle_signals=handle_signals, wall_before=0.0, keep_checkpoint=keep_checkpoint)
 
 
 def resume_chain(
@@ -238,16 +241,19 @@ def resume_chain(
     progress: bool = False,
     handle_signals: bool = False,
     expect_params: ChainParams | None = None,
+    keep_checkpoint: bool | None = None,
 ) -> ChainRun:
     """Continue the run in ``run_dir`` from its checkpoint to its t_end (or a later ``t_end``).
 
     A corrupt checkpoint, one of another format, or one whose parameters differ from
-    ``expect_params`` is refused with :class:`ChainRunError`.
+    ``expect_params`` is refused with :class:`ChainRunError`. The checkpoint is kept at the end
+    if ``keep_checkpoint``, or (None) if the run was started keeping it.
     """
     run_dir = Path(run_dir)
     ckpt = Checkpointer(run_dir)
     if not ckpt.state_path.exists() and (run_dir / "run.json").exists():
-        raise ChainRunError(f"the run in {run_dir} has no checkpoint left to continue from")
+        raise ChainRunError(f"the run in {run_dir} is finished and kept no checkpoint to continue from "
+                            "(a run started with --keep-checkpoint can be continued to a later --t-end)")
     state, header, parts = ckpt.load()
     try:
         params = ChainParams(**header["params"])
@@ -274,13 +280,17 @@ def resume_chain(
     outputs = _Outputs(params.N, options.profile_window is not None)
     outputs.parts = parts
     ckpt.since = {k: len(v) for k, v in parts.items()}
+    if keep_checkpoint is None:
+        keep_checkpoint = header.get("keep_checkpoint") is True
     return _drive(params, options, integrator, header["start"], state, outputs, run_id=run_id, out_dir=run_dir,
                   checkpointer=ckpt, checkpoint_interval=checkpoint_interval, progress=progress,
-                  handle_signals=handle_signals, wall_before=float(header.get("wall_seconds", 0.0)))
+                  handle_signals=handle_signals, wall_before=float(header.get("wall_seconds", 0.0)),
+                  keep_checkpoint=keep_checkpoint)
 
 
 def _drive(params, options, integrator, start_info, state, outputs, *, out_dir, checkpointer,
-           checkpoint_interval, progress, handle_signals, wall_before, run_id=None) -> ChainRun:
+           checkpoint_interval, progress, handle_signals, wall_before, run_id=None,
+           keep_checkpoint=False) -> ChainRun:
     par = _par(params)
     N = params.N
     scratch = [np.zeros(N + 2) for _ in range(6)] + [np.zeros(N + 2, dtype=np.int64)]
@@ -298,6 +308,8 @@ def _drive(params, options, integrator, start_info, state, outputs, *, out_dir, 
     }
     if run_id is not None:
         header["run_id"] = run_id
+    if keep_checkpoint:
+        header["keep_checkpoint"] = True
     bar = _Progress(options.t_end, progress and sys.stderr.isatty())
     t0 = time.perf_counter()
     last_ckpt = t0
@@ -369,9 +381,13 @@ def _drive(params, options, integrator, start_info, state, outputs, *, out_dir, 
     if run.summary["event_in_progress"]:  # the unfinished event began after the last finished one
         run.summary["in_progress_since"] = float(run.events["t_end"].max()) if len(run.events) else 0.0
     if out_dir is not None:
+        # The last checkpoint stands until the results are written: a kill while they are
+        # written leaves a run that --resume finishes.
         if checkpointer is not None:
             checkpointer.write(state, outputs, dict(header, wall_seconds=wall))
         write_run(run, out_dir)
+        if not keep_checkpoint:
+            drop_checkpoint(out_dir)
     return run
 
 
@@ -425,5 +441,7 @@ def drop_checkpoint(run_dir: str | Path) -> None:
     import shutil
 
     path = Path(run_dir) / "checkpoint"
+    # The state file first: a kill part way leaves no checkpoint that lists missing parts.
+    (path / "state.npz").unlink(missing_ok=True)
     if path.is_dir():
         shutil.rmtree(path)

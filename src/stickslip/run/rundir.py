@@ -2,9 +2,10 @@
 
 A run directory holds run.json (parameters, options, summary, versions), state.nc (final state,
 L(t), snapshots and profiles as labelled arrays), events.parquet and first_move.parquet, the
-checkpoint folder while the run goes on, and ``.run_id``, the id its checkpoints carry too. A run
-holds the directory's lock (``.lock``, with the holder's pid and host in ``.lock.json``) for its
-whole life (:func:`owned_run_dir`).
+checkpoint folder while the run goes on (removed when the run finishes, unless kept), and
+``.run_id``, the id its checkpoints carry too. A run holds the directory's lock (``.lock``, with
+the holder's pid and host in ``.lock.json``) for its whole life (:func:`owned_run_dir`); every
+command that writes into an output directory takes the same lock.
 """
 
 from __future__ import annotations
@@ -16,8 +17,8 @@ import shutil
 import socket
 import time
 import uuid
+from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import Iterator
 
 import numpy as np
 import xarray as xr
@@ -146,10 +147,17 @@ def load_run(run_dir: str | Path) -> ChainRun:
 
 
 
+#: The lock of a directory and its holder's record.
+LOCK_FILES = frozenset({".lock", ".lock.json"})
+RUN_ID_FILE = ".run_id"
 #: The files and folders a chain run writes into its run directory.
 OWN_FILES = frozenset({"run.json", "state.nc", "events.parquet", "first_move.parquet", "checkpoint",
-                       ".run_id", ".lock", ".lock.json"})
-RUN_ID_FILE = ".run_id"
+                       RUN_ID_FILE, *LOCK_FILES})
+
+
+def is_temporary(name: str) -> bool:
+    """A file name of :func:`stickslip.io.atomic_path` (``.NAME.XXXX.tmp``), left only by a killed write."""
+    return name.startswith(".") and name.endswith(".tmp")
 
 
 class RunDirBusy(RuntimeError):
@@ -166,9 +174,10 @@ def read_run_id(run_dir: str | Path) -> str | None:
 
 
 @contextlib.contextmanager
-def owned_run_dir(run_dir: str | Path | None) -> Iterator[str | None]:
+def owned_run_dir(run_dir: str | Path | None, *, run_id: bool = True) -> Iterator[str | None]:
     """Hold the lock of ``run_dir`` for the life of a run and yield its run id (a new one for a
-    directory without). A second holder is refused at once with :class:`RunDirBusy`."""
+    directory without; None with ``run_id=False``, for outputs without checkpoints). A second
+    holder is refused at once with :class:`RunDirBusy`; files left by a killed write are removed."""
     if run_dir is None:
         yield None
         return
@@ -197,11 +206,14 @@ def owned_run_dir(run_dir: str | Path | None) -> Iterator[str | None]:
         for stale in run_dir.glob(".*.tmp"):  # left by a write that was killed
             with contextlib.suppress(OSError):
                 stale.unlink()
-        run_id = read_run_id(run_dir)
-        if run_id is None and not (run_dir / "checkpoint").exists():
-            run_id = uuid.uuid4().hex
-            (run_dir / RUN_ID_FILE).write_text(run_id + "\n")
-        yield run_id
+        if not run_id:
+            yield None
+            return
+        rid = read_run_id(run_dir)
+        if rid is None and not (run_dir / "checkpoint").exists():
+            rid = uuid.uuid4().hex
+            (run_dir / RUN_ID_FILE).write_text(rid + "\n")
+        yield rid
     finally:
         # Unlinked while held, so a directory left behind is as it was (the check above
         # keeps a waiter from holding the unlinked file).
@@ -220,13 +232,14 @@ def _same_file(lock, path: Path) -> bool:
         return False
 
 
-def remove_own_files(run_dir: str | Path) -> None:
-    """Remove what a chain run wrote into ``run_dir`` (not the lock nor the run id); other files stay."""
+def remove_own_files(run_dir: str | Path, own: Callable[[str], bool] | None = None) -> None:
+    """Remove what a run wrote into ``run_dir``: the entries whose name ``own`` accepts (default:
+    a chain run's files) and files of killed writes; not the lock nor the run id. Other files stay."""
     for path in Path(run_dir).iterdir():
         name = path.name
-        if name in (".lock", ".lock.json", RUN_ID_FILE):
+        if name in LOCK_FILES or name == RUN_ID_FILE:
             continue
-        if name in OWN_FILES or (name.startswith(".") and name.endswith(".tmp")):
+        if (own(name) if own is not None else name in OWN_FILES) or is_temporary(name):
             if path.is_dir():
                 shutil.rmtree(path)
             else:
