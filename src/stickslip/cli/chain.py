@@ -274,7 +274,7 @@ def run_bench_command(args: argparse.Namespace) -> Result:
     args.seed = None
     start, amplitude, seed = _start_of(params, args)
     if args.profile:
-        result = bench.profile(params, t_end, start=start)
+        result = bench.profile(params, t_end, start=start, perturbation=amplitude, seed=seed)
         return Result(result, bench.format_profile(result))
     result = bench.compare(params, t_end, start=start, repeat=args.repeat, perturbation=amplitude, seed=seed)
     return Result(result, bench.format_result(result))

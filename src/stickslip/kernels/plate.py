@@ -1,5 +1,6 @@
 """Sparse exact steps of the plate drive for frictions without a state variable
-(weakening, strengthening): the Carlson-Langer and train models.
+(weakening, strengthening): the Carlson-Langer and train models (MODEL.md, "The family the
+paper stands in").
 
 There a stopped block does not change at all, and the plate's start of a stopped block is
 known in advance (``trig``, see :mod:`stickslip.kernels.chain`). So a step touches only
@@ -16,8 +17,25 @@ so a mover's stage 2 reads its stopped neighbours' predictors without recomputin
 which it was a candidate and no neighbour moved); a block due in the next step goes on the
 queue, the others are found when the step reaches the smallest of their ``trig``.
 
-Every quantity uses the expressions of :mod:`stickslip.kernels.common`, so the result
-equals run_dense bit for bit.
+A step costs little more than its moving blocks (most steps move one to a few of them):
+
+1. the stopped candidates get the start rule alone and are split, without branches, into
+   starters (appended to the list of movers) and blocks that stay stopped;
+2. stage 1 and then stage 2 (with the stop rule) run over the movers' list in three loops
+   each: gather the forces and velocities into packed arrays, evaluate the friction
+   phi(v) = (1 - sigma) / (1 + 2 alpha max(v, 0) / (1 - sigma)) and the Heun sums on the
+   packed arrays (a loop the compiler vectorises: its two divisions per block dominate a
+   scalar step), scatter the results back. Vector and scalar divisions round alike, so the
+   order of evaluation and every bit are those of run_dense;
+3. the blocks that stopped, the stopped neighbours of the movers and the stopped candidates
+   are then given their next step as candidates (queue) or their plate start (``trig``).
+
+Block indices in the lists are unsigned: numba then indexes the arrays without the
+wraparound code of negative indices. The kernel uses numpy's error model (a float division
+by zero is not checked, so the packed loops have no exit): the only divisor, 1 - sigma, is
+positive since ChainParams holds sigma in [0, 1), and 1 + 2 alpha max(v, 0) / (1 - sigma)
+is at least 1. Every quantity uses the expressions of :mod:`stickslip.kernels.common`, so
+the result equals run_dense bit for bit.
 """
 
 from __future__ import annotations
@@ -30,39 +48,34 @@ from stickslip.kernels import common as c
 _QUEUED = np.int64(-1)  # trig of a stopped block queued as a candidate of the next step
 
 
-@njit(cache=True, inline="always")
-def _retrig(i, n1, n_end, x, th, mov, trig, queue, nq, mp, V, dt, threshold):
-    """Redo trig of block i from step n1 if it is stopped and not queued; queue it when it
-    starts at n1.
-    Returns the new queue length and the block's trig (``_NEVER`` if moving or queued)."""
-    if mov[i] != 0.0 or trig[i] == _QUEUED:
-        return nq, c._NEVER
-    m = c._plate_trigger(x[i - 1], x[i], x[i + 1], c._threshold(th[i], mp[5], threshold),
-                         mp[0], mp[1], V, dt, n1, n_end)
-    if m <= n1:
-        trig[i] = _QUEUED
-        queue[nq] = i
-        return nq + 1, c._NEVER
-    trig[i] = m
-    return nq, m
-
-
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def run_sparse(x, v, th, mov, xs, vs, ths, mm, a1, b1, trig, first_step, x0ev, ist, par,
                ev_int, ev_S, fm, samp_L, samp_step, prof_x, prof_meta,
                n_end, sample_every, profile_every, profile_min_blocks, drive, friction, threshold, ends):
     """:func:`stickslip.kernels.chain.run_exact` for the plate drive with weakening or
-    strengthening friction: same arguments, state and status codes (module docstring)."""
+    strengthening friction: same arguments, state and status codes (module docstring).
+
+    ``mm``, ``a1``, ``b1`` and ``ths`` are not used: the mask is 1 on the movers' list and the
+    stage-1 accelerations are kept in the list's order.
+    """
     N = x.shape[0] - 2
     mp, V, dt = c._unpack(par)
     K, Kp, Fs = mp[0], mp[1], mp[5]
     h2 = 0.5 * dt
     cap_ev, cap_fm, cap_p = ev_int.shape[0], fm.shape[0], prof_x.shape[0]
-    movers = np.empty(N, np.int64)    # moving blocks
-    queue = np.empty(N, np.int64)     # stopped blocks that start in the next step
-    cand = np.empty(N, np.int64)      # blocks of this step
-    nxt = np.empty(N, np.int64)
-    stopped = np.empty(N, np.int64)
+    one = np.uint64(1)
+    uN = np.uint64(N)
+    periodic = ends == c.ENDS_PERIODIC
+    movers = np.empty(N, np.uint64)   # moving blocks, then this step's starters
+    nxt = np.empty(N, np.uint64)      # the movers of the next step
+    queue = np.empty(N, np.uint64)    # stopped blocks that are candidates in the next step
+    still = np.empty(N, np.uint64)    # stopped candidates whose start rule did not fire
+    stopped = np.empty(N, np.uint64)  # movers that stopped in this step
+    acc = np.empty(N)                 # stage-1 acceleration of movers[k]
+    fb = np.empty(N)                  # packed: force on movers[k] (stage 1, then stage 2)
+    vb = np.empty(N)                  # packed: v of movers[k], then its new v
+    vsb = np.empty(N)                 # packed: predicted v of movers[k]
+    kept = np.empty(N, np.bool_)      # packed: movers[k] still moves after the step
     # The interval bookkeeping of run_exact is not used here: leave it conservative.
     ist[c.ACT_LO], ist[c.ACT_HI], ist[c.MECH_LO], ist[c.MECH_HI] = 1, N, 1, N
     c._set_ghosts(x, th, N, 0.0, drive, ends)
@@ -71,85 +84,109 @@ def run_sparse(x, v, th, mov, xs, vs, ths, mm, a1, b1, trig, first_step, x0ev, i
     nq = 0
     t_next = c._NEVER  # no stopped block outside the queue starts before this step
     for i in range(1, N + 1):
+        trig[i] = c._NEVER
         if mov[i] != 0.0:
             movers[nmov] = i
             nmov += 1
-            trig[i] = c._NEVER
         else:
             xs[i] = x[i] + dt * v[i]
-            trig[i] = c._NEVER
     for i in range(1, N + 1):
-        nq, m = _retrig(i, n0, n_end, x, th, mov, trig, queue, nq, mp, V, dt, threshold)
-        t_next = min(t_next, m)
+        if mov[i] == 0.0:
+            m = c._plate_trigger(x[i - 1], x[i], x[i + 1], c._threshold(th[i], Fs, threshold),
+                                 K, Kp, V, dt, n0, n_end)
+            if m <= n0:
+                trig[i] = _QUEUED
+                queue[nq] = i
+                nq += 1
+            else:
+                trig[i] = m
+                t_next = min(t_next, m)
+    if n0 < n_end:
+        # run_dense adds dt/2 (0 + 0) to every theta in each step (no state variable); nothing
+        # here reads theta, and after the first step the sum changes no bit: do it once.
+        for i in range(1, N + 1):
+            th[i] = th[i] + h2 * (0.0 + 0.0)
+    steps_computed = 0
+    block_updates = 0
+    full_updates = 0
+    n = n0
     while True:
-        n = ist[c.STEP]
+        ist[c.STEP] = n
         if n == ist[c.NEXT_SAMPLE] or (profile_every > 0 and ist[c.EV_ACTIVE] == 1 and n == ist[c.NEXT_PROFILE]):
             st = c._service(n, x, N, ist, samp_L, samp_step, prof_x, prof_meta, sample_every, profile_every)
             if st != c.DONE:
-                return st
+                break
         if n >= n_end:
-            return c.DONE
+            st = c.DONE
+            break
         if ist[c.EV_COUNT] >= cap_ev or ist[c.FM_COUNT] + N > cap_fm or (profile_every > 0 and ist[c.P_COUNT] + 2 > cap_p):
-            return c._overflow(ist, N, cap_ev, cap_fm)
-        # This step's blocks: movers, queued starts, and (rarely) starts due to the plate alone.
-        nc = 0
-        for k in range(nmov):
-            cand[nc] = movers[k]
-            nc += 1
+            st = c._overflow(ist, N, cap_ev, cap_fm)
+            break
+        p1 = c._pull(V, n, dt)
+        # Start rule of the stopped candidates: the queue, and (rarely) the plate's due starts.
+        # Each goes to the starters (after the movers) or to the blocks that stay stopped.
+        nst = 0
+        nsl = 0
         for k in range(nq):
             i = queue[k]
             trig[i] = c._NEVER
-            cand[nc] = i
-            nc += 1
+            f = c._force(x[i - one], x[i], x[i + one], K, Kp, p1, drive)
+            fire = f > c._threshold(th[i], Fs, threshold)
+            movers[nmov + nst] = i
+            still[nsl] = i
+            nst += 1 if fire else 0
+            nsl += 0 if fire else 1
         nq = 0
         if n >= t_next:
             t_next = c._NEVER
-            for i in range(1, N + 1):
-                if mov[i] == 0.0:
-                    t = trig[i]
+            for j in range(1, N + 1):
+                if mov[j] == 0.0:
+                    t = trig[j]
                     if 0 <= t and t <= n:
+                        i = np.uint64(j)
                         trig[i] = c._NEVER
-                        cand[nc] = i
-                        nc += 1
+                        f = c._force(x[i - one], x[i], x[i + one], K, Kp, p1, drive)
+                        if f > c._threshold(th[i], Fs, threshold):
+                            movers[nmov + nst] = i
+                            nst += 1
+                        else:
+                            still[nsl] = i
+                            nsl += 1
                     elif t > n and t < t_next:
                         t_next = t
-        if nc == 0:
+        na = nmov + nst
+        if na + nsl == 0:
             # Nothing can change before the plate starts a block: jump, but stop at due outputs.
             target = n_end
             if ist[c.NEXT_SAMPLE] < target:
                 target = ist[c.NEXT_SAMPLE]
             if profile_every > 0 and ist[c.EV_ACTIVE] == 1 and ist[c.NEXT_PROFILE] < target:
                 target = ist[c.NEXT_PROFILE]
-            ist[c.STEP] = t_next if t_next < target else target
+            n = t_next if t_next < target else target
             continue
 
-        # Stage 1 (x holds t_n everywhere; ghost cells are set).
-        p1 = c._pull(V, n, dt)
-        starts = False
-        first = N + 1
-        for k in range(nc):
-            i = cand[k]
-            f = c._force(x[i - 1], x[i], x[i + 1], K, Kp, p1, drive)
-            mo = mov[i]
-            m = 1.0 if f > c._threshold(th[i], Fs, threshold) else mo
-            mm[i] = m
-            if m == 0.0:
-                continue  # stays stopped: its predictor is kept, nothing reads the rest
-            if i < first:
-                first = i
-            starts |= m != mo
-            a = c._accel(f, th[i], v[i], m, mp, friction)
-            b = c._dtheta(th[i - 1], th[i], th[i + 1], v[i], mp, friction)
-            a1[i] = a
-            b1[i] = b
-            xs[i] = x[i] + dt * v[i]
-            vs[i] = v[i] + dt * a
-            ths[i] = th[i] + dt * b
+        # Stage 1 of the movers (x holds t_n everywhere; ghost cells are set). The mask is 1.
+        for k in range(na):
+            i = movers[k]
+            fb[k] = c._force(x[i - one], x[i], x[i + one], K, Kp, p1, drive)
+            vb[k] = v[i]
+        for k in range(na):
+            a = c._accel(fb[k], 0.0, vb[k], 1.0, mp, friction)
+            acc[k] = a
+            vsb[k] = vb[k] + dt * a
+        for k in range(na):
+            i = movers[k]
+            xs[i] = x[i] + dt * vb[k]
+            vs[i] = vsb[k]
         p2 = c._pull(V, n + 1, dt)
         c._set_ghosts(xs, ths, N, p2, drive, ends)
-        # Event start and first moves (as common._start_and_first_moves, on the list).
-        if first <= N and (ist[c.EV_ACTIVE] == 1 or ist[c.N_MOVING] == 0) and (starts or ist[c.EV_ACTIVE] == 0):
+        # Event start and first moves (as common._start_and_first_moves): a block moves for
+        # the first time in an event only in the step it starts.
+        if nst > 0 and (ist[c.EV_ACTIVE] == 1 or nmov == 0):
             if ist[c.EV_ACTIVE] == 0:
+                first = N + 1
+                for k in range(nst):
+                    first = min(first, np.int64(movers[k]))
                 ist[c.EV_ACTIVE] = 1
                 ist[c.EV_START_STEP] = n
                 ist[c.EV_START_BLOCK] = first
@@ -158,48 +195,43 @@ def run_sparse(x, v, th, mov, xs, vs, ths, mm, a1, b1, trig, first_step, x0ev, i
                 if profile_every > 0:
                     r = ist[c.P_COUNT]
                     ist[c.EV_P_FIRST] = r
-                    for i in range(1, N + 1):
-                        prof_x[r, i - 1] = x[i]
+                    for j in range(1, N + 1):
+                        prof_x[r, j - 1] = x[j]
                     prof_meta[r, 0] = ist[c.N_EVENTS]
                     prof_meta[r, 1] = n
                     ist[c.P_COUNT] = r + 1
                     ist[c.NEXT_PROFILE] = n + profile_every
-            for k in range(nc):
-                i = cand[k]
-                if mm[i] != 0.0 and first_step[i] < 0:
+            for k in range(nmov, na):
+                i = movers[k]
+                if first_step[i] < 0:
                     first_step[i] = n
                     x0ev[i] = x[i]
                     ist[c.EV_N_MOVED] += 1
-                    if i > ist[c.EV_MAX_BLOCK]:
-                        ist[c.EV_MAX_BLOCK] = i
-        # Stage 2, corrector and stop rule for the blocks that move (others keep every bit).
+                    if np.int64(i) > ist[c.EV_MAX_BLOCK]:
+                        ist[c.EV_MAX_BLOCK] = np.int64(i)
+        # Stage 2, corrector and stop rule of the movers (stopped blocks keep every bit).
+        # Theta is updated as run_dense does, with both derivatives 0 (no state variable).
+        for k in range(na):
+            i = movers[k]
+            fb[k] = c._force(xs[i - one], xs[i], xs[i + one], K, Kp, p2, drive)
+        for k in range(na):
+            a2 = c._accel(fb[k], 0.0, vsb[k], 1.0, mp, friction)
+            vn = vb[k] + h2 * (acc[k] + a2)
+            keep = vn > 0.0
+            vb[k] = vn if keep else 0.0
+            kept[k] = keep
         nn = 0
         ns = 0
-        nfull = 0
-        for k in range(nc):
-            i = cand[k]
-            m = mm[i]
-            if m == 0.0:
-                stopped[ns] = i  # its start rule did not fire
-                ns += 1
-                continue
-            nfull += 1
-            f2 = c._force(xs[i - 1], xs[i], xs[i + 1], K, Kp, p2, drive)
-            a2 = c._accel(f2, ths[i], vs[i], m, mp, friction)
-            b2 = c._dtheta(ths[i - 1], ths[i], ths[i + 1], vs[i], mp, friction)
-            x[i] = x[i] + h2 * (v[i] + vs[i])
-            vn = v[i] + h2 * (a1[i] + a2)
-            th[i] = th[i] + h2 * (b1[i] + b2)
-            if vn > 0.0:
-                v[i] = vn
-                mov[i] = m
-                nxt[nn] = i
-                nn += 1
-            else:
-                v[i] = 0.0
-                mov[i] = 0.0
-                stopped[ns] = i
-                ns += 1
+        for k in range(na):
+            i = movers[k]
+            x[i] = x[i] + h2 * (v[i] + vsb[k])
+            keep = kept[k]
+            v[i] = vb[k]
+            mov[i] = 1.0 if keep else 0.0
+            nxt[nn] = i
+            stopped[ns] = i
+            nn += 1 if keep else 0
+            ns += 0 if keep else 1
         # Blocks that stopped: the predictor run_dense writes for them from now on.
         for k in range(ns):
             i = stopped[k]
@@ -207,37 +239,45 @@ def run_sparse(x, v, th, mov, xs, vs, ths, mm, a1, b1, trig, first_step, x0ev, i
         c._set_ghosts(x, th, N, 0.0, drive, ends)
         # Stopped blocks next to a block that moved: their force changed, so evaluate their
         # start rule in the next step (cheaper than finding a start step while a front passes).
-        for k in range(nc):
-            i = cand[k]
-            if mm[i] != 0.0:
-                l = i - 1
-                r = i + 1
-                if ends == c.ENDS_PERIODIC:
-                    if l < 1:
-                        l = N
-                    if r > N:
-                        r = 1
-                if l >= 1 and mov[l] == 0.0 and trig[l] != _QUEUED:
-                    trig[l] = _QUEUED
-                    queue[nq] = l
-                    nq += 1
-                if r <= N and mov[r] == 0.0 and trig[r] != _QUEUED:
-                    trig[r] = _QUEUED
-                    queue[nq] = r
-                    nq += 1
+        for k in range(na):
+            i = movers[k]
+            l = i - one
+            r = i + one
+            if periodic:
+                l = l if l >= one else uN
+                r = r if r <= uN else one
+            if l >= one and mov[l] == 0.0 and trig[l] != _QUEUED:
+                trig[l] = _QUEUED
+                queue[nq] = l
+                nq += 1
+            if r <= uN and mov[r] == 0.0 and trig[r] != _QUEUED:
+                trig[r] = _QUEUED
+                queue[nq] = r
+                nq += 1
         # The other stopped blocks of this step have settled neighbours: their start step.
-        for k in range(ns):
-            nq, t = _retrig(stopped[k], n + 1, n_end, x, th, mov, trig, queue, nq, mp, V, dt, threshold)
-            t_next = min(t_next, t)
-        for k in range(nn):
-            movers[k] = nxt[k]
-        moved_before = nmov
+        for k in range(nsl + ns):
+            i = still[k] if k < nsl else stopped[k - nsl]
+            if trig[i] != _QUEUED:
+                m = c._plate_trigger(x[i - one], x[i], x[i + one], c._threshold(th[i], Fs, threshold),
+                                     K, Kp, V, dt, n + 1, n_end)
+                if m <= n + 1:
+                    trig[i] = _QUEUED
+                    queue[nq] = i
+                    nq += 1
+                else:
+                    trig[i] = m
+                    t_next = min(t_next, m)
+        movers, nxt = nxt, movers
+        ist[c.N_MOVING] = nn
         nmov = nn
-        ist[c.N_MOVING] = ist[c.N_MOVING] + nn - moved_before
-        ist[c.BLOCK_UPDATES] += nc
-        ist[c.FULL_UPDATES] += nfull
-        ist[c.STEPS_COMPUTED] += 1
-        ist[c.STEP] = n + 1
+        block_updates += na + nsl
+        full_updates += na
+        steps_computed += 1
         if ist[c.EV_ACTIVE] == 1 and nmov == 0:
             c._end_event(n, x, first_step, x0ev, ist, ev_int, ev_S, fm, prof_x, prof_meta, N,
                          profile_every, profile_min_blocks)
+        n += 1
+    ist[c.BLOCK_UPDATES] += block_updates
+    ist[c.FULL_UPDATES] += full_updates
+    ist[c.STEPS_COMPUTED] += steps_computed
+    return st

@@ -118,16 +118,20 @@ def _unit_costs(params: ChainParams) -> dict[str, float]:
     slide = params.replace(beta=max(params.beta, 1.5))
     t2, s2 = timed(slide, 200.0, "steady")
     per_full = max(t2 - s2["steps_computed"] * per_step, 0.0) / s2["block_updates"]
-    still = params.replace(V=0.0)
-    rng = np.random.default_rng(0)
-    relax = ChainState.from_blocks(np.zeros(params.N), np.zeros(params.N),
-                                   rng.uniform(0.2, 0.9, params.N), np.ones(params.N, bool))
-    t3, s3 = timed(still, 20.0, relax)
-    per_theta = max(t3 - s3["steps_computed"] * per_step, 0.0) / s3["block_updates"]
+    per_theta = 0.0
+    if params.friction == "state":
+        # Without a state variable a stopped block never changes: no such updates.
+        still = params.replace(V=0.0)
+        rng = np.random.default_rng(0)
+        relax = ChainState.from_blocks(np.zeros(params.N), np.zeros(params.N),
+                                       rng.uniform(0.2, 0.9, params.N), np.ones(params.N, bool))
+        t3, s3 = timed(still, 20.0, relax)
+        per_theta = max(t3 - s3["steps_computed"] * per_step, 0.0) / max(s3["block_updates"], 1)
     return {"step": per_step, "full_update": per_full, "theta_update": per_theta}
 
 
-def profile(params: ChainParams, t_end: float, *, start: str = "paper") -> dict[str, Any]:
+def profile(params: ChainParams, t_end: float, *, start: str = "paper", perturbation: float = 0.0,
+            seed: int = 0) -> dict[str, Any]:
     """Where the exact integrator of eq. (4) spends its time on one workload.
 
     Counts its work (steps computed and jumped over, full and state-variable-only block
@@ -135,7 +139,7 @@ def profile(params: ChainParams, t_end: float, *, start: str = "paper") -> dict[
     """
     costs = _unit_costs(params)
     t0 = time.perf_counter()
-    run = run_chain(params, t_end, start=start)
+    run = run_chain(params, t_end, start=start, perturbation=perturbation, seed=seed)
     wall = time.perf_counter() - t0
     s = run.summary
     theta_updates = s["block_updates"] - s["full_block_updates"]
@@ -146,7 +150,8 @@ def profile(params: ChainParams, t_end: float, *, start: str = "paper") -> dict[
     }
     parts["rest (jumps, events, driver)"] = max(wall - sum(parts.values()), 0.0)
     return {
-        "workload": {"N": params.N, "beta": params.beta, "t_end": t_end, "start": start, "steps": s["steps"]},
+        "workload": {"model": params.model, "N": params.N, "beta": params.beta, "t_end": t_end, "start": start,
+                     "steps": s["steps"]},
         "wall_seconds": wall,
         "steps_computed": s["steps_computed"],
         "steps_jumped": s["steps"] - s["steps_computed"],
@@ -154,6 +159,8 @@ def profile(params: ChainParams, t_end: float, *, start: str = "paper") -> dict[
         "blocks_per_computed_step": s["block_updates"] / s["steps_computed"] if s["steps_computed"] else 0.0,
         "full_block_updates": s["full_block_updates"],
         "theta_only_updates": theta_updates,
+        # Without a state variable the other updates are stopped candidates: start rule alone.
+        "partial_updates": "state variable only" if params.friction == "state" else "start rule only (stopped)",
         "n_events": s["n_events"],
         "unit_costs_ns": {k: 1e9 * v for k, v in costs.items()},
         "seconds": parts,
@@ -171,7 +178,7 @@ def format_profile(r: dict[str, Any]) -> str:
         f"steps      {r['steps_computed']} computed ({100 * r['fraction_computed']:.2f}%), "
         f"{r['steps_jumped']} jumped over",
         f"updates    {r['blocks_per_computed_step']:.1f} blocks per computed step: "
-        f"{r['full_block_updates']} full, {r['theta_only_updates']} state variable only",
+        f"{r['full_block_updates']} full, {r['theta_only_updates']} {r['partial_updates']}",
         f"unit cost  {u['step']:.0f} ns per computed step, {u['full_update']:.2f} ns per full update, "
         f"{u['theta_update']:.2f} ns per state-variable update",
         "time split",
