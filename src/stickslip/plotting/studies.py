@@ -50,7 +50,8 @@ def steady_time_figure(table: pd.DataFrame) -> Figure:
             ax.plot(g["beta"], g["t_steady"].astype(float) / load, "o-", color=f"C{k}", ms=4, label=f"N = {N}")
     ax.set_xlabel(r"$\beta$")
     ax.set_ylabel(r"$t_{steady}\,/\,(L_{ss}/V)$")
-    ax.legend()
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend()
     return fig
 
 
@@ -73,7 +74,8 @@ def collapse_figure(table: pd.DataFrame, fits: dict | None = None) -> Figure:
     ax.set_yscale("log")
     ax.set_xlabel(r"$1 - \beta$")
     ax.set_ylabel(r"$m$")
-    ax.legend()
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend()
     return fig
 
 
