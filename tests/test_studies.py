@@ -204,3 +204,18 @@ def test_existing_scheduler_gives_the_local_result(tmp_path):
             if proc is not None:
                 proc.terminate()
                 proc.wait(timeout=30)
+
+
+def test_sample_moving_leaves_the_run_unchanged(tmp_path):
+    from stickslip.models.presets import chain_params
+    from stickslip.run.driver import load_run, run_chain
+
+    p = chain_params("sakaguchi", N=5, beta=0.8)
+    plain = run_chain(p, 2000.0, sample_interval=10.0)
+    run = run_chain(p, 2000.0, sample_interval=10.0, sample_moving=True, out_dir=tmp_path)
+    assert run.summary["state_sha256"] == plain.summary["state_sha256"]
+    n = run.samples["n_moving"].values
+    assert len(n) == 201 and n.min() >= 0 and n.max() <= 5 and n[-1] == run.summary["n_moving"]
+    assert np.array_equal(run.samples["t_moving"].values, np.arange(201) * 10.0)
+    back = load_run(tmp_path)
+    assert np.array_equal(back.samples["n_moving"].values, n)
