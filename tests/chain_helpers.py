@@ -195,17 +195,23 @@ def oracle_run(x, v, th, moving, p, n_steps: int, step=None) -> OracleRun:
 # Command line in a subprocess
 
 
+def _package_root() -> Path:
+    """The folder holding the ``stickslip`` package these tests import."""
+    import stickslip
+
+    return Path(stickslip.__file__).resolve().parents[1]
+
+
 def stickslip_cmd() -> list[str]:
-    """The installed ``stickslip`` entry point next to this interpreter, else ``-m stickslip.cli``."""
-    exe = Path(sys.executable).with_name("stickslip")
-    if exe.exists():
-        return [str(exe)]
+    """``python -m stickslip.cli`` of this interpreter, on the package these tests import
+    (:func:`cli_env` puts it first on PYTHONPATH, so an installed copy elsewhere is not used)."""
     return [sys.executable, "-m", "stickslip.cli"]
 
 
 def cli_env() -> dict[str, str]:
     env = dict(os.environ)
     env.pop("PYTHONWARNINGS", None)
+    env["PYTHONPATH"] = os.pathsep.join([str(_package_root())] + [p for p in [env.get("PYTHONPATH")] if p])
     return env
 
 

@@ -105,3 +105,44 @@ def test_sigterm_sigint_write_a_checkpoint_and_exit_130(tmp_path, reference, sig
     # the resumed run's outputs are those of one run: no event counted twice
     events = pd.read_parquet(out_dir / "events.parquet")
     assert np.array_equal(events["event"].to_numpy(), np.arange(len(events)))
+
+
+# Every model of the family: killed mid-run, resumed from the command line, identical.
+FAMILY = [("carlson-langer", 15000.0), ("train", 4000.0),
+          pytest.param("two-blocks", 6e5, marks=pytest.mark.slow),
+          pytest.param("batista-carlson", 1e6, marks=pytest.mark.slow)]
+
+
+@pytest.mark.parametrize("model, t_end", FAMILY)
+def test_sigkill_then_resume_every_model(tmp_path, model, t_end):
+    from stickslip.models.presets import PRESETS, chain_params
+
+    p = chain_params(model)
+    pr = PRESETS[model]
+    ref = C.run_chain(p, t_end, start=pr.start, perturbation=pr.start_options.get("amplitude", 0.0),
+                      seed=pr.start_options.get("seed", 0))
+    out_dir = tmp_path / "run"
+    cmd = stickslip_cmd() + ["chain", "--model", model, "--out", str(out_dir), "--t-end", f"{t_end:g}",
+                             "--integrator", "dense", "--checkpoint-interval", "0.2", "--no-progress", "--json"]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=cli_env())
+    state = out_dir / "checkpoint" / "state.npz"
+    deadline = time.monotonic() + 120
+    try:
+        while not state.exists():
+            assert proc.poll() is None, f"the run ended before its first checkpoint: {proc.communicate()}"
+            assert time.monotonic() < deadline
+            time.sleep(0.02)
+        time.sleep(0.3)
+        assert proc.poll() is None, "the workload finished before the signal: make it longer"
+        proc.send_signal(signal.SIGKILL)
+        proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    assert 0 < _checkpoint_step(out_dir) < steps_for(t_end, p.dt)
+    done = run_cli_subprocess("chain", "--resume", str(out_dir), "--json", "--no-progress", timeout=300)
+    assert done.returncode == 0, done.stderr
+    data = json.loads(done.stdout)
+    assert data["model"] == model and data["events"] == ref.summary["n_events"] > 0
+    _assert_outputs_match(out_dir, ref, data["state_sha256"])

@@ -20,8 +20,6 @@ import numpy as np
 import pytest
 from matplotlib.figure import Figure
 
-from stickslip.run.driver import ChainState, run_chain
-from stickslip.cli import main
 from stickslip.analysis.lyapunov import (
     largest_lyapunov,
     lyapunov_convergence,
@@ -29,10 +27,12 @@ from stickslip.analysis.lyapunov import (
     separation,
     twin_state,
 )
-from stickslip.models.params import BlockParams, ChainParams, ParameterError
-from stickslip.plotting.lyapunov import plot_lyapunov_beta
 from stickslip.analysis.slip_limit import solve_slip_limit
 from stickslip.analysis.stability import block_eigenvalues, chain_finite_eigenvalues
+from stickslip.cli import main
+from stickslip.models.params import BlockParams, ChainParams, ParameterError
+from stickslip.plotting.lyapunov import plot_lyapunov_beta
+from stickslip.run.driver import run_chain
 
 PAPER_BLOCK = ChainParams(N=1, K=10.0, V=0.001, beta=1.0, Fs=3.0)
 
@@ -238,3 +238,24 @@ def test_cli_bad_input_is_one_line_and_status_2(capsys, argv, name):
     status, out, err = run_cli(capsys, "lyapunov", "--N", "2", "--t-end", "1000", *argv)
     assert status == 2 and out == ""
     assert err.count("\n") == 1 and name in err
+
+
+def test_plate_drive_separation_round_trip():
+    from stickslip.models.presets import chain_params
+
+    p = chain_params("carlson-langer", N=7)
+    ref = run_chain(p, 50.0, start="rest", perturbation=0.01, seed=1).state
+    direction = np.random.default_rng(0).normal(size=3 * p.N)
+    twin = twin_state(ref, direction, 1e-6, p)
+    d = np.linalg.norm(separation(ref, twin, p))
+    assert d == pytest.approx(1e-6, rel=1e-6)
+
+
+def test_plate_drive_steady_sliding_decays_at_minus_beta_over_two():
+    # A block on the plate with friction F0 + beta v slides steadily at v = V; a perturbation
+    # obeys lambda^2 + beta lambda + Kp = 0: Re lambda = -beta / 2 for beta^2 < 4 Kp (closed form).
+    p = ChainParams(N=1, drive="plate", friction="strengthening", ends="free", K=1.0, Kp=1.0, V=0.5,
+                    beta=0.4, F0=0.5, Fs=1.0)
+    res = largest_lyapunov(p, 200.0, interval=2.0, d0=1e-8, transient=0.0, start="steady",
+                           perturbation=1e-3, seed=0)
+    assert res.lyapunov == pytest.approx(-0.2, rel=0.02)

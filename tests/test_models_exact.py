@@ -10,14 +10,14 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from chain_helpers import assert_bits_equal, assert_same_run, model_heun_step, oracle_run
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from stickslip.run.driver import ChainState, run_chain
+from chain_helpers import assert_bits_equal, assert_same_run, model_heun_step, oracle_run
+from stickslip.models.params import ChainParams
 from stickslip.models.pieces import CompositionError, check_composition, names
 from stickslip.models.presets import PRESETS, chain_params
-from stickslip.models.params import ChainParams
+from stickslip.run.driver import ChainState, run_chain
 
 ALL = [
     (d, f, t, e)
@@ -144,3 +144,36 @@ def test_train_model_is_the_paper_chain_with_alpha_zero_and_theta_one():
     assert len(a.events) > 3
     assert_bits_equal(a.state.x, b.state.x, "x")
     assert a.events[["step_start", "step_end", "n_blocks"]].equals(b.events[["step_start", "step_end", "n_blocks"]])
+
+
+def test_plate_drive_block_that_stops_while_all_slide_restarts_on_time():
+    # Found by hypothesis: a single block on a ring stops in a step in which every block slid;
+    # its first start step under the plate must be known before the next start.
+    p = ChainParams(N=1, drive="plate", friction="weakening", ends="periodic", K=1.0, V=0.5, Kp=1.0,
+                    beta=0.0, alpha=0.0, sigma=0.0, F0=0.0, D=0.0, Fs=1.0)
+    x, v, th, stopped = _state(p, 0)
+    runs = [run_chain(p, 40.0, integrator=i, start=ChainState.from_blocks(x, v, th, stopped),
+                      sample_interval=0.5) for i in ("dense", "exact")]
+    assert len(runs[0].events) >= 2
+    assert_same_run(*runs)
+
+
+def test_run_directory_records_the_model_everywhere(tmp_path):
+    import json
+
+    import pyarrow.parquet as pq
+
+    from stickslip import io
+
+    p = chain_params("carlson-langer", N=10)
+    run_chain(p, 300.0, start=ChainState.rest(p, 0.01, 0), out_dir=tmp_path / "run")
+    want = {"model": "carlson-langer", "drive": "plate", "friction": "weakening", "threshold": "constant",
+            "ends": "periodic", "K": 100.0, "Kp": 1.0, "V": 0.01, "alpha": 2.5, "sigma": 0.01, "Fs": 1.0, "N": 10}
+    meta = io.read_json(tmp_path / "run" / "run.json")
+    assert want.items() <= meta["params"].items()
+    ds = io.read_dataset(tmp_path / "run" / "state.nc")
+    assert want.items() <= json.loads(ds.attrs["params"]).items()
+    for table in ("events.parquet", "first_move.parquet"):
+        stored = json.loads(pq.read_schema(tmp_path / "run" / table).metadata[b"stickslip"])
+        assert want.items() <= stored["params"].items()
+    assert "D" not in meta["params"] and "beta" not in meta["params"]  # not read by CL

@@ -111,3 +111,26 @@ def test_html_escapes_everything(tmp_path):
 def test_rows_may_be_plain_dicts(tmp_path):
     write_report(tmp_path, [ROWS[0].to_dict()], [], {})
     assert read_report(tmp_path / "report.json").rows == (ROWS[0],)
+
+
+def test_fig6_row_judges_the_paper_value_against_the_per_event_distribution():
+    import numpy as np
+    import pandas as pd
+
+    from stickslip.report.rows import front_speed_row, front_speed_verdict
+
+    rng = np.random.default_rng(5)
+    centred = pd.DataFrame({"c_first_move": rng.normal(1.5, 0.1, 400), "c_leading_edge": rng.normal(1.45, 0.1, 400)})
+    agrees, text = front_speed_verdict(centred, K=10.0)
+    assert agrees is True and "percentile" in text
+    # the paper's 1.43 below the 5th percentile of one definition: no agreement
+    shifted = centred.assign(c_leading_edge=rng.normal(1.8, 0.05, 400))
+    assert front_speed_verdict(shifted, K=10.0)[0] is False
+    # median above the sound speed: no agreement
+    assert front_speed_verdict(centred, K=1.0)[0] is False
+    # no event: no verdict, and the row says why
+    empty = pd.DataFrame({"c_first_move": [], "c_leading_edge": []})
+    row = front_speed_row(empty, K=10.0, mode="full", command="x")
+    assert row.agrees is None and "no event" in row.na_reason
+    full = front_speed_row(centred, K=10.0, mode="full", command="x")
+    assert full.agrees is True and "central 90%" in full.tolerance

@@ -249,3 +249,64 @@ def test_time_average_of_a_known_series():
     noise = xr.DataArray(rng.normal(3.0, 2.0, 10_000), coords={"t": np.arange(10_000.0)}, dims="t")
     avg = time_average(noise, n_batches=20)
     assert avg.stderr == pytest.approx(2.0 / 100.0, rel=0.4)
+
+
+# --- automatic fit range, per-event distributions ---------------------------------------------
+
+
+def test_default_fit_finds_the_power_law_above_junk_and_recovers_tau():
+    tau, a = 1.5, 10.0
+    law = bounded_power_law(5_000, tau, a, 1e4, seed=21)
+    junk = np.random.default_rng(22).uniform(0.5, a, 3_000)  # not a power law below s_min
+    S = np.concatenate([law, junk])
+    fit = fit_power_law(S, bootstrap=100)
+    assert fit.s_min_rule == "least KS distance"
+    assert a / 2 <= fit.s_min <= 2 * a
+    assert abs(fit.tau - tau) < 3 * fit.tau_err + 0.02
+    # from the smallest S the fit is rejected outright and tau is far off
+    naive = fit_power_law(S, s_min=float(S.min()), bootstrap=0)
+    assert naive.ks_distance > 5 * fit.ks_distance and abs(naive.tau - tau) > 0.2
+
+
+def test_default_s_max_is_the_callers_cutoff_and_explicit_ranges_are_kept():
+    S = bounded_power_law(3_000, 1.5, 1.0, 1e3, seed=23)
+    fit = fit_power_law(S, cutoff=100.0, bootstrap=0)
+    assert fit.s_max == 100.0 and fit.n == int(np.sum((S >= fit.s_min) & (S <= 100.0)))
+    given = fit_power_law(S, s_min=2.0, s_max=50.0, bootstrap=0)
+    assert (given.s_min, given.s_max, given.s_min_rule) == (2.0, 50.0, "given")
+
+
+def test_choose_s_min_stays_importable_from_chain_runs():
+    from stickslip.analysis import chain_runs, statistics
+
+    assert chain_runs.choose_s_min is statistics.choose_s_min
+
+
+def test_central_interval_places_a_value_in_a_known_distribution():
+    from stickslip.analysis.statistics import central_interval
+
+    sample = np.arange(1, 101, dtype=float)  # 1..100
+    inside = central_interval(sample, 50.5)
+    assert inside.inside and inside.percentile == pytest.approx(50.0)
+    assert (inside.lo, inside.hi) == pytest.approx((5.95, 95.05))
+    low = central_interval(sample, 3.0)
+    assert not low.inside and low.percentile == pytest.approx(2.5)
+    assert central_interval(sample, 3.0, level=0.98).inside
+
+
+def test_leading_edge_speed_of_a_known_front():
+    from stickslip.analysis.statistics import leading_edge_speed
+
+    speed, N, window = 1.6, 200, 20.0
+    t_first = np.arange(1, N + 1) / speed
+    starts = np.arange(0.0, t_first.max() + 60.0, window)
+    dx = np.zeros((starts.size, N))
+    for k, s in enumerate(starts):
+        dx[k] = 0.05 * np.clip(np.minimum(s + window, t_first + 60.0) - np.maximum(s, t_first), 0.0, None)
+    profiles = xr.Dataset({"dx": (("row", "block"), dx)},
+                          coords={"event": ("row", np.full(starts.size, 4)), "t": ("row", starts),
+                                  "block": np.arange(1, N + 1)})
+    edge = leading_edge_speed(profiles, 4)
+    # each edge sits within one block-step of the front at the window's end
+    assert edge.speed == pytest.approx(speed, rel=0.05)
+    assert edge.n_windows >= 2 and edge.i_max == N

@@ -86,7 +86,10 @@ def test_sweep_on_two_worker_processes_skips_done_points_and_survives_a_failure(
     assert third.table["value"].tolist() == [sum_of_squares(6) * 1.0, sum_of_squares(6) * 2.0]
 
 
-def test_sweep_starts_its_own_local_cluster(tmp_path, capfd):
+def test_sweep_starts_its_own_local_cluster(tmp_path, capfd, monkeypatch):
+    from stickslip.experiments import sweep as sweep_module
+
+    monkeypatch.setattr(sweep_module, "_on_terminal", lambda: True)  # the bar is drawn on a terminal only
     points = [{"x": 1.0}, {"x": 2.0}]
     result = run_sweep(demo_task, points, tmp_path, common={"n": 3}, n_workers=2, progress=True)
     assert result.n_run == 2 and result.n_failed == 0
@@ -97,6 +100,15 @@ def test_sweep_starts_its_own_local_cluster(tmp_path, capfd):
     # all points done: nothing to compute, no cluster needed
     again = run_sweep(demo_task, points, tmp_path, common={"n": 3}, n_workers=2, progress=False)
     assert again.n_run == 0 and again.n_reused == 2
+
+
+def test_sweep_draws_no_bar_into_a_log(tmp_path, capfd, monkeypatch):
+    from stickslip.experiments import sweep as sweep_module
+
+    monkeypatch.setattr(sweep_module, "_on_terminal", lambda: False)
+    result = run_sweep(demo_task, [{"x": 1.0}], tmp_path, common={"n": 3}, n_workers=1, progress=True)
+    assert result.n_run == 1
+    assert "1/1" not in capfd.readouterr().err
 
 
 def test_sweep_rejects_repeated_points(tmp_path):

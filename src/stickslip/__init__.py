@@ -16,7 +16,8 @@ The main API is importable from here; the simulators load on first use, so that
 """
 
 from importlib import import_module
-from importlib.metadata import PackageNotFoundError, version as _version
+from importlib.metadata import PackageNotFoundError
+from importlib.metadata import version as _version
 
 try:
     __version__ = _version("stickslip")

@@ -63,10 +63,27 @@ def read_dataset(path: str | Path) -> xr.Dataset:
         return ds.load()
 
 
-def write_table(path: str | Path, table: pd.DataFrame) -> Path:
-    """Write a table (events, sweep summaries) to Parquet, atomically."""
+def write_table(path: str | Path, table: pd.DataFrame, descriptions: dict[str, str] | None = None,
+                metadata: dict[str, Any] | None = None) -> Path:
+    """Write a table (events, sweep summaries) to Parquet, atomically.
+
+    ``descriptions`` (column -> text) go into the Parquet schema as each field's metadata
+    (key ``description``), readable with ``pyarrow.parquet.read_schema(path).field(name).metadata``;
+    ``metadata`` (JSON-able) goes into the schema's own metadata under key ``stickslip``.
+    """
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    arrow = pa.Table.from_pandas(table, preserve_index=False)
+    if descriptions:
+        fields = [f.with_metadata({**(f.metadata or {}), b"description": descriptions[f.name].encode()})
+                  if f.name in descriptions else f for f in arrow.schema]
+        arrow = arrow.cast(pa.schema(fields, metadata=arrow.schema.metadata))
+    if metadata:
+        arrow = arrow.replace_schema_metadata({**(arrow.schema.metadata or {}),
+                                               b"stickslip": json.dumps(to_jsonable(metadata)).encode()})
     with atomic_path(path) as tmp:
-        table.to_parquet(tmp, engine="pyarrow", index=False)
+        pq.write_table(arrow, tmp)
     return Path(path)
 
 

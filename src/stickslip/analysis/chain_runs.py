@@ -14,9 +14,21 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from stickslip.analysis.statistics import fit_power_law, front_speed, pick_front_events
+from stickslip.analysis.statistics import (
+    choose_s_min,
+    fit_power_law,
+    front_speed,
+    leading_edge_speed,
+    pick_front_events,
+)
 from stickslip.models.params import ChainParams
+from stickslip.models.physics import chain_steady_length
 from stickslip.run.state import steady_deviation
+
+# choose_s_min lives in stickslip.analysis.statistics; the name is kept importable from here.
+__all__ = ["final_state", "choose_s_min", "size_statistics", "front_speeds", "front_statistics", "chain_analysis",
+           "fig6_start_note",
+           "sweep_table"]
 
 
 def final_state(summary: dict[str, Any], state, params: ChainParams, tolerance: float) -> tuple[str, float]:
@@ -35,31 +47,6 @@ def final_state(summary: dict[str, Any], state, params: ChainParams, tolerance: 
     return "sliding, not yet steady", deviation
 
 
-def choose_s_min(S: np.ndarray, s_max: float, *, max_quantile: float = 0.9, n_candidates: int = 40) -> float:
-    """Lower end of the power-law fit of Figs. 7, 8: the s_min with the least KS distance.
-
-    The candidates are ``n_candidates`` log-spaced values from the smallest S to its
-    ``max_quantile`` quantile (and below ``s_max``); each gets the truncated maximum-likelihood
-    fit of :func:`stickslip.analysis.statistics.fit_power_law` on [s_min, s_max], and the one whose
-    fitted CDF is closest to the data (Kolmogorov-Smirnov) wins (the recipe of Clauset, Shalizi
-    and Newman, SIAM Review 51, 661 (2009), with the upper cut-off kept).
-    """
-    S = np.asarray(S, dtype=float)
-    S = S[np.isfinite(S) & (S > 0)]
-    hi = min(float(np.quantile(S, max_quantile)), s_max / 10.0)
-    lo = float(S.min())
-    if not hi > lo:
-        return lo
-    best, best_ks = lo, math.inf
-    for s_min in np.geomspace(lo, hi, n_candidates):
-        if np.count_nonzero((S >= s_min) & (S <= s_max)) < 50:
-            break
-        fit = fit_power_law(S, s_min=float(s_min), s_max=s_max, bootstrap=0)
-        if math.isfinite(fit.ks_distance) and fit.ks_distance < best_ks:
-            best, best_ks = float(s_min), fit.ks_distance
-    return best
-
-
 def size_statistics(events: pd.DataFrame, N: int, *, small_only: bool, seed: int = 0,
                     spanning: str = "max_block", bootstrap: int = 200) -> dict[str, Any]:
     """Slip-size statistics of one chain run for Fig. 7 (beta = 1) or Fig. 8 (beta = 0.2).
@@ -67,7 +54,8 @@ def size_statistics(events: pd.DataFrame, N: int, *, small_only: bool, seed: int
     The events that reach block N ("system-spanning") set the largest sizes. With
     ``small_only`` (Fig. 8, "about 1.6 for small S") the power law is fitted below the smallest
     system-spanning event, s_span; otherwise (Fig. 7) up to the largest S, with the cut-off in
-    the likelihood. s_min is chosen by :func:`choose_s_min`. ``excess`` is the number of events
+    the likelihood. s_min is the default of :func:`~stickslip.analysis.statistics.fit_power_law`
+    (:func:`~stickslip.analysis.statistics.choose_s_min`, least KS distance). ``excess`` is the number of events
     with S >= s_span over the number the fitted power law, continued without cut-off beyond
     s_span, predicts for them (the paper's "excess of large events" at beta = 0.2 is > 1).
 
@@ -82,8 +70,8 @@ def size_statistics(events: pd.DataFrame, N: int, *, small_only: bool, seed: int
     span_rows = events[events[spanning] >= N]
     s_span = float(span_rows["S"].min()) if len(span_rows) else math.nan
     s_max = s_span if (small_only and math.isfinite(s_span)) else float(S.max())
-    s_min = choose_s_min(S, s_max)
-    fit = fit_power_law(S, s_min=s_min, s_max=s_max, bootstrap=bootstrap, seed=seed)
+    fit = fit_power_law(S, s_max=s_max, bootstrap=bootstrap, seed=seed)
+    s_min = fit.s_min
     excess = expected = math.nan
     observed = 0
     if math.isfinite(s_span) and fit.tau > 1.0:
@@ -105,20 +93,55 @@ def size_statistics(events: pd.DataFrame, N: int, *, small_only: bool, seed: int
     }
 
 
+def front_speeds(run, N: int, t_from: float) -> pd.DataFrame:
+    """Per-event rupture-front speeds of every event after ``t_from`` that reached block N (Fig. 6).
+
+    Two definitions side by side: ``c_first_move``, the least-squares slope of block against
+    first-move time over the far half (:func:`~stickslip.analysis.statistics.front_speed`), and
+    ``c_leading_edge``, the slope of the leading edge of the Delta x_i windows against window
+    end (:func:`~stickslip.analysis.statistics.leading_edge_speed`; NaN where the event has no
+    stored profiles or fewer than two windows in the far half). One row per event.
+    """
+    events = run.events[(run.events["t_start"] >= t_from) & (run.events["max_block"] >= N)]
+    groups = {int(e): g for e, g in run.first_move.groupby("event")}
+    profiles = run.profiles if run.profiles.sizes.get("row") else None
+    stored = set(np.unique(profiles["event"].values).tolist()) if profiles is not None else set()
+    rows = []
+    for r in events.itertuples():
+        e = int(r.event)
+        c_fm = c_edge = math.nan
+        fm = groups.get(e)
+        if fm is not None:
+            try:
+                c_fm = front_speed(fm, e).speed
+            except ValueError:
+                pass
+        if e in stored:
+            try:
+                c_edge = leading_edge_speed(profiles, e).speed
+            except ValueError:
+                pass
+        rows.append({"event": e, "t_start": float(r.t_start), "S": float(r.S), "c_first_move": c_fm,
+                     "c_leading_edge": c_edge})
+    return pd.DataFrame(rows, columns=["event", "t_start", "S", "c_first_move", "c_leading_edge"])
+
+
 def front_statistics(run, N: int, t_from: float) -> dict[str, Any]:
     """Rupture fronts for Fig. 6: the picked large and intermediate events and all spanning ones.
 
     The picks (:func:`stickslip.analysis.statistics.pick_front_events`) are made among the events after
-    ``t_from`` whose displacement profiles were stored. ``speeds`` are the front speeds
-    (:func:`stickslip.analysis.statistics.front_speed`, far half of the chain) of every event after
-    ``t_from`` that reached block N; their median is the number compared with the paper's c.
+    ``t_from`` whose displacement profiles were stored. ``per_event`` is :func:`front_speeds`
+    (both definitions for every event after ``t_from`` that reached block N); ``speeds`` its
+    first-move column without NaN, whose median and quartiles are kept for the summary;
+    ``edges`` the leading-edge fits of the picked events (None where there is none);
+    ``t_first_span``: start of the run's first event that reached block N (NaN if none).
     """
     events = run.events[run.events["t_start"] >= t_from]
     with_profiles = set(np.unique(run.profiles["event"].values).tolist()) if run.profiles.sizes.get("row") else set()
     candidates = events[events["event"].isin(with_profiles)]
     picks = pick_front_events(candidates, N) if len(candidates) else candidates.assign(kind=pd.Series(dtype=str))
     groups = {int(e): g for e, g in run.first_move.groupby("event")}
-    fronts, labels = [], []
+    fronts, labels, edges = [], [], []
     for row in picks.itertuples():
         fm = groups.get(int(row.event))
         if fm is None:
@@ -127,25 +150,44 @@ def front_statistics(run, N: int, t_from: float) -> dict[str, Any]:
             fronts.append(front_speed(fm, int(row.event)))
         except ValueError:
             continue
-        labels.append(f"{row.kind} event (S = {row.S:.4g}, {row.n_blocks} blocks)")
-    speeds = []
-    for e in events.loc[events["max_block"] >= N, "event"]:
-        fm = groups.get(int(e))
-        if fm is None:
-            continue
         try:
-            speeds.append(front_speed(fm, int(e)).speed)
+            edges.append(leading_edge_speed(run.profiles, int(row.event)))
         except ValueError:
-            continue
-    speeds = np.asarray(speeds, dtype=float)
+            edges.append(None)
+        labels.append(f"{row.kind} event ($S = {row.S:.4g}$, {row.n_blocks} blocks)")
+    per_event = front_speeds(run, N, t_from)
+    speeds = per_event["c_first_move"].to_numpy(dtype=float)
+    speeds = speeds[np.isfinite(speeds)]
+    spanning = run.events[run.events["max_block"] >= N]
     return {
         "fronts": fronts,
         "labels": labels,
+        "edges": edges,
         "picks": picks,
+        "per_event": per_event,
         "speeds": speeds,
         "median_speed": float(np.median(speeds)) if speeds.size else math.nan,
         "quartiles": [float(q) for q in np.quantile(speeds, [0.25, 0.75])] if speeds.size else [math.nan] * 2,
+        "t_first_span": float(spanning["t_start"].min()) if len(spanning) else math.nan,
     }
+
+
+def fig6_start_note(a: dict[str, Any]) -> str:
+    """Why the paper's event times of Fig. 6 (t ~ 19100, 40400) cannot come from its stated start.
+
+    From x_i(0) = 0 the pulled end must first stretch the chain by about its steady length
+    L_ss = (c/K) N (N - 1) / 2 before an event can reach block N, which at pulling speed V takes
+    t ~ L_ss / V (8.0e6 for N = 399); ``a`` is :func:`stickslip.analysis.chain_runs.chain_analysis`.
+    """
+    p = a["run1"].params
+    p399 = p.replace(N=399)
+    t_span = a["fronts"].get("t_first_span", float("nan"))
+    here = (f"in this run (N = {p.N}) the first event that reached block N started at t = {t_span:.3g} "
+            f"(L_ss / V = {chain_steady_length(p) / p.V:.3g})" if np.isfinite(t_span) else
+            f"in this run (N = {p.N}) no event reached block N")
+    return ("The paper's event times (t ~ 19100 and 40400) cannot come from its stated start x_i(0) = 0: the "
+            f"chain must first stretch by about L_ss = (c/K) N (N - 1) / 2 = {chain_steady_length(p399):.4g} "
+            f"(N = 399), which at V = {p.V:g} takes t ~ {chain_steady_length(p399) / p.V:.2g}; {here}.")
 
 
 def chain_analysis(outcome) -> dict[str, Any]:

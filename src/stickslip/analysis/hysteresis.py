@@ -190,7 +190,7 @@ def hysteresis_sweep(
     V_up = _first(grid, ~up["stuck"].to_numpy(), require_before=up["stuck"].to_numpy())
     down_stuck = down["stuck"].to_numpy()[::-1]
     V_down = _first(grid[::-1], down_stuck, require_before=~down_stuck)
-    data.attrs.update({k: float(v) for k, v in params.to_dict().items() if k != "V"})
+    data.attrs.update({k: v if isinstance(v, str) else float(v) for k, v in params.to_dict().items() if k != "V"})
     data.attrs.update(settings.to_dict())
     data.attrs.update(
         V_up=math.nan if V_up is None else V_up,

@@ -10,7 +10,7 @@ standard error of the means of M independent segments of them.
 Separation. The state of block i is (x_i, v_i, theta_i, stopped_i). Forces depend on positions
 only through the spring extensions e_i = x_{i-1} - x_i (x_0 = V t_n, the pulling point), so the
 separation is measured in y = (sqrt(K) e_i, v_i, theta_i), i = 1..N, with the Euclidean norm.
-With unit mass, |(sqrt(K) de, dv)|^2 / 2 is the mechanical energy of the perturbation (springs
+With unit mass, ``|(sqrt(K) de, dv)|^2 / 2`` is the mechanical energy of the perturbation (springs
 plus motion): a harmonic oscillation of the perturbation does not make d oscillate, which would
 add noise to every ln(d / d0). The pulling point is the same for both trajectories, so the
 extensions carry the whole position information (no neutral translation direction).
@@ -23,12 +23,18 @@ only; it starts when the start rule says so from its own force, as in the refere
 distance itself is measured from the continuous variables alone, so a twin block that is still
 sliding while the reference's has stopped counts with its velocity: flags never enter d.
 See docs/lyapunov.md for what the exponent means with these switching rules.
+
+Plate drive (Carlson-Langer, two blocks). Every block hangs on the plate by its own leaf spring
+Kp, which both trajectories share: positions relative to the plate are the displacements
+themselves, and y = (sqrt(Kp) dx_i, v_i, theta_i) weighs them with the leaf spring (the part of the
+perturbation's energy that every block has whatever its neighbours do).
 """
 
 from __future__ import annotations
 
 import math
 import sys
+import warnings
 import time
 from dataclasses import dataclass, field
 from typing import Any, Sequence
@@ -36,8 +42,8 @@ from typing import Any, Sequence
 import numpy as np
 import pandas as pd
 
-from stickslip.run.driver import ChainState, Stepper, run_chain
 from stickslip.models.params import ChainParams, ParameterError, check_number, steps_for
+from stickslip.run.driver import ChainState, ShortRunWarning, Stepper, run_chain
 
 #: Largest allowed initial separation: beyond it the twin is not a small perturbation.
 D0_MAX = 1e-3
@@ -77,6 +83,13 @@ class LyapunovResult:
     durations: np.ndarray = field(repr=False)
     counted: np.ndarray = field(repr=False)
 
+    @property
+    def merges(self) -> int:
+        """Counted renormalisations after which the twin had fallen onto the reference (d = 0):
+        d0 at the rounding floor of the state, or a sticking phase that contracts to one point.
+        Any makes the exponent -inf; a larger d0 tells the two apart."""
+        return int(np.count_nonzero(np.isneginf(self.log_growth[self.counted])))
+
     def to_dict(self) -> dict[str, Any]:
         """The scalars of the result, its parameters and the method, as a plain dict for JSON."""
         return {
@@ -88,6 +101,7 @@ class LyapunovResult:
             "interval": self.interval,
             "d0": self.d0,
             "renormalisations": self.renormalisations,
+            "merges": self.merges,
             "segments": self.segments,
             "segment_means": list(self.segment_means),
             "events": self.events,
@@ -120,8 +134,11 @@ def separation(ref: ChainState, twin: ChainState, params: ChainParams) -> np.nda
     """The separation twin - ref in the coordinates y = (sqrt(K) e, v, theta) (length 3N).
 
     e_i = x_{i-1} - x_i with the same pulling point for both, so de_i = dx_{i-1} - dx_i, dx_0 = 0.
+    With the plate drive y = (sqrt(Kp) dx, v, theta) (module docstring).
     """
     dx = twin.x[1:-1] - ref.x[1:-1]
+    if params.drive == "plate":
+        return np.concatenate((math.sqrt(params.Kp) * dx, twin.v[1:-1] - ref.v[1:-1], twin.th[1:-1] - ref.th[1:-1]))
     de = np.concatenate(([0.0], dx[:-1])) - dx
     dv = twin.v[1:-1] - ref.v[1:-1]
     dth = twin.th[1:-1] - ref.th[1:-1]
@@ -189,12 +206,16 @@ def twin_state(ref: ChainState, direction: np.ndarray, d0: float, params: ChainP
     b = ref.blocks()
     N = b["x"].shape[0]
     u = _project(direction, b["stopped"])
+    if params.friction != "state":
+        u[2 * N:] = 0.0  # no state variable: theta is not a coordinate of these models
     norm = float(np.linalg.norm(u))
     if not norm > 0.0:
         raise ValueError("the separation vanished on the reference's branch; cannot renormalise")
     u = u * (d0 / norm)
-    de = u[:N] / math.sqrt(params.K)
-    x = b["x"] - np.cumsum(de)
+    if params.drive == "plate":
+        x = b["x"] + u[:N] / math.sqrt(params.Kp)
+    else:
+        x = b["x"] - np.cumsum(u[:N] / math.sqrt(params.K))
     v = np.where(b["stopped"], 0.0, b["v"] + u[N:2 * N])
     th = b["theta"] + u[2 * N:]
     return _with_step(ChainState.from_blocks(x, v, th, b["stopped"]), ref.step)
@@ -283,8 +304,11 @@ def largest_lyapunov(
     n_count = steps_for(transient + align, dt)
     wall0 = time.perf_counter()
 
-    run = run_chain(params, n0 * dt, start=start, perturbation=perturbation, seed=seed,
-                    sample_interval=max(transient, dt))
+    with warnings.catch_warnings():
+        # Only the state at the transient's end is used, not <L>: loading is no concern here.
+        warnings.simplefilter("ignore", ShortRunWarning)
+        run = run_chain(params, n0 * dt, start=start, perturbation=perturbation, seed=seed,
+                        sample_interval=max(transient, dt))
     ref = run.state
     start_name = start if isinstance(start, str) else "state"
     rng = np.random.default_rng(direction_seed)
@@ -338,7 +362,10 @@ def _bar(progress: bool, total: float):
         return None
     from tqdm import tqdm
 
-    return tqdm(total=total, unit="t", unit_scale=True, dynamic_ncols=True, desc="lyapunov", file=sys.stderr)
+    # rate in model time units per wall-clock second
+    return tqdm(total=total, unit=" time units", unit_scale=False, dynamic_ncols=True, desc="lyapunov",
+                file=sys.stderr, bar_format="{l_bar}{bar}| t = {n:.4g}/{total:.4g} [{elapsed}<{remaining}, "
+                                            "{rate_fmt}]")
 
 
 CONVERGENCE_COLUMNS = ["varied", "d0", "interval", "t_end", "lyapunov", "lyapunov_err", "renormalisations",

@@ -216,7 +216,7 @@ def _curve(p: BlockParams, t, x, v, theta, method: str, f=None) -> xr.Dataset:
             "f": ("t", np.asarray(f), {"long_name": "spring force Fs - K x'"}),
         },
         coords={"t": ("t", np.asarray(t), {"long_name": "time since the start of the slip t - t_c"})},
-        attrs={"method": method, **{f"param_{k}": float(val) for k, val in p.to_dict().items()}},
+        attrs={"method": method, **{f"param_{k}": val if isinstance(val, str) else float(val) for k, val in p.to_dict().items()}},
     )
 
 

@@ -246,7 +246,7 @@ def hopf_curve(p: BlockParams, beta: np.ndarray) -> xr.Dataset:
             "V_c_closed_form": ("beta", np.array(closed), {"long_name": "Hopf point V_c (Routh-Hurwitz)"}),
         },
         coords={"beta": ("beta", beta, {"long_name": "viscous friction beta"})},
-        attrs={k: float(v) for k, v in p.to_dict().items() if k not in ("V", "beta", "Fs", "dt")},
+        attrs={k: v if isinstance(v, str) else float(v) for k, v in p.to_dict().items() if k not in ("V", "beta", "Fs", "dt")},
     )
 
 
@@ -563,7 +563,7 @@ def mode_growth_rates(p: ChainParams) -> pd.DataFrame:
 
     One row per normal mode of :func:`normal_modes`: ``j``, ``k``, ``omega2`` (w_k^2),
     ``growth_rate`` (largest Re lambda), ``growth_rate_2`` (the other root's) and ``frequency``
-    (|Im lambda|).
+    (``|Im lambda|``).
     """
     k, _ = normal_modes(p)
     roots = mode_roots(p, k)

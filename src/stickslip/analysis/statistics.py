@@ -18,6 +18,11 @@ lies in (1.5, 3], i.e. it ignores ``xmax`` exactly in the range of exponents the
 (for tau = 1.5, s_max / s_min = 1e3 it returns about 1.57). Its truncated likelihood is only
 maximised with ``Power_Law(..., force_numerical_fit=True)``, a Nelder-Mead search with
 tolerance 1e-4; the tests use that as an independent check of this module.
+
+Fit range. Without an explicit s_min the lower end is chosen by :func:`choose_s_min` (least
+Kolmogorov-Smirnov distance over a fixed candidate range; docs/statistics.md), because the
+smallest slips of a chain do not follow the power law: on the beta = 1 run of Fig. 7 the fit
+from the smallest S is rejected outright (KS distance about 0.5).
 """
 
 from __future__ import annotations
@@ -34,11 +39,17 @@ from scipy import optimize
 __all__ = [
     "size_distribution",
     "fit_power_law",
+    "choose_s_min",
+    "s_min_scan",
     "PowerLawFit",
     "truncated_power_law_pdf",
     "front_speed",
     "FrontSpeed",
     "pick_front_events",
+    "leading_edge_speed",
+    "EdgeSpeed",
+    "central_interval",
+    "CentralInterval",
     "time_average",
     "TimeAverage",
 ]
@@ -213,6 +224,7 @@ class PowerLawFit:
     ``tau``: the exponent; ``tau_err``: its bootstrap standard error (NaN without bootstrap);
     ``tau_err_fisher``: the asymptotic error 1 / sqrt(n I(tau)) from the Fisher information;
     ``n``: events in [s_min, s_max] used for the fit, ``n_total``: all finite positive events;
+    ``s_min_rule``: how s_min was set ("given", or "least KS distance" from :func:`choose_s_min`);
     ``truncated``: whether the upper cut-off enters the likelihood (False: s_max = inf, the
     classic estimator); ``loglikelihood``: the maximised log-likelihood; ``ks_distance``: the
     Kolmogorov-Smirnov distance between the fitted and the empirical CDF on the range.
@@ -231,6 +243,7 @@ class PowerLawFit:
     method: str
     loglikelihood: float
     ks_distance: float
+    s_min_rule: str = "given"
 
     def pdf(self, s: Any) -> np.ndarray:
         """The fitted density p(S) on [s_min, s_max] (zero outside), integrating to 1."""
@@ -259,11 +272,95 @@ def _truncated_cdf(s: np.ndarray, tau: float, s_min: float, s_max: float) -> np.
     return np.expm1(e * np.log(s / s_min)) / math.expm1(e * math.log(s_max / s_min))
 
 
+#: Defaults of :func:`choose_s_min`: candidates from the smallest S up to this quantile of S ...
+S_MIN_MAX_QUANTILE = 0.9
+#: ... and at most this fraction of s_max (at least a decade of range is left to fit) ...
+S_MIN_MAX_FRACTION = 0.1
+#: ... in this many log-spaced steps, each keeping at least this many events in [s_min, s_max].
+S_MIN_CANDIDATES = 40
+S_MIN_MIN_EVENTS = 50
+
+
+def _range_fit(values: np.ndarray, lo: float, hi: float, truncated: bool) -> tuple[np.ndarray, float, float]:
+    """Events in [lo, hi], log(S/lo) of them, and tau (truncated MLE, or the classic one)."""
+    x = values[(values >= lo) & (values <= hi)]
+    span = math.log(hi / lo) if truncated else math.inf
+    log_ratio = np.log(x / lo)
+    return x, span, _fit_tau(log_ratio, span) if x.size >= 2 else math.nan
+
+
+def _ks_distance(x: np.ndarray, tau: float, lo: float, hi: float) -> float:
+    """Kolmogorov-Smirnov distance between the fitted CDF on [lo, hi] and the sample x."""
+    n = x.size
+    xs = np.sort(x)
+    model = _truncated_cdf(xs, tau, lo, hi)
+    upper = np.arange(1, n + 1) / n
+    return float(max(np.max(upper - model), np.max(model - (upper - 1.0 / n))))
+
+
+def s_min_scan(
+    S: Any,
+    s_max: float | None = None,
+    *,
+    max_quantile: float = S_MIN_MAX_QUANTILE,
+    max_fraction: float = S_MIN_MAX_FRACTION,
+    n_candidates: int = S_MIN_CANDIDATES,
+    min_events: int = S_MIN_MIN_EVENTS,
+) -> pd.DataFrame:
+    """The candidates of :func:`choose_s_min` with, for each, n, tau and the KS distance (Figs. 7, 8).
+
+    Candidates: ``n_candidates`` log-spaced values from the smallest positive S to the smaller
+    of its ``max_quantile`` quantile and ``max_fraction`` * s_max (s_max: the largest S if not
+    given); the scan stops at the first candidate that leaves fewer than ``min_events`` events
+    in [s_min, s_max]. Each gets the truncated maximum-likelihood fit on [s_min, s_max].
+    """
+    values, _ = _positive_finite(S)
+    if values.size == 0:
+        raise ValueError("no positive, finite slip sizes")
+    hi_s = float(values.max()) if s_max is None else float(s_max)
+    lo = float(values.min())
+    top = min(float(np.quantile(values, max_quantile)), max_fraction * hi_s)
+    grid = np.geomspace(lo, top, n_candidates) if top > lo else np.array([lo])
+    rows = []
+    for s_min in grid:
+        s_min = float(s_min)
+        if not hi_s > s_min:
+            break
+        x, _, tau = _range_fit(values, s_min, hi_s, True)
+        if x.size < max(min_events, 2):
+            break
+        ks = _ks_distance(x, tau, s_min, hi_s) if math.isfinite(tau) else math.nan
+        rows.append({"s_min": s_min, "n": int(x.size), "tau": float(tau), "ks_distance": ks})
+    return pd.DataFrame(rows, columns=["s_min", "n", "tau", "ks_distance"])
+
+
+def choose_s_min(S: Any, s_max: float | None = None, **candidates: Any) -> float:
+    """Lower end of the power-law fit of Figs. 7, 8: the s_min with the least KS distance.
+
+    Each candidate of :func:`s_min_scan` gets the truncated fit on [s_min, s_max] and its
+    Kolmogorov-Smirnov distance D (the recipe of Clauset, Shalizi and Newman, SIAM Review 51,
+    661 (2009), with the upper cut-off kept). A KS distance computed from n events is only
+    resolved to about 1/sqrt(n), so candidates with D <= D_least + 1/sqrt(n) count as equally
+    good and the smallest of them is taken (the most events). On a clean power law that is the
+    smallest S; below a range of junk it is the start of the power law. ``candidates``: the
+    keywords of :func:`s_min_scan`. With no candidate (too few events) the smallest S is returned.
+    """
+    scan = s_min_scan(S, s_max, **candidates)
+    scan = scan[np.isfinite(scan["ks_distance"])]
+    if scan.empty:
+        values, _ = _positive_finite(S)
+        return float(values.min())
+    D = scan["ks_distance"].to_numpy()
+    good = D <= D.min() + 1.0 / np.sqrt(scan["n"].to_numpy())
+    return float(scan["s_min"].to_numpy()[np.flatnonzero(good)[0]])
+
+
 def fit_power_law(
     S: Any,
     s_min: float | None = None,
     s_max: float | None = None,
     *,
+    cutoff: float | None = None,
     bootstrap: int = 200,
     seed: int = 0,
     truncated: bool = True,
@@ -271,34 +368,46 @@ def fit_power_law(
     """Exponent tau of the slip-size distribution p(S) ~ S^-tau by maximum likelihood (Figs. 7, 8).
 
     The fit uses the events with s_min <= S <= s_max and maximises the likelihood of the power
-    law truncated to that range (module docstring). Defaults: s_min = the smallest positive S,
-    s_max = the largest S (the maximum-likelihood estimate of an upper cut-off). With
+    law truncated to that range (module docstring). Given s_min and s_max are used as they are.
+    Defaults: s_max = ``cutoff`` when the caller gives one (the size where the system size cuts
+    the distribution off, e.g. the smallest event that spans the chain, Fig. 8), else the
+    largest S (the maximum-likelihood estimate of an upper cut-off); s_min = the least-KS
+    choice of :func:`choose_s_min` on [., s_max] (``s_min_rule`` says which). With
     ``truncated=False`` the upper cut-off is ignored in the likelihood (s_max = inf, the classic
     estimator tau = 1 + n / sum log(S/s_min)) but events above ``s_max`` are still left out;
     that estimate is biased upwards for a cut-off distribution.
 
     The error ``tau_err`` is the standard deviation of the estimate over ``bootstrap``
     resamples (with replacement) of the events in range, drawn with
-    ``numpy.random.default_rng(seed)``; ``bootstrap=0`` skips it.
+    ``numpy.random.default_rng(seed)``, at the chosen s_min; ``bootstrap=0`` skips it.
     """
     values, _ = _positive_finite(S)
     n_total = int(values.size)
     if n_total == 0:
         raise ValueError("no positive, finite slip sizes to fit")
-    lo = float(values.min()) if s_min is None else float(s_min)
-    hi = float(values.max()) if s_max is None else float(s_max)
+    if s_max is not None:
+        hi = float(s_max)
+    elif cutoff is not None:
+        hi = float(cutoff)
+    else:
+        hi = float(values.max())
+    rule = "given"
+    if s_min is not None:
+        lo = float(s_min)
+    elif hi > float(values.min()):
+        lo, rule = choose_s_min(values, hi), "least KS distance"
+    else:
+        lo = float(values.min())
     if not (lo > 0.0 and hi > lo):
         raise ValueError(f"need 0 < s_min < s_max (got s_min={lo!r}, s_max={hi!r})")
     if bootstrap < 0:
         raise ValueError(f"bootstrap must be >= 0 (got {bootstrap!r})")
 
-    x = values[(values >= lo) & (values <= hi)]
+    x, span, tau = _range_fit(values, lo, hi, truncated)
     n = int(x.size)
     if n < 2:
         raise ValueError(f"need at least 2 events in [s_min, s_max] (got {n})")
-    span = math.log(hi / lo) if truncated else math.inf
     log_ratio = np.log(x / lo)
-    tau = _fit_tau(log_ratio, span)
 
     tau_err = math.nan
     if bootstrap > 0:
@@ -314,10 +423,7 @@ def fit_power_law(
         info = _var_log_ratio(1.0 - tau, span) if truncated else 1.0 / (tau - 1.0) ** 2
         tau_err_fisher = 1.0 / math.sqrt(n * info) if info > 0 else math.nan
         loglik = float(-tau * np.log(x).sum() - n * _log_normaliser(tau, lo, s_hi))
-        xs = np.sort(x)
-        model = _truncated_cdf(xs, tau, lo, s_hi)
-        upper = np.arange(1, n + 1) / n
-        ks = float(max(np.max(upper - model), np.max(model - (upper - 1.0 / n))))
+        ks = _ks_distance(x, tau, lo, s_hi)
     else:
         tau_err_fisher = loglik = ks = math.nan
 
@@ -340,6 +446,7 @@ def fit_power_law(
         method=method,
         loglikelihood=loglik,
         ks_distance=ks,
+        s_min_rule=rule,
     )
 
 
@@ -425,6 +532,125 @@ def front_speed(
         n_blocks=n,
         rms=float(np.sqrt(np.mean(residual**2))),
     )
+
+
+@dataclass(frozen=True)
+class EdgeSpeed:
+    """Speed of the leading edge of the Delta x_i windows of one event, as the paper reads Fig. 6.
+
+    For each stored window (Delta x_i = x_i(t + Delta t) - x_i(t)) the edge is the farthest block
+    whose Delta x_i is at least ``edge_fraction`` of that window's largest Delta x_i; ``edges``
+    and ``times`` (window ends) are those of every window. The speed is the least-squares slope
+    of edge against time over the windows whose edge lies in [i_min, i_max) (the far half, as
+    :func:`front_speed`; a window whose edge has reached i_max is left out: it only says the
+    front got there within the window, and so are the windows after it). ``n_windows``: windows fitted; ``speed_err`` NaN with 2.
+    """
+
+    event: int
+    speed: float
+    speed_err: float
+    i_min: int
+    i_max: int
+    n_windows: int
+    edge_fraction: float
+    edges: tuple[int, ...]
+    times: tuple[float, ...]
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+def leading_edge_speed(
+    profiles: xr.Dataset,
+    event: int,
+    *,
+    edge_fraction: float = 0.05,
+    i_min: int | None = None,
+    i_max: int | None = None,
+) -> EdgeSpeed:
+    """Rupture-front speed of one event from the leading edge of its Delta x_i windows (Fig. 6).
+
+    ``profiles``: the run's stored windows (dim ``row`` with ``event``, ``t`` (window start),
+    optionally ``t_next`` (window end), ``dx(row, block)``). Default range: the far half of the
+    blocks the event reached, i_min = ceil(i_far / 2), i_max = i_far (i_far: the farthest edge).
+    """
+    rows = np.flatnonzero(profiles["event"].values == event)
+    if rows.size == 0:
+        raise ValueError(f"no displacement profiles stored for event {event}")
+    sub = profiles.isel(row=rows)
+    order = np.argsort(sub["t"].values, kind="stable")
+    dx = sub["dx"].transpose("row", "block").values[order]
+    blocks = sub["block"].values if "block" in sub.coords else np.arange(1, dx.shape[1] + 1)
+    t_end = (sub["t_next"] if "t_next" in sub.coords else sub["t"]).values[order]
+    if "t_next" not in sub.coords or np.all(t_end == sub["t"].values[order]):
+        # window ends: the next window's start, the last one as long as the one before it
+        starts = sub["t"].values[order]
+        width = float(np.median(np.diff(starts))) if starts.size > 1 else 0.0
+        t_end = np.append(starts[1:], starts[-1] + width)
+    edges = np.zeros(dx.shape[0], dtype=np.int64)
+    for k in range(dx.shape[0]):
+        peak = float(np.nanmax(dx[k])) if np.isfinite(dx[k]).any() else 0.0
+        moved = np.flatnonzero(dx[k] >= edge_fraction * peak) if peak > 0 else np.array([], dtype=int)
+        edges[k] = int(blocks[moved.max()]) if moved.size else 0
+    i_far = int(edges.max())
+    lo = int(math.ceil(i_far / 2)) if i_min is None else int(i_min)
+    hi = i_far if i_max is None else int(i_max)
+    # only the advance: windows before the edge first reaches its farthest block
+    advancing = np.arange(edges.size) < int(np.argmax(edges))
+    use = advancing & (edges >= lo) & (edges < hi)
+    n = int(use.sum())
+    if n < 2:
+        raise ValueError(f"event {event}: need at least 2 windows with the edge in [{lo}, {hi}) (got {n})")
+    t, i = t_end[use], edges[use].astype(np.float64)
+    design = np.column_stack([np.ones(n), t - t[0]])
+    coef, *_ = np.linalg.lstsq(design, i, rcond=None)
+    err = math.nan
+    if n > 2:
+        residual = i - design @ coef
+        tc = t - t.mean()
+        err = math.sqrt(float(residual @ residual) / (n - 2) / float(tc @ tc))
+    return EdgeSpeed(event=int(event), speed=float(coef[1]), speed_err=err, i_min=lo, i_max=hi, n_windows=n,
+                     edge_fraction=float(edge_fraction), edges=tuple(int(e) for e in edges),
+                     times=tuple(float(x) for x in t_end))
+
+
+@dataclass(frozen=True)
+class CentralInterval:
+    """Where a stated value lies in a per-event distribution (Fig. 6: the paper's c = 1.43).
+
+    ``percentile``: the share of the sample below ``value`` (ties count half), in percent;
+    ``lo``, ``hi``: the bounds of the central ``level`` of the sample (5th and 95th percentiles
+    for level 0.9); ``inside``: lo <= value <= hi; ``median``, ``quartiles``, ``n``.
+    """
+
+    value: float
+    level: float
+    lo: float
+    hi: float
+    inside: bool
+    percentile: float
+    median: float
+    quartiles: tuple[float, float]
+    n: int
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+def central_interval(sample: Any, value: float, *, level: float = 0.9) -> CentralInterval:
+    """Is ``value`` inside the central ``level`` of ``sample`` (Fig. 6's row), and at which percentile."""
+    x = np.asarray(sample, dtype=np.float64)
+    x = x[np.isfinite(x)]
+    if x.size == 0:
+        raise ValueError("empty sample")
+    if not 0.0 < level < 1.0:
+        raise ValueError(f"level must lie in (0, 1) (got {level!r})")
+    tail = (1.0 - level) / 2.0
+    lo, hi = (float(q) for q in np.quantile(x, [tail, 1.0 - tail]))
+    pct = 100.0 * (np.count_nonzero(x < value) + 0.5 * np.count_nonzero(x == value)) / x.size
+    q1, q3 = (float(q) for q in np.quantile(x, [0.25, 0.75]))
+    return CentralInterval(value=float(value), level=float(level), lo=lo, hi=hi, inside=bool(lo <= value <= hi),
+                           percentile=float(pct), median=float(np.median(x)), quartiles=(q1, q3), n=int(x.size))
 
 
 def pick_front_events(events: pd.DataFrame, N: int, *, intermediate: tuple[float, float] = (0.3, 0.7)) -> pd.DataFrame:

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import warnings
 
 from stickslip.cli._common import CommandError, Result, emit
 from stickslip.models.params import ParameterError
@@ -27,7 +28,17 @@ class _Parser(argparse.ArgumentParser):
 
 def build_parser() -> argparse.ArgumentParser:
     """The full parser with every subcommand registered."""
-    from stickslip.cli import block, chain, lyapunov, models, reproduce, stability, study, sweep
+    from stickslip.cli import (
+        block,
+        chain,
+        lyapunov,
+        models,
+        plot,
+        reproduce,
+        stability,
+        study,
+        sweep,
+    )
 
     parser = _Parser(
         prog="stickslip",
@@ -38,20 +49,40 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"stickslip {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
-    for module in (block, stability, chain, models, sweep, reproduce, study, lyapunov):
+    for module in (block, stability, chain, models, sweep, reproduce, study, lyapunov, plot):
         module.register(sub)
     return parser
 
 
+def _one_line_warning(command: str):
+    """A ``warnings.showwarning`` that writes ``stickslip COMMAND: warning: MESSAGE`` on stderr."""
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        sys.stderr.write(f"stickslip {command}: warning: {message}\n")
+
+    return show
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``stickslip`` command; returns the exit status."""
+    from stickslip.run.errors import NonFiniteBlock
+
     parser = build_parser()
+    argv = sys.argv[1:] if argv is None else list(argv)
+    if argv and argv[0].startswith("-") and argv[0] not in ("-h", "--help", "--version"):
+        parser.error(f"unrecognized argument {argv[0]} (options follow a COMMAND; see stickslip --help)")
     args = parser.parse_args(argv)
+    name = " ".join(v for v in (args.command, getattr(args, "stability_command", None)) if v)
     try:
-        result = args.handler(args)
+        with warnings.catch_warnings():
+            warnings.showwarning = _one_line_warning(args.command)
+            result = args.handler(args)
     except (ParameterError, CommandError) as exc:
-        sys.stderr.write(f"stickslip {args.command}: error: {exc}\n")
+        sys.stderr.write(f"stickslip {name}: error: {exc}\n")
         return 2
+    except NonFiniteBlock as exc:
+        sys.stderr.write(f"stickslip {name}: error: {exc}\n")
+        return 1
     except KeyboardInterrupt:
         sys.stderr.write("stickslip: interrupted\n")
         return 130

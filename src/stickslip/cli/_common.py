@@ -5,12 +5,14 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import json
+import os
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from stickslip.jsonable import to_jsonable
+from stickslip.models.params import _range_text
 
 
 class CommandError(Exception):
@@ -51,13 +53,16 @@ def add_param_options(parser: argparse.ArgumentParser, params_cls: type, skip: t
     docs = params_cls.field_docs()
     group = parser.add_argument_group("model parameters")
     for f in dataclasses.fields(params_cls):
-        if f.name in skip or f.name not in docs:
+        if f.name in skip or f.name not in docs or "choices" in f.metadata:
             continue
         kind = int if f.metadata.get("integer") else float
+        meta = f.metadata
+        allowed = _range_text(meta.get("low"), meta.get("high"), meta.get("low_open", False),
+                              meta.get("high_open", False))
         group.add_argument(
             f"--{f.name}",
             dest=f"param_{f.name}",
-            type=_number(kind, f.name),
+            type=_number(kind, f.name, allowed),
             default=None,
             metavar=f.name,
             help=f"{docs[f.name]} (default {f.default})",
@@ -75,29 +80,72 @@ def params_from_args(params_cls: type, args: argparse.Namespace, **overrides: An
     return params_cls(**values)
 
 
-def _number(kind: type, name: str):
-    """An argparse type that accepts any number text and leaves range checks to the dataclass."""
+def _number(kind: type, name: str, allowed: str = ""):
+    """An argparse type that accepts any number text and leaves range checks to the dataclass;
+    its error names the allowed range."""
+    what = ("an integer" if kind is int else "a number") + (f" {allowed}" if allowed else "")
 
     def convert(text: str):
         try:
             return kind(text) if kind is int else float(text)
         except ValueError:
-            raise argparse.ArgumentTypeError(f"{name} must be a number (got {text!r})") from None
+            raise argparse.ArgumentTypeError(f"{name} must be {what} (got {text!r})") from None
 
     convert.__name__ = name
     return convert
 
 
-def float_arg(name: str):
-    """An argparse type for a plain float option (range checked by the command)."""
-    return _number(float, name)
+def float_arg(name: str, allowed: str = ""):
+    """An argparse type for a plain float option (range checked by the command; ``allowed``
+    names the range in the message for text that is no number)."""
+    return _number(float, name, allowed)
+
+
+def int_arg(name: str, allowed: str = ""):
+    """An argparse type for a plain integer option."""
+    return _number(int, name, allowed)
+
+
+def check_out_dir(path: str | Path | None, option: str = "--out") -> Path | None:
+    """Refuse an output directory that could not be created or written, creating nothing."""
+    if path is None:
+        return None
+    out = Path(path)
+    if str(path).strip() == "":
+        raise CommandError(f"{option} must name a directory (got '')")
+    probe = out
+    while not probe.exists():
+        if probe.parent == probe:
+            break
+        probe = probe.parent
+    if probe.exists() and not probe.is_dir():
+        raise CommandError(f"{option} {out}: cannot create a directory there ({probe} is not a directory)")
+    if not os.access(probe, os.W_OK | os.X_OK):
+        raise CommandError(f"{option} {out}: {probe} is not writable")
+    return out
+
+
+def check_out_owned(path: str | Path | None, own, what: str, *, overwrite: bool = False,
+                    option: str = "--out") -> Path | None:
+    """Refuse an output directory holding anything that is not ``own(name)`` (one of this
+    command's files); with ``overwrite`` the command's own files are removed instead."""
+    out = check_out_dir(path, option)
+    if out is None or not out.is_dir():
+        return out
+    names = sorted(p.name for p in out.iterdir())
+    foreign = [n for n in names if not own(n)]
+    if foreign and not overwrite:
+        shown = ", ".join(foreign[:3]) + (", ..." if len(foreign) > 3 else "")
+        raise CommandError(f"{option} {out} holds files that are not {what}'s ({shown}); choose an empty "
+                           "directory, or --overwrite to replace this package's files there")
+    return out
 
 
 def prepare_out_dir(path: str | Path | None) -> Path | None:
     """Create the output directory (after all validation has passed)."""
     if path is None:
         return None
-    out = Path(path)
+    out = check_out_dir(path)
     try:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
@@ -157,3 +205,29 @@ def chain_params_from_args(args: argparse.Namespace, **overrides: Any):
     if ("l" in values or "nu" in values) and params.drive != "plate":
         raise ParameterError("--l and --nu are Carlson-Langer's symbols: they need drive plate")
     return params
+
+
+def add_block_model_option(parser: argparse.ArgumentParser) -> None:
+    """``--model`` for the single block: the paper's (default) or the Batista-Carlson reading."""
+    from stickslip.models.presets import SINGLE_BLOCK
+
+    parser.add_argument("--model", choices=SINGLE_BLOCK, default=None,
+                        help="sakaguchi (default: eq. 1 with the constant threshold Fs) or batista-carlson "
+                             "(the paper's reading of Batista-Carlson: a stuck block starts when "
+                             "K (V t - x) > sigma theta)")
+
+
+def block_params_from_args(args: argparse.Namespace, **overrides: Any):
+    """Validated BlockParams of ``--model`` with the ``--NAME`` options as overrides."""
+    from stickslip.models.params import BlockParams
+    from stickslip.models.presets import block_params
+
+    values = {f.name: getattr(args, f"param_{f.name}") for f in dataclasses.fields(BlockParams)
+              if getattr(args, f"param_{f.name}", None) is not None}
+    values.update(overrides)
+    model = getattr(args, "model", None) or "sakaguchi"
+    if model == "batista-carlson" and "Fs" in values:
+        from stickslip.models.params import ParameterError
+
+        raise ParameterError("--Fs is not a parameter of batista-carlson (its threshold is sigma theta)")
+    return block_params(model, **values)

@@ -31,12 +31,15 @@ from stickslip.cli._common import (
     CommandError,
     Result,
     add_json_option,
+    add_block_model_option,
     add_param_options,
+    block_params_from_args,
     float_arg,
     params_from_args,
+    check_out_owned,
     prepare_out_dir,
 )
-from stickslip.models.params import BlockParams, ParameterError, check_number, steps_for
+from stickslip.models.params import MAX_STEPS, BlockParams, ParameterError, check_number, steps_for
 from stickslip.run.block import (
     INTEGRATOR,
     BlockRun,
@@ -52,6 +55,11 @@ MAX_SAMPLES = 20_000_000
 #: Fig. 3: number of pulling velocities (log-spaced in [1e-3, 1e-1]) and periods per velocity.
 FIG3_POINTS = 13
 FIG3_PERIODS = 4
+#: Largest single-block run (steps); its slip table is sized for one slip per 1000 steps.
+MAX_BLOCK_STEPS = 10**10
+#: What ``block --out`` writes (its run directory may hold only these).
+BLOCK_FILES = frozenset({"series.nc", "slips.parquet", "run.json", "fig1.png", "fig1.pdf", "fig1.nc", "fig2.png",
+                         "fig2.pdf", "fig2.nc", "fig3.png", "fig3.pdf", "fig3.parquet"})
 
 
 def register(sub) -> None:
@@ -65,6 +73,7 @@ def register(sub) -> None:
             f"{DEFAULT_PERIODS:g} periods of the law T(V) of eq. (3)."
         ),
     )
+    add_block_model_option(p)
     add_param_options(p, BlockParams)
     p.add_argument("--t-end", type=float_arg("t_end"), default=None, metavar="T",
                    help="end time of the run (default: first slip + 3.5 periods of T(V))")  # fmt: skip
@@ -95,7 +104,11 @@ def register(sub) -> None:
 
 
 def _law_or_none(p: BlockParams) -> SlipLimit | None:
-    """The accurate eq. (3) at these parameters, or None where it has no slip that ends."""
+    """The accurate eq. (3) at these parameters, or None where it has no slip that ends (or one
+    too stiff or too long to resolve: sqrt(K/M) > 1e4 or Fs > 1000 sigma; or where the threshold
+    is not the constant Fs that eq. (3) starts from)."""
+    if p.threshold != "constant" or math.sqrt(p.K / p.M) > 1e4 or p.Fs / p.sigma > 1e3:
+        return None
     try:
         return solve_slip_limit(p)
     except (ParameterError, NoStopError):
@@ -106,15 +119,20 @@ def default_t_end(p: BlockParams, law: SlipLimit | None) -> float:
     """First start plus 3.5 periods of the law (2 Fs / (K V) per period where eq. (3) has none)."""
     if p.V <= 0.0:
         raise ParameterError("t_end must be given when V = 0 (the block never starts)")
-    period = law.period(p.V) if law is not None else 2.0 * p.Fs / (p.K * p.V)
-    return first_start_time(p) + DEFAULT_PERIODS * float(period)
+    # Without eq. (3): the spring must be loaded by about twice the threshold per cycle.
+    threshold = p.Fs if p.threshold == "constant" else p.sigma
+    period = law.period(p.V) if law is not None else 2.0 * threshold / (p.K * p.V)
+    # A state threshold sigma theta is at most sigma: the first start comes no later than that.
+    if p.threshold == "constant":
+        return first_start_time(p) + DEFAULT_PERIODS * float(period)
+    return p.sigma / (p.K * p.V) + 20 * DEFAULT_PERIODS * float(period)
 
 
 def run_block(args: argparse.Namespace) -> Result:
     """Handler of ``stickslip block``: eq. (1), its slips, Figs. 1-3."""
     # Everything is validated before --out is created, so bad input writes nothing.
-    p = params_from_args(BlockParams, args)
-    every = int(check_number("every", args.every, low=1, integer=True))
+    p = block_params_from_args(args)
+    every = int(check_number("every", args.every, low=1, high=MAX_STEPS, integer=True))
     if args.t_end is not None:
         check_number("t_end", args.t_end, low=0.0)
     if args.fig3 and args.out is None:
@@ -122,6 +140,9 @@ def run_block(args: argparse.Namespace) -> Result:
     law = _law_or_none(p)
     t_end = float(args.t_end) if args.t_end is not None else default_t_end(p, law)
     steps = steps_for(t_end, p.dt)
+    if steps > MAX_BLOCK_STEPS:
+        raise CommandError(f"t_end must be <= {MAX_BLOCK_STEPS * p.dt:g} for the single block (at most "
+                           f"{MAX_BLOCK_STEPS:.0e} steps of dt = {p.dt:g}, for the memory of its slip table)")
     if n_samples(steps, every) > MAX_SAMPLES:
         raise CommandError(
             f"every must be >= {math.ceil(steps / MAX_SAMPLES)} for a run of {steps} steps "
@@ -129,6 +150,7 @@ def run_block(args: argparse.Namespace) -> Result:
         )
     if args.fig3 and law is None:
         raise CommandError("--fig3 needs the period law: eq. (3) has no slip that ends at these parameters")
+    check_out_owned(args.out, lambda n: n in BLOCK_FILES, "a block run")
     out = prepare_out_dir(args.out)
 
     run = simulate_block(p, t_end, every=every)
@@ -143,6 +165,11 @@ def block_report(run: BlockRun, law: SlipLimit | None) -> dict[str, Any]:
     data: dict[str, Any] = run.summary()
     data["params"] = run.params.to_dict()
     data["integrator"] = INTEGRATOR
+    if run.params.threshold == "state":
+        from stickslip.models.presets import PRESETS
+
+        data["model"] = "batista-carlson"
+        data["note"] = PRESETS["batista-carlson"].note
     if law is not None and run.params.V > 0.0:
         T = float(law.period(run.params.V))
         data["period_law"] = {"a": law.law_a, "b": law.law_b, "T": T}
@@ -155,11 +182,14 @@ def block_text(d: dict[str, Any]) -> str:
     """The human summary of ``stickslip block``."""
     p = d["params"]
     lines = [
-        "single block, eq. (1): " + " ".join(f"{k}={v:g}" for k, v in p.items() if k != "dt"),
+        "single block, eq. (1): " + " ".join(f"{k}={v}" if isinstance(v, str) else f"{k}={v:g}"
+                                             for k, v in p.items() if k != "dt"),
         f"Heun dt={d['dt']:g}, t_end={d['t_end']:g} ({d['steps']} steps)",
         f"slips: {d['events']} (starts {d['n_starts']}, stops {d['n_stops']}); "
         f"v in [{d['v_min']:.4g}, {d['v_max']:.4g}]",
     ]
+    if d.get("note"):
+        lines.append(f"note: {d['model']} is {d['note']}")
     if d["events"] > 1:
         law = d.get("period_law")
         vs = f" (law {law['T']:.6g}, {100 * d['period_rel_dev']:+.3f}%)" if law else ""
@@ -239,8 +269,15 @@ def write_block_outputs(out: Path, run: BlockRun, law: SlipLimit | None, *, fig3
 def run_slip_limit(args: argparse.Namespace) -> Result:
     """Handler of ``stickslip slip-limit``: eq. (3), the Heun comparison and the period law."""
     p = params_from_args(BlockParams, args)
-    rtol = check_number("rtol", args.rtol, low=0.0, low_open=True)
-    atol = check_number("atol", args.atol, low=0.0, low_open=True)
+    rtol = check_number("rtol", args.rtol, low=1e-13, high=1e-2)
+    atol = check_number("atol", args.atol, low=0.0, low_open=True, high=1e-2)
+    # Heun resolves the oscillation of the spring only for omega dt = dt sqrt(K/M) well below 1.
+    if p.dt * math.sqrt(p.K / p.M) > 0.5:
+        raise CommandError(f"dt must be <= 0.5 sqrt(M/K) = {0.5 * math.sqrt(p.M / p.K):.3g} for the Heun slip "
+                           f"(got dt={p.dt:g})")
+    # eq. (3) is solved for a slip of a few periods 2 pi sqrt(M/K); huge Fs/sigma slips for ever.
+    if p.Fs / p.sigma > 1e3:
+        raise CommandError(f"Fs must be <= 1000 sigma for eq. (3) (got Fs={p.Fs:g}, sigma={p.sigma:g})")
     try:
         law = solve_slip_limit(p, rtol=rtol, atol=atol)
         heun = heun_slip_limit(p)

@@ -14,10 +14,14 @@ from stickslip.cli._common import (
     add_model_options,
     chain_params_from_args,
     float_arg,
+    int_arg,
     params_from_args,
+    check_out_dir,
+    check_out_owned,
     prepare_out_dir,
 )
-from stickslip.models.params import ChainParams, ParameterError, check_number
+from stickslip.models.params import ChainParams, ParameterError, check_number, steps_for
+from stickslip.run.rundir import OWN_FILES, RunDirBusy, owned_run_dir, remove_own_files
 
 
 def register(sub) -> None:
@@ -34,8 +38,10 @@ def register(sub) -> None:
                    help="exact (default, fast) or dense (reference); both give the same answer bit for bit")
     p.add_argument("--out", metavar="DIR", help="run directory: results, checkpoints, run.json")
     p.add_argument("--resume", metavar="DIR", help="continue the run in DIR from its checkpoint")
-    p.add_argument("--checkpoint-interval", type=float_arg("checkpoint-interval"), default=300.0,
+    p.add_argument("--checkpoint-interval", type=float_arg("checkpoint-interval", "> 0"), default=None,
                    metavar="SECONDS", help="wall-clock seconds between checkpoints (default 300; needs --out)")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace this package's files in --out (other files there are left alone)")
     p.add_argument("--sample-interval", type=float_arg("sample-interval"), default=None, metavar="T",
                    help="sample L = x_1 - x_N every T time units (default 10)")
     p.add_argument("--average-from", type=float_arg("average-from"), default=None, metavar="T",
@@ -44,7 +50,7 @@ def register(sub) -> None:
                    help="store all x_i at time T (repeatable; Fig. 5a)")
     p.add_argument("--profile-window", type=float_arg("profile-window"), default=None, metavar="W",
                    help="store the displacement over windows of W during events (Fig. 6 uses 20)")
-    p.add_argument("--profile-min-blocks", type=int, default=None, metavar="M",
+    p.add_argument("--profile-min-blocks", type=int_arg("profile-min-blocks", ">= 0"), default=None, metavar="M",
                    help="keep profiles only of events with at least M moved blocks")
     p.add_argument("--until-steady", type=float_arg("until-steady"), default=None, metavar="TOL",
                    help="stop once every block slides within TOL of steady sliding (velocities, state "
@@ -63,7 +69,7 @@ def register(sub) -> None:
                    help="end time (default 2e5 for the paper's chain, 2e4 for the plate-driven models)")
     b.add_argument("--start", choices=("paper", "steady", "rest"), default=None,
                    help="initial state (default: the model's; the paper's x=0, v=0.1, theta=0.1 for sakaguchi)")
-    b.add_argument("--repeat", type=int, default=1, help="time each integrator this many times, keep the fastest")
+    b.add_argument("--repeat", type=int_arg("repeat", ">= 1"), default=1, help="time each integrator this many times, keep the fastest")
     b.add_argument("--profile", action="store_true",
                    help="instead: where the exact integrator spends its time on this workload")
     add_json_option(b)
@@ -81,17 +87,35 @@ def _add_run_options(p: argparse.ArgumentParser) -> None:
                    help="with --start steady: uniform perturbation of x and v in [-A, A] (default 0)")
     p.add_argument("--amplitude", type=float_arg("amplitude"), default=None, metavar="A",
                    help="with --start rest: x_i = -A u_i, u_i uniform in [0, 1) (default the model's, 0.01 for CL)")
-    p.add_argument("--seed", type=int, default=None, help="seed of the perturbation or of u_i (default 0)")
+    p.add_argument("--seed", type=int_arg("seed", ">= 0"), default=None, help="seed of the perturbation or of u_i (default 0)")
 
 
-def _summary_text(summary: dict, out: Path | None) -> str:
+def _events_text(summary: dict, N: int | None) -> str:
+    """The events line; a chain with every block moving in an unfinished event is said to slide."""
+    text = f"events         {summary['n_events']}"
+    if summary.get("stopped_early") and summary.get("t_steady") is not None:
+        return text + f"  (then steady sliding from t = {summary['t_steady']:g})"
+    if N is not None and summary["n_moving"] == N:
+        since = summary.get("in_progress_since") if summary["event_in_progress"] else None
+        when = f" since t = {since:g}" if since is not None else ""
+        return text + (f"  (every block moving{when}: the chain slides; --until-steady TOL stops a run "
+                       "once the sliding is steady)")
+    return text + ("  (one in progress)" if summary["event_in_progress"] else "")
+
+
+def _summary_text(summary: dict, out: Path | None, N: int | None = None) -> str:
+    wall = f"wall time      {summary['wall_seconds']:.3g} s"
+    this_run = summary.get("wall_seconds_this_run", summary["wall_seconds"])
+    if this_run < summary["wall_seconds"] - 1e-9:
+        wall = (f"wall time      {summary['wall_seconds_this_run']:.3g} s this run, "
+                f"{summary['wall_seconds']:.3g} s in all (resumed)")
     lines = [
         f"t_end          {summary['t_end']:g}  ({summary['steps']} steps, {summary['integrator']})",
-        f"events         {summary['n_events']}" + ("  (one in progress)" if summary["event_in_progress"] else ""),
+        _events_text(summary, N),
         f"L_final        {summary['L_final']:.6g}   (steady sliding {summary['L_steady']:.6g})",
         f"L_mean         {summary['L_mean']:.6g}   (t >= {summary['L_mean_from']:g})",
         f"moving blocks  {summary['n_moving']}",
-        f"wall time      {summary['wall_seconds']:.3g} s",
+        wall,
         f"state sha256   {summary['state_sha256']}",
     ]
     if summary.get("stopped_early"):
@@ -128,10 +152,18 @@ def run_chain_command(args: argparse.Namespace) -> Result:
                 f"{', '.join(fixed)} cannot be combined with --resume: a resumed run keeps the "
                 "parameters and options it was started with (only --t-end may be raised)"
             )
-        check_number("checkpoint-interval", args.checkpoint_interval, low=0.0, low_open=True)
+        interval = 300.0 if args.checkpoint_interval is None else args.checkpoint_interval
+        check_number("checkpoint-interval", interval, low=0.0, low_open=True)
+        if args.overwrite:
+            raise CommandError("--overwrite cannot be combined with --resume")
+        if args.t_end is not None:
+            check_number("t-end", args.t_end, low=0.0)
         try:
-            run = chain.resume_chain(args.resume, t_end=args.t_end, checkpoint_interval=args.checkpoint_interval,
-                                     progress=progress, handle_signals=True)
+            with owned_run_dir(args.resume):
+                run = chain.resume_chain(args.resume, t_end=args.t_end, checkpoint_interval=interval,
+                                         progress=progress, handle_signals=True)
+        except RunDirBusy as exc:
+            raise CommandError(str(exc)) from None
         except chain.NonFiniteState as exc:
             sys.stderr.write(f"stickslip chain: error: {exc}\n")
             return Result({"error": str(exc)}, "", status=1)
@@ -139,7 +171,8 @@ def run_chain_command(args: argparse.Namespace) -> Result:
             raise CommandError(str(exc)) from None
         except chain.Interrupted as exc:
             return _interrupted(exc, Path(args.resume))
-        return Result(_json_summary(run.summary, Path(args.resume)), _summary_text(run.summary, Path(args.resume)))
+        return Result(_json_summary(run.summary, Path(args.resume)),
+                      _summary_text(run.summary, Path(args.resume), run.params.N))
 
     params = chain_params_from_args(args)
     t_end = 2e4 if args.t_end is None else args.t_end
@@ -150,7 +183,14 @@ def run_chain_command(args: argparse.Namespace) -> Result:
         if getattr(args, name) is None:
             setattr(args, name, default)
     check_number("t-end", t_end, low=0.0)
-    check_number("checkpoint-interval", args.checkpoint_interval, low=0.0, low_open=True)
+    steps_for(t_end, params.dt, "t-end")
+    if args.out is None:
+        for flag, value in (("--checkpoint-interval", args.checkpoint_interval),
+                            ("--overwrite", args.overwrite or None)):
+            if value is not None:
+                raise CommandError(f"{flag} needs --out (a run without a run directory writes no checkpoints)")
+    interval = 300.0 if args.checkpoint_interval is None else args.checkpoint_interval
+    check_number("checkpoint-interval", interval, low=0.0, low_open=True)
     check_number("profile-min-blocks", args.profile_min_blocks, low=0, integer=True)
     # Validate every option before anything is written.
     chain.RunOptions(t_end=t_end, sample_interval=args.sample_interval, average_from=args.average_from,
@@ -158,24 +198,34 @@ def run_chain_command(args: argparse.Namespace) -> Result:
                      profile_min_blocks=args.profile_min_blocks,
                      until_steady=args.until_steady).validated(params.dt)
     check_number("perturbation", args.perturbation, low=0.0)
-    out = prepare_out_dir(args.out)
-    if out is not None and (out / "checkpoint" / "state.npz").exists():
-        raise CommandError(f"{out} already holds a run; continue it with --resume {out} or choose another --out")
+    out = check_out_dir(args.out)
+    if out is not None and out.is_dir():
+        if (out / "checkpoint" / "state.npz").exists() and not args.overwrite:
+            raise CommandError(f"{out} already holds a run; continue it with --resume {out}, choose another "
+                               "--out or give --overwrite")
+        check_out_owned(out, lambda n: n in OWN_FILES or (n.startswith(".") and n.endswith(".tmp")),
+                        "a chain run", overwrite=args.overwrite)
+    out = prepare_out_dir(out)
     try:
-        run = chain.run_chain(
-            params, t_end, integrator=args.integrator, start=args.start, perturbation=args.perturbation,
-            seed=args.seed, sample_interval=args.sample_interval, average_from=args.average_from,
-            snapshot_times=args.snapshot, profile_window=args.profile_window,
-            profile_min_blocks=args.profile_min_blocks, until_steady=args.until_steady, out_dir=out,
-            checkpoint_interval=args.checkpoint_interval if out else None, progress=progress,
-            handle_signals=out is not None,
-        )
+        with owned_run_dir(out) as run_id:
+            if args.overwrite:
+                remove_own_files(out)
+            run = chain.run_chain(
+                params, t_end, integrator=args.integrator, start=args.start, perturbation=args.perturbation,
+                seed=args.seed, sample_interval=args.sample_interval, average_from=args.average_from,
+                snapshot_times=args.snapshot, profile_window=args.profile_window,
+                profile_min_blocks=args.profile_min_blocks, until_steady=args.until_steady, out_dir=out,
+                checkpoint_interval=interval if out else None, progress=progress,
+                handle_signals=out is not None, run_id=run_id,
+            )
+    except RunDirBusy as exc:
+        raise CommandError(str(exc)) from None
     except chain.ChainRunError as exc:
         sys.stderr.write(f"stickslip chain: error: {exc}\n")
         return Result({"error": str(exc)}, "", status=1)
     except chain.Interrupted as exc:
         return _interrupted(exc, out)
-    return Result(_json_summary(run.summary, out), _summary_text(run.summary, out))
+    return Result(_json_summary(run.summary, out), _summary_text(run.summary, out, params.N))
 
 
 def _start_of(params, args) -> tuple[str, float, int]:
@@ -188,6 +238,8 @@ def _start_of(params, args) -> tuple[str, float, int]:
         raise CommandError("--amplitude goes with --start rest (use --perturbation with --start steady)")
     if args.perturbation is not None and start != "steady":
         raise CommandError("--perturbation goes with --start steady (use --amplitude with --start rest)")
+    if args.seed is not None and start == "paper":
+        raise CommandError("--seed goes with --start steady or --start rest (the paper's start draws no numbers)")
     if start == "rest":
         amplitude = args.amplitude if args.amplitude is not None else preset.start_options.get("amplitude", 0.0)
         check_number("amplitude", amplitude, low=0.0)
@@ -215,7 +267,8 @@ def run_bench_command(args: argparse.Namespace) -> Result:
     check_number("repeat", args.repeat, low=1, integer=True)
     params = chain_params_from_args(args)
     t_end = args.t_end if args.t_end is not None else (2e4 if params.drive == "plate" else 2e5)
-    check_number("t-end", t_end, low=0.0)
+    check_number("t-end", t_end, low=0.0, low_open=True)
+    steps_for(t_end, params.dt, "t-end")
     args.perturbation = getattr(args, "perturbation", None)
     args.amplitude = None
     args.seed = None

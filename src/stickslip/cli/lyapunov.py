@@ -13,11 +13,11 @@ from stickslip.cli._common import (
     CommandError,
     Result,
     add_json_option,
-    add_param_options,
+    add_model_options,
+    chain_params_from_args,
     float_arg,
-    params_from_args,
 )
-from stickslip.models.params import ChainParams, ParameterError, check_number
+from stickslip.models.params import ParameterError, check_number
 
 
 def register(sub) -> None:
@@ -32,12 +32,13 @@ def register(sub) -> None:
             "with the standard error of the means of M segments. See docs/lyapunov.md."
         ),
     )
-    add_param_options(p, ChainParams)
-    p.add_argument("--start", choices=("paper", "steady"), default="paper",
-                   help="initial state: the paper's (default) or exact steady sliding")
-    p.add_argument("--perturbation", type=float_arg("perturbation"), default=0.0, metavar="A",
-                   help="with --start steady: uniform perturbation of x and v in [-A, A] (default 0)")
-    p.add_argument("--seed", type=int, default=0, help="seed of the perturbation (default 0)")
+    add_model_options(p)
+    p.add_argument("--start", choices=("paper", "steady", "rest"), default=None,
+                   help="initial state (default: the model's; the paper's for sakaguchi, rest for the plate drive)")
+    p.add_argument("--perturbation", type=float_arg("perturbation"), default=None, metavar="A",
+                   help="with --start steady: uniform perturbation of x and v in [-A, A] (default 0); with "
+                        "--start rest: x_i = -A u_i (default the model's, 0.01 for Carlson-Langer)")
+    p.add_argument("--seed", type=int, default=None, help="seed of the perturbation (default the model's, 0)")
     p.add_argument("--t-end", type=float_arg("t-end"), default=2e4, metavar="T", help="end time (default 2e4)")
     p.add_argument("--interval", type=float_arg("interval"), default=10.0, metavar="TAU",
                    help="time between renormalisations (default 10)")
@@ -90,8 +91,18 @@ def run_lyapunov_command(args: argparse.Namespace) -> Result:
     """Handler of `stickslip lyapunov`."""
     from stickslip.analysis import lyapunov as ly
 
-    params = params_from_args(ChainParams, args)
+    from stickslip.models.presets import PRESETS
+
+    params = chain_params_from_args(args)
+    preset = PRESETS[params.model]
+    if args.start is None:
+        args.start = preset.start
+    if args.perturbation is None:
+        args.perturbation = preset.start_options.get("amplitude", 0.0) if args.start == "rest" else 0.0
+    if args.seed is None:
+        args.seed = preset.start_options.get("seed", 0)
     check_number("perturbation", args.perturbation, low=0.0)
+    check_number("seed", args.seed, low=0, integer=True)
     if args.plot and not args.betas:
         raise CommandError("--plot needs --betas")
     if args.convergence and args.betas:
@@ -125,4 +136,10 @@ def run_lyapunov_command(args: argparse.Namespace) -> Result:
         return Result(data, text)
     res = ly.largest_lyapunov(params, args.t_end, progress=not args.no_progress, **kw)
     data = res.to_dict()
+    if data["merges"]:
+        import sys
+
+        sys.stderr.write(f"stickslip lyapunov: warning: the twin fell onto the reference {data['merges']} times "
+                         f"(d0 = {args.d0:g} at the rounding floor, or sticking contracts to a point); "
+                         "try a larger --d0\n")
     return Result(data, _result_text(data))

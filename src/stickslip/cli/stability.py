@@ -13,6 +13,7 @@ V_up and V_down; ``--out DIR`` writes the bifurcation diagram.
 from __future__ import annotations
 
 import argparse
+import math
 from pathlib import Path
 from typing import Any
 
@@ -27,13 +28,16 @@ from stickslip.cli._common import (
     Result,
     add_json_option,
     add_model_options,
+    add_block_model_option,
     add_param_options,
+    block_params_from_args,
     chain_params_from_args,
     float_arg,
     params_from_args,
+    check_out_dir,
     prepare_out_dir,
 )
-from stickslip.models.params import BlockParams, ChainParams, check_number
+from stickslip.models.params import BlockParams, ChainParams, ParameterError, check_number
 from stickslip.run.block import INTEGRATOR
 
 #: Points of the stability map (beta x V) and of the Hopf curve.
@@ -99,6 +103,7 @@ def register(sub) -> None:
             "Fs = 3, K = 10), and V_down, where it starts again going down."
         ),
     )
+    add_block_model_option(h)
     add_param_options(h, BlockParams, skip=("V",))
     h.add_argument("--V-min", dest="V_min", type=float_arg("V_min"), default=hy.DEFAULT_V_MIN,
                    help=f"lowest V (default {hy.DEFAULT_V_MIN:g})")  # fmt: skip
@@ -135,9 +140,18 @@ def run_stability_block(args: argparse.Namespace) -> Result:
     """Handler of ``stickslip stability block``: Hopf point and eigenvalues of eq. (2)."""
     with_V = args.param_V is not None
     p = params_from_args(BlockParams, args)
-    out = prepare_out_dir(args.out)
-
-    hopf = st.hopf_point(p)
+    check_out_dir(args.out)
+    if args.out is not None:
+        with np.errstate(all="ignore"):
+            beta_limit = st.hopf_beta_limit(p)
+        if not math.isfinite(beta_limit):
+            raise CommandError(f"K must be small enough for the stability map's beta range to be finite "
+                               f"(got K={p.K:g}: the Hopf limit of beta overflows)")
+    try:
+        hopf = st.hopf_point(p)
+    except ParameterError as exc:
+        raise CommandError(f"no Hopf point at K={p.K:g}, beta={p.beta:g}, alpha={p.alpha:g} "
+                           f"(steady sliding cannot be linearised there: {exc})") from None
     params = {k: v for k, v in p.to_dict().items() if k not in ("Fs", "dt") and (with_V or k != "V")}
     data: dict[str, Any] = {
         "params": params,
@@ -149,6 +163,7 @@ def run_stability_block(args: argparse.Namespace) -> Result:
     }
     if _is_paper_block(p):
         data["paper_hopf_V"] = 0.106
+    out = prepare_out_dir(args.out)
     if with_V:
         s = st.block_stability(p)
         data.update(V=p.V, theta0=s.theta0, eigenvalues=_eig_list(s.eigenvalues),
@@ -213,7 +228,7 @@ def run_stability_chain(args: argparse.Namespace) -> Result:
     with_N = args.param_N is not None
     D = args.param_D
     # dt is never read by the linear analysis; keep ChainParams' explicit-step check out of the way.
-    overrides = {"dt": 0.5 / D} if D is not None and D > 0.0 and D * 0.005 > 0.5 else {}
+    overrides = {"dt": 1.0 / (2.0 * D + 1.0)} if D is not None and D > 0.0 and (2.0 * D + 1.0) * 0.005 > 1.0 else {}
     p = chain_params_from_args(args, **overrides)
     if p.friction != "state":
         return run_stability_modes(args, p)
@@ -355,11 +370,16 @@ def _modes_text(d: dict[str, Any]) -> str:
 
 def run_hysteresis(args: argparse.Namespace) -> Result:
     """Handler of ``stickslip hysteresis``: the adiabatic sweep of V of section 2."""
-    p = params_from_args(BlockParams, args)
+    p = block_params_from_args(args)
     settings = hy.SweepSettings(
         V_min=args.V_min, V_max=args.V_max, dV=args.dV,
         time_per_step=args.time_per_step, transient=args.transient,
     )  # fmt: skip
+    from stickslip.cli.block import MAX_BLOCK_STEPS
+
+    if settings.time_per_step + settings.transient > MAX_BLOCK_STEPS * p.dt:
+        raise CommandError(f"time_per_step + transient must be <= {MAX_BLOCK_STEPS * p.dt:g} (at most "
+                           f"{MAX_BLOCK_STEPS:.0e} steps of dt = {p.dt:g} per value of V)")
     out = prepare_out_dir(args.out)
 
     result = hy.hysteresis_sweep(p, settings)
@@ -390,7 +410,7 @@ def _hysteresis_text(d: dict[str, Any]) -> str:
 
     lines = [
         "single block, adiabatic sweep of V: "
-        + " ".join(f"{k}={v:g}" for k, v in d["params"].items() if k != "dt"),
+        + " ".join(f"{k}={v}" if isinstance(v, str) else f"{k}={v:g}" for k, v in d["params"].items() if k != "dt"),
         f"V from {s['V_min']:g} to {s['V_max']:g} and back, dV = {s['dV']:g}, "
         f"{s['time_per_step']:g} time units per V (first {s['transient']:g} discarded)",
         f"V_up (stick-slip ends going up) = {fmt(d['V_up'])}"

@@ -16,7 +16,7 @@ import itertools
 from typing import Any
 
 from stickslip.cli._common import CommandError, Result, add_json_option, prepare_out_dir
-from stickslip.models.params import BlockParams, ChainParams, check_number
+from stickslip.models.params import MAX_STEPS, BlockParams, ChainParams, check_number
 
 # Run options a point may carry besides the model parameters, with their value types.
 _OPTIONS: dict[str, dict[str, type]] = {
@@ -46,8 +46,9 @@ def register(sub) -> None:
             "skipped when the command is run again; a failed point is reported and the others go on."
         ),
         epilog=(
-            "example: stickslip sweep chain --grid beta=0.2,0.6,1.0,1.2 --set N=99 "
-            "--t-end 20000 --set average_from=10000 --out sweeps/L-beta"
+            "example: stickslip sweep chain --grid beta=0.2,0.6,1.0,1.2 --set N=49 "
+            "--t-end 3e5 --set average_from=1.5e5 --out sweeps/L-beta (N = 49 loads until "
+            "L_ss / V ~ 1.2e5: run and average beyond that)"
         ),
     )
     parser.add_argument("model", choices=("chain", "block"), help="which system to run")
@@ -145,8 +146,38 @@ def parse_grid(
     from stickslip.experiments.sweep import point_params
 
     for point in points:
-        point_params(model, {**common, **point})  # raises ParameterError
+        settings = {**common, **point}
+        params = point_params(model, settings)  # raises ParameterError
+        _check_options(model, params, settings)
     return points, common
+
+
+def _check_options(model: str, params, settings: dict[str, Any]) -> None:
+    """Validate a point's run options as the point's run will (so nothing fails later)."""
+    from stickslip.models.params import ParameterError, steps_for
+
+    if model == "block":
+        steps_for(settings["t_end"], params.dt)
+        check_number("every", settings.get("every", 1), low=1, high=MAX_STEPS, integer=True)
+        return
+    from stickslip.run.driver import INTEGRATORS, STARTS, RunOptions
+
+    for name, allowed in (("integrator", INTEGRATORS), ("start", STARTS)):
+        if name in settings and settings[name] not in allowed:
+            raise ParameterError(f"{name} must be one of {', '.join(allowed)} (got {settings[name]!r})")
+    RunOptions(t_end=settings["t_end"], sample_interval=settings.get("sample_interval", 10.0),
+               average_from=settings.get("average_from"), profile_window=settings.get("profile_window"),
+               profile_min_blocks=settings.get("profile_min_blocks", 0)).validated(params.dt)
+
+
+def _check_scheduler(address: str | None) -> None:
+    """A scheduler address must read HOST:PORT (or a scheme://HOST:PORT)."""
+    if address is None:
+        return
+    import re
+
+    if not re.fullmatch(r"([a-z+]+://)?[^\s:/]+:\d{1,5}", address.strip()):
+        raise CommandError(f"--scheduler must be an address HOST:PORT, e.g. tcp://127.0.0.1:8786 (got {address!r})")
 
 
 def run(args: argparse.Namespace) -> Result:
@@ -157,6 +188,7 @@ def run(args: argparse.Namespace) -> Result:
     workers = None
     if args.workers is not None:
         workers = check_number("--workers", args.workers, low=1, integer=True)
+    _check_scheduler(args.scheduler)
     out = prepare_out_dir(args.out)
     task = chain_task if args.model == "chain" else block_task
     try:

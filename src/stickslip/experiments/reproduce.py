@@ -44,9 +44,13 @@ from stickslip.experiments.specs import (
     UNTIL_STEADY,
     Experiment,
     Outcome,
-    chain_common as _chain_common,
-    point_settings as _point_settings,
     experiments,
+)
+from stickslip.experiments.specs import (
+    chain_common as _chain_common,
+)
+from stickslip.experiments.specs import (
+    point_settings as _point_settings,
 )
 from stickslip.models.params import BlockParams, ChainParams
 from stickslip.plotting.figures import draw_figures

@@ -40,6 +40,7 @@ __all__ = [
     "MODES",
     "study",
     "study_point_task",
+    "study_command",
     "loading_time",
     "CHECKPOINT_INTERVAL",
 ]
@@ -186,6 +187,11 @@ def study(name: str, mode: str = "quick") -> Study:
     if mode not in MODES:
         raise ValueError(f"mode must be one of {', '.join(MODES)} (got {mode!r})")
     return _BUILDERS[name](mode)
+
+
+def study_command(name: str, mode: str) -> str:
+    """The command line that computes study ``name`` in ``mode`` (shown beside each figure)."""
+    return f"stickslip study {name} --{mode} --out DIR"
 
 
 # ---------------------------------------------------------------------------------------------

@@ -14,7 +14,7 @@ import numpy as np
 import pandas as pd
 
 from stickslip.analysis.order import power_law_fit, transition_bracket
-from stickslip.experiments.studies import Study
+from stickslip.experiments.studies import Study, study_command
 
 __all__ = ["conclusions", "draw"]
 
@@ -143,7 +143,6 @@ def _exponents(table: pd.DataFrame) -> dict[str, Any]:
 
 def draw(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[dict[str, Any]]:
     """Draw the study's figures into ``page_dir`` (PNG and PDF); returns their descriptions."""
-    from stickslip.experiments.study_run import study_command
     from stickslip.plotting import studies as pl
     from stickslip.plotting.style import save_figure
 

@@ -25,7 +25,7 @@ import numpy as np
 import pandas as pd
 
 from stickslip import __version__, io
-from stickslip.experiments.studies import Study, study, study_point_task
+from stickslip.experiments.studies import Study, study, study_command, study_point_task
 from stickslip.jsonable import to_jsonable
 
 __all__ = ["run_study", "study_command", "TABLE_COLUMNS"]
@@ -39,11 +39,6 @@ TABLE_COLUMNS = {
     "exponents": ["model", "N", "beta", "tau", "tau_err", "s_min", "s_max", "n_fit", "n_events", "excess",
                   "observed", "expected", "n_spanning", "S_max", "t_end"],
 }
-
-
-def study_command(name: str, mode: str) -> str:
-    """The command line that computes study ``name`` in ``mode``."""
-    return f"stickslip study {name} --{mode} --out DIR"
 
 
 def _log(enabled: bool, t0: float, text: str) -> None:
@@ -68,14 +63,14 @@ def run_study(
     Progress goes to stderr when ``progress`` and stderr is a terminal. Returns the table as
     records, the conclusions, failed points with their errors, paths and times.
     """
-    from stickslip.experiments.sweep import run_sweep
+    from stickslip.experiments.sweep import _on_terminal, run_sweep
 
     t0 = time.perf_counter()
     spec = study(spec, mode) if isinstance(spec, str) else spec
     out = Path(out_dir)
     run_dir = out / "runs" / spec.dirname
     page_dir = out / spec.name
-    show = progress and sys.stderr.isatty()
+    show = progress and _on_terminal()
     for p in spec.points:  # validate every point before any work starts
         from stickslip.experiments.studies import point_params, point_run_options
 

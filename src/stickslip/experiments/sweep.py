@@ -28,6 +28,7 @@ import re
 import sys
 import time
 import traceback
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Iterable
@@ -39,6 +40,7 @@ from stickslip import __version__
 from stickslip.io import read_json, run_metadata, write_dataset, write_json, write_table
 from stickslip.jsonable import to_jsonable
 from stickslip.models.params import BlockParams, ChainParams
+from stickslip.run.errors import ShortRunWarning
 
 __all__ = [
     "run_sweep",
@@ -155,8 +157,11 @@ def _run_point(task: Task, point: dict[str, Any], common: dict[str, Any], point_
     return record
 
 
-def _row(point: dict[str, Any], name: str, record: dict[str, Any], reused: bool) -> dict[str, Any]:
+def _row(point: dict[str, Any], name: str, record: dict[str, Any], reused: bool,
+         common: dict[str, Any] | None = None) -> dict[str, Any]:
     row: dict[str, Any] = dict(point)
+    for key, value in (common or {}).items():  # the fixed settings (--set, t_end) after the grid values
+        row.setdefault(key, value)
     row.update(point_dir=name, status=record.get("status", "failed"), reused=reused,
                error=record.get("error"), wall_seconds=record.get("wall_seconds", math.nan))
     for key, value in (record.get("summary") or {}).items():
@@ -227,7 +232,8 @@ def run_sweep(
     again. Points run on a new local cluster (``n_workers`` processes, default one per core,
     one thread each) or, with ``scheduler`` = address, on an existing cluster. Progress
     (points done / total, time left) goes to stderr. Writes ``summary.parquet`` and
-    ``summary.csv`` in ``out_dir``: one row per point with its parameters, ``status``
+    ``summary.csv`` in ``out_dir``: one row per point with its parameters, the fixed settings of
+    ``common``, ``status``
     ("ok"/"failed"), ``reused``, ``error``, ``wall_seconds`` and the task's summary fields.
     """
     start = time.perf_counter()
@@ -242,6 +248,8 @@ def run_sweep(
         raise ValueError(f"n_workers must be >= 1 (got {n_workers})")
     out.mkdir(parents=True, exist_ok=True)
 
+    if task is chain_task:
+        _warn_short_chain_runs(points, common, names)
     specs = [_spec(task, p, common) for p in points]
     records: list[dict[str, Any] | None] = [_read_done(out / n, s) for n, s in zip(names, specs)]
     reused = [r is not None for r in records]
@@ -251,8 +259,8 @@ def run_sweep(
         _compute(task, points, common, out, names, specs, pending, records,
                  scheduler=scheduler, n_workers=n_workers, progress=progress)
 
-    rows = [_row(p, n, r, u) for p, n, r, u in zip(points, names, records, reused)]  # type: ignore[arg-type]
-    table = _table(rows, points)
+    rows = [_row(p, n, r, u, common) for p, n, r, u in zip(points, names, records, reused)]  # type: ignore[arg-type]
+    table = _table(rows, points + [common])
     write_table(out / f"{SUMMARY_NAME}.parquet", table)
     _write_csv(out / f"{SUMMARY_NAME}.csv", table)
     n_failed = int((table["status"] != "ok").sum()) if len(table) else 0
@@ -324,12 +332,18 @@ def _compute(task, points, common, out, names, specs, pending, records, *, sched
 
 
 def _progress_bar(total: int, done: int, enabled: bool):
-    if not enabled:
+    """A bar of finished points on stderr, only when asked and stderr is a terminal (not a log)."""
+    if not (enabled and _on_terminal()):
         return None
     from tqdm import tqdm
 
-    return tqdm(total=total, initial=done, desc="points", unit="point", file=sys.stderr,
+    return tqdm(total=total, initial=done, desc="points", unit=" points", file=sys.stderr,
                 dynamic_ncols=True, smoothing=0.1)
+
+
+def _on_terminal() -> bool:
+    """Whether stderr is a terminal: progress bars would garble a log file."""
+    return sys.stderr.isatty()
 
 
 # ---------------------------------------------------------------------------------------------
@@ -361,14 +375,8 @@ def _split(point: dict[str, Any], params_cls: type, options: tuple[str, ...]) ->
     return params, run_options
 
 
-def chain_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
-    """Run the chain of eq. (4) at one point; its outputs go to ``point_dir``; returns its summary.
-
-    ``point`` holds :class:`~stickslip.models.params.ChainParams` fields, ``t_end`` and optionally the
-    run options in :data:`CHAIN_RUN_OPTIONS`.
-    """
-    from stickslip.run import driver as chain  # imported here: workers load the simulator only when needed
-
+def _chain_run_args(point: dict[str, Any]) -> tuple[ChainParams, float, dict[str, Any]]:
+    """The parameters, run length and run options of a chain point (the model's start by default)."""
     from stickslip.models.presets import PRESETS
 
     params, options = _split(point, ChainParams, CHAIN_RUN_OPTIONS)
@@ -378,7 +386,34 @@ def chain_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
         options["start"] = preset.start
         options["perturbation"] = preset.start_options.get("amplitude", 0.0)
         options["seed"] = preset.start_options.get("seed", 0)
-    run = chain.run_chain(params, t_end, out_dir=point_dir, **options)
+    return params, t_end, options
+
+
+def _warn_short_chain_runs(points: list[dict[str, Any]], common: dict[str, Any], names: list[str]) -> None:
+    """One :class:`ShortRunWarning` per chain point too short to leave the loading (run.state.loading_warnings)."""
+    from stickslip.run.state import loading_warnings
+
+    for point, name in zip(points, names):
+        try:
+            params, t_end, options = _chain_run_args({**common, **point})
+        except (ValueError, TypeError):
+            continue  # the point itself reports its error when it runs
+        for message in loading_warnings(params, t_end, options.get("average_from"), options["start"]):
+            warnings.warn(f"{name}: {message}", ShortRunWarning, stacklevel=3)
+
+
+def chain_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
+    """Run the chain of eq. (4) at one point; its outputs go to ``point_dir``; returns its summary.
+
+    ``point`` holds :class:`~stickslip.models.params.ChainParams` fields, ``t_end`` and optionally the
+    run options in :data:`CHAIN_RUN_OPTIONS`.
+    """
+    from stickslip.run import driver as chain  # imported here: workers load the simulator only when needed
+
+    params, t_end, options = _chain_run_args(point)
+    with warnings.catch_warnings():  # said once, by run_sweep, before the points run
+        warnings.simplefilter("ignore", ShortRunWarning)
+        run = chain.run_chain(params, t_end, out_dir=point_dir, **options)
     if not (Path(point_dir) / "run.json").exists():
         chain.write_run(run, point_dir)
     return dict(run.summary)

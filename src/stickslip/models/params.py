@@ -23,7 +23,7 @@ def _range_text(low: float | None, high: float | None, low_open: bool, high_open
         parts.append(f"{'>' if low_open else '>='} {low:g}")
     if high is not None:
         parts.append(f"{'<' if high_open else '<='} {high:g}")
-    return " and ".join(parts) if parts else "finite"
+    return " and ".join(parts)
 
 
 def check_number(
@@ -42,21 +42,38 @@ def check_number(
     """
     allowed = _range_text(low, high, low_open, high_open)
     kind = "an integer" if integer else "a finite number"
+    wanted = f"{kind} {allowed}".rstrip()
+    shown = _shown(value)
     try:
         number = float(value)
-    except (TypeError, ValueError):
-        raise ParameterError(f"{name} must be {kind} {allowed} (got {value!r})") from None
+    except (TypeError, ValueError, OverflowError):
+        raise ParameterError(f"{name} must be {wanted} (got {shown})") from None
     if not math.isfinite(number):
-        raise ParameterError(f"{name} must be {kind} {allowed} (got {value!r})")
+        raise ParameterError(f"{name} must be {wanted} (got {shown})")
     if integer:
         if number != int(number):
-            raise ParameterError(f"{name} must be {kind} {allowed} (got {value!r})")
+            raise ParameterError(f"{name} must be {wanted} (got {shown})")
         number = int(number)
     too_low = low is not None and (number <= low if low_open else number < low)
     too_high = high is not None and (number >= high if high_open else number > high)
     if too_low or too_high:
-        raise ParameterError(f"{name} must be {allowed} (got {value!r})")
+        raise ParameterError(f"{name} must be {allowed} (got {shown})")
     return number
+
+
+def _shown(value: Any) -> str:
+    """A value for an error message, huge integers in short form."""
+    if isinstance(value, int) and not isinstance(value, bool) and abs(value) >= 10**16:
+        return f"{float(value):.6g}"
+    text = repr(value)
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
+#: Largest number of time steps of one run (MODEL.md's longest run, t = 2e7 at dt = 0.005, is 4e9):
+#: far inside int64, and times n dt stay exact to the step.
+MAX_STEPS = 10**12
+#: Largest chain (blocks).
+MAX_BLOCKS = 1_000_000
 
 
 def _positive(default: float, doc: str) -> Any:
@@ -127,6 +144,18 @@ class BlockParams(_Validated):
     M: float = _positive(1.0, "block mass M")
     sigma: float = _positive(1.0, "state-variable friction scale sigma")
     dt: float = _positive(0.005, "Heun time step dt")
+    threshold: str = field(default="constant", metadata={
+        "choices": ("constant", "state"),
+        "doc": "static threshold: constant (Fs) or state (sigma theta: the paper's reading of Batista-Carlson)"})
+
+    def to_dict(self) -> dict[str, Any]:
+        """All parameters; the threshold only when it is not the paper's constant Fs."""
+        d = dataclasses.asdict(self)
+        if self.threshold == "constant":
+            d.pop("threshold")
+        else:
+            d.pop("Fs")
+        return d
 
     def scaled(self) -> "BlockParams":
         """The same system in the units M = sigma = 1 of section 2 (see :func:`scale_block`)."""
@@ -180,7 +209,8 @@ class ChainParams(_Validated):
     their defaults and left out of :meth:`to_dict`.
     """
 
-    N: int = field(default=399, metadata={"low": 1, "integer": True, "doc": "number of blocks N"})
+    N: int = field(default=399, metadata={"low": 1, "high": MAX_BLOCKS, "integer": True,
+                                          "doc": "number of blocks N"})
     K: float = _positive(10.0, "spring constant K")
     D: float = _nonnegative(5.0, "diffusion constant D of the state variable")
     V: float = _nonnegative(0.001, "pulling velocity V of the first spring")
@@ -206,10 +236,11 @@ class ChainParams(_Validated):
             check_composition(self.drive, self.friction, self.threshold, self.ends)
         except CompositionError as exc:
             raise ParameterError(str(exc)) from None
-        # Heun's diffusion part is stable only for D dt <= 1/2 (explicit scheme).
-        if self.friction == "state" and self.D * self.dt > 0.5:
+        # Heun keeps every theta_i in [0, 1] if (2 D + 1) dt <= 1 (docs/limits.md).
+        if self.friction == "state" and (2.0 * self.D + 1.0) * self.dt > 1.0:
             raise ParameterError(
-                f"D*dt must be <= 0.5 for a stable explicit step (got D={self.D:g}, dt={self.dt:g})"
+                f"D*dt must be <= (1 - dt)/2 = {(1.0 - self.dt) / 2:g} so that theta stays in [0, 1] "
+                f"(got D={self.D:g}, dt={self.dt:g})"
             )
 
     @property
@@ -243,6 +274,10 @@ class ChainParams(_Validated):
 
 
 def steps_for(t_end: float, dt: float, name: str = "t_end") -> int:
-    """Number of steps n with t_n = n dt reaching ``t_end`` (rounded to the nearest step)."""
+    """Number of steps n with t_n = n dt reaching ``t_end`` (rounded to the nearest step);
+    at most :data:`MAX_STEPS`."""
     t_end = check_number(name, t_end, low=0.0)
+    if t_end / dt > MAX_STEPS + 0.5:
+        raise ParameterError(f"{name} must be <= {MAX_STEPS * dt:g} (at most {MAX_STEPS:.0e} steps of dt = {dt:g}; "
+                             f"got {t_end:g})")
     return int(round(t_end / dt))

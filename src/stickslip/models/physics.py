@@ -109,3 +109,17 @@ def chain_steady_profile_paper(p: ChainParams, t: float = 0.0) -> np.ndarray:
 def chain_steady_length_paper(p: ChainParams) -> float:
     """The paper's L = {1 - (1 - beta) V} N^2 / 2 as printed (it lacks the factor 1/K; MODEL.md)."""
     return sliding_friction(p.V, p.beta) * p.N**2 / 2.0
+
+
+def loading_time(p: ChainParams) -> float:
+    """Time the end drive takes to stretch the chain to its steady length from x_i = 0: L_ss / V.
+
+    From the paper's start (x_i(0) = 0, section 3) the pulling point x_0 = V t has to move by about
+    L_ss (:func:`chain_steady_length`) before the far blocks load and the chain reaches its
+    stick-slip state; 4.85e5 for N = 99, 1.18e5 for N = 49 and 7.9e6 for the paper's N = 399.
+    NaN for the plate drive (it loads every block at once), for V = 0 and where there is no steady
+    sliding.
+    """
+    if p.drive != "end" or not p.V > 0 or not has_steady_state(p):
+        return float("nan")
+    return chain_steady_length(p) / p.V

@@ -65,7 +65,7 @@ PRESETS: dict[str, Preset] = {
         symbols={"l": "sqrt(K)", "nu": "V", "alpha": "alpha", "sigma": "sigma"},
     ),
     "train": Preset(
-        "train", "the train model (Elmer): the paper's chain with constant friction", 
+        "train", "the train model (Elmer): the paper's chain with constant friction",
         dict(drive="end", friction="strengthening", threshold="constant", ends="free"),
         dict(N=399, K=10.0, V=0.001, beta=1.0, F0=1.0, Fs=3.0, dt=0.005),
         "paper",
@@ -140,3 +140,29 @@ def model_symbols(p) -> dict[str, float]:
     if "nu" in pr.symbols:
         out["nu"] = p.V
     return out
+
+
+# Presets that are a single block of eq. (1): their chain form has N = 1, the end drive, state
+# friction and a free end, which is eq. (1) with M = sigma = 1.
+SINGLE_BLOCK = ("sakaguchi", "batista-carlson")
+
+
+def block_params(model: str = "sakaguchi", **overrides: Any):
+    """Validated :class:`~stickslip.models.params.BlockParams` of a single-block preset.
+
+    ``sakaguchi`` is the paper's block of section 2 (its defaults); ``batista-carlson`` the same
+    equations with the state threshold sigma theta and its preset's K, V, beta, alpha.
+    """
+    from stickslip.models.params import BlockParams, ParameterError
+
+    if model not in SINGLE_BLOCK:
+        raise ParameterError(
+            f"model must be one of {', '.join(SINGLE_BLOCK)} for a single block (got {model!r}); "
+            "run the others with `stickslip chain --model NAME`")
+    values: dict[str, Any] = {}
+    if model == "batista-carlson":
+        pr = PRESETS[model]
+        values = {k: pr.params[k] for k in ("K", "V", "beta", "alpha", "dt")}
+        values["threshold"] = "state"
+    values.update(overrides)
+    return BlockParams(**values)

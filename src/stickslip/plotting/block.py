@@ -18,16 +18,16 @@ from stickslip.run.block import BlockRun
 
 
 def _param_text(p) -> str:
-    return f"K={p.K:g}, V={p.V:g}, beta={p.beta:g}, Fs={p.Fs:g}"
+    return rf"$K={p.K:g}$, $V={p.V:g}$, $\beta={p.beta:g}$, $F_s={p.Fs:g}$"
 
 
 def fig1_position(run: BlockRun) -> Figure:
     """Fig. 1: time evolution of the block position x(t) in eq. (1) (stick-slip staircase)."""
     fig, ax = new_figure(width=6.0, height=3.6)
     s = run.series
-    ax.plot(s["t"], s["x"], **SIM, label="x(t), eq. (1)")
-    ax.set_xlabel("t")
-    ax.set_ylabel("x")
+    ax.plot(s["t"], s["x"], **SIM, label="$x(t)$, eq. (1)")
+    ax.set_xlabel("$t$")
+    ax.set_ylabel("$x$")
     ax.set_xlim(0.0, float(s["t"][-1]))
     ax.set_title(f"Fig. 1: single block, {_param_text(run.params)}", fontsize=9)
     return fig
@@ -61,16 +61,16 @@ def fig2_slip(run: BlockRun, limit: SlipLimit, index: int | None = None) -> Figu
     w = slip_window(run, index)
     c = limit.curve
     fig, (ax_v, ax_p) = new_figure(1, 2, width=4.6, height=3.6)
-    ax_v.plot(w["t"], w["v"], **SIM, label=f"eq. (1), V={run.params.V:g}")
+    ax_v.plot(w["t"], w["v"], **SIM, label=f"eq. (1), $V={run.params.V:g}$")
     ax_v.plot(c["t"], c["v"], **THEORY, label="eq. (3)")
-    ax_v.set_xlabel("t - t_c")
-    ax_v.set_ylabel("v")
+    ax_v.set_xlabel("$t - t_c$")
+    ax_v.set_ylabel("$v$")
     ax_v.set_title("(a)", loc="left")
     ax_v.legend()
-    ax_p.plot(w["v"], w["theta"], **SIM, label=f"eq. (1), V={run.params.V:g}")
+    ax_p.plot(w["v"], w["theta"], **SIM, label=f"eq. (1), $V={run.params.V:g}$")
     ax_p.plot(c["v"], c["theta"], **THEORY, label="eq. (3)")
-    ax_p.set_xlabel("v")
-    ax_p.set_ylabel("theta")
+    ax_p.set_xlabel("$v$")
+    ax_p.set_ylabel(r"$\theta$")
     ax_p.set_title("(b)", loc="left")
     ax_p.legend()
     fig.suptitle(f"Fig. 2: one slip, {_param_text(run.params)}", fontsize=9)
@@ -90,18 +90,18 @@ def fig3_period(sweep: pd.DataFrame, limit: SlipLimit) -> Figure:
     V = sweep["V"].to_numpy()
     grid = np.logspace(np.log10(V.min()), np.log10(V.max()), 200)
     ax.plot(grid, limit.period(grid), **THEORY,
-            label=f"T = {limit.law_a:.4f} + {limit.law_b:.4f} / (K V)")  # fmt: skip
+            label=f"$T = {limit.law_a:.4f} + {limit.law_b:.4f} / (KV)$")  # fmt: skip
     ax.plot(V, sweep["period"], "o", color=SIM["color"], ms=5, label="eq. (1), Heun")
     ax.set_xscale("log")
     ax.set_yscale("log")
-    ax.set_ylabel("period T")
+    ax.set_ylabel("period $T$")
     ax.legend()
-    ax.set_title(f"Fig. 3: K={limit.params.K:g}, beta={limit.params.beta:g}, Fs={limit.params.Fs:g}",
+    ax.set_title(rf"Fig. 3: $K={limit.params.K:g}$, $\beta={limit.params.beta:g}$, $F_s={limit.params.Fs:g}$",
                  fontsize=9)  # fmt: skip
     ax_d.axhline(0.0, color="0.5", lw=0.8)
     ax_d.plot(V, 100.0 * sweep["rel_dev"], "o-", color=SIM["color"], ms=4, lw=0.8)
-    ax_d.set_xlabel("V")
-    ax_d.set_ylabel("T_sim / T_law - 1 (%)")
+    ax_d.set_xlabel("$V$")
+    ax_d.set_ylabel(r"$T_{sim} / T_{law} - 1$ (%)")
     return fig
 
 

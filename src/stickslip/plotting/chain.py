@@ -16,7 +16,7 @@ import xarray as xr
 from matplotlib import cm
 from matplotlib.figure import Figure
 
-from stickslip.analysis.statistics import FrontSpeed, PowerLawFit, size_distribution
+from stickslip.analysis.statistics import EdgeSpeed, FrontSpeed, PowerLawFit, central_interval, size_distribution
 from stickslip.models.params import ChainParams
 from stickslip.models.physics import chain_steady_length, chain_steady_profile_paper, chain_steady_state
 from stickslip.plotting.style import PAPER, SIM, THEORY, new_figure
@@ -28,7 +28,7 @@ PAPER_FRONT_SPEED = 1.43
 
 
 def _param_text(p: ChainParams) -> str:
-    return f"N={p.N}, K={p.K:g}, D={p.D:g}, V={p.V:g}, Fs={p.Fs:g}"
+    return f"$N={p.N}$, $K={p.K:g}$, $D={p.D:g}$, $V={p.V:g}$, $F_s={p.Fs:g}$"
 
 
 def _snapshot_array(x: Any, N: int) -> np.ndarray:
@@ -65,11 +65,11 @@ def fig5a_snapshot(x: Any, params: ChainParams, t: float) -> Figure:
     ax_r.axhline(0.0, color="0.6", lw=0.6)
     ax_r.plot(i, xs - exact, **SIM, label="run - exact")
     ax_r.plot(i, paper - exact, **PAPER, label="continuum - exact")
-    ax_r.set_xlabel("i")
+    ax_r.set_xlabel("block $i$")
     ax_r.set_ylabel(r"$x_i - x_i^{ss}$")
     ax_r.set_xlim(1, params.N)
     ax_r.legend(loc="lower left", fontsize=8)
-    fig.suptitle(f"Fig. 5(a): snapshot and steady sliding, beta={params.beta:g}, {_param_text(params)}",
+    fig.suptitle(rf"Fig. 5(a): snapshot and steady sliding, $\beta={params.beta:g}$, {_param_text(params)}",
                  fontsize=9)
     return fig
 
@@ -78,11 +78,13 @@ def fig5b_length(table: pd.DataFrame, params: ChainParams, *, beta_c: float = 1.
     """Fig. 5(b): average total length <L> = <x_1 - x_N> against beta, with steady sliding.
 
     ``table`` has columns ``beta`` and ``L_mean`` (and optionally ``L_err``, drawn as error
-    bars), e.g. a sweep's summary. The dashed line is the exact discrete steady sliding length
-    L = c N (N - 1) / (2K), c = 1 - (1 - beta) V (:func:`~stickslip.models.physics.chain_steady_length`)
-    for the other parameters of ``params``; the paper's printed L = c N^2 / 2 lacks the factor
-    1/K (MODEL.md) and is not drawn. The dotted vertical line marks beta_c = 1, where the
-    long-wave instability sets in (Fig. 4).
+    bars, and ``final_state``), e.g. a sweep's summary. The dashed line is the exact discrete
+    steady sliding length L_ss = (c/K) N (N - 1) / 2 with the steady friction
+    c = 1 - (1 - beta) V (:func:`~stickslip.models.physics.chain_steady_length`) for the other
+    parameters of ``params``; the paper's printed L = c N^2 / 2 lacks the factor 1/K (MODEL.md)
+    and is not drawn. The dotted vertical line marks beta_c = 1, where the long-wave
+    instability sets in (Fig. 4). With ``final_state``, runs above beta_c that had not settled
+    into steady sliding by their end are drawn with open symbols.
     """
     data = table.sort_values("beta")
     beta = data["beta"].to_numpy(dtype=np.float64)
@@ -94,15 +96,24 @@ def fig5b_length(table: pd.DataFrame, params: ChainParams, *, beta_c: float = 1.
     grid = np.linspace(max(lo - pad, 0.0), hi + pad, 200)
     steady = np.array([chain_steady_length(params.replace(beta=float(b))) for b in grid])
     ax.plot(grid, steady, **THEORY,
-            label="steady sliding, L = cN(N-1)/(2K)\n(paper prints cN²/2, without 1/K)")
+            label="steady sliding, $L_{ss} = (c/K)\\,N(N-1)/2$,\n$c = 1 - (1-\\beta)V$ (paper prints $cN^2/2$, "
+                  "without 1/K)")
     ax.errorbar(beta, L, yerr=err, fmt="o-", color=SIM["color"], lw=SIM["lw"], ms=4, capsize=2,
                 label=r"$\langle L\rangle$, run")
+    if "final_state" in data:
+        unsettled = ((beta > beta_c) & (data["final_state"].to_numpy() != "steady sliding"))
+        if unsettled.any():
+            # open symbols over the filled ones: not settled by the end of the run
+            ax.scatter(beta[unsettled], L[unsettled], s=30, facecolors="white", edgecolors=SIM["color"],
+                       zorder=3, label="not settled into steady sliding\nby the end of the run")
     ax.axvline(beta_c, color="0.5", lw=0.8, ls=":")
+    ax.annotate(rf"$\beta_c = {beta_c:g}$ (Fig. 4)", (beta_c, 0.97), xycoords=("data", "axes fraction"),
+                xytext=(-3, 0), textcoords="offset points", ha="right", va="top", fontsize=8, color="0.35")
     ax.set_xlabel(r"$\beta$")
     ax.set_ylabel(r"$L = \langle x_1 - x_N \rangle$")
     ax.set_title("(b)", loc="left")
-    ax.legend(loc="lower right", fontsize=8)
-    fig.suptitle(f"Fig. 5(b): average length against beta, {_param_text(params)}", fontsize=9)
+    ax.legend(loc="lower right", fontsize=7)
+    fig.suptitle(rf"Fig. 5(b): average length against $\beta$, {_param_text(params)}", fontsize=9)
     return fig
 
 
@@ -114,28 +125,56 @@ def _event_profiles(profiles: xr.Dataset, event: int) -> xr.Dataset:
     return sub.isel(row=np.argsort(sub["t"].values, kind="stable"))
 
 
-def _waterfall(ax, sub: xr.Dataset, window: float | None) -> None:
-    """Delta x_i over successive windows, each curve lifted by its window index (Fig. 6)."""
+def _nice(x: float) -> float:
+    """A round number (1, 2 or 5 times a power of ten) not above x."""
+    if not x > 0:
+        return 1.0
+    e = math.floor(math.log10(x))
+    m = x / 10**e
+    return (5.0 if m >= 5 else 2.0 if m >= 2 else 1.0) * 10**e
+
+
+def _advance(edge: EdgeSpeed) -> int:
+    """Number of windows up to the one whose edge first reaches the farthest block."""
+    return int(np.argmax(edge.edges)) + 1
+
+
+def _waterfall(ax, sub: xr.Dataset, window: float | None, edge: EdgeSpeed | None = None) -> None:
+    """Delta x_i over successive windows, each curve lifted by its window index, with a scale bar (Fig. 6).
+
+    Curves are lifted by a little more than the largest Delta x_i, so they do not overlap; the
+    bar at the right gives the Delta x_i scale. ``edge``: the leading edge of each window (marks).
+    """
     dx = sub["dx"].transpose("row", "block").values
     blocks = sub["block"].values if "block" in sub.coords else np.arange(1, dx.shape[1] + 1)
     t = sub["t"].values
     n = dx.shape[0]
     peak = float(np.nanmax(np.abs(dx))) if np.isfinite(dx).any() else 1.0
-    step = 0.6 * peak if peak > 0 else 1.0
+    step = 1.1 * peak if peak > 0 else 1.0
     colors = cm.viridis(np.linspace(0.0, 0.9, max(n, 1)))
     for k in range(n):
         ax.plot(blocks, dx[k] + k * step, color=colors[k], lw=0.9)
+    if edge is not None and len(edge.edges) == n:
+        k = _advance(edge)
+        ax.scatter(edge.edges[:k], np.arange(k) * step, marker="|", s=60, color="C3", zorder=3,
+                   label=rf"leading edge ($\Delta x_i \geq {edge.edge_fraction:g}\,\max_i \Delta x_i$)")
+        ax.legend(loc="upper left", fontsize=7)
     ticks = np.arange(n) * step
     stride = max(1, int(math.ceil(n / 8)))
     ax.set_yticks(ticks[::stride])
     ax.set_yticklabels([f"{t[k] - t[0]:.0f}" for k in range(0, n, stride)])
+    bar = _nice(0.8 * peak)
+    x_bar = blocks.max() + 0.03 * (blocks.max() - blocks.min())
+    ax.vlines([x_bar], 0.0, bar, color="k", lw=2.0, clip_on=False)
+    ax.annotate(rf"$\Delta x_i = {bar:g}$", (x_bar, bar / 2), xytext=(4, 0), textcoords="offset points",
+                rotation=90, va="center", ha="left", fontsize=8, annotation_clip=False)
     w = f"{window:g}" if window else "W"
-    ax.set_ylabel(f"window start t - t_s\n(Δx_i over Δt = {w}; curves {step:.3g} apart)", fontsize=9)
-    ax.set_xlabel("i")
+    ax.set_ylabel(rf"window start $t - t_s$; curves: $\Delta x_i$ over $\Delta t = {w}$", fontsize=9)
+    ax.set_xlabel("block $i$")
     ax.set_xlim(blocks.min(), blocks.max())
 
 
-def _arrivals(ax, first_move: pd.DataFrame, front: FrontSpeed, K: float) -> None:
+def _arrivals(ax, first_move: pd.DataFrame, front: FrontSpeed, K: float, edge: EdgeSpeed | None = None) -> None:
     """First-move time against block, the fitted front, the paper's c and the sound speed."""
     rows = first_move[(first_move["event"] == front.event) & np.isfinite(first_move["t_first"])]
     i = rows["block"].to_numpy()
@@ -146,14 +185,42 @@ def _arrivals(ax, first_move: pd.DataFrame, front: FrontSpeed, K: float) -> None
     line_i = np.array([front.i_min, front.i_max], dtype=np.float64)
     t_anchor = float(front.arrival_time(front.i_min)) - front.t_start
     ax.plot(line_i, front.arrival_time(line_i) - front.t_start, **THEORY,
-            label=f"fit: c = {front.speed:.3g} ± {front.speed_err:.2g}")
+            label=f"fit: $c = {front.speed:.3g} \\pm {front.speed_err:.2g}$")
     ax.plot(line_i, t_anchor + (line_i - front.i_min) / PAPER_FRONT_SPEED, **PAPER,
-            label=f"paper: c = {PAPER_FRONT_SPEED}")
+            label=f"paper: $c = {PAPER_FRONT_SPEED}$")
     sound = math.sqrt(K)
     ax.plot(line_i, t_anchor + (line_i - front.i_min) / sound, color="0.2", lw=0.9, ls="-.",
-            label=f"sound speed √K = {sound:.3g}")
-    ax.set_xlabel("i")
-    ax.set_ylabel("first-move time t - t_s")
+            label=f"sound speed $\\sqrt{{K}} = {sound:.3g}$")
+    if edge is not None:
+        # window ends at which the edge had advanced to a block (upper bounds of its arrival)
+        k = _advance(edge)
+        ax.scatter(edge.edges[:k], np.asarray(edge.times[:k]) - front.t_start, marker="|", s=40, color="C3",
+                   label=f"leading edge of the windows: $c = {edge.speed:.3g}$")
+    ax.set_xlabel("block $i$")
+    ax.set_ylabel("first-move time $t - t_s$")
+    ax.legend(loc="upper left", fontsize=7)
+
+
+def _speed_histogram(ax, speeds: np.ndarray, title: str, level: float = 0.9) -> None:
+    """Per-event front speeds with the paper's c, its percentile and the central ``level`` (Fig. 6)."""
+    x = np.asarray(speeds, dtype=np.float64)
+    x = x[np.isfinite(x)]
+    ax.set_title(title, loc="left", fontsize=9)
+    ax.set_xlabel("front speed $c$ (blocks per time unit)")
+    ax.set_ylabel("events")
+    if x.size == 0:
+        ax.text(0.5, 0.5, "no event", transform=ax.transAxes, ha="center")
+        return
+    ci = central_interval(x, PAPER_FRONT_SPEED, level=level)
+    lo = min(float(x.min()), PAPER_FRONT_SPEED)
+    hi = max(float(x.max()), PAPER_FRONT_SPEED)
+    ax.hist(x, bins=np.linspace(lo - 0.02, hi + 0.02, 31), color=SIM["color"], alpha=0.8,
+            label=f"{x.size} events reaching block $N$")
+    ax.axvspan(ci.lo, ci.hi, color="0.85", zorder=0, label=f"central {100 * level:.0f}%: "
+               f"${ci.lo:.3g}$-${ci.hi:.3g}$")
+    ax.axvline(ci.median, color=SIM["color"], lw=1.0, ls="--", label=f"median ${ci.median:.3g}$")
+    ax.axvline(PAPER_FRONT_SPEED, **{**PAPER, "lw": 1.6},
+               label=f"paper: $c = {PAPER_FRONT_SPEED}$, percentile {ci.percentile:.0f}")
     ax.legend(loc="upper left", fontsize=7)
 
 
@@ -165,33 +232,49 @@ def fig6_fronts(
     *,
     labels: Sequence[str] | None = None,
     window: float | None = 20.0,
+    edges: Sequence[EdgeSpeed | None] | None = None,
+    speeds: pd.DataFrame | None = None,
 ) -> Figure:
     """Fig. 6: rupture fronts, one row per event (the paper: (a) a large, (b) an intermediate event).
 
     Left: the displacement Delta x_i = x_i(t + Delta t) - x_i(t) over successive windows of
     Delta t = ``window`` (20 in the paper) from the event's start, stacked upwards in time like
-    the paper's plot (``profiles``: dim ``row`` with ``event``, ``t`` and ``dx(row, block)``).
-    Right: the time each block first moved against i, the front speed fitted over the far part
-    of the chain (:func:`~stickslip.analysis.statistics.front_speed`), the paper's c = 1.43 and the sound
-    speed sqrt(K) = 3.16 (for K = 10) as slopes from the same point.
+    the paper's plot, with a scale bar for Delta x_i (``profiles``: dim ``row`` with ``event``,
+    ``t`` and ``dx(row, block)``). Right: the time each block first moved against i, the front
+    speed fitted over the far part of the chain (:func:`~stickslip.analysis.statistics.front_speed`),
+    the paper's c = 1.43 and the sound speed sqrt(K) = 3.16 (for K = 10) as slopes from the
+    same point. ``edges`` (one :class:`~stickslip.analysis.statistics.EdgeSpeed` or None per
+    front) marks the leading edge of each window in both panels. ``speeds`` (columns
+    ``c_first_move``, ``c_leading_edge``, one row per event that reached block N) adds a last
+    row: the per-event distribution of c by both definitions, with the paper's value and its
+    percentile.
     """
     fronts = list(fronts)
     if not fronts:
         raise ValueError("give at least one fitted front")
     if labels is None:
         labels = [f"event {f.event}" for f in fronts]
-    fig, axes = new_figure(len(fronts), 2, width=4.8, height=3.8)
-    axes = np.asarray(axes).reshape(len(fronts), 2)
-    for row, (front, label) in enumerate(zip(fronts, labels)):
+    edges = list(edges) if edges is not None else [None] * len(fronts)
+    n_rows = len(fronts) + (1 if speeds is not None else 0)
+    fig, axes = new_figure(n_rows, 2, width=4.8, height=3.8)
+    axes = np.asarray(axes).reshape(n_rows, 2)
+    letters = "abcdefgh"
+    for row, (front, label, edge) in enumerate(zip(fronts, labels, edges)):
         ax_w, ax_t = axes[row]
         sub = _event_profiles(profiles, front.event)
-        _waterfall(ax_w, sub, window)
-        letter = "abcdefgh"[row] if row < 8 else str(row)
+        _waterfall(ax_w, sub, window, edge)
+        letter = letters[row] if row < 8 else str(row)
         t0 = float(sub["t"].values[0])
-        ax_w.set_title(f"({letter}) {label}, t ≈ {t0:.6g}", loc="left", fontsize=9)
-        _arrivals(ax_t, first_move, front, params.K)
+        ax_w.set_title(f"({letter}) {label}, $t_s \\approx {t0:.6g}$", loc="left", fontsize=9)
+        _arrivals(ax_t, first_move, front, params.K, edge)
         ax_t.set_title(f"front: blocks {front.i_min}-{front.i_max}", loc="left", fontsize=9)
-    fig.suptitle(f"Fig. 6: rupture fronts, beta={params.beta:g}, {_param_text(params)}", fontsize=9)
+    if speeds is not None:
+        letter = letters[len(fronts)]
+        _speed_histogram(axes[-1, 0], speeds["c_first_move"].to_numpy(dtype=float),
+                         f"({letter}) per event: first motion, far half")
+        _speed_histogram(axes[-1, 1], speeds["c_leading_edge"].to_numpy(dtype=float),
+                         f"({letter}) per event: leading edge of the windows")
+    fig.suptitle(rf"Fig. 6: rupture fronts, $\beta={params.beta:g}$, {_param_text(params)}", fontsize=9)
     return fig
 
 
@@ -221,23 +304,23 @@ def fig7_8_sizes(
     s_line = np.geomspace(fit.s_min, fit.s_max, 100)
     err = f" ± {fit.tau_err:.2f}" if math.isfinite(fit.tau_err) else ""
     ax_a.loglog(s_line, share * fit.pdf(s_line), **THEORY,
-                label=f"fit: τ = {fit.tau:.2f}{err}\n(S in [{fit.s_min:.3g}, {fit.s_max:.3g}], {fit.n} events)")
+                label=f"fit: $\\tau = {fit.tau:.2f}${err}\n($S \\in [{fit.s_min:.3g}, {fit.s_max:.3g}]$, {fit.n} events)")
     if paper_tau is not None:
         s_mid = math.sqrt(fit.s_min * fit.s_max)
         anchor = share * float(fit.pdf(s_mid))
         ax_a.loglog(s_line, anchor * (s_line / s_mid) ** (-paper_tau), **PAPER,
-                    label=f"paper: slope -{paper_tau:g}")
-    ax_a.set_xlabel("S")
-    ax_a.set_ylabel("p(S)")
+                    label=f"paper: slope $-{paper_tau:g}$")
+    ax_a.set_xlabel("$S$")
+    ax_a.set_ylabel("$p(S)$")
     ax_a.set_title("(a)", loc="left")
     ax_a.legend(loc="lower left", fontsize=8)
 
     t = events["t_start"].to_numpy(dtype=np.float64)
     positive = S > 0
     ax_b.semilogy(t[positive], S[positive], ".", color=SIM["color"], ms=2.0)
-    ax_b.set_xlabel("event time t")
-    ax_b.set_ylabel("S")
+    ax_b.set_xlabel("event start time $t$")
+    ax_b.set_ylabel("$S$")
     ax_b.set_title("(b)", loc="left")
     number = {1.0: "Fig. 7", 0.2: "Fig. 8"}.get(round(float(beta), 6), "Figs. 7, 8")
-    fig.suptitle(f"{number}: slip sizes S = Σ Δx_i at beta = {beta:g}", fontsize=9)
+    fig.suptitle(rf"{number}: slip sizes $S = \sum_i \Delta x_i$ at $\beta = {beta:g}$", fontsize=9)
     return fig

@@ -41,7 +41,7 @@ def family_sizes(panels: Sequence[tuple[str, pd.DataFrame, dict[str, Any]]], *, 
         s_fit = np.geomspace(fit.s_min, fit.s_max, 100)
         err = f" ± {fit.tau_err:.2f}" if math.isfinite(fit.tau_err) else ""
         ax.loglog(s_fit, share * fit.pdf(s_fit), **THEORY,
-                  label=f"τ = {fit.tau:.2f}{err} on [{fit.s_min:.3g}, {fit.s_max:.3g}]")
+                  label=rf"$\tau = {fit.tau:.2f}${err} on $[{fit.s_min:.3g}, {fit.s_max:.3g}]$")
         s_hi = float(np.nanmax(S))
         if s_hi > fit.s_max:
             s_ext = np.geomspace(fit.s_max, s_hi, 50)
@@ -51,10 +51,10 @@ def family_sizes(panels: Sequence[tuple[str, pd.DataFrame, dict[str, Any]]], *, 
         if math.isfinite(stats["s_span"]):
             ex = stats["excess"]
             ax.axvline(stats["s_span"], color="0.5", lw=0.8,
-                       label=f"S ≥ {stats['s_span']:.3g}: {stats['observed']} events, "
+                       label=rf"$S \geq {stats['s_span']:.3g}$: {stats['observed']} events, "
                              f"{ex:.3g}x the power law" if math.isfinite(ex) else "smallest spanning event")
-        ax.set_xlabel("S")
-        ax.set_ylabel("p(S)")
+        ax.set_xlabel("$S$")
+        ax.set_ylabel("$p(S)$")
         ax.set_title(title, fontsize=9, loc="left")
         ax.legend(loc="lower left", fontsize=7)
     return fig

@@ -16,12 +16,11 @@ import pandas as pd
 import xarray as xr
 
 from stickslip import io
-from stickslip.analysis.chain_runs import sweep_table
+from stickslip.analysis.chain_runs import fig6_start_note, sweep_table
 from stickslip.experiments.specs import Outcome
 from stickslip.models.params import ChainParams
 from stickslip.report.commands import block_command, chain_command, hysteresis_command, sweep_command
 from stickslip.report.writer import ReportFigure
-
 
 FORMATS = ("png", "pdf")
 
@@ -142,15 +141,18 @@ def _fig5(o: dict[str, Outcome], a: dict[str, Any], d: Path, mode: str) -> list[
     steady_note = ", ".join(f"{b:g}" for b in sweep.loc[sweep["final_state"] == "steady sliding", "beta"])
     figs.append(_figure("fig5b", "Fig. 5(b)", f"Time-averaged length <L> = <x_1 - x_N> against beta (N = "
                         f"{a['sweep_N']}, second half of each run; error bars: batch means) and the steady "
-                        "sliding length (dashed). Runs that reached steady sliding (beta = "
-                        f"{steady_note or 'none'}) were stopped there and count L_ss from then on.", d,
+                        "sliding length L_ss = (c/K) N (N - 1) / 2 with the steady friction c = 1 - (1 - beta) V "
+                        "(dashed); dotted: beta_c = 1. Runs that reached steady sliding (beta = "
+                        f"{steady_note or 'none'}) were stopped there and count L_ss from then on; open symbols: "
+                        "runs above beta_c that had not settled into steady sliding by their end.", d,
                         fig5b_length(sweep, q), [fb], sweep_command(o["chain-runs"], mode)))
     return figs
 
 
 def _fig6(o: dict[str, Outcome], a: dict[str, Any], d: Path) -> list[ReportFigure]:
-    """Fig. 6: rupture fronts of a large and an intermediate event at beta = 1."""
-    from stickslip.plotting.chain import fig6_fronts
+    """Fig. 6: rupture fronts of a large and an intermediate event at beta = 1, and c per event."""
+    from stickslip.analysis.statistics import central_interval
+    from stickslip.plotting.chain import PAPER_FRONT_SPEED, fig6_fronts
 
     fr = a["fronts"]
     run = a["run1"]
@@ -163,20 +165,33 @@ def _fig6(o: dict[str, Outcome], a: dict[str, Any], d: Path) -> list[ReportFigur
     fm = run.first_move[run.first_move["event"].isin(ids)]
     f2 = _write_csv(d / "fig6_first_move.csv", fm)
     f3 = _write_csv(d / "fig6_fronts.csv", pd.DataFrame([f.to_dict() for f in fr["fronts"]]).assign(
-        label=fr["labels"]))
-    caption = (f"Displacement over windows of 20 time units in a large and an intermediate slip event at beta = 1 "
-               f"(N = {run.params.N}), and the time each block first moved with the fitted front speed. Median "
-               f"front speed over the {fr['speeds'].size} events that reached block N: "
-               f"{fr['median_speed']:.3g} (the paper: 1.43; sound speed 3.16).")
-    return [_figure("fig6", "Fig. 6", caption, d,
-                    fig6_fronts(prof, fm, fr["fronts"], run.params, labels=fr["labels"], window=20.0),
-                    [f1, f2, f3], chain_command(o["chain-runs"], run.params.N, 1.0))]
+        label=fr["labels"], c_leading_edge=[e.speed if e is not None else np.nan for e in fr["edges"]]))
+    per_event = fr["per_event"]
+    f4 = _write_csv(d / "fig6_speeds.csv", per_event)
+    parts = []
+    for col, name in (("c_first_move", "first motion"), ("c_leading_edge", "leading edge")):
+        x = per_event[col].to_numpy(dtype=float)
+        x = x[np.isfinite(x)]
+        if x.size:
+            ci = central_interval(x, PAPER_FRONT_SPEED)
+            parts.append(f"{name}: median {ci.median:.3g}, central 90% {ci.lo:.3g}-{ci.hi:.3g}, the paper's 1.43 at "
+                         f"percentile {ci.percentile:.0f}")
+    caption = (f"(a, b) Displacement over windows of 20 time units in a large and an intermediate slip event at "
+               f"beta = 1 (N = {run.params.N}; curves lifted, scale bar at the right; red marks: leading edge of each "
+               f"window), and the time each block first moved with the fitted front speed. (c) Front speed of each "
+               f"of the {len(per_event)} events that reached block N in the second half, by first motion over the "
+               f"far half and by the leading edge of the windows: " + "; ".join(parts)
+               + f" (sound speed 3.16). {fig6_start_note(a)}")
+    fig = fig6_fronts(prof, fm, fr["fronts"], run.params, labels=fr["labels"], window=20.0, edges=fr["edges"],
+                      speeds=per_event)
+    return [_figure("fig6", "Fig. 6", caption, d, fig, [f1, f2, f3, f4],
+                    chain_command(o["chain-runs"], run.params.N, 1.0))]
 
 
 def _fig7_8(o: dict[str, Outcome], a: dict[str, Any], d: Path, which: str) -> list[ReportFigure]:
     """Figs. 7 (beta = 1) and 8 (beta = 0.2): slip-size distribution and S against time."""
-    from stickslip.plotting.chain import fig7_8_sizes
     from stickslip.analysis.statistics import size_distribution
+    from stickslip.plotting.chain import fig7_8_sizes
 
     beta, stem, label, paper_tau = (1.0, "fig7", "Fig. 7", 1.5) if which == "7" else (0.2, "fig8", "Fig. 8", 1.6)
     events = a["events1"] if which == "7" else a["events02"]

@@ -19,10 +19,10 @@ def plot_lyapunov_beta(table: pd.DataFrame, params=None, *, beta_c: float | None
                 capsize=3, **SIM)
     ax.axhline(0.0, color="0.3", lw=0.8)
     if beta_c is not None:
-        ax.axvline(beta_c, color="0.5", lw=0.8, ls=":", label=f"beta_c = {beta_c:g}")
+        ax.axvline(beta_c, color="0.5", lw=0.8, ls=":", label=rf"$\beta_c = {beta_c:g}$ (linear threshold)")
         ax.legend()
-    ax.set_xlabel("beta")
-    ax.set_ylabel("largest Lyapunov exponent lambda")
+    ax.set_xlabel(r"$\beta$")
+    ax.set_ylabel(r"largest Lyapunov exponent $\lambda$")
     if params is not None:
         ax.set_title(f"chain, N = {params.N}, K = {params.K:g}, D = {params.D:g}, V = {params.V:g}", fontsize=9)
     return fig

@@ -46,7 +46,7 @@ def plot_stability_map(
     K = curve.attrs.get("K")
     ax.set_xlabel(r"$\beta$")
     ax.set_ylabel(r"$V$")
-    ax.set_title(f"one block, K = {K:g}: steady sliding unstable below the curve" if K else "", fontsize=9)
+    ax.set_title(f"one block, $K = {K:g}$: steady sliding unstable below the curve" if K else "", fontsize=9)
     if growth is not None:
         ax.set_xlim(float(growth["beta"].min()), float(growth["beta"].max()))
         ax.set_ylim(float(growth["V"].min()), float(growth["V"].max()))
@@ -72,6 +72,7 @@ def plot_fig4(ds: xr.Dataset, *, k_zoom: float = 0.3) -> Figure:
         ax.axhline(0.0, color="k", lw=0.6)
         ax.set_xlabel(r"wavenumber $k$")
     axes[0].set_ylabel(r"Re$\,\lambda$ (two largest)")
+    axes[1].set_ylabel(r"Re$\,\lambda$ (two largest), $k \leq %g$" % k_zoom)
     axes[0].set_xlim(0.0, np.pi)
     axes[1].set_xlim(0.0, k_zoom)
     small = ds["real"].where(ds["k"] <= k_zoom).isel(branch=slice(0, 2))
@@ -79,8 +80,8 @@ def plot_fig4(ds: xr.Dataset, *, k_zoom: float = 0.3) -> Figure:
     pad = 0.08 * (hi - lo)
     axes[1].set_ylim(lo - pad, hi + pad)
     attrs = ds.attrs
-    axes[0].set_title(f"K = {attrs.get('K', float('nan')):g}, D = {attrs.get('D', float('nan')):g}, "
-                      f"V = {attrs.get('V', float('nan')):g}", fontsize=9)
+    axes[0].set_title(f"$K = {attrs.get('K', float('nan')):g}$, $D = {attrs.get('D', float('nan')):g}$, "
+                      f"$V = {attrs.get('V', float('nan')):g}$", fontsize=9)
     axes[1].set_title("long waves (solid: largest, dashed: second)", fontsize=9)
     axes[0].legend(fontsize=8)
     return fig
@@ -98,10 +99,10 @@ def plot_hysteresis(sweep: xr.Dataset) -> Figure:
         d = sweep.sel(direction=direction)
         st = styles[direction]
         # markers only: a line across the jump at V_up would suggest states that do not exist
-        ax.plot(d["V"], d["v_max"], ls="none", ms=4, **st, label=f"sweep {direction}: max v")
-        ax.plot(d["V"], d["v_min"], ls="none", ms=4, mfc="none", **st, label=f"sweep {direction}: min v")
+        ax.plot(d["V"], d["v_max"], ls="none", ms=4, **st, label=f"sweep {direction}: max $v$")
+        ax.plot(d["V"], d["v_min"], ls="none", ms=4, mfc="none", **st, label=f"sweep {direction}: min $v$")
     V = sweep["V"].values
-    ax.plot(V, V, **THEORY, label="steady sliding v = V")
+    ax.plot(V, V, **THEORY, label="steady sliding $v = V$")
     v_up = sweep.attrs.get("V_up")
     v_down = sweep.attrs.get("V_down")
     if v_up is not None and np.isfinite(v_up):
@@ -119,11 +120,11 @@ def plot_hysteresis(sweep: xr.Dataset) -> Figure:
                 ha="right", va="center", fontsize=8, color="C1")
     a = sweep.attrs
     if all(a.get(name) == value for name, value in PAPER_SWEEP.items()):
-        ax.axvline(PAPER_V_UP, **PAPER, label="paper: V = 0.345")
+        ax.axvline(PAPER_V_UP, **PAPER, label="paper: $V = 0.345$")
     ax.set_xlabel(r"pulling velocity $V$")
     ax.set_ylabel(r"block velocity $v$ (max, min)")
-    ax.set_title(f"single block, K = {a.get('K', float('nan')):g}, beta = {a.get('beta', float('nan')):g}, "
-                 f"Fs = {a.get('Fs', float('nan')):g}; dV = {a.get('dV', float('nan')):g}, "
+    ax.set_title(f"single block, $K = {a.get('K', float('nan')):g}$, $\\beta = {a.get('beta', float('nan')):g}$, "
+                 f"$F_s = {a.get('Fs', float('nan')):g}$; $\\Delta V = {a.get('dV', float('nan')):g}$, "
                  f"{a.get('time_per_step', float('nan')):g} time units per V",
                  fontsize=9)
     ax.legend(fontsize=7, loc="best")
@@ -146,7 +147,7 @@ def plot_mode_growth(ds: xr.Dataset, modes=None) -> Figure:
         km = np.asarray(modes["k"], dtype=float)
         km = np.where(km > np.pi, 2.0 * np.pi - km, km)
         ax.plot(km, modes["growth_rate"], "o", ms=3, mfc="none", color="C1",
-                label=f"modes of the chain (N = {len(km)})")
+                label=f"modes of the chain ($N = {len(km)}$)")
     ax.axhline(0.0, color="k", lw=0.6)
     ax.set_xlim(0.0, np.pi)
     ax.set_xlabel(r"wavenumber $k$")

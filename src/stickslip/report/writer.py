@@ -34,7 +34,7 @@ class ReportRow:
     - ``paper``: the paper's value as printed ("c = 1.43"); ``value``: this run's value
       (text or a number; None when not computed);
     - ``agrees``: True / False, or None when the comparison is not settled at this run length;
-    - ``tolerance``: the tolerance used ("|c - 1.43| <= 0.15"); ``na_reason``: why ``agrees`` is
+    - ``tolerance``: the tolerance used (``"|c - 1.43| <= 0.15"``); ``na_reason``: why ``agrees`` is
       None ("quick run"); ``command``: the shell command that reproduces the row;
     - ``note``: anything a reader needs to judge the row (e.g. a slip of the paper).
     """

@@ -170,11 +170,13 @@ def simulate_block(
             params.K, params.V, params.beta, params.alpha, params.Fs, params.M, params.sigma,
             params.dt,
             out_t, out_x, out_v, out_theta, out_stopped,
-            slip_start, slip_end, slip_x_start, slip_x_end,
+            slip_start, slip_end, slip_x_start, slip_x_end, params.threshold == "state",
         )  # fmt: skip
         if n_slips <= capacity:
             break
         capacity = n_slips
+    if not (np.isfinite(x) and np.isfinite(v) and np.isfinite(theta)):
+        _blow_up(params, out_t, out_x, out_v, out_theta, steps)
 
     series = _series(params, out_t, out_x, out_v, out_theta, out_stopped, every)
     slips = _slip_table(
@@ -196,9 +198,19 @@ def simulate_block(
     )
 
 
+def _blow_up(p: BlockParams, t, x, v, theta, steps: int) -> None:
+    """Raise NonFiniteBlock naming the first stored time with a non-finite state."""
+    from stickslip.run.errors import NonFiniteBlock
+
+    bad = ~(np.isfinite(x) & np.isfinite(v) & np.isfinite(theta))
+    when = f"t = {float(t[np.argmax(bad)]):.6g}" if bad.any() else f"t <= {steps * p.dt:.6g}"
+    raise NonFiniteBlock(f"the block's state became non-finite by {when} (blow-up; a smaller dt may help, "
+                         f"dt = {p.dt:g}, K/M = {p.K / p.M:g})")
+
+
 def _series(p: BlockParams, t, x, v, theta, stopped, every: int) -> xr.Dataset:
     f = p.K * (p.V * t - x)
-    attrs = {f"param_{k}": float(val) for k, val in p.to_dict().items()}
+    attrs = {f"param_{k}": val if isinstance(val, str) else float(val) for k, val in p.to_dict().items()}
     attrs.update(integrator=INTEGRATOR, every=int(every), model="eq. (1), single block")
     return xr.Dataset(
         {

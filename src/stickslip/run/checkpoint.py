@@ -9,6 +9,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import re
 from pathlib import Path
 from typing import Any
 
@@ -130,6 +131,11 @@ class Checkpointer:
         state = ChainState(**{k: arrays[k].copy() for k in ChainState.ARRAYS})
         parts: dict[str, list[np.ndarray]] = {k: [] for k in PART_KEYS}
         listed = header.get("parts", [])
+        if not isinstance(listed, list) or not all(
+            isinstance(e, dict) and isinstance(e.get("sha256"), str)
+            and re.fullmatch(r"part-\d{6}\.npz", str(e.get("file"))) for e in listed
+        ):
+            raise ChainRunError(f"checkpoint in {self.dir.parent} lists its parts wrongly")
         for entry in listed:
             part_arrays, _, digest = _read_npz(self.dir / entry["file"])
             if digest != entry["sha256"]:

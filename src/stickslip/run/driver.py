@@ -28,6 +28,7 @@ from __future__ import annotations
 import signal
 import sys
 import time
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Sequence
@@ -38,10 +39,11 @@ from stickslip.kernels import chain as K
 from stickslip.models.params import ChainParams, ParameterError, check_number, steps_for
 # The checkpoint file helpers (_read_npz, _write_npz) are named here too, for checks of the files.
 from stickslip.run.checkpoint import CHECKPOINT_FORMAT, Checkpointer, _read_npz, _write_npz  # noqa: F401
-from stickslip.run.errors import ChainRunError, Interrupted, NonFiniteState
+from stickslip.run.errors import ChainRunError, Interrupted, NonFiniteState, ShortRunWarning
 from stickslip.run.outputs import EVENT_COLUMNS, ChainRun, RunOptions, _assemble, _Outputs
-from stickslip.run.rundir import load_run, write_run
-from stickslip.run.state import STARTS, ChainState, initial_state, steady_deviation
+from stickslip.run.rundir import load_run, read_run_id, write_run
+from stickslip.run.state import STARTS, ChainState, initial_state, loading_warnings, steady_deviation
+from stickslip.run.validate import check_checkpoint_state
 
 __all__ = [
     "run_chain",
@@ -56,6 +58,7 @@ __all__ = [
     "Checkpointer",
     "ChainRunError",
     "NonFiniteState",
+    "ShortRunWarning",
     "Interrupted",
     "CHECKPOINT_FORMAT",
     "EVENT_COLUMNS",
@@ -81,8 +84,10 @@ class _Progress:
         if self.enabled:
             from tqdm import tqdm
 
-            self.bar = tqdm(total=self.t_end, unit="t", unit_scale=True, dynamic_ncols=True,
-                            desc="chain", file=sys.stderr, smoothing=0.1)
+            self.bar = tqdm(total=self.t_end, unit=" time units", unit_scale=False, dynamic_ncols=True,
+                            desc="chain", file=sys.stderr, smoothing=0.1,
+                            bar_format="{l_bar}{bar}| t = {n:.4g}/{total:.4g} [{elapsed}<{remaining}, "
+                                       "{rate_fmt}{postfix}]")
 
     def update(self, t: float, n_events: int) -> None:
         if self.bar is not None:
@@ -182,6 +187,7 @@ def run_chain(
     checkpoint_interval: float | None = None,
     progress: bool = False,
     handle_signals: bool = False,
+    run_id: str | None = None,
 ) -> ChainRun:
     """Integrate the chain of eq. (4) from ``start`` to ``t_end`` (MODEL.md, "Chain").
 
@@ -192,7 +198,8 @@ def run_chain(
     slides within TOL of steady sliding; L is then taken from the steady solution up to t_end.
     With ``sample_moving`` the number of moving blocks is sampled at the times of L.
     With ``out_dir``, checkpoints are written there every ``checkpoint_interval`` wall-clock
-    seconds and on SIGINT/SIGTERM (``handle_signals``), and the results at the end.
+    seconds and on SIGINT/SIGTERM (``handle_signals``), and the results at the end; ``run_id``
+    (that of the run directory, :func:`rundir.owned_run_dir`) goes into every checkpoint.
     """
     if integrator not in INTEGRATORS:
         raise ParameterError(f"integrator must be one of {', '.join(INTEGRATORS)} (got {integrator!r})")
@@ -216,9 +223,11 @@ def run_chain(
     else:
         state = initial_state(params, start, amplitude=perturbation, seed=seed)
         start_info = {"kind": start, "perturbation": perturbation, "seed": seed}
+        for message in loading_warnings(params, options.t_end, options.average_from, start):
+            warnings.warn(message, ShortRunWarning, stacklevel=2)
     state.ist[K.NEXT_SAMPLE] = state.step
     outputs = _Outputs(params.N, options.profile_window is not None)
-    return _drive(params, options, integrator, start_info, state, outputs,
+    return _drive(params, options, integrator, start_info, state, outputs, run_id=run_id,
                   out_dir=out_dir, checkpointer=Checkpointer(Path(out_dir)) if out_dir else None,
                   checkpoint_interval=checkpoint_interval, progress=progress,
                   handle_signals=handle_signals, wall_before=0.0)
@@ -240,13 +249,22 @@ def resume_chain(
     """
     run_dir = Path(run_dir)
     ckpt = Checkpointer(run_dir)
+    if not ckpt.state_path.exists() and (run_dir / "run.json").exists():
+        raise ChainRunError(f"the run in {run_dir} has no checkpoint left to continue from")
     state, header, parts = ckpt.load()
     try:
         params = ChainParams(**header["params"])
-        options = RunOptions.from_dict(header["options"])
+        options = RunOptions.from_dict(header["options"]).validated(params.dt)
         integrator = header["integrator"]
-    except (KeyError, TypeError, ParameterError) as exc:
+        if integrator not in INTEGRATORS:
+            raise ParameterError(f"integrator must be one of {', '.join(INTEGRATORS)} (got {integrator!r})")
+    except (KeyError, TypeError, ValueError, AttributeError) as exc:
         raise ChainRunError(f"checkpoint in {run_dir} has an unusable header ({exc})") from None
+    run_id = header.get("run_id")
+    if run_id != read_run_id(run_dir):
+        raise ChainRunError(f"the checkpoint in {run_dir} belongs to another run (run id {run_id}, the directory's "
+                            f"{read_run_id(run_dir)}); resume the directory it was written in")
+    check_checkpoint_state(state, params, options, parts, run_dir)
     if expect_params is not None and expect_params != params:
         raise ChainRunError(
             f"checkpoint in {run_dir} was made with other parameters: {params.to_dict()} != {expect_params.to_dict()}"
@@ -259,13 +277,13 @@ def resume_chain(
     outputs = _Outputs(params.N, options.profile_window is not None)
     outputs.parts = parts
     ckpt.since = {k: len(v) for k, v in parts.items()}
-    return _drive(params, options, integrator, header["start"], state, outputs, out_dir=run_dir,
+    return _drive(params, options, integrator, header["start"], state, outputs, run_id=run_id, out_dir=run_dir,
                   checkpointer=ckpt, checkpoint_interval=checkpoint_interval, progress=progress,
                   handle_signals=handle_signals, wall_before=float(header.get("wall_seconds", 0.0)))
 
 
 def _drive(params, options, integrator, start_info, state, outputs, *, out_dir, checkpointer,
-           checkpoint_interval, progress, handle_signals, wall_before) -> ChainRun:
+           checkpoint_interval, progress, handle_signals, wall_before, run_id=None) -> ChainRun:
     par = _par(params)
     N = params.N
     scratch = [np.zeros(N + 2) for _ in range(6)] + [np.zeros(N + 2, dtype=np.int64)]
@@ -283,6 +301,8 @@ def _drive(params, options, integrator, start_info, state, outputs, *, out_dir, 
         "params": params.to_dict(), "options": options.to_dict(), "integrator": integrator,
         "start": start_info,
     }
+    if run_id is not None:
+        header["run_id"] = run_id
     bar = _Progress(options.t_end, progress and sys.stderr.isatty())
     t0 = time.perf_counter()
     last_ckpt = t0
@@ -353,6 +373,9 @@ def _drive(params, options, integrator, start_info, state, outputs, *, out_dir, 
     outputs.flush(state.ist)
     wall = wall_before + time.perf_counter() - t0
     run = _assemble(params, options, integrator, start_info, state, outputs, wall, steady_at)
+    run.summary["wall_seconds_this_run"] = wall - wall_before  # wall_seconds counts every part of a resumed run
+    if run.summary["event_in_progress"]:  # the unfinished event began after the last finished one
+        run.summary["in_progress_since"] = float(run.events["t_end"].max()) if len(run.events) else 0.0
     if out_dir is not None:
         if checkpointer is not None:
             checkpointer.write(state, outputs, dict(header, wall_seconds=wall))
@@ -403,3 +426,12 @@ class Stepper:
             ist[K.EV_P_FIRST] = 0
             if status == K.DONE:
                 return state, int(ist[K.N_EVENTS]) - events0
+
+
+def drop_checkpoint(run_dir: str | Path) -> None:
+    """Remove the checkpoint of a finished run (its results are in the run directory)."""
+    import shutil
+
+    path = Path(run_dir) / "checkpoint"
+    if path.is_dir():
+        shutil.rmtree(path)

@@ -1,4 +1,5 @@
-"""Errors of a chain run (eq. 4): a run that cannot go on, a non-finite state, a stop by a signal."""
+"""Errors of a run: a chain run (eq. 4) that cannot go on, a non-finite state of the chain or of
+the single block (eq. 1), a stop by a signal."""
 
 from __future__ import annotations
 
@@ -20,3 +21,11 @@ class Interrupted(Exception):
         super().__init__(f"interrupted at t = {t:g}; checkpoint in {checkpoint}")
         self.checkpoint = checkpoint
         self.t = t
+
+
+class ShortRunWarning(UserWarning):
+    """A chain run with the end drive ends, or averages from, before the chain has loaded."""
+
+
+class NonFiniteBlock(ArithmeticError):
+    """The single block of eq. (1) blew up (a non-finite state); the message names the time."""

@@ -17,7 +17,7 @@ import xarray as xr
 
 from stickslip.kernels import chain as K
 from stickslip.models import physics
-from stickslip.models.params import ChainParams, ParameterError, check_number, steps_for
+from stickslip.models.params import MAX_STEPS, ChainParams, ParameterError, check_number, steps_for
 from stickslip.run.state import ChainState
 
 
@@ -46,16 +46,18 @@ class RunOptions:
     sample_moving: bool = False
 
     def validated(self, dt: float) -> "RunOptions":
-        check_number("t_end", self.t_end, low=0.0)
-        check_number("sample_interval", self.sample_interval, low=0.0, low_open=True)
+        """Check every option against the time step (ranges in docs/limits.md); returns self."""
+        steps_for(self.t_end, dt)
+        longest = MAX_STEPS * dt
+        check_number("sample_interval", self.sample_interval, low=0.0, low_open=True, high=longest)
         if round(self.sample_interval / dt) < 1:
             raise ParameterError(f"sample_interval must be >= dt = {dt:g} (got {self.sample_interval!r})")
         if self.average_from is not None:
-            check_number("average_from", self.average_from, low=0.0)
+            check_number("average_from", self.average_from, low=0.0, high=self.t_end)
         for t in self.snapshot_times:
             check_number("snapshot time", t, low=0.0, high=self.t_end)
         if self.profile_window is not None:
-            check_number("profile_window", self.profile_window, low=0.0, low_open=True)
+            check_number("profile_window", self.profile_window, low=0.0, low_open=True, high=longest)
             if round(self.profile_window / dt) < 1:
                 raise ParameterError(f"profile_window must be >= dt = {dt:g} (got {self.profile_window!r})")
         check_number("profile_min_blocks", self.profile_min_blocks, low=0, integer=True)
@@ -245,6 +247,7 @@ def _assemble(params, options, integrator, start_info, state, outputs, wall, ste
     summary = {
         "model": params.model,
         **params.pieces,
+        **_model_note(params),
         "n_events": int(len(events)),
         "event_in_progress": bool(state.ist[K.EV_ACTIVE]),
         "L_final": L_final,
@@ -265,6 +268,14 @@ def _assemble(params, options, integrator, start_info, state, outputs, wall, ste
     }
     return ChainRun(params, options, integrator, start_info, state, events, first_move, samples,
                     snapshots, profiles, summary)
+
+
+def _model_note(params) -> dict[str, str]:
+    """The preset's caveat (Batista-Carlson: the paper's reading; train: one member), if any."""
+    from stickslip.models.presets import PRESETS
+
+    note = PRESETS[params.model].note
+    return {"model_note": note} if note and params.model in ("batista-carlson", "train") else {}
 
 
 def _profiles(parts, events, options, params) -> xr.Dataset:

@@ -1,13 +1,23 @@
 """Run directories of the chain (eq. 4): :func:`write_run` and :func:`load_run`.
 
 A run directory holds run.json (parameters, options, summary, versions), state.nc (final state,
-L(t), snapshots and profiles as labelled arrays), events.parquet and first_move.parquet.
+L(t), snapshots and profiles as labelled arrays), events.parquet and first_move.parquet, the
+checkpoint folder while the run goes on, and ``.run_id``, the id its checkpoints carry too. A run
+holds the directory's lock (``.lock``, with the holder's pid and host in ``.lock.json``) for its
+whole life (:func:`owned_run_dir`).
 """
 
 from __future__ import annotations
 
+import contextlib
 import json
+import os
+import shutil
+import socket
+import time
+import uuid
 from pathlib import Path
+from typing import Iterator
 
 import numpy as np
 import xarray as xr
@@ -17,6 +27,58 @@ from stickslip.kernels import chain as K
 from stickslip.models.params import ChainParams
 from stickslip.run.outputs import ChainRun, RunOptions
 from stickslip.run.state import ChainState
+
+UNITS = "model units"  # eq. (4) scaled to M = sigma = 1 (MODEL.md, "Units")
+
+#: long_name and units of the variables of state.nc (CF attributes).
+VARIABLE_ATTRS = {
+    "block": {"long_name": "block index i (1 = pulled end, N = free end)", "units": "1"},
+    "x": {"long_name": "block position x_i at the end of the run", "units": f"length ({UNITS})"},
+    "v": {"long_name": "block velocity v_i at the end of the run", "units": f"length/time ({UNITS})"},
+    "theta": {"long_name": "state variable theta_i of the friction at the end of the run",
+              "units": "1 (dimensionless)"},
+    "stopped": {"long_name": "block stuck (start and stop rules of eq. 4) at the end of the run",
+                "units": "1", "flag_values": np.array([0, 1], dtype=np.int8),
+                "flag_meanings": "moving stopped"},
+    "t_sample": {"long_name": "sampling time of L", "units": f"time ({UNITS})"},
+    "L": {"long_name": "chain length L = x_1 - x_N (Fig. 5b)", "units": f"length ({UNITS})"},
+    "snapshot_time": {"long_name": "time of the snapshot", "units": f"time ({UNITS})"},
+    "snapshot_x": {"long_name": "block positions x_i at the snapshot time (Fig. 5a)",
+                   "units": f"length ({UNITS})"},
+    "profile_dx": {"long_name": "displacement Delta x_i = x_i(t_next) - x_i(t) over one window (Fig. 6)",
+                   "units": f"length ({UNITS})"},
+    "profile_event": {"long_name": "slip event of the profile row (events.parquet column event)",
+                      "units": "1"},
+    "profile_t": {"long_name": "start of the profile window", "units": f"time ({UNITS})"},
+    "profile_t_next": {"long_name": "end of the profile window", "units": f"time ({UNITS})"},
+    "t": {"long_name": "start of the profile window", "units": f"time ({UNITS})"},
+}
+
+#: Descriptions of the columns of events.parquet and first_move.parquet (Parquet field metadata).
+EVENT_DOCS = {
+    "event": "event number, 0-based, in order of start",
+    "step_start": "first step n in which a block moved (t = n dt)",
+    "step_end": "first step that ended with every block stopped again",
+    "t_start": f"start time step_start * dt, {UNITS}",
+    "t_end": f"end time step_end * dt, {UNITS}",
+    "duration": f"t_end - t_start, {UNITS}",
+    "S": f"slip size S = sum_i (x_i(end) - x_i(start)), {UNITS} (Figs. 7, 8)",
+    "start_block": "block that moved first (1..N)",
+    "max_block": "farthest block that moved (1..N)",
+    "n_blocks": "number of blocks that moved",
+}
+FIRST_MOVE_DOCS = {
+    "event": "event number (events.parquet column event)",
+    "block": "block index i (1..N)",
+    "t_first": f"time at which block i first moved in the event, {UNITS} (Fig. 6)",
+    "step": "step at which block i first moved in the event",
+}
+
+
+def _param_attrs(params: ChainParams) -> dict[str, object]:
+    """The parameters as individual attributes ``param_<name>`` (bools as 0/1)."""
+    return {f"param_{k}": (int(v) if isinstance(v, bool) else v) for k, v in params.to_dict().items()
+            if isinstance(v, (int, float, str, bool))}
 
 
 def write_run(run: ChainRun, out_dir: str | Path) -> Path:
@@ -39,16 +101,24 @@ def write_run(run: ChainRun, out_dir: str | Path) -> Path:
             "profile_t_next": ("profile_row", run.profiles["t_next"].values),
         },
         coords={"block": blocks},
-        attrs={"params": json.dumps(run.params.to_dict()), "integrator": run.integrator,
-               "version": __version__, "t": run.summary["t_end"]},
+        attrs={"Conventions": "CF-1.10", "title": "chain of eq. (4): final state, L(t), snapshots, profiles",
+               "source": f"stickslip {__version__}, {run.integrator} integrator", "units_note":
+               "model units: eq. (4) scaled to M = sigma = 1 (MODEL.md)",
+               "params": json.dumps(run.params.to_dict()), **_param_attrs(run.params),
+               "integrator": run.integrator, "version": __version__, "t": run.summary["t_end"]},
     )
     if "n_moving" in run.samples:
         ds["n_moving"] = ("t_moving", run.samples["n_moving"].values)
         ds = ds.assign_coords(t_moving=run.samples["t_moving"].values)
     ds = ds.drop_vars([c for c in ("event", "t_next") if c in ds.coords], errors="ignore")
+    for name, attrs in VARIABLE_ATTRS.items():
+        if name in ds.variables:
+            ds[name].attrs.update(attrs)
     io.write_dataset(out / "state.nc", ds)
-    io.write_table(out / "events.parquet", run.events)
-    io.write_table(out / "first_move.parquet", run.first_move)
+    # The model, its pieces and every parameter travel with each table too.
+    model = {"params": run.params.to_dict(), "integrator": run.integrator}
+    io.write_table(out / "events.parquet", run.events, EVENT_DOCS, metadata=model)
+    io.write_table(out / "first_move.parquet", run.first_move, FIRST_MOVE_DOCS, metadata=model)
     meta = io.run_metadata(run.params, integrator=run.integrator, options=run.options.to_dict(),
                            start=run.start, summary=run.summary)
     io.write_json(out / "run.json", meta)
@@ -80,3 +150,90 @@ def load_run(run_dir: str | Path) -> ChainRun:
                     io.read_table(run_dir / "events.parquet"), io.read_table(run_dir / "first_move.parquet"),
                     samples, snapshots, profiles, meta["summary"])
 
+
+
+#: The files and folders a chain run writes into its run directory.
+OWN_FILES = frozenset({"run.json", "state.nc", "events.parquet", "first_move.parquet", "checkpoint",
+                       ".run_id", ".lock", ".lock.json"})
+RUN_ID_FILE = ".run_id"
+
+
+class RunDirBusy(RuntimeError):
+    """Another run holds the run directory's lock; the message names the holder."""
+
+
+def read_run_id(run_dir: str | Path) -> str | None:
+    """The run id of a run directory (None for one written before run ids)."""
+    path = Path(run_dir) / RUN_ID_FILE
+    try:
+        return path.read_text().strip() or None
+    except OSError:
+        return None
+
+
+@contextlib.contextmanager
+def owned_run_dir(run_dir: str | Path | None) -> Iterator[str | None]:
+    """Hold the lock of ``run_dir`` for the life of a run and yield its run id (a new one for a
+    directory without). A second holder is refused at once with :class:`RunDirBusy`."""
+    if run_dir is None:
+        yield None
+        return
+    from filelock import FileLock, Timeout
+
+    run_dir = Path(run_dir)
+    run_dir.mkdir(parents=True, exist_ok=True)
+    lock = FileLock(str(run_dir / ".lock"))
+    info = run_dir / ".lock.json"
+    try:
+        lock.acquire(timeout=0)
+        if not _same_file(lock, run_dir / ".lock"):  # removed by a holder finishing meanwhile
+            lock.release()
+            raise Timeout(str(run_dir / ".lock"))
+    except Timeout:
+        try:
+            holder = json.loads(info.read_text())
+            who = f"pid {holder['pid']} on {holder['host']} since {holder['since']}"
+        except (OSError, ValueError, KeyError, TypeError):
+            who = "another process"
+        raise RunDirBusy(f"{run_dir} is in use by another run ({who}); wait for it or choose another "
+                         "directory") from None
+    try:
+        info.write_text(json.dumps({"pid": os.getpid(), "host": socket.gethostname(),
+                                    "since": time.strftime("%Y-%m-%dT%H:%M:%S")}))
+        for stale in run_dir.glob(".*.tmp"):  # left by a write that was killed
+            with contextlib.suppress(OSError):
+                stale.unlink()
+        run_id = read_run_id(run_dir)
+        if run_id is None and not (run_dir / "checkpoint").exists():
+            run_id = uuid.uuid4().hex
+            (run_dir / RUN_ID_FILE).write_text(run_id + "\n")
+        yield run_id
+    finally:
+        # Unlinked while held, so a directory left behind is as it was (the check above
+        # keeps a waiter from holding the unlinked file).
+        for path in (info, run_dir / ".lock"):
+            with contextlib.suppress(OSError):
+                path.unlink()
+        lock.release()
+
+
+def _same_file(lock, path: Path) -> bool:
+    """The lock held is on the file now at ``path``."""
+    fd = getattr(getattr(lock, "_context", None), "lock_file_fd", None)
+    try:
+        return fd is None or os.fstat(fd).st_ino == os.stat(path).st_ino
+    except OSError:
+        return False
+
+
+def remove_own_files(run_dir: str | Path) -> None:
+    """Remove what a chain run wrote into ``run_dir`` (not the lock nor the run id); other files stay."""
+    for path in Path(run_dir).iterdir():
+        name = path.name
+        if name in (".lock", ".lock.json", RUN_ID_FILE):
+            continue
+        if name in OWN_FILES or (name.startswith(".") and name.endswith(".tmp")):
+            if path.is_dir():
+                shutil.rmtree(path)
+            else:
+                path.unlink()

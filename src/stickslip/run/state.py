@@ -135,7 +135,7 @@ def initial_state(p: ChainParams, start: str = "paper", *, amplitude: float = 0.
 def steady_deviation(state: ChainState, p: ChainParams) -> float:
     """Distance of a state from steady sliding of the chain (MODEL.md), in the frame moving with V.
 
-    The largest of |v_i - V|, |theta_i - theta_0| and |e_i - e_i^ss| over all blocks, where
+    The largest of ``|v_i - V|``, ``|theta_i - theta_0|`` and ``|e_i - e_i^ss|`` over all blocks, where
     e_i = x_{i-1} - x_i are the spring extensions (x_0 = V t_n) and e_i^ss = (c/K)(N - i + 1)
     those of steady sliding. Infinite unless every block is moving.
     """
@@ -155,3 +155,26 @@ def steady_deviation(state: ChainState, p: ChainParams) -> float:
         np.max(np.abs(state.th[1:-1] - ss["theta"])),
         np.max(np.abs(ext - ss["ext"])),
     ))
+
+
+def loading_warnings(p: ChainParams, t_end: float, average_from: float | None = None,
+                     start: str = "paper") -> list[str]:
+    """Why a run of the end-driven chain (eq. 4) is too short to show its stick-slip state, if it is.
+
+    From a start with x_i = 0 ('paper', 'rest') the chain loads until t ~ L_ss / V
+    (:func:`stickslip.models.physics.loading_time`). One message if the run ends before that, one if
+    the <L> average (from ``average_from``, default t_end / 2) starts before it; none otherwise.
+    """
+    t_load = physics.loading_time(p)
+    if start not in ("paper", "rest") or not np.isfinite(t_load):
+        return []
+    where = (f"from x_i = 0 the chain of N = {p.N} loads until t ~ L_ss / V = {t_load:.3g} "
+             f"(L_ss = {physics.chain_steady_length(p):.4g}, V = {p.V:g})")
+    if t_end < t_load:
+        return [f"{where}; this run ends at t = {t_end:.3g} and shows only the loading: "
+                f"use a t_end of a few times {t_load:.3g}, or fewer blocks"]
+    t_avg = t_end / 2.0 if average_from is None else average_from
+    if t_avg < t_load:
+        return [f"{where}; <L> averages from t = {t_avg:.3g}, before the chain has loaded: "
+                f"average from t >= {t_load:.3g} (average_from) and run to well beyond it"]
+    return []

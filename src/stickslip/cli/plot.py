@@ -1,0 +1,46 @@
+"""`stickslip plot RUN_DIR`: every figure a chain run's data supports, as PNG and PDF."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from stickslip.cli._common import CommandError, Result, add_json_option
+
+
+def register(sub) -> None:
+    """Add the `plot` subcommand."""
+    p = sub.add_parser(
+        "plot",
+        help="draw every figure a chain run directory supports (PNG and PDF)",
+        description="Draw L(t), the final state and stored snapshots against steady sliding, the slip-size "
+                    "distribution with its fit and the rupture fronts of the largest events, as far as the "
+                    "run's data allow, from a directory written by `stickslip chain --out`.",
+    )
+    p.add_argument("run_dir", metavar="RUN_DIR", help="a run directory (run.json, state.nc, events.parquet)")
+    p.add_argument("--out", metavar="DIR", default=None,
+                   help="where the figures go (default RUN_DIR/figures)")
+    p.add_argument("--format", action="append", choices=("png", "pdf", "svg"), default=None,
+                   help="file format (repeatable; default png and pdf)")
+    add_json_option(p)
+    p.set_defaults(handler=run_plot_command)
+
+
+def run_plot_command(args: argparse.Namespace) -> Result:
+    """Handler of `stickslip plot`."""
+    from stickslip.plotting.run import draw_run_figures
+    from stickslip.run.rundir import load_run
+
+    run_dir = Path(args.run_dir)
+    if not (run_dir / "run.json").is_file() or not (run_dir / "state.nc").is_file():
+        raise CommandError(f"{run_dir} is not a finished chain run directory (no run.json or state.nc)")
+    out = Path(args.out) if args.out else run_dir / "figures"
+    formats = tuple(dict.fromkeys(args.format or ("png", "pdf")))
+    records = draw_run_figures(load_run(run_dir), out, formats=formats)
+    lines = []
+    for r in records:
+        if "files" in r:
+            lines.append(f"{r['figure']:<16} {', '.join(r['files'])}")
+        else:
+            lines.append(f"{r['figure']:<16} not drawn: {r['skipped']}")
+    return Result({"out": str(out), "figures": records}, "\n".join(lines))
