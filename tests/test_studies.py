@@ -219,3 +219,52 @@ def test_sample_moving_leaves_the_run_unchanged(tmp_path):
     assert np.array_equal(run.samples["t_moving"].values, np.arange(201) * 10.0)
     back = load_run(tmp_path)
     assert np.array_equal(back.samples["n_moving"].values, n)
+
+
+# --- chaos: the largest Lyapunov exponent as a study ----------------------------------------
+
+
+def test_tiny_chaos_study_end_to_end(tmp_path, cluster):
+    from stickslip.analysis.stability import chain_finite_eigenvalues
+    from stickslip.models.params import ChainParams
+
+    spec = study("chaos", "tiny")
+    first = run_study(spec, tmp_path, scheduler=cluster, progress=False)
+    assert first["failed"] == 0 and first["run"] == len(spec.points) == 5
+    rows = first["rows"]
+    for key in ("model", "N", "beta", "lyapunov", "lyapunov_err", "t_end", "renormalisations"):
+        assert all(key in r for r in rows)
+    # steady sliding of N = 4 at beta = 1.5, V = 0.5: separations decay at the least stable
+    # eigenvalue of the linearised chain (eq. 5), a negative number
+    steady = next(r for r in rows if r["model"] == "sakaguchi" and r["N"] == 4)
+    expected = float(chain_finite_eigenvalues(ChainParams(N=4, beta=1.5, V=0.5))[0].real)
+    assert expected < 0 and steady["lyapunov"] < 0
+    assert abs(steady["lyapunov"] - expected) <= 0.03 * abs(expected)
+    # (400 - 0.1 * 400) / 5 = 72 counted renormalisations
+    assert steady["renormalisations"] == 72
+    family = {r["model"]: r for r in rows if r["model"] != "sakaguchi"}
+    assert set(family) == {"two-blocks", "carlson-langer"}
+    assert family["two-blocks"]["N"] == 2 and family["carlson-langer"]["N"] == 16
+    assert all(r["beta"] is None for r in family.values())
+    assert all(math.isfinite(r["lyapunov"]) for r in rows)
+    assert (tmp_path / "chaos" / "lyapunov_beta.png").is_file()
+    point = tmp_path / "runs" / spec.dirname / "points"
+    assert len(list(point.glob("*/renormalisations.parquet"))) == 5
+    json.dumps(first, allow_nan=True)
+    second = run_study(spec, tmp_path, scheduler=cluster, progress=False)
+    assert second["run"] == 0 and second["reused"] == 5
+    assert [r["lyapunov"] for r in second["rows"]] == [r["lyapunov"] for r in rows]
+
+
+def test_bad_study_input_is_one_line_and_exit_2(tmp_path):
+    env = {**os.environ, "PYTHONPATH": str(Path(__file__).parents[1] / "src")}
+    cases = [["study", "bogus"], ["study", "chaos", "--workers", "0"], ["study", "chaos", "--quick", "--full"],
+             ["study", "transition", "--scheduler", " "], ["study", "chaos", "--workers", "two"],
+             ["study", "exponents", "--bogus"]]
+    for argv in cases:
+        proc = subprocess.run([sys.executable, "-m", "stickslip.cli", *argv, "--out", str(tmp_path / "o")],
+                              env=env, capture_output=True, text=True, timeout=120)
+        assert proc.returncode == 2, (argv, proc.stderr)
+        assert len(proc.stderr.strip().splitlines()) == 1, (argv, proc.stderr)
+        assert proc.stdout == ""
+    assert not (tmp_path / "o").exists()  # refused before the output folder is made

@@ -3,8 +3,8 @@
     stickslip study NAME [--quick | --full] [--out DIR] [--scheduler ADDRESS] [--workers N] [--json]
 
 NAME is ``transition`` (order parameter against beta and N), ``phase-diagram`` (final state over
-(alpha, beta) and (D, beta), two starts) or ``exponents`` (slip-size exponent against beta, and
-Carlson-Langer). Every point is cached and reused; an interrupted study resumes; a failed point
+(alpha, beta) and (D, beta), two starts), ``exponents`` (slip-size exponent against beta, and
+Carlson-Langer) or ``chaos`` (largest Lyapunov exponent against beta, two blocks, Carlson-Langer). Every point is cached and reused; an interrupted study resumes; a failed point
 is reported and retried by the next call. See docs/studies/.
 """
 
@@ -24,7 +24,7 @@ def register(sub) -> None:
 
     p = sub.add_parser(
         "study",
-        help="run a study the paper leaves open (transition, phase-diagram, exponents); writes a page",
+        help="run a study the paper leaves open (transition, phase-diagram, exponents, chaos); writes a page",
         description=("Run every point of a study on Dask (reusing finished points), then write its table "
                      "(Parquet, CSV), figures and an HTML page under DIR/NAME/."),
     )
@@ -50,11 +50,12 @@ def run(args: argparse.Namespace) -> Result:
     """Handler of ``stickslip study``."""
     from stickslip.experiments.study_run import run_study
 
+    from stickslip.cli.sweep import _check_scheduler
+
     workers = None
     if args.workers is not None:
-        workers = int(check_number("workers", args.workers, low=1, integer=True))
-    if args.scheduler is not None and not args.scheduler.strip():
-        raise CommandError("--scheduler needs an address, e.g. tcp://127.0.0.1:8786")
+        workers = int(check_number("--workers", args.workers, low=1, integer=True))
+    _check_scheduler(args.scheduler)  # refused as `stickslip sweep` refuses it
     out = prepare_out_dir(args.out)
     try:
         result = run_study(args.name, out, args.mode, scheduler=args.scheduler, n_workers=workers,

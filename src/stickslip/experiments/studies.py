@@ -14,6 +14,9 @@ recorded and retried by the next call, interrupted runs continue from their chec
 * ``phase-diagram``: final state and m over (alpha, beta) and over (D, beta) at N = 99, each
   point started from the paper's start and from perturbed steady sliding (hysteresis).
 * ``exponents``: the slip-size exponent tau (Figs. 7, 8) against beta, and for Carlson-Langer.
+* ``chaos``: the largest Lyapunov exponent (:func:`stickslip.analysis.lyapunov.largest_lyapunov`)
+  against beta for the paper's chain at N = 99 (section 3, "chaotic motion"), and for two blocks
+  and Carlson-Langer at their standard parameters.
 
 The runners that turn the points' results into tables, figures and pages are in
 :mod:`stickslip.experiments.study_run`.
@@ -41,11 +44,13 @@ __all__ = [
     "study",
     "study_point_task",
     "study_command",
+    "check_point",
+    "lyapunov_point",
     "loading_time",
     "CHECKPOINT_INTERVAL",
 ]
 
-STUDIES = ("transition", "phase-diagram", "exponents")
+STUDIES = ("transition", "phase-diagram", "exponents", "chaos")
 #: ``tiny`` runs every study on chains of a few blocks in seconds (tests); its numbers mean nothing.
 MODES = ("quick", "full", "tiny")
 #: Wall-clock seconds between checkpoints of a chain run.
@@ -177,7 +182,48 @@ def _exponents(mode: str) -> Study:
                        f"t = {cl['t_end']:g}, events after the first fifth"))
 
 
-_BUILDERS = {"transition": _transition, "phase-diagram": _phase_diagram, "exponents": _exponents}
+_CHAOS_BETAS_QUICK = tuple(round(0.2 + 0.1 * k, 3) for k in range(11))
+_CHAOS_BETAS_FULL = tuple(round(0.2 + 0.05 * k, 3) for k in range(21))
+
+
+def _chaos(mode: str) -> Study:
+    # Transients: the chain needs about one loading time (4.85e5 at N = 99) before its length
+    # fluctuates about its mean (docs/lyapunov.md); the plate-driven relatives forget their start
+    # within 2e3.
+    if mode == "tiny":
+        chain = [{"N": 9, "beta": b, "t_end": 6000.0, "transient": 3000.0, "interval": 10.0} for b in (0.6, 1.2)]
+        # steady sliding well above the inverse transition: the exponent is the least stable
+        # eigenvalue of eq. (5), negative (docs/lyapunov.md, checks with known answers)
+        chain.append({"N": 4, "beta": 1.5, "V": 0.5, "start": "steady", "perturbation": 1e-3, "t_end": 400.0,
+                      "transient": 0.0, "interval": 5.0})
+        family = [{"model": "two-blocks", "t_end": 600.0, "transient": 100.0},
+                  {"model": "carlson-langer", "N": 16, "t_end": 300.0, "transient": 100.0}]
+        d0s = (1e-10,)
+    elif mode == "quick":
+        chain = [{"N": 99, "beta": b, "t_end": 6e5, "transient": 5e5, "interval": 10.0} for b in _CHAOS_BETAS_QUICK]
+        family = [{"model": "two-blocks", "t_end": 4.2e4, "transient": 2e3},
+                  {"model": "carlson-langer", "t_end": 2.2e4, "transient": 2e3}]
+        d0s = (1e-10,)
+    else:
+        chain = [{"N": 99, "beta": b, "t_end": 1.5e6, "transient": 1e6, "interval": 10.0} for b in _CHAOS_BETAS_FULL]
+        family = [{"model": "two-blocks", "t_end": 2.02e5, "transient": 2e3},
+                  {"model": "carlson-langer", "t_end": 1.02e5, "transient": 2e3}]
+        d0s = (1e-8, 1e-10, 1e-11)  # CL does not settle in d0 (docs/lyapunov.md): show the spread
+    points = [{"model": "sakaguchi", "start": "paper", **c, "d0": 1e-10} for c in chain]
+    points += [{**f, "interval": 1.0, "start": "rest", "perturbation": 0.01, "seed": 0, "d0": d0}
+               for f in family for d0 in d0s]
+    # Longest first: a shorter tail on a few workers.
+    points.sort(key=lambda p: -(p["t_end"] - p["transient"]) * p.get("N", 100) / p["interval"])
+    common = {"analysis": "lyapunov", "segments": 10, "direction_seed": 0}
+    n_chain = len([p for p in points if p["model"] == "sakaguchi"])
+    return Study("chaos", mode, common, tuple(points),
+                 note=(f"{mode}: eq. (4) at N = {chain[0]['N']}, {n_chain} points in beta, "
+                       f"t = {chain[0]['transient']:g} .. {chain[0]['t_end']:g}, d0 = 1e-10; two blocks "
+                       f"and Carlson-Langer at standard parameters, d0 = {', '.join(f'{d:g}' for d in d0s)}"))
+
+
+_BUILDERS = {"transition": _transition, "phase-diagram": _phase_diagram, "exponents": _exponents,
+             "chaos": _chaos}
 
 
 def study(name: str, mode: str = "quick") -> Study:
@@ -229,6 +275,68 @@ def point_run_options(cfg: dict[str, Any], params) -> tuple[float, dict[str, Any
     return t_end, options
 
 
+_LYAPUNOV_OPTIONS = ("interval", "d0", "transient", "align", "segments", "direction_seed")
+
+
+def lyapunov_options(cfg: dict[str, Any], params) -> tuple[float, dict[str, Any]]:
+    """Run length and :func:`~stickslip.analysis.lyapunov.largest_lyapunov` options of a chaos
+    point (start, perturbation and seed default to the model's preset), checked as that
+    function checks them."""
+    from stickslip.analysis.lyapunov import _check_run
+    from stickslip.models.presets import PRESETS
+
+    preset = PRESETS[params.model]
+    t_end = float(cfg["t_end"])
+    options: dict[str, Any] = {k: cfg[k] for k in _LYAPUNOV_OPTIONS if k in cfg}
+    options["start"] = cfg.get("start", preset.start)
+    options["perturbation"] = float(cfg.get("perturbation", preset.start_options.get("amplitude", 0.0)))
+    options["seed"] = int(cfg.get("seed", preset.start_options.get("seed", 0)))
+    if options["start"] == "paper":
+        options["perturbation"] = 0.0
+    _check_run(params, t_end, options.get("interval", 10.0), options.get("d0", 1e-10), options.get("transient", 0.0),
+               options.get("align"), options.get("segments", 10))
+    return t_end, options
+
+
+def check_point(cfg: dict[str, Any]) -> None:
+    """Raise ParameterError (one line) unless a point's merged settings make a valid run."""
+    params = point_params(cfg)
+    if cfg.get("analysis") == "lyapunov":
+        lyapunov_options(cfg, params)
+    else:
+        point_run_options(cfg, params)
+
+
+def lyapunov_point(cfg: dict[str, Any], point_dir: Path) -> dict[str, Any]:
+    """One point of ``chaos``: the largest Lyapunov exponent of a model of the family
+    (Benettin et al. 1980, :func:`stickslip.analysis.lyapunov.largest_lyapunov`), written to
+    ``lyapunov.json`` and ``renormalisations.parquet`` (every renormalisation: end time,
+    ln(d/d0), length, counted) in ``point_dir``. Adds the exponent per slip event."""
+    from stickslip import io
+    from stickslip.analysis.lyapunov import largest_lyapunov
+
+    params = point_params(cfg)
+    t_end, options = lyapunov_options(cfg, params)
+    res = largest_lyapunov(params, t_end, **options)
+    point_dir = Path(point_dir)
+    point_dir.mkdir(parents=True, exist_ok=True)
+    import pandas as pd
+
+    io.write_table(point_dir / "renormalisations.parquet",
+                   pd.DataFrame({"t": res.times, "log_growth": res.log_growth, "duration": res.durations,
+                                 "counted": res.counted}),
+                   descriptions={"t": "end of the interval", "log_growth": "ln(d / d0) over the interval",
+                                 "duration": "length of the interval", "counted": "enters the exponent"})
+    info = res.to_dict()
+    io.write_json(point_dir / "lyapunov.json", info)
+    counted_time = float(np.sum(res.durations[res.counted]))
+    per_event = res.lyapunov * counted_time / res.events if res.events > 0 else math.nan
+    keep = ("lyapunov", "lyapunov_err", "t_end", "renormalisations", "d0", "interval", "transient", "align",
+            "segments", "events", "merges", "max_log_growth", "reference_sha256", "start")
+    return {"model": params.model, **{k: info[k] for k in keep}, "counted_time": counted_time,
+            "lyapunov_per_event": per_event, "run_wall_seconds": float(res.wall_seconds)}
+
+
 def _run(params, t_end: float, options: dict[str, Any], point_dir: Path):
     """Run the chain into ``point_dir``, continuing from a checkpoint there if one is usable."""
     from stickslip.run import driver
@@ -244,9 +352,12 @@ def _run(params, t_end: float, options: dict[str, Any], point_dir: Path):
 def study_point_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     """One point of a study: the chain run and its analysis (a task of ``run_sweep``).
 
-    ``analysis = "order"``: :func:`order_summary`; ``"sizes"``: :func:`sizes_summary`.
+    ``analysis = "order"``: :func:`order_summary`; ``"sizes"``: :func:`sizes_summary`;
+    ``"lyapunov"``: :func:`lyapunov_point` (no chain run record, only the exponent's data).
     Returns the summary stored in the point's ``done.json``.
     """
+    if point.get("analysis") == "lyapunov":
+        return lyapunov_point(point, point_dir)
     params = point_params(point)
     t_end, options = point_run_options(point, params)
     point_dir = Path(point_dir)

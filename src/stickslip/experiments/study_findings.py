@@ -27,7 +27,8 @@ def conclusions(spec: Study, table: pd.DataFrame) -> dict[str, Any]:
     """Findings of a study from the rows of its finished points."""
     if not len(table):
         return {"statements": ["no finished points"]}
-    return {"transition": _transition, "phase-diagram": _phase, "exponents": _exponents}[spec.name](table)
+    return {"transition": _transition, "phase-diagram": _phase, "exponents": _exponents,
+            "chaos": _chaos}[spec.name](table)
 
 
 def _transition(table: pd.DataFrame) -> dict[str, Any]:
@@ -141,6 +142,46 @@ def _exponents(table: pd.DataFrame) -> dict[str, Any]:
     return out
 
 
+def _chaos(table: pd.DataFrame) -> dict[str, Any]:
+    """Statements on the largest Lyapunov exponents: is each distinguishable from zero, and how
+    the chain of eq. (4) compares with its plate-driven relatives."""
+    out: dict[str, Any] = {"statements": [], "chain": {}, "family": {}}
+    say = out["statements"].append
+    chain = table[table["model"] == "sakaguchi"].sort_values("beta")
+    lam = chain["lyapunov"].to_numpy(float)
+    err = chain["lyapunov_err"].to_numpy(float)
+    ok = np.isfinite(lam) & np.isfinite(err) & (err > 0)
+    if ok.any():
+        z = lam[ok] / err[ok]
+        pos, neg = chain["beta"][ok][z > 3].tolist(), chain["beta"][ok][z < -3].tolist()
+        bound = float(np.max(np.abs(lam[ok]) + 2 * err[ok]))
+        out["chain"] = {"n": int(ok.sum()), "positive_3sigma": pos, "negative_3sigma": neg, "bound_2sigma": bound}
+        Ns = sorted(int(n) for n in chain["N"].unique())
+        say(f"eq. (4), N = {', '.join(map(str, Ns))}: lambda within 3 error bars of zero at "
+            f"{int(np.count_nonzero(np.abs(z) <= 3))} of {int(ok.sum())} values of beta "
+            f"(|lambda| + 2 errors <= {_g(bound, 2)} per unit time everywhere)"
+            + (f"; positive beyond 3 errors at beta = {', '.join(f'{b:g}' for b in pos)}" if pos else "")
+            + (f"; negative beyond 3 errors at beta = {', '.join(f'{b:g}' for b in neg)}" if neg else "") + ".")
+        per_event = chain["lyapunov_per_event"].to_numpy(float)[ok]
+        if np.isfinite(per_event).any():
+            say(f"eq. (4): per slip event, lambda ranges over [{_g(np.nanmin(per_event), 2)}, "
+                f"{_g(np.nanmax(per_event), 2)}].")
+    for model, g in table[table["model"] != "sakaguchi"].groupby("model"):
+        rows = g.sort_values("d0")
+        vals = ", ".join(f"{_g(r.lyapunov)} +- {_g(r.lyapunov_err, 2)} (d0 = {r.d0:g})" for r in rows.itertuples())
+        lam_m = rows["lyapunov"].to_numpy(float)
+        err_m = rows["lyapunov_err"].to_numpy(float)
+        positive = bool(np.all(lam_m > 3 * err_m))
+        out["family"][model] = {"lyapunov": lam_m.tolist(), "lyapunov_err": err_m.tolist(),
+                                "d0": rows["d0"].tolist(), "positive_3sigma": positive}
+        spread = ""
+        if len(rows) > 1:
+            spread = f"; spread over d0 {_g(np.ptp(lam_m), 2)} against errors of {_g(np.max(err_m), 2)}"
+        say(f"{model} (N = {int(rows['N'].iloc[0])}): lambda = {vals}: "
+            f"{'chaotic (positive beyond 3 errors)' if positive else 'not positive beyond 3 errors'}{spread}.")
+    return out
+
+
 def draw(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[dict[str, Any]]:
     """Draw the study's figures into ``page_dir`` (PNG and PDF); returns their descriptions."""
     from stickslip.plotting import studies as pl
@@ -166,6 +207,11 @@ def draw(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[dict[str, Any
                      "Final state and m over (alpha, beta) at D = 5; dashed: beta_c = alpha."))
         figs.append(("phase_D_beta", pl.phase_map_figure(table[table["alpha"] == 1.0], "D", "alpha = 1"),
                      "Final state and m over (D, beta) at alpha = 1; dashed: beta_c = alpha = 1."))
+    elif spec.name == "chaos":
+        figs.append(("lyapunov_beta", pl.chaos_figure(table),
+                     "Largest Lyapunov exponent (Benettin et al. two-trajectory method, d0 = 1e-10 unless "
+                     "marked) against beta for eq. (4), error bars from 10 segments; right: two blocks and "
+                     "Carlson-Langer at standard parameters as marked points."))
     else:
         figs.append(("tau_beta", pl.exponents_figure(table),
                      "Slip-size exponent tau (truncated power law below the smallest spanning event, "

@@ -38,6 +38,8 @@ TABLE_COLUMNS = {
                       "order_parameter_err", "stuck_fraction", "t_steady", "t_end"],
     "exponents": ["model", "N", "beta", "tau", "tau_err", "s_min", "s_max", "n_fit", "n_events", "excess",
                   "observed", "expected", "n_spanning", "S_max", "t_end"],
+    "chaos": ["model", "N", "beta", "lyapunov", "lyapunov_err", "t_end", "renormalisations", "d0", "interval",
+              "transient", "events", "lyapunov_per_event", "merges", "max_log_growth"],
 }
 
 
@@ -71,11 +73,10 @@ def run_study(
     run_dir = out / "runs" / spec.dirname
     page_dir = out / spec.name
     show = progress and _on_terminal()
-    for p in spec.points:  # validate every point before any work starts
-        from stickslip.experiments.studies import point_params, point_run_options
+    from stickslip.experiments.studies import check_point
 
-        cfg = {**spec.common, **p}
-        point_run_options(cfg, point_params(cfg))
+    for p in spec.points:  # validate every point before any work starts
+        check_point({**spec.common, **p})
     _log(show, t0, f"{spec.name} --{spec.mode}: {len(spec.points)} points in {run_dir} "
                    f"({'scheduler ' + scheduler if scheduler else 'local cluster'}); finished points are reused")
     io.write_json(run_dir / "study-spec.json", spec.spec())
@@ -124,8 +125,15 @@ def _study_table(spec: Study, sweep_table: pd.DataFrame) -> pd.DataFrame:
             table[key] = spec.common[key]
     if "model" in table.columns:
         table["model"] = table["model"].fillna(spec.common.get("model", "sakaguchi"))
+    if "N" in table.columns and "model" in table.columns:
+        # a relative run at its preset's N carries no N in its point
+        from stickslip.models.presets import PRESETS
+
+        missing = table["N"].isna()
+        table.loc[missing, "N"] = [PRESETS[m].params["N"] for m in table.loc[missing, "model"]]
     if "beta" in table.columns and "model" in table.columns:
-        table.loc[table["model"] == "carlson-langer", "beta"] = np.nan
+        # the plate-driven relatives have no beta (velocity-weakening friction)
+        table.loc[table["model"].isin(["carlson-langer", "two-blocks"]), "beta"] = np.nan
     if "final_state" in table.columns:
         table.loc[table["status"] != "ok", "final_state"] = "failed"
     lead = [c for c in TABLE_COLUMNS[spec.name] if c in table.columns]
