@@ -122,9 +122,10 @@ def _transition(mode: str) -> Study:
         Ns, betas, loads = (49, 99, 199), _T_BETAS_QUICK, 2.5
     else:
         Ns, betas, loads = (49, 99, 199, 399, 799), _T_BETAS_FULL, 4.0
-    # Longest runs first (large N, beta near 1): a shorter tail on a few workers.
+    # Longest runs first, for a shorter tail on a few workers: large N, then large beta (runs
+    # that slide update every block at every step until they settle; stick-slip is cheap).
     points = [{"N": N, "beta": b, "t_end": _t_end(N, loads)}
-              for N in sorted(Ns, reverse=True) for b in sorted(betas, key=lambda b: abs(b - 1.0))]
+              for N in sorted(Ns, reverse=True) for b in sorted(betas, reverse=True)]
     common = {**_PAPER, "model": "sakaguchi", "start": "paper", "loads": loads, "average_fraction": 0.5,
               "n_samples": 20000 if mode != "tiny" else 2000, "until_steady": UNTIL_STEADY,
               "analysis": "order"}
@@ -152,7 +153,9 @@ def _phase_diagram(mode: str) -> Study:
     for c in cells:
         if c not in unique:
             unique.append(c)
-    unique.sort(key=lambda c: abs(c["beta"] - c["alpha"]))
+    # Longest first: deep on the sliding side (beta - alpha large) the paper's start slides
+    # longest before it settles.
+    unique.sort(key=lambda c: -(c["beta"] - c["alpha"]))
     points = [{**c, "N": N, "t_end": t_end, "start": s} for c in unique for s in ("paper", "steady")]
     common = {**{k: v for k, v in _PAPER.items() if k not in ("alpha", "D")}, "model": "sakaguchi",
               "loads": loads, "average_fraction": 0.5, "n_samples": 20000 if mode != "tiny" else 2000,

@@ -130,7 +130,9 @@ def _study_table(spec: Study, sweep_table: pd.DataFrame) -> pd.DataFrame:
         from stickslip.models.presets import PRESETS
 
         missing = table["N"].isna()
-        table.loc[missing, "N"] = [PRESETS[m].params["N"] for m in table.loc[missing, "model"]]
+        if missing.any():
+            table.loc[missing, "N"] = [PRESETS[m].params["N"] for m in table.loc[missing, "model"]]
+            table["N"] = table["N"].astype("int64")
     if "beta" in table.columns and "model" in table.columns:
         # the plate-driven relatives have no beta (velocity-weakening friction)
         table.loc[table["model"].isin(["carlson-langer", "two-blocks"]), "beta"] = np.nan
