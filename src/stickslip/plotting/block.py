@@ -101,7 +101,7 @@ def fig3_period(sweep: pd.DataFrame, limit: SlipLimit) -> Figure:
     ax_d.axhline(0.0, color="0.5", lw=0.8)
     ax_d.plot(V, 100.0 * sweep["rel_dev"], "o-", color=SIM["color"], ms=4, lw=0.8)
     ax_d.set_xlabel("$V$")
-    ax_d.set_ylabel(r"$T_{sim} / T_{law} - 1$ (%)")
+    ax_d.set_ylabel(r"$T_\mathrm{sim} / T_\mathrm{law} - 1$ (%)")
     return fig
 
 

@@ -107,7 +107,7 @@ def plot_hysteresis(sweep: xr.Dataset) -> Figure:
     v_down = sweep.attrs.get("V_down")
     if v_up is not None and np.isfinite(v_up):
         ax.axvline(v_up, color="C0", lw=0.8, alpha=0.6)
-        ax.annotate(rf"$V_{{up}}={v_up:.4g}$", (v_up, 0.55), xycoords=("data", "axes fraction"),
+        ax.annotate(rf"$V_\mathrm{{up}}={v_up:.4g}$", (v_up, 0.55), xycoords=("data", "axes fraction"),
                     xytext=(-3, 0), textcoords="offset points", ha="right", va="center", fontsize=8,
                     color="C0", rotation=90)
     if v_down is not None and np.isfinite(v_down):
