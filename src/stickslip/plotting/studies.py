@@ -36,7 +36,7 @@ def order_parameter_figure(table: pd.DataFrame) -> Figure:
     ax.axvline(1.0, color="0.5", lw=0.8, ls=":")
     ax.axhline(0.0, color="0.5", lw=0.8)
     ax.set_xlabel(r"$\beta$")
-    ax.set_ylabel(r"$m = 1 - \langle L\rangle / L_{ss}$")
+    ax.set_ylabel(r"$m = 1 - \langle L\rangle / L_\mathrm{ss}$")
     ax.legend(title="large open circle: undecided")
     return fig
 
@@ -50,7 +50,7 @@ def steady_time_figure(table: pd.DataFrame) -> Figure:
             load = N * (N - 1) / (2.0 * 10.0 * 0.001)
             ax.plot(g["beta"], g["t_steady"].astype(float) / load, "o-", color=f"C{k}", ms=4, label=f"N = {N}")
     ax.set_xlabel(r"$\beta$")
-    ax.set_ylabel(r"$t_{steady}\,/\,(L_{ss}/V)$")
+    ax.set_ylabel(r"$t_\mathrm{steady}\,/\,(L_\mathrm{ss}/V)$")
     if ax.get_legend_handles_labels()[0]:
         ax.legend()
     return fig
