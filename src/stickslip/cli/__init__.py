@@ -28,7 +28,17 @@ class _Parser(argparse.ArgumentParser):
 
 def build_parser() -> argparse.ArgumentParser:
     """The full parser with every subcommand registered."""
-    from stickslip.cli import block, chain, lyapunov, models, plot, reproduce, stability, sweep
+    from stickslip.cli import (
+        block,
+        chain,
+        lyapunov,
+        models,
+        plot,
+        reproduce,
+        stability,
+        study,
+        sweep,
+    )
 
     parser = _Parser(
         prog="stickslip",
@@ -39,7 +49,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"stickslip {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
-    for module in (block, stability, chain, models, sweep, reproduce, lyapunov, plot):
+    for module in (block, stability, chain, models, sweep, reproduce, study, lyapunov, plot):
         module.register(sub)
     return parser
 

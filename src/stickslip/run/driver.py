@@ -182,6 +182,7 @@ def run_chain(
     profile_window: float | None = None,
     profile_min_blocks: int = 0,
     until_steady: float | None = None,
+    sample_moving: bool = False,
     out_dir: str | Path | None = None,
     checkpoint_interval: float | None = None,
     progress: bool = False,
@@ -196,6 +197,7 @@ def run_chain(
     sliding, optionally perturbed by ``perturbation`` with ``seed``) or a :class:`ChainState`.
     With ``until_steady`` = TOL the run stops at the first sampling time at which every block
     slides within TOL of steady sliding; L is then taken from the steady solution up to t_end.
+    With ``sample_moving`` the number of moving blocks is sampled at the times of L.
     With ``out_dir``, checkpoints are written there every ``checkpoint_interval`` wall-clock
     seconds and on SIGINT/SIGTERM (``handle_signals``), and the results at the end; ``run_id``
     (that of the run directory, :func:`rundir.owned_run_dir`) goes into every checkpoint. A
@@ -212,6 +214,7 @@ def run_chain(
         profile_window=profile_window,
         profile_min_blocks=int(profile_min_blocks),
         until_steady=until_steady,
+        sample_moving=bool(sample_moving),
     ).validated(params.dt)
     if checkpoint_interval is not None:
         check_number("checkpoint_interval", checkpoint_interval, low=0.0, low_open=True)
@@ -301,6 +304,8 @@ def _drive(params, options, integrator, start_info, state, outputs, *, out_dir, 
                      options.profile_min_blocks)
     stops = sorted({steps_for(t, params.dt) for t in options.snapshot_times} | {n_end})
     done_snaps = set(int(s) for a in outputs.parts["snap_step"] for s in a)
+    on_grid = options.until_steady is not None or options.sample_moving
+    last_moving = max((int(a[-1, 0]) for a in outputs.parts["moving"] if len(a)), default=-1)
     steady_at: dict[str, float] = {}
     header = {
         "params": params.to_dict(), "options": options.to_dict(), "integrator": integrator,
@@ -323,13 +328,16 @@ def _drive(params, options, integrator, start_info, state, outputs, *, out_dir, 
                 if n in stops and n not in done_snaps and n != n_end:
                     outputs.add_snapshot(n, state.x)
                     done_snaps.add(n)
+                if options.sample_moving and n % sample_every == 0 and n > last_moving:
+                    outputs.add_moving(n, int(np.count_nonzero(state.mov[1:-1])))
+                    last_moving = n
                 if options.until_steady is not None and n % sample_every == 0:
                     dev = steady_deviation(state, params)
                     if dev <= options.until_steady:
                         steady_at = {"t_steady": n * params.dt, "deviation": dev}
                         break
                 next_stop = min((s for s in stops if s > n), default=n_end)
-                if options.until_steady is not None:
+                if on_grid:
                     # Check on a fixed grid of steps, so the stop does not depend on timing.
                     next_stop = min(next_stop, (n // sample_every + 1) * sample_every)
                 if n >= n_end:

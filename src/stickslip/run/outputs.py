@@ -31,7 +31,9 @@ class RunOptions:
     profile_window: if set, x_i is stored every this long during each event, for the
     displacement over windows of Fig. 6, for events with >= profile_min_blocks moved blocks;
     until_steady: if set, the run stops at the first sampling time at which every block slides
-    and the state is within this tolerance of steady sliding (:func:`steady_deviation`).
+    and the state is within this tolerance of steady sliding (:func:`steady_deviation`);
+    sample_moving: if set, the number of moving blocks is sampled at the times of L as well
+    (``samples["n_moving"]`` over ``t_moving``: the fraction of time with some block stuck).
     """
 
     t_end: float
@@ -41,6 +43,7 @@ class RunOptions:
     profile_window: float | None = None
     profile_min_blocks: int = 0
     until_steady: float | None = None
+    sample_moving: bool = False
 
     def validated(self, dt: float) -> "RunOptions":
         """Check every option against the time step (ranges in docs/limits.md); returns self."""
@@ -71,6 +74,7 @@ class RunOptions:
             "profile_window": self.profile_window,
             "profile_min_blocks": self.profile_min_blocks,
             "until_steady": self.until_steady,
+            "sample_moving": bool(self.sample_moving),
         }
 
     @classmethod
@@ -147,6 +151,9 @@ class _Outputs:
         self.parts["snap_step"].append(np.array([step], dtype=np.int64))
         self.parts["snap_x"].append(x[1:-1].copy()[None, :])
 
+    def add_moving(self, step: int, n_moving: int) -> None:
+        self.parts["moving"].append(np.array([[step, n_moving]], dtype=np.int64))
+
     def take_new(self, since: dict[str, int]) -> dict[str, np.ndarray]:
         """Concatenate the parts added since ``since`` (counts per key); updates ``since``."""
         out = {}
@@ -160,10 +167,11 @@ class _Outputs:
         return {key: _concat(key, self.parts[key]) for key in PART_KEYS}
 
 
-PART_KEYS = ("ev_int", "ev_S", "fm", "samp_L", "samp_step", "prof_x", "prof_meta", "snap_step", "snap_x")
-_PART_SHAPES = {"ev_int": (0, K.EV_INT_COLS), "ev_S": (0,), "fm": (0, 3), "samp_L": (0,),
+PART_KEYS = ("ev_int", "ev_S", "fm", "samp_L", "samp_step", "prof_x", "prof_meta", "snap_step", "snap_x",
+             "moving")
+_PART_SHAPES = {"moving": (0, 2), "ev_int": (0, K.EV_INT_COLS), "ev_S": (0,), "fm": (0, 3), "samp_L": (0,),
                 "samp_step": (0,), "prof_x": None, "prof_meta": (0, 2), "snap_step": (0,), "snap_x": None}
-_PART_DTYPES = {"ev_int": np.int64, "fm": np.int64, "samp_step": np.int64, "prof_meta": np.int64,
+_PART_DTYPES = {"moving": np.int64, "ev_int": np.int64, "fm": np.int64, "samp_step": np.int64, "prof_meta": np.int64,
                 "snap_step": np.int64}
 
 
@@ -197,6 +205,10 @@ def _assemble(params, options, integrator, start_info, state, outputs, wall, ste
         {"L": ("t", parts["samp_L"], {"long_name": "total length x_1 - x_N"})},
         coords={"t": ("t", t_samples, {"units": "model time"})},
     )
+    if options.sample_moving:
+        mv = parts["moving"]
+        samples["n_moving"] = xr.DataArray(mv[:, 1], dims="t_moving", attrs={"long_name": "blocks moving"})
+        samples = samples.assign_coords(t_moving=("t_moving", mv[:, 0] * dt, {"units": "model time"}))
     blocks = np.arange(1, params.N + 1)
     snap_steps = list(parts["snap_step"]) + [state.step]
     snap_x = np.vstack([parts["snap_x"].reshape(-1, params.N), state.x[1:-1][None, :]])

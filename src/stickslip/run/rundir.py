@@ -108,6 +108,9 @@ def write_run(run: ChainRun, out_dir: str | Path) -> Path:
                "params": json.dumps(run.params.to_dict()), **_param_attrs(run.params),
                "integrator": run.integrator, "version": __version__, "t": run.summary["t_end"]},
     )
+    if "n_moving" in run.samples:
+        ds["n_moving"] = ("t_moving", run.samples["n_moving"].values)
+        ds = ds.assign_coords(t_moving=run.samples["t_moving"].values)
     ds = ds.drop_vars([c for c in ("event", "t_next") if c in ds.coords], errors="ignore")
     for name, attrs in VARIABLE_ATTRS.items():
         if name in ds.variables:
@@ -135,6 +138,9 @@ def load_run(run_dir: str | Path) -> ChainRun:
                                    ds["stopped"].values.astype(bool))
     state.ist[K.STEP] = int(meta["summary"]["steps"])
     samples = xr.Dataset({"L": ("t", ds["L"].values)}, coords={"t": ds["t_sample"].values})
+    if "n_moving" in ds:
+        samples["n_moving"] = xr.DataArray(ds["n_moving"].values, dims="t_moving")
+        samples = samples.assign_coords(t_moving=("t_moving", ds["t_moving"].values))
     snapshots = ds["snapshot_x"].rename({"snapshot_time": "time"}).rename("x")
     profiles = xr.Dataset(
         {"dx": (("row", "block"), ds["profile_dx"].values)},

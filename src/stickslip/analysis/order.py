@@ -1,0 +1,233 @@
+"""The order parameter of the stick-slip transition and the final state of a chain run.
+
+Sakaguchi's chain (eq. 4) slides steadily for beta > 1 and stick-slips for beta <= 1 (section 3);
+Fig. 5(b) shows <L> falling continuously below the steady length as beta drops below 1. The
+order parameter here is
+
+    m = 1 - <L> / L_ss,
+
+zero in steady sliding and positive in stick-slip (L_ss: the exact discrete steady length,
+MODEL.md). Its samples L(t) are strongly correlated in time (the chain loads for ~L_ss / V
+between large events), so its error bar comes from batch means whose batch length is set by
+the integrated autocorrelation time (:func:`integrated_time`), not from the naive formula.
+
+:func:`classify_final_state` names the end of a run ``steady`` / ``stick-slip`` / ``undecided``
+from numbers measured over the last two quarters of the run.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+from typing import Any
+
+import numpy as np
+
+__all__ = [
+    "integrated_time",
+    "batch_means",
+    "MeanEstimate",
+    "mean_with_error",
+    "order_parameter",
+    "classify_final_state",
+    "FINAL_STATES",
+    "quarter_stats",
+    "transition_bracket",
+    "power_law_fit",
+]
+
+#: The three final states of a study point.
+FINAL_STATES = ("steady", "stick-slip", "undecided")
+
+#: Batch length in units of the integrated autocorrelation time.
+BATCH_TAUS = 10.0
+#: Fewest batches for which the batch-means error is called reliable.
+MIN_BATCHES = 8
+
+
+def _autocorrelation(x: np.ndarray) -> np.ndarray:
+    """Normalised autocorrelation function of ``x`` (FFT, zero-padded: no wrap-around)."""
+    x = np.asarray(x, dtype=float) - np.mean(x)
+    n = x.size
+    size = 1 << (2 * n - 1).bit_length()
+    f = np.fft.rfft(x, size)
+    acf = np.fft.irfft(f * np.conjugate(f), size)[:n]
+    return acf / acf[0] if acf[0] > 0 else np.zeros(n)
+
+
+def integrated_time(x: np.ndarray, *, c: float = 6.0) -> float:
+    """Integrated autocorrelation time tau_int = 1/2 + sum_{t>=1} rho(t), in samples.
+
+    Summed up to Sokal's self-consistent window, the smallest W with W >= c tau_int(W)
+    (A. Sokal, "Monte Carlo methods in statistical mechanics", 1997). Var(mean) ~ 2 tau_int
+    sigma^2 / n. A constant series gives 0.5; a series shorter than its window gives the
+    estimate at the largest window (an underestimate: see ``mean_with_error``'s ``reliable``).
+    """
+    x = np.asarray(x, dtype=float)
+    if x.size < 2 or not np.ptp(x) > 0:
+        return 0.5
+    rho = _autocorrelation(x)
+    taus = 0.5 + np.cumsum(rho[1:])
+    windows = np.arange(1, x.size)
+    ok = windows >= c * taus
+    w = int(np.argmax(ok)) if ok.any() else x.size - 2
+    return float(max(taus[w], 0.5))
+
+
+def batch_means(x: np.ndarray, batch: int) -> tuple[float, int]:
+    """Standard error of the mean of ``x`` from non-overlapping batches of ``batch`` samples.
+
+    Returns (error, number of batches); the samples left over at the start are dropped, so the
+    batches end with the series.
+    """
+    x = np.asarray(x, dtype=float)
+    batch = max(int(batch), 1)
+    k = x.size // batch
+    if k < 2:
+        return math.nan, k
+    means = x[x.size - k * batch:].reshape(k, batch).mean(axis=1)
+    return float(np.std(means, ddof=1) / math.sqrt(k)), k
+
+
+@dataclass(frozen=True)
+class MeanEstimate:
+    """A time average with its error: ``mean``, ``err`` (batch means), ``err_tau``
+    (sqrt(2 tau_int var / n)), ``tau_int`` (samples), ``batch`` (samples per batch),
+    ``n_batches``, ``n`` (samples), ``reliable`` (at least :data:`MIN_BATCHES` batches of
+    :data:`BATCH_TAUS` tau_int each)."""
+
+    mean: float
+    err: float
+    err_tau: float
+    tau_int: float
+    batch: int
+    n_batches: int
+    n: int
+    reliable: bool
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+def mean_with_error(x: np.ndarray) -> MeanEstimate:
+    """Mean of a correlated series and its error by batch means.
+
+    The batch length is ``BATCH_TAUS * tau_int`` (:func:`integrated_time`): batches much
+    longer than the correlation time have nearly independent means, and the relative bias of
+    the variance estimate is about 2 tau_int / batch. If the series holds fewer than
+    ``MIN_BATCHES`` such batches, it is cut into ``MIN_BATCHES`` batches and the estimate is
+    flagged ``reliable = False`` (the error is then likely too small).
+    """
+    x = np.asarray(x, dtype=float)
+    x = x[np.isfinite(x)]
+    n = int(x.size)
+    if n == 0:
+        return MeanEstimate(math.nan, math.nan, math.nan, math.nan, 0, 0, 0, False)
+    mean = float(np.mean(x))
+    if not np.ptp(x) > 0:
+        return MeanEstimate(mean, 0.0, 0.0, 0.5, 1, n, n, True)
+    tau = integrated_time(x)
+    batch = int(math.ceil(BATCH_TAUS * tau))
+    reliable = n // batch >= MIN_BATCHES
+    if not reliable:
+        batch = max(n // MIN_BATCHES, 1)
+    err, k = batch_means(x, batch)
+    err_tau = math.sqrt(2.0 * tau * float(np.var(x)) / n)
+    return MeanEstimate(mean, err, err_tau, tau, batch, k, n, bool(reliable))
+
+
+def order_parameter(L: np.ndarray, L_ss: float) -> MeanEstimate:
+    """m = 1 - <L>/L_ss with its batch-means error (Fig. 5b as an order parameter)."""
+    return mean_with_error(1.0 - np.asarray(L, dtype=float) / float(L_ss))
+
+
+def quarter_stats(t: np.ndarray, m: np.ndarray, stuck: np.ndarray | None, t_end: float) -> dict[str, float]:
+    """m and the fraction of samples with some block stuck over the third and fourth quarters
+    of ``[0, t_end]`` (what :func:`classify_final_state` compares)."""
+    t = np.asarray(t, dtype=float)
+    out: dict[str, float] = {}
+    for name, lo, hi in (("q3", 0.5, 0.75), ("q4", 0.75, 1.0 + 1e-12)):
+        sel = (t >= lo * t_end) & (t < hi * t_end)
+        est = mean_with_error(np.asarray(m)[sel])
+        out[f"m_{name}"], out[f"m_err_{name}"] = est.mean, est.err
+        if stuck is not None:
+            s = np.asarray(stuck, dtype=float)[sel]
+            out[f"stuck_{name}"] = float(s.mean()) if s.size else math.nan
+    return out
+
+
+def classify_final_state(
+    *,
+    reached_steady: bool,
+    stuck_q3: float,
+    stuck_q4: float,
+    m_q3: float,
+    m_err_q3: float,
+    m_q4: float,
+    m_err_q4: float,
+    drift_z: float = 4.0,
+    decay: float = 0.5,
+) -> tuple[str, str]:
+    """Final state of a run: ``steady``, ``stick-slip`` or ``undecided``, and why.
+
+    - ``steady``: the run reached steady sliding (every block within tolerance of it);
+    - ``stick-slip``: some block is stuck during the last quarter of the run, the fraction of
+      time with a stuck block there is at least ``decay`` times that of the third quarter (it
+      is not dying out), and m does not drift between the two quarters by more than
+      ``drift_z`` combined errors;
+    - ``undecided``: anything else: sliding but not yet steady, stick-slip dying out, or m
+      still drifting. Such a point is reported as it is, never averaged as settled.
+    """
+    if reached_steady:
+        return "steady", "reached steady sliding"
+    if not (math.isfinite(stuck_q4) and stuck_q4 > 0):
+        return "undecided", "no block stuck in the last quarter, but not yet steady sliding"
+    if math.isfinite(stuck_q3) and stuck_q4 < decay * stuck_q3:
+        return "undecided", f"stuck fraction falling ({stuck_q3:.3g} -> {stuck_q4:.3g})"
+    errs = math.hypot(m_err_q3, m_err_q4) if math.isfinite(m_err_q3) and math.isfinite(m_err_q4) else math.nan
+    if math.isfinite(errs) and errs > 0 and abs(m_q4 - m_q3) > drift_z * errs:
+        return "undecided", f"m drifting ({m_q3:.3g} -> {m_q4:.3g}, {abs(m_q4 - m_q3) / errs:.1f} errors)"
+    return "stick-slip", "blocks stick in the last quarter at a steady rate"
+
+
+def transition_bracket(betas, states) -> dict[str, Any]:
+    """Where the final state changes from stick-slip to steady sliding along beta (one N).
+
+    ``lo`` is the largest beta whose run ends in stick-slip, ``hi`` the smallest beta above
+    ``lo`` whose run ends steady; the transition lies in [lo, hi] (estimate: the midpoint,
+    uncertainty: half the width). Undecided points between them are listed, and points that
+    contradict a single transition (steady below ``lo``, stick-slip above ``hi``) are counted.
+    """
+    order = np.argsort(np.asarray(betas, dtype=float))
+    b = np.asarray(betas, dtype=float)[order]
+    s = np.asarray(states, dtype=object)[order]
+    stick = b[s == "stick-slip"]
+    if stick.size == 0:
+        return {"lo": math.nan, "hi": float(b[s == "steady"].min()) if (s == "steady").any() else math.nan,
+                "estimate": math.nan, "uncertainty": math.nan, "undecided": b[s == "undecided"].tolist(),
+                "contradictions": 0}
+    lo = float(stick.max())
+    above = b[(s == "steady") & (b > lo)]
+    hi = float(above.min()) if above.size else math.nan
+    between = b[(s == "undecided") & (b > lo) & ((b < hi) if math.isfinite(hi) else True)].tolist()
+    contradictions = int(np.count_nonzero((s == "steady") & (b < lo)))
+    est = 0.5 * (lo + hi) if math.isfinite(hi) else math.nan
+    return {"lo": lo, "hi": hi, "estimate": est, "uncertainty": 0.5 * (hi - lo) if math.isfinite(hi) else math.nan,
+            "undecided": between, "contradictions": contradictions}
+
+
+def power_law_fit(x, y, yerr=None) -> dict[str, float]:
+    """Least-squares fit of log y = log A + b log x (weights from ``yerr`` if given): the
+    exponent b of m ~ (beta_c - beta)^b, its standard error and A."""
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    ok = (x > 0) & (y > 0) & np.isfinite(x) & np.isfinite(y)
+    if np.count_nonzero(ok) < 3:
+        return {"b": math.nan, "b_err": math.nan, "A": math.nan, "n": int(np.count_nonzero(ok))}
+    lx, ly = np.log(x[ok]), np.log(y[ok])
+    w = None
+    if yerr is not None:
+        rel = np.asarray(yerr, dtype=float)[ok] / y[ok]
+        w = 1.0 / np.maximum(rel, 1e-3)
+    coef, cov = np.polyfit(lx, ly, 1, w=w, cov="unscaled" if w is not None and ok.sum() < 4 else True)
+    return {"b": float(coef[0]), "b_err": float(math.sqrt(cov[0, 0])), "A": float(math.exp(coef[1])),
+            "n": int(np.count_nonzero(ok))}

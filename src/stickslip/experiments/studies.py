@@ -1,0 +1,456 @@
+"""The studies the paper leaves open (``stickslip study NAME``), as specs, and the task of one point.
+
+A :class:`Study` is data: a name, a mode, the settings every point shares and the list of points.
+Its key hashes the name, the shared settings and the package version (not the point list, so a
+point added to a study keeps the directory and runs only the new point). Each point is one chain
+run of eq. (4) (or of a relative of it, :mod:`stickslip.models.presets`) plus the analysis of
+that run, carried out on a Dask worker by :func:`study_point_task` through
+:func:`stickslip.experiments.sweep.run_sweep`: finished points are reused, failed ones are
+recorded and retried by the next call, interrupted runs continue from their checkpoints.
+
+* ``transition``: the order parameter m = 1 - <L>/L_ss against beta for several N (section 3,
+  Fig. 5b as a phase transition), its error bar, the fraction of time with some block stuck, the
+  event rate, the largest event and the final state.
+* ``phase-diagram``: final state and m over (alpha, beta) and over (D, beta) at N = 99, each
+  point started from the paper's start and from perturbed steady sliding (hysteresis).
+* ``exponents``: the slip-size exponent tau (Figs. 7, 8) against beta, and for Carlson-Langer.
+* ``chaos``: the largest Lyapunov exponent (:func:`stickslip.analysis.lyapunov.largest_lyapunov`)
+  against beta for the paper's chain at N = 99 (section 3, "chaotic motion"), and for two blocks
+  and Carlson-Langer at their standard parameters.
+
+The runners that turn the points' results into tables, figures and pages are in
+:mod:`stickslip.experiments.study_run`.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import shutil
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from stickslip import __version__
+from stickslip.experiments.specs import _canonical
+
+__all__ = [
+    "Study",
+    "STUDIES",
+    "MODES",
+    "study",
+    "study_point_task",
+    "study_command",
+    "check_point",
+    "lyapunov_point",
+    "loading_time",
+    "CHECKPOINT_INTERVAL",
+]
+
+STUDIES = ("transition", "phase-diagram", "exponents", "chaos")
+#: ``tiny`` runs every study on chains of a few blocks in seconds (tests); its numbers mean nothing.
+MODES = ("quick", "full", "tiny")
+#: Wall-clock seconds between checkpoints of a chain run.
+CHECKPOINT_INTERVAL = 120.0
+#: Tolerance of the stop at steady sliding (largest deviation of v, theta, springs).
+UNTIL_STEADY = 1e-6
+
+_PAPER = {"K": 10.0, "D": 5.0, "V": 0.001, "Fs": 3.0, "alpha": 1.0, "dt": 0.005}
+
+
+@dataclass(frozen=True)
+class Study:
+    """One study as data: ``name`` (one of :data:`STUDIES`), ``mode``, ``common`` (settings
+    every point shares: model parameters, run options, analysis), ``points`` (the varying
+    settings of each point) and a ``note`` for the page. The result depends on ``name``,
+    ``common``, the points and the package version only."""
+
+    name: str
+    mode: str
+    common: dict[str, Any] = field(default_factory=dict)
+    points: tuple[dict[str, Any], ...] = ()
+    note: str = ""
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "common", _canonical(dict(self.common)))
+        object.__setattr__(self, "points", tuple(_canonical(dict(p)) for p in self.points))
+
+    def spec(self) -> dict[str, Any]:
+        """What the results depend on: name, shared settings, points, package version."""
+        return _canonical({"study": self.name, "common": self.common, "points": list(self.points),
+                           "version": __version__})
+
+    def key(self) -> str:
+        """First 12 hex digits of the SHA-256 of the spec without its points."""
+        spec = self.spec()
+        spec.pop("points")
+        text = json.dumps(spec, sort_keys=True, separators=(",", ":"))
+        return hashlib.sha256(text.encode()).hexdigest()[:12]
+
+    @property
+    def dirname(self) -> str:
+        return f"{self.name}-{self.key()}"
+
+
+def loading_time(N: int, K: float = 10.0, V: float = 0.001) -> float:
+    """L_ss / V at c = 1: the time the pulling point takes to stretch the chain to its steady
+    length, ``N (N - 1) / (2 K V)`` (MODEL.md, "Steady sliding")."""
+    return N * (N - 1) / (2.0 * K * V)
+
+
+def _t_end(N: int, loads: float) -> float:
+    """Run length: ``loads`` loading times, rounded up to 3 significant digits."""
+    t = loads * loading_time(N)
+    scale = 10.0 ** (math.floor(math.log10(t)) - 2)
+    return math.ceil(t / scale) * scale
+
+
+# ---------------------------------------------------------------------------------------------
+# The spec sets
+
+_T_BETAS_QUICK = (0.6, 0.7, 0.8, 0.9, 0.95, 0.975, 1.0, 1.025, 1.05, 1.1, 1.2, 1.4)
+_T_BETAS_FULL = tuple(sorted({round(0.6 + 0.05 * k, 3) for k in range(17)} | {0.975, 0.99, 1.01, 1.025}))
+
+
+def _transition(mode: str) -> Study:
+    if mode == "tiny":
+        Ns, betas, loads = (9,), (0.8, 1.2), 2.5
+    elif mode == "quick":
+        Ns, betas, loads = (49, 99, 199), _T_BETAS_QUICK, 2.5
+    else:
+        Ns, betas, loads = (49, 99, 199, 399, 799), _T_BETAS_FULL, 4.0
+    # Longest runs first, for a shorter tail on a few workers: large N, then large beta (runs
+    # that slide update every block at every step until they settle; stick-slip is cheap).
+    points = [{"N": N, "beta": b, "t_end": _t_end(N, loads)}
+              for N in sorted(Ns, reverse=True) for b in sorted(betas, reverse=True)]
+    common = {**_PAPER, "model": "sakaguchi", "start": "paper", "loads": loads, "average_fraction": 0.5,
+              "n_samples": 20000 if mode != "tiny" else 2000, "until_steady": UNTIL_STEADY,
+              "analysis": "order"}
+    return Study("transition", mode, common, tuple(points),
+                 note=f"{mode}: N in {list(Ns)}, {len(betas)} values of beta, runs of {loads:g} loading times")
+
+
+def _phase_diagram(mode: str) -> Study:
+    if mode == "tiny":
+        N, alphas, Ds, betas = 9, (1.0,), (5.0,), (0.8, 1.2)
+        D_betas = betas
+    elif mode == "quick":
+        N, alphas, Ds = 99, (0.5, 1.0, 1.5), (0.5, 5.0, 50.0)
+        betas = (0.25, 0.5, 0.75, 1.0, 1.25, 1.5, 1.75)
+        D_betas = (0.7, 0.9, 1.0, 1.1, 1.3)
+    else:
+        N, alphas, Ds = 99, (0.25, 0.5, 0.75, 1.0, 1.25, 1.5, 1.75, 2.0), (0.1, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0)
+        betas = tuple(round(0.125 * k, 3) for k in range(1, 19))
+        D_betas = (0.6, 0.7, 0.8, 0.85, 0.9, 0.95, 1.0, 1.05, 1.1, 1.15, 1.2, 1.3, 1.4)
+    loads = 2.5
+    t_end = _t_end(N, loads)
+    cells = [{"alpha": a, "D": 5.0, "beta": b} for a in alphas for b in betas]
+    cells += [{"alpha": 1.0, "D": d, "beta": b} for d in Ds for b in D_betas]
+    unique: list[dict[str, Any]] = []
+    for c in cells:
+        if c not in unique:
+            unique.append(c)
+    # Longest first: deep on the sliding side (beta - alpha large) the paper's start slides
+    # longest before it settles.
+    unique.sort(key=lambda c: -(c["beta"] - c["alpha"]))
+    points = [{**c, "N": N, "t_end": t_end, "start": s} for c in unique for s in ("paper", "steady")]
+    common = {**{k: v for k, v in _PAPER.items() if k not in ("alpha", "D")}, "model": "sakaguchi",
+              "loads": loads, "average_fraction": 0.5, "n_samples": 20000 if mode != "tiny" else 2000,
+              "until_steady": UNTIL_STEADY, "perturbation": 0.01, "seed": 0, "analysis": "order",
+              "alphas": list(alphas), "Ds": list(Ds)}
+    return Study("phase-diagram", mode, common, tuple(points),
+                 note=(f"{mode}: N = {N}, {len(unique)} cells of (alpha, beta) and (D, beta), each from the "
+                       f"paper's start and from steady sliding perturbed by 0.01"))
+
+
+def _exponents(mode: str) -> Study:
+    if mode == "tiny":
+        N, betas, loads, cl = 19, (0.2, 1.0), 5.0, {"N": 16, "t_end": 2000.0}
+    elif mode == "quick":
+        N, betas, loads, cl = 199, (0.2, 0.4, 0.6, 0.8, 1.0), 5.0, {"N": 100, "t_end": 1e5}
+    else:
+        N, betas, loads, cl = 399, (0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0), 5.0, {"N": 100, "t_end": 1e6}
+    t_end = _t_end(N, loads)
+    points = [{"model": "sakaguchi", "N": N, "beta": b, "t_end": t_end} for b in betas]
+    points.append({"model": "carlson-langer", **cl, "start": "rest", "perturbation": 0.01, "seed": 0,
+                   "spanning": "n_blocks", "transient": 0.2})
+    common = {"start": "paper", "average_fraction": 0.5, "n_samples": 2000, "analysis": "sizes",
+              "spanning": "max_block", "bootstrap": 200}
+    return Study("exponents", mode, common, tuple(points),
+                 note=(f"{mode}: eq. (4) at N = {N} to t = {t_end:g} ({loads:g} loading times), events of the "
+                       f"second half; Carlson-Langer (standard parameters, N = {cl['N']}, periodic) to "
+                       f"t = {cl['t_end']:g}, events after the first fifth"))
+
+
+_CHAOS_BETAS_QUICK = tuple(round(0.2 + 0.1 * k, 3) for k in range(11))
+_CHAOS_BETAS_FULL = tuple(round(0.2 + 0.05 * k, 3) for k in range(21))
+
+
+def _chaos(mode: str) -> Study:
+    # Transients: the chain needs about one loading time (4.85e5 at N = 99) before its length
+    # fluctuates about its mean (docs/lyapunov.md); the plate-driven relatives forget their start
+    # within 2e3.
+    if mode == "tiny":
+        chain = [{"N": 9, "beta": b, "t_end": 6000.0, "transient": 3000.0, "interval": 10.0} for b in (0.6, 1.2)]
+        # steady sliding well above the inverse transition: the exponent is the least stable
+        # eigenvalue of eq. (5), negative (docs/lyapunov.md, checks with known answers)
+        chain.append({"N": 4, "beta": 1.5, "V": 0.5, "start": "steady", "perturbation": 1e-3, "t_end": 400.0,
+                      "transient": 0.0, "interval": 5.0})
+        family = [{"model": "two-blocks", "t_end": 600.0, "transient": 100.0},
+                  {"model": "carlson-langer", "N": 16, "t_end": 300.0, "transient": 100.0}]
+        d0s = (1e-10,)
+    elif mode == "quick":
+        chain = [{"N": 99, "beta": b, "t_end": 6e5, "transient": 5e5, "interval": 10.0} for b in _CHAOS_BETAS_QUICK]
+        family = [{"model": "two-blocks", "t_end": 4.2e4, "transient": 2e3},
+                  {"model": "carlson-langer", "t_end": 2.2e4, "transient": 2e3}]
+        d0s = (1e-10,)
+    else:
+        chain = [{"N": 99, "beta": b, "t_end": 1.5e6, "transient": 1e6, "interval": 10.0} for b in _CHAOS_BETAS_FULL]
+        family = [{"model": "two-blocks", "t_end": 2.02e5, "transient": 2e3},
+                  {"model": "carlson-langer", "t_end": 1.02e5, "transient": 2e3}]
+        d0s = (1e-8, 1e-10, 1e-11)  # CL does not settle in d0 (docs/lyapunov.md): show the spread
+    points = [{"model": "sakaguchi", "start": "paper", **c, "d0": 1e-10} for c in chain]
+    points += [{**f, "interval": 1.0, "start": "rest", "perturbation": 0.01, "seed": 0, "d0": d0}
+               for f in family for d0 in d0s]
+    # Longest first: a shorter tail on a few workers.
+    points.sort(key=lambda p: -(p["t_end"] - p["transient"]) * p.get("N", 100) / p["interval"])
+    common = {"analysis": "lyapunov", "segments": 10, "direction_seed": 0}
+    n_chain = len([p for p in points if p["model"] == "sakaguchi"])
+    return Study("chaos", mode, common, tuple(points),
+                 note=(f"{mode}: eq. (4) at N = {chain[0]['N']}, {n_chain} points in beta, "
+                       f"t = {chain[0]['transient']:g} .. {chain[0]['t_end']:g}, d0 = 1e-10; two blocks "
+                       f"and Carlson-Langer at standard parameters, d0 = {', '.join(f'{d:g}' for d in d0s)}"))
+
+
+_BUILDERS = {"transition": _transition, "phase-diagram": _phase_diagram, "exponents": _exponents,
+             "chaos": _chaos}
+
+
+def study(name: str, mode: str = "quick") -> Study:
+    """The spec of study ``name`` (:data:`STUDIES`) in ``mode`` (:data:`MODES`)."""
+    if name not in _BUILDERS:
+        raise ValueError(f"study must be one of {', '.join(STUDIES)} (got {name!r})")
+    if mode not in MODES:
+        raise ValueError(f"mode must be one of {', '.join(MODES)} (got {mode!r})")
+    return _BUILDERS[name](mode)
+
+
+def study_command(name: str, mode: str) -> str:
+    """The command line that computes study ``name`` in ``mode`` (shown beside each figure)."""
+    return f"stickslip study {name} --{mode} --out DIR"
+
+
+# ---------------------------------------------------------------------------------------------
+# One point: a chain run and its analysis, on a worker
+
+_PARAM_FIELDS = ("N", "K", "D", "V", "beta", "alpha", "Fs", "dt", "l", "nu")
+
+
+def point_params(cfg: dict[str, Any]):
+    """The :class:`~stickslip.models.params.ChainParams` of a point's merged settings."""
+    from stickslip.models.presets import chain_params
+
+    return chain_params(cfg.get("model", "sakaguchi"), **{k: cfg[k] for k in _PARAM_FIELDS if k in cfg})
+
+
+def point_run_options(cfg: dict[str, Any], params) -> tuple[float, dict[str, Any]]:
+    """Run length and :func:`~stickslip.run.driver.run_chain` options of a point."""
+    from stickslip.models.presets import PRESETS
+
+    t_end = float(cfg["t_end"])
+    preset = PRESETS[params.model]
+    start = cfg.get("start", preset.start)
+    options: dict[str, Any] = {
+        "start": start,
+        "perturbation": float(cfg.get("perturbation", preset.start_options.get("amplitude", 0.0))),
+        "seed": int(cfg.get("seed", preset.start_options.get("seed", 0))),
+        "sample_interval": max(t_end / float(cfg.get("n_samples", 2000)), params.dt),
+        "average_from": float(cfg.get("average_fraction", 0.5)) * t_end,
+        "sample_moving": cfg.get("analysis") == "order",
+    }
+    if start == "paper":
+        options["perturbation"] = 0.0
+    if cfg.get("until_steady"):
+        options["until_steady"] = float(cfg["until_steady"])
+    return t_end, options
+
+
+_LYAPUNOV_OPTIONS = ("interval", "d0", "transient", "align", "segments", "direction_seed")
+
+
+def lyapunov_options(cfg: dict[str, Any], params) -> tuple[float, dict[str, Any]]:
+    """Run length and :func:`~stickslip.analysis.lyapunov.largest_lyapunov` options of a chaos
+    point (start, perturbation and seed default to the model's preset), checked as that
+    function checks them."""
+    from stickslip.analysis.lyapunov import _check_run
+    from stickslip.models.presets import PRESETS
+
+    preset = PRESETS[params.model]
+    t_end = float(cfg["t_end"])
+    options: dict[str, Any] = {k: cfg[k] for k in _LYAPUNOV_OPTIONS if k in cfg}
+    options["start"] = cfg.get("start", preset.start)
+    options["perturbation"] = float(cfg.get("perturbation", preset.start_options.get("amplitude", 0.0)))
+    options["seed"] = int(cfg.get("seed", preset.start_options.get("seed", 0)))
+    if options["start"] == "paper":
+        options["perturbation"] = 0.0
+    _check_run(params, t_end, options.get("interval", 10.0), options.get("d0", 1e-10), options.get("transient", 0.0),
+               options.get("align"), options.get("segments", 10))
+    return t_end, options
+
+
+def check_point(cfg: dict[str, Any]) -> None:
+    """Raise ParameterError (one line) unless a point's merged settings make a valid run."""
+    params = point_params(cfg)
+    if cfg.get("analysis") == "lyapunov":
+        lyapunov_options(cfg, params)
+    else:
+        point_run_options(cfg, params)
+
+
+def lyapunov_point(cfg: dict[str, Any], point_dir: Path) -> dict[str, Any]:
+    """One point of ``chaos``: the largest Lyapunov exponent of a model of the family
+    (Benettin et al. 1980, :func:`stickslip.analysis.lyapunov.largest_lyapunov`), written to
+    ``lyapunov.json`` and ``renormalisations.parquet`` (every renormalisation: end time,
+    ln(d/d0), length, counted) in ``point_dir``. Adds the exponent per slip event."""
+    from stickslip import io
+    from stickslip.analysis.lyapunov import largest_lyapunov
+
+    params = point_params(cfg)
+    t_end, options = lyapunov_options(cfg, params)
+    res = largest_lyapunov(params, t_end, **options)
+    point_dir = Path(point_dir)
+    point_dir.mkdir(parents=True, exist_ok=True)
+    import pandas as pd
+
+    io.write_table(point_dir / "renormalisations.parquet",
+                   pd.DataFrame({"t": res.times, "log_growth": res.log_growth, "duration": res.durations,
+                                 "counted": res.counted}),
+                   descriptions={"t": "end of the interval", "log_growth": "ln(d / d0) over the interval",
+                                 "duration": "length of the interval", "counted": "enters the exponent"})
+    info = res.to_dict()
+    io.write_json(point_dir / "lyapunov.json", info)
+    counted_time = float(np.sum(res.durations[res.counted]))
+    per_event = res.lyapunov * counted_time / res.events if res.events > 0 else math.nan
+    keep = ("lyapunov", "lyapunov_err", "t_end", "renormalisations", "d0", "interval", "transient", "align",
+            "segments", "events", "merges", "max_log_growth", "reference_sha256", "start")
+    return {"model": params.model, **{k: info[k] for k in keep}, "counted_time": counted_time,
+            "lyapunov_per_event": per_event, "run_wall_seconds": float(res.wall_seconds)}
+
+
+def _run(params, t_end: float, options: dict[str, Any], point_dir: Path):
+    """Run the chain into ``point_dir``, continuing from a checkpoint there if one is usable."""
+    from stickslip.run import driver
+
+    if (point_dir / "checkpoint" / "state.npz").is_file():
+        try:
+            return driver.resume_chain(point_dir, checkpoint_interval=CHECKPOINT_INTERVAL, expect_params=params)
+        except driver.ChainRunError:
+            shutil.rmtree(point_dir / "checkpoint", ignore_errors=True)
+    return driver.run_chain(params, t_end, out_dir=point_dir, checkpoint_interval=CHECKPOINT_INTERVAL, **options)
+
+
+def study_point_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
+    """One point of a study: the chain run and its analysis (a task of ``run_sweep``).
+
+    ``analysis = "order"``: :func:`order_summary`; ``"sizes"``: :func:`sizes_summary`;
+    ``"lyapunov"``: :func:`lyapunov_point` (no chain run record, only the exponent's data).
+    Returns the summary stored in the point's ``done.json``.
+    """
+    if point.get("analysis") == "lyapunov":
+        return lyapunov_point(point, point_dir)
+    params = point_params(point)
+    t_end, options = point_run_options(point, params)
+    point_dir = Path(point_dir)
+    run = _run(params, t_end, options, point_dir)
+    base = {"model": params.model, "t_end": t_end, "t_reached": float(run.summary["t_reached"]),
+            "n_events_total": int(run.summary["n_events"]), "run_wall_seconds": float(run.summary["wall_seconds"]),
+            "block_updates": int(run.summary["block_updates"])}
+    if point.get("analysis") == "sizes":
+        return {**base, **sizes_summary(run, point)}
+    return {**base, **order_summary(run, params, options["average_from"])}
+
+
+def order_summary(run, params, t_from: float) -> dict[str, Any]:
+    """The order parameter m = 1 - <L>/L_ss over t >= ``t_from`` with its batch-means error, the
+    fraction of samples with some block stuck, the event rate and largest event over the same
+    window, the time steady sliding was reached, and the final state
+    (:func:`stickslip.analysis.order.classify_final_state`)."""
+    from stickslip.analysis.order import classify_final_state, order_parameter, quarter_stats
+    from stickslip.models.physics import chain_steady_length
+
+    L_ss = chain_steady_length(params)
+    s = run.summary
+    t_end = float(run.options.t_end)
+    dt_s = float(run.options.sample_interval)
+    t = run.samples["t"].values
+    L = run.samples["L"].values
+    tm = run.samples["t_moving"].values
+    stuck = (run.samples["n_moving"].values < params.N).astype(float)
+    reached = bool(s.get("stopped_early", False))
+    if reached:
+        # steady sliding from t_steady on: L = L_ss and nothing stuck at the remaining sample times
+        t_rest = np.arange(math.floor(float(s["t_steady"]) / dt_s + 1e-9) + 1, math.floor(t_end / dt_s + 1e-9) + 1) * dt_s
+        t = np.concatenate([t[t < t_rest[0]] if t_rest.size else t, t_rest])
+        L = np.concatenate([run.samples["L"].values[:t.size - t_rest.size], np.full(t_rest.size, L_ss)])
+        tm_keep = tm < t_rest[0] if t_rest.size else np.ones(tm.size, bool)
+        tm = np.concatenate([tm[tm_keep], t_rest])
+        stuck = np.concatenate([stuck[tm_keep], np.zeros(t_rest.size)])
+    m = 1.0 - L / L_ss
+    late = t >= t_from - 1e-9
+    est = order_parameter(L[late], L_ss)
+    late_m = tm >= t_from - 1e-9
+    stuck_fraction = float(stuck[late_m].mean()) if late_m.any() else math.nan
+    q = quarter_stats(t, m, None, t_end)
+    q.update({k: v for k, v in quarter_stats(tm, np.zeros(tm.size), stuck, t_end).items() if k.startswith("stuck")})
+    state, reason = classify_final_state(reached_steady=reached, stuck_q3=q["stuck_q3"], stuck_q4=q["stuck_q4"],
+                                         m_q3=q["m_q3"], m_err_q3=q["m_err_q3"], m_q4=q["m_q4"],
+                                         m_err_q4=q["m_err_q4"])
+    ev = run.events[run.events["t_start"] >= t_from]
+    window = t_end - t_from
+    return {
+        "order_parameter": est.mean,
+        "order_parameter_err": est.err,
+        "order_parameter_err_tau": est.err_tau,
+        "tau_int": est.tau_int * dt_s,
+        "batch_time": est.batch * dt_s,
+        "n_batches": est.n_batches,
+        "err_reliable": est.reliable,
+        "L_mean": float(np.mean(L[late])) if late.any() else math.nan,
+        "L_steady": L_ss,
+        "stuck_fraction": stuck_fraction,
+        "event_rate": len(ev) / window if window > 0 else math.nan,
+        "n_events": int(len(ev)),
+        "S_max": float(ev["S"].max()) if len(ev) else 0.0,
+        "max_blocks": int(ev["n_blocks"].max()) if len(ev) else 0,
+        "t_steady": float(s["t_steady"]) if reached else None,
+        "final_state": state,
+        "final_reason": reason,
+        **q,
+    }
+
+
+def sizes_summary(run, cfg: dict[str, Any]) -> dict[str, Any]:
+    """Slip-size exponent tau (truncated power law below the smallest spanning event, s_min by
+    least KS distance, bootstrap error), the fitted range and the excess of great events
+    (:func:`stickslip.analysis.chain_runs.size_statistics`) over the events after the transient."""
+    from stickslip.analysis.chain_runs import size_statistics
+
+    t_end = float(run.options.t_end)
+    t_from = float(cfg.get("transient", cfg.get("average_fraction", 0.5))) * t_end
+    events = run.events[run.events["t_start"] >= t_from]
+    spanning = cfg.get("spanning", "max_block")
+    out: dict[str, Any] = {"t_from": t_from, "n_events": int(len(events)), "spanning": spanning}
+    if len(events) < 20:
+        out.update(tau=math.nan, tau_err=math.nan, error_note=f"only {len(events)} events after t = {t_from:g}")
+        return out
+    st = size_statistics(events, run.params.N, small_only=True, seed=int(cfg.get("seed", 0)), spanning=spanning,
+                         bootstrap=int(cfg.get("bootstrap", 200)))
+    fit = st["fit"]
+    out.update(tau=fit.tau, tau_err=fit.tau_err, tau_err_fisher=fit.tau_err_fisher, s_min=fit.s_min,
+               s_max=fit.s_max, n_fit=fit.n, ks_distance=fit.ks_distance, n_spanning=st["n_spanning"],
+               s_span=st["s_span"], S_max=st["S_max"], excess=st["excess"], observed=st["observed"],
+               expected=st["expected"])
+    return out

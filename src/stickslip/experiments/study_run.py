@@ -1,0 +1,201 @@
+"""Running a study (``stickslip study NAME``): its points on Dask, its table, figures and page.
+
+:func:`run_study` takes a :class:`~stickslip.experiments.studies.Study`, runs its points through
+:func:`stickslip.experiments.sweep.run_sweep` (each point reused if done, failed points recorded
+and retried next time, interrupted chain runs continued from their checkpoints), builds the
+study's table (:mod:`stickslip.analysis.order` for the conclusions drawn from it), draws its
+figures (:mod:`stickslip.plotting.studies`) and writes its page. Layout::
+
+    OUT/runs/<name>-<key>/points/<point>/   one chain run and its analysis per point
+    OUT/<name>/table.parquet, table.csv     the study's table, one row per point
+    OUT/<name>/<figure>.png|.pdf            its figures
+    OUT/<name>/study.json, index.html       the conclusions, the commands, the page
+"""
+
+from __future__ import annotations
+
+import html
+import math
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from stickslip import __version__, io
+from stickslip.experiments.studies import Study, study, study_command, study_point_task
+from stickslip.jsonable import to_jsonable
+
+__all__ = ["run_study", "study_command", "TABLE_COLUMNS"]
+
+#: The leading columns of each study's table (the rest follow).
+TABLE_COLUMNS = {
+    "transition": ["N", "beta", "order_parameter", "order_parameter_err", "final_state", "stuck_fraction",
+                   "event_rate", "S_max", "max_blocks", "t_steady", "tau_int", "err_reliable", "t_end"],
+    "phase-diagram": ["N", "alpha", "D", "beta", "start", "final_state", "order_parameter",
+                      "order_parameter_err", "stuck_fraction", "t_steady", "t_end"],
+    "exponents": ["model", "N", "beta", "tau", "tau_err", "s_min", "s_max", "n_fit", "n_events", "excess",
+                  "observed", "expected", "n_spanning", "S_max", "t_end"],
+    "chaos": ["model", "N", "beta", "lyapunov", "lyapunov_err", "t_end", "renormalisations", "d0", "interval",
+              "transient", "events", "lyapunov_per_event", "merges", "max_log_growth"],
+}
+
+
+def _log(enabled: bool, t0: float, text: str) -> None:
+    if enabled:
+        sys.stderr.write(f"[study {time.perf_counter() - t0:6.1f} s] {text}\n")
+        sys.stderr.flush()
+
+
+def run_study(
+    spec: Study | str,
+    out_dir: str | Path,
+    mode: str = "quick",
+    *,
+    scheduler: str | None = None,
+    n_workers: int | None = None,
+    progress: bool = True,
+) -> dict[str, Any]:
+    """Run (or reuse) every point of a study and write its table, figures and page under ``out_dir``.
+
+    ``spec`` is a :class:`Study` or a study name (then ``mode`` picks its spec set). Points run
+    on a local Dask cluster of ``n_workers`` processes or on the cluster at ``scheduler``.
+    Progress goes to stderr when ``progress`` and stderr is a terminal. Returns the table as
+    records, the conclusions, failed points with their errors, paths and times.
+    """
+    from stickslip.experiments.sweep import _on_terminal, run_sweep
+
+    t0 = time.perf_counter()
+    spec = study(spec, mode) if isinstance(spec, str) else spec
+    out = Path(out_dir)
+    run_dir = out / "runs" / spec.dirname
+    page_dir = out / spec.name
+    show = progress and _on_terminal()
+    from stickslip.experiments.studies import check_point
+
+    for p in spec.points:  # validate every point before any work starts
+        check_point({**spec.common, **p})
+    _log(show, t0, f"{spec.name} --{spec.mode}: {len(spec.points)} points in {run_dir} "
+                   f"({'scheduler ' + scheduler if scheduler else 'local cluster'}); finished points are reused")
+    io.write_json(run_dir / "study-spec.json", spec.spec())
+    result = run_sweep(study_point_task, [dict(p) for p in spec.points], run_dir / "points", common=dict(spec.common),
+                       scheduler=scheduler, n_workers=n_workers, progress=show)
+    table = _study_table(spec, result.table)
+    failed = table[table["status"] != "ok"]
+    page_dir.mkdir(parents=True, exist_ok=True)
+    io.write_table(page_dir / "table.parquet", table)
+    table.to_csv(page_dir / "table.csv", index=False)
+    ok = table[table["status"] == "ok"]
+    from stickslip.experiments import study_findings
+
+    findings = study_findings.conclusions(spec, ok)
+    figures = study_findings.draw(spec, ok, page_dir)
+    wall = time.perf_counter() - t0
+    meta = {
+        "study": spec.name, "mode": spec.mode, "key": spec.key(), "version": __version__,
+        "command": study_command(spec.name, spec.mode), "note": spec.note,
+        "points": len(table), "run": result.n_run, "reused": result.n_reused, "failed": int(len(failed)),
+        "wall_seconds": round(wall, 1),
+        "compute_seconds": round(float(np.nansum(table["wall_seconds"].to_numpy(dtype=float))), 1),
+        "runs": str(run_dir),
+    }
+    records = _records(table)
+    io.write_json(page_dir / "study.json", {"meta": meta, "findings": findings, "figures": figures, "rows": records})
+    _write_page(page_dir / "index.html", spec, meta, findings, figures, table)
+    _log(show, t0, f"page: {page_dir / 'index.html'} ({wall:.1f} s)")
+    return {
+        **meta,
+        "out": str(out),
+        "page": str(page_dir / "index.html"),
+        "table_file": str(page_dir / "table.parquet"),
+        "findings": findings,
+        "figures": figures,
+        "failed_points": [{"point": r.point_dir, "error": r.error} for r in failed.itertuples()],
+        "rows": records,
+    }
+
+
+def _study_table(spec: Study, sweep_table: pd.DataFrame) -> pd.DataFrame:
+    """The sweep's table with the shared settings filled in and the study's columns first."""
+    table = sweep_table.copy()
+    for key in ("N", "alpha", "D", "beta", "model"):
+        if key not in table.columns and key in spec.common:
+            table[key] = spec.common[key]
+    if "model" in table.columns:
+        table["model"] = table["model"].fillna(spec.common.get("model", "sakaguchi"))
+    if "N" in table.columns and "model" in table.columns:
+        # a relative run at its preset's N carries no N in its point
+        from stickslip.models.presets import PRESETS
+
+        missing = table["N"].isna()
+        if missing.any():
+            table.loc[missing, "N"] = [PRESETS[m].params["N"] for m in table.loc[missing, "model"]]
+            table["N"] = table["N"].astype("int64")
+    if "beta" in table.columns and "model" in table.columns:
+        # the plate-driven relatives have no beta (velocity-weakening friction)
+        table.loc[table["model"].isin(["carlson-langer", "two-blocks"]), "beta"] = np.nan
+    if "final_state" in table.columns:
+        table.loc[table["status"] != "ok", "final_state"] = "failed"
+    lead = [c for c in TABLE_COLUMNS[spec.name] if c in table.columns]
+    rest = [c for c in table.columns if c not in lead]
+    return table[lead + rest].reset_index(drop=True)
+
+
+def _records(table: pd.DataFrame) -> list[dict[str, Any]]:
+    return to_jsonable(table.astype(object).where(table.notna(), None).to_dict(orient="records"))
+
+
+# ---------------------------------------------------------------------------------------------
+# The page
+
+_CSS = """
+body { font-family: system-ui, sans-serif; margin: 2em auto; max-width: 76em; padding: 0 1em; color: #222; }
+table { border-collapse: collapse; font-size: 0.85em; } th, td { border: 1px solid #ccc; padding: 0.25em 0.45em; }
+th { background: #f3f3f3; } code { font-size: 0.9em; } figure { display: inline-block; margin: 0.8em; max-width: 46em; }
+figure img { max-width: 100%; border: 1px solid #ddd; } figcaption { font-size: 0.9em; } td.failed { background: #f9e0e0; }
+"""
+
+
+def _cell(value: Any) -> str:
+    if value is None or (isinstance(value, float) and not math.isfinite(value)):
+        return ""
+    if isinstance(value, float):
+        return f"{value:.4g}"
+    return html.escape(str(value))
+
+
+def _write_page(path: Path, spec: Study, meta: dict[str, Any], findings: dict[str, Any],
+                figures: list[dict[str, Any]], table: pd.DataFrame) -> None:
+    import base64
+
+    parts = ["<!DOCTYPE html>", '<html lang="en"><head><meta charset="utf-8">',
+             f"<title>Study: {html.escape(spec.name)}</title><style>{_CSS}</style></head><body>",
+             f"<h1>Study: {html.escape(spec.name)} ({html.escape(spec.mode)})</h1>",
+             f"<p><code>{html.escape(meta['command'])}</code> &mdash; {html.escape(spec.note)}</p>",
+             f"<p>{meta['points']} points: {meta['run']} run now, {meta['reused']} reused, {meta['failed']} failed; "
+             f"{meta['wall_seconds']} s wall, {meta['compute_seconds']} s of point runs; stickslip {__version__}; "
+             f"runs in <code>{html.escape(meta['runs'])}</code>.</p>",
+             "<h2>What the data say</h2><ul>"]
+    for line in findings.get("statements", []):
+        parts.append(f"<li>{html.escape(line)}</li>")
+    parts.append("</ul><h2>Figures</h2>")
+    for fig in figures:
+        png = path.parent / fig["image"]
+        src = ("data:image/png;base64," + base64.b64encode(png.read_bytes()).decode()) if png.is_file() else fig["image"]
+        parts.append(f'<figure><img src="{src}" alt="{html.escape(fig["name"])}"><figcaption>'
+                     f'{html.escape(fig["caption"])} <a href="{html.escape(fig["pdf"])}">PDF</a><br>'
+                     f'<code>{html.escape(fig["command"])}</code></figcaption></figure>')
+    parts.append('<h2>Table</h2><p>Data: <a href="table.parquet">table.parquet</a>, <a href="table.csv">table.csv</a>, '
+                 '<a href="study.json">study.json</a>; each point\'s run (state.nc, events.parquet) in its '
+                 'directory under the runs folder.</p><table><thead><tr>')
+    cols = [c for c in TABLE_COLUMNS[spec.name] if c in table.columns] + ["status", "error"]
+    parts.append("".join(f"<th>{html.escape(c)}</th>" for c in cols) + "</tr></thead><tbody>")
+    for row in table.itertuples(index=False):
+        r = row._asdict()
+        cls = ' class="failed"' if r.get("status") != "ok" else ""
+        parts.append(f"<tr{cls}>" + "".join(f"<td>{_cell(r.get(c))}</td>" for c in cols) + "</tr>")
+    parts.append("</tbody></table></body></html>\n")
+    with io.atomic_path(path) as tmp:
+        tmp.write_text("\n".join(parts), encoding="utf-8")

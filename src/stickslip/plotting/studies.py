@@ -1,0 +1,184 @@
+"""Figures of the studies (``stickslip study``): the order parameter against beta, the time to
+reach steady sliding, the collapse of m against 1 - beta, the phase diagrams, tau against beta and
+the largest Lyapunov exponent against beta.
+
+Each function takes the study's table (one row per point, :mod:`stickslip.experiments.study_run`)
+and returns a matplotlib Figure.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+
+from stickslip.plotting.style import new_figure
+
+__all__ = ["order_parameter_figure", "steady_time_figure", "collapse_figure", "phase_map_figure",
+           "exponents_figure", "chaos_figure", "STATE_STYLE"]
+
+#: Marker colour of each final state.
+STATE_STYLE = {"steady": "C0", "stick-slip": "C3", "undecided": "C1", "failed": "0.5"}
+
+
+def order_parameter_figure(table: pd.DataFrame) -> Figure:
+    """m = 1 - <L>/L_ss against beta, one curve per N, error bars from batch means; open
+    markers for runs whose final state is undecided (section 3, Fig. 5b as an order parameter)."""
+    fig, ax = new_figure(width=6.0, height=4.0)
+    for k, (N, g) in enumerate(sorted(table.groupby("N"), key=lambda x: x[0])):
+        g = g.sort_values("beta")
+        color = f"C{k}"
+        ax.errorbar(g["beta"], g["order_parameter"], yerr=g["order_parameter_err"], color=color, lw=1,
+                    marker="o", ms=4, capsize=2, label=f"N = {N}")
+        und = g[g["final_state"] == "undecided"]
+        ax.plot(und["beta"], und["order_parameter"], "o", ms=9, mfc="none", mec=color)
+    ax.axvline(1.0, color="0.5", lw=0.8, ls=":")
+    ax.axhline(0.0, color="0.5", lw=0.8)
+    ax.set_xlabel(r"$\beta$")
+    ax.set_ylabel(r"$m = 1 - \langle L\rangle / L_\mathrm{ss}$")
+    ax.legend(title="large open circle: undecided")
+    return fig
+
+
+def steady_time_figure(table: pd.DataFrame) -> Figure:
+    """Time at which the run reached steady sliding, in loading times L_ss/V, against beta."""
+    fig, ax = new_figure(width=6.0, height=4.0)
+    for k, (N, g) in enumerate(sorted(table.groupby("N"), key=lambda x: x[0])):
+        g = g[g["t_steady"].notna()].sort_values("beta")
+        if len(g):
+            load = N * (N - 1) / (2.0 * 10.0 * 0.001)
+            ax.plot(g["beta"], g["t_steady"].astype(float) / load, "o-", color=f"C{k}", ms=4, label=f"N = {N}")
+    ax.set_xlabel(r"$\beta$")
+    ax.set_ylabel(r"$t_\mathrm{steady}\,/\,(L_\mathrm{ss}/V)$")
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend()
+    return fig
+
+
+def collapse_figure(table: pd.DataFrame, fits: dict | None = None) -> Figure:
+    """m against 1 - beta on log-log axes for every N (stick-slip points with m > 0): curves
+    that fall on one another need no N-dependent rescaling; dashed: the fitted power laws."""
+    fig, ax = new_figure(width=6.0, height=4.0)
+    for k, (N, g) in enumerate(sorted(table.groupby("N"), key=lambda x: x[0])):
+        g = g[(g["beta"] < 1.0) & (g["order_parameter"] > 0)].sort_values("beta")
+        if not len(g):
+            continue
+        x = 1.0 - g["beta"].to_numpy(float)
+        ax.errorbar(x, g["order_parameter"], yerr=g["order_parameter_err"], fmt="o", color=f"C{k}", ms=4,
+                    capsize=2, label=f"N = {N}")
+        f = (fits or {}).get(int(N))
+        if f and np.isfinite(f.get("b", np.nan)):
+            xx = np.geomspace(x.min(), x.max(), 20)
+            ax.plot(xx, f["A"] * xx ** f["b"], "--", color=f"C{k}", lw=0.8)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel(r"$1 - \beta$")
+    ax.set_ylabel(r"$m$")
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend()
+    return fig
+
+
+def phase_map_figure(table: pd.DataFrame, x: str, title: str) -> Figure:
+    """Final state (left) and m (right) over (``x``, beta): filled markers from the paper's start,
+    rings from perturbed steady sliding; crosses where the two disagree (hysteresis). The
+    dashed line is the linear threshold beta_c = alpha (eq. 5, Fig. 4)."""
+    fig, (a1, a2) = new_figure(1, 2, width=5.0, height=4.2)
+    paper = table[table["start"] == "paper"].set_index([x, "beta"])
+    steady = table[table["start"] == "steady"].set_index([x, "beta"])
+    for (xv, b), r in paper.iterrows():
+        a1.plot(xv, b, "o", ms=9, color=STATE_STYLE.get(r["final_state"], "k"))
+        if (xv, b) in steady.index:
+            s = steady.loc[(xv, b)]
+            a1.plot(xv, b, "o", ms=14, mfc="none", mew=2, mec=STATE_STYLE.get(s["final_state"], "k"))
+            if s["final_state"] != r["final_state"]:
+                a1.plot(xv, b, "kx", ms=12)
+    sc = a2.scatter([i[0] for i in paper.index], [i[1] for i in paper.index], c=paper["order_parameter"],
+                    cmap="viridis", s=80)
+    fig.colorbar(sc, ax=a2, label="m (paper's start)")
+    for ax in (a1, a2):
+        xs = np.array(sorted(table[x].unique()), dtype=float)
+        if x == "alpha":
+            ax.plot(xs, xs, "k--", lw=1)
+        else:
+            ax.axhline(1.0, color="k", ls="--", lw=1)
+        ax.set_xlabel(x if x != "alpha" else r"$\alpha$")
+        ax.set_ylabel(r"$\beta$")
+        if x == "D":
+            ax.set_xscale("log")
+    handles = [Line2D([], [], ls="", marker="o", color=c, label=s) for s, c in STATE_STYLE.items()]
+    handles.append(Line2D([], [], ls="", marker="x", color="k", label="starts disagree"))
+    handles.append(Line2D([], [], ls="--", color="k", label=r"$\beta_c = \alpha$"))
+    a1.legend(handles=handles, fontsize=7, loc="best")
+    a1.set_title(f"{title}: final state (dot: paper start, ring: steady start)", fontsize=8)
+    a2.set_title(f"{title}: order parameter", fontsize=8)
+    return fig
+
+
+def exponents_figure(table: pd.DataFrame) -> Figure:
+    """tau against beta for eq. (4) (bootstrap errors) with Carlson-Langer's tau as a band, and
+    the great-event excess (observed / power-law count at and above the smallest spanning event)."""
+    fig, (a1, a2) = new_figure(1, 2, width=4.6, height=3.8)
+    chain = table[table["model"] == "sakaguchi"].sort_values("beta")
+    cl = table[table["model"] == "carlson-langer"]
+    a1.errorbar(chain["beta"], chain["tau"], yerr=chain["tau_err"], fmt="o-", ms=4, capsize=2, label="eq. (4)")
+    for r in cl.itertuples():
+        if np.isfinite(r.tau):
+            a1.axhspan(r.tau - r.tau_err, r.tau + r.tau_err, color="C3", alpha=0.25,
+                       label=f"Carlson-Langer, N = {r.N}")
+    a1.plot([1.0], [1.5], "k*", ms=8, label="paper, beta = 1")
+    a1.plot([0.2], [1.6], "k^", ms=6, label="paper, beta = 0.2")
+    a1.set_xlabel(r"$\beta$")
+    a1.set_ylabel(r"$\tau$")
+    a1.legend(fontsize=7)
+    a2.plot(chain["beta"], chain["excess"], "o-", ms=4, label="eq. (4)")
+    for r in cl.itertuples():
+        a2.axhline(r.excess, color="C3", ls="--", label="Carlson-Langer")
+    a2.axhline(1.0, color="0.5", lw=0.8)
+    a2.set_yscale("log")
+    a2.set_xlabel(r"$\beta$")
+    a2.set_ylabel("great-event excess (observed / power law)")
+    a2.legend(fontsize=7)
+    return fig
+
+
+#: Marker of each plate-driven relative in the chaos figure.
+FAMILY_MARKERS = {"two-blocks": "s", "carlson-langer": "D"}
+
+
+def chaos_figure(table: pd.DataFrame) -> Figure:
+    """Largest Lyapunov exponent lambda against beta for the chain of eq. (4) (section 3,
+    "chaotic motion"; Benettin et al. 1980, error bars from segment means), with the linear
+    threshold beta_c = alpha = 1 (Fig. 4) dotted; right panel: two blocks and Carlson-Langer as
+    marked points, one per d0 (their exponents are orders of magnitude larger)."""
+    fig, (a1, a2) = new_figure(1, 2, width=4.4, height=3.6, gridspec_kw={"width_ratios": [2.2, 1]})
+    chain = table[table["model"] == "sakaguchi"].sort_values("beta")
+    for k, (N, g) in enumerate(sorted(chain.groupby("N"), key=lambda x: x[0])):
+        a1.errorbar(g["beta"], g["lyapunov"], yerr=g["lyapunov_err"], fmt="o-", color=f"C{k}", ms=4, lw=1,
+                    capsize=2, label=f"eq. (4), N = {int(N)}")
+    a1.axhline(0.0, color="0.3", lw=0.8)
+    a1.axvline(1.0, color="0.5", lw=0.8, ls=":", label=r"$\beta_c = \alpha = 1$")
+    a1.set_xlabel(r"$\beta$")
+    a1.set_ylabel(r"largest Lyapunov exponent $\lambda$")
+    a1.ticklabel_format(axis="y", style="sci", scilimits=(-3, 3))
+    if a1.get_legend_handles_labels()[0]:
+        a1.legend(fontsize=7)
+    family = table[table["model"] != "sakaguchi"]
+    models = [m for m in FAMILY_MARKERS if m in set(family["model"])]
+    models += sorted(set(family["model"]) - set(models))
+    for i, model in enumerate(models):
+        g = family[family["model"] == model].sort_values("d0")
+        offsets = np.linspace(-0.15, 0.15, len(g)) if len(g) > 1 else np.zeros(1)
+        for off, r in zip(offsets, g.itertuples()):
+            a2.errorbar([i + off], [r.lyapunov], yerr=[r.lyapunov_err], fmt=FAMILY_MARKERS.get(model, "o"),
+                        color=f"C{3 + i}", ms=6, capsize=2)
+            if len(g) > 1:
+                a2.annotate(f"{r.d0:g}", (i + off, r.lyapunov), fontsize=6, xytext=(3, 3),
+                            textcoords="offset points")
+    a2.axhline(0.0, color="0.3", lw=0.8)
+    a2.set_xticks(range(len(models)), [m.replace("-", "\n") for m in models], fontsize=8)
+    a2.set_xlim(-0.6, len(models) - 0.4)
+    a2.set_ylabel(r"$\lambda$")
+    a2.set_title("relatives, standard parameters", fontsize=8)
+    return fig
