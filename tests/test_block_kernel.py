@@ -32,7 +32,7 @@ def _assert_same(a, b):
     (ret_a, bufs_a), (ret_b, bufs_b) = a, b
     assert tuple(ret_a) == tuple(ret_b)
     n_slips = ret_a[4]
-    for i, (xa, xb) in enumerate(zip(bufs_a, bufs_b)):
+    for i, (xa, xb) in enumerate(zip(bufs_a, bufs_b, strict=False)):
         if i >= 5:  # slip buffers: only the filled part is defined
             xa, xb = xa[:n_slips], xb[:n_slips]
         assert np.array_equal(xa, xb), f"output array {i} differs"

@@ -45,8 +45,25 @@ def test_block_and_hysteresis_take_the_model(capsys, tmp_path):
     assert main(["block", "--model", "batista-carlson", "--t-end", "100", "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
     assert data["params"]["threshold"] == "state" and "Batista" in data["note"]
-    assert main(["hysteresis", "--model", "batista-carlson", "--V-min", "0.05", "--V-max", "0.2",
-                 "--dV", "0.05", "--time-per-step", "50", "--json"]) == 0
+    assert (
+        main(
+            [
+                "hysteresis",
+                "--model",
+                "batista-carlson",
+                "--V-min",
+                "0.05",
+                "--V-max",
+                "0.2",
+                "--dV",
+                "0.05",
+                "--time-per-step",
+                "50",
+                "--json",
+            ]
+        )
+        == 0
+    )
     assert json.loads(capsys.readouterr().out)
 
 

@@ -9,9 +9,9 @@ import numpy as np
 import pandas as pd
 import pytest
 import xarray as xr
-from chain_helpers import assert_bits_equal, assert_same_run
 
 import stickslip
+from chain_helpers import assert_bits_equal, assert_same_run
 from stickslip.models import physics
 from stickslip.models.params import ChainParams
 from stickslip.run.driver import ChainRunError, load_run, run_chain, steady_deviation, write_run

@@ -14,8 +14,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from chain_helpers import assert_bits_equal, assert_same_run, assert_same_state, run_cli_subprocess
 
+from chain_helpers import assert_bits_equal, assert_same_run, assert_same_state, run_cli_subprocess
 from stickslip.cli import main
 from stickslip.kernels import chain as K
 from stickslip.models.params import ChainParams, ParameterError

@@ -17,7 +17,6 @@ from stickslip.kernels import chain as K
 from stickslip.models.params import ChainParams
 from stickslip.run.driver import run_chain
 
-
 # The block loops: separate compiled functions, and the all-moving ones inlined in run_exact.
 STAGES = ("_stage1", "_stage2", "_stage1_theta", "_stage1_theta_only", "_stage2_theta")
 
@@ -34,7 +33,8 @@ def _fresh_ir(kernel, args=None) -> str:
         # The model's pieces (trailing arguments) are compile-time literals in the engine.
         n_pieces = 3 if kernel.py_func.__name__ == "_stage1" else 2 if kernel.py_func.__name__ == "_stage2" else 1
         sig = tuple(numba.typeof(a) for a in args[:-n_pieces]) + tuple(
-            numba.types.literal(int(c)) for c in args[-n_pieces:])
+            numba.types.literal(int(c)) for c in args[-n_pieces:]
+        )
         fresh.compile(sig)
     return fresh.inspect_llvm(fresh.signatures[0])
 

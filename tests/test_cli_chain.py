@@ -6,8 +6,8 @@ import json
 
 import pandas as pd
 import pytest
-from chain_helpers import run_cli_subprocess
 
+from chain_helpers import run_cli_subprocess
 from stickslip.cli import main
 from stickslip.models.params import ChainParams
 from stickslip.run.driver import run_chain

@@ -16,8 +16,8 @@ import time
 import numpy as np
 import pandas as pd
 import pytest
-from chain_helpers import assert_bits_equal, assert_same_run, cli_env, run_cli_subprocess, stickslip_cmd
 
+from chain_helpers import assert_bits_equal, assert_same_run, cli_env, run_cli_subprocess, stickslip_cmd
 from stickslip import io
 from stickslip.kernels import chain as K
 from stickslip.models.params import ChainParams, steps_for
@@ -108,9 +108,12 @@ def test_sigterm_sigint_write_a_checkpoint_and_exit_130(tmp_path, reference, sig
 
 
 # Every model of the family: killed mid-run, resumed from the command line, identical.
-FAMILY = [("carlson-langer", 15000.0), ("train", 4000.0),
-          pytest.param("two-blocks", 6e5, marks=pytest.mark.slow),
-          pytest.param("batista-carlson", 1e6, marks=pytest.mark.slow)]
+FAMILY = [
+    ("carlson-langer", 15000.0),
+    ("train", 4000.0),
+    pytest.param("two-blocks", 6e5, marks=pytest.mark.slow),
+    pytest.param("batista-carlson", 1e6, marks=pytest.mark.slow),
+]
 
 
 @pytest.mark.parametrize("model, t_end", FAMILY)
@@ -119,11 +122,29 @@ def test_sigkill_then_resume_every_model(tmp_path, model, t_end):
 
     p = chain_params(model)
     pr = PRESETS[model]
-    ref = C.run_chain(p, t_end, start=pr.start, perturbation=pr.start_options.get("amplitude", 0.0),
-                      seed=pr.start_options.get("seed", 0))
+    ref = C.run_chain(
+        p,
+        t_end,
+        start=pr.start,
+        perturbation=pr.start_options.get("amplitude", 0.0),
+        seed=pr.start_options.get("seed", 0),
+    )
     out_dir = tmp_path / "run"
-    cmd = stickslip_cmd() + ["chain", "--model", model, "--out", str(out_dir), "--t-end", f"{t_end:g}",
-                             "--integrator", "dense", "--checkpoint-interval", "0.2", "--no-progress", "--json"]
+    cmd = stickslip_cmd() + [
+        "chain",
+        "--model",
+        model,
+        "--out",
+        str(out_dir),
+        "--t-end",
+        f"{t_end:g}",
+        "--integrator",
+        "dense",
+        "--checkpoint-interval",
+        "0.2",
+        "--no-progress",
+        "--json",
+    ]
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=cli_env())
     state = out_dir / "checkpoint" / "state.npz"
     deadline = time.monotonic() + 120

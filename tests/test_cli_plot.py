@@ -10,8 +10,29 @@ from stickslip.cli import main
 @pytest.fixture(scope="module")
 def run_dir(tmp_path_factory):
     out = tmp_path_factory.mktemp("plot") / "run"
-    assert main(["chain", "--N", "20", "--t-end", "1e5", "--average-from", "5e4", "--profile-window", "20",
-                 "--profile-min-blocks", "10", "--snapshot", "5e4", "--out", str(out), "--no-progress"]) == 0
+    assert (
+        main(
+            [
+                "chain",
+                "--N",
+                "20",
+                "--t-end",
+                "1e5",
+                "--average-from",
+                "5e4",
+                "--profile-window",
+                "20",
+                "--profile-min-blocks",
+                "10",
+                "--snapshot",
+                "5e4",
+                "--out",
+                str(out),
+                "--no-progress",
+            ]
+        )
+        == 0
+    )
     return out
 
 

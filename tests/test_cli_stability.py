@@ -99,9 +99,7 @@ def test_bad_input_one_line_exit_2_nothing_written(capsys, tmp_path, argv):
     assert not out.exists()
 
 
-@pytest.mark.parametrize(
-    "argv", [["stability"], ["stability", "block", "--K", "abc"], ["hysteresis", "--dV", "x"]]
-)
+@pytest.mark.parametrize("argv", [["stability"], ["stability", "block", "--K", "abc"], ["hysteresis", "--dV", "x"]])
 def test_parse_errors_exit_2(capsys, argv):
     with pytest.raises(SystemExit) as exc:
         main(argv)

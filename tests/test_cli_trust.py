@@ -4,40 +4,59 @@ are owned by one run; checkpoints are validated before a kernel sees them; blow-
 from __future__ import annotations
 
 import json
-import os
 import shlex
 import subprocess
 import time
 
-import numpy as np
 import pytest
-from chain_helpers import cli_env, run_cli_subprocess, stickslip_cmd
 
+from chain_helpers import cli_env, run_cli_subprocess, stickslip_cmd
 from stickslip.cli import main
 
 BAD = [
-    ("block --every 1e300", "every"), ("block --t-end 1e300", "t_end"), ("block --K abc", "K must be a number > 0"),
-    ("block --out afile/x", "--out"), ("block --M -1", "M"),
-    ("slip-limit --rtol 10", "rtol"), ("slip-limit --K 1e12", "dt"), ("slip-limit --dt 1e3", "dt"),
+    ("block --every 1e300", "every"),
+    ("block --t-end 1e300", "t_end"),
+    ("block --K abc", "K must be a number > 0"),
+    ("block --out afile/x", "--out"),
+    ("block --M -1", "M"),
+    ("slip-limit --rtol 10", "rtol"),
+    ("slip-limit --K 1e12", "dt"),
+    ("slip-limit --dt 1e3", "dt"),
     ("slip-limit --Fs 1e9", "Fs"),
-    ("stability block --out afile/x", "--out"), ("stability chain --K -1", "K"),
+    ("stability block --out afile/x", "--out"),
+    ("stability chain --K -1", "K"),
     ("stability block --K 1e300 --out sbk", "K"),
-    ("chain --model carlson-langer --D 3", "--D"), ("chain --ends periodic", "periodic"),
-    ("chain --model train --threshold state", "threshold"), ("chain --model nosuch", "--model"),
-    ("chain --model carlson-langer --amplitude -1", "amplitude"), ("block --model carlson-langer", "--model"),
-    ("bench --model carlson-langer --l 0", "l"), ("lyapunov --model two-blocks --d0 1", "d0"),
+    ("chain --model carlson-langer --D 3", "--D"),
+    ("chain --ends periodic", "periodic"),
+    ("chain --model train --threshold state", "threshold"),
+    ("chain --model nosuch", "--model"),
+    ("chain --model carlson-langer --amplitude -1", "amplitude"),
+    ("block --model carlson-langer", "--model"),
+    ("bench --model carlson-langer --l 0", "l"),
+    ("lyapunov --model two-blocks --d0 1", "d0"),
     ("hysteresis --time-per-step 1e12", "time_per_step"),
-    ("chain --sample-interval 1e300", "sample_interval"), ("chain --sample-interval 1e30", "sample_interval"),
-    ("chain --profile-window 1e300", "profile_window"), ("chain --start steady --perturbation 0.1 --seed -1", "seed"),
-    ("chain --out afile/x --t-end 10", "--out"), ("chain --N 10000000 --t-end 100", "N"),
-    ("chain --t-end 1e300", "t-end"), ("chain --t-end 1e17", "t-end"), ("chain --dt 1e-12", "t-end"),
-    ("chain --D 100", "D*dt"), ("chain --D 99.9", "D*dt"), ("chain --checkpoint-interval 5 --t-end 10", "--checkpoint-interval"),
-    ("chain --seed 3 --t-end 10", "--seed"), ("chain --average-from 100 --t-end 10", "average_from"),
+    ("chain --sample-interval 1e300", "sample_interval"),
+    ("chain --sample-interval 1e30", "sample_interval"),
+    ("chain --profile-window 1e300", "profile_window"),
+    ("chain --start steady --perturbation 0.1 --seed -1", "seed"),
+    ("chain --out afile/x --t-end 10", "--out"),
+    ("chain --N 10000000 --t-end 100", "N"),
+    ("chain --t-end 1e300", "t-end"),
+    ("chain --t-end 1e17", "t-end"),
+    ("chain --dt 1e-12", "t-end"),
+    ("chain --D 100", "D*dt"),
+    ("chain --D 99.9", "D*dt"),
+    ("chain --checkpoint-interval 5 --t-end 10", "--checkpoint-interval"),
+    ("chain --seed 3 --t-end 10", "--seed"),
+    ("chain --average-from 100 --t-end 10", "average_from"),
     ("chain --overwrite --t-end 10", "--overwrite"),
-    ("bench --N 9 --t-end 0", "t-end"), ("bench --N 10000000 --t-end 100", "N"), ("bench --t-end 1e300", "t-end"),
+    ("bench --N 9 --t-end 0", "t-end"),
+    ("bench --N 10000000 --t-end 100", "N"),
+    ("bench --t-end 1e300", "t-end"),
     ("sweep chain --t-end 10 --out o --scheduler garbage", "--scheduler"),
     ("sweep chain --t-end 10 --out o --scheduler ''", "--scheduler"),
-    ("sweep chain --t-end 10 --out afile/x", "--out"), ("sweep chain --t-end 1e300 --out o", "t_end"),
+    ("sweep chain --t-end 10 --out afile/x", "--out"),
+    ("sweep chain --t-end 1e300 --out o", "t_end"),
     ("sweep chain --t-end 10 --out o --set integrator=foo", "integrator"),
     ("sweep chain --t-end 10 --out o --set start=foo", "start"),
     ("sweep chain --t-end 10 --out o --set sample_interval=0", "sample_interval"),
@@ -49,23 +68,28 @@ BAD = [
     ("sweep chain --t-end 10 --out o --set K=nan", "K must be a finite number > 0"),
     ("sweep chain --t-end 10 --out o --set N=inf", "N must be an integer >= 1"),
     ("sweep chain --t-end 10 --out o --grid beta=1,nan", "beta must be a finite number >= 0"),
-    ("sweep chain --t-end 10 --out o --set sample_interval=inf",
-     "sample_interval must be a finite number > 0"),
+    ("sweep chain --t-end 10 --out o --set sample_interval=inf", "sample_interval must be a finite number > 0"),
     ("sweep chain --t-end 10 --out o --set average_from=-inf", "average_from must be a finite number >= 0"),
     ("sweep block --t-end 10 --out o --set every=inf", "every must be an integer >= 1"),
     ("sweep block --t-end 10 --out o --set K=-inf", "K must be a finite number > 0"),
     # --out holding somebody else's files; --overwrite or --keep-checkpoint without --out
-    ("block --t-end 10 --out foreign", "notes.txt"), ("stability block --out foreign", "notes.txt"),
+    ("block --t-end 10 --out foreign", "notes.txt"),
+    ("stability block --out foreign", "notes.txt"),
     ("stability chain --out foreign", "notes.txt"),
     ("stability chain --model train --out foreign", "notes.txt"),
     ("hysteresis --time-per-step 10 --out foreign", "notes.txt"),
-    ("sweep block --t-end 10 --out foreign", "notes.txt"), ("reproduce --smoke --out foreign", "notes.txt"),
+    ("sweep block --t-end 10 --out foreign", "notes.txt"),
+    ("reproduce --smoke --out foreign", "notes.txt"),
     ("chain --t-end 10 --out foreign", "notes.txt"),
-    ("block --t-end 10 --overwrite", "--overwrite"), ("stability block --overwrite", "--overwrite"),
+    ("block --t-end 10 --overwrite", "--overwrite"),
+    ("stability block --overwrite", "--overwrite"),
     ("stability chain --overwrite", "--overwrite"),
     ("hysteresis --time-per-step 10 --overwrite", "--overwrite"),
     ("chain --keep-checkpoint --t-end 10", "--keep-checkpoint"),
-    ("models --bogus", "--bogus"), ("lyapunov --N 0", "N"), ("reproduce --bogus", "--bogus"), ("--bogus", "--bogus"),
+    ("models --bogus", "--bogus"),
+    ("lyapunov --N 0", "N"),
+    ("reproduce --bogus", "--bogus"),
+    ("--bogus", "--bogus"),
 ]
 
 
@@ -94,8 +118,9 @@ def test_bad_input_one_line_exit_2(argv, name, tmp_path, monkeypatch, capsys):
 
 @pytest.mark.parametrize("argv", ["--bogus", "chain --t-end 1e300", "block --K abc"])
 def test_bad_input_subprocess(argv, tmp_path):
-    proc = subprocess.run(stickslip_cmd() + shlex.split(argv), capture_output=True, text=True, cwd=tmp_path,
-                          env=cli_env(), timeout=120)
+    proc = subprocess.run(
+        stickslip_cmd() + shlex.split(argv), capture_output=True, text=True, cwd=tmp_path, env=cli_env(), timeout=120
+    )
     assert proc.returncode == 2 and proc.stdout == "" and proc.stderr.count("\n") == 1, proc.stderr
     assert list(tmp_path.iterdir()) == []
 
@@ -120,8 +145,24 @@ def test_foreign_folders_refused(tmp_path, capsys):
 
 
 def _finished_run(path):
-    assert main(["chain", "--N", "4", "--V", "0.01", "--t-end", "400", "--out", str(path),
-                 "--keep-checkpoint", "--no-progress"]) == 0
+    assert (
+        main(
+            [
+                "chain",
+                "--N",
+                "4",
+                "--V",
+                "0.01",
+                "--t-end",
+                "400",
+                "--out",
+                str(path),
+                "--keep-checkpoint",
+                "--no-progress",
+            ]
+        )
+        == 0
+    )
     return path
 
 
@@ -167,9 +208,26 @@ def test_crafted_checkpoint_refused(craft, tmp_path, capsys):
 
 def test_second_writer_refused_while_first_runs(tmp_path):
     out = tmp_path / "run"
-    first = subprocess.Popen(stickslip_cmd() + ["chain", "--N", "99", "--t-end", "20000", "--out", str(out),
-                                                "--integrator", "dense", "--no-progress", "--json"],
-                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=cli_env())
+    first = subprocess.Popen(
+        stickslip_cmd()
+        + [
+            "chain",
+            "--N",
+            "99",
+            "--t-end",
+            "20000",
+            "--out",
+            str(out),
+            "--integrator",
+            "dense",
+            "--no-progress",
+            "--json",
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=cli_env(),
+    )
     deadline = time.time() + 60
     while not (out / ".lock.json").exists() and time.time() < deadline:
         time.sleep(0.1)
@@ -185,9 +243,14 @@ def test_second_writer_refused_while_first_runs(tmp_path):
 # foreign files, --overwrite removes only this package's files.
 
 WRITERS = [
-    "block --t-end 10 --out {out}", "stability block --out {out}", "stability chain --out {out}",
-    "stability chain --model train --out {out}", "hysteresis --time-per-step 10 --out {out}",
-    "sweep block --t-end 10 --out {out}", "plot {run} --out {out}", "reproduce --smoke --out {out}",
+    "block --t-end 10 --out {out}",
+    "stability block --out {out}",
+    "stability chain --out {out}",
+    "stability chain --model train --out {out}",
+    "hysteresis --time-per-step 10 --out {out}",
+    "sweep block --t-end 10 --out {out}",
+    "plot {run} --out {out}",
+    "reproduce --smoke --out {out}",
     "chain --N 3 --t-end 10 --no-progress --out {out}",
 ]
 
@@ -205,11 +268,12 @@ def held(tmp_path_factory):
     import sys
 
     d = tmp_path_factory.mktemp("held")
-    code = ("import sys, time\nfrom stickslip.run.rundir import owned_run_dir\n"
-            "with owned_run_dir(sys.argv[1], run_id=False):\n"
-            "    print('held', flush=True)\n    time.sleep(600)\n")
-    proc = subprocess.Popen([sys.executable, "-c", code, str(d)], stdout=subprocess.PIPE, text=True,
-                            env=cli_env())
+    code = (
+        "import sys, time\nfrom stickslip.run.rundir import owned_run_dir\n"
+        "with owned_run_dir(sys.argv[1], run_id=False):\n"
+        "    print('held', flush=True)\n    time.sleep(600)\n"
+    )
+    proc = subprocess.Popen([sys.executable, "-c", code, str(d)], stdout=subprocess.PIPE, text=True, env=cli_env())
     try:
         assert proc.stdout.readline().strip() == "held"
         yield d, proc.pid
@@ -262,8 +326,20 @@ def test_overwrite_removes_only_this_packages_files(tmp_path, capsys):
 
 def test_sweep_reuses_its_own_folder_and_refuses_others(tmp_path, capsys):
     out = tmp_path / "sweep"
-    argv = ["sweep", "block", "--t-end", "10", "--grid", "K=8,10", "--out", str(out), "--workers", "1",
-            "--no-progress", "--json"]
+    argv = [
+        "sweep",
+        "block",
+        "--t-end",
+        "10",
+        "--grid",
+        "K=8,10",
+        "--out",
+        str(out),
+        "--workers",
+        "1",
+        "--no-progress",
+        "--json",
+    ]
     assert main(argv) == 0
     capsys.readouterr()
     assert main(argv) == 0, "a sweep run again into its own folder reuses its points"
@@ -281,12 +357,18 @@ def test_finished_run_drops_its_checkpoint_and_still_loads(tmp_path, capsys):
     from stickslip.run.rundir import load_run
 
     run = tmp_path / "run"
-    assert main(["chain", "--N", "4", "--V", "0.01", "--t-end", "400", "--out", str(run), "--no-progress",
-                 "--json"]) == 0
+    assert (
+        main(["chain", "--N", "4", "--V", "0.01", "--t-end", "400", "--out", str(run), "--no-progress", "--json"]) == 0
+    )
     printed = json.loads(capsys.readouterr().out)
     assert not (run / "checkpoint").exists()
-    assert sorted(p.name for p in run.iterdir()) == [".run_id", "events.parquet", "first_move.parquet",
-                                                     "run.json", "state.nc"]
+    assert sorted(p.name for p in run.iterdir()) == [
+        ".run_id",
+        "events.parquet",
+        "first_move.parquet",
+        "run.json",
+        "state.nc",
+    ]
     loaded = load_run(run)
     assert loaded.summary["state_sha256"] == printed["state_sha256"]
     assert len(loaded.events) == printed["events"]
@@ -302,8 +384,24 @@ def test_finished_run_drops_its_checkpoint_and_still_loads(tmp_path, capsys):
 
 def test_kept_checkpoint_stays_through_a_resume(tmp_path, capsys):
     run = tmp_path / "run"
-    assert main(["chain", "--N", "4", "--V", "0.01", "--t-end", "400", "--out", str(run), "--no-progress",
-                 "--keep-checkpoint"]) == 0
+    assert (
+        main(
+            [
+                "chain",
+                "--N",
+                "4",
+                "--V",
+                "0.01",
+                "--t-end",
+                "400",
+                "--out",
+                str(run),
+                "--no-progress",
+                "--keep-checkpoint",
+            ]
+        )
+        == 0
+    )
     assert (run / "checkpoint" / "state.npz").is_file()
     capsys.readouterr()
     assert main(["chain", "--resume", str(run), "--t-end", "800", "--no-progress", "--json"]) == 0
@@ -318,8 +416,24 @@ def test_results_killed_while_written_are_finished_by_resume(tmp_path, capsys):
 
     ref, run = tmp_path / "ref", tmp_path / "run"
     for d in (ref, run):
-        assert main(["chain", "--N", "4", "--V", "0.01", "--t-end", "400", "--out", str(d), "--no-progress",
-                     "--keep-checkpoint"]) == 0
+        assert (
+            main(
+                [
+                    "chain",
+                    "--N",
+                    "4",
+                    "--V",
+                    "0.01",
+                    "--t-end",
+                    "400",
+                    "--out",
+                    str(d),
+                    "--no-progress",
+                    "--keep-checkpoint",
+                ]
+            )
+            == 0
+        )
     for name in ("state.nc", "run.json"):
         (run / name).unlink()
     stale = run / ".state.nc.k1ll3d.tmp"

@@ -40,8 +40,9 @@ def test_added_great_events_show_as_excess():
     base = size_statistics(events, N, small_only=True, spanning="n_blocks", bootstrap=0)
     extra = int(4 * base["observed"])
     bump = pd.DataFrame({"S": np.full(extra, 500.0), "n_blocks": N, "max_block": N})
-    st = size_statistics(pd.concat([events, bump], ignore_index=True), N, small_only=True,
-                         spanning="n_blocks", bootstrap=0)
+    st = size_statistics(
+        pd.concat([events, bump], ignore_index=True), N, small_only=True, spanning="n_blocks", bootstrap=0
+    )
     # the bump also enters the count above s_min that the prediction scales, so less than 5x
     assert st["observed"] == 5 * base["observed"]
     assert st["excess"] > 3.5 * base["excess"]
@@ -54,8 +55,24 @@ def test_spanning_choice_is_checked():
 
 def test_cl_statistics_returns_its_numbers_and_files(tmp_path):
     res = cl_statistics(4e3, tmp_path, fig8_N=19, fig8_t_end=4e4, bootstrap=10)
-    keys = {"model", "N", "t_end", "t_from", "n_events", "n_spanning", "s_span", "tau", "tau_err", "s_min",
-            "s_max", "n_fit", "excess", "observed", "expected", "spanning"}
+    keys = {
+        "model",
+        "N",
+        "t_end",
+        "t_from",
+        "n_events",
+        "n_spanning",
+        "s_span",
+        "tau",
+        "tau_err",
+        "s_min",
+        "s_max",
+        "n_fit",
+        "excess",
+        "observed",
+        "expected",
+        "spanning",
+    }
     for name, model, n in (("carlson_langer", "carlson-langer", 100), ("fig8", "sakaguchi", 19)):
         assert keys <= set(res[name])
         assert res[name]["model"] == model and res[name]["N"] == n

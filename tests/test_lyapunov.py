@@ -83,10 +83,10 @@ def test_twin_is_d0_away_on_the_reference_branch():
     assert np.all(b["v"][stopped] == 0.0)
     dy = separation(ref, twin, p)
     assert math.isclose(np.linalg.norm(dy), 1e-8, rel_tol=1e-5)
-    assert np.all(dy[p.N:2 * p.N][stopped] == 0.0)
+    assert np.all(dy[p.N : 2 * p.N][stopped] == 0.0)
     # the separation is along the projected direction
     u = direction.copy()
-    u[p.N:2 * p.N][stopped] = 0.0
+    u[p.N : 2 * p.N][stopped] = 0.0
     assert np.dot(dy, u) / (np.linalg.norm(dy) * np.linalg.norm(u)) > 1 - 1e-5
 
 
@@ -153,8 +153,18 @@ def test_result_dict_and_truncation():
     p = ChainParams(N=5, beta=0.5)
     res = largest_lyapunov(p, 2000.0, interval=10.0, segments=5)
     d = res.to_dict()
-    for key in ("lyapunov", "lyapunov_err", "t_end", "renormalisations", "d0", "interval", "segments",
-                "params", "norm", "method"):
+    for key in (
+        "lyapunov",
+        "lyapunov_err",
+        "t_end",
+        "renormalisations",
+        "d0",
+        "interval",
+        "segments",
+        "params",
+        "norm",
+        "method",
+    ):
         assert key in d, key
     json.dumps(d)
     assert d["renormalisations"] == int(np.count_nonzero(res.counted)) == 180
@@ -201,8 +211,23 @@ def test_bad_options_name_the_parameter(kw, name):
 
 
 def test_cli_json_is_one_document(capsys):
-    status, out, err = run_cli(capsys, "lyapunov", "--N", "1", "--V", "0.5", "--start", "steady",
-                               "--perturbation", "1e-3", "--t-end", "100", "--interval", "5", "--json")
+    status, out, err = run_cli(
+        capsys,
+        "lyapunov",
+        "--N",
+        "1",
+        "--V",
+        "0.5",
+        "--start",
+        "steady",
+        "--perturbation",
+        "1e-3",
+        "--t-end",
+        "100",
+        "--interval",
+        "5",
+        "--json",
+    )
     assert status == 0
     data = json.loads(out)
     for key in ("lyapunov", "lyapunov_err", "t_end", "renormalisations"):
@@ -216,8 +241,21 @@ def test_cli_text_and_beta_table_with_plot(capsys, tmp_path):
     status, out, _ = run_cli(capsys, "lyapunov", "--N", "3", "--t-end", "500", "--segments", "4")
     assert status == 0 and "lyapunov" in out and "renormalisations" in out
     png = tmp_path / "l.png"
-    status, out, _ = run_cli(capsys, "lyapunov", "--N", "3", "--t-end", "500", "--segments", "4",
-                             "--betas", "0.5,1.0", "--plot", str(png), "--json")
+    status, out, _ = run_cli(
+        capsys,
+        "lyapunov",
+        "--N",
+        "3",
+        "--t-end",
+        "500",
+        "--segments",
+        "4",
+        "--betas",
+        "0.5,1.0",
+        "--plot",
+        str(png),
+        "--json",
+    )
     assert status == 0 and png.is_file()
     assert [row["beta"] for row in json.loads(out)["table"]] == [0.5, 1.0]
 
@@ -254,8 +292,8 @@ def test_plate_drive_separation_round_trip():
 def test_plate_drive_steady_sliding_decays_at_minus_beta_over_two():
     # A block on the plate with friction F0 + beta v slides steadily at v = V; a perturbation
     # obeys lambda^2 + beta lambda + Kp = 0: Re lambda = -beta / 2 for beta^2 < 4 Kp (closed form).
-    p = ChainParams(N=1, drive="plate", friction="strengthening", ends="free", K=1.0, Kp=1.0, V=0.5,
-                    beta=0.4, F0=0.5, Fs=1.0)
-    res = largest_lyapunov(p, 200.0, interval=2.0, d0=1e-8, transient=0.0, start="steady",
-                           perturbation=1e-3, seed=0)
+    p = ChainParams(
+        N=1, drive="plate", friction="strengthening", ends="free", K=1.0, Kp=1.0, V=0.5, beta=0.4, F0=0.5, Fs=1.0
+    )
+    res = largest_lyapunov(p, 200.0, interval=2.0, d0=1e-8, transient=0.0, start="steady", perturbation=1e-3, seed=0)
     assert res.lyapunov == pytest.approx(-0.2, rel=0.02)

@@ -21,17 +21,25 @@ from stickslip.run.driver import ChainState, run_chain
 
 ALL = [
     (d, f, t, e)
-    for d in names("drive") for f in names("friction") for t in names("threshold") for e in names("ends")
+    for d in names("drive")
+    for f in names("friction")
+    for t in names("threshold")
+    for e in names("ends")
     if not (e == "periodic" and d != "plate") and not (t == "state" and f != "state")
 ]
 VALID = ALL
 # Every choice of every piece, the presets' compositions and the interactions the fast path
 # treats apart (the ring, the plate with a state threshold): compiled in the default run.
 COVER = [
-    ("end", "state", "constant", "free"), ("end", "state", "state", "free"), ("end", "state", "state", "fixed"),
-    ("end", "strengthening", "constant", "free"), ("end", "weakening", "constant", "fixed"),
-    ("plate", "weakening", "constant", "periodic"), ("plate", "weakening", "constant", "free"),
-    ("plate", "state", "state", "periodic"), ("plate", "strengthening", "constant", "fixed"),
+    ("end", "state", "constant", "free"),
+    ("end", "state", "state", "free"),
+    ("end", "state", "state", "fixed"),
+    ("end", "strengthening", "constant", "free"),
+    ("end", "weakening", "constant", "fixed"),
+    ("plate", "weakening", "constant", "periodic"),
+    ("plate", "weakening", "constant", "free"),
+    ("plate", "state", "state", "periodic"),
+    ("plate", "strengthening", "constant", "fixed"),
 ]
 
 
@@ -72,9 +80,14 @@ def _compare_with_oracle(p, start_arrays, steps):
         assert b["stopped"].tolist() == [not m for m in ref.moving]
         assert_bits_equal(run.samples["L"].values, ref.L, f"{integrator} L(t_n)")
         assert len(run.events) == len(ref.events)
-        for row, ev in zip(run.events.itertuples(), ref.events):
+        for row, ev in zip(run.events.itertuples(), ref.events, strict=False):
             assert (row.step_start, row.step_end, row.start_block, row.max_block, row.n_blocks) == (
-                ev["step_start"], ev["step_end"], ev["start_block"], ev["max_block"], ev["n_blocks"])
+                ev["step_start"],
+                ev["step_end"],
+                ev["start_block"],
+                ev["max_block"],
+                ev["n_blocks"],
+            )
             assert_bits_equal([row.S], [ev["S"]], "S")
         runs[integrator] = run
     assert_same_run(runs["dense"], runs["exact"])
@@ -85,8 +98,9 @@ def _compare_with_oracle(p, start_arrays, steps):
 LIVELY = dict(K=5.0, V=0.2, Kp=1.0, beta=0.5, alpha=0.7, sigma=0.2, F0=0.5, D=2.0, Fs=0.9, dt=0.005)
 
 
-@pytest.mark.parametrize("pieces", [
-    pytest.param(c, id="-".join(c), marks=() if c in COVER else pytest.mark.slow) for c in ALL])
+@pytest.mark.parametrize(
+    "pieces", [pytest.param(c, id="-".join(c), marks=() if c in COVER else pytest.mark.slow) for c in ALL]
+)
 def test_every_composition_matches_plain_python(pieces):
     d, f, t, e = pieces
     p = ChainParams(N=6, drive=d, friction=f, threshold=t, ends=e, **LIVELY)
@@ -110,17 +124,40 @@ def test_presets_dense_equals_exact_and_plain_python(name):
 @given(
     pieces=st.sampled_from(COVER),
     N=st.integers(1, 12),
-    K=st.floats(0.5, 30.0), V=st.floats(0.01, 0.5), Kp=st.floats(0.2, 3.0),
-    beta=st.floats(0.0, 2.0), alpha=st.floats(0.0, 3.0), sigma=st.floats(0.0, 0.6),
-    F0=st.floats(0.0, 1.5), D=st.floats(0.0, 20.0), Fs=st.floats(0.2, 3.0), seed=st.integers(0, 2**16),
+    K=st.floats(0.5, 30.0),
+    V=st.floats(0.01, 0.5),
+    Kp=st.floats(0.2, 3.0),
+    beta=st.floats(0.0, 2.0),
+    alpha=st.floats(0.0, 3.0),
+    sigma=st.floats(0.0, 0.6),
+    F0=st.floats(0.0, 1.5),
+    D=st.floats(0.0, 20.0),
+    Fs=st.floats(0.2, 3.0),
+    seed=st.integers(0, 2**16),
 )
 def test_drawn_compositions_dense_equals_exact(pieces, N, K, V, Kp, beta, alpha, sigma, F0, D, Fs, seed):
     d, f, t, e = pieces
-    p = ChainParams(N=N, drive=d, friction=f, threshold=t, ends=e, K=K, V=V, Kp=Kp, beta=beta,
-                    alpha=alpha, sigma=sigma, F0=F0, D=D, Fs=Fs)
+    p = ChainParams(
+        N=N,
+        drive=d,
+        friction=f,
+        threshold=t,
+        ends=e,
+        K=K,
+        V=V,
+        Kp=Kp,
+        beta=beta,
+        alpha=alpha,
+        sigma=sigma,
+        F0=F0,
+        D=D,
+        Fs=Fs,
+    )
     x, v, th, stopped = _state(p, seed)
-    runs = [run_chain(p, 40.0, integrator=i, start=ChainState.from_blocks(x, v, th, stopped),
-                      sample_interval=0.5) for i in ("dense", "exact")]
+    runs = [
+        run_chain(p, 40.0, integrator=i, start=ChainState.from_blocks(x, v, th, stopped), sample_interval=0.5)
+        for i in ("dense", "exact")
+    ]
     assert_same_run(*runs)
 
 
@@ -137,10 +174,12 @@ def test_train_model_is_the_paper_chain_with_alpha_zero_and_theta_one():
     # MODEL.md: the train model is the paper's chain with alpha = 0 and theta = F0 = 1.
     train = chain_params("train", N=9)
     paper = ChainParams(N=9, alpha=0.0, D=0.0)
-    a = run_chain(train, 3000.0, start=ChainState.from_blocks(np.zeros(9), np.full(9, 0.1), np.zeros(9),
-                                                                 np.zeros(9, bool)))
-    b = run_chain(paper, 3000.0, start=ChainState.from_blocks(np.zeros(9), np.full(9, 0.1), np.ones(9),
-                                                                 np.zeros(9, bool)))
+    a = run_chain(
+        train, 3000.0, start=ChainState.from_blocks(np.zeros(9), np.full(9, 0.1), np.zeros(9), np.zeros(9, bool))
+    )
+    b = run_chain(
+        paper, 3000.0, start=ChainState.from_blocks(np.zeros(9), np.full(9, 0.1), np.ones(9), np.zeros(9, bool))
+    )
     assert len(a.events) > 3
     assert_bits_equal(a.state.x, b.state.x, "x")
     assert a.events[["step_start", "step_end", "n_blocks"]].equals(b.events[["step_start", "step_end", "n_blocks"]])
@@ -149,11 +188,26 @@ def test_train_model_is_the_paper_chain_with_alpha_zero_and_theta_one():
 def test_plate_drive_block_that_stops_while_all_slide_restarts_on_time():
     # Found by hypothesis: a single block on a ring stops in a step in which every block slid;
     # its first start step under the plate must be known before the next start.
-    p = ChainParams(N=1, drive="plate", friction="weakening", ends="periodic", K=1.0, V=0.5, Kp=1.0,
-                    beta=0.0, alpha=0.0, sigma=0.0, F0=0.0, D=0.0, Fs=1.0)
+    p = ChainParams(
+        N=1,
+        drive="plate",
+        friction="weakening",
+        ends="periodic",
+        K=1.0,
+        V=0.5,
+        Kp=1.0,
+        beta=0.0,
+        alpha=0.0,
+        sigma=0.0,
+        F0=0.0,
+        D=0.0,
+        Fs=1.0,
+    )
     x, v, th, stopped = _state(p, 0)
-    runs = [run_chain(p, 40.0, integrator=i, start=ChainState.from_blocks(x, v, th, stopped),
-                      sample_interval=0.5) for i in ("dense", "exact")]
+    runs = [
+        run_chain(p, 40.0, integrator=i, start=ChainState.from_blocks(x, v, th, stopped), sample_interval=0.5)
+        for i in ("dense", "exact")
+    ]
     assert len(runs[0].events) >= 2
     assert_same_run(*runs)
 
@@ -167,8 +221,20 @@ def test_run_directory_records_the_model_everywhere(tmp_path):
 
     p = chain_params("carlson-langer", N=10)
     run_chain(p, 300.0, start=ChainState.rest(p, 0.01, 0), out_dir=tmp_path / "run")
-    want = {"model": "carlson-langer", "drive": "plate", "friction": "weakening", "threshold": "constant",
-            "ends": "periodic", "K": 100.0, "Kp": 1.0, "V": 0.01, "alpha": 2.5, "sigma": 0.01, "Fs": 1.0, "N": 10}
+    want = {
+        "model": "carlson-langer",
+        "drive": "plate",
+        "friction": "weakening",
+        "threshold": "constant",
+        "ends": "periodic",
+        "K": 100.0,
+        "Kp": 1.0,
+        "V": 0.01,
+        "alpha": 2.5,
+        "sigma": 0.01,
+        "Fs": 1.0,
+        "N": 10,
+    }
     meta = io.read_json(tmp_path / "run" / "run.json")
     assert want.items() <= meta["params"].items()
     ds = io.read_dataset(tmp_path / "run" / "state.nc")

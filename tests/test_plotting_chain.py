@@ -49,8 +49,9 @@ def test_fig5a_draws_the_snapshot_and_both_steady_profiles(tmp_path):
 
 
 def test_fig5b_draws_the_exact_steady_length():
-    table = pd.DataFrame({"beta": [1.2, 0.4, 0.8, 1.0], "L_mean": [480.0, 300.0, 420.0, 484.0],
-                          "L_err": [1.0, 5.0, 4.0, 2.0]})
+    table = pd.DataFrame(
+        {"beta": [1.2, 0.4, 0.8, 1.0], "L_mean": [480.0, 300.0, 420.0, 484.0], "L_err": [1.0, 5.0, 4.0, 2.0]}
+    )
     fig = fig5b_length(table, P)
     ax = fig.axes[0]
     steady = line(ax, "steady sliding")
@@ -75,9 +76,10 @@ def synthetic_event(event: int, reach: int, t0: float, speed: float, window: flo
     for k, s in enumerate(starts):
         overlap = np.clip(np.minimum(s + window, t_first + 30.0) - np.maximum(s, t_first), 0.0, None)
         dx[k, :reach] = 0.05 * overlap
-    profiles = xr.Dataset({"dx": (("row", "block"), dx)},
-                          coords={"event": ("row", np.full(starts.size, event)), "t": ("row", starts),
-                                  "block": np.arange(1, P.N + 1)})
+    profiles = xr.Dataset(
+        {"dx": (("row", "block"), dx)},
+        coords={"event": ("row", np.full(starts.size, event)), "t": ("row", starts), "block": np.arange(1, P.N + 1)},
+    )
     return first_move, profiles
 
 

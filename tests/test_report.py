@@ -14,31 +14,117 @@ from stickslip.report.writer import ReportFigure, ReportRow, read_report, write_
 
 # The last table of MODEL.md, as the reproduction reports it (values of an imagined run).
 ROWS = [
-    ReportRow("sec. 2", "Hopf point of steady sliding, K = 10, beta = 0.08", "V_c = 0.106", 0.10612, True,
-              "|V_c - 0.106| <= 0.001", "stickslip stability hopf --K 10 --beta 0.08"),
-    ReportRow("sec. 2", "steady sliding linearly stable for all V > 0", "K = 10, beta = 1",
-              "max Re(lambda) < 0 for 1e-4 <= V <= 10", True, "all V on the grid", "stickslip stability scan"),
-    ReportRow("sec. 2", "inverse transition stick-slip -> sliding, V raised slowly", "V = 0.345", 0.29, False,
-              "|V - 0.345| <= 0.01", "stickslip block ramp --V-from 0.2 --V-to 0.4"),
-    ReportRow("eq. 3", "slip duration, force at stop", "1.035, Fs - K x' = -0.432", "1.0348, -0.4318", True,
-              "3 digits", "stickslip block limit"),
-    ReportRow("Fig. 3", "period T(V)", "T = 1.035 + 3.432 / (K V)", "max rel. dev. 0.2 %", True, "1 %",
-              "stickslip block periods"),
-    ReportRow("Fig. 4", "long-wave instability of the chain, K = 10, D = 5", "for beta <= 1 (beta = 1 critical)",
-              "unstable for beta < 1.000", True, "grid step 0.01", "stickslip stability chain"),
-    ReportRow("sec. 3", "final state", "steady sliding for beta > 1, stick-slip for beta <= 1", None, None,
-              "", "stickslip reproduce --full", na_reason="quick run"),
-    ReportRow("Fig. 5", "snapshot at t = 2e7, beta = 1", "close to the steady sliding profile", None, None, "",
-              "stickslip reproduce --full", na_reason="quick run: t = 2e5, not 2e7"),
-    ReportRow("Fig. 5b", "<L> vs beta", "continuous decrease below beta = 1", "monotone in 6 points", True,
-              "monotone", "stickslip sweep chain --grid beta=0.2,0.4,0.6,0.8,1.0,1.2 --t-end 1e5 --out L"),
-    ReportRow("Fig. 6", "rupture front speed in large events, beta = 1", "c = 1.43 (sqrt(K) = 3.16)", 1.47, True,
-              "|c - 1.43| <= 0.15", "stickslip reproduce --only fig6"),
-    ReportRow("Fig. 7", "slip-size distribution, beta = 1", "power law, exponent about 1.5, cut off by N",
-              "tau = 1.52 +- 0.03", True, "|tau - 1.5| <= 0.1", "stickslip reproduce --only fig7"),
-    ReportRow("Fig. 8", "slip-size distribution, beta = 0.2", "about 1.6 for small S, excess of large events",
-              "tau = 1.63 +- 0.05", True, "|tau - 1.6| <= 0.15", "stickslip reproduce --only fig8",
-              note="the paper's text says 'Figure 7' here; it means Fig. 8"),
+    ReportRow(
+        "sec. 2",
+        "Hopf point of steady sliding, K = 10, beta = 0.08",
+        "V_c = 0.106",
+        0.10612,
+        True,
+        "|V_c - 0.106| <= 0.001",
+        "stickslip stability hopf --K 10 --beta 0.08",
+    ),
+    ReportRow(
+        "sec. 2",
+        "steady sliding linearly stable for all V > 0",
+        "K = 10, beta = 1",
+        "max Re(lambda) < 0 for 1e-4 <= V <= 10",
+        True,
+        "all V on the grid",
+        "stickslip stability scan",
+    ),
+    ReportRow(
+        "sec. 2",
+        "inverse transition stick-slip -> sliding, V raised slowly",
+        "V = 0.345",
+        0.29,
+        False,
+        "|V - 0.345| <= 0.01",
+        "stickslip block ramp --V-from 0.2 --V-to 0.4",
+    ),
+    ReportRow(
+        "eq. 3",
+        "slip duration, force at stop",
+        "1.035, Fs - K x' = -0.432",
+        "1.0348, -0.4318",
+        True,
+        "3 digits",
+        "stickslip block limit",
+    ),
+    ReportRow(
+        "Fig. 3",
+        "period T(V)",
+        "T = 1.035 + 3.432 / (K V)",
+        "max rel. dev. 0.2 %",
+        True,
+        "1 %",
+        "stickslip block periods",
+    ),
+    ReportRow(
+        "Fig. 4",
+        "long-wave instability of the chain, K = 10, D = 5",
+        "for beta <= 1 (beta = 1 critical)",
+        "unstable for beta < 1.000",
+        True,
+        "grid step 0.01",
+        "stickslip stability chain",
+    ),
+    ReportRow(
+        "sec. 3",
+        "final state",
+        "steady sliding for beta > 1, stick-slip for beta <= 1",
+        None,
+        None,
+        "",
+        "stickslip reproduce --full",
+        na_reason="quick run",
+    ),
+    ReportRow(
+        "Fig. 5",
+        "snapshot at t = 2e7, beta = 1",
+        "close to the steady sliding profile",
+        None,
+        None,
+        "",
+        "stickslip reproduce --full",
+        na_reason="quick run: t = 2e5, not 2e7",
+    ),
+    ReportRow(
+        "Fig. 5b",
+        "<L> vs beta",
+        "continuous decrease below beta = 1",
+        "monotone in 6 points",
+        True,
+        "monotone",
+        "stickslip sweep chain --grid beta=0.2,0.4,0.6,0.8,1.0,1.2 --t-end 1e5 --out L",
+    ),
+    ReportRow(
+        "Fig. 6",
+        "rupture front speed in large events, beta = 1",
+        "c = 1.43 (sqrt(K) = 3.16)",
+        1.47,
+        True,
+        "|c - 1.43| <= 0.15",
+        "stickslip reproduce --only fig6",
+    ),
+    ReportRow(
+        "Fig. 7",
+        "slip-size distribution, beta = 1",
+        "power law, exponent about 1.5, cut off by N",
+        "tau = 1.52 +- 0.03",
+        True,
+        "|tau - 1.5| <= 0.1",
+        "stickslip reproduce --only fig7",
+    ),
+    ReportRow(
+        "Fig. 8",
+        "slip-size distribution, beta = 0.2",
+        "about 1.6 for small S, excess of large events",
+        "tau = 1.63 +- 0.05",
+        True,
+        "|tau - 1.6| <= 0.15",
+        "stickslip reproduce --only fig8",
+        note="the paper's text says 'Figure 7' here; it means Fig. 8",
+    ),
 ]
 
 
@@ -51,9 +137,16 @@ def figures(tmp_path):
         save_figure(fig, tmp_path / "figures" / name, formats=("png", "pdf"))
         (tmp_path / "data").mkdir(exist_ok=True)
         (tmp_path / "data" / f"{name}.nc").write_bytes(b"")
-        out.append(ReportFigure(f"Fig. {name[3:]}", f"figures/{name}.png", f"caption of {name} <x_i>",
-                                pdf=f"figures/{name}.pdf", data=(f"data/{name}.nc",),
-                                command=f"stickslip reproduce --only {name}"))
+        out.append(
+            ReportFigure(
+                f"Fig. {name[3:]}",
+                f"figures/{name}.png",
+                f"caption of {name} <x_i>",
+                pdf=f"figures/{name}.pdf",
+                data=(f"data/{name}.nc",),
+                command=f"stickslip reproduce --only {name}",
+            )
+        )
     return out
 
 
@@ -67,7 +160,10 @@ def test_json_round_trips(tmp_path, figures):
     assert "version" in report.meta
     raw = json.loads((tmp_path / "report.json").read_text())
     assert [r["agreement"] for r in raw["rows"]][:3] == [
-        "yes (|V_c - 0.106| <= 0.001)", "yes (all V on the grid)", "no (|V - 0.345| <= 0.01)"]
+        "yes (|V_c - 0.106| <= 0.001)",
+        "yes (all V on the grid)",
+        "no (|V - 0.345| <= 0.01)",
+    ]
     assert raw["rows"][6]["agreement"] == "n/a (quick run)"
     # a report read back and written again is the same document
     write_report(tmp_path / "again", report.rows, report.figures, report.meta)

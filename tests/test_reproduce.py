@@ -41,13 +41,19 @@ MODEL_ROWS = [
 
 def test_spec_key_depends_on_what_the_result_depends_on_only():
     e = ex.Experiment("a", "chain_modes", {"K": 10.0, "D": 5.0}, options={"betas": [0.5, 1.0]})
-    assert e.key() == ex.Experiment("b", "chain_modes", {"D": 5, "K": 10}, options={"betas": (0.5, 1.0)},
-                                    figures=("fig4",), note="label").key()
+    assert (
+        e.key()
+        == ex.Experiment(
+            "b", "chain_modes", {"D": 5, "K": 10}, options={"betas": (0.5, 1.0)}, figures=("fig4",), note="label"
+        ).key()
+    )
     assert len(e.key()) == 12 and e.dirname == f"a-{e.key()}"
     assert e.key() != ex.Experiment("a", "chain_modes", {"K": 10.0, "D": 4.0}, options={"betas": [0.5, 1.0]}).key()
     assert e.key() != ex.Experiment("a", "chain_modes", {"K": 10.0, "D": 5.0}, options={"betas": [0.5]}).key()
-    assert e.key() != ex.Experiment("a", "chain_modes", {"K": 10.0, "D": 5.0}, t_end=1.0,
-                                    options={"betas": [0.5, 1.0]}).key()
+    assert (
+        e.key()
+        != ex.Experiment("a", "chain_modes", {"K": 10.0, "D": 5.0}, t_end=1.0, options={"betas": [0.5, 1.0]}).key()
+    )
     assert e.key() != ex.Experiment("a", "block_run", {"K": 10.0, "D": 5.0}, options={"betas": [0.5, 1.0]}).key()
 
 
@@ -60,8 +66,9 @@ def test_spec_key_includes_the_package_version(monkeypatch):
 
 def test_chain_points_are_left_out_of_the_directory_key_but_not_the_spec():
     e1 = ex.Experiment("c", "chain_runs", {"K": 10.0}, options={"points": [{"N": 9, "beta": 1.0}], "x": 1})
-    e2 = ex.Experiment("c", "chain_runs", {"K": 10.0},
-                       options={"points": [{"N": 9, "beta": 1.0}, {"N": 9, "beta": 0.5}], "x": 1})
+    e2 = ex.Experiment(
+        "c", "chain_runs", {"K": 10.0}, options={"points": [{"N": 9, "beta": 1.0}, {"N": 9, "beta": 0.5}], "x": 1}
+    )
     assert e1.key() == e2.key()
     assert e1.spec() != e2.spec()
 
@@ -168,7 +175,7 @@ def test_report_has_a_row_for_every_stated_number(smoke):
     report = read_json(out / "report.json")
     rows = report["rows"]
     assert len(rows) == len(MODEL_ROWS)
-    for (where, word), row in zip(MODEL_ROWS, rows):
+    for (where, word), row in zip(MODEL_ROWS, rows, strict=False):
         assert row["where"] == where and word in row["quantity"], (where, word, row)
         assert row["paper"] and row["value"] is not None
         assert row["command"].startswith("stickslip ")

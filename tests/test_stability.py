@@ -299,9 +299,7 @@ def test_critical_beta_equals_closed_form(K, D, V, alpha):
     assert st.chain_critical_beta_numeric(p) == pytest.approx(alpha, abs=5e-6)
 
 
-@pytest.mark.parametrize(
-    "beta,unstable", [(0.5, True), (0.9, True), (0.99, True), (1.01, False), (1.5, False)]
-)
+@pytest.mark.parametrize("beta,unstable", [(0.5, True), (0.9, True), (0.99, True), (1.01, False), (1.5, False)])
 def test_fig4_sign_of_growth(beta, unstable):
     """Fig. 4 at K = 10, D = 5: unstable for beta < 1, stable for beta > 1."""
     s = st.chain_stability(ChainParams(K=10, D=5, V=0.001, beta=beta))

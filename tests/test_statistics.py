@@ -112,8 +112,7 @@ def test_truncated_fit_equals_powerlaw_packages_numerical_mle():
         fit = fit_power_law(S, s_min=a, s_max=b, bootstrap=0)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            reference = powerlaw.Power_Law(data=S, xmin=a, xmax=b, discrete=False,
-                                           force_numerical_fit=True, verbose=0)
+            reference = powerlaw.Power_Law(data=S, xmin=a, xmax=b, discrete=False, force_numerical_fit=True, verbose=0)
         assert fit.tau == pytest.approx(reference.alpha, abs=5e-4)
         assert fit.loglikelihood == pytest.approx(reference.loglikelihood, rel=1e-6)
 
@@ -167,8 +166,13 @@ def test_truncated_pdf_integrates_to_one():
     from scipy import integrate
 
     for tau in (0.7, 1.0, 1.5, 2.5):
-        total, _ = integrate.quad(lambda s: float(truncated_power_law_pdf(s, tau, 0.1, 1e3)), 0.1, 1e3,
-                                  points=np.geomspace(0.1, 1e3, 9)[1:-1].tolist(), limit=400)
+        total, _ = integrate.quad(
+            lambda s, tau=tau: float(truncated_power_law_pdf(s, tau, 0.1, 1e3)),
+            0.1,
+            1e3,
+            points=np.geomspace(0.1, 1e3, 9)[1:-1].tolist(),
+            limit=400,
+        )
         assert total == pytest.approx(1.0, rel=1e-7)
 
 
@@ -191,10 +195,12 @@ def synthetic_front(speed: float, reach: int, t0: float, noise: float, seed: int
 
 
 def test_front_speed_recovers_a_known_speed_on_the_far_part():
-    table = pd.concat([
-        synthetic_front(1.43, 399, 19_100.0, 0.2, seed=1, event=7),
-        synthetic_front(2.5, 150, 500.0, 0.2, seed=2, event=8),
-    ])
+    table = pd.concat(
+        [
+            synthetic_front(1.43, 399, 19_100.0, 0.2, seed=1, event=7),
+            synthetic_front(2.5, 150, 500.0, 0.2, seed=2, event=8),
+        ]
+    )
     front = front_speed(table, 7)
     assert front.i_min == 200 and front.i_max == 399 and front.n_blocks == 200
     assert front.speed == pytest.approx(1.43, abs=3 * front.speed_err)
@@ -225,12 +231,14 @@ def test_front_speed_needs_moved_blocks():
 
 
 def test_pick_front_events():
-    events = pd.DataFrame({
-        "event": [0, 1, 2, 3, 4],
-        "S": [10.0, 5000.0, 300.0, 6000.0, 200.0],
-        "max_block": [10, 399, 180, 399, 220],
-        "t_start": [1.0, 2.0, 3.0, 4.0, 5.0],
-    })
+    events = pd.DataFrame(
+        {
+            "event": [0, 1, 2, 3, 4],
+            "S": [10.0, 5000.0, 300.0, 6000.0, 200.0],
+            "max_block": [10, 399, 180, 399, 220],
+            "t_start": [1.0, 2.0, 3.0, 4.0, 5.0],
+        }
+    )
     chosen = pick_front_events(events, 399)
     assert chosen.set_index("kind")["event"].to_dict() == {"large": 3, "intermediate": 2}
 
@@ -303,9 +311,10 @@ def test_leading_edge_speed_of_a_known_front():
     dx = np.zeros((starts.size, N))
     for k, s in enumerate(starts):
         dx[k] = 0.05 * np.clip(np.minimum(s + window, t_first + 60.0) - np.maximum(s, t_first), 0.0, None)
-    profiles = xr.Dataset({"dx": (("row", "block"), dx)},
-                          coords={"event": ("row", np.full(starts.size, 4)), "t": ("row", starts),
-                                  "block": np.arange(1, N + 1)})
+    profiles = xr.Dataset(
+        {"dx": (("row", "block"), dx)},
+        coords={"event": ("row", np.full(starts.size, 4)), "t": ("row", starts), "block": np.arange(1, N + 1)},
+    )
     edge = leading_edge_speed(profiles, 4)
     # each edge sits within one block-step of the front at the window's end
     assert edge.speed == pytest.approx(speed, rel=0.05)

@@ -129,8 +129,17 @@ def _tiny(points=None) -> Study:
 
 
 def _science(rows) -> pd.DataFrame:
-    cols = ["N", "beta", "order_parameter", "order_parameter_err", "final_state", "stuck_fraction", "event_rate",
-            "S_max", "t_steady"]
+    cols = [
+        "N",
+        "beta",
+        "order_parameter",
+        "order_parameter_err",
+        "final_state",
+        "stuck_fraction",
+        "event_rate",
+        "S_max",
+        "t_steady",
+    ]
     return pd.DataFrame(rows)[cols].sort_values(["N", "beta"]).reset_index(drop=True)
 
 
@@ -185,16 +194,25 @@ def test_existing_scheduler_gives_the_local_result(tmp_path):
     """`dask scheduler` and `dask worker` processes on 127.0.0.1 give the local cluster's table."""
     dask = str(Path(sys.executable).with_name("dask"))
     port = _free_port()
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(Path(__file__).parents[1] / "src"),
-                                                         os.environ.get("PYTHONPATH", "")])}
-    sched = subprocess.Popen([dask, "scheduler", "--host", "127.0.0.1", "--port", str(port),
-                              "--dashboard-address", ":0"], env=env, stdout=subprocess.DEVNULL,
-                             stderr=subprocess.DEVNULL)
+    env = {
+        **os.environ,
+        "PYTHONPATH": os.pathsep.join([str(Path(__file__).parents[1] / "src"), os.environ.get("PYTHONPATH", "")]),
+    }
+    sched = subprocess.Popen(
+        [dask, "scheduler", "--host", "127.0.0.1", "--port", str(port), "--dashboard-address", ":0"],
+        env=env,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
     worker = None
     try:
         time.sleep(3)
-        worker = subprocess.Popen([dask, "worker", f"tcp://127.0.0.1:{port}", "--nthreads", "1", "--nworkers", "2"],
-                                  env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        worker = subprocess.Popen(
+            [dask, "worker", f"tcp://127.0.0.1:{port}", "--nthreads", "1", "--nworkers", "2"],
+            env=env,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
         time.sleep(5)
         remote = run_study(_tiny(), tmp_path / "remote", scheduler=f"tcp://127.0.0.1:{port}", progress=False)
         local = run_study(_tiny(), tmp_path / "local", n_workers=2, progress=False)
@@ -258,12 +276,22 @@ def test_tiny_chaos_study_end_to_end(tmp_path, cluster):
 
 def test_bad_study_input_is_one_line_and_exit_2(tmp_path):
     env = {**os.environ, "PYTHONPATH": str(Path(__file__).parents[1] / "src")}
-    cases = [["study", "bogus"], ["study", "chaos", "--workers", "0"], ["study", "chaos", "--quick", "--full"],
-             ["study", "transition", "--scheduler", " "], ["study", "chaos", "--workers", "two"],
-             ["study", "exponents", "--bogus"]]
+    cases = [
+        ["study", "bogus"],
+        ["study", "chaos", "--workers", "0"],
+        ["study", "chaos", "--quick", "--full"],
+        ["study", "transition", "--scheduler", " "],
+        ["study", "chaos", "--workers", "two"],
+        ["study", "exponents", "--bogus"],
+    ]
     for argv in cases:
-        proc = subprocess.run([sys.executable, "-m", "stickslip.cli", *argv, "--out", str(tmp_path / "o")],
-                              env=env, capture_output=True, text=True, timeout=120)
+        proc = subprocess.run(
+            [sys.executable, "-m", "stickslip.cli", *argv, "--out", str(tmp_path / "o")],
+            env=env,
+            capture_output=True,
+            text=True,
+            timeout=120,
+        )
         assert proc.returncode == 2, (argv, proc.stderr)
         assert len(proc.stderr.strip().splitlines()) == 1, (argv, proc.stderr)
         assert proc.stdout == ""

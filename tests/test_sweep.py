@@ -44,11 +44,9 @@ def test_sweep_on_two_worker_processes_skips_done_points_and_survives_a_failure(
     points = [{"x": 1.0}, {"x": 2.0}, {"x": 3.0, "fail": True}, {"x": 4.0}]
     common = {"n": 5, "sleep": 0.2}
 
-    first = run_sweep(demo_task, points, tmp_path, common=common, scheduler=lc.scheduler_address,
-                      progress=False)
+    first = run_sweep(demo_task, points, tmp_path, common=common, scheduler=lc.scheduler_address, progress=False)
     table = first.table.set_index("point_dir")
-    assert sorted(p.name for p in tmp_path.iterdir() if p.is_dir()) == sorted(
-        ["x=1", "x=2", "x=4", "fail=True_x=3"])
+    assert sorted(p.name for p in tmp_path.iterdir() if p.is_dir()) == sorted(["x=1", "x=2", "x=4", "fail=True_x=3"])
     assert first.n_run == 4 and first.n_reused == 0 and first.n_failed == 1
     for x in (1.0, 2.0, 4.0):
         name = point_name({"x": x})
@@ -72,16 +70,18 @@ def test_sweep_on_two_worker_processes_skips_done_points_and_survives_a_failure(
 
     # a second call runs only the failed point again
     stamp = (tmp_path / "x=1" / "done.json").stat().st_mtime_ns
-    second = run_sweep(demo_task, points, tmp_path, common=common, scheduler=lc.scheduler_address,
-                       progress=False)
+    second = run_sweep(demo_task, points, tmp_path, common=common, scheduler=lc.scheduler_address, progress=False)
     assert second.n_run == 1 and second.n_reused == 3 and second.n_failed == 1
     assert second.table.set_index("point_dir")["reused"].to_dict() == {
-        "x=1": True, "x=2": True, "fail=True_x=3": False, "x=4": True}
+        "x=1": True,
+        "x=2": True,
+        "fail=True_x=3": False,
+        "x=4": True,
+    }
     assert (tmp_path / "x=1" / "done.json").stat().st_mtime_ns == stamp
 
     # a changed common setting makes the stored results stale: they are run again
-    third = run_sweep(demo_task, points[:2], tmp_path, common={"n": 6}, scheduler=lc.scheduler_address,
-                      progress=False)
+    third = run_sweep(demo_task, points[:2], tmp_path, common={"n": 6}, scheduler=lc.scheduler_address, progress=False)
     assert third.n_run == 2 and third.n_reused == 0
     assert third.table["value"].tolist() == [sum_of_squares(6) * 1.0, sum_of_squares(6) * 2.0]
 
@@ -172,8 +172,22 @@ def test_cli_bad_t_end_and_workers(tmp_path, capsys):
 
 def test_cli_block_sweep_json(tmp_path, capsys):
     out = tmp_path / "sweep"
-    argv = ["sweep", "block", "--grid", "V=0.01,0.02", "--set", "Fs=3", "--t-end", "150",
-            "--out", str(out), "--workers", "2", "--no-progress", "--json"]
+    argv = [
+        "sweep",
+        "block",
+        "--grid",
+        "V=0.01,0.02",
+        "--set",
+        "Fs=3",
+        "--t-end",
+        "150",
+        "--out",
+        str(out),
+        "--workers",
+        "2",
+        "--no-progress",
+        "--json",
+    ]
     assert main(argv) == 0
     data = json.loads(capsys.readouterr().out)
     assert data["n_points"] == 2 and data["n_failed"] == 0

@@ -10,9 +10,10 @@ import json
 import os
 import platform
 import tempfile
+from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any, Iterator
+from typing import Any
 
 import pandas as pd
 import xarray as xr
@@ -63,8 +64,12 @@ def read_dataset(path: str | Path) -> xr.Dataset:
         return ds.load()
 
 
-def write_table(path: str | Path, table: pd.DataFrame, descriptions: dict[str, str] | None = None,
-                metadata: dict[str, Any] | None = None) -> Path:
+def write_table(
+    path: str | Path,
+    table: pd.DataFrame,
+    descriptions: dict[str, str] | None = None,
+    metadata: dict[str, Any] | None = None,
+) -> Path:
     """Write a table (events, sweep summaries) to Parquet, atomically.
 
     ``descriptions`` (column -> text) go into the Parquet schema as each field's metadata
@@ -76,12 +81,17 @@ def write_table(path: str | Path, table: pd.DataFrame, descriptions: dict[str, s
 
     arrow = pa.Table.from_pandas(table, preserve_index=False)
     if descriptions:
-        fields = [f.with_metadata({**(f.metadata or {}), b"description": descriptions[f.name].encode()})
-                  if f.name in descriptions else f for f in arrow.schema]
+        fields = [
+            f.with_metadata({**(f.metadata or {}), b"description": descriptions[f.name].encode()})
+            if f.name in descriptions
+            else f
+            for f in arrow.schema
+        ]
         arrow = arrow.cast(pa.schema(fields, metadata=arrow.schema.metadata))
     if metadata:
-        arrow = arrow.replace_schema_metadata({**(arrow.schema.metadata or {}),
-                                               b"stickslip": json.dumps(to_jsonable(metadata)).encode()})
+        arrow = arrow.replace_schema_metadata(
+            {**(arrow.schema.metadata or {}), b"stickslip": json.dumps(to_jsonable(metadata)).encode()}
+        )
     with atomic_path(path) as tmp:
         pq.write_table(arrow, tmp)
     return Path(path)

@@ -26,9 +26,16 @@ from stickslip.models.physics import chain_steady_length
 from stickslip.run.state import steady_deviation
 
 # choose_s_min lives in stickslip.analysis.statistics; the name is kept importable from here.
-__all__ = ["final_state", "choose_s_min", "size_statistics", "front_speeds", "front_statistics", "chain_analysis",
-           "fig6_start_note",
-           "sweep_table"]
+__all__ = [
+    "final_state",
+    "choose_s_min",
+    "size_statistics",
+    "front_speeds",
+    "front_statistics",
+    "chain_analysis",
+    "fig6_start_note",
+    "sweep_table",
+]
 
 
 def final_state(summary: dict[str, Any], state, params: ChainParams, tolerance: float) -> tuple[str, float]:
@@ -36,7 +43,8 @@ def final_state(summary: dict[str, Any], state, params: ChainParams, tolerance: 
 
     Steady sliding: the run stopped there (``until_steady``), or its final state is within
     ``tolerance`` of it (:func:`stickslip.run.state.steady_deviation`; ``stickslip reproduce``
-    uses :data:`stickslip.experiments.specs.UNTIL_STEADY`), which for beta > 1 it never leaves. Otherwise stick-slip if events happened in the averaged
+    uses :data:`stickslip.experiments.specs.UNTIL_STEADY`), which for beta > 1 it never leaves.
+    Otherwise stick-slip if events happened in the averaged
     second half or some block is stopped at the end. Returns the state and the final deviation.
     """
     deviation = steady_deviation(state, params)
@@ -47,8 +55,9 @@ def final_state(summary: dict[str, Any], state, params: ChainParams, tolerance: 
     return "sliding, not yet steady", deviation
 
 
-def size_statistics(events: pd.DataFrame, N: int, *, small_only: bool, seed: int = 0,
-                    spanning: str = "max_block", bootstrap: int = 200) -> dict[str, Any]:
+def size_statistics(
+    events: pd.DataFrame, N: int, *, small_only: bool, seed: int = 0, spanning: str = "max_block", bootstrap: int = 200
+) -> dict[str, Any]:
     """Slip-size statistics of one chain run for Fig. 7 (beta = 1) or Fig. 8 (beta = 0.2).
 
     The events that reach block N ("system-spanning") set the largest sizes. With
@@ -121,8 +130,9 @@ def front_speeds(run, N: int, t_from: float) -> pd.DataFrame:
                 c_edge = leading_edge_speed(profiles, e).speed
             except ValueError:
                 pass
-        rows.append({"event": e, "t_start": float(r.t_start), "S": float(r.S), "c_first_move": c_fm,
-                     "c_leading_edge": c_edge})
+        rows.append(
+            {"event": e, "t_start": float(r.t_start), "S": float(r.S), "c_first_move": c_fm, "c_leading_edge": c_edge}
+        )
     return pd.DataFrame(rows, columns=["event", "t_start", "S", "c_first_move", "c_leading_edge"])
 
 
@@ -182,12 +192,17 @@ def fig6_start_note(a: dict[str, Any]) -> str:
     p = a["run1"].params
     p399 = p.replace(N=399)
     t_span = a["fronts"].get("t_first_span", float("nan"))
-    here = (f"in this run (N = {p.N}) the first event that reached block N started at t = {t_span:.3g} "
-            f"(L_ss / V = {chain_steady_length(p) / p.V:.3g})" if np.isfinite(t_span) else
-            f"in this run (N = {p.N}) no event reached block N")
-    return ("The paper's event times (t ~ 19100 and 40400) cannot come from its stated start x_i(0) = 0: the "
-            f"chain must first stretch by about L_ss = (c/K) N (N - 1) / 2 = {chain_steady_length(p399):.4g} "
-            f"(N = 399), which at V = {p.V:g} takes t ~ {chain_steady_length(p399) / p.V:.2g}; {here}.")
+    here = (
+        f"in this run (N = {p.N}) the first event that reached block N started at t = {t_span:.3g} "
+        f"(L_ss / V = {chain_steady_length(p) / p.V:.3g})"
+        if np.isfinite(t_span)
+        else f"in this run (N = {p.N}) no event reached block N"
+    )
+    return (
+        "The paper's event times (t ~ 19100 and 40400) cannot come from its stated start x_i(0) = 0: the "
+        f"chain must first stretch by about L_ss = (c/K) N (N - 1) / 2 = {chain_steady_length(p399):.4g} "
+        f"(N = 399), which at V = {p.V:g} takes t ~ {chain_steady_length(p399) / p.V:.2g}; {here}."
+    )
 
 
 def chain_analysis(outcome) -> dict[str, Any]:
@@ -201,8 +216,7 @@ def chain_analysis(outcome) -> dict[str, Any]:
     sweep_N, fig_N = int(opts["sweep_N"]), int(opts["figure_N"])
     t_fig = float(opts["t_end_by_N"][str(fig_N)])
     t_from = float(opts["average_fraction"]) * t_fig
-    out: dict[str, Any] = {"table": table, "sweep_N": sweep_N, "figure_N": fig_N, "t_fig": t_fig,
-                           "t_from": t_from}
+    out: dict[str, Any] = {"table": table, "sweep_N": sweep_N, "figure_N": fig_N, "t_fig": t_fig, "t_from": t_from}
     run1 = outcome.data["run"](fig_N, 1.0)
     run02 = outcome.data["run"](fig_N, 0.2)
     out["run1"], out["run02"] = run1, run02
@@ -219,6 +233,18 @@ def sweep_table(a: dict[str, Any]) -> pd.DataFrame:
     """The runs at the sweep's N (Fig. 5b), by beta, with the columns the figure and its row show."""
     t = a["table"]
     t = t[t["N"] == a["sweep_N"]].sort_values("beta")
-    cols = ["beta", "N", "L_mean", "L_err", "L_steady", "final_state", "n_events", "n_events_late",
-            "t_steady", "stopped_early", "t_end", "wall_seconds"]
+    cols = [
+        "beta",
+        "N",
+        "L_mean",
+        "L_err",
+        "L_steady",
+        "final_state",
+        "n_events",
+        "n_events_late",
+        "t_steady",
+        "stopped_early",
+        "t_end",
+        "wall_seconds",
+    ]
     return t[[c for c in cols if c in t.columns]].reset_index(drop=True)

@@ -121,9 +121,7 @@ def _no_series(p: BlockParams, t: float) -> int:
     return max(1, steps_for(t, p.dt))
 
 
-def _hold(
-    params: BlockParams, V: float, settings: SweepSettings, state: BlockState
-) -> tuple[dict, BlockState]:
+def _hold(params: BlockParams, V: float, settings: SweepSettings, state: BlockState) -> tuple[dict, BlockState]:
     """Hold V for one step of the sweep: discard the transient, measure the rest."""
     p = params.replace(V=float(V))
     t_transient = settings.transient * settings.time_per_step

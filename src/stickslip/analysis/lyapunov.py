@@ -34,10 +34,11 @@ from __future__ import annotations
 
 import math
 import sys
-import warnings
 import time
+import warnings
+from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any, Sequence
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -114,7 +115,7 @@ class LyapunovResult:
             "norm": NORM,
         }
 
-    def truncated(self, t_end: float) -> "LyapunovResult":
+    def truncated(self, t_end: float) -> LyapunovResult:
         """The estimate a run to ``t_end`` (a renormalisation time of this run) would have given.
 
         The twin's history does not depend on the run's end, so this equals the shorter run
@@ -123,10 +124,26 @@ class LyapunovResult:
         keep = self.times <= t_end + 0.5 * self.params.dt
         lam, err, means = _estimate(self.log_growth[keep], self.durations[keep], self.counted[keep], self.segments)
         return LyapunovResult(
-            lam, err, float(t_end), self.transient, self.align, self.interval, self.d0,
-            int(np.count_nonzero(self.counted[keep])), self.segments, means, -1,
-            float(np.max(self.log_growth[keep], initial=-np.inf)), "", float("nan"), self.params,
-            self.start, self.times[keep], self.log_growth[keep], self.durations[keep], self.counted[keep],
+            lam,
+            err,
+            float(t_end),
+            self.transient,
+            self.align,
+            self.interval,
+            self.d0,
+            int(np.count_nonzero(self.counted[keep])),
+            self.segments,
+            means,
+            -1,
+            float(np.max(self.log_growth[keep], initial=-np.inf)),
+            "",
+            float("nan"),
+            self.params,
+            self.start,
+            self.times[keep],
+            self.log_growth[keep],
+            self.durations[keep],
+            self.counted[keep],
         )
 
 
@@ -149,7 +166,7 @@ def _project(dy: np.ndarray, stopped: np.ndarray) -> np.ndarray:
     """Drop the velocity components of blocks stuck in the reference (the constraint v = 0)."""
     N = stopped.shape[0]
     out = dy.copy()
-    out[N:2 * N][stopped] = 0.0
+    out[N : 2 * N][stopped] = 0.0
     return out
 
 
@@ -207,7 +224,7 @@ def twin_state(ref: ChainState, direction: np.ndarray, d0: float, params: ChainP
     N = b["x"].shape[0]
     u = _project(direction, b["stopped"])
     if params.friction != "state":
-        u[2 * N:] = 0.0  # no state variable: theta is not a coordinate of these models
+        u[2 * N :] = 0.0  # no state variable: theta is not a coordinate of these models
     norm = float(np.linalg.norm(u))
     if not norm > 0.0:
         raise ValueError("the separation vanished on the reference's branch; cannot renormalise")
@@ -216,8 +233,8 @@ def twin_state(ref: ChainState, direction: np.ndarray, d0: float, params: ChainP
         x = b["x"] + u[:N] / math.sqrt(params.Kp)
     else:
         x = b["x"] - np.cumsum(u[:N] / math.sqrt(params.K))
-    v = np.where(b["stopped"], 0.0, b["v"] + u[N:2 * N])
-    th = b["theta"] + u[2 * N:]
+    v = np.where(b["stopped"], 0.0, b["v"] + u[N : 2 * N])
+    th = b["theta"] + u[2 * N :]
     return _with_step(ChainState.from_blocks(x, v, th, b["stopped"]), ref.step)
 
 
@@ -293,7 +310,8 @@ def largest_lyapunov(
     rounding, so ln(d / d0) is not biased by the rounding of the twin's positions.
     """
     t_end, interval, d0, transient, align, segments = _check_run(
-        params, t_end, interval, d0, transient, align, segments)
+        params, t_end, interval, d0, transient, align, segments
+    )
     if engine not in ENGINES:
         raise ParameterError(f"engine must be one of {', '.join(ENGINES)} (got {engine!r})")
     stepper = _LeanEngine(params) if engine == "lean" else _RunChainEngine(params)
@@ -307,8 +325,9 @@ def largest_lyapunov(
     with warnings.catch_warnings():
         # Only the state at the transient's end is used, not <L>: loading is no concern here.
         warnings.simplefilter("ignore", ShortRunWarning)
-        run = run_chain(params, n0 * dt, start=start, perturbation=perturbation, seed=seed,
-                        sample_interval=max(transient, dt))
+        run = run_chain(
+            params, n0 * dt, start=start, perturbation=perturbation, seed=seed, sample_interval=max(transient, dt)
+        )
     ref = run.state
     start_name = start if isinstance(start, str) else "state"
     rng = np.random.default_rng(direction_seed)
@@ -348,11 +367,26 @@ def largest_lyapunov(
     counted = times > n_count * dt + 0.5 * dt
     lam, err, means = _estimate(logs, taus, counted, segments)
     return LyapunovResult(
-        lyapunov=lam, lyapunov_err=err, t_end=t_end, transient=transient, align=align,
-        interval=interval, d0=d0, renormalisations=int(np.count_nonzero(counted)), segments=segments,
-        segment_means=means, events=events, max_log_growth=float(np.max(logs[counted], initial=-np.inf)),
-        reference_sha256=ref.sha256(), wall_seconds=time.perf_counter() - wall0, params=params,
-        start=start_name, times=times, log_growth=logs, durations=taus, counted=counted,
+        lyapunov=lam,
+        lyapunov_err=err,
+        t_end=t_end,
+        transient=transient,
+        align=align,
+        interval=interval,
+        d0=d0,
+        renormalisations=int(np.count_nonzero(counted)),
+        segments=segments,
+        segment_means=means,
+        events=events,
+        max_log_growth=float(np.max(logs[counted], initial=-np.inf)),
+        reference_sha256=ref.sha256(),
+        wall_seconds=time.perf_counter() - wall0,
+        params=params,
+        start=start_name,
+        times=times,
+        log_growth=logs,
+        durations=taus,
+        counted=counted,
     )
 
 
@@ -363,13 +397,27 @@ def _bar(progress: bool, total: float):
     from tqdm import tqdm
 
     # rate in model time units per wall-clock second
-    return tqdm(total=total, unit=" time units", unit_scale=False, dynamic_ncols=True, desc="lyapunov",
-                file=sys.stderr, bar_format="{l_bar}{bar}| t = {n:.4g}/{total:.4g} [{elapsed}<{remaining}, "
-                                            "{rate_fmt}]")
+    return tqdm(
+        total=total,
+        unit=" time units",
+        unit_scale=False,
+        dynamic_ncols=True,
+        desc="lyapunov",
+        file=sys.stderr,
+        bar_format="{l_bar}{bar}| t = {n:.4g}/{total:.4g} [{elapsed}<{remaining}, {rate_fmt}]",
+    )
 
 
-CONVERGENCE_COLUMNS = ["varied", "d0", "interval", "t_end", "lyapunov", "lyapunov_err", "renormalisations",
-                       "wall_seconds"]
+CONVERGENCE_COLUMNS = [
+    "varied",
+    "d0",
+    "interval",
+    "t_end",
+    "lyapunov",
+    "lyapunov_err",
+    "renormalisations",
+    "wall_seconds",
+]
 
 
 def lyapunov_convergence(
@@ -393,9 +441,18 @@ def lyapunov_convergence(
     rows = []
 
     def add(varied, res, wall):
-        rows.append({"varied": varied, "d0": res.d0, "interval": res.interval, "t_end": res.t_end,
-                     "lyapunov": res.lyapunov, "lyapunov_err": res.lyapunov_err,
-                     "renormalisations": res.renormalisations, "wall_seconds": wall})
+        rows.append(
+            {
+                "varied": varied,
+                "d0": res.d0,
+                "interval": res.interval,
+                "t_end": res.t_end,
+                "lyapunov": res.lyapunov,
+                "lyapunov_err": res.lyapunov_err,
+                "renormalisations": res.renormalisations,
+                "wall_seconds": wall,
+            }
+        )
 
     base = largest_lyapunov(params, t_end, interval=interval, d0=d0, **kwargs)
     for value in d0s:
@@ -416,8 +473,7 @@ def lyapunov_convergence(
     return pd.DataFrame(rows, columns=CONVERGENCE_COLUMNS)
 
 
-BETA_COLUMNS = ["beta", "lyapunov", "lyapunov_err", "renormalisations", "events", "max_log_growth",
-                "wall_seconds"]
+BETA_COLUMNS = ["beta", "lyapunov", "lyapunov_err", "renormalisations", "events", "max_log_growth", "wall_seconds"]
 
 
 def lyapunov_vs_beta(params: ChainParams, betas: Sequence[float], t_end: float, **kwargs: Any) -> pd.DataFrame:
@@ -429,7 +485,15 @@ def lyapunov_vs_beta(params: ChainParams, betas: Sequence[float], t_end: float, 
     rows = []
     for beta in betas:
         res = largest_lyapunov(params.replace(beta=float(beta)), t_end, **kwargs)
-        rows.append({"beta": float(beta), "lyapunov": res.lyapunov, "lyapunov_err": res.lyapunov_err,
-                     "renormalisations": res.renormalisations, "events": res.events,
-                     "max_log_growth": res.max_log_growth, "wall_seconds": res.wall_seconds})
+        rows.append(
+            {
+                "beta": float(beta),
+                "lyapunov": res.lyapunov,
+                "lyapunov_err": res.lyapunov_err,
+                "renormalisations": res.renormalisations,
+                "events": res.events,
+                "max_log_growth": res.max_log_growth,
+                "wall_seconds": res.wall_seconds,
+            }
+        )
     return pd.DataFrame(rows, columns=BETA_COLUMNS)

@@ -85,7 +85,7 @@ def batch_means(x: np.ndarray, batch: int) -> tuple[float, int]:
     k = x.size // batch
     if k < 2:
         return math.nan, k
-    means = x[x.size - k * batch:].reshape(k, batch).mean(axis=1)
+    means = x[x.size - k * batch :].reshape(k, batch).mean(axis=1)
     return float(np.std(means, ddof=1) / math.sqrt(k)), k
 
 
@@ -203,17 +203,28 @@ def transition_bracket(betas, states) -> dict[str, Any]:
     s = np.asarray(states, dtype=object)[order]
     stick = b[s == "stick-slip"]
     if stick.size == 0:
-        return {"lo": math.nan, "hi": float(b[s == "steady"].min()) if (s == "steady").any() else math.nan,
-                "estimate": math.nan, "uncertainty": math.nan, "undecided": b[s == "undecided"].tolist(),
-                "contradictions": 0}
+        return {
+            "lo": math.nan,
+            "hi": float(b[s == "steady"].min()) if (s == "steady").any() else math.nan,
+            "estimate": math.nan,
+            "uncertainty": math.nan,
+            "undecided": b[s == "undecided"].tolist(),
+            "contradictions": 0,
+        }
     lo = float(stick.max())
     above = b[(s == "steady") & (b > lo)]
     hi = float(above.min()) if above.size else math.nan
     between = b[(s == "undecided") & (b > lo) & ((b < hi) if math.isfinite(hi) else True)].tolist()
     contradictions = int(np.count_nonzero((s == "steady") & (b < lo)))
     est = 0.5 * (lo + hi) if math.isfinite(hi) else math.nan
-    return {"lo": lo, "hi": hi, "estimate": est, "uncertainty": 0.5 * (hi - lo) if math.isfinite(hi) else math.nan,
-            "undecided": between, "contradictions": contradictions}
+    return {
+        "lo": lo,
+        "hi": hi,
+        "estimate": est,
+        "uncertainty": 0.5 * (hi - lo) if math.isfinite(hi) else math.nan,
+        "undecided": between,
+        "contradictions": contradictions,
+    }
 
 
 def power_law_fit(x, y, yerr=None) -> dict[str, float]:
@@ -229,5 +240,9 @@ def power_law_fit(x, y, yerr=None) -> dict[str, float]:
         rel = np.asarray(yerr, dtype=float)[ok] / y[ok]
         w = 1.0 / np.maximum(rel, 1e-3)
     coef, cov = np.polyfit(lx, ly, 1, w=w, cov="unscaled" if w is not None and ok.sum() < 4 else True)
-    return {"b": float(coef[0]), "b_err": float(math.sqrt(cov[0, 0])), "A": float(math.exp(coef[1])),
-            "n": int(np.count_nonzero(ok))}
+    return {
+        "b": float(coef[0]),
+        "b_err": float(math.sqrt(cov[0, 0])),
+        "A": float(math.exp(coef[1])),
+        "n": int(np.count_nonzero(ok)),
+    }

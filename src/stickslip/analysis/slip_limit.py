@@ -21,8 +21,9 @@ beside the law (Fig. 3).
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass, field
-from typing import Any, Iterable
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -97,9 +98,7 @@ class SlipLimit:
 def _check_can_slip(p: BlockParams) -> None:
     # The slip starts from v = 0, theta = 1 with M v' = Fs - sigma: it must be pushed forward.
     if not p.Fs > p.sigma:
-        raise ParameterError(
-            f"Fs must be > sigma = {p.sigma:g} for a slip of eq. (3) to start (got {p.Fs:g})"
-        )
+        raise ParameterError(f"Fs must be > sigma = {p.sigma:g} for a slip of eq. (3) to start (got {p.Fs:g})")
 
 
 def eq3_rhs(t: float, y: np.ndarray, K: float, beta: float, alpha: float, Fs: float, M: float, sigma: float):
@@ -164,9 +163,7 @@ def solve_slip_limit(
     )
 
 
-def heun_slip_limit(
-    params: BlockParams | None = None, *, dt: float | None = None, t_max: float = 1000.0
-) -> SlipLimit:
+def heun_slip_limit(params: BlockParams | None = None, *, dt: float | None = None, t_max: float = 1000.0) -> SlipLimit:
     """Eq. (3) with the Heun step and stop rule of eq. (1) at step ``dt`` (default params.dt).
 
     This is eq. (1) at V = 0 started moving with v = 0, theta = 1 and spring force Fs
@@ -216,16 +213,17 @@ def _curve(p: BlockParams, t, x, v, theta, method: str, f=None) -> xr.Dataset:
             "f": ("t", np.asarray(f), {"long_name": "spring force Fs - K x'"}),
         },
         coords={"t": ("t", np.asarray(t), {"long_name": "time since the start of the slip t - t_c"})},
-        attrs={"method": method, **{f"param_{k}": val if isinstance(val, str) else float(val) for k, val in p.to_dict().items()}},
+        attrs={
+            "method": method,
+            **{f"param_{k}": val if isinstance(val, str) else float(val) for k, val in p.to_dict().items()},
+        },
     )
 
 
 def matches_paper(params: BlockParams) -> bool:
     """Whether eq. (3) at these parameters is the paper's case (K = 10, beta = 1, Fs = 3)."""
     d = BlockParams()
-    return all(
-        math.isclose(getattr(params, k), getattr(d, k)) for k in ("K", "beta", "alpha", "Fs", "M", "sigma")
-    )
+    return all(math.isclose(getattr(params, k), getattr(d, k)) for k in ("K", "beta", "alpha", "Fs", "M", "sigma"))
 
 
 def period_sweep(

@@ -186,9 +186,7 @@ def hopf_point(p: BlockParams) -> HopfPoint:
     flips = np.flatnonzero(unstable[:-1] != unstable[1:])
     # The Routh-Hurwitz margin is monotone in theta_0, so there is one crossing; take the last.
     i = flips[-1]
-    Vc = brentq(
-        lambda v: float(_block_growth(p, np.array([v]))[0]), V[i], V[i + 1], xtol=1e-14, rtol=1e-14
-    )
+    Vc = brentq(lambda v: float(_block_growth(p, np.array([v]))[0]), V[i], V[i + 1], xtol=1e-14, rtol=1e-14)
     eig = block_eigenvalues(p.replace(V=Vc))
     side = "V < V_c" if unstable[i] else "V > V_c"
     return HopfPoint(
@@ -246,7 +244,11 @@ def hopf_curve(p: BlockParams, beta: np.ndarray) -> xr.Dataset:
             "V_c_closed_form": ("beta", np.array(closed), {"long_name": "Hopf point V_c (Routh-Hurwitz)"}),
         },
         coords={"beta": ("beta", beta, {"long_name": "viscous friction beta"})},
-        attrs={k: v if isinstance(v, str) else float(v) for k, v in p.to_dict().items() if k not in ("V", "beta", "Fs", "dt")},
+        attrs={
+            k: v if isinstance(v, str) else float(v)
+            for k, v in p.to_dict().items()
+            if k not in ("V", "beta", "Fs", "dt")
+        },
     )
 
 
@@ -310,7 +312,11 @@ def chain_dispersion(p: ChainParams, k: np.ndarray) -> xr.Dataset:
             "k": ("k", k, {"long_name": "lattice wavenumber k"}),
             "branch": ("branch", np.arange(3)),
         },
-        attrs={name: v if isinstance(v, str) else float(v) for name, v in p.to_dict().items() if name not in ("N", "Fs", "dt")},
+        attrs={
+            name: v if isinstance(v, str) else float(v)
+            for name, v in p.to_dict().items()
+            if name not in ("N", "Fs", "dt")
+        },
     )
 
 
@@ -657,5 +663,7 @@ def mode_dispersion(p: ChainParams, k: np.ndarray | None = None) -> xr.Dataset:
             "imag": (("k", "branch"), roots.imag, {"long_name": "Im(lambda)"}),
         },
         coords={"k": ("k", k, {"long_name": "lattice wavenumber k"}), "branch": ("branch", np.arange(2))},
-        attrs={name: v if isinstance(v, str) else float(v) for name, v in p.to_dict().items() if name not in ("Fs", "dt")},
+        attrs={
+            name: v if isinstance(v, str) else float(v) for name, v in p.to_dict().items() if name not in ("Fs", "dt")
+        },
     )

@@ -543,7 +543,8 @@ class EdgeSpeed:
     and ``times`` (window ends) are those of every window. The speed is the least-squares slope
     of edge against time over the windows whose edge lies in [i_min, i_max) (the far half, as
     :func:`front_speed`; a window whose edge has reached i_max is left out: it only says the
-    front got there within the window, and so are the windows after it). ``n_windows``: windows fitted; ``speed_err`` NaN with 2.
+    front got there within the window, and so are the windows after it). ``n_windows``: windows
+    fitted; ``speed_err`` NaN with 2.
     """
 
     event: int
@@ -609,9 +610,17 @@ def leading_edge_speed(
         residual = i - design @ coef
         tc = t - t.mean()
         err = math.sqrt(float(residual @ residual) / (n - 2) / float(tc @ tc))
-    return EdgeSpeed(event=int(event), speed=float(coef[1]), speed_err=err, i_min=lo, i_max=hi, n_windows=n,
-                     edge_fraction=float(edge_fraction), edges=tuple(int(e) for e in edges),
-                     times=tuple(float(x) for x in t_end))
+    return EdgeSpeed(
+        event=int(event),
+        speed=float(coef[1]),
+        speed_err=err,
+        i_min=lo,
+        i_max=hi,
+        n_windows=n,
+        edge_fraction=float(edge_fraction),
+        edges=tuple(int(e) for e in edges),
+        times=tuple(float(x) for x in t_end),
+    )
 
 
 @dataclass(frozen=True)
@@ -649,8 +658,17 @@ def central_interval(sample: Any, value: float, *, level: float = 0.9) -> Centra
     lo, hi = (float(q) for q in np.quantile(x, [tail, 1.0 - tail]))
     pct = 100.0 * (np.count_nonzero(x < value) + 0.5 * np.count_nonzero(x == value)) / x.size
     q1, q3 = (float(q) for q in np.quantile(x, [0.25, 0.75]))
-    return CentralInterval(value=float(value), level=float(level), lo=lo, hi=hi, inside=bool(lo <= value <= hi),
-                           percentile=float(pct), median=float(np.median(x)), quartiles=(q1, q3), n=int(x.size))
+    return CentralInterval(
+        value=float(value),
+        level=float(level),
+        lo=lo,
+        hi=hi,
+        inside=bool(lo <= value <= hi),
+        percentile=float(pct),
+        median=float(np.median(x)),
+        quartiles=(q1, q3),
+        n=int(x.size),
+    )
 
 
 def pick_front_events(events: pd.DataFrame, N: int, *, intermediate: tuple[float, float] = (0.3, 0.7)) -> pd.DataFrame:

@@ -59,8 +59,9 @@ def add_param_options(parser: argparse.ArgumentParser, params_cls: type, skip: t
             continue
         kind = int if f.metadata.get("integer") else float
         meta = f.metadata
-        allowed = _range_text(meta.get("low"), meta.get("high"), meta.get("low_open", False),
-                              meta.get("high_open", False))
+        allowed = _range_text(
+            meta.get("low"), meta.get("high"), meta.get("low_open", False), meta.get("high_open", False)
+        )
         group.add_argument(
             f"--{f.name}",
             dest=f"param_{f.name}",
@@ -164,8 +165,9 @@ def _owner(own: Callable[[str], bool] | Collection[str]) -> Callable[[str], bool
     return lambda name: name in LOCK_FILES or is_temporary(name) or test(name)
 
 
-def check_out_owned(path: str | Path | None, own, what: str, *, overwrite: bool = False,
-                    option: str = "--out") -> Path | None:
+def check_out_owned(
+    path: str | Path | None, own, what: str, *, overwrite: bool = False, option: str = "--out"
+) -> Path | None:
     """Refuse an output directory holding anything that ``own`` (a set of names or a test of a
     name) does not accept as written by the command ``what``; with ``overwrite`` the check is left out (the
     command then removes only this package's files, :func:`owned_out_dir`)."""
@@ -177,14 +179,17 @@ def check_out_owned(path: str | Path | None, own, what: str, *, overwrite: bool 
     foreign = [n for n in names if not own(n)]
     if foreign and not overwrite:
         shown = ", ".join(foreign[:3]) + (", ..." if len(foreign) > 3 else "")
-        raise CommandError(f"{option} {out} holds files that `{what}` does not write ({shown}); choose an "
-                           "empty directory, or --overwrite to replace this package's files there")
+        raise CommandError(
+            f"{option} {out} holds files that `{what}` does not write ({shown}); choose an "
+            "empty directory, or --overwrite to replace this package's files there"
+        )
     return out
 
 
 @contextlib.contextmanager
-def owned_out_dir(path: str | Path | None, own, what: str, *, overwrite: bool = False,
-                  run_id: bool = False) -> Iterator[Path | None]:
+def owned_out_dir(
+    path: str | Path | None, own, what: str, *, overwrite: bool = False, run_id: bool = False
+) -> Iterator[Path | None]:
     """Claim ``--out`` for one command: refuse foreign files (:func:`check_out_owned`), create the
     directory, hold its lock while the command writes (a second writer is refused at once,
     naming the holder; :func:`stickslip.run.rundir.owned_run_dir`) and, with ``overwrite``,
@@ -211,8 +216,11 @@ def owned_out_dir(path: str | Path | None, own, what: str, *, overwrite: bool = 
 
 def add_overwrite_option(parser: argparse.ArgumentParser) -> None:
     """``--overwrite``: replace this package's files in ``--out``; other files there stay."""
-    parser.add_argument("--overwrite", action="store_true",
-                        help="replace this package's files in --out (other files there are left alone)")
+    parser.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="replace this package's files in --out (other files there are left alone)",
+    )
 
 
 def prepare_out_dir(path: str | Path | None) -> Path | None:
@@ -235,15 +243,28 @@ def add_model_options(parser: argparse.ArgumentParser) -> None:
     from stickslip.models.presets import PRESETS
 
     group = parser.add_argument_group("model (see `stickslip models`)")
-    group.add_argument("--model", choices=tuple(PRESETS), default=None,
-                       help="preset to start from (default sakaguchi: the paper's chain of eq. 4)")
+    group.add_argument(
+        "--model",
+        choices=tuple(PRESETS),
+        default=None,
+        help="preset to start from (default sakaguchi: the paper's chain of eq. 4)",
+    )
     for kind in ("drive", "friction", "threshold", "ends"):
-        group.add_argument(f"--{kind}", choices=names(kind), default=None,
-                           help=f"{kind} piece (default: the preset's)")
-    group.add_argument("--l", dest="param_l", type=_number(float, "l"), default=None,
-                       help="Carlson-Langer's spring ratio l (sets K = l^2)")
-    group.add_argument("--nu", dest="param_nu", type=_number(float, "nu"), default=None,
-                       help="Carlson-Langer's plate velocity nu (sets V)")
+        group.add_argument(f"--{kind}", choices=names(kind), default=None, help=f"{kind} piece (default: the preset's)")
+    group.add_argument(
+        "--l",
+        dest="param_l",
+        type=_number(float, "l"),
+        default=None,
+        help="Carlson-Langer's spring ratio l (sets K = l^2)",
+    )
+    group.add_argument(
+        "--nu",
+        dest="param_nu",
+        type=_number(float, "nu"),
+        default=None,
+        help="Carlson-Langer's plate velocity nu (sets V)",
+    )
     add_param_options(parser, ChainParams)
 
 
@@ -285,10 +306,14 @@ def add_block_model_option(parser: argparse.ArgumentParser) -> None:
     """``--model`` for the single block: the paper's (default) or the Batista-Carlson reading."""
     from stickslip.models.presets import SINGLE_BLOCK
 
-    parser.add_argument("--model", choices=SINGLE_BLOCK, default=None,
-                        help="sakaguchi (default: eq. 1 with the constant threshold Fs) or batista-carlson "
-                             "(the paper's reading of Batista-Carlson: a stuck block starts when "
-                             "K (V t - x) > sigma theta)")
+    parser.add_argument(
+        "--model",
+        choices=SINGLE_BLOCK,
+        default=None,
+        help="sakaguchi (default: eq. 1 with the constant threshold Fs) or batista-carlson "
+        "(the paper's reading of Batista-Carlson: a stuck block starts when "
+        "K (V t - x) > sigma theta)",
+    )
 
 
 def block_params_from_args(args: argparse.Namespace, **overrides: Any):
@@ -296,8 +321,11 @@ def block_params_from_args(args: argparse.Namespace, **overrides: Any):
     from stickslip.models.params import BlockParams
     from stickslip.models.presets import block_params
 
-    values = {f.name: getattr(args, f"param_{f.name}") for f in dataclasses.fields(BlockParams)
-              if getattr(args, f"param_{f.name}", None) is not None}
+    values = {
+        f.name: getattr(args, f"param_{f.name}")
+        for f in dataclasses.fields(BlockParams)
+        if getattr(args, f"param_{f.name}", None) is not None
+    }
     values.update(overrides)
     model = getattr(args, "model", None) or "sakaguchi"
     if model == "batista-carlson" and "Fs" in values:

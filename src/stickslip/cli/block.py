@@ -28,11 +28,11 @@ from stickslip.analysis.slip_limit import (
     solve_slip_limit,
 )
 from stickslip.cli._common import (
+    OUT_FILES,
     CommandError,
     Result,
-    add_json_option,
-    OUT_FILES,
     add_block_model_option,
+    add_json_option,
     add_overwrite_option,
     add_param_options,
     block_params_from_args,
@@ -142,8 +142,10 @@ def run_block(args: argparse.Namespace) -> Result:
     t_end = float(args.t_end) if args.t_end is not None else default_t_end(p, law)
     steps = steps_for(t_end, p.dt)
     if steps > MAX_BLOCK_STEPS:
-        raise CommandError(f"t_end must be <= {MAX_BLOCK_STEPS * p.dt:g} for the single block (at most "
-                           f"{MAX_BLOCK_STEPS:.0e} steps of dt = {p.dt:g}, for the memory of its slip table)")
+        raise CommandError(
+            f"t_end must be <= {MAX_BLOCK_STEPS * p.dt:g} for the single block (at most "
+            f"{MAX_BLOCK_STEPS:.0e} steps of dt = {p.dt:g}, for the memory of its slip table)"
+        )
     if n_samples(steps, every) > MAX_SAMPLES:
         raise CommandError(
             f"every must be >= {math.ceil(steps / MAX_SAMPLES)} for a run of {steps} steps "
@@ -181,8 +183,8 @@ def block_text(d: dict[str, Any]) -> str:
     """The human summary of ``stickslip block``."""
     p = d["params"]
     lines = [
-        "single block, eq. (1): " + " ".join(f"{k}={v}" if isinstance(v, str) else f"{k}={v:g}"
-                                             for k, v in p.items() if k != "dt"),
+        "single block, eq. (1): "
+        + " ".join(f"{k}={v}" if isinstance(v, str) else f"{k}={v:g}" for k, v in p.items() if k != "dt"),
         f"Heun dt={d['dt']:g}, t_end={d['t_end']:g} ({d['steps']} steps)",
         f"slips: {d['events']} (starts {d['n_starts']}, stops {d['n_stops']}); "
         f"v in [{d['v_min']:.4g}, {d['v_max']:.4g}]",
@@ -272,8 +274,9 @@ def run_slip_limit(args: argparse.Namespace) -> Result:
     atol = check_number("atol", args.atol, low=0.0, low_open=True, high=1e-2)
     # Heun resolves the oscillation of the spring only for omega dt = dt sqrt(K/M) well below 1.
     if p.dt * math.sqrt(p.K / p.M) > 0.5:
-        raise CommandError(f"dt must be <= 0.5 sqrt(M/K) = {0.5 * math.sqrt(p.M / p.K):.3g} for the Heun slip "
-                           f"(got dt={p.dt:g})")
+        raise CommandError(
+            f"dt must be <= 0.5 sqrt(M/K) = {0.5 * math.sqrt(p.M / p.K):.3g} for the Heun slip (got dt={p.dt:g})"
+        )
     # eq. (3) is solved for a slip of a few periods 2 pi sqrt(M/K); huge Fs/sigma slips for ever.
     if p.Fs / p.sigma > 1e3:
         raise CommandError(f"Fs must be <= 1000 sigma for eq. (3) (got Fs={p.Fs:g}, sigma={p.sigma:g})")
@@ -288,8 +291,7 @@ def run_slip_limit(args: argparse.Namespace) -> Result:
     if matches_paper(p):
         data["paper"] = {"duration": PAPER_DURATION, "force_at_stop": PAPER_FORCE_AT_STOP}
     text = [
-        "slip in the limit V -> 0, eq. (3): "
-        + " ".join(f"{k}={v:g}" for k, v in data["params"].items() if k != "dt"),
+        "slip in the limit V -> 0, eq. (3): " + " ".join(f"{k}={v:g}" for k, v in data["params"].items() if k != "dt"),
         f"accurate ({law.method}): duration t_e - t_c = {law.duration:.6f}, "
         f"force at stop Fs - K x' = {law.force_at_stop:.6f}",
         f"Heun dt={p.dt:g} with the stop rule of eq. (1): duration {heun.duration:.6f}, "

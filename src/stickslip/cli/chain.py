@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 import sys
-import time
 from pathlib import Path
 
 from stickslip.cli._common import (
@@ -13,9 +12,9 @@ from stickslip.cli._common import (
     add_json_option,
     add_model_options,
     chain_params_from_args,
+    check_out_owned,
     float_arg,
     int_arg,
-    check_out_owned,
     owned_out_dir,
 )
 from stickslip.models.params import check_number, steps_for
@@ -28,34 +27,81 @@ def register(sub) -> None:
         "chain",
         help="run the chain of eq. (4) or any model of its family (--model)",
         description="Integrate the chain of eq. (4) (MODEL.md), or a relative chosen with --model or "
-                    "composed with --drive/--friction/--threshold/--ends, and record its slip events.",
+        "composed with --drive/--friction/--threshold/--ends, and record its slip events.",
     )
     add_model_options(p)
     _add_run_options(p)
-    p.add_argument("--integrator", choices=("exact", "dense"), default=None,
-                   help="exact (default, fast) or dense (reference); both give the same answer bit for bit")
+    p.add_argument(
+        "--integrator",
+        choices=("exact", "dense"),
+        default=None,
+        help="exact (default, fast) or dense (reference); both give the same answer bit for bit",
+    )
     p.add_argument("--out", metavar="DIR", help="run directory: results, checkpoints, run.json")
     p.add_argument("--resume", metavar="DIR", help="continue the run in DIR from its checkpoint")
-    p.add_argument("--checkpoint-interval", type=float_arg("checkpoint-interval", "> 0"), default=None,
-                   metavar="SECONDS", help="wall-clock seconds between checkpoints (default 300; needs --out)")
-    p.add_argument("--overwrite", action="store_true",
-                   help="replace this package's files in --out (other files there are left alone)")
-    p.add_argument("--keep-checkpoint", action="store_true", default=None,
-                   help="keep the checkpoint (tens of MB for long chains) when the run finishes, so that "
-                        "--resume can continue it to a later --t-end (default: removed)")
-    p.add_argument("--sample-interval", type=float_arg("sample-interval"), default=None, metavar="T",
-                   help="sample L = x_1 - x_N every T time units (default 10)")
-    p.add_argument("--average-from", type=float_arg("average-from"), default=None, metavar="T",
-                   help="<L> averages the samples with t >= T (default t_end / 2)")
-    p.add_argument("--snapshot", type=float_arg("snapshot"), action="append", default=None, metavar="T",
-                   help="store all x_i at time T (repeatable; Fig. 5a)")
-    p.add_argument("--profile-window", type=float_arg("profile-window"), default=None, metavar="W",
-                   help="store the displacement over windows of W during events (Fig. 6 uses 20)")
-    p.add_argument("--profile-min-blocks", type=int_arg("profile-min-blocks", ">= 0"), default=None, metavar="M",
-                   help="keep profiles only of events with at least M moved blocks")
-    p.add_argument("--until-steady", type=float_arg("until-steady"), default=None, metavar="TOL",
-                   help="stop once every block slides within TOL of steady sliding (velocities, state "
-                        "variables, spring extensions); L is taken from the steady solution from then on")
+    p.add_argument(
+        "--checkpoint-interval",
+        type=float_arg("checkpoint-interval", "> 0"),
+        default=None,
+        metavar="SECONDS",
+        help="wall-clock seconds between checkpoints (default 300; needs --out)",
+    )
+    p.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="replace this package's files in --out (other files there are left alone)",
+    )
+    p.add_argument(
+        "--keep-checkpoint",
+        action="store_true",
+        default=None,
+        help="keep the checkpoint (tens of MB for long chains) when the run finishes, so that "
+        "--resume can continue it to a later --t-end (default: removed)",
+    )
+    p.add_argument(
+        "--sample-interval",
+        type=float_arg("sample-interval"),
+        default=None,
+        metavar="T",
+        help="sample L = x_1 - x_N every T time units (default 10)",
+    )
+    p.add_argument(
+        "--average-from",
+        type=float_arg("average-from"),
+        default=None,
+        metavar="T",
+        help="<L> averages the samples with t >= T (default t_end / 2)",
+    )
+    p.add_argument(
+        "--snapshot",
+        type=float_arg("snapshot"),
+        action="append",
+        default=None,
+        metavar="T",
+        help="store all x_i at time T (repeatable; Fig. 5a)",
+    )
+    p.add_argument(
+        "--profile-window",
+        type=float_arg("profile-window"),
+        default=None,
+        metavar="W",
+        help="store the displacement over windows of W during events (Fig. 6 uses 20)",
+    )
+    p.add_argument(
+        "--profile-min-blocks",
+        type=int_arg("profile-min-blocks", ">= 0"),
+        default=None,
+        metavar="M",
+        help="keep profiles only of events with at least M moved blocks",
+    )
+    p.add_argument(
+        "--until-steady",
+        type=float_arg("until-steady"),
+        default=None,
+        metavar="TOL",
+        help="stop once every block slides within TOL of steady sliding (velocities, state "
+        "variables, spring extensions); L is taken from the steady solution from then on",
+    )
     p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     add_json_option(p)
     p.set_defaults(handler=run_chain_command)
@@ -66,29 +112,64 @@ def register(sub) -> None:
         description="Run the same chain workload with the dense and the exact integrator and compare.",
     )
     add_model_options(b)
-    b.add_argument("--t-end", type=float_arg("t-end"), default=None,
-                   help="end time (default 2e5 for the paper's chain, 2e4 for the plate-driven models)")
-    b.add_argument("--start", choices=("paper", "steady", "rest"), default=None,
-                   help="initial state (default: the model's; the paper's x=0, v=0.1, theta=0.1 for sakaguchi)")
-    b.add_argument("--repeat", type=int_arg("repeat", ">= 1"), default=1, help="time each integrator this many times, keep the fastest")
-    b.add_argument("--profile", action="store_true",
-                   help="instead: where the exact integrator spends its time on this workload")
+    b.add_argument(
+        "--t-end",
+        type=float_arg("t-end"),
+        default=None,
+        help="end time (default 2e5 for the paper's chain, 2e4 for the plate-driven models)",
+    )
+    b.add_argument(
+        "--start",
+        choices=("paper", "steady", "rest"),
+        default=None,
+        help="initial state (default: the model's; the paper's x=0, v=0.1, theta=0.1 for sakaguchi)",
+    )
+    b.add_argument(
+        "--repeat",
+        type=int_arg("repeat", ">= 1"),
+        default=1,
+        help="time each integrator this many times, keep the fastest",
+    )
+    b.add_argument(
+        "--profile", action="store_true", help="instead: where the exact integrator spends its time on this workload"
+    )
     add_json_option(b)
     b.set_defaults(handler=run_bench_command)
 
 
 def _add_run_options(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--t-end", type=float_arg("t-end"), default=None, metavar="T",
-                   help="end time (default 2e4; the paper's runs use 2e7)")
-    p.add_argument("--start", choices=("paper", "steady", "rest"), default=None,
-                   help="initial state: the paper's (x=0, v=0.1, theta=0.1; default for sakaguchi), exact "
-                        "steady sliding, or every block stuck at x_i = -A u_i (Carlson-Langer's; default for "
-                        "the plate-driven models)")
-    p.add_argument("--perturbation", type=float_arg("perturbation"), default=None, metavar="A",
-                   help="with --start steady: uniform perturbation of x and v in [-A, A] (default 0)")
-    p.add_argument("--amplitude", type=float_arg("amplitude"), default=None, metavar="A",
-                   help="with --start rest: x_i = -A u_i, u_i uniform in [0, 1) (default the model's, 0.01 for CL)")
-    p.add_argument("--seed", type=int_arg("seed", ">= 0"), default=None, help="seed of the perturbation or of u_i (default 0)")
+    p.add_argument(
+        "--t-end",
+        type=float_arg("t-end"),
+        default=None,
+        metavar="T",
+        help="end time (default 2e4; the paper's runs use 2e7)",
+    )
+    p.add_argument(
+        "--start",
+        choices=("paper", "steady", "rest"),
+        default=None,
+        help="initial state: the paper's (x=0, v=0.1, theta=0.1; default for sakaguchi), exact "
+        "steady sliding, or every block stuck at x_i = -A u_i (Carlson-Langer's; default for "
+        "the plate-driven models)",
+    )
+    p.add_argument(
+        "--perturbation",
+        type=float_arg("perturbation"),
+        default=None,
+        metavar="A",
+        help="with --start steady: uniform perturbation of x and v in [-A, A] (default 0)",
+    )
+    p.add_argument(
+        "--amplitude",
+        type=float_arg("amplitude"),
+        default=None,
+        metavar="A",
+        help="with --start rest: x_i = -A u_i, u_i uniform in [0, 1) (default the model's, 0.01 for CL)",
+    )
+    p.add_argument(
+        "--seed", type=int_arg("seed", ">= 0"), default=None, help="seed of the perturbation or of u_i (default 0)"
+    )
 
 
 def _events_text(summary: dict, N: int | None) -> str:
@@ -99,8 +180,9 @@ def _events_text(summary: dict, N: int | None) -> str:
     if N is not None and summary["n_moving"] == N:
         since = summary.get("in_progress_since") if summary["event_in_progress"] else None
         when = f" since t = {since:g}" if since is not None else ""
-        return text + (f"  (every block moving{when}: the chain slides; --until-steady TOL stops a run "
-                       "once the sliding is steady)")
+        return text + (
+            f"  (every block moving{when}: the chain slides; --until-steady TOL stops a run once the sliding is steady)"
+        )
     return text + ("  (one in progress)" if summary["event_in_progress"] else "")
 
 
@@ -108,8 +190,10 @@ def _summary_text(summary: dict, out: Path | None, N: int | None = None) -> str:
     wall = f"wall time      {summary['wall_seconds']:.3g} s"
     this_run = summary.get("wall_seconds_this_run", summary["wall_seconds"])
     if this_run < summary["wall_seconds"] - 1e-9:
-        wall = (f"wall time      {summary['wall_seconds_this_run']:.3g} s this run, "
-                f"{summary['wall_seconds']:.3g} s in all (resumed)")
+        wall = (
+            f"wall time      {summary['wall_seconds_this_run']:.3g} s this run, "
+            f"{summary['wall_seconds']:.3g} s in all (resumed)"
+        )
     lines = [
         f"t_end          {summary['t_end']:g}  ({summary['steps']} steps, {summary['integrator']})",
         _events_text(summary, N),
@@ -134,8 +218,18 @@ def _json_summary(summary: dict, out: Path | None) -> dict:
     return data
 
 
-_FIXED_BY_CHECKPOINT = ("integrator", "start", "perturbation", "seed", "sample_interval", "average_from",
-                        "snapshot", "profile_window", "profile_min_blocks", "until_steady")
+_FIXED_BY_CHECKPOINT = (
+    "integrator",
+    "start",
+    "perturbation",
+    "seed",
+    "sample_interval",
+    "average_from",
+    "snapshot",
+    "profile_window",
+    "profile_min_blocks",
+    "until_steady",
+)
 
 
 def run_chain_command(args: argparse.Namespace) -> Result:
@@ -146,8 +240,11 @@ def run_chain_command(args: argparse.Namespace) -> Result:
     if args.resume:
         if args.out and Path(args.out) != Path(args.resume):
             raise CommandError("--out and --resume name different directories; give only --resume")
-        fixed = [f"--{k.removeprefix('param_').replace('_', '-')}" for k, v in vars(args).items()
-                 if v is not None and (k.startswith("param_") or k in _FIXED_BY_CHECKPOINT)]
+        fixed = [
+            f"--{k.removeprefix('param_').replace('_', '-')}"
+            for k, v in vars(args).items()
+            if v is not None and (k.startswith("param_") or k in _FIXED_BY_CHECKPOINT)
+        ]
         if fixed:
             raise CommandError(
                 f"{', '.join(fixed)} cannot be combined with --resume: a resumed run keeps the "
@@ -161,9 +258,14 @@ def run_chain_command(args: argparse.Namespace) -> Result:
             check_number("t-end", args.t_end, low=0.0)
         try:
             with owned_run_dir(args.resume):
-                run = chain.resume_chain(args.resume, t_end=args.t_end, checkpoint_interval=interval,
-                                         progress=progress, handle_signals=True,
-                                         keep_checkpoint=args.keep_checkpoint)
+                run = chain.resume_chain(
+                    args.resume,
+                    t_end=args.t_end,
+                    checkpoint_interval=interval,
+                    progress=progress,
+                    handle_signals=True,
+                    keep_checkpoint=args.keep_checkpoint,
+                )
         except RunDirBusy as exc:
             raise CommandError(str(exc)) from None
         except chain.NonFiniteState as exc:
@@ -173,51 +275,77 @@ def run_chain_command(args: argparse.Namespace) -> Result:
             raise CommandError(str(exc)) from None
         except chain.Interrupted as exc:
             return _interrupted(exc, Path(args.resume))
-        return Result(_json_summary(run.summary, Path(args.resume)),
-                      _summary_text(run.summary, Path(args.resume), run.params.N))
+        return Result(
+            _json_summary(run.summary, Path(args.resume)), _summary_text(run.summary, Path(args.resume), run.params.N)
+        )
 
     params = chain_params_from_args(args)
     t_end = 2e4 if args.t_end is None else args.t_end
     start, amplitude, seed = _start_of(params, args)
     args.start, args.perturbation, args.seed = start, amplitude, seed
-    for name, default in (("integrator", "exact"), ("start", "paper"), ("perturbation", 0.0), ("seed", 0),
-                          ("sample_interval", 10.0), ("snapshot", []), ("profile_min_blocks", 0)):
+    for name, default in (
+        ("integrator", "exact"),
+        ("start", "paper"),
+        ("perturbation", 0.0),
+        ("seed", 0),
+        ("sample_interval", 10.0),
+        ("snapshot", []),
+        ("profile_min_blocks", 0),
+    ):
         if getattr(args, name) is None:
             setattr(args, name, default)
     check_number("t-end", t_end, low=0.0)
     steps_for(t_end, params.dt, "t-end")
     if args.out is None:
-        for flag, value in (("--checkpoint-interval", args.checkpoint_interval),
-                            ("--overwrite", args.overwrite or None),
-                            ("--keep-checkpoint", args.keep_checkpoint)):
+        for flag, value in (
+            ("--checkpoint-interval", args.checkpoint_interval),
+            ("--overwrite", args.overwrite or None),
+            ("--keep-checkpoint", args.keep_checkpoint),
+        ):
             if value is not None:
                 raise CommandError(f"{flag} needs --out (a run without a run directory writes no checkpoints)")
     interval = 300.0 if args.checkpoint_interval is None else args.checkpoint_interval
     check_number("checkpoint-interval", interval, low=0.0, low_open=True)
     check_number("profile-min-blocks", args.profile_min_blocks, low=0, integer=True)
     # Validate every option before anything is written.
-    chain.RunOptions(t_end=t_end, sample_interval=args.sample_interval, average_from=args.average_from,
-                     snapshot_times=tuple(args.snapshot), profile_window=args.profile_window,
-                     profile_min_blocks=args.profile_min_blocks,
-                     until_steady=args.until_steady).validated(params.dt)
+    chain.RunOptions(
+        t_end=t_end,
+        sample_interval=args.sample_interval,
+        average_from=args.average_from,
+        snapshot_times=tuple(args.snapshot),
+        profile_window=args.profile_window,
+        profile_min_blocks=args.profile_min_blocks,
+        until_steady=args.until_steady,
+    ).validated(params.dt)
     check_number("perturbation", args.perturbation, low=0.0)
     out = check_out_owned(args.out, OWN_FILES, "stickslip chain", overwrite=args.overwrite)
     if out is not None and out.is_dir():
         if (out / "checkpoint" / "state.npz").exists() and not args.overwrite:
-            raise CommandError(f"{out} already holds a run; continue it with --resume {out}, choose another "
-                               "--out or give --overwrite")
+            raise CommandError(
+                f"{out} already holds a run; continue it with --resume {out}, choose another --out or give --overwrite"
+            )
         if (out / "run.json").exists() and not args.overwrite:
-            raise CommandError(f"{out} already holds a finished run; choose another --out or give "
-                               "--overwrite")
+            raise CommandError(f"{out} already holds a finished run; choose another --out or give --overwrite")
     try:
         with owned_out_dir(out, OWN_FILES, "stickslip chain", overwrite=args.overwrite, run_id=True) as out:
             run = chain.run_chain(
-                params, t_end, integrator=args.integrator, start=args.start, perturbation=args.perturbation,
-                seed=args.seed, sample_interval=args.sample_interval, average_from=args.average_from,
-                snapshot_times=args.snapshot, profile_window=args.profile_window,
-                profile_min_blocks=args.profile_min_blocks, until_steady=args.until_steady, out_dir=out,
-                checkpoint_interval=interval if out else None, progress=progress,
-                handle_signals=out is not None, run_id=read_run_id(out) if out else None,
+                params,
+                t_end,
+                integrator=args.integrator,
+                start=args.start,
+                perturbation=args.perturbation,
+                seed=args.seed,
+                sample_interval=args.sample_interval,
+                average_from=args.average_from,
+                snapshot_times=args.snapshot,
+                profile_window=args.profile_window,
+                profile_min_blocks=args.profile_min_blocks,
+                until_steady=args.until_steady,
+                out_dir=out,
+                checkpoint_interval=interval if out else None,
+                progress=progress,
+                handle_signals=out is not None,
+                run_id=read_run_id(out) if out else None,
                 keep_checkpoint=bool(args.keep_checkpoint),
             )
     except chain.ChainRunError as exc:

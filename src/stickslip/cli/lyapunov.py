@@ -33,29 +33,59 @@ def register(sub) -> None:
         ),
     )
     add_model_options(p)
-    p.add_argument("--start", choices=("paper", "steady", "rest"), default=None,
-                   help="initial state (default: the model's; the paper's for sakaguchi, rest for the plate drive)")
-    p.add_argument("--perturbation", type=float_arg("perturbation"), default=None, metavar="A",
-                   help="with --start steady: uniform perturbation of x and v in [-A, A] (default 0); with "
-                        "--start rest: x_i = -A u_i (default the model's, 0.01 for Carlson-Langer)")
+    p.add_argument(
+        "--start",
+        choices=("paper", "steady", "rest"),
+        default=None,
+        help="initial state (default: the model's; the paper's for sakaguchi, rest for the plate drive)",
+    )
+    p.add_argument(
+        "--perturbation",
+        type=float_arg("perturbation"),
+        default=None,
+        metavar="A",
+        help="with --start steady: uniform perturbation of x and v in [-A, A] (default 0); with "
+        "--start rest: x_i = -A u_i (default the model's, 0.01 for Carlson-Langer)",
+    )
     p.add_argument("--seed", type=int, default=None, help="seed of the perturbation (default the model's, 0)")
     p.add_argument("--t-end", type=float_arg("t-end"), default=2e4, metavar="T", help="end time (default 2e4)")
-    p.add_argument("--interval", type=float_arg("interval"), default=10.0, metavar="TAU",
-                   help="time between renormalisations (default 10)")
-    p.add_argument("--d0", type=float_arg("d0"), default=1e-10, metavar="D0",
-                   help="initial separation of the twin (default 1e-10)")
-    p.add_argument("--transient", type=float_arg("transient"), default=0.0, metavar="T0",
-                   help="the reference runs alone up to T0 before the twin is placed (default 0)")
-    p.add_argument("--align", type=float_arg("align"), default=None, metavar="TA",
-                   help="renormalisations ending before T0 + TA are not counted (default (T - T0) / 10)")
-    p.add_argument("--segments", type=int, default=10, metavar="M",
-                   help="independent segments for the error bar (default 10)")
+    p.add_argument(
+        "--interval",
+        type=float_arg("interval"),
+        default=10.0,
+        metavar="TAU",
+        help="time between renormalisations (default 10)",
+    )
+    p.add_argument(
+        "--d0", type=float_arg("d0"), default=1e-10, metavar="D0", help="initial separation of the twin (default 1e-10)"
+    )
+    p.add_argument(
+        "--transient",
+        type=float_arg("transient"),
+        default=0.0,
+        metavar="T0",
+        help="the reference runs alone up to T0 before the twin is placed (default 0)",
+    )
+    p.add_argument(
+        "--align",
+        type=float_arg("align"),
+        default=None,
+        metavar="TA",
+        help="renormalisations ending before T0 + TA are not counted (default (T - T0) / 10)",
+    )
+    p.add_argument(
+        "--segments", type=int, default=10, metavar="M", help="independent segments for the error bar (default 10)"
+    )
     p.add_argument("--direction-seed", type=int, default=0, help="seed of the twin's first direction (default 0)")
-    p.add_argument("--convergence", action="store_true",
-                   help="tabulate the exponent against d0 (1e-8, 1e-10, 1e-12), the interval (TAU/2, TAU, 2 TAU) "
-                        "and the run length")
-    p.add_argument("--betas", default=None, metavar="B1,B2,...",
-                   help="tabulate the exponent against these values of beta")
+    p.add_argument(
+        "--convergence",
+        action="store_true",
+        help="tabulate the exponent against d0 (1e-8, 1e-10, 1e-12), the interval (TAU/2, TAU, 2 TAU) "
+        "and the run length",
+    )
+    p.add_argument(
+        "--betas", default=None, metavar="B1,B2,...", help="tabulate the exponent against these values of beta"
+    )
     p.add_argument("--plot", default=None, metavar="FILE", help="with --betas: draw lambda(beta) to FILE (.png, .pdf)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     add_json_option(p)
@@ -75,22 +105,23 @@ def _betas(text: str) -> list[float]:
 
 
 def _result_text(d: dict) -> str:
-    return "\n".join([
-        f"lyapunov          {d['lyapunov']:.6g} +- {d['lyapunov_err']:.2g}   (per unit time)",
-        f"renormalisations  {d['renormalisations']} counted, interval {d['interval']:g}, d0 {d['d0']:g}",
-        f"window            t = {d['transient'] + d['align']:g} .. {d['t_end']:g}  (transient {d['transient']:g}, "
-        f"align {d['align']:g}); {d['events']} events in it",
-        f"segments          {d['segments']} (error bar: standard error of their means)",
-        f"max ln(d/d0)      {d['max_log_growth']:.3g} in one interval",
-        f"reference sha256  {d['reference_sha256']}",
-        f"wall time         {d['wall_seconds']:.3g} s",
-    ])
+    return "\n".join(
+        [
+            f"lyapunov          {d['lyapunov']:.6g} +- {d['lyapunov_err']:.2g}   (per unit time)",
+            f"renormalisations  {d['renormalisations']} counted, interval {d['interval']:g}, d0 {d['d0']:g}",
+            f"window            t = {d['transient'] + d['align']:g} .. {d['t_end']:g}  (transient {d['transient']:g}, "
+            f"align {d['align']:g}); {d['events']} events in it",
+            f"segments          {d['segments']} (error bar: standard error of their means)",
+            f"max ln(d/d0)      {d['max_log_growth']:.3g} in one interval",
+            f"reference sha256  {d['reference_sha256']}",
+            f"wall time         {d['wall_seconds']:.3g} s",
+        ]
+    )
 
 
 def run_lyapunov_command(args: argparse.Namespace) -> Result:
     """Handler of `stickslip lyapunov`."""
     from stickslip.analysis import lyapunov as ly
-
     from stickslip.models.presets import PRESETS
 
     params = chain_params_from_args(args)
@@ -107,21 +138,38 @@ def run_lyapunov_command(args: argparse.Namespace) -> Result:
         raise CommandError("--plot needs --betas")
     if args.convergence and args.betas:
         raise CommandError("give either --convergence or --betas, not both")
-    kw = dict(interval=args.interval, d0=args.d0, transient=args.transient, align=args.align,
-              start=args.start, perturbation=args.perturbation, seed=args.seed,
-              direction_seed=args.direction_seed, segments=args.segments)
+    kw = dict(
+        interval=args.interval,
+        d0=args.d0,
+        transient=args.transient,
+        align=args.align,
+        start=args.start,
+        perturbation=args.perturbation,
+        seed=args.seed,
+        direction_seed=args.direction_seed,
+        segments=args.segments,
+    )
     # Validate every option before the first (possibly long) run.
     ly._check_run(params, args.t_end, args.interval, args.d0, args.transient, args.align, args.segments)
     if args.convergence:
         table = ly.lyapunov_convergence(params, args.t_end, **kw)
-        data = {"params": params.to_dict(), "convergence": table.to_dict(orient="records"),
-                "method": "Benettin et al. (1980) two-trajectory method", "norm": ly.NORM}
+        data = {
+            "params": params.to_dict(),
+            "convergence": table.to_dict(orient="records"),
+            "method": "Benettin et al. (1980) two-trajectory method",
+            "norm": ly.NORM,
+        }
         return Result(data, table.to_string(index=False))
     if args.betas:
         betas = _betas(args.betas)
         table = ly.lyapunov_vs_beta(params, betas, args.t_end, progress=not args.no_progress, **kw)
-        data = {"params": params.to_dict(), "t_end": args.t_end, "table": table.to_dict(orient="records"),
-                "method": "Benettin et al. (1980) two-trajectory method", "norm": ly.NORM}
+        data = {
+            "params": params.to_dict(),
+            "t_end": args.t_end,
+            "table": table.to_dict(orient="records"),
+            "method": "Benettin et al. (1980) two-trajectory method",
+            "norm": ly.NORM,
+        }
         text = table.to_string(index=False)
         if args.plot:
             from stickslip.plotting.lyapunov import plot_lyapunov_beta
@@ -139,7 +187,9 @@ def run_lyapunov_command(args: argparse.Namespace) -> Result:
     if data["merges"]:
         import sys
 
-        sys.stderr.write(f"stickslip lyapunov: warning: the twin fell onto the reference {data['merges']} times "
-                         f"(d0 = {args.d0:g} at the rounding floor, or sticking contracts to a point); "
-                         "try a larger --d0\n")
+        sys.stderr.write(
+            f"stickslip lyapunov: warning: the twin fell onto the reference {data['merges']} times "
+            f"(d0 = {args.d0:g} at the rounding floor, or sticking contracts to a point); "
+            "try a larger --d0\n"
+        )
     return Result(data, _result_text(data))

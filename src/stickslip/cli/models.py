@@ -25,8 +25,10 @@ def run_models_command(args: argparse.Namespace) -> Result:
 
     data = {
         "presets": [p.describe() for p in PRESETS.values()],
-        "pieces": {kind: [{"name": p.name, "meaning": p.meaning, "reads": list(p.reads)} for p in choices]
-                   for kind, choices in PIECES.items()},
+        "pieces": {
+            kind: [{"name": p.name, "meaning": p.meaning, "reads": list(p.reads)} for p in choices]
+            for kind, choices in PIECES.items()
+        },
         "rules": ["ends periodic needs drive plate", "threshold state needs friction state"],
     }
     lines = []

@@ -18,14 +18,18 @@ def register(sub) -> None:
         "plot",
         help="draw every figure a chain run directory supports (PNG and PDF)",
         description="Draw L(t), the final state and stored snapshots against steady sliding, the slip-size "
-                    "distribution with its fit and the rupture fronts of the largest events, as far as the "
-                    "run's data allow, from a directory written by `stickslip chain --out`.",
+        "distribution with its fit and the rupture fronts of the largest events, as far as the "
+        "run's data allow, from a directory written by `stickslip chain --out`.",
     )
     p.add_argument("run_dir", metavar="RUN_DIR", help="a run directory (run.json, state.nc, events.parquet)")
-    p.add_argument("--out", metavar="DIR", default=None,
-                   help="where the figures go (default RUN_DIR/figures)")
-    p.add_argument("--format", action="append", choices=("png", "pdf", "svg"), default=None,
-                   help="file format (repeatable; default png and pdf)")
+    p.add_argument("--out", metavar="DIR", default=None, help="where the figures go (default RUN_DIR/figures)")
+    p.add_argument(
+        "--format",
+        action="append",
+        choices=("png", "pdf", "svg"),
+        default=None,
+        help="file format (repeatable; default png and pdf)",
+    )
     add_overwrite_option(p)
     add_json_option(p)
     p.set_defaults(handler=run_plot_command)
@@ -41,8 +45,10 @@ def run_plot_command(args: argparse.Namespace) -> Result:
         raise CommandError(f"{run_dir} is not a finished chain run directory (no run.json or state.nc)")
     out = Path(args.out) if args.out else run_dir / "figures"
     if out.resolve() == run_dir.resolve():
-        raise CommandError(f"--out {out} is the run directory itself; the figures go into a folder of "
-                           "their own (default RUN_DIR/figures)")
+        raise CommandError(
+            f"--out {out} is the run directory itself; the figures go into a folder of "
+            "their own (default RUN_DIR/figures)"
+        )
     formats = tuple(dict.fromkeys(args.format or ("png", "pdf")))
     run = load_run(run_dir)
     with owned_out_dir(out, _FIGURE.fullmatch, "stickslip plot", overwrite=args.overwrite) as out:

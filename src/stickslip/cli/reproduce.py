@@ -39,19 +39,38 @@ def register(sub) -> None:
         ),
     )
     mode = p.add_mutually_exclusive_group()
-    mode.add_argument("--quick", dest="mode", action="store_const", const="quick",
-                      help="shorter chain runs (N = 99 and 199, t = 2e6 and 4e6): minutes on two cores (default)")
-    mode.add_argument("--full", dest="mode", action="store_const", const="full",
-                      help="the paper's chains (N = 399, t = 2e7): hours; run again to resume")
+    mode.add_argument(
+        "--quick",
+        dest="mode",
+        action="store_const",
+        const="quick",
+        help="shorter chain runs (N = 99 and 199, t = 2e6 and 4e6): minutes on two cores (default)",
+    )
+    mode.add_argument(
+        "--full",
+        dest="mode",
+        action="store_const",
+        const="full",
+        help="the paper's chains (N = 399, t = 2e7): hours; run again to resume",
+    )
     # A tiny spec set that exercises the whole pipeline in seconds; used by the tests.
     mode.add_argument("--smoke", dest="mode", action="store_const", const="smoke", help=argparse.SUPPRESS)
     p.set_defaults(mode="quick")
-    p.add_argument("--out", default=DEFAULT_OUT, metavar="DIR",
-                   help=f"output directory (default {DEFAULT_OUT}); stored results in it are reused")
-    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
-                   help="address of an existing Dask scheduler for the chain runs (default: a local cluster)")
-    p.add_argument("--workers", default=None, metavar="N",
-                   help="worker processes of the local cluster (default: one per core)")
+    p.add_argument(
+        "--out",
+        default=DEFAULT_OUT,
+        metavar="DIR",
+        help=f"output directory (default {DEFAULT_OUT}); stored results in it are reused",
+    )
+    p.add_argument(
+        "--scheduler",
+        default=None,
+        metavar="ADDRESS",
+        help="address of an existing Dask scheduler for the chain runs (default: a local cluster)",
+    )
+    p.add_argument(
+        "--workers", default=None, metavar="N", help="worker processes of the local cluster (default: one per core)"
+    )
     p.add_argument("--no-progress", action="store_true", help="no progress lines on stderr")
     add_overwrite_option(p)
     add_json_option(p)
@@ -75,8 +94,7 @@ def _run(out, args: argparse.Namespace, workers: int | None) -> Result:
     from stickslip.experiments.reproduce import ReproduceError, reproduce
 
     try:
-        result = reproduce(out, args.mode, scheduler=args.scheduler, n_workers=workers,
-                           progress=not args.no_progress)
+        result = reproduce(out, args.mode, scheduler=args.scheduler, n_workers=workers, progress=not args.no_progress)
     except ReproduceError as exc:
         return Result({"error": str(exc)}, f"stickslip reproduce: {exc}", status=1)
     except KeyboardInterrupt:

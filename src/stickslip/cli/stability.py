@@ -6,7 +6,8 @@
 rate over Fourier modes and, with ``--N``, the check against the finite 3N x 3N chain;
 ``--out DIR`` writes Fig. 4. With ``--model`` (or the pieces) a chain without state variable, the
 plate drive of Carlson-Langer or the train model, gets its growth rates mode by mode
-(lambda^2 + phi'(V) lambda + w_k^2 = 0) and ``--out DIR`` the growth rate against k. ``hysteresis`` sweeps V up and down for the single block and gives
+(lambda^2 + phi'(V) lambda + w_k^2 = 0) and ``--out DIR`` the growth rate against k.
+``hysteresis`` sweeps V up and down for the single block and gives
 V_up and V_down; ``--out DIR`` writes the bifurcation diagram.
 """
 
@@ -24,20 +25,20 @@ from stickslip import io
 from stickslip.analysis import hysteresis as hy
 from stickslip.analysis import stability as st
 from stickslip.cli._common import (
+    OUT_FILES,
     CommandError,
     Result,
+    add_block_model_option,
     add_json_option,
     add_model_options,
-    add_block_model_option,
+    add_overwrite_option,
     add_param_options,
     block_params_from_args,
     chain_params_from_args,
-    float_arg,
-    params_from_args,
-    OUT_FILES,
-    add_overwrite_option,
     check_out_owned,
+    float_arg,
     owned_out_dir,
+    params_from_args,
 )
 from stickslip.models.params import BlockParams, ChainParams, ParameterError, check_number
 from stickslip.run.block import INTEGRATOR
@@ -153,13 +154,17 @@ def run_stability_block(args: argparse.Namespace) -> Result:
         with np.errstate(all="ignore"):
             beta_limit = st.hopf_beta_limit(p)
         if not math.isfinite(beta_limit):
-            raise CommandError(f"K must be small enough for the stability map's beta range to be finite "
-                               f"(got K={p.K:g}: the Hopf limit of beta overflows)")
+            raise CommandError(
+                f"K must be small enough for the stability map's beta range to be finite "
+                f"(got K={p.K:g}: the Hopf limit of beta overflows)"
+            )
     try:
         hopf = st.hopf_point(p)
     except ParameterError as exc:
-        raise CommandError(f"no Hopf point at K={p.K:g}, beta={p.beta:g}, alpha={p.alpha:g} "
-                           f"(steady sliding cannot be linearised there: {exc})") from None
+        raise CommandError(
+            f"no Hopf point at K={p.K:g}, beta={p.beta:g}, alpha={p.alpha:g} "
+            f"(steady sliding cannot be linearised there: {exc})"
+        ) from None
     params = {k: v for k, v in p.to_dict().items() if k not in ("Fs", "dt") and (with_V or k != "V")}
     data: dict[str, Any] = {
         "params": params,
@@ -241,8 +246,10 @@ def run_stability_chain(args: argparse.Namespace) -> Result:
     if p.friction != "state":
         return run_stability_modes(args, p)
     if p.drive != "end":
-        raise CommandError("friction state with drive plate is not covered: use friction weakening or "
-                           "strengthening with the plate drive")
+        raise CommandError(
+            "friction state with drive plate is not covered: use friction weakening or "
+            "strengthening with the plate drive"
+        )
     if with_N:
         check_number("N", p.N, low=1, high=MAX_FINITE_N, integer=True)
     check_out_owned(args.out, _CHAIN_MAP, "stickslip stability chain", overwrite=args.overwrite)
@@ -298,8 +305,7 @@ def _chain_text(d: dict[str, Any]) -> str:
     lines = [
         "steady sliding of the chain, eq. (5): " + " ".join(f"{k}={v:g}" for k, v in p.items()),
         f"critical beta = {d['critical_beta']:g} (closed form), {d['critical_beta_numeric']:.8f} (numerical)",
-        f"largest Re(lambda) over 0 < k <= pi: {d['max_growth_rate']:.6g} "
-        f"at k = {d['k_at_max']:.4g}: {state}",
+        f"largest Re(lambda) over 0 < k <= pi: {d['max_growth_rate']:.6g} at k = {d['k_at_max']:.4g}: {state}",
     ]
     if "finite_chain" in d:
         f = d["finite_chain"]
@@ -388,8 +394,10 @@ def run_hysteresis(args: argparse.Namespace) -> Result:
     from stickslip.cli.block import MAX_BLOCK_STEPS
 
     if settings.time_per_step + settings.transient > MAX_BLOCK_STEPS * p.dt:
-        raise CommandError(f"time_per_step + transient must be <= {MAX_BLOCK_STEPS * p.dt:g} (at most "
-                           f"{MAX_BLOCK_STEPS:.0e} steps of dt = {p.dt:g} per value of V)")
+        raise CommandError(
+            f"time_per_step + transient must be <= {MAX_BLOCK_STEPS * p.dt:g} (at most "
+            f"{MAX_BLOCK_STEPS:.0e} steps of dt = {p.dt:g} per value of V)"
+        )
     own = OUT_FILES["hysteresis"]
     with owned_out_dir(args.out, own, "stickslip hysteresis", overwrite=args.overwrite) as out:
         result = hy.hysteresis_sweep(p, settings)

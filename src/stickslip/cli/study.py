@@ -4,7 +4,8 @@
 
 NAME is ``transition`` (order parameter against beta and N), ``phase-diagram`` (final state over
 (alpha, beta) and (D, beta), two starts), ``exponents`` (slip-size exponent against beta, and
-Carlson-Langer) or ``chaos`` (largest Lyapunov exponent against beta, two blocks, Carlson-Langer). Every point is cached and reused; an interrupted study resumes; a failed point
+Carlson-Langer) or ``chaos`` (largest Lyapunov exponent against beta, two blocks, Carlson-Langer).
+Every point is cached and reused; an interrupted study resumes; a failed point
 is reported and retried by the next call. See docs/studies/.
 """
 
@@ -25,22 +26,39 @@ def register(sub) -> None:
     p = sub.add_parser(
         "study",
         help="run a study the paper leaves open (transition, phase-diagram, exponents, chaos); writes a page",
-        description=("Run every point of a study on Dask (reusing finished points), then write its table "
-                     "(Parquet, CSV), figures and an HTML page under DIR/NAME/."),
+        description=(
+            "Run every point of a study on Dask (reusing finished points), then write its table "
+            "(Parquet, CSV), figures and an HTML page under DIR/NAME/."
+        ),
     )
     p.add_argument("name", choices=STUDIES, metavar="NAME", help=f"one of {', '.join(STUDIES)}")
     mode = p.add_mutually_exclusive_group()
-    mode.add_argument("--quick", dest="mode", action="store_const", const="quick",
-                      help="small chains, coarse grids: minutes on two cores (default)")
-    mode.add_argument("--full", dest="mode", action="store_const", const="full",
-                      help="larger chains and finer grids: sized for a small cluster; run again to resume")
+    mode.add_argument(
+        "--quick",
+        dest="mode",
+        action="store_const",
+        const="quick",
+        help="small chains, coarse grids: minutes on two cores (default)",
+    )
+    mode.add_argument(
+        "--full",
+        dest="mode",
+        action="store_const",
+        const="full",
+        help="larger chains and finer grids: sized for a small cluster; run again to resume",
+    )
     mode.add_argument("--tiny", dest="mode", action="store_const", const="tiny", help=argparse.SUPPRESS)
     p.set_defaults(mode="quick")
     p.add_argument("--out", default=DEFAULT_OUT, metavar="DIR", help=f"output directory (default {DEFAULT_OUT})")
-    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
-                   help="address of an existing Dask scheduler (default: a local cluster)")
-    p.add_argument("--workers", default=None, metavar="N",
-                   help="worker processes of the local cluster (default: one per core)")
+    p.add_argument(
+        "--scheduler",
+        default=None,
+        metavar="ADDRESS",
+        help="address of an existing Dask scheduler (default: a local cluster)",
+    )
+    p.add_argument(
+        "--workers", default=None, metavar="N", help="worker processes of the local cluster (default: one per core)"
+    )
     p.add_argument("--no-progress", action="store_true", help="no progress on stderr")
     add_json_option(p)
     p.set_defaults(handler=run)
@@ -48,9 +66,8 @@ def register(sub) -> None:
 
 def run(args: argparse.Namespace) -> Result:
     """Handler of ``stickslip study``."""
-    from stickslip.experiments.study_run import run_study
-
     from stickslip.cli.sweep import _check_scheduler
+    from stickslip.experiments.study_run import run_study
 
     workers = None
     if args.workers is not None:
@@ -58,13 +75,16 @@ def run(args: argparse.Namespace) -> Result:
     _check_scheduler(args.scheduler)  # refused as `stickslip sweep` refuses it
     out = prepare_out_dir(args.out)
     try:
-        result = run_study(args.name, out, args.mode, scheduler=args.scheduler, n_workers=workers,
-                           progress=not args.no_progress)
+        result = run_study(
+            args.name, out, args.mode, scheduler=args.scheduler, n_workers=workers, progress=not args.no_progress
+        )
     except KeyboardInterrupt:
         import sys
 
-        sys.stderr.write(f"stickslip study: interrupted; run the same command again to continue "
-                         f"(finished points in {out} are kept, chain runs continue from their checkpoints)\n")
+        sys.stderr.write(
+            f"stickslip study: interrupted; run the same command again to continue "
+            f"(finished points in {out} are kept, chain runs continue from their checkpoints)\n"
+        )
         return Result({"interrupted": True, "out": str(out)}, "", status=130)
     except OSError as exc:
         raise CommandError(f"cannot run the study: {exc}") from None
@@ -74,8 +94,10 @@ def run(args: argparse.Namespace) -> Result:
 
 
 def _text(result: dict) -> str:
-    lines = [f"stickslip study {result['study']} --{result['mode']}: {result['points']} points "
-             f"({result['run']} run, {result['reused']} reused, {result['failed']} failed), {result['wall_seconds']} s"]
+    lines = [
+        f"stickslip study {result['study']} --{result['mode']}: {result['points']} points "
+        f"({result['run']} run, {result['reused']} reused, {result['failed']} failed), {result['wall_seconds']} s"
+    ]
     lines += [f"  {s}" for s in result["findings"].get("statements", [])]
     for f in result["failed_points"]:
         lines.append(f"  failed: {f['point']}: {f['error']}")

@@ -42,8 +42,11 @@ _OPTIONS: dict[str, dict[str, type]] = {
 _PARAMS: dict[str, type] = {"chain": ChainParams, "block": BlockParams}
 # Lower ends of the numeric run options (their upper ends depend on dt: RunOptions.validated).
 _OPTION_RANGES: dict[str, dict[str, Any]] = {
-    "sample_interval": {"low": 0.0, "low_open": True}, "average_from": {"low": 0.0},
-    "profile_window": {"low": 0.0, "low_open": True}, "profile_min_blocks": {"low": 0}, "every": {"low": 1},
+    "sample_interval": {"low": 0.0, "low_open": True},
+    "average_from": {"low": 0.0},
+    "profile_window": {"low": 0.0, "low_open": True},
+    "profile_min_blocks": {"low": 0},
+    "every": {"low": 1},
 }
 
 
@@ -82,10 +85,19 @@ def register(sub) -> None:
     )
     parser.add_argument("--t-end", type=str, required=True, metavar="T", help="run length of every point")
     parser.add_argument("--out", required=True, metavar="DIR", help="output directory of the sweep")
-    parser.add_argument("--scheduler", default=None, metavar="ADDRESS",
-                        help="address of an existing Dask scheduler (default: start a local cluster)")
-    parser.add_argument("--workers", type=str, default=None, metavar="N",
-                        help="worker processes of the local cluster (default: one per core)")
+    parser.add_argument(
+        "--scheduler",
+        default=None,
+        metavar="ADDRESS",
+        help="address of an existing Dask scheduler (default: start a local cluster)",
+    )
+    parser.add_argument(
+        "--workers",
+        type=str,
+        default=None,
+        metavar="N",
+        help="worker processes of the local cluster (default: one per core)",
+    )
     parser.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     add_overwrite_option(parser)
     add_json_option(parser)
@@ -160,7 +172,7 @@ def parse_grid(
     common["t_end"] = check_number("t_end", t_end, low=0.0, low_open=True)
 
     names = list(axes)
-    points = [dict(zip(names, combo)) for combo in itertools.product(*axes.values())] if names else [{}]
+    points = [dict(zip(names, combo, strict=False)) for combo in itertools.product(*axes.values())] if names else [{}]
     from stickslip.experiments.sweep import point_params
 
     for point in points:
@@ -183,9 +195,13 @@ def _check_options(model: str, params, settings: dict[str, Any]) -> None:
     for name, allowed in (("integrator", INTEGRATORS), ("start", STARTS)):
         if name in settings and settings[name] not in allowed:
             raise ParameterError(f"{name} must be one of {', '.join(allowed)} (got {settings[name]!r})")
-    RunOptions(t_end=settings["t_end"], sample_interval=settings.get("sample_interval", 10.0),
-               average_from=settings.get("average_from"), profile_window=settings.get("profile_window"),
-               profile_min_blocks=settings.get("profile_min_blocks", 0)).validated(params.dt)
+    RunOptions(
+        t_end=settings["t_end"],
+        sample_interval=settings.get("sample_interval", 10.0),
+        average_from=settings.get("average_from"),
+        profile_window=settings.get("profile_window"),
+        profile_min_blocks=settings.get("profile_min_blocks", 0),
+    ).validated(params.dt)
 
 
 def _check_scheduler(address: str | None) -> None:
@@ -211,8 +227,15 @@ def run(args: argparse.Namespace) -> Result:
     task = chain_task if args.model == "chain" else block_task
     with owned_out_dir(args.out, own, "stickslip sweep", overwrite=args.overwrite) as out:
         try:
-            result = run_sweep(task, points, out, common=common, scheduler=args.scheduler,
-                               n_workers=workers, progress=not args.no_progress)
+            result = run_sweep(
+                task,
+                points,
+                out,
+                common=common,
+                scheduler=args.scheduler,
+                n_workers=workers,
+                progress=not args.no_progress,
+            )
         except OSError as exc:  # e.g. no scheduler at the given address
             raise CommandError(f"cannot run the sweep: {exc}") from None
     data = {"model": args.model, "common": common, **result.to_dict()}

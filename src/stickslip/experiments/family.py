@@ -28,12 +28,27 @@ def _measure(p, t_end: float, start, transient: float, spanning: str, seed: int,
     stats = size_statistics(events, p.N, small_only=True, seed=seed, spanning=spanning, bootstrap=bootstrap)
     fit = stats["fit"]
     summary = {
-        "model": p.model, "N": p.N, "t_end": float(t_end), "t_from": t_from, "wall_seconds": wall,
-        "n_events_run": int(len(run.events)), "n_events": stats["n_events"], "spanning": spanning,
-        "n_spanning": stats["n_spanning"], "s_span": stats["s_span"], "S_max": stats["S_max"],
-        "tau": fit.tau, "tau_err": fit.tau_err, "tau_err_fisher": fit.tau_err_fisher,
-        "s_min": fit.s_min, "s_max": fit.s_max, "n_fit": fit.n, "ks_distance": fit.ks_distance,
-        "excess": stats["excess"], "observed": stats["observed"], "expected": stats["expected"],
+        "model": p.model,
+        "N": p.N,
+        "t_end": float(t_end),
+        "t_from": t_from,
+        "wall_seconds": wall,
+        "n_events_run": int(len(run.events)),
+        "n_events": stats["n_events"],
+        "spanning": spanning,
+        "n_spanning": stats["n_spanning"],
+        "s_span": stats["s_span"],
+        "S_max": stats["S_max"],
+        "tau": fit.tau,
+        "tau_err": fit.tau_err,
+        "tau_err_fisher": fit.tau_err_fisher,
+        "s_min": fit.s_min,
+        "s_max": fit.s_max,
+        "n_fit": fit.n,
+        "ks_distance": fit.ks_distance,
+        "excess": stats["excess"],
+        "observed": stats["observed"],
+        "expected": stats["expected"],
     }
     return events, stats, summary
 
@@ -67,20 +82,20 @@ def cl_statistics(
     from stickslip.plotting.style import save_figure
 
     p_cl = chain_params("carlson-langer")
-    ev_cl, st_cl, cl = _measure(p_cl, t_end, ChainState.rest(p_cl, 0.01, seed), transient, "n_blocks", seed,
-                                bootstrap)
+    ev_cl, st_cl, cl = _measure(p_cl, t_end, ChainState.rest(p_cl, 0.01, seed), transient, "n_blocks", seed, bootstrap)
     p_8 = chain_params("sakaguchi", beta=0.2, N=int(fig8_N))
     ev_8, st_8, f8 = _measure(p_8, fig8_t_end, "paper", fig8_transient, "max_block", seed, bootstrap)
     result: dict[str, Any] = {"carlson_langer": cl, "fig8": f8, "files": []}
     if out is not None:
         out = Path(out)
         out.mkdir(parents=True, exist_ok=True)
-        fig = family_sizes([
-            (f"Carlson-Langer, N = {p_cl.N} periodic, t = {t_end:g} (from {cl['t_from']:g})", ev_cl, st_cl),
-            (f"eq. (4), beta = 0.2 (Fig. 8), N = {p_8.N}, t = {fig8_t_end:g} (from {f8['t_from']:g})", ev_8, st_8),
-        ])
+        fig = family_sizes(
+            [
+                (f"Carlson-Langer, N = {p_cl.N} periodic, t = {t_end:g} (from {cl['t_from']:g})", ev_cl, st_cl),
+                (f"eq. (4), beta = 0.2 (Fig. 8), N = {p_8.N}, t = {fig8_t_end:g} (from {f8['t_from']:g})", ev_8, st_8),
+            ]
+        )
         files = [str(f) for f in save_figure(fig, out / "family_sizes.png")]
-        files.append(str(io.write_json(out / "family_sizes.json",
-                                       {k: v for k, v in result.items() if k != "files"})))
+        files.append(str(io.write_json(out / "family_sizes.json", {k: v for k, v in result.items() if k != "files"})))
         result["files"] = files
     return result

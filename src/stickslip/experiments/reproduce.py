@@ -31,9 +31,10 @@ import math
 import shutil
 import sys
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -109,8 +110,14 @@ def _stored(run_dir: Path, exp: Experiment) -> dict[str, Any] | None:
     return record if record.get("spec") == exp.spec() else None
 
 
-def run_experiment(exp: Experiment, runs_dir: str | Path, *, scheduler: str | None = None,
-                   n_workers: int | None = None, log: Callable[[str], None] | None = None) -> Outcome:
+def run_experiment(
+    exp: Experiment,
+    runs_dir: str | Path,
+    *,
+    scheduler: str | None = None,
+    n_workers: int | None = None,
+    log: Callable[[str], None] | None = None,
+) -> Outcome:
     """Compute one experiment into ``runs_dir/<name>-<key>/``, or load it if already there.
 
     The stored result is reused only if its ``result.json`` holds the same spec (kind,
@@ -127,8 +134,7 @@ def run_experiment(exp: Experiment, runs_dir: str | Path, *, scheduler: str | No
         (run_dir / RESULT_FILE).unlink(missing_ok=True)
         start = time.perf_counter()
         summary = runner.compute(exp, run_dir, scheduler=scheduler, n_workers=n_workers, log=log)
-        record = {"spec": exp.spec(), "name": exp.name, "summary": summary,
-                  "wall_seconds": time.perf_counter() - start}
+        record = {"spec": exp.spec(), "name": exp.name, "summary": summary, "wall_seconds": time.perf_counter() - start}
         io.write_json(run_dir / RESULT_FILE, record)
     data = runner.load(exp, run_dir, record["summary"])
     return Outcome(exp, run_dir, data, record["summary"], reused, float(record.get("wall_seconds", math.nan)))
@@ -183,8 +189,7 @@ def _compute_slip_limit(exp: Experiment, run_dir: Path, **_: Any) -> dict[str, A
     law = solve_slip_limit(p, rtol=exp.options["rtol"], atol=exp.options["atol"])
     heun = heun_slip_limit(p)
     io.write_dataset(run_dir / "curve.nc", law.curve)
-    return {**law.summary(), "heun_duration": heun.duration, "heun_force_at_stop": heun.force_at_stop,
-            "heun_dt": p.dt}
+    return {**law.summary(), "heun_duration": heun.duration, "heun_force_at_stop": heun.force_at_stop, "heun_dt": p.dt}
 
 
 def _load_slip_limit(exp: Experiment, run_dir: Path, summary: dict[str, Any]) -> dict[str, Any]:
@@ -210,11 +215,16 @@ def _compute_period_sweep(exp: Experiment, run_dir: Path, **_: Any) -> dict[str,
     from stickslip.analysis.slip_limit import paper_V_values, period_sweep
 
     o = exp.options
-    table = period_sweep(BlockParams(**exp.params), paper_V_values(o["n"], o["V_min"], o["V_max"]),
-                         periods=o["periods"])
+    table = period_sweep(
+        BlockParams(**exp.params), paper_V_values(o["n"], o["V_min"], o["V_max"]), periods=o["periods"]
+    )
     io.write_table(run_dir / "periods.parquet", table)
-    return {"max_abs_rel_dev": float(np.nanmax(np.abs(table["rel_dev"]))),
-            "n_V": int(len(table)), "V": table["V"].tolist(), "rel_dev": table["rel_dev"].tolist()}
+    return {
+        "max_abs_rel_dev": float(np.nanmax(np.abs(table["rel_dev"]))),
+        "n_V": int(len(table)),
+        "V": table["V"].tolist(),
+        "rel_dev": table["rel_dev"].tolist(),
+    }
 
 
 def _load_period_sweep(exp: Experiment, run_dir: Path, summary: dict[str, Any]) -> dict[str, Any]:
@@ -287,8 +297,15 @@ def _compute_chain_modes(exp: Experiment, run_dir: Path, **_: Any) -> dict[str, 
     per_beta = []
     for b in betas:
         s = st.chain_stability(p.replace(beta=b))
-        per_beta.append({"beta": b, "max_growth_rate": s.max_growth_rate, "k_at_max": s.k_at_max,
-                         "unstable": s.unstable, "marginal": s.marginal})
+        per_beta.append(
+            {
+                "beta": b,
+                "max_growth_rate": s.max_growth_rate,
+                "k_at_max": s.k_at_max,
+                "unstable": s.unstable,
+                "marginal": s.marginal,
+            }
+        )
     return {
         "critical_beta": st.chain_critical_beta(p),
         "critical_beta_numeric": st.chain_critical_beta_numeric(p),
@@ -328,8 +345,7 @@ def chain_point_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
             shutil.rmtree(point_dir / "checkpoint", ignore_errors=True)
             run = None
     if run is None:
-        run = chain.run_chain(params, t_end, out_dir=point_dir, checkpoint_interval=CHECKPOINT_INTERVAL,
-                              **options)
+        run = chain.run_chain(params, t_end, out_dir=point_dir, checkpoint_interval=CHECKPOINT_INTERVAL, **options)
     s = dict(run.summary)
     stopped_early = bool(s.get("stopped_early", False))
     avg_from = options["average_from"]
@@ -348,8 +364,7 @@ def chain_point_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     return s
 
 
-def _compute_chain_runs(exp: Experiment, run_dir: Path, *, scheduler=None, n_workers=None,
-                        log=None) -> dict[str, Any]:
+def _compute_chain_runs(exp: Experiment, run_dir: Path, *, scheduler=None, n_workers=None, log=None) -> dict[str, Any]:
     """All chain runs of the experiment as one Dask sweep (Figs. 5-8)."""
     from stickslip.experiments.sweep import run_sweep
 
@@ -358,10 +373,19 @@ def _compute_chain_runs(exp: Experiment, run_dir: Path, *, scheduler=None, n_wor
     for p in points:  # validate every point before any work starts
         _point_settings({**common, **p})
     if log:
-        log(f"chain runs: {len(points)} points on Dask "
-            f"({'scheduler ' + scheduler if scheduler else 'local cluster'}); finished points are reused")
-    result = run_sweep(chain_point_task, points, run_dir / "points", common=common, scheduler=scheduler,
-                       n_workers=n_workers, progress=bool(getattr(log, "enabled", False)))
+        log(
+            f"chain runs: {len(points)} points on Dask "
+            f"({'scheduler ' + scheduler if scheduler else 'local cluster'}); finished points are reused"
+        )
+    result = run_sweep(
+        chain_point_task,
+        points,
+        run_dir / "points",
+        common=common,
+        scheduler=scheduler,
+        n_workers=n_workers,
+        progress=bool(getattr(log, "enabled", False)),
+    )
     failed = result.table[result.table["status"] != "ok"]
     if len(failed):
         lines = "; ".join(f"{r.point_dir}: {r.error}" for r in failed.itertuples())
@@ -445,8 +469,10 @@ def reproduce(
         log(f"{head}: {'stored result, reusing' if stored else 'computing'} in runs/{exp.dirname}")
         outcome = run_experiment(exp, runs, scheduler=scheduler, n_workers=n_workers, log=log)
         if not outcome.reused:
-            log(f"{head}: done in {time.perf_counter() - start:.1f} s since start "
-                f"({outcome.wall_seconds:.1f} s for this experiment)")
+            log(
+                f"{head}: done in {time.perf_counter() - start:.1f} s since start "
+                f"({outcome.wall_seconds:.1f} s for this experiment)"
+            )
         outcomes[exp.name] = outcome
     log("analysing the chain runs")
     analysis = chain_analysis(outcomes["chain-runs"]) if "chain-runs" in outcomes else None
@@ -454,11 +480,18 @@ def reproduce(
     figures, not_drawn = draw_figures(outcomes, analysis, out, mode, log=log)
     rows = report_rows(outcomes, analysis, mode)
     wall = time.perf_counter() - start
-    io.write_json(out / "experiments.json", [
-        {**oc.experiment.to_dict(), "run_dir": f"runs/{oc.experiment.dirname}", "reused": oc.reused,
-         "compute_seconds": oc.wall_seconds}
-        for oc in outcomes.values()
-    ])
+    io.write_json(
+        out / "experiments.json",
+        [
+            {
+                **oc.experiment.to_dict(),
+                "run_dir": f"runs/{oc.experiment.dirname}",
+                "reused": oc.reused,
+                "compute_seconds": oc.wall_seconds,
+            }
+            for oc in outcomes.values()
+        ],
+    )
     meta = {
         "mode": mode,
         "command": f"stickslip reproduce --{mode} --out {out}",
@@ -485,7 +518,13 @@ def reproduce(
         "rows": [r.to_dict() for r in rows],
         "figures": [f.to_dict() for f in figures],
         "figures_not_drawn": not_drawn,
-        "experiments": [{"name": oc.experiment.name, "run_dir": str(oc.run_dir), "reused": oc.reused,
-                         "compute_seconds": oc.wall_seconds} for oc in outcomes.values()],
+        "experiments": [
+            {
+                "name": oc.experiment.name,
+                "run_dir": str(oc.run_dir),
+                "reused": oc.reused,
+                "compute_seconds": oc.wall_seconds,
+            }
+            for oc in outcomes.values()
+        ],
     }
-

@@ -29,9 +29,10 @@ from __future__ import annotations
 import hashlib
 import json
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any
 
 from stickslip import __version__
 from stickslip.jsonable import to_jsonable
@@ -132,8 +133,13 @@ class Experiment:
     def spec(self) -> dict[str, Any]:
         """What the result depends on: kind, parameters, run length, options, package version."""
         return _canonical(
-            {"kind": self.kind, "params": self.params, "t_end": self.t_end, "options": self.options,
-             "version": __version__}
+            {
+                "kind": self.kind,
+                "params": self.params,
+                "t_end": self.t_end,
+                "options": self.options,
+                "version": __version__,
+            }
         )
 
     def key(self) -> str:
@@ -155,8 +161,7 @@ class Experiment:
 
     def to_dict(self) -> dict[str, Any]:
         """The spec with its labels, for report.json."""
-        return {"name": self.name, "key": self.key(), "figures": list(self.figures), "note": self.note,
-                **self.spec()}
+        return {"name": self.name, "key": self.key(), "figures": list(self.figures), "note": self.note, **self.spec()}
 
 
 # ---------------------------------------------------------------------------------------------
@@ -209,21 +214,36 @@ def _section2(mode: str) -> list[Experiment]:
     )
     return [
         # Fig. 1: the first slip at t = Fs / (K V) = 300, then one every T = 344.3: six slips.
-        Experiment("block", "block_run", _BLOCK, t_end=600.0 if smoke else 2000.0,
-                   figures=("fig1", "fig2")),
+        Experiment("block", "block_run", _BLOCK, t_end=600.0 if smoke else 2000.0, figures=("fig1", "fig2")),
         Experiment("slip-limit", "slip_limit", _BLOCK, options={"rtol": 1e-10, "atol": 1e-12}),
-        Experiment("period-sweep", "period_sweep", _BLOCK,
-                   options={"V_min": 1e-3, "V_max": 1e-1, "n": 4 if smoke else 13,
-                            "periods": 4},
-                   figures=("fig3",)),
-        Experiment("stability-block", "block_stability", {**_BLOCK, "beta": 0.08},
-                   options={"beta_stable": 1.0, "map_betas": 31 if smoke else 121,
-                            "map_Vs": 40 if smoke else 200},
-                   figures=("stability_map",)),
-        Experiment("hysteresis", "hysteresis", {k: v for k, v in _BLOCK.items() if k != "V"},
-                   options=hysteresis, figures=("hysteresis",)),
-        Experiment("chain-modes", "chain_modes", {**_CHAIN, "N": 399, "beta": 1.0},
-                   options={"betas": [0.5, 1.0, 1.5], "n_k": 629}, figures=("fig4",)),
+        Experiment(
+            "period-sweep",
+            "period_sweep",
+            _BLOCK,
+            options={"V_min": 1e-3, "V_max": 1e-1, "n": 4 if smoke else 13, "periods": 4},
+            figures=("fig3",),
+        ),
+        Experiment(
+            "stability-block",
+            "block_stability",
+            {**_BLOCK, "beta": 0.08},
+            options={"beta_stable": 1.0, "map_betas": 31 if smoke else 121, "map_Vs": 40 if smoke else 200},
+            figures=("stability_map",),
+        ),
+        Experiment(
+            "hysteresis",
+            "hysteresis",
+            {k: v for k, v in _BLOCK.items() if k != "V"},
+            options=hysteresis,
+            figures=("hysteresis",),
+        ),
+        Experiment(
+            "chain-modes",
+            "chain_modes",
+            {**_CHAIN, "N": 399, "beta": 1.0},
+            options={"betas": [0.5, 1.0, 1.5], "n_k": 629},
+            figures=("fig4",),
+        ),
     ]
 
 
@@ -233,15 +253,19 @@ def _chain(mode: str) -> Experiment:
         t_sweep = t_fig = 2e7
         betas = _FULL_BETAS
         steady_above = 1.3
-        note = ("full: beta = 1.2 runs its whole length (the paper's run of the sliding regime); "
-                "beta = 1.5 stops at steady sliding")
+        note = (
+            "full: beta = 1.2 runs its whole length (the paper's run of the sliding regime); "
+            "beta = 1.5 stops at steady sliding"
+        )
     elif mode == "quick":
         sweep_N, figure_N = 99, 199
         t_sweep, t_fig = 2e6, 4e6
         betas = _QUICK_BETAS
         steady_above = 1.0
-        note = ("quick: Fig. 5(b) on N = 99 chains to t = 2e6, Figs. 5(a), 6, 7, 8 on N = 199 chains "
-                "to t = 4e6 (the paper: N = 399 to t = 2e7)")
+        note = (
+            "quick: Fig. 5(b) on N = 99 chains to t = 2e6, Figs. 5(a), 6, 7, 8 on N = 199 chains "
+            "to t = 4e6 (the paper: N = 399 to t = 2e7)"
+        )
     else:  # smoke
         sweep_N = figure_N = 19
         t_sweep = t_fig = 4e4

@@ -80,8 +80,9 @@ class Study:
 
     def spec(self) -> dict[str, Any]:
         """What the results depend on: name, shared settings, points, package version."""
-        return _canonical({"study": self.name, "common": self.common, "points": list(self.points),
-                           "version": __version__})
+        return _canonical(
+            {"study": self.name, "common": self.common, "points": list(self.points), "version": __version__}
+        )
 
     def key(self) -> str:
         """First 12 hex digits of the SHA-256 of the spec without its points."""
@@ -124,13 +125,28 @@ def _transition(mode: str) -> Study:
         Ns, betas, loads = (49, 99, 199, 399, 799), _T_BETAS_FULL, 4.0
     # Longest runs first, for a shorter tail on a few workers: large N, then large beta (runs
     # that slide update every block at every step until they settle; stick-slip is cheap).
-    points = [{"N": N, "beta": b, "t_end": _t_end(N, loads)}
-              for N in sorted(Ns, reverse=True) for b in sorted(betas, reverse=True)]
-    common = {**_PAPER, "model": "sakaguchi", "start": "paper", "loads": loads, "average_fraction": 0.5,
-              "n_samples": 20000 if mode != "tiny" else 2000, "until_steady": UNTIL_STEADY,
-              "analysis": "order"}
-    return Study("transition", mode, common, tuple(points),
-                 note=f"{mode}: N in {list(Ns)}, {len(betas)} values of beta, runs of {loads:g} loading times")
+    points = [
+        {"N": N, "beta": b, "t_end": _t_end(N, loads)}
+        for N in sorted(Ns, reverse=True)
+        for b in sorted(betas, reverse=True)
+    ]
+    common = {
+        **_PAPER,
+        "model": "sakaguchi",
+        "start": "paper",
+        "loads": loads,
+        "average_fraction": 0.5,
+        "n_samples": 20000 if mode != "tiny" else 2000,
+        "until_steady": UNTIL_STEADY,
+        "analysis": "order",
+    }
+    return Study(
+        "transition",
+        mode,
+        common,
+        tuple(points),
+        note=f"{mode}: N in {list(Ns)}, {len(betas)} values of beta, runs of {loads:g} loading times",
+    )
 
 
 def _phase_diagram(mode: str) -> Study:
@@ -157,13 +173,29 @@ def _phase_diagram(mode: str) -> Study:
     # longest before it settles.
     unique.sort(key=lambda c: -(c["beta"] - c["alpha"]))
     points = [{**c, "N": N, "t_end": t_end, "start": s} for c in unique for s in ("paper", "steady")]
-    common = {**{k: v for k, v in _PAPER.items() if k not in ("alpha", "D")}, "model": "sakaguchi",
-              "loads": loads, "average_fraction": 0.5, "n_samples": 20000 if mode != "tiny" else 2000,
-              "until_steady": UNTIL_STEADY, "perturbation": 0.01, "seed": 0, "analysis": "order",
-              "alphas": list(alphas), "Ds": list(Ds)}
-    return Study("phase-diagram", mode, common, tuple(points),
-                 note=(f"{mode}: N = {N}, {len(unique)} cells of (alpha, beta) and (D, beta), each from the "
-                       f"paper's start and from steady sliding perturbed by 0.01"))
+    common = {
+        **{k: v for k, v in _PAPER.items() if k not in ("alpha", "D")},
+        "model": "sakaguchi",
+        "loads": loads,
+        "average_fraction": 0.5,
+        "n_samples": 20000 if mode != "tiny" else 2000,
+        "until_steady": UNTIL_STEADY,
+        "perturbation": 0.01,
+        "seed": 0,
+        "analysis": "order",
+        "alphas": list(alphas),
+        "Ds": list(Ds),
+    }
+    return Study(
+        "phase-diagram",
+        mode,
+        common,
+        tuple(points),
+        note=(
+            f"{mode}: N = {N}, {len(unique)} cells of (alpha, beta) and (D, beta), each from the "
+            f"paper's start and from steady sliding perturbed by 0.01"
+        ),
+    )
 
 
 def _exponents(mode: str) -> Study:
@@ -175,14 +207,36 @@ def _exponents(mode: str) -> Study:
         N, betas, loads, cl = 399, (0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0), 5.0, {"N": 100, "t_end": 1e6}
     t_end = _t_end(N, loads)
     points = [{"model": "sakaguchi", "N": N, "beta": b, "t_end": t_end} for b in betas]
-    points.append({"model": "carlson-langer", **cl, "start": "rest", "perturbation": 0.01, "seed": 0,
-                   "spanning": "n_blocks", "transient": 0.2})
-    common = {"start": "paper", "average_fraction": 0.5, "n_samples": 2000, "analysis": "sizes",
-              "spanning": "max_block", "bootstrap": 200}
-    return Study("exponents", mode, common, tuple(points),
-                 note=(f"{mode}: eq. (4) at N = {N} to t = {t_end:g} ({loads:g} loading times), events of the "
-                       f"second half; Carlson-Langer (standard parameters, N = {cl['N']}, periodic) to "
-                       f"t = {cl['t_end']:g}, events after the first fifth"))
+    points.append(
+        {
+            "model": "carlson-langer",
+            **cl,
+            "start": "rest",
+            "perturbation": 0.01,
+            "seed": 0,
+            "spanning": "n_blocks",
+            "transient": 0.2,
+        }
+    )
+    common = {
+        "start": "paper",
+        "average_fraction": 0.5,
+        "n_samples": 2000,
+        "analysis": "sizes",
+        "spanning": "max_block",
+        "bootstrap": 200,
+    }
+    return Study(
+        "exponents",
+        mode,
+        common,
+        tuple(points),
+        note=(
+            f"{mode}: eq. (4) at N = {N} to t = {t_end:g} ({loads:g} loading times), events of the "
+            f"second half; Carlson-Langer (standard parameters, N = {cl['N']}, periodic) to "
+            f"t = {cl['t_end']:g}, events after the first fifth"
+        ),
+    )
 
 
 _CHAOS_BETAS_QUICK = tuple(round(0.2 + 0.1 * k, 3) for k in range(11))
@@ -197,36 +251,59 @@ def _chaos(mode: str) -> Study:
         chain = [{"N": 9, "beta": b, "t_end": 6000.0, "transient": 3000.0, "interval": 10.0} for b in (0.6, 1.2)]
         # steady sliding well above the inverse transition: the exponent is the least stable
         # eigenvalue of eq. (5), negative (docs/lyapunov.md, checks with known answers)
-        chain.append({"N": 4, "beta": 1.5, "V": 0.5, "start": "steady", "perturbation": 1e-3, "t_end": 400.0,
-                      "transient": 0.0, "interval": 5.0})
-        family = [{"model": "two-blocks", "t_end": 600.0, "transient": 100.0},
-                  {"model": "carlson-langer", "N": 16, "t_end": 300.0, "transient": 100.0}]
+        chain.append(
+            {
+                "N": 4,
+                "beta": 1.5,
+                "V": 0.5,
+                "start": "steady",
+                "perturbation": 1e-3,
+                "t_end": 400.0,
+                "transient": 0.0,
+                "interval": 5.0,
+            }
+        )
+        family = [
+            {"model": "two-blocks", "t_end": 600.0, "transient": 100.0},
+            {"model": "carlson-langer", "N": 16, "t_end": 300.0, "transient": 100.0},
+        ]
         d0s = (1e-10,)
     elif mode == "quick":
         chain = [{"N": 99, "beta": b, "t_end": 6e5, "transient": 5e5, "interval": 10.0} for b in _CHAOS_BETAS_QUICK]
-        family = [{"model": "two-blocks", "t_end": 4.2e4, "transient": 2e3},
-                  {"model": "carlson-langer", "t_end": 2.2e4, "transient": 2e3}]
+        family = [
+            {"model": "two-blocks", "t_end": 4.2e4, "transient": 2e3},
+            {"model": "carlson-langer", "t_end": 2.2e4, "transient": 2e3},
+        ]
         d0s = (1e-10,)
     else:
         chain = [{"N": 99, "beta": b, "t_end": 1.5e6, "transient": 1e6, "interval": 10.0} for b in _CHAOS_BETAS_FULL]
-        family = [{"model": "two-blocks", "t_end": 2.02e5, "transient": 2e3},
-                  {"model": "carlson-langer", "t_end": 1.02e5, "transient": 2e3}]
+        family = [
+            {"model": "two-blocks", "t_end": 2.02e5, "transient": 2e3},
+            {"model": "carlson-langer", "t_end": 1.02e5, "transient": 2e3},
+        ]
         d0s = (1e-8, 1e-10, 1e-11)  # CL does not settle in d0 (docs/lyapunov.md): show the spread
     points = [{"model": "sakaguchi", "start": "paper", **c, "d0": 1e-10} for c in chain]
-    points += [{**f, "interval": 1.0, "start": "rest", "perturbation": 0.01, "seed": 0, "d0": d0}
-               for f in family for d0 in d0s]
+    points += [
+        {**f, "interval": 1.0, "start": "rest", "perturbation": 0.01, "seed": 0, "d0": d0} for f in family for d0 in d0s
+    ]
     # Longest first: a shorter tail on a few workers.
     points.sort(key=lambda p: -(p["t_end"] - p["transient"]) * p.get("N", 100) / p["interval"])
     common = {"analysis": "lyapunov", "segments": 10, "direction_seed": 0}
     n_chain = len([p for p in points if p["model"] == "sakaguchi"])
-    return Study("chaos", mode, common, tuple(points),
-                 note=(f"{mode}: eq. (4) at N = {chain[0]['N']}, {n_chain} points in beta, "
-                       f"t = {chain[0]['transient']:g} .. {chain[0]['t_end']:g}, d0 = 1e-10; two blocks "
-                       f"and Carlson-Langer at standard parameters, d0 = {', '.join(f'{d:g}' for d in d0s)}"))
+    return Study(
+        "chaos",
+        mode,
+        common,
+        tuple(points),
+        note=(
+            f"{mode}: eq. (4) at N = {chain[0]['N']}, {n_chain} points in beta, "
+            f"t = {chain[0]['transient']:g} .. {chain[0]['t_end']:g}, d0 = 1e-10; two blocks "
+            f"and Carlson-Langer at standard parameters, d0 = {', '.join(f'{d:g}' for d in d0s)}"
+        ),
+    )
 
 
-_BUILDERS = {"transition": _transition, "phase-diagram": _phase_diagram, "exponents": _exponents,
-             "chaos": _chaos}
+_BUILDERS = {"transition": _transition, "phase-diagram": _phase_diagram, "exponents": _exponents, "chaos": _chaos}
 
 
 def study(name: str, mode: str = "quick") -> Study:
@@ -296,8 +373,15 @@ def lyapunov_options(cfg: dict[str, Any], params) -> tuple[float, dict[str, Any]
     options["seed"] = int(cfg.get("seed", preset.start_options.get("seed", 0)))
     if options["start"] == "paper":
         options["perturbation"] = 0.0
-    _check_run(params, t_end, options.get("interval", 10.0), options.get("d0", 1e-10), options.get("transient", 0.0),
-               options.get("align"), options.get("segments", 10))
+    _check_run(
+        params,
+        t_end,
+        options.get("interval", 10.0),
+        options.get("d0", 1e-10),
+        options.get("transient", 0.0),
+        options.get("align"),
+        options.get("segments", 10),
+    )
     return t_end, options
 
 
@@ -325,19 +409,43 @@ def lyapunov_point(cfg: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     point_dir.mkdir(parents=True, exist_ok=True)
     import pandas as pd
 
-    io.write_table(point_dir / "renormalisations.parquet",
-                   pd.DataFrame({"t": res.times, "log_growth": res.log_growth, "duration": res.durations,
-                                 "counted": res.counted}),
-                   descriptions={"t": "end of the interval", "log_growth": "ln(d / d0) over the interval",
-                                 "duration": "length of the interval", "counted": "enters the exponent"})
+    io.write_table(
+        point_dir / "renormalisations.parquet",
+        pd.DataFrame({"t": res.times, "log_growth": res.log_growth, "duration": res.durations, "counted": res.counted}),
+        descriptions={
+            "t": "end of the interval",
+            "log_growth": "ln(d / d0) over the interval",
+            "duration": "length of the interval",
+            "counted": "enters the exponent",
+        },
+    )
     info = res.to_dict()
     io.write_json(point_dir / "lyapunov.json", info)
     counted_time = float(np.sum(res.durations[res.counted]))
     per_event = res.lyapunov * counted_time / res.events if res.events > 0 else math.nan
-    keep = ("lyapunov", "lyapunov_err", "t_end", "renormalisations", "d0", "interval", "transient", "align",
-            "segments", "events", "merges", "max_log_growth", "reference_sha256", "start")
-    return {"model": params.model, **{k: info[k] for k in keep}, "counted_time": counted_time,
-            "lyapunov_per_event": per_event, "run_wall_seconds": float(res.wall_seconds)}
+    keep = (
+        "lyapunov",
+        "lyapunov_err",
+        "t_end",
+        "renormalisations",
+        "d0",
+        "interval",
+        "transient",
+        "align",
+        "segments",
+        "events",
+        "merges",
+        "max_log_growth",
+        "reference_sha256",
+        "start",
+    )
+    return {
+        "model": params.model,
+        **{k: info[k] for k in keep},
+        "counted_time": counted_time,
+        "lyapunov_per_event": per_event,
+        "run_wall_seconds": float(res.wall_seconds),
+    }
 
 
 def _run(params, t_end: float, options: dict[str, Any], point_dir: Path):
@@ -365,9 +473,14 @@ def study_point_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     t_end, options = point_run_options(point, params)
     point_dir = Path(point_dir)
     run = _run(params, t_end, options, point_dir)
-    base = {"model": params.model, "t_end": t_end, "t_reached": float(run.summary["t_reached"]),
-            "n_events_total": int(run.summary["n_events"]), "run_wall_seconds": float(run.summary["wall_seconds"]),
-            "block_updates": int(run.summary["block_updates"])}
+    base = {
+        "model": params.model,
+        "t_end": t_end,
+        "t_reached": float(run.summary["t_reached"]),
+        "n_events_total": int(run.summary["n_events"]),
+        "run_wall_seconds": float(run.summary["wall_seconds"]),
+        "block_updates": int(run.summary["block_updates"]),
+    }
     if point.get("analysis") == "sizes":
         return {**base, **sizes_summary(run, point)}
     return {**base, **order_summary(run, params, options["average_from"])}
@@ -392,9 +505,11 @@ def order_summary(run, params, t_from: float) -> dict[str, Any]:
     reached = bool(s.get("stopped_early", False))
     if reached:
         # steady sliding from t_steady on: L = L_ss and nothing stuck at the remaining sample times
-        t_rest = np.arange(math.floor(float(s["t_steady"]) / dt_s + 1e-9) + 1, math.floor(t_end / dt_s + 1e-9) + 1) * dt_s
+        t_rest = (
+            np.arange(math.floor(float(s["t_steady"]) / dt_s + 1e-9) + 1, math.floor(t_end / dt_s + 1e-9) + 1) * dt_s
+        )
         t = np.concatenate([t[t < t_rest[0]] if t_rest.size else t, t_rest])
-        L = np.concatenate([run.samples["L"].values[:t.size - t_rest.size], np.full(t_rest.size, L_ss)])
+        L = np.concatenate([run.samples["L"].values[: t.size - t_rest.size], np.full(t_rest.size, L_ss)])
         tm_keep = tm < t_rest[0] if t_rest.size else np.ones(tm.size, bool)
         tm = np.concatenate([tm[tm_keep], t_rest])
         stuck = np.concatenate([stuck[tm_keep], np.zeros(t_rest.size)])
@@ -405,9 +520,15 @@ def order_summary(run, params, t_from: float) -> dict[str, Any]:
     stuck_fraction = float(stuck[late_m].mean()) if late_m.any() else math.nan
     q = quarter_stats(t, m, None, t_end)
     q.update({k: v for k, v in quarter_stats(tm, np.zeros(tm.size), stuck, t_end).items() if k.startswith("stuck")})
-    state, reason = classify_final_state(reached_steady=reached, stuck_q3=q["stuck_q3"], stuck_q4=q["stuck_q4"],
-                                         m_q3=q["m_q3"], m_err_q3=q["m_err_q3"], m_q4=q["m_q4"],
-                                         m_err_q4=q["m_err_q4"])
+    state, reason = classify_final_state(
+        reached_steady=reached,
+        stuck_q3=q["stuck_q3"],
+        stuck_q4=q["stuck_q4"],
+        m_q3=q["m_q3"],
+        m_err_q3=q["m_err_q3"],
+        m_q4=q["m_q4"],
+        m_err_q4=q["m_err_q4"],
+    )
     ev = run.events[run.events["t_start"] >= t_from]
     window = t_end - t_from
     return {
@@ -446,11 +567,28 @@ def sizes_summary(run, cfg: dict[str, Any]) -> dict[str, Any]:
     if len(events) < 20:
         out.update(tau=math.nan, tau_err=math.nan, error_note=f"only {len(events)} events after t = {t_from:g}")
         return out
-    st = size_statistics(events, run.params.N, small_only=True, seed=int(cfg.get("seed", 0)), spanning=spanning,
-                         bootstrap=int(cfg.get("bootstrap", 200)))
+    st = size_statistics(
+        events,
+        run.params.N,
+        small_only=True,
+        seed=int(cfg.get("seed", 0)),
+        spanning=spanning,
+        bootstrap=int(cfg.get("bootstrap", 200)),
+    )
     fit = st["fit"]
-    out.update(tau=fit.tau, tau_err=fit.tau_err, tau_err_fisher=fit.tau_err_fisher, s_min=fit.s_min,
-               s_max=fit.s_max, n_fit=fit.n, ks_distance=fit.ks_distance, n_spanning=st["n_spanning"],
-               s_span=st["s_span"], S_max=st["S_max"], excess=st["excess"], observed=st["observed"],
-               expected=st["expected"])
+    out.update(
+        tau=fit.tau,
+        tau_err=fit.tau_err,
+        tau_err_fisher=fit.tau_err_fisher,
+        s_min=fit.s_min,
+        s_max=fit.s_max,
+        n_fit=fit.n,
+        ks_distance=fit.ks_distance,
+        n_spanning=st["n_spanning"],
+        s_span=st["s_span"],
+        S_max=st["S_max"],
+        excess=st["excess"],
+        observed=st["observed"],
+        expected=st["expected"],
+    )
     return out

@@ -32,14 +32,67 @@ __all__ = ["run_study", "study_command", "TABLE_COLUMNS"]
 
 #: The leading columns of each study's table (the rest follow).
 TABLE_COLUMNS = {
-    "transition": ["N", "beta", "order_parameter", "order_parameter_err", "final_state", "stuck_fraction",
-                   "event_rate", "S_max", "max_blocks", "t_steady", "tau_int", "err_reliable", "t_end"],
-    "phase-diagram": ["N", "alpha", "D", "beta", "start", "final_state", "order_parameter",
-                      "order_parameter_err", "stuck_fraction", "t_steady", "t_end"],
-    "exponents": ["model", "N", "beta", "tau", "tau_err", "s_min", "s_max", "n_fit", "n_events", "excess",
-                  "observed", "expected", "n_spanning", "S_max", "t_end"],
-    "chaos": ["model", "N", "beta", "lyapunov", "lyapunov_err", "t_end", "renormalisations", "d0", "interval",
-              "transient", "events", "lyapunov_per_event", "merges", "max_log_growth"],
+    "transition": [
+        "N",
+        "beta",
+        "order_parameter",
+        "order_parameter_err",
+        "final_state",
+        "stuck_fraction",
+        "event_rate",
+        "S_max",
+        "max_blocks",
+        "t_steady",
+        "tau_int",
+        "err_reliable",
+        "t_end",
+    ],
+    "phase-diagram": [
+        "N",
+        "alpha",
+        "D",
+        "beta",
+        "start",
+        "final_state",
+        "order_parameter",
+        "order_parameter_err",
+        "stuck_fraction",
+        "t_steady",
+        "t_end",
+    ],
+    "exponents": [
+        "model",
+        "N",
+        "beta",
+        "tau",
+        "tau_err",
+        "s_min",
+        "s_max",
+        "n_fit",
+        "n_events",
+        "excess",
+        "observed",
+        "expected",
+        "n_spanning",
+        "S_max",
+        "t_end",
+    ],
+    "chaos": [
+        "model",
+        "N",
+        "beta",
+        "lyapunov",
+        "lyapunov_err",
+        "t_end",
+        "renormalisations",
+        "d0",
+        "interval",
+        "transient",
+        "events",
+        "lyapunov_per_event",
+        "merges",
+        "max_log_growth",
+    ],
 }
 
 
@@ -77,11 +130,22 @@ def run_study(
 
     for p in spec.points:  # validate every point before any work starts
         check_point({**spec.common, **p})
-    _log(show, t0, f"{spec.name} --{spec.mode}: {len(spec.points)} points in {run_dir} "
-                   f"({'scheduler ' + scheduler if scheduler else 'local cluster'}); finished points are reused")
+    _log(
+        show,
+        t0,
+        f"{spec.name} --{spec.mode}: {len(spec.points)} points in {run_dir} "
+        f"({'scheduler ' + scheduler if scheduler else 'local cluster'}); finished points are reused",
+    )
     io.write_json(run_dir / "study-spec.json", spec.spec())
-    result = run_sweep(study_point_task, [dict(p) for p in spec.points], run_dir / "points", common=dict(spec.common),
-                       scheduler=scheduler, n_workers=n_workers, progress=show)
+    result = run_sweep(
+        study_point_task,
+        [dict(p) for p in spec.points],
+        run_dir / "points",
+        common=dict(spec.common),
+        scheduler=scheduler,
+        n_workers=n_workers,
+        progress=show,
+    )
     table = _study_table(spec, result.table)
     failed = table[table["status"] != "ok"]
     page_dir.mkdir(parents=True, exist_ok=True)
@@ -94,9 +158,16 @@ def run_study(
     figures = study_findings.draw(spec, ok, page_dir)
     wall = time.perf_counter() - t0
     meta = {
-        "study": spec.name, "mode": spec.mode, "key": spec.key(), "version": __version__,
-        "command": study_command(spec.name, spec.mode), "note": spec.note,
-        "points": len(table), "run": result.n_run, "reused": result.n_reused, "failed": int(len(failed)),
+        "study": spec.name,
+        "mode": spec.mode,
+        "key": spec.key(),
+        "version": __version__,
+        "command": study_command(spec.name, spec.mode),
+        "note": spec.note,
+        "points": len(table),
+        "run": result.n_run,
+        "reused": result.n_reused,
+        "failed": int(len(failed)),
         "wall_seconds": round(wall, 1),
         "compute_seconds": round(float(np.nansum(table["wall_seconds"].to_numpy(dtype=float))), 1),
         "runs": str(run_dir),
@@ -153,8 +224,10 @@ def _records(table: pd.DataFrame) -> list[dict[str, Any]]:
 _CSS = """
 body { font-family: system-ui, sans-serif; margin: 2em auto; max-width: 76em; padding: 0 1em; color: #222; }
 table { border-collapse: collapse; font-size: 0.85em; } th, td { border: 1px solid #ccc; padding: 0.25em 0.45em; }
-th { background: #f3f3f3; } code { font-size: 0.9em; } figure { display: inline-block; margin: 0.8em; max-width: 46em; }
-figure img { max-width: 100%; border: 1px solid #ddd; } figcaption { font-size: 0.9em; } td.failed { background: #f9e0e0; }
+th { background: #f3f3f3; } code { font-size: 0.9em; }
+figure { display: inline-block; margin: 0.8em; max-width: 46em; }
+figure img { max-width: 100%; border: 1px solid #ddd; } figcaption { font-size: 0.9em; }
+td.failed { background: #f9e0e0; }
 """
 
 
@@ -166,30 +239,45 @@ def _cell(value: Any) -> str:
     return html.escape(str(value))
 
 
-def _write_page(path: Path, spec: Study, meta: dict[str, Any], findings: dict[str, Any],
-                figures: list[dict[str, Any]], table: pd.DataFrame) -> None:
+def _write_page(
+    path: Path,
+    spec: Study,
+    meta: dict[str, Any],
+    findings: dict[str, Any],
+    figures: list[dict[str, Any]],
+    table: pd.DataFrame,
+) -> None:
     import base64
 
-    parts = ["<!DOCTYPE html>", '<html lang="en"><head><meta charset="utf-8">',
-             f"<title>Study: {html.escape(spec.name)}</title><style>{_CSS}</style></head><body>",
-             f"<h1>Study: {html.escape(spec.name)} ({html.escape(spec.mode)})</h1>",
-             f"<p><code>{html.escape(meta['command'])}</code> &mdash; {html.escape(spec.note)}</p>",
-             f"<p>{meta['points']} points: {meta['run']} run now, {meta['reused']} reused, {meta['failed']} failed; "
-             f"{meta['wall_seconds']} s wall, {meta['compute_seconds']} s of point runs; stickslip {__version__}; "
-             f"runs in <code>{html.escape(meta['runs'])}</code>.</p>",
-             "<h2>What the data say</h2><ul>"]
+    parts = [
+        "<!DOCTYPE html>",
+        '<html lang="en"><head><meta charset="utf-8">',
+        f"<title>Study: {html.escape(spec.name)}</title><style>{_CSS}</style></head><body>",
+        f"<h1>Study: {html.escape(spec.name)} ({html.escape(spec.mode)})</h1>",
+        f"<p><code>{html.escape(meta['command'])}</code> &mdash; {html.escape(spec.note)}</p>",
+        f"<p>{meta['points']} points: {meta['run']} run now, {meta['reused']} reused, {meta['failed']} failed; "
+        f"{meta['wall_seconds']} s wall, {meta['compute_seconds']} s of point runs; stickslip {__version__}; "
+        f"runs in <code>{html.escape(meta['runs'])}</code>.</p>",
+        "<h2>What the data say</h2><ul>",
+    ]
     for line in findings.get("statements", []):
         parts.append(f"<li>{html.escape(line)}</li>")
     parts.append("</ul><h2>Figures</h2>")
     for fig in figures:
         png = path.parent / fig["image"]
-        src = ("data:image/png;base64," + base64.b64encode(png.read_bytes()).decode()) if png.is_file() else fig["image"]
-        parts.append(f'<figure><img src="{src}" alt="{html.escape(fig["name"])}"><figcaption>'
-                     f'{html.escape(fig["caption"])} <a href="{html.escape(fig["pdf"])}">PDF</a><br>'
-                     f'<code>{html.escape(fig["command"])}</code></figcaption></figure>')
-    parts.append('<h2>Table</h2><p>Data: <a href="table.parquet">table.parquet</a>, <a href="table.csv">table.csv</a>, '
-                 '<a href="study.json">study.json</a>; each point\'s run (state.nc, events.parquet) in its '
-                 'directory under the runs folder.</p><table><thead><tr>')
+        src = (
+            ("data:image/png;base64," + base64.b64encode(png.read_bytes()).decode()) if png.is_file() else fig["image"]
+        )
+        parts.append(
+            f'<figure><img src="{src}" alt="{html.escape(fig["name"])}"><figcaption>'
+            f'{html.escape(fig["caption"])} <a href="{html.escape(fig["pdf"])}">PDF</a><br>'
+            f"<code>{html.escape(fig['command'])}</code></figcaption></figure>"
+        )
+    parts.append(
+        '<h2>Table</h2><p>Data: <a href="table.parquet">table.parquet</a>, <a href="table.csv">table.csv</a>, '
+        '<a href="study.json">study.json</a>; each point\'s run (state.nc, events.parquet) in its '
+        "directory under the runs folder.</p><table><thead><tr>"
+    )
     cols = [c for c in TABLE_COLUMNS[spec.name] if c in table.columns] + ["status", "error"]
     parts.append("".join(f"<th>{html.escape(c)}</th>" for c in cols) + "</tr></thead><tbody>")
     for row in table.itertuples(index=False):

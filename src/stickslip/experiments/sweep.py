@@ -29,9 +29,10 @@ import sys
 import time
 import traceback
 import warnings
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, Iterable
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -62,8 +63,15 @@ POINT_FILE = "point.json"  # a point's spec, written first: marks the folder as 
 SUMMARY_NAME = "summary"
 
 # Keys of a point that are options of the run rather than model parameters.
-CHAIN_RUN_OPTIONS = ("t_end", "integrator", "start", "sample_interval", "average_from",
-                     "profile_window", "profile_min_blocks")
+CHAIN_RUN_OPTIONS = (
+    "t_end",
+    "integrator",
+    "start",
+    "sample_interval",
+    "average_from",
+    "profile_window",
+    "profile_min_blocks",
+)
 BLOCK_RUN_OPTIONS = ("t_end", "every")
 
 # Columns of the summary table that are not parameters or task results.
@@ -126,8 +134,9 @@ def _read_done(point_dir: Path, spec: dict[str, Any]) -> dict[str, Any] | None:
     return record if record.get("spec") == spec else None
 
 
-def _run_point(task: Task, point: dict[str, Any], common: dict[str, Any], point_dir: str,
-               spec: dict[str, Any]) -> dict[str, Any]:
+def _run_point(
+    task: Task, point: dict[str, Any], common: dict[str, Any], point_dir: str, spec: dict[str, Any]
+) -> dict[str, Any]:
     """Run one point on a worker: call the task, record done.json or error.json, never raise."""
     directory = Path(point_dir)
     directory.mkdir(parents=True, exist_ok=True)
@@ -159,13 +168,19 @@ def _run_point(task: Task, point: dict[str, Any], common: dict[str, Any], point_
     return record
 
 
-def _row(point: dict[str, Any], name: str, record: dict[str, Any], reused: bool,
-         common: dict[str, Any] | None = None) -> dict[str, Any]:
+def _row(
+    point: dict[str, Any], name: str, record: dict[str, Any], reused: bool, common: dict[str, Any] | None = None
+) -> dict[str, Any]:
     row: dict[str, Any] = dict(point)
     for key, value in (common or {}).items():  # the fixed settings (--set, t_end) after the grid values
         row.setdefault(key, value)
-    row.update(point_dir=name, status=record.get("status", "failed"), reused=reused,
-               error=record.get("error"), wall_seconds=record.get("wall_seconds", math.nan))
+    row.update(
+        point_dir=name,
+        status=record.get("status", "failed"),
+        reused=reused,
+        error=record.get("error"),
+        wall_seconds=record.get("wall_seconds", math.nan),
+    )
     for key, value in (record.get("summary") or {}).items():
         # a result named like a parameter or a status column keeps both, prefixed
         row[f"result_{key}" if key in row else key] = value
@@ -187,8 +202,12 @@ def _table(rows: list[dict[str, Any]], points: list[dict[str, Any]]) -> pd.DataF
         values = [v for v in table[column] if v is not None and not (isinstance(v, float) and math.isnan(v))]
         kinds = {type(v) for v in values}
         if kinds and not (kinds <= {str} or kinds <= {bool}):
-            table[column] = [None if v is None or (isinstance(v, float) and math.isnan(v))
-                             else (v if isinstance(v, str) else json.dumps(v)) for v in table[column]]
+            table[column] = [
+                None
+                if v is None or (isinstance(v, float) and math.isnan(v))
+                else (v if isinstance(v, str) else json.dumps(v))
+                for v in table[column]
+            ]
     return table
 
 
@@ -253,15 +272,26 @@ def run_sweep(
     if task is chain_task:
         _warn_short_chain_runs(points, common, names)
     specs = [_spec(task, p, common) for p in points]
-    records: list[dict[str, Any] | None] = [_read_done(out / n, s) for n, s in zip(names, specs)]
+    records: list[dict[str, Any] | None] = [_read_done(out / n, s) for n, s in zip(names, specs, strict=False)]
     reused = [r is not None for r in records]
     pending = [k for k, r in enumerate(records) if r is None]
 
     if pending:
-        _compute(task, points, common, out, names, specs, pending, records,
-                 scheduler=scheduler, n_workers=n_workers, progress=progress)
+        _compute(
+            task,
+            points,
+            common,
+            out,
+            names,
+            specs,
+            pending,
+            records,
+            scheduler=scheduler,
+            n_workers=n_workers,
+            progress=progress,
+        )
 
-    rows = [_row(p, n, r, u, common) for p, n, r, u in zip(points, names, records, reused)]  # type: ignore[arg-type]
+    rows = [_row(p, n, r, u, common) for p, n, r, u in zip(points, names, records, reused, strict=False)]  # type: ignore[arg-type]
     table = _table(rows, points + [common])
     write_table(out / f"{SUMMARY_NAME}.parquet", table)
     _write_csv(out / f"{SUMMARY_NAME}.csv", table)
@@ -305,8 +335,16 @@ def _compute(task, points, common, out, names, specs, pending, records, *, sched
     try:
         futures = {}
         for k in pending:
-            future = client.submit(_run_point, task, points[k], common, str(out / names[k]), specs[k],
-                                   key=f"sweep-{names[k]}-{os.getpid()}-{time.time_ns()}", pure=False)
+            future = client.submit(
+                _run_point,
+                task,
+                points[k],
+                common,
+                str(out / names[k]),
+                specs[k],
+                key=f"sweep-{names[k]}-{os.getpid()}-{time.time_ns()}",
+                pure=False,
+            )
             futures[future] = k
         for future in as_completed(futures):
             k = futures[future]
@@ -339,8 +377,9 @@ def _progress_bar(total: int, done: int, enabled: bool):
         return None
     from tqdm import tqdm
 
-    return tqdm(total=total, initial=done, desc="points", unit=" points", file=sys.stderr,
-                dynamic_ncols=True, smoothing=0.1)
+    return tqdm(
+        total=total, initial=done, desc="points", unit=" points", file=sys.stderr, dynamic_ncols=True, smoothing=0.1
+    )
 
 
 def _on_terminal() -> bool:
@@ -395,7 +434,7 @@ def _warn_short_chain_runs(points: list[dict[str, Any]], common: dict[str, Any],
     """One :class:`ShortRunWarning` per chain point too short to leave the loading (run.state.loading_warnings)."""
     from stickslip.run.state import loading_warnings
 
-    for point, name in zip(points, names):
+    for point, name in zip(points, names, strict=False):
         try:
             params, t_end, options = _chain_run_args({**common, **point})
         except (ValueError, TypeError):
@@ -437,8 +476,7 @@ def block_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     directory = Path(point_dir)
     write_dataset(directory / "series.nc", run.series)
     write_table(directory / "slips.parquet", run.slips)
-    write_json(directory / "run.json", run_metadata(params, integrator="heun", t_end=t_end,
-                                                    summary=summary, **options))
+    write_json(directory / "run.json", run_metadata(params, integrator="heun", t_end=t_end, summary=summary, **options))
     return summary
 
 

@@ -78,24 +78,119 @@ from __future__ import annotations
 from numba import njit
 
 from stickslip.kernels.common import (  # noqa: F401 (re-exported: the kernels' public names)
-    STEP, N_MOVING, EV_ACTIVE, EV_START_STEP, EV_START_BLOCK, EV_MAX_BLOCK, EV_N_MOVED, ACT_LO,
-    ACT_HI, N_EVENTS, EV_COUNT, FM_COUNT, S_COUNT, P_COUNT, EV_P_FIRST, NEXT_PROFILE, BAD_BLOCK,
-    BLOCK_UPDATES, STEPS_COMPUTED, NEXT_SAMPLE, MECH_LO, MECH_HI, FULL_UPDATES, IST_SIZE, P_K,
-    P_D, P_V, P_BETA, P_ALPHA, P_FS, P_DT, P_KP, P_SIGMA, P_F0, PAR_SIZE, DRIVE_END,
-    DRIVE_PLATE, FRICTION_STATE, FRICTION_WEAKENING, FRICTION_STRENGTHENING, THRESHOLD_CONSTANT,
-    THRESHOLD_STATE, ENDS_FREE, ENDS_FIXED, ENDS_PERIODIC, E_ID, E_START_STEP, E_END_STEP,
-    E_START_BLOCK, E_MAX_BLOCK, E_N_BLOCKS, EV_INT_COLS, DONE, EVENTS_FULL, FIRST_MOVES_FULL,
-    SAMPLES_FULL, PROFILES_FULL, NONFINITE, _BIG, _NEVER, _force, _accel, _dtheta, _threshold,
-    _pull, _set_ghosts, _right_of_first, _service, _merge, _unpack, _overflow,
-    _start_and_first_moves, _end_event, _plate_fires, _plate_trigger, _plate_triggers,
+    _BIG,
+    _NEVER,
+    ACT_HI,
+    ACT_LO,
+    BAD_BLOCK,
+    BLOCK_UPDATES,
+    DONE,
+    DRIVE_END,
+    DRIVE_PLATE,
+    E_END_STEP,
+    E_ID,
+    E_MAX_BLOCK,
+    E_N_BLOCKS,
+    E_START_BLOCK,
+    E_START_STEP,
+    ENDS_FIXED,
+    ENDS_FREE,
+    ENDS_PERIODIC,
+    EV_ACTIVE,
+    EV_COUNT,
+    EV_INT_COLS,
+    EV_MAX_BLOCK,
+    EV_N_MOVED,
+    EV_P_FIRST,
+    EV_START_BLOCK,
+    EV_START_STEP,
+    EVENTS_FULL,
+    FIRST_MOVES_FULL,
+    FM_COUNT,
+    FRICTION_STATE,
+    FRICTION_STRENGTHENING,
+    FRICTION_WEAKENING,
+    FULL_UPDATES,
+    IST_SIZE,
+    MECH_HI,
+    MECH_LO,
+    N_EVENTS,
+    N_MOVING,
+    NEXT_PROFILE,
+    NEXT_SAMPLE,
+    NONFINITE,
+    P_ALPHA,
+    P_BETA,
+    P_COUNT,
+    P_D,
+    P_DT,
+    P_F0,
+    P_FS,
+    P_K,
+    P_KP,
+    P_SIGMA,
+    P_V,
+    PAR_SIZE,
+    PROFILES_FULL,
+    S_COUNT,
+    SAMPLES_FULL,
+    STEP,
+    STEPS_COMPUTED,
+    THRESHOLD_CONSTANT,
+    THRESHOLD_STATE,
+    _accel,
+    _dtheta,
+    _end_event,
+    _force,
+    _merge,
+    _overflow,
+    _plate_fires,
+    _plate_trigger,
+    _plate_triggers,
+    _pull,
+    _right_of_first,
+    _service,
+    _set_ghosts,
+    _start_and_first_moves,
+    _threshold,
+    _unpack,
 )
 from stickslip.kernels.plate import run_sparse
 
 
 @njit(cache=True)
-def run_dense(x, v, th, mov, xs, vs, ths, mm, a1, b1, trig, first_step, x0ev, ist, par,
-              ev_int, ev_S, fm, samp_L, samp_step, prof_x, prof_meta,
-              n_end, sample_every, profile_every, profile_min_blocks, drive, friction, threshold, ends):
+def run_dense(
+    x,
+    v,
+    th,
+    mov,
+    xs,
+    vs,
+    ths,
+    mm,
+    a1,
+    b1,
+    trig,
+    first_step,
+    x0ev,
+    ist,
+    par,
+    ev_int,
+    ev_S,
+    fm,
+    samp_L,
+    samp_step,
+    prof_x,
+    prof_meta,
+    n_end,
+    sample_every,
+    profile_every,
+    profile_min_blocks,
+    drive,
+    friction,
+    threshold,
+    ends,
+):
     """Reference integrator of the chain (eq. 4 and its relatives): Heun over every block at
     every step, written plainly.
 
@@ -166,8 +261,9 @@ def run_dense(x, v, th, mov, xs, vs, ths, mm, a1, b1, trig, first_step, x0ev, is
             ist[BAD_BLOCK] = bad
             return NONFINITE
         if ist[EV_ACTIVE] == 1 and n_moving == 0:
-            _end_event(n, x, first_step, x0ev, ist, ev_int, ev_S, fm, prof_x, prof_meta, N,
-                       profile_every, profile_min_blocks)
+            _end_event(
+                n, x, first_step, x0ev, ist, ev_int, ev_S, fm, prof_x, prof_meta, N, profile_every, profile_min_blocks
+            )
 
 
 @njit(cache=True)
@@ -201,16 +297,16 @@ def _stage1(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, p, mp, dt, drive, fr
     Returns the first and the last block that move in this step (lo > hi if none) and
     whether a stopped block starts.
     """
-    x = x[lo - 1:hi + 2]
-    v = v[lo - 1:hi + 2]
-    th = th[lo - 1:hi + 2]
-    mov = mov[lo - 1:hi + 2]
-    xs = xs[lo - 1:hi + 2]
-    vs = vs[lo - 1:hi + 2]
-    ths = ths[lo - 1:hi + 2]
-    mm = mm[lo - 1:hi + 2]
-    a1 = a1[lo - 1:hi + 2]
-    b1 = b1[lo - 1:hi + 2]
+    x = x[lo - 1 : hi + 2]
+    v = v[lo - 1 : hi + 2]
+    th = th[lo - 1 : hi + 2]
+    mov = mov[lo - 1 : hi + 2]
+    xs = xs[lo - 1 : hi + 2]
+    vs = vs[lo - 1 : hi + 2]
+    ths = ths[lo - 1 : hi + 2]
+    mm = mm[lo - 1 : hi + 2]
+    a1 = a1[lo - 1 : hi + 2]
+    b1 = b1[lo - 1 : hi + 2]
     K, Kp, Fs = mp[0], mp[1], mp[5]
     n = hi - lo + 1
     first = n + 1
@@ -282,14 +378,14 @@ def _stage1_theta(x, v, th, xs, vs, ths, mm, b1, lo, hi, mp, dt, friction):
     For such a block v = 0 and the acceleration is 0 * (...), so the full stage gives
     xs = x, vs = v exactly; only the state variable needs its derivative.
     """
-    x = x[lo - 1:hi + 2]
-    v = v[lo - 1:hi + 2]
-    th = th[lo - 1:hi + 2]
-    xs = xs[lo - 1:hi + 2]
-    vs = vs[lo - 1:hi + 2]
-    ths = ths[lo - 1:hi + 2]
-    mm = mm[lo - 1:hi + 2]
-    b1 = b1[lo - 1:hi + 2]
+    x = x[lo - 1 : hi + 2]
+    v = v[lo - 1 : hi + 2]
+    th = th[lo - 1 : hi + 2]
+    xs = xs[lo - 1 : hi + 2]
+    vs = vs[lo - 1 : hi + 2]
+    ths = ths[lo - 1 : hi + 2]
+    mm = mm[lo - 1 : hi + 2]
+    b1 = b1[lo - 1 : hi + 2]
     for j in range(1, hi - lo + 2):
         b = _dtheta(th[j - 1], th[j], th[j + 1], v[j], mp, friction)
         b1[j] = b
@@ -306,10 +402,10 @@ def _stage1_theta_only(v, th, ths, b1, lo, hi, mp, dt, friction):
     Then nothing reads the predictors of x and v or the mask, so only the state variable's
     derivative and predictor are written (see _stage1_theta for why this is exact).
     """
-    v = v[lo - 1:hi + 2]
-    th = th[lo - 1:hi + 2]
-    ths = ths[lo - 1:hi + 2]
-    b1 = b1[lo - 1:hi + 2]
+    v = v[lo - 1 : hi + 2]
+    th = th[lo - 1 : hi + 2]
+    ths = ths[lo - 1 : hi + 2]
+    b1 = b1[lo - 1 : hi + 2]
     for j in range(1, hi - lo + 2):
         b = _dtheta(th[j - 1], th[j], th[j + 1], v[j], mp, friction)
         b1[j] = b
@@ -324,10 +420,10 @@ def _stage2_theta(th, ths, v, b1, lo, hi, mp, h2, friction):
     predicted velocity equals v = 0, which is read instead. Returns the first and last block
     whose state variable changed (lo > hi if none).
     """
-    th = th[lo - 1:hi + 2]
-    ths = ths[lo - 1:hi + 2]
-    v = v[lo - 1:hi + 2]
-    b1 = b1[lo - 1:hi + 2]
+    th = th[lo - 1 : hi + 2]
+    ths = ths[lo - 1 : hi + 2]
+    v = v[lo - 1 : hi + 2]
+    b1 = b1[lo - 1 : hi + 2]
     n = hi - lo + 1
     c_lo = n + 1
     c_hi = 0
@@ -349,16 +445,16 @@ def _stage2(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, p, mp, h2, drive, fr
     Returns the first and last block that changed (lo > hi if none) and the number of
     moving blocks among lo..hi before and after.
     """
-    x = x[lo - 1:hi + 2]
-    v = v[lo - 1:hi + 2]
-    th = th[lo - 1:hi + 2]
-    mov = mov[lo - 1:hi + 2]
-    xs = xs[lo - 1:hi + 2]
-    vs = vs[lo - 1:hi + 2]
-    ths = ths[lo - 1:hi + 2]
-    mm = mm[lo - 1:hi + 2]
-    a1 = a1[lo - 1:hi + 2]
-    b1 = b1[lo - 1:hi + 2]
+    x = x[lo - 1 : hi + 2]
+    v = v[lo - 1 : hi + 2]
+    th = th[lo - 1 : hi + 2]
+    mov = mov[lo - 1 : hi + 2]
+    xs = xs[lo - 1 : hi + 2]
+    vs = vs[lo - 1 : hi + 2]
+    ths = ths[lo - 1 : hi + 2]
+    mm = mm[lo - 1 : hi + 2]
+    a1 = a1[lo - 1 : hi + 2]
+    b1 = b1[lo - 1 : hi + 2]
     K, Kp = mp[0], mp[1]
     n = hi - lo + 1
     c_lo = n + 1
@@ -393,9 +489,38 @@ def _stage2(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, p, mp, h2, drive, fr
 
 
 @njit(cache=True)
-def run_exact(x, v, th, mov, xs, vs, ths, mm, a1, b1, trig, first_step, x0ev, ist, par,
-              ev_int, ev_S, fm, samp_L, samp_step, prof_x, prof_meta,
-              n_end, sample_every, profile_every, profile_min_blocks, drive, friction, threshold, ends):
+def run_exact(
+    x,
+    v,
+    th,
+    mov,
+    xs,
+    vs,
+    ths,
+    mm,
+    a1,
+    b1,
+    trig,
+    first_step,
+    x0ev,
+    ist,
+    par,
+    ev_int,
+    ev_S,
+    fm,
+    samp_L,
+    samp_step,
+    prof_x,
+    prof_meta,
+    n_end,
+    sample_every,
+    profile_every,
+    profile_min_blocks,
+    drive,
+    friction,
+    threshold,
+    ends,
+):
     """Fast integrator of the chain, bit for bit equal to :func:`run_dense`.
 
     Updates only the blocks that can change (see the module docstring), in branch-free
@@ -409,10 +534,38 @@ def run_exact(x, v, th, mov, xs, vs, ths, mm, a1, b1, trig, first_step, x0ev, is
     if drive == DRIVE_PLATE:
         if friction != FRICTION_STATE:
             # No state variable: stopped blocks never change, so update a list, not an interval.
-            return run_sparse(x, v, th, mov, xs, vs, ths, mm, a1, b1, trig, first_step, x0ev, ist,
-                                     par, ev_int, ev_S, fm, samp_L, samp_step, prof_x, prof_meta, n_end,
-                                     sample_every, profile_every, profile_min_blocks, drive, friction,
-                                     threshold, ends)
+            return run_sparse(
+                x,
+                v,
+                th,
+                mov,
+                xs,
+                vs,
+                ths,
+                mm,
+                a1,
+                b1,
+                trig,
+                first_step,
+                x0ev,
+                ist,
+                par,
+                ev_int,
+                ev_S,
+                fm,
+                samp_L,
+                samp_step,
+                prof_x,
+                prof_meta,
+                n_end,
+                sample_every,
+                profile_every,
+                profile_min_blocks,
+                drive,
+                friction,
+                threshold,
+                ends,
+            )
     N = x.shape[0] - 2
     mp, V, dt = _unpack(par)
     K, Kp, Fs = mp[0], mp[1], mp[5]
@@ -508,8 +661,21 @@ def run_exact(x, v, th, mov, xs, vs, ths, mm, a1, b1, trig, first_step, x0ev, is
                     if t < t_next:
                         t_next = t
                 if ist[EV_ACTIVE] == 1 and n_moving == 0:
-                    _end_event(n, x, first_step, x0ev, ist, ev_int, ev_S, fm, prof_x, prof_meta, N,
-                               profile_every, profile_min_blocks)
+                    _end_event(
+                        n,
+                        x,
+                        first_step,
+                        x0ev,
+                        ist,
+                        ev_int,
+                        ev_S,
+                        fm,
+                        prof_x,
+                        prof_meta,
+                        N,
+                        profile_every,
+                        profile_min_blocks,
+                    )
             continue
 
         p1 = _pull(V, n, dt)
@@ -523,8 +689,9 @@ def run_exact(x, v, th, mov, xs, vs, ths, mm, a1, b1, trig, first_step, x0ev, is
         last = l1 - 1
         starts = False
         if fl <= fh:
-            first, last, starts = _stage1(x, v, th, mov, xs, vs, ths, mm, a1, b1, fl, fh, p1, mp, dt,
-                                          drive, friction, threshold)
+            first, last, starts = _stage1(
+                x, v, th, mov, xs, vs, ths, mm, a1, b1, fl, fh, p1, mp, dt, drive, friction, threshold
+            )
             if l1 < fl:
                 _stage1_theta(x, v, th, xs, vs, ths, mm, b1, l1, fl - 1, mp, dt, friction)
             if fh < h1:
@@ -535,8 +702,9 @@ def run_exact(x, v, th, mov, xs, vs, ths, mm, a1, b1, trig, first_step, x0ev, is
         _set_ghosts(xs, ths, N, p2, drive, ends)
         # Only a block that starts in this step can move for the first time in an event.
         if (ist[EV_ACTIVE] == 1 and starts) or (ist[N_MOVING] == 0 and first <= last):
-            _start_and_first_moves(n, max(first, lo), min(last, hi), x, mm, first_step, x0ev, ist,
-                                   prof_x, prof_meta, N, profile_every)
+            _start_and_first_moves(
+                n, max(first, lo), min(last, hi), x, mm, first_step, x0ev, ist, prof_x, prof_meta, N, profile_every
+            )
         # Stage 2: full over the blocks that move, state variable alone elsewhere.
         sl = first if first > lo else lo
         sh = last if last < hi else hi
@@ -546,7 +714,8 @@ def run_exact(x, v, th, mov, xs, vs, ths, mm, a1, b1, trig, first_step, x0ev, is
         moved_after = 0
         if sl <= sh:
             c_lo, c_hi, moved_before, moved_after = _stage2(
-                x, v, th, mov, xs, vs, ths, mm, a1, b1, sl, sh, p2, mp, h2, drive, friction)
+                x, v, th, mov, xs, vs, ths, mm, a1, b1, sl, sh, p2, mp, h2, drive, friction
+            )
             ist[FULL_UPDATES] += sh - sl + 1
             if friction == FRICTION_STATE:
                 if lo < sl:
@@ -595,13 +764,13 @@ def run_exact(x, v, th, mov, xs, vs, ths, mm, a1, b1, trig, first_step, x0ev, is
                 every = False
             if w_lo <= w_hi:
                 _set_ghosts(x, th, N, 0.0, drive, ends)
-                t = _plate_triggers(x, th, mov, mm, trig, w_lo, w_hi, every, n + 1, n_end, mp, V, dt,
-                                    threshold)
+                t = _plate_triggers(x, th, mov, mm, trig, w_lo, w_hi, every, n + 1, n_end, mp, V, dt, threshold)
                 if t < t_next:
                     t_next = t
         if ist[EV_ACTIVE] == 1 and n_moving == 0:
-            _end_event(n, x, first_step, x0ev, ist, ev_int, ev_S, fm, prof_x, prof_meta, N,
-                       profile_every, profile_min_blocks)
+            _end_event(
+                n, x, first_step, x0ev, ist, ev_int, ev_S, fm, prof_x, prof_meta, N, profile_every, profile_min_blocks
+            )
 
 
 def specialise(kernel, args, pieces):

@@ -15,27 +15,27 @@ import numpy as np
 from numba import njit
 
 # Indices into the int64 state vector ``ist``.
-STEP = 0           # n: the state held is at t_n = n dt
-N_MOVING = 1       # blocks moving at t_n
-EV_ACTIVE = 2      # 1 while an event is in progress
+STEP = 0  # n: the state held is at t_n = n dt
+N_MOVING = 1  # blocks moving at t_n
+EV_ACTIVE = 2  # 1 while an event is in progress
 EV_START_STEP = 3  # step in which the event's first block moved
 EV_START_BLOCK = 4
-EV_MAX_BLOCK = 5   # farthest block moved so far in the event
-EV_N_MOVED = 6     # blocks moved so far in the event
-ACT_LO = 7         # blocks that may change in the next step: [ACT_LO, ACT_HI] (empty if lo > hi)
+EV_MAX_BLOCK = 5  # farthest block moved so far in the event
+EV_N_MOVED = 6  # blocks moved so far in the event
+ACT_LO = 7  # blocks that may change in the next step: [ACT_LO, ACT_HI] (empty if lo > hi)
 ACT_HI = 8
-N_EVENTS = 9       # events completed since the start of the run (the next event's id)
-EV_COUNT = 10      # rows filled in the event buffer
-FM_COUNT = 11      # rows filled in the first-move buffer
-S_COUNT = 12       # samples filled in the sample buffer
-P_COUNT = 13       # rows filled in the profile buffer
-EV_P_FIRST = 14    # first profile row of the current event in the buffer
+N_EVENTS = 9  # events completed since the start of the run (the next event's id)
+EV_COUNT = 10  # rows filled in the event buffer
+FM_COUNT = 11  # rows filled in the first-move buffer
+S_COUNT = 12  # samples filled in the sample buffer
+P_COUNT = 13  # rows filled in the profile buffer
+EV_P_FIRST = 14  # first profile row of the current event in the buffer
 NEXT_PROFILE = 15  # next step at which a profile row is due
-BAD_BLOCK = 16     # block found non-finite (status NONFINITE)
+BAD_BLOCK = 16  # block found non-finite (status NONFINITE)
 BLOCK_UPDATES = 17  # block updates performed (stage 2), for profiling
 STEPS_COMPUTED = 18  # steps actually computed (not jumped over)
-NEXT_SAMPLE = 19   # next step at which L = x_1 - x_N is sampled
-MECH_LO = 20       # blocks that may move in the next step: [MECH_LO, MECH_HI] (exact only)
+NEXT_SAMPLE = 19  # next step at which L = x_1 - x_N is sampled
+MECH_LO = 20  # blocks that may move in the next step: [MECH_LO, MECH_HI] (exact only)
 MECH_HI = 21
 FULL_UPDATES = 22  # block updates of exact that were full (the rest updated the state variable alone)
 IST_SIZE = 23
@@ -185,8 +185,17 @@ def _merge(a_lo, a_hi, b_lo, b_hi):
 @njit(cache=True, inline="always")
 def _unpack(par):
     """(K, Kp, beta, alpha, D, Fs, 1 - sigma, 2 alpha, F0), V and dt from the parameter vector."""
-    mp = (par[P_K], par[P_KP], par[P_BETA], par[P_ALPHA], par[P_D], par[P_FS],
-          1.0 - par[P_SIGMA], 2.0 * par[P_ALPHA], par[P_F0])
+    mp = (
+        par[P_K],
+        par[P_KP],
+        par[P_BETA],
+        par[P_ALPHA],
+        par[P_D],
+        par[P_FS],
+        1.0 - par[P_SIGMA],
+        2.0 * par[P_ALPHA],
+        par[P_F0],
+    )
     return mp, par[P_V], par[P_DT]
 
 
@@ -237,8 +246,7 @@ def _start_and_first_moves(n, lo, hi, x, mm, first_step, x0ev, ist, prof_x, prof
 
 
 @njit(cache=True)
-def _end_event(n, x, first_step, x0ev, ist, ev_int, ev_S, fm, prof_x, prof_meta, N, profile_every,
-               profile_min_blocks):
+def _end_event(n, x, first_step, x0ev, ist, ev_int, ev_S, fm, prof_x, prof_meta, N, profile_every, profile_min_blocks):
     """Close the event that ended in step n (x holds t_{n+1}): S, its row, first-move rows."""
     eid = ist[N_EVENTS]
     S = 0.0
@@ -294,8 +302,8 @@ def _plate_trigger(xl, xc, xr, thr, K, Kp, V, dt, n0, n_cap):
         return n0
     if not _plate_fires(xl, xc, xr, thr, K, Kp, V, dt, n_cap - 1):
         return n_cap
-    lo = n0          # does not fire
-    hi = n_cap - 1   # fires
+    lo = n0  # does not fire
+    hi = n_cap - 1  # fires
     f0 = _force(xl, xc, xr, K, Kp, _pull(V, n0, dt), DRIVE_PLATE)
     rate = Kp * V * dt
     if rate > 0.0:
@@ -344,8 +352,7 @@ def _plate_triggers(x, th, mov, mm, trig, lo, hi, every, n0, n_cap, mp, V, dt, t
                 t_min = trig[i]
             continue
         if mov[i] == 0.0:
-            m = _plate_trigger(x[i - 1], x[i], x[i + 1], _threshold(th[i], Fs, threshold), K, Kp, V, dt,
-                               n0, n_cap)
+            m = _plate_trigger(x[i - 1], x[i], x[i + 1], _threshold(th[i], Fs, threshold), K, Kp, V, dt, n0, n_cap)
             trig[i] = m
             if m < t_min:
                 t_min = m

@@ -49,9 +49,38 @@ _QUEUED = np.int64(-1)  # trig of a stopped block queued as a candidate of the n
 
 
 @njit(cache=True, error_model="numpy")
-def run_sparse(x, v, th, mov, xs, vs, ths, mm, a1, b1, trig, first_step, x0ev, ist, par,
-               ev_int, ev_S, fm, samp_L, samp_step, prof_x, prof_meta,
-               n_end, sample_every, profile_every, profile_min_blocks, drive, friction, threshold, ends):
+def run_sparse(
+    x,
+    v,
+    th,
+    mov,
+    xs,
+    vs,
+    ths,
+    mm,
+    a1,
+    b1,
+    trig,
+    first_step,
+    x0ev,
+    ist,
+    par,
+    ev_int,
+    ev_S,
+    fm,
+    samp_L,
+    samp_step,
+    prof_x,
+    prof_meta,
+    n_end,
+    sample_every,
+    profile_every,
+    profile_min_blocks,
+    drive,
+    friction,
+    threshold,
+    ends,
+):
     """:func:`stickslip.kernels.chain.run_exact` for the plate drive with weakening or
     strengthening friction: same arguments, state and status codes (module docstring).
 
@@ -66,16 +95,16 @@ def run_sparse(x, v, th, mov, xs, vs, ths, mm, a1, b1, trig, first_step, x0ev, i
     one = np.uint64(1)
     uN = np.uint64(N)
     periodic = ends == c.ENDS_PERIODIC
-    movers = np.empty(N, np.uint64)   # moving blocks, then this step's starters
-    nxt = np.empty(N, np.uint64)      # the movers of the next step
-    queue = np.empty(N, np.uint64)    # stopped blocks that are candidates in the next step
-    still = np.empty(N, np.uint64)    # stopped candidates whose start rule did not fire
+    movers = np.empty(N, np.uint64)  # moving blocks, then this step's starters
+    nxt = np.empty(N, np.uint64)  # the movers of the next step
+    queue = np.empty(N, np.uint64)  # stopped blocks that are candidates in the next step
+    still = np.empty(N, np.uint64)  # stopped candidates whose start rule did not fire
     stopped = np.empty(N, np.uint64)  # movers that stopped in this step
-    acc = np.empty(N)                 # stage-1 acceleration of movers[k]
-    fb = np.empty(N)                  # packed: force on movers[k] (stage 1, then stage 2)
-    vb = np.empty(N)                  # packed: v of movers[k], then its new v
-    vsb = np.empty(N)                 # packed: predicted v of movers[k]
-    kept = np.empty(N, np.bool_)      # packed: movers[k] still moves after the step
+    acc = np.empty(N)  # stage-1 acceleration of movers[k]
+    fb = np.empty(N)  # packed: force on movers[k] (stage 1, then stage 2)
+    vb = np.empty(N)  # packed: v of movers[k], then its new v
+    vsb = np.empty(N)  # packed: predicted v of movers[k]
+    kept = np.empty(N, np.bool_)  # packed: movers[k] still moves after the step
     # The interval bookkeeping of run_exact is not used here: leave it conservative.
     ist[c.ACT_LO], ist[c.ACT_HI], ist[c.MECH_LO], ist[c.MECH_HI] = 1, N, 1, N
     c._set_ghosts(x, th, N, 0.0, drive, ends)
@@ -92,8 +121,7 @@ def run_sparse(x, v, th, mov, xs, vs, ths, mm, a1, b1, trig, first_step, x0ev, i
             xs[i] = x[i] + dt * v[i]
     for i in range(1, N + 1):
         if mov[i] == 0.0:
-            m = c._plate_trigger(x[i - 1], x[i], x[i + 1], c._threshold(th[i], Fs, threshold),
-                                 K, Kp, V, dt, n0, n_end)
+            m = c._plate_trigger(x[i - 1], x[i], x[i + 1], c._threshold(th[i], Fs, threshold), K, Kp, V, dt, n0, n_end)
             if m <= n0:
                 trig[i] = _QUEUED
                 queue[nq] = i
@@ -119,7 +147,11 @@ def run_sparse(x, v, th, mov, xs, vs, ths, mm, a1, b1, trig, first_step, x0ev, i
         if n >= n_end:
             st = c.DONE
             break
-        if ist[c.EV_COUNT] >= cap_ev or ist[c.FM_COUNT] + N > cap_fm or (profile_every > 0 and ist[c.P_COUNT] + 2 > cap_p):
+        if (
+            ist[c.EV_COUNT] >= cap_ev
+            or ist[c.FM_COUNT] + N > cap_fm
+            or (profile_every > 0 and ist[c.P_COUNT] + 2 > cap_p)
+        ):
             st = c._overflow(ist, N, cap_ev, cap_fm)
             break
         p1 = c._pull(V, n, dt)
@@ -258,8 +290,9 @@ def run_sparse(x, v, th, mov, xs, vs, ths, mm, a1, b1, trig, first_step, x0ev, i
         for k in range(nsl + ns):
             i = still[k] if k < nsl else stopped[k - nsl]
             if trig[i] != _QUEUED:
-                m = c._plate_trigger(x[i - one], x[i], x[i + one], c._threshold(th[i], Fs, threshold),
-                                     K, Kp, V, dt, n + 1, n_end)
+                m = c._plate_trigger(
+                    x[i - one], x[i], x[i + one], c._threshold(th[i], Fs, threshold), K, Kp, V, dt, n + 1, n_end
+                )
                 if m <= n + 1:
                     trig[i] = _QUEUED
                     queue[nq] = i
@@ -274,8 +307,9 @@ def run_sparse(x, v, th, mov, xs, vs, ths, mm, a1, b1, trig, first_step, x0ev, i
         full_updates += na
         steps_computed += 1
         if ist[c.EV_ACTIVE] == 1 and nmov == 0:
-            c._end_event(n, x, first_step, x0ev, ist, ev_int, ev_S, fm, prof_x, prof_meta, N,
-                         profile_every, profile_min_blocks)
+            c._end_event(
+                n, x, first_step, x0ev, ist, ev_int, ev_S, fm, prof_x, prof_meta, N, profile_every, profile_min_blocks
+            )
         n += 1
     ist[c.BLOCK_UPDATES] += block_updates
     ist[c.FULL_UPDATES] += full_updates

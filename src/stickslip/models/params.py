@@ -144,9 +144,13 @@ class BlockParams(_Validated):
     M: float = _positive(1.0, "block mass M")
     sigma: float = _positive(1.0, "state-variable friction scale sigma")
     dt: float = _positive(0.005, "Heun time step dt")
-    threshold: str = field(default="constant", metadata={
-        "choices": ("constant", "state"),
-        "doc": "static threshold: constant (Fs) or state (sigma theta: the paper's reading of Batista-Carlson)"})
+    threshold: str = field(
+        default="constant",
+        metadata={
+            "choices": ("constant", "state"),
+            "doc": "static threshold: constant (Fs) or state (sigma theta: the paper's reading of Batista-Carlson)",
+        },
+    )
 
     def to_dict(self) -> dict[str, Any]:
         """All parameters; the threshold only when it is not the paper's constant Fs."""
@@ -157,7 +161,7 @@ class BlockParams(_Validated):
             d.pop("Fs")
         return d
 
-    def scaled(self) -> "BlockParams":
+    def scaled(self) -> BlockParams:
         """The same system in the units M = sigma = 1 of section 2 (see :func:`scale_block`)."""
         return scale_block(self)
 
@@ -209,8 +213,7 @@ class ChainParams(_Validated):
     their defaults and left out of :meth:`to_dict`.
     """
 
-    N: int = field(default=399, metadata={"low": 1, "high": MAX_BLOCKS, "integer": True,
-                                          "doc": "number of blocks N"})
+    N: int = field(default=399, metadata={"low": 1, "high": MAX_BLOCKS, "integer": True, "doc": "number of blocks N"})
     K: float = _positive(10.0, "spring constant K")
     D: float = _nonnegative(5.0, "diffusion constant D of the state variable")
     V: float = _nonnegative(0.001, "pulling velocity V of the first spring")
@@ -224,10 +227,11 @@ class ChainParams(_Validated):
     threshold: str = _choice("constant", "threshold", "static threshold: constant (Fs) or state (theta_i)")
     ends: str = _choice("free", "ends", "ends of the chain: free, fixed or periodic (plate drive only)")
     Kp: float = _positive(1.0, "leaf spring Kp joining each block to the plate (plate drive)")
-    sigma: float = field(default=0.01, metadata={"low": 0.0, "high": 1.0, "high_open": True,
-                                                 "doc": "friction drop sigma of velocity weakening (CL)"})
+    sigma: float = field(
+        default=0.01,
+        metadata={"low": 0.0, "high": 1.0, "high_open": True, "doc": "friction drop sigma of velocity weakening (CL)"},
+    )
     F0: float = _nonnegative(1.0, "constant part F0 of strengthening friction (train model)")
-
 
     def _check(self) -> None:
         from stickslip.models.pieces import CompositionError, check_composition
@@ -269,8 +273,11 @@ class ChainParams(_Validated):
 
     @classmethod
     def field_docs(cls) -> dict[str, str]:
-        return {k: v for k, v in super().field_docs().items() if k not in ("model", "drive", "friction",
-                                                                               "threshold", "ends")}
+        return {
+            k: v
+            for k, v in super().field_docs().items()
+            if k not in ("model", "drive", "friction", "threshold", "ends")
+        }
 
 
 def steps_for(t_end: float, dt: float, name: str = "t_end") -> int:
@@ -278,6 +285,7 @@ def steps_for(t_end: float, dt: float, name: str = "t_end") -> int:
     at most :data:`MAX_STEPS`."""
     t_end = check_number(name, t_end, low=0.0)
     if t_end / dt > MAX_STEPS + 0.5:
-        raise ParameterError(f"{name} must be <= {MAX_STEPS * dt:g} (at most {MAX_STEPS:.0e} steps of dt = {dt:g}; "
-                             f"got {t_end:g})")
+        raise ParameterError(
+            f"{name} must be <= {MAX_STEPS * dt:g} (at most {MAX_STEPS:.0e} steps of dt = {dt:g}; got {t_end:g})"
+        )
     return int(round(t_end / dt))

@@ -41,20 +41,32 @@ class Piece:
 PIECES: dict[str, tuple[Piece, ...]] = {
     "drive": (
         Piece("drive", "end", "pulling point x_0 = V t joined to block 1 by the spring K (eq. 4)"),
-        Piece("drive", "plate", "every block joined to a plate at V t by a leaf spring Kp: "
-              "f_i gains Kp (V t - x_i)", ("Kp",)),
+        Piece(
+            "drive",
+            "plate",
+            "every block joined to a plate at V t by a leaf spring Kp: f_i gains Kp (V t - x_i)",
+            ("Kp",),
+        ),
     ),
     "friction": (
-        Piece("friction", "state", "theta_i + beta v_i while moving; dtheta_i/dt = theta_i (1 - theta_i) "
-              "- alpha theta_i v_i + D (theta_{i+1} - 2 theta_i + theta_{i-1}) (eq. 4)", ("beta", "alpha", "D")),
-        Piece("friction", "weakening", "phi(v) = (1 - sigma) / (1 + 2 alpha max(v, 0) / (1 - sigma)) "
-              "(Carlson-Langer)", ("alpha", "sigma")),
+        Piece(
+            "friction",
+            "state",
+            "theta_i + beta v_i while moving; dtheta_i/dt = theta_i (1 - theta_i) "
+            "- alpha theta_i v_i + D (theta_{i+1} - 2 theta_i + theta_{i-1}) (eq. 4)",
+            ("beta", "alpha", "D"),
+        ),
+        Piece(
+            "friction",
+            "weakening",
+            "phi(v) = (1 - sigma) / (1 + 2 alpha max(v, 0) / (1 - sigma)) (Carlson-Langer)",
+            ("alpha", "sigma"),
+        ),
         Piece("friction", "strengthening", "F0 + beta v, no state variable (train model)", ("beta", "F0")),
     ),
     "threshold": (
         Piece("threshold", "constant", "a stuck block starts when f_i > Fs", ("Fs",)),
-        Piece("threshold", "state", "a stuck block starts when f_i > theta_i (the paper's reading of "
-              "Batista-Carlson)"),
+        Piece("threshold", "state", "a stuck block starts when f_i > theta_i (the paper's reading of Batista-Carlson)"),
     ),
     "ends": (
         Piece("ends", "free", "x_{N+1} = x_N (plate drive: also x_0 = x_1)"),
@@ -86,7 +98,7 @@ def code(kind: str, name: str) -> int:
 
 def check_composition(drive: str, friction: str, threshold: str, ends: str) -> None:
     """Refuse a composition MODEL.md does not allow, in one line."""
-    for kind, name in zip(KINDS, (drive, friction, threshold, ends)):
+    for kind, name in zip(KINDS, (drive, friction, threshold, ends), strict=False):
         piece(kind, name)
     if ends == "periodic" and drive != "plate":
         raise CompositionError("ends periodic needs drive plate (the end drive pulls block 1 only)")
@@ -97,7 +109,7 @@ def check_composition(drive: str, friction: str, threshold: str, ends: str) -> N
 def reads(drive: str, friction: str, threshold: str, ends: str) -> tuple[str, ...]:
     """Parameters a composition reads, besides N, K, V and dt that every chain reads."""
     out: list[str] = []
-    for kind, name in zip(KINDS, (drive, friction, threshold, ends)):
+    for kind, name in zip(KINDS, (drive, friction, threshold, ends), strict=False):
         for r in piece(kind, name).reads:
             if r not in out:
                 out.append(r)

@@ -31,9 +31,15 @@ class Preset:
     def describe(self) -> dict[str, Any]:
         """Everything ``stickslip models`` prints about the preset (JSON-able)."""
         return {
-            "name": self.name, "title": self.title, "pieces": dict(self.pieces),
-            "params": dict(self.params), "start": self.start, "start_options": dict(self.start_options),
-            "equations": self.equations, "source": self.source, "note": self.note,
+            "name": self.name,
+            "title": self.title,
+            "pieces": dict(self.pieces),
+            "params": dict(self.params),
+            "start": self.start,
+            "start_options": dict(self.start_options),
+            "equations": self.equations,
+            "source": self.source,
+            "note": self.note,
             "symbols": dict(self.symbols),
         }
 
@@ -41,54 +47,76 @@ class Preset:
 _SAKAGUCHI = dict(drive="end", friction="state", threshold="constant", ends="free")
 _CL = dict(drive="plate", friction="weakening", threshold="constant", ends="periodic")
 _CL_PARAMS = dict(N=100, K=100.0, Kp=1.0, V=0.01, alpha=2.5, sigma=0.01, Fs=1.0, dt=0.005)
-_BC_NOTE = ("the paper's reading of Batista-Carlson (a stuck block starts when K (V t - x) > theta), "
-            "not Batista and Carlson's published model, which could not be consulted")
+_BC_NOTE = (
+    "the paper's reading of Batista-Carlson (a stuck block starts when K (V t - x) > theta), "
+    "not Batista and Carlson's published model, which could not be consulted"
+)
 
 PRESETS: dict[str, Preset] = {
     "sakaguchi": Preset(
-        "sakaguchi", "the chain of eq. (4) (Sakaguchi)", _SAKAGUCHI,
+        "sakaguchi",
+        "the chain of eq. (4) (Sakaguchi)",
+        _SAKAGUCHI,
         dict(N=399, K=10.0, D=5.0, V=0.001, beta=1.0, alpha=1.0, Fs=3.0, dt=0.005),
         "paper",
-        equations=("dv_i/dt = K (x_{i+1} - 2 x_i + x_{i-1}) - theta_i - beta v_i while moving, x_0 = V t, "
-                   "free end; dtheta_i/dt = theta_i (1 - theta_i) - alpha theta_i v_i + D (theta_{i+1} - "
-                   "2 theta_i + theta_{i-1}); a stuck block starts when its force exceeds Fs"),
+        equations=(
+            "dv_i/dt = K (x_{i+1} - 2 x_i + x_{i-1}) - theta_i - beta v_i while moving, x_0 = V t, "
+            "free end; dtheta_i/dt = theta_i (1 - theta_i) - alpha theta_i v_i + D (theta_{i+1} - "
+            "2 theta_i + theta_{i-1}); a stuck block starts when its force exceeds Fs"
+        ),
         source="H. Sakaguchi, Stick-Slip Motion and Phase Transition in a Block-Spring System, eq. (4)",
     ),
     "carlson-langer": Preset(
-        "carlson-langer", "Carlson-Langer (Burridge-Knopoff with velocity weakening)", _CL, _CL_PARAMS,
-        "rest", {"amplitude": 0.01, "seed": 0},
-        equations=("dv_i/dt = l^2 (x_{i+1} - 2 x_i + x_{i-1}) + (nu t - x_i) - phi(v_i) while moving, "
-                   "phi(v) = (1 - sigma) / (1 + 2 alpha v / (1 - sigma)); a stuck block starts when its "
-                   "force exceeds 1; periodic ends; start x_i = -A u_i, u_i uniform in [0, 1)"),
+        "carlson-langer",
+        "Carlson-Langer (Burridge-Knopoff with velocity weakening)",
+        _CL,
+        _CL_PARAMS,
+        "rest",
+        {"amplitude": 0.01, "seed": 0},
+        equations=(
+            "dv_i/dt = l^2 (x_{i+1} - 2 x_i + x_{i-1}) + (nu t - x_i) - phi(v_i) while moving, "
+            "phi(v) = (1 - sigma) / (1 + 2 alpha v / (1 - sigma)); a stuck block starts when its "
+            "force exceeds 1; periodic ends; start x_i = -A u_i, u_i uniform in [0, 1)"
+        ),
         source="J. M. Carlson, J. S. Langer, B. E. Shaw and C. Tang, Phys. Rev. A 44, 884 (1991)",
         note="units of the leaf spring and of the static friction: Kp = 1, Fs = 1; K = l^2, V = nu",
         symbols={"l": "sqrt(K)", "nu": "V", "alpha": "alpha", "sigma": "sigma"},
     ),
     "train": Preset(
-        "train", "the train model (Elmer): the paper's chain with constant friction",
+        "train",
+        "the train model (Elmer): the paper's chain with constant friction",
         dict(drive="end", friction="strengthening", threshold="constant", ends="free"),
         dict(N=399, K=10.0, V=0.001, beta=1.0, F0=1.0, Fs=3.0, dt=0.005),
         "paper",
-        equations=("dv_i/dt = K (x_{i+1} - 2 x_i + x_{i-1}) - F0 - beta v_i while moving, x_0 = V t, free "
-                   "end; a stuck block starts when its force exceeds Fs"),
+        equations=(
+            "dv_i/dt = K (x_{i+1} - 2 x_i + x_{i-1}) - F0 - beta v_i while moving, x_0 = V t, free "
+            "end; a stuck block starts when its force exceeds Fs"
+        ),
         source="F.-J. Elmer; here the paper's chain with alpha = 0 and theta = F0 = 1",
         note="Elmer's own parametrisation was not available; this is one member of the model",
     ),
     "batista-carlson": Preset(
-        "batista-carlson", "a single block with a state-dependent threshold",
+        "batista-carlson",
+        "a single block with a state-dependent threshold",
         dict(drive="end", friction="state", threshold="state", ends="free"),
         dict(N=1, K=10.0, D=0.0, V=0.05, beta=0.08, alpha=1.0, dt=0.005),
-        "rest", {"amplitude": 0.0, "seed": 0},
-        equations=("eq. (1) with M = sigma = 1: dv/dt = K (V t - x) - theta - beta v while moving; "
-                   "dtheta/dt = theta (1 - theta) - alpha theta v; a stuck block starts when "
-                   "K (V t - x) > theta"),
+        "rest",
+        {"amplitude": 0.0, "seed": 0},
+        equations=(
+            "eq. (1) with M = sigma = 1: dv/dt = K (V t - x) - theta - beta v while moving; "
+            "dtheta/dt = theta (1 - theta) - alpha theta v; a stuck block starts when "
+            "K (V t - x) > theta"
+        ),
         source="after A. A. Batista and J. M. Carlson, Phys. Rev. E 57, 4986 (1998)",
         note=_BC_NOTE,
     ),
     "two-blocks": Preset(
-        "two-blocks", "two blocks (de Sousa Vieira): Carlson-Langer with N = 2, free ends",
-        dict(_CL, ends="free"), dict(_CL_PARAMS, N=2),
-        "rest", {"amplitude": 0.01, "seed": 0},
+        "two-blocks",
+        "two blocks (de Sousa Vieira): Carlson-Langer with N = 2, free ends",
+        dict(_CL, ends="free"),
+        dict(_CL_PARAMS, N=2),
+        "rest",
+        {"amplitude": 0.01, "seed": 0},
         equations="as carlson-langer with N = 2 and free ends (x_0 = x_1, x_3 = x_2)",
         source="M. de Sousa Vieira, Phys. Rev. A 46, 6288 (1992); H. Sakaguchi and T. Morita (2013)",
         symbols={"l": "sqrt(K)", "nu": "V", "alpha": "alpha", "sigma": "sigma"},
@@ -158,7 +186,8 @@ def block_params(model: str = "sakaguchi", **overrides: Any):
     if model not in SINGLE_BLOCK:
         raise ParameterError(
             f"model must be one of {', '.join(SINGLE_BLOCK)} for a single block (got {model!r}); "
-            "run the others with `stickslip chain --model NAME`")
+            "run the others with `stickslip chain --model NAME`"
+        )
     values: dict[str, Any] = {}
     if model == "batista-carlson":
         pr = PRESETS[model]

@@ -84,9 +84,7 @@ def fig3_period(sweep: pd.DataFrame, limit: SlipLimit) -> Figure:
     T(V) = a + b / (K V) from eq. (3) (``limit``). The lower panel shows the relative deviation
     of the simulated period from the law.
     """
-    fig, (ax, ax_d) = new_figure(
-        2, 1, width=5.2, height=2.4, sharex=True, gridspec_kw={"height_ratios": [2.2, 1.0]}
-    )
+    fig, (ax, ax_d) = new_figure(2, 1, width=5.2, height=2.4, sharex=True, gridspec_kw={"height_ratios": [2.2, 1.0]})
     V = sweep["V"].to_numpy()
     grid = np.logspace(np.log10(V.min()), np.log10(V.max()), 200)
     ax.plot(grid, limit.period(grid), **THEORY,

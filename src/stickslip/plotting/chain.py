@@ -8,7 +8,8 @@ Each function takes results of a chain run (a snapshot of x_i, a table of <L> ag
 from __future__ import annotations
 
 import math
-from typing import Any, Sequence
+from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -54,8 +55,7 @@ def fig5a_snapshot(x: Any, params: ChainParams, t: float) -> Figure:
     shift = params.V * t
     exact = chain_steady_state(params, t)["x"]
     paper = chain_steady_profile_paper(params, t)
-    fig, (ax, ax_r) = new_figure(2, 1, width=6.0, height=2.4, sharex=True,
-                                 gridspec_kw={"height_ratios": [2.2, 1.0]})
+    fig, (ax, ax_r) = new_figure(2, 1, width=6.0, height=2.4, sharex=True, gridspec_kw={"height_ratios": [2.2, 1.0]})
     ax.plot(i, xs - shift, **SIM, label=f"$x_i$ at t = {t:.4g}")
     ax.plot(i, exact - shift, **THEORY, label="steady sliding, exact discrete")
     ax.plot(i, paper - shift, **PAPER, label="steady sliding, paper's continuum form")
@@ -69,8 +69,7 @@ def fig5a_snapshot(x: Any, params: ChainParams, t: float) -> Figure:
     ax_r.set_ylabel(r"$x_i - x_i^{ss}$")
     ax_r.set_xlim(1, params.N)
     ax_r.legend(loc="lower left", fontsize=8)
-    fig.suptitle(rf"Fig. 5(a): snapshot and steady sliding, $\beta={params.beta:g}$, {_param_text(params)}",
-                 fontsize=9)
+    fig.suptitle(rf"Fig. 5(a): snapshot and steady sliding, $\beta={params.beta:g}$, {_param_text(params)}", fontsize=9)
     return fig
 
 
@@ -95,20 +94,41 @@ def fig5b_length(table: pd.DataFrame, params: ChainParams, *, beta_c: float = 1.
     pad = 0.05 * max(hi - lo, 0.1)
     grid = np.linspace(max(lo - pad, 0.0), hi + pad, 200)
     steady = np.array([chain_steady_length(params.replace(beta=float(b))) for b in grid])
-    ax.plot(grid, steady, **THEORY,
-            label="steady sliding, $L_{ss} = (c/K)\\,N(N-1)/2$,\n$c = 1 - (1-\\beta)V$ (paper prints $cN^2/2$, "
-                  "without 1/K)")
-    ax.errorbar(beta, L, yerr=err, fmt="o-", color=SIM["color"], lw=SIM["lw"], ms=4, capsize=2,
-                label=r"$\langle L\rangle$, run")
+    ax.plot(
+        grid,
+        steady,
+        **THEORY,
+        label="steady sliding, $L_{ss} = (c/K)\\,N(N-1)/2$,\n$c = 1 - (1-\\beta)V$ (paper prints $cN^2/2$, "
+        "without 1/K)",
+    )
+    ax.errorbar(
+        beta, L, yerr=err, fmt="o-", color=SIM["color"], lw=SIM["lw"], ms=4, capsize=2, label=r"$\langle L\rangle$, run"
+    )
     if "final_state" in data:
-        unsettled = ((beta > beta_c) & (data["final_state"].to_numpy() != "steady sliding"))
+        unsettled = (beta > beta_c) & (data["final_state"].to_numpy() != "steady sliding")
         if unsettled.any():
             # open symbols over the filled ones: not settled by the end of the run
-            ax.scatter(beta[unsettled], L[unsettled], s=30, facecolors="white", edgecolors=SIM["color"],
-                       zorder=3, label="not settled into steady sliding\nby the end of the run")
+            ax.scatter(
+                beta[unsettled],
+                L[unsettled],
+                s=30,
+                facecolors="white",
+                edgecolors=SIM["color"],
+                zorder=3,
+                label="not settled into steady sliding\nby the end of the run",
+            )
     ax.axvline(beta_c, color="0.5", lw=0.8, ls=":")
-    ax.annotate(rf"$\beta_c = {beta_c:g}$ (Fig. 4)", (beta_c, 0.97), xycoords=("data", "axes fraction"),
-                xytext=(-3, 0), textcoords="offset points", ha="right", va="top", fontsize=8, color="0.35")
+    ax.annotate(
+        rf"$\beta_c = {beta_c:g}$ (Fig. 4)",
+        (beta_c, 0.97),
+        xycoords=("data", "axes fraction"),
+        xytext=(-3, 0),
+        textcoords="offset points",
+        ha="right",
+        va="top",
+        fontsize=8,
+        color="0.35",
+    )
     ax.set_xlabel(r"$\beta$")
     ax.set_ylabel(r"$L = \langle x_1 - x_N \rangle$")
     ax.set_title("(b)", loc="left")
@@ -156,8 +176,15 @@ def _waterfall(ax, sub: xr.Dataset, window: float | None, edge: EdgeSpeed | None
         ax.plot(blocks, dx[k] + k * step, color=colors[k], lw=0.9)
     if edge is not None and len(edge.edges) == n:
         k = _advance(edge)
-        ax.scatter(edge.edges[:k], np.arange(k) * step, marker="|", s=60, color="C3", zorder=3,
-                   label=rf"leading edge ($\Delta x_i \geq {edge.edge_fraction:g}\,\max_i \Delta x_i$)")
+        ax.scatter(
+            edge.edges[:k],
+            np.arange(k) * step,
+            marker="|",
+            s=60,
+            color="C3",
+            zorder=3,
+            label=rf"leading edge ($\Delta x_i \geq {edge.edge_fraction:g}\,\max_i \Delta x_i$)",
+        )
         ax.legend(loc="upper left", fontsize=7)
     ticks = np.arange(n) * step
     stride = max(1, int(math.ceil(n / 8)))
@@ -166,8 +193,17 @@ def _waterfall(ax, sub: xr.Dataset, window: float | None, edge: EdgeSpeed | None
     bar = _nice(0.8 * peak)
     x_bar = blocks.max() + 0.03 * (blocks.max() - blocks.min())
     ax.vlines([x_bar], 0.0, bar, color="k", lw=2.0, clip_on=False)
-    ax.annotate(rf"$\Delta x_i = {bar:g}$", (x_bar, bar / 2), xytext=(4, 0), textcoords="offset points",
-                rotation=90, va="center", ha="left", fontsize=8, annotation_clip=False)
+    ax.annotate(
+        rf"$\Delta x_i = {bar:g}$",
+        (x_bar, bar / 2),
+        xytext=(4, 0),
+        textcoords="offset points",
+        rotation=90,
+        va="center",
+        ha="left",
+        fontsize=8,
+        annotation_clip=False,
+    )
     w = f"{window:g}" if window else "W"
     ax.set_ylabel(rf"window start $t - t_s$; curves: $\Delta x_i$ over $\Delta t = {w}$", fontsize=9)
     ax.set_xlabel("block $i$")
@@ -184,18 +220,38 @@ def _arrivals(ax, first_move: pd.DataFrame, front: FrontSpeed, K: float, edge: E
     ax.plot(i[used], t[used], ".", color=SIM["color"], ms=2.5, label="first motion (fitted)")
     line_i = np.array([front.i_min, front.i_max], dtype=np.float64)
     t_anchor = float(front.arrival_time(front.i_min)) - front.t_start
-    ax.plot(line_i, front.arrival_time(line_i) - front.t_start, **THEORY,
-            label=f"fit: $c = {front.speed:.3g} \\pm {front.speed_err:.2g}$")
-    ax.plot(line_i, t_anchor + (line_i - front.i_min) / PAPER_FRONT_SPEED, **PAPER,
-            label=f"paper: $c = {PAPER_FRONT_SPEED}$")
+    ax.plot(
+        line_i,
+        front.arrival_time(line_i) - front.t_start,
+        **THEORY,
+        label=f"fit: $c = {front.speed:.3g} \\pm {front.speed_err:.2g}$",
+    )
+    ax.plot(
+        line_i,
+        t_anchor + (line_i - front.i_min) / PAPER_FRONT_SPEED,
+        **PAPER,
+        label=f"paper: $c = {PAPER_FRONT_SPEED}$",
+    )
     sound = math.sqrt(K)
-    ax.plot(line_i, t_anchor + (line_i - front.i_min) / sound, color="0.2", lw=0.9, ls="-.",
-            label=f"sound speed $\\sqrt{{K}} = {sound:.3g}$")
+    ax.plot(
+        line_i,
+        t_anchor + (line_i - front.i_min) / sound,
+        color="0.2",
+        lw=0.9,
+        ls="-.",
+        label=f"sound speed $\\sqrt{{K}} = {sound:.3g}$",
+    )
     if edge is not None:
         # window ends at which the edge had advanced to a block (upper bounds of its arrival)
         k = _advance(edge)
-        ax.scatter(edge.edges[:k], np.asarray(edge.times[:k]) - front.t_start, marker="|", s=40, color="C3",
-                   label=f"leading edge of the windows: $c = {edge.speed:.3g}$")
+        ax.scatter(
+            edge.edges[:k],
+            np.asarray(edge.times[:k]) - front.t_start,
+            marker="|",
+            s=40,
+            color="C3",
+            label=f"leading edge of the windows: $c = {edge.speed:.3g}$",
+        )
     ax.set_xlabel("block $i$")
     ax.set_ylabel("first-move time $t - t_s$")
     ax.legend(loc="upper left", fontsize=7)
@@ -214,13 +270,20 @@ def _speed_histogram(ax, speeds: np.ndarray, title: str, level: float = 0.9) -> 
     ci = central_interval(x, PAPER_FRONT_SPEED, level=level)
     lo = min(float(x.min()), PAPER_FRONT_SPEED)
     hi = max(float(x.max()), PAPER_FRONT_SPEED)
-    ax.hist(x, bins=np.linspace(lo - 0.02, hi + 0.02, 31), color=SIM["color"], alpha=0.8,
-            label=f"{x.size} events reaching block $N$")
-    ax.axvspan(ci.lo, ci.hi, color="0.85", zorder=0, label=f"central {100 * level:.0f}%: "
-               f"${ci.lo:.3g}$-${ci.hi:.3g}$")
+    ax.hist(
+        x,
+        bins=np.linspace(lo - 0.02, hi + 0.02, 31),
+        color=SIM["color"],
+        alpha=0.8,
+        label=f"{x.size} events reaching block $N$",
+    )
+    ax.axvspan(ci.lo, ci.hi, color="0.85", zorder=0, label=f"central {100 * level:.0f}%: ${ci.lo:.3g}$-${ci.hi:.3g}$")
     ax.axvline(ci.median, color=SIM["color"], lw=1.0, ls="--", label=f"median ${ci.median:.3g}$")
-    ax.axvline(PAPER_FRONT_SPEED, **{**PAPER, "lw": 1.6},
-               label=f"paper: $c = {PAPER_FRONT_SPEED}$, percentile {ci.percentile:.0f}")
+    ax.axvline(
+        PAPER_FRONT_SPEED,
+        **{**PAPER, "lw": 1.6},
+        label=f"paper: $c = {PAPER_FRONT_SPEED}$, percentile {ci.percentile:.0f}",
+    )
     ax.legend(loc="upper left", fontsize=7)
 
 
@@ -259,7 +322,7 @@ def fig6_fronts(
     fig, axes = new_figure(n_rows, 2, width=4.8, height=3.8)
     axes = np.asarray(axes).reshape(n_rows, 2)
     letters = "abcdefgh"
-    for row, (front, label, edge) in enumerate(zip(fronts, labels, edges)):
+    for row, (front, label, edge) in enumerate(zip(fronts, labels, edges, strict=False)):
         ax_w, ax_t = axes[row]
         sub = _event_profiles(profiles, front.event)
         _waterfall(ax_w, sub, window, edge)
@@ -270,10 +333,14 @@ def fig6_fronts(
         ax_t.set_title(f"front: blocks {front.i_min}-{front.i_max}", loc="left", fontsize=9)
     if speeds is not None:
         letter = letters[len(fronts)]
-        _speed_histogram(axes[-1, 0], speeds["c_first_move"].to_numpy(dtype=float),
-                         f"({letter}) per event: first motion, far half")
-        _speed_histogram(axes[-1, 1], speeds["c_leading_edge"].to_numpy(dtype=float),
-                         f"({letter}) per event: leading edge of the windows")
+        _speed_histogram(
+            axes[-1, 0], speeds["c_first_move"].to_numpy(dtype=float), f"({letter}) per event: first motion, far half"
+        )
+        _speed_histogram(
+            axes[-1, 1],
+            speeds["c_leading_edge"].to_numpy(dtype=float),
+            f"({letter}) per event: leading edge of the windows",
+        )
     fig.suptitle(rf"Fig. 6: rupture fronts, $\beta={params.beta:g}$, {_param_text(params)}", fontsize=9)
     return fig
 
@@ -298,18 +365,27 @@ def fig7_8_sizes(
     dist = size_distribution(S, bins)
     fig, (ax_a, ax_b) = new_figure(1, 2, width=4.8, height=3.8)
     filled = dist["count"].values > 0
-    ax_a.loglog(dist["S"].values[filled], dist["density"].values[filled], "o", color=SIM["color"],
-                ms=4, label=f"simulation ({dist.attrs['n_binned']} events)")
+    ax_a.loglog(
+        dist["S"].values[filled],
+        dist["density"].values[filled],
+        "o",
+        color=SIM["color"],
+        ms=4,
+        label=f"simulation ({dist.attrs['n_binned']} events)",
+    )
     share = fit.n / dist.attrs["n_binned"] if dist.attrs["n_binned"] else 1.0
     s_line = np.geomspace(fit.s_min, fit.s_max, 100)
     err = f" ± {fit.tau_err:.2f}" if math.isfinite(fit.tau_err) else ""
-    ax_a.loglog(s_line, share * fit.pdf(s_line), **THEORY,
-                label=f"fit: $\\tau = {fit.tau:.2f}${err}\n($S \\in [{fit.s_min:.3g}, {fit.s_max:.3g}]$, {fit.n} events)")
+    ax_a.loglog(
+        s_line,
+        share * fit.pdf(s_line),
+        **THEORY,
+        label=f"fit: $\\tau = {fit.tau:.2f}${err}\n($S \\in [{fit.s_min:.3g}, {fit.s_max:.3g}]$, {fit.n} events)",
+    )
     if paper_tau is not None:
         s_mid = math.sqrt(fit.s_min * fit.s_max)
         anchor = share * float(fit.pdf(s_mid))
-        ax_a.loglog(s_line, anchor * (s_line / s_mid) ** (-paper_tau), **PAPER,
-                    label=f"paper: slope $-{paper_tau:g}$")
+        ax_a.loglog(s_line, anchor * (s_line / s_mid) ** (-paper_tau), **PAPER, label=f"paper: slope $-{paper_tau:g}$")
     ax_a.set_xlabel("$S$")
     ax_a.set_ylabel("$p(S)$")
     ax_a.set_title("(a)", loc="left")

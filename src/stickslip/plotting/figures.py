@@ -8,8 +8,9 @@ beside it (NetCDF or CSV), and returns the report's entries for them; the drawin
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -39,11 +40,18 @@ def _write_csv(path: Path, table: pd.DataFrame) -> Path:
     return path
 
 
-def _figure(stem: str, label: str, caption: str, figures_dir: Path, fig, data: list[Path],
-            command: str = "") -> ReportFigure:
+def _figure(
+    stem: str, label: str, caption: str, figures_dir: Path, fig, data: list[Path], command: str = ""
+) -> ReportFigure:
     png, pdf = _save(fig, figures_dir, stem)
-    return ReportFigure(figure=label, image=png, caption=caption, pdf=pdf,
-                        data=tuple(f"figures/{p.name}" for p in data), command=command)
+    return ReportFigure(
+        figure=label,
+        image=png,
+        caption=caption,
+        pdf=pdf,
+        data=tuple(f"figures/{p.name}" for p in data),
+        command=command,
+    )
 
 
 def _fig1_2(o: dict[str, Outcome], d: Path) -> list[ReportFigure]:
@@ -54,18 +62,46 @@ def _fig1_2(o: dict[str, Outcome], d: Path) -> list[ReportFigure]:
     law = o["slip-limit"].data["law"]
     s = run.series
     f1 = io.write_dataset(d / "fig1.nc", s[["x"]])
-    figs = [_figure("fig1", "Fig. 1", "Time evolution of x of the single block, eq. (1), at M = alpha = beta = "
-                    "sigma = 1, K = 10, V = 0.001, Fs = 3 (Heun, dt = 0.005, from x = v = 0, theta = 0.1): "
-                    "stick-slip with period 344.", d, fig1_position(run), [f1], block_command(o["block"]))]
+    figs = [
+        _figure(
+            "fig1",
+            "Fig. 1",
+            "Time evolution of x of the single block, eq. (1), at M = alpha = beta = "
+            "sigma = 1, K = 10, V = 0.001, Fs = 3 (Heun, dt = 0.005, from x = v = 0, theta = 0.1): "
+            "stick-slip with period 344.",
+            d,
+            fig1_position(run),
+            [f1],
+            block_command(o["block"]),
+        )
+    ]
     w = slip_window(run)
-    f2 = io.write_dataset(d / "fig2.nc", xr.Dataset(
-        {"eq1_v": ("t_eq1", w["v"].values), "eq1_theta": ("t_eq1", w["theta"].values),
-         "eq3_v": ("t_eq3", law.curve["v"].values), "eq3_theta": ("t_eq3", law.curve["theta"].values)},
-        coords={"t_eq1": w["t"].values, "t_eq3": law.curve["t"].values},
-        attrs={"description": "Fig. 2: v and theta against t - t_c, eq. (1) (Heun) and eq. (3) (DOP853)"}))
-    figs.append(_figure("fig2", "Fig. 2", "(a) v(t - t_c) during the second slip of the run of Fig. 1 (solid) "
-                        "and of eq. (3) (dashed); (b) the phase portrait (v, theta). The paper: the curves "
-                        "overlap.", d, fig2_slip(run, law), [f2], "stickslip slip-limit --json"))
+    f2 = io.write_dataset(
+        d / "fig2.nc",
+        xr.Dataset(
+            {
+                "eq1_v": ("t_eq1", w["v"].values),
+                "eq1_theta": ("t_eq1", w["theta"].values),
+                "eq3_v": ("t_eq3", law.curve["v"].values),
+                "eq3_theta": ("t_eq3", law.curve["theta"].values),
+            },
+            coords={"t_eq1": w["t"].values, "t_eq3": law.curve["t"].values},
+            attrs={"description": "Fig. 2: v and theta against t - t_c, eq. (1) (Heun) and eq. (3) (DOP853)"},
+        ),
+    )
+    figs.append(
+        _figure(
+            "fig2",
+            "Fig. 2",
+            "(a) v(t - t_c) during the second slip of the run of Fig. 1 (solid) "
+            "and of eq. (3) (dashed); (b) the phase portrait (v, theta). The paper: the curves "
+            "overlap.",
+            d,
+            fig2_slip(run, law),
+            [f2],
+            "stickslip slip-limit --json",
+        )
+    )
     return figs
 
 
@@ -76,10 +112,19 @@ def _fig3(o: dict[str, Outcome], d: Path) -> list[ReportFigure]:
     table = o["period-sweep"].data["table"]
     law = o["slip-limit"].data["law"]
     f = _write_csv(d / "fig3.csv", table)
-    return [_figure("fig3", "Fig. 3", f"Period of stick-slip against V: simulated (marks) and "
-                    f"T = {law.law_a:.4f} + {law.law_b:.4f} / (K V) from eq. (3) (dashed; the paper: "
-                    "T = 1.035 + 3.432 / (K V)).", d, fig3_period(table, law), [f],
-                    "stickslip block --fig3 --out DIR")]
+    return [
+        _figure(
+            "fig3",
+            "Fig. 3",
+            f"Period of stick-slip against V: simulated (marks) and "
+            f"T = {law.law_a:.4f} + {law.law_b:.4f} / (K V) from eq. (3) (dashed; the paper: "
+            "T = 1.035 + 3.432 / (K V)).",
+            d,
+            fig3_period(table, law),
+            [f],
+            "stickslip block --fig3 --out DIR",
+        )
+    ]
 
 
 def _stability_map(o: dict[str, Outcome], d: Path) -> list[ReportFigure]:
@@ -89,10 +134,19 @@ def _stability_map(o: dict[str, Outcome], d: Path) -> list[ReportFigure]:
     ds = o["stability-block"].data["map"]
     f = io.write_dataset(d / "stability_map.nc", ds)
     fig = plot_stability_map(ds[["V_c", "V_c_closed_form"]].assign_attrs(ds.attrs), ds["growth_rate"])
-    return [_figure("stability_map", "Section 2, eq. (2)", "Linear stability of steady sliding of the single "
-                    "block at K = 10: largest Re(lambda) of eq. (2) over (beta, V) and the Hopf curve V_c(beta). "
-                    "The paper: V_c = 0.106 at beta = 0.08; stable for all V at beta = 1.", d, fig, [f],
-                    "stickslip stability block --K 10 --beta 0.08 --out DIR")]
+    return [
+        _figure(
+            "stability_map",
+            "Section 2, eq. (2)",
+            "Linear stability of steady sliding of the single "
+            "block at K = 10: largest Re(lambda) of eq. (2) over (beta, V) and the Hopf curve V_c(beta). "
+            "The paper: V_c = 0.106 at beta = 0.08; stable for all V at beta = 1.",
+            d,
+            fig,
+            [f],
+            "stickslip stability block --K 10 --beta 0.08 --out DIR",
+        )
+    ]
 
 
 def _hysteresis(o: dict[str, Outcome], d: Path) -> list[ReportFigure]:
@@ -101,10 +155,19 @@ def _hysteresis(o: dict[str, Outcome], d: Path) -> list[ReportFigure]:
 
     data = o["hysteresis"].data["data"]
     f = io.write_dataset(d / "hysteresis.nc", data)
-    return [_figure("hysteresis", "Section 2, inverse transition", "Single block, beta = 1, Fs = 3, K = 10: "
-                    "largest and least v at each V as V is raised slowly and lowered again. Stick-slip "
-                    "(min v = 0) ends at V_up (the paper: 0.345).", d, plot_hysteresis(data), [f],
-                    hysteresis_command(o["hysteresis"]))]
+    return [
+        _figure(
+            "hysteresis",
+            "Section 2, inverse transition",
+            "Single block, beta = 1, Fs = 3, K = 10: "
+            "largest and least v at each V as V is raised slowly and lowered again. Stick-slip "
+            "(min v = 0) ends at V_up (the paper: 0.345).",
+            d,
+            plot_hysteresis(data),
+            [f],
+            hysteresis_command(o["hysteresis"]),
+        )
+    ]
 
 
 def _fig4(o: dict[str, Outcome], d: Path) -> list[ReportFigure]:
@@ -113,10 +176,19 @@ def _fig4(o: dict[str, Outcome], d: Path) -> list[ReportFigure]:
 
     ds = o["chain-modes"].data["modes"]
     f = io.write_dataset(d / "fig4.nc", ds)
-    return [_figure("fig4", "Fig. 4", "Real parts of the two largest eigenvalues of the Fourier modes of the "
-                    "linearised chain, eq. (5), against k at beta = 0.5, 1, 1.5 (K = 10, D = 5). Right: long "
-                    "waves, unstable for beta < 1.", d, plot_fig4(ds), [f],
-                    "stickslip stability chain --K 10 --D 5 --beta 1 --out DIR")]
+    return [
+        _figure(
+            "fig4",
+            "Fig. 4",
+            "Real parts of the two largest eigenvalues of the Fourier modes of the "
+            "linearised chain, eq. (5), against k at beta = 0.5, 1, 1.5 (K = 10, D = 5). Right: long "
+            "waves, unstable for beta < 1.",
+            d,
+            plot_fig4(ds),
+            [f],
+            "stickslip stability chain --K 10 --D 5 --beta 1 --out DIR",
+        )
+    ]
 
 
 def _fig5(o: dict[str, Outcome], a: dict[str, Any], d: Path, mode: str) -> list[ReportFigure]:
@@ -128,24 +200,50 @@ def _fig5(o: dict[str, Outcome], a: dict[str, Any], d: Path, mode: str) -> list[
     snap = run.snapshots.isel(time=-1)
     t = float(snap["time"])
     p = run.params
-    fa = _write_csv(d / "fig5a.csv", pd.DataFrame({
-        "block": np.arange(1, p.N + 1), "x": snap.values, "x_steady_exact": chain_steady_state(p, t)["x"],
-        "x_steady_paper": chain_steady_profile_paper(p, t)}))
-    figs = [_figure("fig5a", "Fig. 5(a)", f"Snapshot of x_i at t = {t:.3g} at beta = 1 (N = {p.N}), in the frame "
-                    "of the pulling point, against the exact discrete steady sliding profile (dashed) and the "
-                    "paper's continuum form (dotted).", d, fig5a_snapshot(snap, p, t), [fa],
-                    chain_command(o["chain-runs"], p.N, 1.0))]
+    fa = _write_csv(
+        d / "fig5a.csv",
+        pd.DataFrame(
+            {
+                "block": np.arange(1, p.N + 1),
+                "x": snap.values,
+                "x_steady_exact": chain_steady_state(p, t)["x"],
+                "x_steady_paper": chain_steady_profile_paper(p, t),
+            }
+        ),
+    )
+    figs = [
+        _figure(
+            "fig5a",
+            "Fig. 5(a)",
+            f"Snapshot of x_i at t = {t:.3g} at beta = 1 (N = {p.N}), in the frame "
+            "of the pulling point, against the exact discrete steady sliding profile (dashed) and the "
+            "paper's continuum form (dotted).",
+            d,
+            fig5a_snapshot(snap, p, t),
+            [fa],
+            chain_command(o["chain-runs"], p.N, 1.0),
+        )
+    ]
     sweep = sweep_table(a)
     fb = _write_csv(d / "fig5b.csv", sweep)
     q = ChainParams(**{k: v for k, v in o["chain-runs"].experiment.params.items()}, N=a["sweep_N"])
     steady_note = ", ".join(f"{b:g}" for b in sweep.loc[sweep["final_state"] == "steady sliding", "beta"])
-    figs.append(_figure("fig5b", "Fig. 5(b)", f"Time-averaged length <L> = <x_1 - x_N> against beta (N = "
-                        f"{a['sweep_N']}, second half of each run; error bars: batch means) and the steady "
-                        "sliding length L_ss = (c/K) N (N - 1) / 2 with the steady friction c = 1 - (1 - beta) V "
-                        "(dashed); dotted: beta_c = 1. Runs that reached steady sliding (beta = "
-                        f"{steady_note or 'none'}) were stopped there and count L_ss from then on; open symbols: "
-                        "runs above beta_c that had not settled into steady sliding by their end.", d,
-                        fig5b_length(sweep, q), [fb], sweep_command(o["chain-runs"], mode)))
+    figs.append(
+        _figure(
+            "fig5b",
+            "Fig. 5(b)",
+            f"Time-averaged length <L> = <x_1 - x_N> against beta (N = "
+            f"{a['sweep_N']}, second half of each run; error bars: batch means) and the steady "
+            "sliding length L_ss = (c/K) N (N - 1) / 2 with the steady friction c = 1 - (1 - beta) V "
+            "(dashed); dotted: beta_c = 1. Runs that reached steady sliding (beta = "
+            f"{steady_note or 'none'}) were stopped there and count L_ss from then on; open symbols: "
+            "runs above beta_c that had not settled into steady sliding by their end.",
+            d,
+            fig5b_length(sweep, q),
+            [fb],
+            sweep_command(o["chain-runs"], mode),
+        )
+    )
     return figs
 
 
@@ -164,8 +262,12 @@ def _fig6(o: dict[str, Outcome], a: dict[str, Any], d: Path) -> list[ReportFigur
     f1 = io.write_dataset(d / "fig6.nc", prof)
     fm = run.first_move[run.first_move["event"].isin(ids)]
     f2 = _write_csv(d / "fig6_first_move.csv", fm)
-    f3 = _write_csv(d / "fig6_fronts.csv", pd.DataFrame([f.to_dict() for f in fr["fronts"]]).assign(
-        label=fr["labels"], c_leading_edge=[e.speed if e is not None else np.nan for e in fr["edges"]]))
+    f3 = _write_csv(
+        d / "fig6_fronts.csv",
+        pd.DataFrame([f.to_dict() for f in fr["fronts"]]).assign(
+            label=fr["labels"], c_leading_edge=[e.speed if e is not None else np.nan for e in fr["edges"]]
+        ),
+    )
     per_event = fr["per_event"]
     f4 = _write_csv(d / "fig6_speeds.csv", per_event)
     parts = []
@@ -174,18 +276,25 @@ def _fig6(o: dict[str, Outcome], a: dict[str, Any], d: Path) -> list[ReportFigur
         x = x[np.isfinite(x)]
         if x.size:
             ci = central_interval(x, PAPER_FRONT_SPEED)
-            parts.append(f"{name}: median {ci.median:.3g}, central 90% {ci.lo:.3g}-{ci.hi:.3g}, the paper's 1.43 at "
-                         f"percentile {ci.percentile:.0f}")
-    caption = (f"(a, b) Displacement over windows of 20 time units in a large and an intermediate slip event at "
-               f"beta = 1 (N = {run.params.N}; curves lifted, scale bar at the right; red marks: leading edge of each "
-               f"window), and the time each block first moved with the fitted front speed. (c) Front speed of each "
-               f"of the {len(per_event)} events that reached block N in the second half, by first motion over the "
-               f"far half and by the leading edge of the windows: " + "; ".join(parts)
-               + f" (sound speed 3.16). {fig6_start_note(a)}")
-    fig = fig6_fronts(prof, fm, fr["fronts"], run.params, labels=fr["labels"], window=20.0, edges=fr["edges"],
-                      speeds=per_event)
-    return [_figure("fig6", "Fig. 6", caption, d, fig, [f1, f2, f3, f4],
-                    chain_command(o["chain-runs"], run.params.N, 1.0))]
+            parts.append(
+                f"{name}: median {ci.median:.3g}, central 90% {ci.lo:.3g}-{ci.hi:.3g}, the paper's 1.43 at "
+                f"percentile {ci.percentile:.0f}"
+            )
+    caption = (
+        f"(a, b) Displacement over windows of 20 time units in a large and an intermediate slip event at "
+        f"beta = 1 (N = {run.params.N}; curves lifted, scale bar at the right; red marks: leading edge of each "
+        f"window), and the time each block first moved with the fitted front speed. (c) Front speed of each "
+        f"of the {len(per_event)} events that reached block N in the second half, by first motion over the "
+        f"far half and by the leading edge of the windows: "
+        + "; ".join(parts)
+        + f" (sound speed 3.16). {fig6_start_note(a)}"
+    )
+    fig = fig6_fronts(
+        prof, fm, fr["fronts"], run.params, labels=fr["labels"], window=20.0, edges=fr["edges"], speeds=per_event
+    )
+    return [
+        _figure("fig6", "Fig. 6", caption, d, fig, [f1, f2, f3, f4], chain_command(o["chain-runs"], run.params.N, 1.0))
+    ]
 
 
 def _fig7_8(o: dict[str, Outcome], a: dict[str, Any], d: Path, which: str) -> list[ReportFigure]:
@@ -203,18 +312,35 @@ def _fig7_8(o: dict[str, Outcome], a: dict[str, Any], d: Path, which: str) -> li
     hist = size_distribution(events["S"].to_numpy(dtype=float), 30)
     f2 = io.write_dataset(d / f"{stem}_histogram.nc", hist)
     N = a["figure_N"]
-    fit_range = (f"fitted on [{fit.s_min:.3g}, {fit.s_max:.3g}]" + (" (below the smallest event that reached "
-                 "block N)" if which == "8" else " with the cut-off in the likelihood"))
-    caption = (f"(a) Density of slip sizes S = sum_i dx_i at beta = {beta:g} (N = {N}, events of the second half "
-               f"of the run), truncated power law {fit_range}: tau = {fit.tau:.2f} ± {fit.tau_err:.2f} (the paper: "
-               f"{'nearly 1.5' if which == '7' else 'about 1.6 for small S, with an excess of large events'}). "
-               f"(b) S against the event's start time.")
-    return [_figure(stem, label, caption, d, fig7_8_sizes(events, fit, beta, paper_tau=paper_tau), [f1, f2],
-                    chain_command(o["chain-runs"], N, beta))]
+    fit_range = f"fitted on [{fit.s_min:.3g}, {fit.s_max:.3g}]" + (
+        " (below the smallest event that reached block N)" if which == "8" else " with the cut-off in the likelihood"
+    )
+    caption = (
+        f"(a) Density of slip sizes S = sum_i dx_i at beta = {beta:g} (N = {N}, events of the second half "
+        f"of the run), truncated power law {fit_range}: tau = {fit.tau:.2f} ± {fit.tau_err:.2f} (the paper: "
+        f"{'nearly 1.5' if which == '7' else 'about 1.6 for small S, with an excess of large events'}). "
+        f"(b) S against the event's start time."
+    )
+    return [
+        _figure(
+            stem,
+            label,
+            caption,
+            d,
+            fig7_8_sizes(events, fit, beta, paper_tau=paper_tau),
+            [f1, f2],
+            chain_command(o["chain-runs"], N, beta),
+        )
+    ]
 
 
-def draw_figures(outcomes: dict[str, Outcome], analysis: dict[str, Any] | None, out_dir: Path,
-                 mode: str, log: Callable[[str], None] | None = None) -> tuple[list[ReportFigure], dict[str, str]]:
+def draw_figures(
+    outcomes: dict[str, Outcome],
+    analysis: dict[str, Any] | None,
+    out_dir: Path,
+    mode: str,
+    log: Callable[[str], None] | None = None,
+) -> tuple[list[ReportFigure], dict[str, str]]:
     """Draw every figure of the paper (Figs. 1-8 and the two of section 2) into ``out_dir/figures``.
 
     Returns the report entries and, for a figure that cannot be drawn from these results (e.g.

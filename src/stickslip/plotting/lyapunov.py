@@ -15,8 +15,7 @@ def plot_lyapunov_beta(table: pd.DataFrame, params=None, *, beta_c: float | None
     ``beta_c`` draws the long-wave critical value (beta = alpha = 1, Fig. 4) as a dotted line.
     """
     fig, ax = new_figure()
-    ax.errorbar(table["beta"], table["lyapunov"], yerr=table["lyapunov_err"], marker="o", ms=4,
-                capsize=3, **SIM)
+    ax.errorbar(table["beta"], table["lyapunov"], yerr=table["lyapunov_err"], marker="o", ms=4, capsize=3, **SIM)
     ax.axhline(0.0, color="0.3", lw=0.8)
     if beta_c is not None:
         ax.axvline(beta_c, color="0.5", lw=0.8, ls=":", label=rf"$\beta_c = {beta_c:g}$ (linear threshold)")

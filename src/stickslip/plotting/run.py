@@ -64,35 +64,58 @@ def run_figures(run, *, max_snapshots: int = 4) -> list[RunFigure]:
     steady = has_steady_state(p) and p.drive == "end"
     t_end = float(run.summary["t_end"])
     if steady:
-        out.append(RunFigure("snapshot_final", f"final state at t = {t_end:g} against steady sliding",
-                             fig5a_snapshot(run.state.blocks()["x"], p, t_end)))
+        out.append(
+            RunFigure(
+                "snapshot_final",
+                f"final state at t = {t_end:g} against steady sliding",
+                fig5a_snapshot(run.state.blocks()["x"], p, t_end),
+            )
+        )
         times = run.snapshots["time"].values if "time" in run.snapshots.dims else []
         for t in [t for t in times if not math.isclose(float(t), t_end)][:max_snapshots]:
-            out.append(RunFigure(f"snapshot_t{float(t):.6g}", f"snapshot at t = {float(t):g}",
-                                 fig5a_snapshot(run.snapshots.sel(time=t), p, float(t))))
+            out.append(
+                RunFigure(
+                    f"snapshot_t{float(t):.6g}",
+                    f"snapshot at t = {float(t):g}",
+                    fig5a_snapshot(run.snapshots.sel(time=t), p, float(t)),
+                )
+            )
     else:
-        out.append(RunFigure("snapshot_final", "final state", None,
-                             "no steady sliding profile for this model"))
+        out.append(RunFigure("snapshot_final", "final state", None, "no steady sliding profile for this model"))
     events = run.events
     n_pos = int(np.count_nonzero(events["S"].to_numpy(dtype=float) > 0)) if len(events) else 0
     if n_pos >= MIN_EVENTS_FOR_SIZES:
         stats = size_statistics(events, p.N, small_only=False, bootstrap=100)
         out.append(RunFigure("sizes", "slip-size distribution", fig7_8_sizes(events, stats["fit"], p.beta)))
     else:
-        out.append(RunFigure("sizes", "slip-size distribution", None,
-                             f"{n_pos} events with S > 0 (a distribution needs {MIN_EVENTS_FOR_SIZES})"))
+        out.append(
+            RunFigure(
+                "sizes",
+                "slip-size distribution",
+                None,
+                f"{n_pos} events with S > 0 (a distribution needs {MIN_EVENTS_FOR_SIZES})",
+            )
+        )
     if run.profiles.sizes.get("row", 0) and len(events):
         fronts = front_statistics(run, p.N, 0.0)
         if fronts["fronts"]:
-            fig = fig6_fronts(run.profiles, run.first_move, fronts["fronts"], p, labels=fronts["labels"],
-                              window=run.options.profile_window)
+            fig = fig6_fronts(
+                run.profiles,
+                run.first_move,
+                fronts["fronts"],
+                p,
+                labels=fronts["labels"],
+                window=run.options.profile_window,
+            )
             out.append(RunFigure("fronts", "rupture fronts of the largest events", fig))
         else:
-            out.append(RunFigure("fronts", "rupture fronts", None,
-                                 "no event with stored profiles could be fitted"))
+            out.append(RunFigure("fronts", "rupture fronts", None, "no event with stored profiles could be fitted"))
     else:
-        out.append(RunFigure("fronts", "rupture fronts", None,
-                             "no displacement profiles stored (run with --profile-window 20)"))
+        out.append(
+            RunFigure(
+                "fronts", "rupture fronts", None, "no displacement profiles stored (run with --profile-window 20)"
+            )
+        )
     return out
 
 

@@ -20,9 +20,7 @@ PAPER_V_UP = 0.345
 PAPER_SWEEP = {"K": 10.0, "beta": 1.0, "Fs": 3.0, "alpha": 1.0, "M": 1.0, "sigma": 1.0}
 
 
-def plot_stability_map(
-    curve: xr.Dataset, growth: xr.DataArray | None = None, *, mark: dict | None = None
-) -> Figure:
+def plot_stability_map(curve: xr.Dataset, growth: xr.DataArray | None = None, *, mark: dict | None = None) -> Figure:
     """Stability map of steady sliding of the block (section 2, eq. 2): V_c(beta) at fixed K.
 
     ``curve`` is :func:`stickslip.analysis.stability.hopf_curve`; ``growth`` (optional) the largest
@@ -33,14 +31,26 @@ def plot_stability_map(
         g = growth.transpose("V", "beta").values
         lim = float(np.nanmax(np.abs(g))) or 1.0
         mesh = ax.pcolormesh(
-            growth["beta"].values, growth["V"].values, g, cmap="RdBu_r",
-            norm=TwoSlopeNorm(vcenter=0.0, vmin=-lim, vmax=lim), shading="auto", rasterized=True,
+            growth["beta"].values,
+            growth["V"].values,
+            g,
+            cmap="RdBu_r",
+            norm=TwoSlopeNorm(vcenter=0.0, vmin=-lim, vmax=lim),
+            shading="auto",
+            rasterized=True,
         )
         fig.colorbar(mesh, ax=ax, label=r"largest Re$\,\lambda$")
     ax.plot(curve["beta"], curve["V_c"], **SIM, label=r"Hopf curve $V_c(\beta)$ (root finding)")
     ax.plot(curve["beta"], curve["V_c_closed_form"], **THEORY, label="Routh-Hurwitz closed form")
-    ax.plot([PAPER_HOPF["beta"]], [PAPER_HOPF["V"]], "o", mfc="none", mec="k", ms=7,
-            label=r"paper: $V_c=0.106$ at $\beta=0.08$")
+    ax.plot(
+        [PAPER_HOPF["beta"]],
+        [PAPER_HOPF["V"]],
+        "o",
+        mfc="none",
+        mec="k",
+        ms=7,
+        label=r"paper: $V_c=0.106$ at $\beta=0.08$",
+    )
     if mark is not None:
         ax.plot([mark["beta"]], [mark["V"]], "x", color="k", ms=7, label="requested point")
     K = curve.attrs.get("K")
@@ -72,7 +82,7 @@ def plot_fig4(ds: xr.Dataset, *, k_zoom: float = 0.3) -> Figure:
         ax.axhline(0.0, color="k", lw=0.6)
         ax.set_xlabel(r"wavenumber $k$")
     axes[0].set_ylabel(r"Re$\,\lambda$ (two largest)")
-    axes[1].set_ylabel(r"Re$\,\lambda$ (two largest), $k \leq %g$" % k_zoom)
+    axes[1].set_ylabel(rf"Re$\,\lambda$ (two largest), $k \leq {k_zoom:g}$")
     axes[0].set_xlim(0.0, np.pi)
     axes[1].set_xlim(0.0, k_zoom)
     small = ds["real"].where(ds["k"] <= k_zoom).isel(branch=slice(0, 2))
@@ -80,8 +90,11 @@ def plot_fig4(ds: xr.Dataset, *, k_zoom: float = 0.3) -> Figure:
     pad = 0.08 * (hi - lo)
     axes[1].set_ylim(lo - pad, hi + pad)
     attrs = ds.attrs
-    axes[0].set_title(f"$K = {attrs.get('K', float('nan')):g}$, $D = {attrs.get('D', float('nan')):g}$, "
-                      f"$V = {attrs.get('V', float('nan')):g}$", fontsize=9)
+    axes[0].set_title(
+        f"$K = {attrs.get('K', float('nan')):g}$, $D = {attrs.get('D', float('nan')):g}$, "
+        f"$V = {attrs.get('V', float('nan')):g}$",
+        fontsize=9,
+    )
     axes[1].set_title("long waves (solid: largest, dashed: second)", fontsize=9)
     axes[0].legend(fontsize=8)
     return fig
@@ -107,26 +120,54 @@ def plot_hysteresis(sweep: xr.Dataset) -> Figure:
     v_down = sweep.attrs.get("V_down")
     if v_up is not None and np.isfinite(v_up):
         ax.axvline(v_up, color="C0", lw=0.8, alpha=0.6)
-        ax.annotate(rf"$V_\mathrm{{up}}={v_up:.4g}$", (v_up, 0.55), xycoords=("data", "axes fraction"),
-                    xytext=(-3, 0), textcoords="offset points", ha="right", va="center", fontsize=8,
-                    color="C0", rotation=90)
+        ax.annotate(
+            rf"$V_\mathrm{{up}}={v_up:.4g}$",
+            (v_up, 0.55),
+            xycoords=("data", "axes fraction"),
+            xytext=(-3, 0),
+            textcoords="offset points",
+            ha="right",
+            va="center",
+            fontsize=8,
+            color="C0",
+            rotation=90,
+        )
     if v_down is not None and np.isfinite(v_down):
         ax.axvline(v_down, color="C1", lw=0.8, alpha=0.6)
-        ax.annotate(rf"$V_{{down}}={v_down:.4g}$", (v_down, 0.55), xycoords=("data", "axes fraction"),
-                    xytext=(-3, 0), textcoords="offset points", ha="right", va="center", fontsize=8,
-                    color="C1", rotation=90)
+        ax.annotate(
+            rf"$V_{{down}}={v_down:.4g}$",
+            (v_down, 0.55),
+            xycoords=("data", "axes fraction"),
+            xytext=(-3, 0),
+            textcoords="offset points",
+            ha="right",
+            va="center",
+            fontsize=8,
+            color="C1",
+            rotation=90,
+        )
     elif v_up is not None and np.isfinite(v_up):
-        ax.text(0.98, 0.55, "going down: no return\nto stick-slip in this range", transform=ax.transAxes,
-                ha="right", va="center", fontsize=8, color="C1")
+        ax.text(
+            0.98,
+            0.55,
+            "going down: no return\nto stick-slip in this range",
+            transform=ax.transAxes,
+            ha="right",
+            va="center",
+            fontsize=8,
+            color="C1",
+        )
     a = sweep.attrs
     if all(a.get(name) == value for name, value in PAPER_SWEEP.items()):
         ax.axvline(PAPER_V_UP, **PAPER, label="paper: $V = 0.345$")
     ax.set_xlabel(r"pulling velocity $V$")
     ax.set_ylabel(r"block velocity $v$ (max, min)")
-    ax.set_title(f"single block, $K = {a.get('K', float('nan')):g}$, $\\beta = {a.get('beta', float('nan')):g}$, "
-                 f"$F_s = {a.get('Fs', float('nan')):g}$; $\\Delta V = {a.get('dV', float('nan')):g}$, "
-                 f"{a.get('time_per_step', float('nan')):g} time units per V",
-                 fontsize=9)
+    ax.set_title(
+        f"single block, $K = {a.get('K', float('nan')):g}$, $\\beta = {a.get('beta', float('nan')):g}$, "
+        f"$F_s = {a.get('Fs', float('nan')):g}$; $\\Delta V = {a.get('dV', float('nan')):g}$, "
+        f"{a.get('time_per_step', float('nan')):g} time units per V",
+        fontsize=9,
+    )
     ax.legend(fontsize=7, loc="best")
     return fig
 
@@ -146,15 +187,19 @@ def plot_mode_growth(ds: xr.Dataset, modes=None) -> Figure:
     if modes is not None:
         km = np.asarray(modes["k"], dtype=float)
         km = np.where(km > np.pi, 2.0 * np.pi - km, km)
-        ax.plot(km, modes["growth_rate"], "o", ms=3, mfc="none", color="C1",
-                label=f"modes of the chain ($N = {len(km)}$)")
+        ax.plot(
+            km, modes["growth_rate"], "o", ms=3, mfc="none", color="C1", label=f"modes of the chain ($N = {len(km)}$)"
+        )
     ax.axhline(0.0, color="k", lw=0.6)
     ax.set_xlim(0.0, np.pi)
     ax.set_xlabel(r"wavenumber $k$")
     ax.set_ylabel(r"Re$\,\lambda$")
     a = ds.attrs
     names = [n for n in ("K", "Kp", "V", "alpha", "sigma", "beta") if n in a and not isinstance(a[n], str)]
-    ax.set_title(f"{a.get('model', '')}: {a.get('drive', '')} drive, {a.get('friction', '')} friction\n"
-                 + ", ".join(f"{n} = {a[n]:g}" for n in names), fontsize=8)
+    ax.set_title(
+        f"{a.get('model', '')}: {a.get('drive', '')} drive, {a.get('friction', '')} friction\n"
+        + ", ".join(f"{n} = {a[n]:g}" for n in names),
+        fontsize=8,
+    )
     ax.legend(fontsize=8, loc="best")
     return fig

@@ -15,8 +15,15 @@ from matplotlib.lines import Line2D
 
 from stickslip.plotting.style import new_figure
 
-__all__ = ["order_parameter_figure", "steady_time_figure", "collapse_figure", "phase_map_figure",
-           "exponents_figure", "chaos_figure", "STATE_STYLE"]
+__all__ = [
+    "order_parameter_figure",
+    "steady_time_figure",
+    "collapse_figure",
+    "phase_map_figure",
+    "exponents_figure",
+    "chaos_figure",
+    "STATE_STYLE",
+]
 
 #: Marker colour of each final state.
 STATE_STYLE = {"steady": "C0", "stick-slip": "C3", "undecided": "C1", "failed": "0.5"}
@@ -29,8 +36,17 @@ def order_parameter_figure(table: pd.DataFrame) -> Figure:
     for k, (N, g) in enumerate(sorted(table.groupby("N"), key=lambda x: x[0])):
         g = g.sort_values("beta")
         color = f"C{k}"
-        ax.errorbar(g["beta"], g["order_parameter"], yerr=g["order_parameter_err"], color=color, lw=1,
-                    marker="o", ms=4, capsize=2, label=f"N = {N}")
+        ax.errorbar(
+            g["beta"],
+            g["order_parameter"],
+            yerr=g["order_parameter_err"],
+            color=color,
+            lw=1,
+            marker="o",
+            ms=4,
+            capsize=2,
+            label=f"N = {N}",
+        )
         und = g[g["final_state"] == "undecided"]
         ax.plot(und["beta"], und["order_parameter"], "o", ms=9, mfc="none", mec=color)
     ax.axvline(1.0, color="0.5", lw=0.8, ls=":")
@@ -65,8 +81,16 @@ def collapse_figure(table: pd.DataFrame, fits: dict | None = None) -> Figure:
         if not len(g):
             continue
         x = 1.0 - g["beta"].to_numpy(float)
-        ax.errorbar(x, g["order_parameter"], yerr=g["order_parameter_err"], fmt="o", color=f"C{k}", ms=4,
-                    capsize=2, label=f"N = {N}")
+        ax.errorbar(
+            x,
+            g["order_parameter"],
+            yerr=g["order_parameter_err"],
+            fmt="o",
+            color=f"C{k}",
+            ms=4,
+            capsize=2,
+            label=f"N = {N}",
+        )
         f = (fits or {}).get(int(N))
         if f and np.isfinite(f.get("b", np.nan)):
             xx = np.geomspace(x.min(), x.max(), 20)
@@ -94,8 +118,9 @@ def phase_map_figure(table: pd.DataFrame, x: str, title: str) -> Figure:
             a1.plot(xv, b, "o", ms=14, mfc="none", mew=2, mec=STATE_STYLE.get(s["final_state"], "k"))
             if s["final_state"] != r["final_state"]:
                 a1.plot(xv, b, "kx", ms=12)
-    sc = a2.scatter([i[0] for i in paper.index], [i[1] for i in paper.index], c=paper["order_parameter"],
-                    cmap="viridis", s=80)
+    sc = a2.scatter(
+        [i[0] for i in paper.index], [i[1] for i in paper.index], c=paper["order_parameter"], cmap="viridis", s=80
+    )
     fig.colorbar(sc, ax=a2, label="m (paper's start)")
     for ax in (a1, a2):
         xs = np.array(sorted(table[x].unique()), dtype=float)
@@ -125,8 +150,7 @@ def exponents_figure(table: pd.DataFrame) -> Figure:
     a1.errorbar(chain["beta"], chain["tau"], yerr=chain["tau_err"], fmt="o-", ms=4, capsize=2, label="eq. (4)")
     for r in cl.itertuples():
         if np.isfinite(r.tau):
-            a1.axhspan(r.tau - r.tau_err, r.tau + r.tau_err, color="C3", alpha=0.25,
-                       label=f"Carlson-Langer, N = {r.N}")
+            a1.axhspan(r.tau - r.tau_err, r.tau + r.tau_err, color="C3", alpha=0.25, label=f"Carlson-Langer, N = {r.N}")
     a1.plot([1.0], [1.5], "k*", ms=8, label="paper, beta = 1")
     a1.plot([0.2], [1.6], "k^", ms=6, label="paper, beta = 0.2")
     a1.set_xlabel(r"$\beta$")
@@ -155,8 +179,17 @@ def chaos_figure(table: pd.DataFrame) -> Figure:
     fig, (a1, a2) = new_figure(1, 2, width=4.4, height=3.6, gridspec_kw={"width_ratios": [2.2, 1]})
     chain = table[table["model"] == "sakaguchi"].sort_values("beta")
     for k, (N, g) in enumerate(sorted(chain.groupby("N"), key=lambda x: x[0])):
-        a1.errorbar(g["beta"], g["lyapunov"], yerr=g["lyapunov_err"], fmt="o-", color=f"C{k}", ms=4, lw=1,
-                    capsize=2, label=f"eq. (4), N = {int(N)}")
+        a1.errorbar(
+            g["beta"],
+            g["lyapunov"],
+            yerr=g["lyapunov_err"],
+            fmt="o-",
+            color=f"C{k}",
+            ms=4,
+            lw=1,
+            capsize=2,
+            label=f"eq. (4), N = {int(N)}",
+        )
     a1.axhline(0.0, color="0.3", lw=0.8)
     a1.axvline(1.0, color="0.5", lw=0.8, ls=":", label=r"$\beta_c = \alpha = 1$")
     a1.set_xlabel(r"$\beta$")
@@ -170,12 +203,18 @@ def chaos_figure(table: pd.DataFrame) -> Figure:
     for i, model in enumerate(models):
         g = family[family["model"] == model].sort_values("d0")
         offsets = np.linspace(-0.15, 0.15, len(g)) if len(g) > 1 else np.zeros(1)
-        for off, r in zip(offsets, g.itertuples()):
-            a2.errorbar([i + off], [r.lyapunov], yerr=[r.lyapunov_err], fmt=FAMILY_MARKERS.get(model, "o"),
-                        color=f"C{3 + i}", ms=6, capsize=2)
+        for off, r in zip(offsets, g.itertuples(), strict=False):
+            a2.errorbar(
+                [i + off],
+                [r.lyapunov],
+                yerr=[r.lyapunov_err],
+                fmt=FAMILY_MARKERS.get(model, "o"),
+                color=f"C{3 + i}",
+                ms=6,
+                capsize=2,
+            )
             if len(g) > 1:
-                a2.annotate(f"{r.d0:g}", (i + off, r.lyapunov), fontsize=6, xytext=(3, 3),
-                            textcoords="offset points")
+                a2.annotate(f"{r.d0:g}", (i + off, r.lyapunov), fontsize=6, xytext=(3, 3), textcoords="offset points")
     a2.axhline(0.0, color="0.3", lw=0.8)
     a2.set_xticks(range(len(models)), [m.replace("-", "\n") for m in models], fontsize=8)
     a2.set_xlim(-0.6, len(models) - 0.4)

@@ -21,9 +21,9 @@ RC = {
     "legend.frameon": False,
 }
 
-SIM = {"color": "C0", "lw": 1.2}          # simulation of the model: solid
+SIM = {"color": "C0", "lw": 1.2}  # simulation of the model: solid
 THEORY = {"color": "C3", "lw": 1.2, "ls": "--"}  # analytic/limit curves: dashed, as in the paper
-PAPER = {"color": "0.4", "lw": 1.0, "ls": ":"}   # the paper's own formula where it differs
+PAPER = {"color": "0.4", "lw": 1.0, "ls": ":"}  # the paper's own formula where it differs
 
 
 def new_figure(nrows: int = 1, ncols: int = 1, *, width: float = 5.0, height: float = 3.6, **kw):

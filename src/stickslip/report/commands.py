@@ -22,16 +22,20 @@ def block_command(o: Outcome) -> str:
 def hysteresis_command(o: Outcome) -> str:
     """The ``stickslip hysteresis`` command of the sweep of V (section 2)."""
     s = o.experiment.options
-    return (f"stickslip hysteresis --K 10 --beta 1 --Fs 3 --V-min {g(s['V_min'])} --V-max {g(s['V_max'])} "
-            f"--dV {g(s['dV'])} --time-per-step {g(s['time_per_step'])} --transient {g(s['transient'])} --json")
+    return (
+        f"stickslip hysteresis --K 10 --beta 1 --Fs 3 --V-min {g(s['V_min'])} --V-max {g(s['V_max'])} "
+        f"--dV {g(s['dV'])} --time-per-step {g(s['time_per_step'])} --transient {g(s['transient'])} --json"
+    )
 
 
 def chain_command(o: Outcome, N: int, beta: float) -> str:
     """The ``stickslip chain`` command of one chain run of the experiment."""
     cfg = {**chain_common(o.experiment), "N": N, "beta": beta}
     params, t_end, opts = point_settings(cfg)
-    parts = [f"stickslip chain --N {N} --beta {g(beta)} --t-end {g(t_end)}",
-             f"--sample-interval {g(opts['sample_interval'])} --average-from {g(opts['average_from'])}"]
+    parts = [
+        f"stickslip chain --N {N} --beta {g(beta)} --t-end {g(t_end)}",
+        f"--sample-interval {g(opts['sample_interval'])} --average-from {g(opts['average_from'])}",
+    ]
     if opts.get("profile_window"):
         parts.append(f"--profile-window {g(opts['profile_window'])} --profile-min-blocks {opts['profile_min_blocks']}")
     if opts.get("until_steady"):

@@ -14,9 +14,10 @@ import base64
 import datetime as _dt
 import html
 import math
+from collections.abc import Iterable, Mapping
 from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
-from typing import Any, Iterable, Mapping
+from typing import Any
 
 from stickslip import __version__
 from stickslip.io import atomic_path, read_json, write_json
@@ -60,7 +61,7 @@ class ReportRow:
         return data
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> "ReportRow":
+    def from_dict(cls, data: Mapping[str, Any]) -> ReportRow:
         names = {f.name for f in fields(cls)}
         return cls(**{k: v for k, v in data.items() if k in names})
 
@@ -82,7 +83,7 @@ class ReportFigure:
         return data
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> "ReportFigure":
+    def from_dict(cls, data: Mapping[str, Any]) -> ReportFigure:
         names = {f.name for f in fields(cls)}
         values = {k: v for k, v in data.items() if k in names}
         values["data"] = tuple(values.get("data") or ())
@@ -105,7 +106,7 @@ class Report:
         }
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> "Report":
+    def from_dict(cls, data: Mapping[str, Any]) -> Report:
         return cls(
             meta=dict(data.get("meta") or {}),
             rows=tuple(ReportRow.from_dict(r) for r in data.get("rows") or ()),
@@ -149,7 +150,7 @@ def write_report(
     meta = dict(meta or {})
     meta.setdefault("package", "stickslip")
     meta.setdefault("version", __version__)
-    meta.setdefault("written", _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"))
+    meta.setdefault("written", _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"))
     report = Report(
         meta=meta,
         rows=tuple(_as_row(r) for r in rows),

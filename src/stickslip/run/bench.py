@@ -22,8 +22,15 @@ def _warm(params: ChainParams, start: str) -> None:
         run_chain(small, 20 * small.dt, integrator=integrator, start=start)
 
 
-def compare(params: ChainParams, t_end: float, *, start: str = "paper", repeat: int = 1,
-            perturbation: float = 0.0, seed: int = 0) -> dict[str, Any]:
+def compare(
+    params: ChainParams,
+    t_end: float,
+    *,
+    start: str = "paper",
+    repeat: int = 1,
+    perturbation: float = 0.0,
+    seed: int = 0,
+) -> dict[str, Any]:
     """Time ``dense`` and ``exact`` on the chain of eq. (4), or any model of the family, from
     ``start`` (with ``perturbation`` and ``seed``) to ``t_end``.
 
@@ -36,8 +43,7 @@ def compare(params: ChainParams, t_end: float, *, start: str = "paper", repeat: 
     for integrator in ("dense", "exact"):
         for _ in range(repeat):
             t0 = time.perf_counter()
-            run = run_chain(params, t_end, integrator=integrator, start=start, perturbation=perturbation,
-                            seed=seed)
+            run = run_chain(params, t_end, integrator=integrator, start=start, perturbation=perturbation, seed=seed)
             elapsed = time.perf_counter() - t0
             best[integrator] = min(best.get(integrator, float("inf")), elapsed)
             runs[integrator] = run
@@ -50,12 +56,21 @@ def compare(params: ChainParams, t_end: float, *, start: str = "paper", repeat: 
     )
     block_steps = params.N * d.steps
     return {
-        "workload": {"model": params.model, "N": params.N, "beta": params.beta, "t_end": t_end,
-                     "start": start, "steps": d.steps, "block_steps": block_steps},
+        "workload": {
+            "model": params.model,
+            "N": params.N,
+            "beta": params.beta,
+            "t_end": t_end,
+            "start": start,
+            "steps": d.steps,
+            "block_steps": block_steps,
+        },
         "params": params.to_dict(),
-        "skipped": {"steps_computed_fraction": e.summary["steps_computed"] / max(e.steps, 1),
-                    "block_updates_fraction": e.summary["block_updates"] / max(block_steps, 1),
-                    "full_block_updates_fraction": e.summary["full_block_updates"] / max(block_steps, 1)},
+        "skipped": {
+            "steps_computed_fraction": e.summary["steps_computed"] / max(e.steps, 1),
+            "block_updates_fraction": e.summary["block_updates"] / max(block_steps, 1),
+            "full_block_updates_fraction": e.summary["full_block_updates"] / max(block_steps, 1),
+        },
         "dense_seconds": best["dense"],
         "exact_seconds": best["exact"],
         "speedup": best["dense"] / best["exact"] if best["exact"] > 0 else float("inf"),
@@ -78,15 +93,17 @@ def format_result(r: dict[str, Any]) -> str:
     """Human-readable lines of :func:`compare`'s result."""
     w = r["workload"]
     ns = r["ns_per_block_step"]
-    return "\n".join([
-        f"workload   {w['model']} N={w['N']} beta={w['beta']:g} t_end={w['t_end']:g} start={w['start']} "
-        f"({w['steps']} steps, {r['n_events']} events)",
-        f"dense      {r['dense_seconds']:.3f} s   {ns['dense']:.3g} ns/block-step",
-        f"exact      {r['exact_seconds']:.3f} s   {ns['exact']:.3g} ns/block-step "
-        f"({r['exact_block_updates']} block updates in {r['exact_steps_computed']} computed steps)",
-        f"speedup    {r['speedup']:.1f}x",
-        f"identical  {'yes' if r['identical'] else 'NO'}   sha256 {r['state_sha256'][:16]}...",
-    ])
+    return "\n".join(
+        [
+            f"workload   {w['model']} N={w['N']} beta={w['beta']:g} t_end={w['t_end']:g} start={w['start']} "
+            f"({w['steps']} steps, {r['n_events']} events)",
+            f"dense      {r['dense_seconds']:.3f} s   {ns['dense']:.3g} ns/block-step",
+            f"exact      {r['exact_seconds']:.3f} s   {ns['exact']:.3g} ns/block-step "
+            f"({r['exact_block_updates']} block updates in {r['exact_steps_computed']} computed steps)",
+            f"speedup    {r['speedup']:.1f}x",
+            f"identical  {'yes' if r['identical'] else 'NO'}   sha256 {r['state_sha256'][:16]}...",
+        ]
+    )
 
 
 def _unit_costs(params: ChainParams) -> dict[str, float]:
@@ -123,15 +140,17 @@ def _unit_costs(params: ChainParams) -> dict[str, float]:
         # Without a state variable a stopped block never changes: no such updates.
         still = params.replace(V=0.0)
         rng = np.random.default_rng(0)
-        relax = ChainState.from_blocks(np.zeros(params.N), np.zeros(params.N),
-                                       rng.uniform(0.2, 0.9, params.N), np.ones(params.N, bool))
+        relax = ChainState.from_blocks(
+            np.zeros(params.N), np.zeros(params.N), rng.uniform(0.2, 0.9, params.N), np.ones(params.N, bool)
+        )
         t3, s3 = timed(still, 20.0, relax)
         per_theta = max(t3 - s3["steps_computed"] * per_step, 0.0) / max(s3["block_updates"], 1)
     return {"step": per_step, "full_update": per_full, "theta_update": per_theta}
 
 
-def profile(params: ChainParams, t_end: float, *, start: str = "paper", perturbation: float = 0.0,
-            seed: int = 0) -> dict[str, Any]:
+def profile(
+    params: ChainParams, t_end: float, *, start: str = "paper", perturbation: float = 0.0, seed: int = 0
+) -> dict[str, Any]:
     """Where the exact integrator of eq. (4) spends its time on one workload.
 
     Counts its work (steps computed and jumped over, full and state-variable-only block
@@ -150,8 +169,14 @@ def profile(params: ChainParams, t_end: float, *, start: str = "paper", perturba
     }
     parts["rest (jumps, events, driver)"] = max(wall - sum(parts.values()), 0.0)
     return {
-        "workload": {"model": params.model, "N": params.N, "beta": params.beta, "t_end": t_end, "start": start,
-                     "steps": s["steps"]},
+        "workload": {
+            "model": params.model,
+            "N": params.N,
+            "beta": params.beta,
+            "t_end": t_end,
+            "start": start,
+            "steps": s["steps"],
+        },
         "wall_seconds": wall,
         "steps_computed": s["steps_computed"],
         "steps_jumped": s["steps"] - s["steps_computed"],

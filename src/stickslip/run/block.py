@@ -179,9 +179,7 @@ def simulate_block(
         _blow_up(params, out_t, out_x, out_v, out_theta, steps)
 
     series = _series(params, out_t, out_x, out_v, out_theta, out_stopped, every)
-    slips = _slip_table(
-        params, slip_start[:n_slips], slip_end[:n_slips], slip_x_start[:n_slips], slip_x_end[:n_slips]
-    )
+    slips = _slip_table(params, slip_start[:n_slips], slip_end[:n_slips], slip_x_start[:n_slips], slip_x_end[:n_slips])
     final = BlockState(x=x, v=v, theta=theta, stopped=bool(stopped))
     return BlockRun(
         params=params,
@@ -204,8 +202,10 @@ def _blow_up(p: BlockParams, t, x, v, theta, steps: int) -> None:
 
     bad = ~(np.isfinite(x) & np.isfinite(v) & np.isfinite(theta))
     when = f"t = {float(t[np.argmax(bad)]):.6g}" if bad.any() else f"t <= {steps * p.dt:.6g}"
-    raise NonFiniteBlock(f"the block's state became non-finite by {when} (blow-up; a smaller dt may help, "
-                         f"dt = {p.dt:g}, K/M = {p.K / p.M:g})")
+    raise NonFiniteBlock(
+        f"the block's state became non-finite by {when} (blow-up; a smaller dt may help, "
+        f"dt = {p.dt:g}, K/M = {p.K / p.M:g})"
+    )
 
 
 def _series(p: BlockParams, t, x, v, theta, stopped, every: int) -> xr.Dataset:

@@ -73,9 +73,13 @@ def _check_layout(arrays: dict[str, np.ndarray], header: dict[str, Any]) -> None
     except (KeyError, TypeError, ValueError):
         raise ChainRunError("checkpoint header has no valid N") from None
     expected = {
-        "x": (np.float64, (N + 2,)), "v": (np.float64, (N + 2,)), "th": (np.float64, (N + 2,)),
-        "mov": (np.float64, (N + 2,)), "x0ev": (np.float64, (N + 2,)),
-        "first_step": (np.int64, (N + 2,)), "ist": (np.int64, (K.IST_SIZE,)),
+        "x": (np.float64, (N + 2,)),
+        "v": (np.float64, (N + 2,)),
+        "th": (np.float64, (N + 2,)),
+        "mov": (np.float64, (N + 2,)),
+        "x0ev": (np.float64, (N + 2,)),
+        "first_step": (np.int64, (N + 2,)),
+        "ist": (np.int64, (K.IST_SIZE,)),
     }
     for name, (dtype, shape) in expected.items():
         a = arrays[name]
@@ -111,8 +115,7 @@ class Checkpointer:
         digest = _write_npz(self.dir / name, new, {"format": CHECKPOINT_FORMAT})
         self.parts.append({"file": name, "sha256": digest})
         arrays = {k: getattr(state, k) for k in ChainState.ARRAYS}
-        full_header = dict(header, format=CHECKPOINT_FORMAT, parts=self.parts, version=__version__,
-                           ist_size=K.IST_SIZE)
+        full_header = dict(header, format=CHECKPOINT_FORMAT, parts=self.parts, version=__version__, ist_size=K.IST_SIZE)
         _write_npz(self.state_path, arrays, full_header)
         return self.state_path
 
@@ -132,8 +135,10 @@ class Checkpointer:
         parts: dict[str, list[np.ndarray]] = {k: [] for k in PART_KEYS}
         listed = header.get("parts", [])
         if not isinstance(listed, list) or not all(
-            isinstance(e, dict) and isinstance(e.get("sha256"), str)
-            and re.fullmatch(r"part-\d{6}\.npz", str(e.get("file"))) for e in listed
+            isinstance(e, dict)
+            and isinstance(e.get("sha256"), str)
+            and re.fullmatch(r"part-\d{6}\.npz", str(e.get("file")))
+            for e in listed
         ):
             raise ChainRunError(f"checkpoint in {self.dir.parent} lists its parts wrongly")
         for entry in listed:

@@ -29,14 +29,16 @@ import signal
 import sys
 import time
 import warnings
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any
 
 import numpy as np
 
 from stickslip.kernels import chain as K
 from stickslip.models.params import ChainParams, ParameterError, check_number, steps_for
+
 # The checkpoint file helpers (_read_npz, _write_npz) are named here too, for checks of the files.
 from stickslip.run.checkpoint import CHECKPOINT_FORMAT, Checkpointer, _read_npz, _write_npz  # noqa: F401
 from stickslip.run.errors import ChainRunError, Interrupted, NonFiniteState, ShortRunWarning
@@ -84,10 +86,16 @@ class _Progress:
         if self.enabled:
             from tqdm import tqdm
 
-            self.bar = tqdm(total=self.t_end, unit=" time units", unit_scale=False, dynamic_ncols=True,
-                            desc="chain", file=sys.stderr, smoothing=0.1,
-                            bar_format="{l_bar}{bar}| t = {n:.4g}/{total:.4g} [{elapsed}<{remaining}, "
-                                       "{rate_fmt}{postfix}]")
+            self.bar = tqdm(
+                total=self.t_end,
+                unit=" time units",
+                unit_scale=False,
+                dynamic_ncols=True,
+                desc="chain",
+                file=sys.stderr,
+                smoothing=0.1,
+                bar_format="{l_bar}{bar}| t = {n:.4g}/{total:.4g} [{elapsed}<{remaining}, {rate_fmt}{postfix}]",
+            )
 
     def update(self, t: float, n_events: int) -> None:
         if self.bar is not None:
@@ -156,8 +164,17 @@ class _Kernel:
         self.entry = K.specialise(_KERNELS[name], probe, self.pieces)
 
     def _args(self, state):
-        return (state.x, state.v, state.th, state.mov, *self.scratch, state.first_step, state.x0ev,
-                state.ist, *self.rest)
+        return (
+            state.x,
+            state.v,
+            state.th,
+            state.mov,
+            *self.scratch,
+            state.first_step,
+            state.x0ev,
+            state.ist,
+            *self.rest,
+        )
 
     def __call__(self, state, target):
         return self.entry(*self._args(state), target, *self.tail, *self.pieces)
@@ -230,10 +247,22 @@ def run_chain(
             warnings.warn(message, ShortRunWarning, stacklevel=2)
     state.ist[K.NEXT_SAMPLE] = state.step
     outputs = _Outputs(params.N, options.profile_window is not None)
-    return _drive(params, options, integrator, start_info, state, outputs, run_id=run_id,
-                  out_dir=out_dir, checkpointer=Checkpointer(Path(out_dir)) if out_dir else None,
-                  checkpoint_interval=checkpoint_interval, progress=progress,
-                  handle_signals=handle_signals, wall_before=0.0, keep_checkpoint=keep_checkpoint)
+    return _drive(
+        params,
+        options,
+        integrator,
+        start_info,
+        state,
+        outputs,
+        run_id=run_id,
+        out_dir=out_dir,
+        checkpointer=Checkpointer(Path(out_dir)) if out_dir else None,
+        checkpoint_interval=checkpoint_interval,
+        progress=progress,
+        handle_signals=handle_signals,
+        wall_before=0.0,
+        keep_checkpoint=keep_checkpoint,
+    )
 
 
 def resume_chain(
@@ -255,8 +284,10 @@ def resume_chain(
     run_dir = Path(run_dir)
     ckpt = Checkpointer(run_dir)
     if not ckpt.state_path.exists() and (run_dir / "run.json").exists():
-        raise ChainRunError(f"the run in {run_dir} is finished and kept no checkpoint to continue from "
-                            "(a run started with --keep-checkpoint can be continued to a later --t-end)")
+        raise ChainRunError(
+            f"the run in {run_dir} is finished and kept no checkpoint to continue from "
+            "(a run started with --keep-checkpoint can be continued to a later --t-end)"
+        )
     state, header, parts = ckpt.load()
     try:
         params = ChainParams(**header["params"])
@@ -268,8 +299,10 @@ def resume_chain(
         raise ChainRunError(f"checkpoint in {run_dir} has an unusable header ({exc})") from None
     run_id = header.get("run_id")
     if run_id != read_run_id(run_dir):
-        raise ChainRunError(f"the checkpoint in {run_dir} belongs to another run (run id {run_id}, the directory's "
-                            f"{read_run_id(run_dir)}); resume the directory it was written in")
+        raise ChainRunError(
+            f"the checkpoint in {run_dir} belongs to another run (run id {run_id}, the directory's "
+            f"{read_run_id(run_dir)}); resume the directory it was written in"
+        )
     check_checkpoint_state(state, params, options, parts, run_dir)
     if expect_params is not None and expect_params != params:
         raise ChainRunError(
@@ -285,30 +318,59 @@ def resume_chain(
     ckpt.since = {k: len(v) for k, v in parts.items()}
     if keep_checkpoint is None:
         keep_checkpoint = header.get("keep_checkpoint") is True
-    return _drive(params, options, integrator, header["start"], state, outputs, run_id=run_id, out_dir=run_dir,
-                  checkpointer=ckpt, checkpoint_interval=checkpoint_interval, progress=progress,
-                  handle_signals=handle_signals, wall_before=float(header.get("wall_seconds", 0.0)),
-                  keep_checkpoint=keep_checkpoint)
+    return _drive(
+        params,
+        options,
+        integrator,
+        header["start"],
+        state,
+        outputs,
+        run_id=run_id,
+        out_dir=run_dir,
+        checkpointer=ckpt,
+        checkpoint_interval=checkpoint_interval,
+        progress=progress,
+        handle_signals=handle_signals,
+        wall_before=float(header.get("wall_seconds", 0.0)),
+        keep_checkpoint=keep_checkpoint,
+    )
 
 
-def _drive(params, options, integrator, start_info, state, outputs, *, out_dir, checkpointer,
-           checkpoint_interval, progress, handle_signals, wall_before, run_id=None,
-           keep_checkpoint=False) -> ChainRun:
+def _drive(
+    params,
+    options,
+    integrator,
+    start_info,
+    state,
+    outputs,
+    *,
+    out_dir,
+    checkpointer,
+    checkpoint_interval,
+    progress,
+    handle_signals,
+    wall_before,
+    run_id=None,
+    keep_checkpoint=False,
+) -> ChainRun:
     par = _par(params)
     N = params.N
     scratch = [np.zeros(N + 2) for _ in range(6)] + [np.zeros(N + 2, dtype=np.int64)]
     n_end = steps_for(options.t_end, params.dt)
     sample_every = int(round(options.sample_interval / params.dt))
     profile_every = int(round(options.profile_window / params.dt)) if options.profile_window else 0
-    kernel = _Kernel(integrator, params, state, scratch, par, outputs, sample_every, profile_every,
-                     options.profile_min_blocks)
+    kernel = _Kernel(
+        integrator, params, state, scratch, par, outputs, sample_every, profile_every, options.profile_min_blocks
+    )
     stops = sorted({steps_for(t, params.dt) for t in options.snapshot_times} | {n_end})
     done_snaps = set(int(s) for a in outputs.parts["snap_step"] for s in a)
     on_grid = options.until_steady is not None or options.sample_moving
     last_moving = max((int(a[-1, 0]) for a in outputs.parts["moving"] if len(a)), default=-1)
     steady_at: dict[str, float] = {}
     header = {
-        "params": params.to_dict(), "options": options.to_dict(), "integrator": integrator,
+        "params": params.to_dict(),
+        "options": options.to_dict(),
+        "integrator": integrator,
         "start": start_info,
     }
     if run_id is not None:
@@ -356,8 +418,17 @@ def _drive(params, options, integrator, start_info, state, outputs, *, out_dir, 
                     # The fast kernel does not look for non-finite values; replay this call
                     # with the reference, which follows the same arithmetic and checks each step.
                     state = before
-                    reference = _Kernel("dense", params, state, scratch, par, outputs, sample_every, profile_every,
-                                        options.profile_min_blocks)
+                    reference = _Kernel(
+                        "dense",
+                        params,
+                        state,
+                        scratch,
+                        par,
+                        outputs,
+                        sample_every,
+                        profile_every,
+                        options.profile_min_blocks,
+                    )
                     status = reference(state, target)
                 if status == K.NONFINITE:
                     bad = int(state.ist[K.BAD_BLOCK])
@@ -419,7 +490,7 @@ class Stepper:
         self.outputs = _Outputs(params.N, False)
         self._kernels: dict[str, _Kernel] = {}
 
-    def _kernel(self, name: str, state: ChainState) -> "_Kernel":
+    def _kernel(self, name: str, state: ChainState) -> _Kernel:
         if name not in self._kernels:
             self._kernels[name] = _Kernel(name, self.params, state, self.scratch, self.par, self.outputs, 1, 0, 0)
         return self._kernels[name]
@@ -436,8 +507,10 @@ class Stepper:
                 state.__dict__.update(before.__dict__)
                 status = self._kernel("dense", state)(state, step)
             if status == K.NONFINITE:
-                raise NonFiniteState(f"state became non-finite at t = {state.step * self.params.dt:.6g} "
-                                     f"(step {state.step}) in block {int(ist[K.BAD_BLOCK])}")
+                raise NonFiniteState(
+                    f"state became non-finite at t = {state.step * self.params.dt:.6g} "
+                    f"(step {state.step}) in block {int(ist[K.BAD_BLOCK])}"
+                )
             ist[K.EV_COUNT] = ist[K.FM_COUNT] = ist[K.S_COUNT] = ist[K.P_COUNT] = 0
             ist[K.EV_P_FIRST] = 0
             if status == K.DONE:

@@ -45,7 +45,7 @@ class RunOptions:
     until_steady: float | None = None
     sample_moving: bool = False
 
-    def validated(self, dt: float) -> "RunOptions":
+    def validated(self, dt: float) -> RunOptions:
         """Check every option against the time step (ranges in docs/limits.md); returns self."""
         steps_for(self.t_end, dt)
         longest = MAX_STEPS * dt
@@ -78,14 +78,24 @@ class RunOptions:
         }
 
     @classmethod
-    def from_dict(cls, d: dict[str, Any]) -> "RunOptions":
+    def from_dict(cls, d: dict[str, Any]) -> RunOptions:
         d = dict(d)
         d["snapshot_times"] = tuple(d.get("snapshot_times", ()))
         return cls(**d)
 
 
-EVENT_COLUMNS = ["event", "step_start", "step_end", "t_start", "t_end", "duration", "S",
-                 "start_block", "max_block", "n_blocks"]
+EVENT_COLUMNS = [
+    "event",
+    "step_start",
+    "step_end",
+    "t_start",
+    "t_end",
+    "duration",
+    "S",
+    "start_block",
+    "max_block",
+    "n_blocks",
+]
 
 
 @dataclass
@@ -158,7 +168,7 @@ class _Outputs:
         """Concatenate the parts added since ``since`` (counts per key); updates ``since``."""
         out = {}
         for key in PART_KEYS:
-            new = self.parts[key][since.get(key, 0):]
+            new = self.parts[key][since.get(key, 0) :]
             since[key] = len(self.parts[key])
             out[key] = _concat(key, new)
         return out
@@ -167,12 +177,27 @@ class _Outputs:
         return {key: _concat(key, self.parts[key]) for key in PART_KEYS}
 
 
-PART_KEYS = ("ev_int", "ev_S", "fm", "samp_L", "samp_step", "prof_x", "prof_meta", "snap_step", "snap_x",
-             "moving")
-_PART_SHAPES = {"moving": (0, 2), "ev_int": (0, K.EV_INT_COLS), "ev_S": (0,), "fm": (0, 3), "samp_L": (0,),
-                "samp_step": (0,), "prof_x": None, "prof_meta": (0, 2), "snap_step": (0,), "snap_x": None}
-_PART_DTYPES = {"moving": np.int64, "ev_int": np.int64, "fm": np.int64, "samp_step": np.int64, "prof_meta": np.int64,
-                "snap_step": np.int64}
+PART_KEYS = ("ev_int", "ev_S", "fm", "samp_L", "samp_step", "prof_x", "prof_meta", "snap_step", "snap_x", "moving")
+_PART_SHAPES = {
+    "moving": (0, 2),
+    "ev_int": (0, K.EV_INT_COLS),
+    "ev_S": (0,),
+    "fm": (0, 3),
+    "samp_L": (0,),
+    "samp_step": (0,),
+    "prof_x": None,
+    "prof_meta": (0, 2),
+    "snap_step": (0,),
+    "snap_x": None,
+}
+_PART_DTYPES = {
+    "moving": np.int64,
+    "ev_int": np.int64,
+    "fm": np.int64,
+    "samp_step": np.int64,
+    "prof_meta": np.int64,
+    "snap_step": np.int64,
+}
 
 
 def _concat(key: str, arrays: list[np.ndarray]) -> np.ndarray:
@@ -186,18 +211,21 @@ def _assemble(params, options, integrator, start_info, state, outputs, wall, ste
     dt = params.dt
     parts = outputs.all()
     ev = parts["ev_int"]
-    events = pd.DataFrame({
-        "event": ev[:, K.E_ID],
-        "step_start": ev[:, K.E_START_STEP],
-        "step_end": ev[:, K.E_END_STEP],
-        "t_start": ev[:, K.E_START_STEP] * dt,
-        "t_end": (ev[:, K.E_END_STEP] + 1) * dt,
-        "duration": (ev[:, K.E_END_STEP] + 1 - ev[:, K.E_START_STEP]) * dt,
-        "S": parts["ev_S"],
-        "start_block": ev[:, K.E_START_BLOCK],
-        "max_block": ev[:, K.E_MAX_BLOCK],
-        "n_blocks": ev[:, K.E_N_BLOCKS],
-    }, columns=EVENT_COLUMNS)
+    events = pd.DataFrame(
+        {
+            "event": ev[:, K.E_ID],
+            "step_start": ev[:, K.E_START_STEP],
+            "step_end": ev[:, K.E_END_STEP],
+            "t_start": ev[:, K.E_START_STEP] * dt,
+            "t_end": (ev[:, K.E_END_STEP] + 1) * dt,
+            "duration": (ev[:, K.E_END_STEP] + 1 - ev[:, K.E_START_STEP]) * dt,
+            "S": parts["ev_S"],
+            "start_block": ev[:, K.E_START_BLOCK],
+            "max_block": ev[:, K.E_MAX_BLOCK],
+            "n_blocks": ev[:, K.E_N_BLOCKS],
+        },
+        columns=EVENT_COLUMNS,
+    )
     fm = parts["fm"]
     first_move = pd.DataFrame({"event": fm[:, 0], "block": fm[:, 1], "step": fm[:, 2], "t_first": fm[:, 2] * dt})
     t_samples = parts["samp_step"] * dt
@@ -214,8 +242,10 @@ def _assemble(params, options, integrator, start_info, state, outputs, wall, ste
     snap_x = np.vstack([parts["snap_x"].reshape(-1, params.N), state.x[1:-1][None, :]])
     order = np.argsort(snap_steps, kind="stable")
     snapshots = xr.DataArray(
-        snap_x[order], dims=("time", "block"),
-        coords={"time": np.asarray(snap_steps)[order] * dt, "block": blocks}, name="x",
+        snap_x[order],
+        dims=("time", "block"),
+        coords={"time": np.asarray(snap_steps)[order] * dt, "block": blocks},
+        name="x",
         attrs={"long_name": "block positions x_i"},
     )
     profiles = _profiles(parts, events, options, params)
@@ -235,9 +265,11 @@ def _assemble(params, options, integrator, start_info, state, outputs, wall, ste
         L_final = L_ss
         early = {
             "stopped_early": True,
-            "reason": (f"steady sliding reached at t = {steady_at['t_steady']:g}: every block slides "
-                       f"within {options.until_steady:g} of the steady state (deviation "
-                       f"{steady_at['deviation']:.3g}); L taken from the steady solution from then on"),
+            "reason": (
+                f"steady sliding reached at t = {steady_at['t_steady']:g}: every block slides "
+                f"within {options.until_steady:g} of the steady state (deviation "
+                f"{steady_at['deviation']:.3g}); L taken from the steady solution from then on"
+            ),
             "t_steady": steady_at["t_steady"],
             "steady_deviation": steady_at["deviation"],
             "until_steady": options.until_steady,
@@ -259,15 +291,18 @@ def _assemble(params, options, integrator, start_info, state, outputs, wall, ste
         "steps": state.step,
         "steps_computed": int(state.ist[K.STEPS_COMPUTED]),
         "block_updates": int(state.ist[K.BLOCK_UPDATES]),
-        "full_block_updates": int(state.ist[K.FULL_UPDATES]) if integrator == "exact" else int(state.ist[K.BLOCK_UPDATES]),
+        "full_block_updates": int(state.ist[K.FULL_UPDATES])
+        if integrator == "exact"
+        else int(state.ist[K.BLOCK_UPDATES]),
         "n_moving": int(state.ist[K.N_MOVING]),
         "wall_seconds": wall,
         "integrator": integrator,
         "state_sha256": state.sha256(),
         **early,
     }
-    return ChainRun(params, options, integrator, start_info, state, events, first_move, samples,
-                    snapshots, profiles, summary)
+    return ChainRun(
+        params, options, integrator, start_info, state, events, first_move, samples, snapshots, profiles, summary
+    )
 
 
 def _model_note(params) -> dict[str, str]:
@@ -286,7 +321,7 @@ def _profiles(parts, events, options, params) -> xr.Dataset:
     for eid in sorted(set(pm[:, 0].tolist()) & keep_ids) if len(pm) else []:
         idx = np.flatnonzero(pm[:, 0] == eid)
         idx = idx[np.argsort(pm[idx, 1], kind="stable")]
-        for a, b in zip(idx[:-1], idx[1:]):
+        for a, b in zip(idx[:-1], idx[1:], strict=False):
             rows_dx.append(px[b] - px[a])
             rows_ev.append(eid)
             rows_t0.append(pm[a, 1] * params.dt)

@@ -36,20 +36,25 @@ VARIABLE_ATTRS = {
     "block": {"long_name": "block index i (1 = pulled end, N = free end)", "units": "1"},
     "x": {"long_name": "block position x_i at the end of the run", "units": f"length ({UNITS})"},
     "v": {"long_name": "block velocity v_i at the end of the run", "units": f"length/time ({UNITS})"},
-    "theta": {"long_name": "state variable theta_i of the friction at the end of the run",
-              "units": "1 (dimensionless)"},
-    "stopped": {"long_name": "block stuck (start and stop rules of eq. 4) at the end of the run",
-                "units": "1", "flag_values": np.array([0, 1], dtype=np.int8),
-                "flag_meanings": "moving stopped"},
+    "theta": {
+        "long_name": "state variable theta_i of the friction at the end of the run",
+        "units": "1 (dimensionless)",
+    },
+    "stopped": {
+        "long_name": "block stuck (start and stop rules of eq. 4) at the end of the run",
+        "units": "1",
+        "flag_values": np.array([0, 1], dtype=np.int8),
+        "flag_meanings": "moving stopped",
+    },
     "t_sample": {"long_name": "sampling time of L", "units": f"time ({UNITS})"},
     "L": {"long_name": "chain length L = x_1 - x_N (Fig. 5b)", "units": f"length ({UNITS})"},
     "snapshot_time": {"long_name": "time of the snapshot", "units": f"time ({UNITS})"},
-    "snapshot_x": {"long_name": "block positions x_i at the snapshot time (Fig. 5a)",
-                   "units": f"length ({UNITS})"},
-    "profile_dx": {"long_name": "displacement Delta x_i = x_i(t_next) - x_i(t) over one window (Fig. 6)",
-                   "units": f"length ({UNITS})"},
-    "profile_event": {"long_name": "slip event of the profile row (events.parquet column event)",
-                      "units": "1"},
+    "snapshot_x": {"long_name": "block positions x_i at the snapshot time (Fig. 5a)", "units": f"length ({UNITS})"},
+    "profile_dx": {
+        "long_name": "displacement Delta x_i = x_i(t_next) - x_i(t) over one window (Fig. 6)",
+        "units": f"length ({UNITS})",
+    },
+    "profile_event": {"long_name": "slip event of the profile row (events.parquet column event)", "units": "1"},
     "profile_t": {"long_name": "start of the profile window", "units": f"time ({UNITS})"},
     "profile_t_next": {"long_name": "end of the profile window", "units": f"time ({UNITS})"},
     "t": {"long_name": "start of the profile window", "units": f"time ({UNITS})"},
@@ -78,8 +83,11 @@ FIRST_MOVE_DOCS = {
 
 def _param_attrs(params: ChainParams) -> dict[str, object]:
     """The parameters as individual attributes ``param_<name>`` (bools as 0/1)."""
-    return {f"param_{k}": (int(v) if isinstance(v, bool) else v) for k, v in params.to_dict().items()
-            if isinstance(v, (int, float, str, bool))}
+    return {
+        f"param_{k}": (int(v) if isinstance(v, bool) else v)
+        for k, v in params.to_dict().items()
+        if isinstance(v, (int, float, str, bool))
+    }
 
 
 def write_run(run: ChainRun, out_dir: str | Path) -> Path:
@@ -92,7 +100,9 @@ def write_run(run: ChainRun, out_dir: str | Path) -> Path:
     b = run.state.blocks()
     ds = xr.Dataset(
         {
-            "x": ("block", b["x"]), "v": ("block", b["v"]), "theta": ("block", b["theta"]),
+            "x": ("block", b["x"]),
+            "v": ("block", b["v"]),
+            "theta": ("block", b["theta"]),
             "stopped": ("block", b["stopped"].astype(np.int8)),
             "L": run.samples["L"].rename({"t": "t_sample"}),
             "snapshot_x": run.snapshots.rename({"time": "snapshot_time"}),
@@ -102,11 +112,17 @@ def write_run(run: ChainRun, out_dir: str | Path) -> Path:
             "profile_t_next": ("profile_row", run.profiles["t_next"].values),
         },
         coords={"block": blocks},
-        attrs={"Conventions": "CF-1.10", "title": "chain of eq. (4): final state, L(t), snapshots, profiles",
-               "source": f"stickslip {__version__}, {run.integrator} integrator", "units_note":
-               "model units: eq. (4) scaled to M = sigma = 1 (MODEL.md)",
-               "params": json.dumps(run.params.to_dict()), **_param_attrs(run.params),
-               "integrator": run.integrator, "version": __version__, "t": run.summary["t_end"]},
+        attrs={
+            "Conventions": "CF-1.10",
+            "title": "chain of eq. (4): final state, L(t), snapshots, profiles",
+            "source": f"stickslip {__version__}, {run.integrator} integrator",
+            "units_note": "model units: eq. (4) scaled to M = sigma = 1 (MODEL.md)",
+            "params": json.dumps(run.params.to_dict()),
+            **_param_attrs(run.params),
+            "integrator": run.integrator,
+            "version": __version__,
+            "t": run.summary["t_end"],
+        },
     )
     if "n_moving" in run.samples:
         ds["n_moving"] = ("t_moving", run.samples["n_moving"].values)
@@ -120,8 +136,9 @@ def write_run(run: ChainRun, out_dir: str | Path) -> Path:
     model = {"params": run.params.to_dict(), "integrator": run.integrator}
     io.write_table(out / "events.parquet", run.events, EVENT_DOCS, metadata=model)
     io.write_table(out / "first_move.parquet", run.first_move, FIRST_MOVE_DOCS, metadata=model)
-    meta = io.run_metadata(run.params, integrator=run.integrator, options=run.options.to_dict(),
-                           start=run.start, summary=run.summary)
+    meta = io.run_metadata(
+        run.params, integrator=run.integrator, options=run.options.to_dict(), start=run.start, summary=run.summary
+    )
     io.write_json(out / "run.json", meta)
     return out
 
@@ -134,8 +151,9 @@ def load_run(run_dir: str | Path) -> ChainRun:
     meta = io.read_json(run_dir / "run.json")
     ds = io.read_dataset(run_dir / "state.nc")
     params = ChainParams(**meta["params"])
-    state = ChainState.from_blocks(ds["x"].values, ds["v"].values, ds["theta"].values,
-                                   ds["stopped"].values.astype(bool))
+    state = ChainState.from_blocks(
+        ds["x"].values, ds["v"].values, ds["theta"].values, ds["stopped"].values.astype(bool)
+    )
     state.ist[K.STEP] = int(meta["summary"]["steps"])
     samples = xr.Dataset({"L": ("t", ds["L"].values)}, coords={"t": ds["t_sample"].values})
     if "n_moving" in ds:
@@ -144,21 +162,35 @@ def load_run(run_dir: str | Path) -> ChainRun:
     snapshots = ds["snapshot_x"].rename({"snapshot_time": "time"}).rename("x")
     profiles = xr.Dataset(
         {"dx": (("row", "block"), ds["profile_dx"].values)},
-        coords={"event": ("row", ds["profile_event"].values), "t": ("row", ds["profile_t"].values),
-                "t_next": ("row", ds["profile_t_next"].values), "block": ds["block"].values},
+        coords={
+            "event": ("row", ds["profile_event"].values),
+            "t": ("row", ds["profile_t"].values),
+            "t_next": ("row", ds["profile_t_next"].values),
+            "block": ds["block"].values,
+        },
     )
-    return ChainRun(params, RunOptions.from_dict(meta["options"]), meta["integrator"], meta["start"], state,
-                    io.read_table(run_dir / "events.parquet"), io.read_table(run_dir / "first_move.parquet"),
-                    samples, snapshots, profiles, meta["summary"])
-
+    return ChainRun(
+        params,
+        RunOptions.from_dict(meta["options"]),
+        meta["integrator"],
+        meta["start"],
+        state,
+        io.read_table(run_dir / "events.parquet"),
+        io.read_table(run_dir / "first_move.parquet"),
+        samples,
+        snapshots,
+        profiles,
+        meta["summary"],
+    )
 
 
 #: The lock of a directory and its holder's record.
 LOCK_FILES = frozenset({".lock", ".lock.json"})
 RUN_ID_FILE = ".run_id"
 #: The files and folders a chain run writes into its run directory.
-OWN_FILES = frozenset({"run.json", "state.nc", "events.parquet", "first_move.parquet", "checkpoint",
-                       RUN_ID_FILE, *LOCK_FILES})
+OWN_FILES = frozenset(
+    {"run.json", "state.nc", "events.parquet", "first_move.parquet", "checkpoint", RUN_ID_FILE, *LOCK_FILES}
+)
 
 
 def is_temporary(name: str) -> bool:
@@ -204,11 +236,13 @@ def owned_run_dir(run_dir: str | Path | None, *, run_id: bool = True) -> Iterato
             who = f"pid {holder['pid']} on {holder['host']} since {holder['since']}"
         except (OSError, ValueError, KeyError, TypeError):
             who = "another process"
-        raise RunDirBusy(f"{run_dir} is in use by another run ({who}); wait for it or choose another "
-                         "directory") from None
+        raise RunDirBusy(
+            f"{run_dir} is in use by another run ({who}); wait for it or choose another directory"
+        ) from None
     try:
-        info.write_text(json.dumps({"pid": os.getpid(), "host": socket.gethostname(),
-                                    "since": time.strftime("%Y-%m-%dT%H:%M:%S")}))
+        info.write_text(
+            json.dumps({"pid": os.getpid(), "host": socket.gethostname(), "since": time.strftime("%Y-%m-%dT%H:%M:%S")})
+        )
         for stale in run_dir.glob(".*.tmp"):  # left by a write that was killed
             with contextlib.suppress(OSError):
                 stale.unlink()

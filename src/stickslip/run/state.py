@@ -46,7 +46,7 @@ class ChainState:
         return int(self.ist[K.STEP])
 
     @classmethod
-    def from_blocks(cls, x, v, theta, stopped) -> "ChainState":
+    def from_blocks(cls, x, v, theta, stopped) -> ChainState:
         """Build a state from per-block arrays (length N) of x, v, theta and stopped flags."""
         x = np.asarray(x, dtype=np.float64)
         N = x.shape[0]
@@ -65,19 +65,22 @@ class ChainState:
         ist[K.ACT_LO], ist[K.ACT_HI] = 1, N
         ist[K.MECH_LO], ist[K.MECH_HI] = 1, N
         return cls(
-            first_step=np.full(N + 2, -1, dtype=np.int64), x0ev=np.zeros(N + 2), mov=mov,
-            ist=ist, **arrays,
+            first_step=np.full(N + 2, -1, dtype=np.int64),
+            x0ev=np.zeros(N + 2),
+            mov=mov,
+            ist=ist,
+            **arrays,
         )
 
     @classmethod
-    def paper(cls, p: ChainParams) -> "ChainState":
+    def paper(cls, p: ChainParams) -> ChainState:
         """The paper's initial state (section 3): x_i = 0, v_i = 0.1, theta_i = 0.1, all moving."""
         N = p.N
         theta = np.full(N, 0.1 if p.friction == "state" else 0.0)
         return cls.from_blocks(np.zeros(N), np.full(N, 0.1), theta, np.zeros(N, bool))
 
     @classmethod
-    def steady(cls, p: ChainParams, amplitude: float = 0.0, seed: int = 0) -> "ChainState":
+    def steady(cls, p: ChainParams, amplitude: float = 0.0, seed: int = 0) -> ChainState:
         """Exact discrete steady sliding (MODEL.md) at t = 0, all blocks moving.
 
         With ``amplitude`` > 0, x_i and v_i get independent uniform perturbations in
@@ -92,7 +95,7 @@ class ChainState:
         return cls.from_blocks(x, v, s["theta"], np.zeros(p.N, bool))
 
     @classmethod
-    def rest(cls, p: ChainParams, amplitude: float = 0.01, seed: int = 0) -> "ChainState":
+    def rest(cls, p: ChainParams, amplitude: float = 0.01, seed: int = 0) -> ChainState:
         """Every block stuck: v_i = 0, x_i = -A u_i with u_i = ``default_rng(seed).random(N)``
         (Carlson-Langer's start, MODEL.md), theta_i = 0.1 (the paper's) for state friction."""
         x = -amplitude * np.random.default_rng(seed).random(p.N) if amplitude > 0 else np.zeros(p.N)
@@ -116,7 +119,7 @@ class ChainState:
         h.update((self.mov[1:-1] == 0.0).astype(np.uint8).tobytes())
         return h.hexdigest()
 
-    def copy(self) -> "ChainState":
+    def copy(self) -> ChainState:
         return ChainState(**{k: getattr(self, k).copy() for k in self.ARRAYS})
 
 
@@ -144,21 +147,23 @@ def steady_deviation(state: ChainState, p: ChainParams) -> float:
     if p.drive == "plate":
         # Every block lags the plate by c / Kp: compare positions in the plate's frame.
         ss = physics.chain_steady_state(p, float(np.float64(state.step) * p.dt))
-        return float(max(np.max(np.abs(state.v[1:-1] - ss["v"])),
-                         np.max(np.abs(state.x[1:-1] - ss["x"]))))
+        return float(max(np.max(np.abs(state.v[1:-1] - ss["v"])), np.max(np.abs(state.x[1:-1] - ss["x"]))))
     ss = physics.chain_steady_state(p)
     x = state.x[1:-1]
     x0 = p.V * (np.float64(state.step) * p.dt)
     ext = np.diff(np.concatenate(([x0], x))) * -1.0
-    return float(max(
-        np.max(np.abs(state.v[1:-1] - ss["v"])),
-        np.max(np.abs(state.th[1:-1] - ss["theta"])),
-        np.max(np.abs(ext - ss["ext"])),
-    ))
+    return float(
+        max(
+            np.max(np.abs(state.v[1:-1] - ss["v"])),
+            np.max(np.abs(state.th[1:-1] - ss["theta"])),
+            np.max(np.abs(ext - ss["ext"])),
+        )
+    )
 
 
-def loading_warnings(p: ChainParams, t_end: float, average_from: float | None = None,
-                     start: str = "paper") -> list[str]:
+def loading_warnings(
+    p: ChainParams, t_end: float, average_from: float | None = None, start: str = "paper"
+) -> list[str]:
     """Why a run of the end-driven chain (eq. 4) is too short to show its stick-slip state, if it is.
 
     From a start with x_i = 0 ('paper', 'rest') the chain loads until t ~ L_ss / V
@@ -168,13 +173,19 @@ def loading_warnings(p: ChainParams, t_end: float, average_from: float | None = 
     t_load = physics.loading_time(p)
     if start not in ("paper", "rest") or not np.isfinite(t_load):
         return []
-    where = (f"from x_i = 0 the chain of N = {p.N} loads until t ~ L_ss / V = {t_load:.3g} "
-             f"(L_ss = {physics.chain_steady_length(p):.4g}, V = {p.V:g})")
+    where = (
+        f"from x_i = 0 the chain of N = {p.N} loads until t ~ L_ss / V = {t_load:.3g} "
+        f"(L_ss = {physics.chain_steady_length(p):.4g}, V = {p.V:g})"
+    )
     if t_end < t_load:
-        return [f"{where}; this run ends at t = {t_end:.3g} and shows only the loading: "
-                f"use a t_end of a few times {t_load:.3g}, or fewer blocks"]
+        return [
+            f"{where}; this run ends at t = {t_end:.3g} and shows only the loading: "
+            f"use a t_end of a few times {t_load:.3g}, or fewer blocks"
+        ]
     t_avg = t_end / 2.0 if average_from is None else average_from
     if t_avg < t_load:
-        return [f"{where}; <L> averages from t = {t_avg:.3g}, before the chain has loaded: "
-                f"average from t >= {t_load:.3g} (average_from) and run to well beyond it"]
+        return [
+            f"{where}; <L> averages from t = {t_avg:.3g}, before the chain has loaded: "
+            f"average from t >= {t_load:.3g} (average_from) and run to well beyond it"
+        ]
     return []

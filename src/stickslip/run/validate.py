@@ -47,8 +47,13 @@ def check_checkpoint_state(state, params: ChainParams, options, parts: dict, whe
     for lo, hi, name in ((K.ACT_LO, K.ACT_HI, "ACT"), (K.MECH_LO, K.MECH_HI, "MECH")):
         if not _interval(ist, lo, hi, N):
             raise bad(f"{name} interval [{int(ist[lo])}, {int(ist[hi])}] is neither empty nor within [1, {N}]")
-    for idx, name in ((K.EV_COUNT, "EV_COUNT"), (K.FM_COUNT, "FM_COUNT"), (K.S_COUNT, "S_COUNT"),
-                      (K.P_COUNT, "P_COUNT"), (K.EV_P_FIRST, "EV_P_FIRST")):
+    for idx, name in (
+        (K.EV_COUNT, "EV_COUNT"),
+        (K.FM_COUNT, "FM_COUNT"),
+        (K.S_COUNT, "S_COUNT"),
+        (K.P_COUNT, "P_COUNT"),
+        (K.EV_P_FIRST, "EV_P_FIRST"),
+    ):
         if int(ist[idx]) != 0:
             raise bad(f"{name} is {int(ist[idx])}, not 0 after a flush")
     if not 0 <= int(ist[K.BAD_BLOCK]) <= N + 1:
