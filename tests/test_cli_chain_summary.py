@@ -13,7 +13,9 @@ def test_a_chain_with_every_block_moving_is_said_to_slide(capsys):
 
 def test_a_resumed_run_reports_this_run_and_the_total(tmp_path, capsys):
     out = tmp_path / "run"
-    assert main(["chain", "--N", "20", "--t-end", "3e4", "--out", str(out), "--no-progress"]) == 0
+    # a finished run keeps its checkpoint only on request, and a longer resume needs it
+    first = ["chain", "--N", "20", "--t-end", "3e4", "--out", str(out), "--keep-checkpoint", "--no-progress"]
+    assert main(first) == 0
     assert main(["chain", "--resume", str(out), "--t-end", "6e4", "--no-progress"]) == 0
     text = capsys.readouterr().out.splitlines()
     wall = [line for line in text if line.startswith("wall time")]
