@@ -7,6 +7,7 @@ import subprocess
 import sys
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from stickslip import io
@@ -61,8 +62,10 @@ def test_block_out_writes_run_and_figures(capsys, tmp_path):
     assert status == 0
     data = json.loads(out)
     names = {p.split("/")[-1] for p in data["outputs"]}
-    assert {"series.nc", "slips.parquet", "run.json", "fig1.png", "fig2.png", "fig2.nc",
-            "fig3.png", "fig3.parquet"} <= names  # fmt: skip
+    # The outputs convention: every figure as PNG and PDF, a figure's table as Parquet and CSV.
+    assert {"series.nc", "slips.parquet", "run.json", "fig1.png", "fig1.pdf", "fig2.png", "fig2.pdf", "fig2.nc",
+            "fig3.png", "fig3.pdf", "fig3.parquet", "fig3.csv"} <= names  # fmt: skip
+    assert (out_dir / "fig3.pdf").read_bytes().startswith(b"%PDF")
     series = io.read_dataset(out_dir / "series.nc")
     assert series["t"].size == 120 / 0.005 // 7 + 2
     slips = io.read_table(out_dir / "slips.parquet")
@@ -70,6 +73,7 @@ def test_block_out_writes_run_and_figures(capsys, tmp_path):
     meta = io.read_json(out_dir / "run.json")
     assert meta["params"]["V"] == 0.01 and meta["integrator"].startswith("heun")
     fig3 = io.read_table(out_dir / "fig3.parquet")
+    pd.testing.assert_frame_equal(pd.read_csv(out_dir / "fig3.csv"), fig3, check_dtype=False)
     assert len(fig3) >= 12 and fig3["V"].min() == pytest.approx(1e-3) and fig3["V"].max() == pytest.approx(0.1)
     small = fig3[fig3["V"] <= 0.01 + 1e-12]
     assert np.all(np.abs(small["period"] / small["period_law"] - 1) < 0.005)

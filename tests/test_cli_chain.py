@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import warnings
 
 import pandas as pd
 import pytest
@@ -124,6 +125,17 @@ def test_bench_json(capsys):
     assert ns["dense"] == pytest.approx(1e9 * data["dense_seconds"] / block_steps)
     assert ns["exact"] == pytest.approx(1e9 * data["exact_seconds"] / block_steps)
     assert data["state_sha256"] == run_chain(ChainParams(N=20), 200.0).summary["state_sha256"]
+
+
+def test_bench_does_not_warn_about_its_own_workload():
+    from stickslip.run.bench import compare
+    from stickslip.run.driver import ShortRunWarning
+
+    with pytest.warns(ShortRunWarning):  # the workload is short of the loading time ...
+        run_chain(ChainParams(N=20), 200.0)
+    with warnings.catch_warnings():  # ... but a benchmark times it on purpose
+        warnings.simplefilter("error", ShortRunWarning)
+        assert compare(ChainParams(N=20), 200.0)["identical"] is True
 
 
 @pytest.mark.parametrize("argv, name", [(["--N", "0"], "N"), (["--t-end=-5"], "t-end"), (["--repeat", "0"], "repeat")])

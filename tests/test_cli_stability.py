@@ -63,7 +63,8 @@ def test_outputs_written(capsys, tmp_path):
     d = run_json(capsys, "stability", "block", "--beta", "0.08", "--V", "0.2", "--out", str(tmp_path / "b"))
     assert (tmp_path / "b" / "stability_map.png").stat().st_size > 0
     assert io.read_dataset(tmp_path / "b" / "stability_map.nc")["V_c"].size > 10
-    assert len(d["outputs"]) == 3
+    names = sorted(p.split("/")[-1] for p in d["outputs"])
+    assert names == ["stability_block.json", "stability_map.nc", "stability_map.pdf", "stability_map.png"]
     run_json(capsys, "stability", "chain", "--out", str(tmp_path / "c"))
     ds = io.read_dataset(tmp_path / "c" / "fig4.nc")
     assert set(ds["beta"].values) == {0.5, 1.0, 1.5}

@@ -97,6 +97,28 @@ def write_table(
     return Path(path)
 
 
+def write_csv(path: str | Path, table: pd.DataFrame) -> Path:
+    """Write a table as CSV (no index), atomically."""
+    with atomic_path(path) as tmp:
+        table.to_csv(tmp, index=False)
+    return Path(path)
+
+
+def write_table_files(
+    stem: str | Path,
+    table: pd.DataFrame,
+    descriptions: dict[str, str] | None = None,
+    metadata: dict[str, Any] | None = None,
+) -> list[Path]:
+    """Write a table the way every command writes one: STEM.parquet (typed, its columns described,
+    :func:`write_table`) and STEM.csv (for any tool); returns both paths."""
+    stem = Path(stem)
+    return [
+        write_table(stem.with_suffix(".parquet"), table, descriptions, metadata),
+        write_csv(stem.with_suffix(".csv"), table),
+    ]
+
+
 def read_table(path: str | Path) -> pd.DataFrame:
     return pd.read_parquet(path, engine="pyarrow")
 

@@ -2,8 +2,9 @@
 
 ``stickslip block`` runs eq. (1) and reports its slips; with ``--out DIR`` it writes the series
 (series.nc), the slip table (slips.parquet), run.json and Figs. 1 and 2 of the run; ``--fig3``
-adds the period sweep of Fig. 3 (fig3.png, fig3.parquet). ``stickslip slip-limit`` integrates
-eq. (3) and prints the slip duration, the force at stop and the period law T(V) = a + b / (K V).
+adds the period sweep of Fig. 3 (fig3.png and .pdf; its table fig3.parquet and .csv).
+``stickslip slip-limit`` integrates eq. (3) and prints the slip duration, the force at stop and
+the period law T(V) = a + b / (K V).
 """
 
 from __future__ import annotations
@@ -83,7 +84,7 @@ def register(sub) -> None:
                    help="write series.nc, slips.parquet, run.json, fig1.png, fig2.png (+ data) to DIR")  # fmt: skip
     p.add_argument("--fig3", action="store_true",
                    help=f"also simulate the period at {FIG3_POINTS} values of V in [1e-3, 1e-1] and "
-                        "write fig3.png and fig3.parquet (needs --out)")  # fmt: skip
+                        "write fig3.png, fig3.pdf and the table fig3.parquet, fig3.csv (needs --out)")  # fmt: skip
     add_overwrite_option(p)
     add_json_option(p)
     p.set_defaults(handler=run_block)
@@ -250,7 +251,7 @@ def write_block_outputs(out: Path, run: BlockRun, law: SlipLimit | None, *, fig3
     sweep = None
     if fig3 and law is not None:
         sweep = period_sweep(run.params, paper_V_values(FIG3_POINTS), periods=FIG3_PERIODS)
-        written.append(io.write_table(out / "fig3.parquet", sweep))
+        written += io.write_table_files(out / "fig3", sweep)
         written += save_figure(fig3_period(sweep, law), out / "fig3")
     meta = io.run_metadata(
         run.params,

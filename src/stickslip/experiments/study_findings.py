@@ -315,6 +315,6 @@ def draw(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[dict[str, Any
         )
     out = []
     for name, fig, caption in figs:
-        save_figure(fig, page_dir / f"{name}.png", formats=("png", "pdf"))
+        save_figure(fig, page_dir / name)
         out.append({"name": name, "image": f"{name}.png", "pdf": f"{name}.pdf", "caption": caption, "command": cmd})
     return out

@@ -149,8 +149,7 @@ def run_study(
     table = _study_table(spec, result.table)
     failed = table[table["status"] != "ok"]
     page_dir.mkdir(parents=True, exist_ok=True)
-    io.write_table(page_dir / "table.parquet", table)
-    table.to_csv(page_dir / "table.csv", index=False)
+    io.write_table_files(page_dir / "table", table)
     ok = table[table["status"] == "ok"]
     from stickslip.experiments import study_findings
 

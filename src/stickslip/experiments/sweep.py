@@ -38,7 +38,7 @@ import numpy as np
 import pandas as pd
 
 from stickslip import __version__
-from stickslip.io import read_json, run_metadata, write_dataset, write_json, write_table
+from stickslip.io import read_json, run_metadata, write_dataset, write_json, write_table, write_table_files
 from stickslip.jsonable import to_jsonable
 from stickslip.models.params import BlockParams, ChainParams
 from stickslip.run.errors import ShortRunWarning
@@ -293,8 +293,7 @@ def run_sweep(
 
     rows = [_row(p, n, r, u, common) for p, n, r, u in zip(points, names, records, reused, strict=False)]  # type: ignore[arg-type]
     table = _table(rows, points + [common])
-    write_table(out / f"{SUMMARY_NAME}.parquet", table)
-    _write_csv(out / f"{SUMMARY_NAME}.csv", table)
+    write_table_files(out / SUMMARY_NAME, table)
     n_failed = int((table["status"] != "ok").sum()) if len(table) else 0
     return SweepResult(
         table=table,
@@ -305,13 +304,6 @@ def run_sweep(
         n_failed=n_failed,
         wall_seconds=time.perf_counter() - start,
     )
-
-
-def _write_csv(path: Path, table: pd.DataFrame) -> None:
-    from stickslip.io import atomic_path
-
-    with atomic_path(path) as tmp:
-        table.to_csv(tmp, index=False)
 
 
 def _compute(task, points, common, out, names, specs, pending, records, *, scheduler, n_workers, progress):

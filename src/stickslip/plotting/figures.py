@@ -23,21 +23,13 @@ from stickslip.models.params import ChainParams
 from stickslip.report.commands import block_command, chain_command, hysteresis_command, sweep_command
 from stickslip.report.writer import ReportFigure
 
-FORMATS = ("png", "pdf")
-
 
 def _save(fig, figures_dir: Path, stem: str) -> tuple[str, str]:
     """Save a figure as figures/<stem>.png and .pdf; return both paths relative to the report."""
     from stickslip.plotting.style import save_figure
 
-    save_figure(fig, figures_dir / stem, formats=FORMATS)
+    save_figure(fig, figures_dir / stem)
     return f"figures/{stem}.png", f"figures/{stem}.pdf"
-
-
-def _write_csv(path: Path, table: pd.DataFrame) -> Path:
-    with io.atomic_path(path) as tmp:
-        table.to_csv(tmp, index=False)
-    return path
 
 
 def _figure(
@@ -111,7 +103,7 @@ def _fig3(o: dict[str, Outcome], d: Path) -> list[ReportFigure]:
 
     table = o["period-sweep"].data["table"]
     law = o["slip-limit"].data["law"]
-    f = _write_csv(d / "fig3.csv", table)
+    f = io.write_table_files(d / "fig3", table)
     return [
         _figure(
             "fig3",
@@ -121,7 +113,7 @@ def _fig3(o: dict[str, Outcome], d: Path) -> list[ReportFigure]:
             "T = 1.035 + 3.432 / (K V)).",
             d,
             fig3_period(table, law),
-            [f],
+            f,
             "stickslip block --fig3 --out DIR",
         )
     ]
@@ -200,8 +192,8 @@ def _fig5(o: dict[str, Outcome], a: dict[str, Any], d: Path, mode: str) -> list[
     snap = run.snapshots.isel(time=-1)
     t = float(snap["time"])
     p = run.params
-    fa = _write_csv(
-        d / "fig5a.csv",
+    fa = io.write_table_files(
+        d / "fig5a",
         pd.DataFrame(
             {
                 "block": np.arange(1, p.N + 1),
@@ -220,12 +212,12 @@ def _fig5(o: dict[str, Outcome], a: dict[str, Any], d: Path, mode: str) -> list[
             "paper's continuum form (dotted).",
             d,
             fig5a_snapshot(snap, p, t),
-            [fa],
+            fa,
             chain_command(o["chain-runs"], p.N, 1.0),
         )
     ]
     sweep = sweep_table(a)
-    fb = _write_csv(d / "fig5b.csv", sweep)
+    fb = io.write_table_files(d / "fig5b", sweep)
     q = ChainParams(**{k: v for k, v in o["chain-runs"].experiment.params.items()}, N=a["sweep_N"])
     steady_note = ", ".join(f"{b:g}" for b in sweep.loc[sweep["final_state"] == "steady sliding", "beta"])
     figs.append(
@@ -240,7 +232,7 @@ def _fig5(o: dict[str, Outcome], a: dict[str, Any], d: Path, mode: str) -> list[
             "runs above beta_c that had not settled into steady sliding by their end.",
             d,
             fig5b_length(sweep, q),
-            [fb],
+            fb,
             sweep_command(o["chain-runs"], mode),
         )
     )
@@ -261,15 +253,15 @@ def _fig6(o: dict[str, Outcome], a: dict[str, Any], d: Path) -> list[ReportFigur
     prof = run.profiles.isel(row=rows)
     f1 = io.write_dataset(d / "fig6.nc", prof)
     fm = run.first_move[run.first_move["event"].isin(ids)]
-    f2 = _write_csv(d / "fig6_first_move.csv", fm)
-    f3 = _write_csv(
-        d / "fig6_fronts.csv",
+    f2 = io.write_table_files(d / "fig6_first_move", fm)
+    f3 = io.write_table_files(
+        d / "fig6_fronts",
         pd.DataFrame([f.to_dict() for f in fr["fronts"]]).assign(
             label=fr["labels"], c_leading_edge=[e.speed if e is not None else np.nan for e in fr["edges"]]
         ),
     )
     per_event = fr["per_event"]
-    f4 = _write_csv(d / "fig6_speeds.csv", per_event)
+    f4 = io.write_table_files(d / "fig6_speeds", per_event)
     parts = []
     for col, name in (("c_first_move", "first motion"), ("c_leading_edge", "leading edge")):
         x = per_event[col].to_numpy(dtype=float)
@@ -293,7 +285,9 @@ def _fig6(o: dict[str, Outcome], a: dict[str, Any], d: Path) -> list[ReportFigur
         prof, fm, fr["fronts"], run.params, labels=fr["labels"], window=20.0, edges=fr["edges"], speeds=per_event
     )
     return [
-        _figure("fig6", "Fig. 6", caption, d, fig, [f1, f2, f3, f4], chain_command(o["chain-runs"], run.params.N, 1.0))
+        _figure(
+            "fig6", "Fig. 6", caption, d, fig, [f1, *f2, *f3, *f4], chain_command(o["chain-runs"], run.params.N, 1.0)
+        )
     ]
 
 
@@ -308,7 +302,7 @@ def _fig7_8(o: dict[str, Outcome], a: dict[str, Any], d: Path, which: str) -> li
     if stats is None:
         raise ValueError("too few events in the second half of the run")
     fit = stats["fit"]
-    f1 = _write_csv(d / f"{stem}_events.csv", events[["event", "t_start", "S", "max_block", "n_blocks"]])
+    f1 = io.write_table_files(d / f"{stem}_events", events[["event", "t_start", "S", "max_block", "n_blocks"]])
     hist = size_distribution(events["S"].to_numpy(dtype=float), 30)
     f2 = io.write_dataset(d / f"{stem}_histogram.nc", hist)
     N = a["figure_N"]
@@ -328,7 +322,7 @@ def _fig7_8(o: dict[str, Outcome], a: dict[str, Any], d: Path, which: str) -> li
             caption,
             d,
             fig7_8_sizes(events, fit, beta, paper_tau=paper_tau),
-            [f1, f2],
+            [*f1, f2],
             chain_command(o["chain-runs"], N, beta),
         )
     ]

@@ -19,7 +19,7 @@ from matplotlib.figure import Figure
 from stickslip.analysis.chain_runs import front_statistics, size_statistics
 from stickslip.models.physics import chain_steady_length, has_steady_state, loading_time
 from stickslip.plotting.chain import fig5a_snapshot, fig6_fronts, fig7_8_sizes
-from stickslip.plotting.style import PAPER, SIM, THEORY, new_figure, save_figure
+from stickslip.plotting.style import FIGURE_FORMATS, PAPER, SIM, THEORY, new_figure, save_figure
 
 __all__ = ["RunFigure", "length_series", "run_figures", "draw_run_figures", "MIN_EVENTS_FOR_SIZES"]
 
@@ -119,7 +119,7 @@ def run_figures(run, *, max_snapshots: int = 4) -> list[RunFigure]:
     return out
 
 
-def draw_run_figures(run, out_dir: str | Path, *, formats: tuple[str, ...] = ("png", "pdf")) -> list[dict]:
+def draw_run_figures(run, out_dir: str | Path, *, formats: tuple[str, ...] = FIGURE_FORMATS) -> list[dict]:
     """Save every figure of :func:`run_figures` as OUT_DIR/<stem>.<fmt>; one record per figure."""
     records = []
     for item in run_figures(run):

@@ -34,8 +34,12 @@ def new_figure(nrows: int = 1, ncols: int = 1, *, width: float = 5.0, height: fl
     return fig, axes
 
 
-def save_figure(fig: Figure, path: str | Path, *, formats: tuple[str, ...] = ("png",)) -> list[Path]:
-    """Save ``fig`` as PATH.png (and other formats); returns the written paths."""
+#: Every figure is saved in these formats: PNG to look at, PDF to print or put in a paper.
+FIGURE_FORMATS = ("png", "pdf")
+
+
+def save_figure(fig: Figure, path: str | Path, *, formats: tuple[str, ...] = FIGURE_FORMATS) -> list[Path]:
+    """Save ``fig`` as PATH.png and PATH.pdf (or ``formats``); returns the written paths."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     written = []
@@ -47,4 +51,4 @@ def save_figure(fig: Figure, path: str | Path, *, formats: tuple[str, ...] = ("p
     return written
 
 
-__all__ = ["new_figure", "save_figure", "plt", "SIM", "THEORY", "PAPER", "RC"]
+__all__ = ["new_figure", "save_figure", "FIGURE_FORMATS", "plt", "SIM", "THEORY", "PAPER", "RC"]
