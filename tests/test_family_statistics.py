@@ -80,5 +80,9 @@ def test_cl_statistics_returns_its_numbers_and_files(tmp_path):
     assert res["carlson_langer"]["spanning"] == "n_blocks"
     assert res["fig8"]["spanning"] == "max_block"
     assert (tmp_path / "family_sizes.png").stat().st_size > 0
+    assert (tmp_path / "family_sizes.pdf").read_bytes().startswith(b"%PDF")
+    drawn = pd.read_parquet(tmp_path / "family_sizes.parquet")
+    assert set(drawn["model"]) == {"carlson-langer", "fig8"} and (drawn["S"] > 0).all()
+    pd.testing.assert_frame_equal(pd.read_csv(tmp_path / "family_sizes.csv"), drawn, check_dtype=False)
     stored = json.loads((tmp_path / "family_sizes.json").read_text())
     assert stored["carlson_langer"]["tau"] == pytest.approx(res["carlson_langer"]["tau"])

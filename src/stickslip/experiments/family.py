@@ -11,6 +11,8 @@ import time
 from pathlib import Path
 from typing import Any
 
+import pandas as pd
+
 from stickslip import io
 from stickslip.analysis.chain_runs import size_statistics
 from stickslip.models.presets import chain_params
@@ -74,7 +76,9 @@ def cl_statistics(
     s_min by least KS distance, bootstrap error, and the excess of events at or above it over the
     power law's count (:func:`stickslip.analysis.chain_runs.size_statistics`).
 
-    With ``out``, writes ``family_sizes.png`` and ``family_sizes.json`` there. Returns
+    With ``out``, writes the figure ``family_sizes.png`` and ``.pdf``, the sizes drawn in it
+    (``family_sizes.parquet`` and ``.csv``: model, event, t_start, S) and the summaries
+    (``family_sizes.json``) there. Returns
     {"carlson_langer": summary, "fig8": summary, "files": [...]}; a model without a spanning
     event has NaN excess.
     """
@@ -95,7 +99,14 @@ def cl_statistics(
                 (f"eq. (4), beta = 0.2 (Fig. 8), N = {p_8.N}, t = {fig8_t_end:g} (from {f8['t_from']:g})", ev_8, st_8),
             ]
         )
-        files = [str(f) for f in save_figure(fig, out / "family_sizes.png")]
+        files = [str(f) for f in save_figure(fig, out / "family_sizes")]
+        drawn = pd.concat(
+            [
+                ev[["event", "t_start", "S"]].assign(model=name)
+                for name, ev in (("carlson-langer", ev_cl), ("fig8", ev_8))
+            ]
+        )[["model", "event", "t_start", "S"]]
+        files += [str(f) for f in io.write_table_files(out / "family_sizes", drawn)]
         files.append(str(io.write_json(out / "family_sizes.json", {k: v for k, v in result.items() if k != "files"})))
         result["files"] = files
     return result
