@@ -61,7 +61,7 @@ def cl_statistics(
     *,
     transient: float = 0.2,
     fig8_N: int = 399,
-    fig8_t_end: float = 4e6,
+    fig8_t_end: float = 1e7,
     fig8_transient: float = 0.5,
     seed: int = 0,
     bootstrap: int = 200,
