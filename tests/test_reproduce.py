@@ -211,6 +211,10 @@ def test_every_figure_is_drawn_with_png_pdf_and_data(smoke):
         for d in f["data"]:
             assert (out / d).is_file(), d
         assert f["command"].startswith("stickslip ")
+        # The command under a figure is one that draws it.
+        assert "--out DIR" in f["command"], f["figure"]
+        if f["command"].startswith("stickslip chain "):
+            assert "&& stickslip plot DIR" in f["command"], f["figure"]
     html = (out / "report.html").read_text()
     assert html.count("data:image/png;base64,") == len(report["figures"])
 

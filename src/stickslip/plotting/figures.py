@@ -91,7 +91,7 @@ def _fig1_2(o: dict[str, Outcome], d: Path) -> list[ReportFigure]:
             d,
             fig2_slip(run, law),
             [f2],
-            "stickslip slip-limit --json",
+            block_command(o["block"]),
         )
     )
     return figs
@@ -157,7 +157,7 @@ def _hysteresis(o: dict[str, Outcome], d: Path) -> list[ReportFigure]:
             d,
             plot_hysteresis(data),
             [f],
-            hysteresis_command(o["hysteresis"]),
+            hysteresis_command(o["hysteresis"], draw=True),
         )
     ]
 
@@ -213,7 +213,7 @@ def _fig5(o: dict[str, Outcome], a: dict[str, Any], d: Path, mode: str) -> list[
             d,
             fig5a_snapshot(snap, p, t),
             fa,
-            chain_command(o["chain-runs"], p.N, 1.0),
+            chain_command(o["chain-runs"], p.N, 1.0, plot="snapshot_final"),
         )
     ]
     sweep = sweep_table(a)
@@ -286,7 +286,13 @@ def _fig6(o: dict[str, Outcome], a: dict[str, Any], d: Path) -> list[ReportFigur
     )
     return [
         _figure(
-            "fig6", "Fig. 6", caption, d, fig, [f1, *f2, *f3, *f4], chain_command(o["chain-runs"], run.params.N, 1.0)
+            "fig6",
+            "Fig. 6",
+            caption,
+            d,
+            fig,
+            [f1, *f2, *f3, *f4],
+            chain_command(o["chain-runs"], run.params.N, 1.0, plot="fronts"),
         )
     ]
 
@@ -323,7 +329,7 @@ def _fig7_8(o: dict[str, Outcome], a: dict[str, Any], d: Path, which: str) -> li
             d,
             fig7_8_sizes(events, fit, beta, paper_tau=paper_tau),
             [*f1, f2],
-            chain_command(o["chain-runs"], N, beta),
+            chain_command(o["chain-runs"], N, beta, plot="sizes"),
         )
     ]
 

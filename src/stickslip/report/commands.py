@@ -19,17 +19,21 @@ def block_command(o: Outcome) -> str:
     return f"stickslip block --t-end {g(o.experiment.t_end)} --out DIR"
 
 
-def hysteresis_command(o: Outcome) -> str:
-    """The ``stickslip hysteresis`` command of the sweep of V (section 2)."""
+def hysteresis_command(o: Outcome, *, draw: bool = False) -> str:
+    """The ``stickslip hysteresis`` command of the sweep of V (section 2): printing its numbers,
+    or with ``draw`` writing its figure (hysteresis.png) into DIR."""
     s = o.experiment.options
     return (
         f"stickslip hysteresis --K 10 --beta 1 --Fs 3 --V-min {g(s['V_min'])} --V-max {g(s['V_max'])} "
-        f"--dV {g(s['dV'])} --time-per-step {g(s['time_per_step'])} --transient {g(s['transient'])} --json"
+        f"--dV {g(s['dV'])} --time-per-step {g(s['time_per_step'])} --transient {g(s['transient'])} "
+        + ("--out DIR" if draw else "--json")
     )
 
 
-def chain_command(o: Outcome, N: int, beta: float) -> str:
-    """The ``stickslip chain`` command of one chain run of the experiment."""
+def chain_command(o: Outcome, N: int, beta: float, *, plot: str | None = None) -> str:
+    """The ``stickslip chain`` command of one chain run of the experiment; with ``plot`` (a figure
+    of ``stickslip plot``: snapshot_final, sizes, fronts, ...) followed by the command that draws
+    it from the run directory."""
     cfg = {**chain_common(o.experiment), "N": N, "beta": beta}
     params, t_end, opts = point_settings(cfg)
     parts = [
@@ -41,6 +45,8 @@ def chain_command(o: Outcome, N: int, beta: float) -> str:
     if opts.get("until_steady"):
         parts.append(f"--until-steady {g(opts['until_steady'])}")
     parts.append("--out DIR")
+    if plot is not None:
+        parts.append(f"&& stickslip plot DIR  (DIR/figures/{plot}.png)")
     return " ".join(parts)
 
 
