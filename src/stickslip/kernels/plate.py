@@ -19,16 +19,27 @@ queue, the others are found when the step reaches the smallest of their ``trig``
 
 A step costs little more than its moving blocks (most steps move one to a few of them):
 
-1. the stopped candidates get the start rule alone and are split, without branches, into
-   starters (appended to the list of movers) and blocks that stay stopped;
-2. stage 1 and then stage 2 (with the stop rule) run over the movers' list in three loops
-   each: gather the forces and velocities into packed arrays, evaluate the friction
-   phi(v) = (1 - sigma) / (1 + 2 alpha max(v, 0) / (1 - sigma)) and the Heun sums on the
-   packed arrays (a loop the compiler vectorises: its two divisions per block dominate a
-   scalar step), scatter the results back. Vector and scalar divisions round alike, so the
-   order of evaluation and every bit are those of run_dense;
-3. the blocks that stopped, the stopped neighbours of the movers and the stopped candidates
-   are then given their next step as candidates (queue) or their plate start (``trig``).
+1. the start rule of the stopped candidates: a first pass only asks whether any fires (it
+   rarely does); if one does, a second pass splits them, without branches, into starters
+   (appended to the list of movers) and blocks that stay stopped;
+2. stage 1 and then stage 2 (with the stop rule) of the movers. With more than a few movers
+   each stage runs in three loops: gather the forces and velocities into packed arrays,
+   evaluate the friction phi(v) = (1 - sigma) / (1 + 2 alpha max(v, 0) / (1 - sigma)) and the
+   Heun sums on the packed arrays (a loop the compiler vectorises: its two divisions per
+   block dominate a scalar step), scatter the results back. With a few movers a vector loop
+   does not pay for its set-up, and each stage is one scalar loop over the list. Vector and
+   scalar divisions round alike, so the order of evaluation and every bit are those of
+   run_dense;
+3. if no block started or stopped (and the last step stopped none), the movers' list and the
+   queue of candidates stay as they are. Otherwise the lists are rebuilt from what changed:
+   ``cnt`` counts the moving neighbours of each block, so the next queue (the stopped
+   neighbours of the blocks that moved) is found from the candidates that stayed stopped,
+   the starters' neighbours and the blocks that stopped and their neighbours, not from every
+   mover. The stopped blocks that leave the queue get their plate start (``trig``).
+
+Outputs, the end of the call and the buffers are looked at only from the step ``n_chk``: the
+next sample, profile row or end, or the step after an event started or ended (the only
+steps at which a buffer can fill).
 
 Block indices in the lists are unsigned: numba then indexes the arrays without the
 wraparound code of negative indices. The kernel uses numpy's error model (a float division
@@ -46,6 +57,44 @@ from numba import njit
 from stickslip.kernels import common as c
 
 _QUEUED = np.int64(-1)  # trig of a stopped block queued as a candidate of the next step
+_FEW = 8  # up to this many movers, each stage is one scalar loop (faster than the packed loops: measured)
+
+
+@njit(cache=True, inline="always")
+def _x_ghosts(x, N, ends):
+    """Ghost cells of x under the plate drive, as common._set_ghosts sets them (theta's do not
+    change here)."""
+    if ends == c.ENDS_PERIODIC:
+        x[0] = x[N]
+        x[N + 1] = x[1]
+    elif ends == c.ENDS_FIXED:
+        x[0] = 0.0
+        x[N + 1] = 0.0
+    else:
+        x[0] = x[1]
+        x[N + 1] = x[N]
+
+
+@njit(cache=True, inline="always")
+def _sides(i, one, uN, periodic):
+    """Left and right neighbour of block i (through the ring with periodic ends)."""
+    l = i - one
+    r = i + one
+    if periodic:
+        l = l if l >= one else uN
+        r = r if r <= uN else one
+    return l, r
+
+
+@njit(cache=True, inline="always")
+def _enqueue(j, ok, mov, trig, queue, nq, one, uN):
+    """Queue block j for the next step if ok and it is a stopped block not queued yet; returns
+    the new length. Without branches (they mispredict): a slot not taken is overwritten."""
+    t = trig[j]
+    q = ok & (j >= one) & (j <= uN) & (mov[j] == 0.0) & (t != _QUEUED)
+    trig[j] = _QUEUED if q else t
+    queue[nq] = j
+    return nq + (1 if q else 0)
 
 
 @njit(cache=True, error_model="numpy")
@@ -84,8 +133,8 @@ def run_sparse(
     """:func:`stickslip.kernels.chain.run_exact` for the plate drive with weakening or
     strengthening friction: same arguments, state and status codes (module docstring).
 
-    ``mm``, ``a1``, ``b1`` and ``ths`` are not used: the mask is 1 on the movers' list and the
-    stage-1 accelerations are kept in the list's order.
+    ``mm``, ``a1``, ``b1``, ``vs`` and ``ths`` are not used: the mask is 1 on the movers' list,
+    and the stage-1 accelerations and predicted velocities are kept in the list's order.
     """
     N = x.shape[0] - 2
     mp, V, dt = c._unpack(par)
@@ -97,8 +146,9 @@ def run_sparse(
     periodic = ends == c.ENDS_PERIODIC
     movers = np.empty(N, np.uint64)  # moving blocks, then this step's starters
     nxt = np.empty(N, np.uint64)  # the movers of the next step
-    queue = np.empty(N, np.uint64)  # stopped blocks that are candidates in the next step
-    still = np.empty(N, np.uint64)  # stopped candidates whose start rule did not fire
+    queue = np.empty(N + 1, np.uint64)  # stopped candidates of the next step (a spare slot: _enqueue)
+    cnt = np.zeros(N + 2, np.int64)  # how many neighbours of each block are movers
+    still = np.empty(N + 1, np.uint64)  # stopped candidates whose start rule did not fire (swaps with queue)
     stopped = np.empty(N, np.uint64)  # movers that stopped in this step
     acc = np.empty(N)  # stage-1 acceleration of movers[k]
     fb = np.empty(N)  # packed: force on movers[k] (stage 1, then stage 2)
@@ -117,6 +167,9 @@ def run_sparse(
         if mov[i] != 0.0:
             movers[nmov] = i
             nmov += 1
+            l, r = _sides(np.uint64(i), one, uN, periodic)
+            cnt[l] += 1
+            cnt[r] += 1
         else:
             xs[i] = x[i] + dt * v[i]
     for i in range(1, N + 1):
@@ -137,39 +190,64 @@ def run_sparse(
     steps_computed = 0
     block_updates = 0
     full_updates = 0
+    active = ist[c.EV_ACTIVE] == 1
+    # The queue holds the stopped neighbours of the movers (and the plate's due starts); while
+    # no block starts or stops it stays so, and the next step's queue is this one.
+    qexact = False
+    full = True  # the next rebuild of the queue looks at every mover
     n = n0
+    n_chk = n0  # outputs, the end and the buffers are looked at from this step on
+    st = c.DONE
     while True:
-        ist[c.STEP] = n
-        if n == ist[c.NEXT_SAMPLE] or (profile_every > 0 and ist[c.EV_ACTIVE] == 1 and n == ist[c.NEXT_PROFILE]):
-            st = c._service(n, x, N, ist, samp_L, samp_step, prof_x, prof_meta, sample_every, profile_every)
-            if st != c.DONE:
+        if n >= n_chk:
+            # Outputs due, the end, buffers that could overflow. These change only at the steps
+            # named here or when an event starts or ends, after which n_chk is the next step.
+            ist[c.STEP] = n
+            if n == ist[c.NEXT_SAMPLE] or (profile_every > 0 and active and n == ist[c.NEXT_PROFILE]):
+                st = c._service(n, x, N, ist, samp_L, samp_step, prof_x, prof_meta, sample_every, profile_every)
+                if st != c.DONE:
+                    break
+            if n >= n_end:
+                st = c.DONE
                 break
-        if n >= n_end:
-            st = c.DONE
-            break
-        if (
-            ist[c.EV_COUNT] >= cap_ev
-            or ist[c.FM_COUNT] + N > cap_fm
-            or (profile_every > 0 and ist[c.P_COUNT] + 2 > cap_p)
-        ):
-            st = c._overflow(ist, N, cap_ev, cap_fm)
-            break
+            if (
+                ist[c.EV_COUNT] >= cap_ev
+                or ist[c.FM_COUNT] + N > cap_fm
+                or (profile_every > 0 and ist[c.P_COUNT] + 2 > cap_p)
+            ):
+                st = c._overflow(ist, N, cap_ev, cap_fm)
+                break
+            n_chk = n_end if n_end < ist[c.NEXT_SAMPLE] else ist[c.NEXT_SAMPLE]
+            if profile_every > 0 and active and ist[c.NEXT_PROFILE] < n_chk:
+                n_chk = ist[c.NEXT_PROFILE]
         p1 = c._pull(V, n, dt)
         # Start rule of the stopped candidates: the queue, and (rarely) the plate's due starts.
-        # Each goes to the starters (after the movers) or to the blocks that stay stopped.
+        # Each goes to the starters (after the movers) or to the blocks that stay stopped; the
+        # latter stay marked as queued.
         nst = 0
         nsl = 0
+        fired = False
         for k in range(nq):
             i = queue[k]
-            trig[i] = c._NEVER
             f = c._force(x[i - one], x[i], x[i + one], K, Kp, p1, drive)
-            fire = f > c._threshold(th[i], Fs, threshold)
-            movers[nmov + nst] = i
-            still[nsl] = i
-            nst += 1 if fire else 0
-            nsl += 0 if fire else 1
-        nq = 0
-        if n >= t_next:
+            fired |= f > c._threshold(th[i], Fs, threshold)
+        if fired:
+            for k in range(nq):
+                i = queue[k]
+                f = c._force(x[i - one], x[i], x[i + one], K, Kp, p1, drive)
+                fire = f > c._threshold(th[i], Fs, threshold)
+                movers[nmov + nst] = i
+                still[nsl] = i
+                nst += 1 if fire else 0
+                nsl += 0 if fire else 1
+        else:
+            # Usually none starts: the queue is the list of blocks that stay stopped.
+            still, queue = queue, still
+            nsl = nq
+        for k in range(nmov, nmov + nst):
+            trig[movers[k]] = c._NEVER
+        scanned = n >= t_next
+        if scanned:
             t_next = c._NEVER
             for j in range(1, N + 1):
                 if mov[j] == 0.0:
@@ -192,33 +270,46 @@ def run_sparse(
             target = n_end
             if ist[c.NEXT_SAMPLE] < target:
                 target = ist[c.NEXT_SAMPLE]
-            if profile_every > 0 and ist[c.EV_ACTIVE] == 1 and ist[c.NEXT_PROFILE] < target:
+            if profile_every > 0 and active and ist[c.NEXT_PROFILE] < target:
                 target = ist[c.NEXT_PROFILE]
             n = t_next if t_next < target else target
             continue
 
         # Stage 1 of the movers (x holds t_n everywhere; ghost cells are set). The mask is 1.
-        for k in range(na):
-            i = movers[k]
-            fb[k] = c._force(x[i - one], x[i], x[i + one], K, Kp, p1, drive)
-            vb[k] = v[i]
-        for k in range(na):
-            a = c._accel(fb[k], 0.0, vb[k], 1.0, mp, friction)
-            acc[k] = a
-            vsb[k] = vb[k] + dt * a
-        for k in range(na):
-            i = movers[k]
-            xs[i] = x[i] + dt * vb[k]
-            vs[i] = vsb[k]
+        # The predictor of x goes to xs (stage 2 reads it), that of v stays packed.
+        packed = na > _FEW
+        if packed:
+            for k in range(na):
+                i = movers[k]
+                fb[k] = c._force(x[i - one], x[i], x[i + one], K, Kp, p1, drive)
+                vi = v[i]
+                vb[k] = vi
+                xs[i] = x[i] + dt * vi
+            for k in range(na):
+                a = c._accel(fb[k], 0.0, vb[k], 1.0, mp, friction)
+                acc[k] = a
+                vsb[k] = vb[k] + dt * a
+        else:
+            for k in range(na):
+                i = movers[k]
+                f = c._force(x[i - one], x[i], x[i + one], K, Kp, p1, drive)
+                vi = v[i]
+                a = c._accel(f, 0.0, vi, 1.0, mp, friction)
+                vb[k] = vi
+                acc[k] = a
+                vsb[k] = vi + dt * a
+                xs[i] = x[i] + dt * vi
+        _x_ghosts(xs, N, ends)
         p2 = c._pull(V, n + 1, dt)
-        c._set_ghosts(xs, ths, N, p2, drive, ends)
         # Event start and first moves (as common._start_and_first_moves): a block moves for
         # the first time in an event only in the step it starts.
-        if nst > 0 and (ist[c.EV_ACTIVE] == 1 or nmov == 0):
-            if ist[c.EV_ACTIVE] == 0:
+        if nst > 0 and (active or nmov == 0):
+            if not active:
                 first = N + 1
                 for k in range(nst):
                     first = min(first, np.int64(movers[k]))
+                active = True
+                n_chk = n + 1
                 ist[c.EV_ACTIVE] = 1
                 ist[c.EV_START_STEP] = n
                 ist[c.EV_START_BLOCK] = first
@@ -242,75 +333,128 @@ def run_sparse(
                     if np.int64(i) > ist[c.EV_MAX_BLOCK]:
                         ist[c.EV_MAX_BLOCK] = np.int64(i)
         # Stage 2, corrector and stop rule of the movers (stopped blocks keep every bit).
-        # Theta is updated as run_dense does, with both derivatives 0 (no state variable).
-        for k in range(na):
-            i = movers[k]
-            fb[k] = c._force(xs[i - one], xs[i], xs[i + one], K, Kp, p2, drive)
-        for k in range(na):
-            a2 = c._accel(fb[k], 0.0, vsb[k], 1.0, mp, friction)
-            vn = vb[k] + h2 * (acc[k] + a2)
-            keep = vn > 0.0
-            vb[k] = vn if keep else 0.0
-            kept[k] = keep
-        nn = 0
+        # Theta is left as run_dense leaves it (both derivatives 0, no state variable).
         ns = 0
-        for k in range(na):
-            i = movers[k]
-            x[i] = x[i] + h2 * (v[i] + vsb[k])
-            keep = kept[k]
-            v[i] = vb[k]
-            mov[i] = 1.0 if keep else 0.0
-            nxt[nn] = i
-            stopped[ns] = i
-            nn += 1 if keep else 0
-            ns += 0 if keep else 1
-        # Blocks that stopped: the predictor run_dense writes for them from now on.
-        for k in range(ns):
-            i = stopped[k]
-            xs[i] = x[i] + dt * v[i]
-        c._set_ghosts(x, th, N, 0.0, drive, ends)
-        # Stopped blocks next to a block that moved: their force changed, so evaluate their
-        # start rule in the next step (cheaper than finding a start step while a front passes).
-        for k in range(na):
-            i = movers[k]
-            l = i - one
-            r = i + one
-            if periodic:
-                l = l if l >= one else uN
-                r = r if r <= uN else one
-            if l >= one and mov[l] == 0.0 and trig[l] != _QUEUED:
-                trig[l] = _QUEUED
-                queue[nq] = l
-                nq += 1
-            if r <= uN and mov[r] == 0.0 and trig[r] != _QUEUED:
-                trig[r] = _QUEUED
-                queue[nq] = r
-                nq += 1
-        # The other stopped blocks of this step have settled neighbours: their start step.
-        for k in range(nsl + ns):
-            i = still[k] if k < nsl else stopped[k - nsl]
-            if trig[i] != _QUEUED:
-                m = c._plate_trigger(
-                    x[i - one], x[i], x[i + one], c._threshold(th[i], Fs, threshold), K, Kp, V, dt, n + 1, n_end
-                )
-                if m <= n + 1:
-                    trig[i] = _QUEUED
-                    queue[nq] = i
-                    nq += 1
-                else:
-                    trig[i] = m
-                    t_next = min(t_next, m)
-        movers, nxt = nxt, movers
-        ist[c.N_MOVING] = nn
-        nmov = nn
+        if packed:
+            for k in range(na):
+                i = movers[k]
+                fb[k] = c._force(xs[i - one], xs[i], xs[i + one], K, Kp, p2, drive)
+            for k in range(na):
+                a2 = c._accel(fb[k], 0.0, vsb[k], 1.0, mp, friction)
+                vn = vb[k] + h2 * (acc[k] + a2)
+                keep = vn > 0.0
+                vb[k] = vn if keep else 0.0
+                kept[k] = keep
+            for k in range(na):
+                i = movers[k]
+                x[i] = x[i] + h2 * (v[i] + vsb[k])
+                keep = kept[k]
+                v[i] = vb[k]
+                mov[i] = 1.0 if keep else 0.0
+                ns += 0 if keep else 1
+        else:
+            for k in range(na):
+                i = movers[k]
+                f2 = c._force(xs[i - one], xs[i], xs[i + one], K, Kp, p2, drive)
+                sv = vsb[k]
+                vo = vb[k]
+                vn = vo + h2 * (acc[k] + c._accel(f2, 0.0, sv, 1.0, mp, friction))
+                keep = vn > 0.0
+                x[i] = x[i] + h2 * (vo + sv)
+                v[i] = vn if keep else 0.0
+                mov[i] = 1.0 if keep else 0.0
+                kept[k] = keep
+                ns += 0 if keep else 1
+        _x_ghosts(x, N, ends)
         block_updates += na + nsl
         full_updates += na
         steps_computed += 1
-        if ist[c.EV_ACTIVE] == 1 and nmov == 0:
+        if qexact and nst == 0 and ns == 0 and not scanned:
+            still, queue = queue, still  # the candidates stay the queue
+        else:
+            # The movers changed: rebuild the lists. (Otherwise every candidate stayed stopped
+            # and stays queued, and the movers' list is the same.)
+            if ns > 0:
+                nn = 0
+                q = 0
+                for k in range(na):
+                    i = movers[k]
+                    keep = kept[k]
+                    nxt[nn] = i
+                    stopped[q] = i
+                    nn += 1 if keep else 0
+                    q += 0 if keep else 1
+                # Blocks that stopped: the predictor run_dense writes for them from now on.
+                for k in range(ns):
+                    i = stopped[k]
+                    xs[i] = x[i] + dt * v[i]
+            # Moving neighbours: this step's starters joined the movers, the blocks that stopped left.
+            for k in range(nmov, na):
+                l, r = _sides(movers[k], one, uN, periodic)
+                cnt[l] += 1
+                cnt[r] += 1
+            for k in range(ns):
+                l, r = _sides(stopped[k], one, uN, periodic)
+                cnt[l] -= 1
+                cnt[r] -= 1
+            for k in range(nsl):
+                trig[still[k]] = c._NEVER
+            # Stopped blocks next to a block that moved: their force changed, so evaluate their
+            # start rule in the next step (cheaper than finding a start step while a front passes).
+            nq = 0
+            if full:
+                for k in range(na):
+                    l, r = _sides(movers[k], one, uN, periodic)
+                    nq = _enqueue(l, True, mov, trig, queue, nq, one, uN)
+                    nq = _enqueue(r, True, mov, trig, queue, nq, one, uN)
+                full = False
+            else:
+                # The same set from what changed: the last queue holds the stopped neighbours of
+                # the movers before this step, so only the candidates that stayed stopped (if
+                # still next to a mover), the starters' neighbours, and the blocks that stopped
+                # and their neighbours can be in the new one.
+                for k in range(nsl):
+                    j = still[k]
+                    nq = _enqueue(j, cnt[j] > 0, mov, trig, queue, nq, one, uN)
+                for k in range(nmov, na):
+                    l, r = _sides(movers[k], one, uN, periodic)
+                    nq = _enqueue(l, True, mov, trig, queue, nq, one, uN)
+                    nq = _enqueue(r, True, mov, trig, queue, nq, one, uN)
+                for k in range(ns):
+                    j = stopped[k]
+                    nq = _enqueue(j, cnt[j] > 0, mov, trig, queue, nq, one, uN)
+                    l, r = _sides(j, one, uN, periodic)
+                    nq = _enqueue(l, True, mov, trig, queue, nq, one, uN)
+                    nq = _enqueue(r, True, mov, trig, queue, nq, one, uN)
+            # The other stopped blocks of this step have settled neighbours: their start step.
+            for k in range(nsl + ns):
+                i = still[k] if k < nsl else stopped[k - nsl]
+                if trig[i] != _QUEUED:
+                    m = c._plate_trigger(
+                        x[i - one], x[i], x[i + one], c._threshold(th[i], Fs, threshold), K, Kp, V, dt, n + 1, n_end
+                    )
+                    if m <= n + 1:
+                        trig[i] = _QUEUED
+                        queue[nq] = i
+                        nq += 1
+                    else:
+                        trig[i] = m
+                        t_next = min(t_next, m)
+            if ns > 0:
+                movers, nxt = nxt, movers
+            qexact = ns == 0
+        nmov = na - ns
+        if active and nmov == 0:
             c._end_event(
                 n, x, first_step, x0ev, ist, ev_int, ev_S, fm, prof_x, prof_meta, N, profile_every, profile_min_blocks
             )
+            active = False
+            n_chk = n + 1
         n += 1
+    if steps_computed > 0:
+        # Ghost cells of theta as run_dense leaves them (x's are set).
+        c._set_ghosts(x, th, N, 0.0, drive, ends)
+        ist[c.N_MOVING] = nmov
     ist[c.BLOCK_UPDATES] += block_updates
     ist[c.FULL_UPDATES] += full_updates
     ist[c.STEPS_COMPUTED] += steps_computed
