@@ -35,7 +35,6 @@ from __future__ import annotations
 import math
 import sys
 import time
-import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -44,7 +43,8 @@ import numpy as np
 import pandas as pd
 
 from stickslip.models.params import ChainParams, ParameterError, check_number, steps_for
-from stickslip.run.driver import ChainState, ShortRunWarning, Stepper, run_chain
+from stickslip.run.driver import ChainState, Stepper, run_chain
+from stickslip.run.errors import short_runs_expected
 
 #: Largest allowed initial separation: beyond it the twin is not a small perturbation.
 D0_MAX = 1e-3
@@ -322,9 +322,7 @@ def largest_lyapunov(
     n_count = steps_for(transient + align, dt)
     wall0 = time.perf_counter()
 
-    with warnings.catch_warnings():
-        # Only the state at the transient's end is used, not <L>: loading is no concern here.
-        warnings.simplefilter("ignore", ShortRunWarning)
+    with short_runs_expected():  # only the state at the transient's end is used, not <L>
         run = run_chain(
             params, n0 * dt, start=start, perturbation=perturbation, seed=seed, sample_interval=max(transient, dt)
         )

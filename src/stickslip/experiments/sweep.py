@@ -41,7 +41,7 @@ from stickslip import __version__
 from stickslip.io import read_json, run_metadata, write_dataset, write_json, write_table, write_table_files
 from stickslip.jsonable import to_jsonable
 from stickslip.models.params import BlockParams, ChainParams
-from stickslip.run.errors import ShortRunWarning
+from stickslip.run.errors import ShortRunWarning, short_runs_expected
 
 __all__ = [
     "run_sweep",
@@ -444,8 +444,7 @@ def chain_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     from stickslip.run import driver as chain  # imported here: workers load the simulator only when needed
 
     params, t_end, options = _chain_run_args(point)
-    with warnings.catch_warnings():  # said once, by run_sweep, before the points run
-        warnings.simplefilter("ignore", ShortRunWarning)
+    with short_runs_expected():  # said once, by run_sweep, before the points run
         run = chain.run_chain(params, t_end, out_dir=point_dir, **options)
     if not (Path(point_dir) / "run.json").exists():
         chain.write_run(run, point_dir)

@@ -7,27 +7,13 @@ as nanoseconds per block-step: wall time divided by the block updates a dense ru
 
 from __future__ import annotations
 
-import functools
 import platform
 import time
-import warnings
 from typing import Any
 
 from stickslip.models.params import ChainParams
-from stickslip.run.driver import ShortRunWarning, run_chain
-
-
-def _fixed_workload(func):
-    """A benchmark times a fixed workload, not a study: its runs end before the chain has
-    loaded on purpose, so the loading-time warning of :func:`run_chain` is not shown."""
-
-    @functools.wraps(func)
-    def wrapper(*args, **kwargs):
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", ShortRunWarning)
-            return func(*args, **kwargs)
-
-    return wrapper
+from stickslip.run.driver import run_chain
+from stickslip.run.errors import short_runs_expected
 
 
 def _warm(params: ChainParams, start: str) -> None:
@@ -37,7 +23,7 @@ def _warm(params: ChainParams, start: str) -> None:
         run_chain(small, 20 * small.dt, integrator=integrator, start=start)
 
 
-@_fixed_workload
+@short_runs_expected()  # a fixed workload, short of the loading time on purpose
 def compare(
     params: ChainParams,
     t_end: float,
@@ -164,7 +150,7 @@ def _unit_costs(params: ChainParams) -> dict[str, float]:
     return {"step": per_step, "full_update": per_full, "theta_update": per_theta}
 
 
-@_fixed_workload
+@short_runs_expected()
 def profile(
     params: ChainParams, t_end: float, *, start: str = "paper", perturbation: float = 0.0, seed: int = 0
 ) -> dict[str, Any]:

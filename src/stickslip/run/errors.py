@@ -3,6 +3,8 @@ the single block (eq. 1), a stop by a signal."""
 
 from __future__ import annotations
 
+import contextlib
+import warnings
 from pathlib import Path
 
 
@@ -25,6 +27,16 @@ class Interrupted(Exception):
 
 class ShortRunWarning(UserWarning):
     """A chain run with the end drive ends, or averages from, before the chain has loaded."""
+
+
+@contextlib.contextmanager
+def short_runs_expected():
+    """Leave :class:`ShortRunWarning` out inside the block (or the decorated function): for runs
+    that end before the chain has loaded on purpose (a benchmark's fixed workload, the transient
+    before a Lyapunov exponent, sweep points already warned of)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ShortRunWarning)
+        yield
 
 
 class NonFiniteBlock(ArithmeticError):
