@@ -50,6 +50,35 @@ def add_json_option(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--json", action="store_true", help="print one JSON document on stdout")
 
 
+def add_dask_options(parser: argparse.ArgumentParser, *, what: str = "") -> None:
+    """``--scheduler``, ``--workers`` and ``--no-progress`` of the commands that run on Dask
+    (sweep, study, reproduce); ``what`` says what runs there. Read back by :func:`dask_options`."""
+    parser.add_argument(
+        "--scheduler",
+        default=None,
+        metavar="ADDRESS",
+        help=f"address of an existing Dask scheduler{what} (default: a local cluster)",
+    )
+    parser.add_argument(
+        "--workers", default=None, metavar="N", help="worker processes of the local cluster (default: one per core)"
+    )
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
+
+
+def dask_options(args: argparse.Namespace) -> tuple[str | None, int | None]:
+    """The scheduler address (HOST:PORT or scheme://HOST:PORT, else refused) and the number of
+    workers (a positive integer, else refused) of :func:`add_dask_options`."""
+    import re
+
+    from stickslip.models.params import check_number
+
+    workers = None if args.workers is None else int(check_number("--workers", args.workers, low=1, integer=True))
+    address = args.scheduler
+    if address is not None and not re.fullmatch(r"([a-z+]+://)?[^\s:/]+:\d{1,5}", address.strip()):
+        raise CommandError(f"--scheduler must be an address HOST:PORT, e.g. tcp://127.0.0.1:8786 (got {address!r})")
+    return address, workers
+
+
 def add_param_options(parser: argparse.ArgumentParser, params_cls: type, skip: tuple[str, ...] = ()) -> None:
     """One ``--NAME`` option per field of a parameter dataclass (default: the dataclass's)."""
     docs = params_cls.field_docs()

@@ -17,11 +17,12 @@ from stickslip.cli._common import (
     OUT_FILES,
     CommandError,
     Result,
+    add_dask_options,
     add_json_option,
     add_overwrite_option,
+    dask_options,
     owned_out_dir,
 )
-from stickslip.models.params import check_number
 
 DEFAULT_OUT = "paper-reproduction"
 
@@ -62,16 +63,7 @@ def register(sub) -> None:
         metavar="DIR",
         help=f"output directory (default {DEFAULT_OUT}); stored results in it are reused",
     )
-    p.add_argument(
-        "--scheduler",
-        default=None,
-        metavar="ADDRESS",
-        help="address of an existing Dask scheduler for the chain runs (default: a local cluster)",
-    )
-    p.add_argument(
-        "--workers", default=None, metavar="N", help="worker processes of the local cluster (default: one per core)"
-    )
-    p.add_argument("--no-progress", action="store_true", help="no progress lines on stderr")
+    add_dask_options(p, what=" for the chain runs")
     add_overwrite_option(p)
     add_json_option(p)
     p.set_defaults(handler=run)
@@ -79,11 +71,7 @@ def register(sub) -> None:
 
 def run(args: argparse.Namespace) -> Result:
     """Handler of ``stickslip reproduce``."""
-    workers = None
-    if args.workers is not None:
-        workers = int(check_number("workers", args.workers, low=1, integer=True))
-    if args.scheduler is not None and not args.scheduler.strip():
-        raise CommandError("--scheduler needs an address, e.g. tcp://127.0.0.1:8786")
+    _, workers = dask_options(args)
     own = OUT_FILES["reproduce"]
     with owned_out_dir(args.out, own, "stickslip reproduce", overwrite=args.overwrite) as out:
         return _run(out, args, workers)

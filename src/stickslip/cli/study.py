@@ -13,8 +13,7 @@ from __future__ import annotations
 
 import argparse
 
-from stickslip.cli._common import CommandError, Result, add_json_option, prepare_out_dir
-from stickslip.models.params import check_number
+from stickslip.cli._common import CommandError, Result, add_dask_options, add_json_option, dask_options, prepare_out_dir
 
 DEFAULT_OUT = "studies"
 
@@ -50,29 +49,16 @@ def register(sub) -> None:
     mode.add_argument("--tiny", dest="mode", action="store_const", const="tiny", help=argparse.SUPPRESS)
     p.set_defaults(mode="quick")
     p.add_argument("--out", default=DEFAULT_OUT, metavar="DIR", help=f"output directory (default {DEFAULT_OUT})")
-    p.add_argument(
-        "--scheduler",
-        default=None,
-        metavar="ADDRESS",
-        help="address of an existing Dask scheduler (default: a local cluster)",
-    )
-    p.add_argument(
-        "--workers", default=None, metavar="N", help="worker processes of the local cluster (default: one per core)"
-    )
-    p.add_argument("--no-progress", action="store_true", help="no progress on stderr")
+    add_dask_options(p)
     add_json_option(p)
     p.set_defaults(handler=run)
 
 
 def run(args: argparse.Namespace) -> Result:
     """Handler of ``stickslip study``."""
-    from stickslip.cli.sweep import _check_scheduler
     from stickslip.experiments.study_run import run_study
 
-    workers = None
-    if args.workers is not None:
-        workers = int(check_number("--workers", args.workers, low=1, integer=True))
-    _check_scheduler(args.scheduler)  # refused as `stickslip sweep` refuses it
+    _, workers = dask_options(args)
     out = prepare_out_dir(args.out)
     try:
         result = run_study(

@@ -20,8 +20,10 @@ from stickslip.cli._common import (
     OUT_FILES,
     CommandError,
     Result,
+    add_dask_options,
     add_json_option,
     add_overwrite_option,
+    dask_options,
     owned_out_dir,
 )
 from stickslip.models.params import MAX_STEPS, BlockParams, ChainParams, check_number
@@ -85,20 +87,7 @@ def register(sub) -> None:
     )
     parser.add_argument("--t-end", type=str, required=True, metavar="T", help="run length of every point")
     parser.add_argument("--out", required=True, metavar="DIR", help="output directory of the sweep")
-    parser.add_argument(
-        "--scheduler",
-        default=None,
-        metavar="ADDRESS",
-        help="address of an existing Dask scheduler (default: start a local cluster)",
-    )
-    parser.add_argument(
-        "--workers",
-        type=str,
-        default=None,
-        metavar="N",
-        help="worker processes of the local cluster (default: one per core)",
-    )
-    parser.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
+    add_dask_options(parser)
     add_overwrite_option(parser)
     add_json_option(parser)
     parser.set_defaults(handler=run)
@@ -204,25 +193,12 @@ def _check_options(model: str, params, settings: dict[str, Any]) -> None:
     ).validated(params.dt)
 
 
-def _check_scheduler(address: str | None) -> None:
-    """A scheduler address must read HOST:PORT (or a scheme://HOST:PORT)."""
-    if address is None:
-        return
-    import re
-
-    if not re.fullmatch(r"([a-z+]+://)?[^\s:/]+:\d{1,5}", address.strip()):
-        raise CommandError(f"--scheduler must be an address HOST:PORT, e.g. tcp://127.0.0.1:8786 (got {address!r})")
-
-
 def run(args: argparse.Namespace) -> Result:
     """Handler of ``stickslip sweep``."""
     from stickslip.experiments.sweep import block_task, chain_task, run_sweep
 
     points, common = parse_grid(args.model, args.grid, args.fixed, args.t_end)
-    workers = None
-    if args.workers is not None:
-        workers = check_number("--workers", args.workers, low=1, integer=True)
-    _check_scheduler(args.scheduler)
+    _, workers = dask_options(args)
     own = _sweep_files(args.out)
     task = chain_task if args.model == "chain" else block_task
     with owned_out_dir(args.out, own, "stickslip sweep", overwrite=args.overwrite) as out:
