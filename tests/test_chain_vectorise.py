@@ -24,7 +24,8 @@ STAGES = ("_stage1", "_stage2", "_stage1_theta", "_stage1_theta_only", "_stage2_
 def _fresh_ir(kernel, args=None) -> str:
     """LLVM IR of a kernel compiled afresh with its own options (code loaded from numba's cache
     cannot be inspected); ``args`` are example arguments when it has no recorded signature."""
-    options = {k: v for k, v in kernel.targetoptions.items() if k != "cache"}
+    # njit implies nopython (passing it again only warns).
+    options = {k: v for k, v in kernel.targetoptions.items() if k not in ("cache", "nopython")}
     fresh = numba.njit(**options)(kernel.py_func)
     if args is None:
         assert kernel.signatures, "kernel was not compiled by the workloads"
