@@ -296,3 +296,20 @@ def test_bad_study_input_is_one_line_and_exit_2(tmp_path):
         assert len(proc.stderr.strip().splitlines()) == 1, (argv, proc.stderr)
         assert proc.stdout == ""
     assert not (tmp_path / "o").exists()  # refused before the output folder is made
+
+
+def test_chaos_findings_judge_the_relatives_on_the_exponents_they_have():
+    """A value of d0 at which the twin fell onto the reference has no exponent (-inf, stored as
+    empty): the relative is judged on the others and the lost one is named with its merges."""
+    from stickslip.experiments.study_findings import conclusions
+
+    rows = [
+        {"model": "two-blocks", "N": 2, "beta": None, "d0": d0, "lyapunov": lam, "lyapunov_err": err, "merges": m}
+        for d0, lam, err, m in ((1e-11, None, None, 6), (1e-10, 0.0443, 0.00066, 0), (1e-8, 0.0474, 0.00077, 0))
+    ]
+    out = conclusions(study("chaos", "quick"), pd.DataFrame(rows))
+    (line,) = out["statements"]
+    assert out["family"]["two-blocks"]["positive_3sigma"] is True
+    assert "chaotic (positive beyond 3 errors) at d0 = 1e-10, 1e-08" in line
+    assert "no exponent at d0 = 1e-11 (the twin fell onto the reference 6 times" in line
+    assert "spread over d0 0.0031" in line

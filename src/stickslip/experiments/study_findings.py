@@ -227,20 +227,33 @@ def _chaos(table: pd.DataFrame) -> dict[str, Any]:
         vals = ", ".join(f"{_g(r.lyapunov)} +- {_g(r.lyapunov_err, 2)} (d0 = {r.d0:g})" for r in rows.itertuples())
         lam_m = rows["lyapunov"].to_numpy(float)
         err_m = rows["lyapunov_err"].to_numpy(float)
-        positive = bool(np.all(lam_m > 3 * err_m))
+        # A twin that falls onto the reference makes the exponent -inf (no number): judge the
+        # values of d0 that gave one, and name the others.
+        fin = np.isfinite(lam_m) & np.isfinite(err_m)
+        positive = bool(fin.any() and np.all(lam_m[fin] > 3 * err_m[fin]))
         out["family"][model] = {
             "lyapunov": lam_m.tolist(),
             "lyapunov_err": err_m.tolist(),
             "d0": rows["d0"].tolist(),
             "positive_3sigma": positive,
         }
-        spread = ""
-        if len(rows) > 1:
-            spread = f"; spread over d0 {_g(np.ptp(lam_m), 2)} against errors of {_g(np.max(err_m), 2)}"
-        say(
-            f"{model} (N = {int(rows['N'].iloc[0])}): lambda = {vals}: "
-            f"{'chaotic (positive beyond 3 errors)' if positive else 'not positive beyond 3 errors'}{spread}."
-        )
+        verdict = "chaotic (positive beyond 3 errors)" if positive else "not positive beyond 3 errors"
+        if not fin.any():
+            verdict = "no finite exponent"
+        elif not fin.all():
+            verdict += f" at d0 = {', '.join(f'{d:g}' for d in rows['d0'][fin])}"
+        if fin.sum() > 1:
+            verdict += f"; spread over d0 {_g(np.ptp(lam_m[fin]), 2)} against errors of {_g(np.max(err_m[fin]), 2)}"
+        lost = [
+            f"d0 = {r.d0:g} (the twin fell onto the reference {int(r.merges)} times: d0 at the rounding floor)"
+            if "merges" in rows and np.isfinite(r.merges) and r.merges > 0
+            else f"d0 = {r.d0:g}"
+            for r, f in zip(rows.itertuples(), fin, strict=True)
+            if not f
+        ]
+        if lost:
+            verdict += "; no exponent at " + ", ".join(lost)
+        say(f"{model} (N = {int(rows['N'].iloc[0])}): lambda = {vals}: {verdict}.")
     return out
 
 
