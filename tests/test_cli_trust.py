@@ -450,20 +450,3 @@ def test_start_removes_files_of_a_killed_write(tmp_path):
     (out / ".state.nc.k1ll3d.tmp").write_bytes(b"half a netCDF file")
     assert main(["chain", "--N", "3", "--t-end", "10", "--out", str(out), "--no-progress"]) == 0
     assert not list(out.glob(".*.tmp")) and (out / "state.nc").is_file()
-
-
-def test_python_dash_m_stickslip_is_the_command(tmp_path):
-    """``python -m stickslip`` runs the same command line as ``stickslip``: same output for a
-    good command, exit 2 and one line for a bad one."""
-    import sys
-
-    def run(*argv):
-        return subprocess.run(
-            [sys.executable, "-m", *argv], capture_output=True, text=True, env=cli_env(), cwd=tmp_path, timeout=120
-        )
-
-    top, cli = run("stickslip", "models", "--json"), run("stickslip.cli", "models", "--json")
-    assert top.returncode == 0 and top.stdout == cli.stdout
-    assert "carlson-langer" in {m["name"] for m in json.loads(top.stdout)["presets"]}
-    bad = run("stickslip", "chain", "--model", "nosuch")
-    assert bad.returncode == 2 and bad.stdout == "" and len(bad.stderr.strip().splitlines()) == 1
