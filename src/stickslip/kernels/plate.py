@@ -97,6 +97,18 @@ def _enqueue(j, ok, mov, trig, queue, nq, one, uN):
     return nq + (1 if q else 0)
 
 
+@njit(cache=True, inline="always")
+def _settle(i, m, n, trig, queue, nq, t_next):
+    """Stopped block i with still neighbours and plate start step m: queued for step n if m is
+    due by then, else m kept in ``trig``. Returns the queue's length and the smallest start step."""
+    if m <= n:
+        trig[i] = _QUEUED
+        queue[nq] = i
+        return nq + 1, t_next
+    trig[i] = m
+    return nq, min(t_next, m)
+
+
 @njit(cache=True, error_model="numpy")
 def run_sparse(
     x,
@@ -175,13 +187,7 @@ def run_sparse(
     for i in range(1, N + 1):
         if mov[i] == 0.0:
             m = c._plate_trigger(x[i - 1], x[i], x[i + 1], c._threshold(th[i], Fs, threshold), K, Kp, V, dt, n0, n_end)
-            if m <= n0:
-                trig[i] = _QUEUED
-                queue[nq] = i
-                nq += 1
-            else:
-                trig[i] = m
-                t_next = min(t_next, m)
+            nq, t_next = _settle(i, m, n0, trig, queue, nq, t_next)
     if n0 < n_end:
         # run_dense adds dt/2 (0 + 0) to every theta in each step (no state variable); nothing
         # here reads theta, and after the first step the sum changes no bit: do it once.
@@ -433,13 +439,7 @@ def run_sparse(
                     m = c._plate_trigger(
                         x[i - one], x[i], x[i + one], c._threshold(th[i], Fs, threshold), K, Kp, V, dt, n + 1, n_end
                     )
-                    if m <= n + 1:
-                        trig[i] = _QUEUED
-                        queue[nq] = i
-                        nq += 1
-                    else:
-                        trig[i] = m
-                        t_next = min(t_next, m)
+                    nq, t_next = _settle(i, m, n + 1, trig, queue, nq, t_next)
             if ns > 0:
                 movers, nxt = nxt, movers
             qexact = ns == 0
