@@ -3,7 +3,11 @@ span several modules (:mod:`~stickslip.kernels.common` shared pieces, :mod:`~sti
 reference and exact integrators and entry points, :mod:`~stickslip.kernels.plate` sparse exact steps
 of the plate drive).
 
-numba's on-disk cache (``cache=True``) does not notice edits in another module that a cached
-kernel calls (a numba limitation): after editing any of these modules, clear the cache
-directory (``NUMBA_CACHE_DIR``, or the ``__pycache__`` folders beside them).
+numba's on-disk cache (``cache=True``) stamps a kernel with its own module only, and would load
+a kernel compiled from an older version of a module it calls. :mod:`~stickslip.kernels._cache`
+stamps every kernel with all the kernel modules, so an edit to any of them recompiles them all.
 """
+
+from stickslip.kernels import _cache
+
+_cache.install()

@@ -1,0 +1,50 @@
+"""The kernels' on-disk cache follows edits to any kernel module, not only the kernel's own."""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import stickslip
+from stickslip.kernels._cache import modules_digest
+
+_SCRIPT = """
+import numpy as np
+from stickslip.kernels import chain as K
+# End drive, blocks 1 and 2 at rest: f_1 = K V n dt exceeds 0.5 first at n = 51.
+print(K._first_trigger(np.zeros(5), 3, 1.0, 0.01, 1.0, 0.5, 0, 1000, 0))
+"""
+
+
+def _run(root: Path) -> str:
+    env = {"PYTHONPATH": str(root), "PATH": ""}
+    out = subprocess.run([sys.executable, "-c", _SCRIPT], cwd=root, env=env, capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    return out.stdout.strip()
+
+
+def test_editing_a_called_module_recompiles_the_cached_kernel(tmp_path):
+    # _first_trigger lives in chain.py and inlines _pull from common.py; numba's own stamp
+    # covers chain.py only and would load the kernel compiled before the edit.
+    src = Path(stickslip.__file__).parent
+    shutil.copytree(src, tmp_path / "stickslip", ignore=shutil.ignore_patterns("__pycache__"))
+    assert _run(tmp_path) == "51"
+    assert _run(tmp_path) == "51"  # from the cache
+    common = tmp_path / "stickslip" / "kernels" / "common.py"
+    text = common.read_text()
+    old = "return V * (np.float64(n) * dt)"
+    assert old in text
+    common.write_text(text.replace(old, "return 2.0 * V * (np.float64(n) * dt)"))
+    assert _run(tmp_path) == "26"
+
+
+def test_digest_changes_with_any_module(tmp_path):
+    a, b = tmp_path / "a.py", tmp_path / "b.py"
+    a.write_text("x = 1\n")
+    b.write_text("y = 2\n")
+    before = modules_digest([a, b])
+    assert modules_digest([b, a]) == before
+    b.write_text("y = 3\n")
+    assert modules_digest([a, b]) != before
