@@ -28,11 +28,12 @@ def modules_digest(paths) -> str:
     return h.hexdigest()
 
 
+_DIGEST = modules_digest(_DIR.glob("*.py"))
+
+
 class KernelsLocator(caching._CacheLocator):
     """numba's own locator for a function of this package (same cache folder and name), with
-    a source stamp that also covers every other kernel module."""
-
-    _digest: str | None = None
+    a source stamp that covers every kernel module, its own included."""
 
     def __init__(self, inner):
         self._inner = inner
@@ -44,9 +45,7 @@ class KernelsLocator(caching._CacheLocator):
         return self._inner.get_cache_path()
 
     def get_source_stamp(self):
-        if KernelsLocator._digest is None:
-            KernelsLocator._digest = modules_digest(_DIR.glob("*.py"))
-        return (KernelsLocator._digest, self._inner.get_source_stamp())
+        return _DIGEST
 
     def get_disambiguator(self):
         return self._inner.get_disambiguator()
