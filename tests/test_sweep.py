@@ -216,3 +216,62 @@ def test_a_point_that_kills_its_worker_is_recorded_and_the_others_finish(tmp_pat
     assert (tmp_path / crashed / "error.json").is_file()
     assert table.loc[["x=1", "x=3"], "status"].tolist() == ["ok", "ok"]
     assert table.loc[["x=1", "x=3"], "value"].tolist() == [5.0, 15.0]
+
+
+def test_an_interrupted_sweep_says_so_in_one_line_and_resumes(tmp_path):
+    """SIGINT to the command alone (as ``timeout -s INT`` sends it) while its worker runs a chain:
+    exit 130, one line on stderr, the directory left to the next call."""
+    import signal
+    import subprocess
+    import time
+
+    from chain_helpers import cli_env, stickslip_cmd
+
+    out = tmp_path / "sweep"
+    # a sliding N = 199 chain to t = 1e7 runs for hours: the worker is busy when the signal comes
+    cmd = stickslip_cmd() + ["sweep", "chain", "--grid", "beta=1.5", "--set", "N=199", "--t-end", "1e7",
+                             "--workers", "1", "--out", str(out), "--no-progress"]  # fmt: skip
+    proc = subprocess.Popen(
+        cmd,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=cli_env(),
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),  # even where a shell ignores it
+    )
+    try:
+        deadline = time.monotonic() + 120
+        while not (out / "beta=1.5" / "point.json").is_file():
+            assert proc.poll() is None, proc.communicate()
+            assert time.monotonic() < deadline, "the point did not start within 120 s"
+            time.sleep(0.05)
+        time.sleep(3.0)  # into the kernel
+        assert proc.poll() is None
+        proc.send_signal(signal.SIGINT)
+        stdout, stderr = proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    assert proc.returncode == 130, stderr
+    assert stdout == ""
+    assert stderr.splitlines() == [
+        f"stickslip sweep: interrupted; run the same command again to continue (finished points in {out} are kept)"
+    ], stderr
+    assert not (out / "summary.parquet").exists()
+    assert (out / "beta=1.5" / "point.json").is_file()  # the point's spec stays for the next call
+
+
+def log_an_error_on_the_worker(point: dict, point_dir: Path) -> dict:
+    """Logs as a worker does when its scheduler is gone (at every Ctrl-C during a point)."""
+    import logging
+
+    logging.getLogger("distributed.worker").error("failed to communicate with scheduler (test)")
+    return {"value": 1.0}
+
+
+def test_the_local_clusters_log_stays_off_the_terminal(tmp_path, capfd):
+    result = run_sweep(log_an_error_on_the_worker, [{"x": 1.0}], tmp_path, n_workers=1, progress=False)
+    assert result.table["status"].tolist() == ["ok"]  # the task ran on the worker ...
+    err = capfd.readouterr().err
+    assert "failed to communicate" not in err  # ... and its log did not reach the terminal

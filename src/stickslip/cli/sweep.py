@@ -13,6 +13,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import itertools
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -212,6 +213,12 @@ def run(args: argparse.Namespace) -> Result:
                 n_workers=workers,
                 progress=not args.no_progress,
             )
+        except KeyboardInterrupt:
+            sys.stderr.write(
+                f"stickslip sweep: interrupted; run the same command again to continue "
+                f"(finished points in {out} are kept)\n"
+            )
+            return Result({"interrupted": True, "out": str(out)}, "", status=130)
         except OSError as exc:  # e.g. no scheduler at the given address
             raise CommandError(f"cannot run the sweep: {exc}") from None
     data = {"model": args.model, "common": common, **result.to_dict()}

@@ -318,7 +318,7 @@ def _compute(task, points, common, out, names, specs, pending, records, *, sched
             threads_per_worker=1,
             processes=True,
             dashboard_address=":0",  # any free port: never clash with another cluster
-            silence_logs=logging.ERROR,
+            silence_logs=logging.CRITICAL,  # failures are in error.json; keep worker heartbeats off a Ctrl-C
         )
         client = Client(cluster)
     else:
