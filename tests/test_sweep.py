@@ -218,9 +218,10 @@ def test_a_point_that_kills_its_worker_is_recorded_and_the_others_finish(tmp_pat
     assert table.loc[["x=1", "x=3"], "value"].tolist() == [5.0, 15.0]
 
 
-def test_an_interrupted_sweep_says_so_in_one_line_and_resumes(tmp_path):
-    """SIGINT to the command alone (as ``timeout -s INT`` sends it) while its worker runs a chain:
-    exit 130, one line on stderr, the directory left to the next call."""
+@pytest.mark.parametrize("signame", ["SIGINT", "SIGTERM"])
+def test_an_interrupted_sweep_says_so_in_one_line_and_resumes(tmp_path, signame):
+    """SIGINT or SIGTERM to the command alone (as ``timeout`` or ``kill`` send them) while its worker
+    runs a chain: exit 130, one line on stderr, the directory left to the next call."""
     import signal
     import subprocess
     import time
@@ -247,7 +248,7 @@ def test_an_interrupted_sweep_says_so_in_one_line_and_resumes(tmp_path):
             time.sleep(0.05)
         time.sleep(3.0)  # into the kernel
         assert proc.poll() is None
-        proc.send_signal(signal.SIGINT)
+        proc.send_signal(getattr(signal, signame))
         stdout, stderr = proc.communicate(timeout=120)
     finally:
         if proc.poll() is None:

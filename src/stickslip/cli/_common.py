@@ -79,6 +79,27 @@ def dask_options(args: argparse.Namespace) -> tuple[str | None, int | None]:
     return address, workers
 
 
+@contextlib.contextmanager
+def sigterm_as_interrupt() -> Iterator[None]:
+    """Within the block, SIGTERM (``kill``, a batch system's stop) raises KeyboardInterrupt, so the
+    commands that run on Dask end on it as on Ctrl-C: the cluster closed, one line, status 130."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def interrupt(signum, frame):
+        raise KeyboardInterrupt
+
+    previous = signal.signal(signal.SIGTERM, interrupt)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
 def add_param_options(parser: argparse.ArgumentParser, params_cls: type, skip: tuple[str, ...] = ()) -> None:
     """One ``--NAME`` option per field of a parameter dataclass (default: the dataclass's)."""
     docs = params_cls.field_docs()

@@ -22,6 +22,7 @@ from stickslip.cli._common import (
     add_overwrite_option,
     dask_options,
     owned_out_dir,
+    sigterm_as_interrupt,
 )
 
 DEFAULT_OUT = "paper-reproduction"
@@ -82,7 +83,10 @@ def _run(out, args: argparse.Namespace, workers: int | None) -> Result:
     from stickslip.experiments.reproduce import ReproduceError, reproduce
 
     try:
-        result = reproduce(out, args.mode, scheduler=args.scheduler, n_workers=workers, progress=not args.no_progress)
+        with sigterm_as_interrupt():
+            result = reproduce(
+                out, args.mode, scheduler=args.scheduler, n_workers=workers, progress=not args.no_progress
+            )
     except ReproduceError as exc:
         return Result({"error": str(exc)}, f"stickslip reproduce: {exc}", status=1)
     except KeyboardInterrupt:

@@ -13,7 +13,15 @@ from __future__ import annotations
 
 import argparse
 
-from stickslip.cli._common import CommandError, Result, add_dask_options, add_json_option, dask_options, prepare_out_dir
+from stickslip.cli._common import (
+    CommandError,
+    Result,
+    add_dask_options,
+    add_json_option,
+    dask_options,
+    prepare_out_dir,
+    sigterm_as_interrupt,
+)
 
 DEFAULT_OUT = "studies"
 
@@ -61,9 +69,10 @@ def run(args: argparse.Namespace) -> Result:
     _, workers = dask_options(args)
     out = prepare_out_dir(args.out)
     try:
-        result = run_study(
-            args.name, out, args.mode, scheduler=args.scheduler, n_workers=workers, progress=not args.no_progress
-        )
+        with sigterm_as_interrupt():
+            result = run_study(
+                args.name, out, args.mode, scheduler=args.scheduler, n_workers=workers, progress=not args.no_progress
+            )
     except KeyboardInterrupt:
         import sys
 

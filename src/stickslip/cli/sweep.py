@@ -26,6 +26,7 @@ from stickslip.cli._common import (
     add_overwrite_option,
     dask_options,
     owned_out_dir,
+    sigterm_as_interrupt,
 )
 from stickslip.models.params import MAX_STEPS, BlockParams, ChainParams, check_number
 
@@ -204,15 +205,16 @@ def run(args: argparse.Namespace) -> Result:
     task = chain_task if args.model == "chain" else block_task
     with owned_out_dir(args.out, own, "stickslip sweep", overwrite=args.overwrite) as out:
         try:
-            result = run_sweep(
-                task,
-                points,
-                out,
-                common=common,
-                scheduler=args.scheduler,
-                n_workers=workers,
-                progress=not args.no_progress,
-            )
+            with sigterm_as_interrupt():
+                result = run_sweep(
+                    task,
+                    points,
+                    out,
+                    common=common,
+                    scheduler=args.scheduler,
+                    n_workers=workers,
+                    progress=not args.no_progress,
+                )
         except KeyboardInterrupt:
             sys.stderr.write(
                 f"stickslip sweep: interrupted; run the same command again to continue "
