@@ -240,6 +240,23 @@ def test_checkpoint_with_other_parameters_is_refused(run_dir):
     assert resume_chain(run_dir, t_end=200.0, expect_params=SMALL).steps == 40000
 
 
+def test_a_point_continues_a_usable_checkpoint_and_reruns_past_a_damaged_one(run_dir, monkeypatch):
+    """continue_or_run, the step of every sweep, study and reproduction point."""
+    reference = run_chain(SMALL, 100.0, profile_window=0.5)
+    with monkeypatch.context() as m:
+        m.setattr(C, "run_chain", lambda *a, **k: pytest.fail("a usable checkpoint must be continued"))
+        assert_same_run(C.continue_or_run(SMALL, 100.0, run_dir, checkpoint_interval=60.0), reference)
+    path = run_dir / "checkpoint" / "state.npz"
+    arrays, _, _ = C._read_npz(path)
+    _flip(path, _array_offset(path, arrays["x"]))
+    fresh = []
+    monkeypatch.setattr(C, "run_chain", lambda *a, **k: fresh.append(1) or run_chain(*a, **k))
+    run = C.continue_or_run(SMALL, 100.0, run_dir, checkpoint_interval=60.0, profile_window=0.5)
+    assert fresh == [1], "a damaged checkpoint is refused and the point run afresh"
+    assert_same_run(run, reference)
+    assert not (run_dir / "checkpoint").exists(), "the damaged checkpoint is gone"
+
+
 @pytest.mark.parametrize("mismatch", ["arrays-of-N=4", "ist-one-entry-short"])
 def test_checkpoint_arrays_that_do_not_fit_are_refused(tmp_path, run_dir, mismatch):
     """A checksum-valid state file whose arrays do not fit its parameters or the kernels'

@@ -28,7 +28,6 @@ of stated numbers :mod:`stickslip.report.rows`.
 from __future__ import annotations
 
 import math
-import shutil
 import sys
 import time
 from collections.abc import Callable
@@ -336,16 +335,7 @@ def chain_point_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     from stickslip.run import driver as chain
 
     params, t_end, options = _point_settings(point)
-    point_dir = Path(point_dir)
-    run = None
-    if (point_dir / "checkpoint" / "state.npz").is_file():
-        try:
-            run = chain.resume_chain(point_dir, checkpoint_interval=CHECKPOINT_INTERVAL, expect_params=params)
-        except chain.ChainRunError:
-            shutil.rmtree(point_dir / "checkpoint", ignore_errors=True)
-            run = None
-    if run is None:
-        run = chain.run_chain(params, t_end, out_dir=point_dir, checkpoint_interval=CHECKPOINT_INTERVAL, **options)
+    run = chain.continue_or_run(params, t_end, point_dir, checkpoint_interval=CHECKPOINT_INTERVAL, **options)
     s = dict(run.summary)
     stopped_early = bool(s.get("stopped_early", False))
     avg_from = options["average_from"]

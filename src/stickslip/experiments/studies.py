@@ -27,7 +27,6 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-import shutil
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -452,12 +451,7 @@ def _run(params, t_end: float, options: dict[str, Any], point_dir: Path):
     """Run the chain into ``point_dir``, continuing from a checkpoint there if one is usable."""
     from stickslip.run import driver
 
-    if (point_dir / "checkpoint" / "state.npz").is_file():
-        try:
-            return driver.resume_chain(point_dir, checkpoint_interval=CHECKPOINT_INTERVAL, expect_params=params)
-        except driver.ChainRunError:
-            shutil.rmtree(point_dir / "checkpoint", ignore_errors=True)
-    return driver.run_chain(params, t_end, out_dir=point_dir, checkpoint_interval=CHECKPOINT_INTERVAL, **options)
+    return driver.continue_or_run(params, t_end, point_dir, checkpoint_interval=CHECKPOINT_INTERVAL, **options)
 
 
 def study_point_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
