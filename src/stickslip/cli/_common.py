@@ -100,6 +100,13 @@ def sigterm_as_interrupt() -> Iterator[None]:
         signal.signal(signal.SIGTERM, previous)
 
 
+def interrupted(command: str, out: Path | None, kept: str) -> Result:
+    """What ``sweep``, ``study`` and ``reproduce`` answer to Ctrl-C or SIGTERM: one line on stderr
+    (``kept``: what the next call reuses), exit status 130."""
+    sys.stderr.write(f"stickslip {command}: interrupted; run the same command again to continue ({kept})\n")
+    return Result({"interrupted": True, "out": str(out)}, "", status=130)
+
+
 def add_param_options(parser: argparse.ArgumentParser, params_cls: type, skip: tuple[str, ...] = ()) -> None:
     """One ``--NAME`` option per field of a parameter dataclass (default: the dataclass's)."""
     docs = params_cls.field_docs()

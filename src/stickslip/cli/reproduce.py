@@ -21,6 +21,7 @@ from stickslip.cli._common import (
     add_json_option,
     add_overwrite_option,
     dask_options,
+    interrupted,
     owned_out_dir,
     sigterm_as_interrupt,
 )
@@ -90,13 +91,9 @@ def _run(out, args: argparse.Namespace, workers: int | None) -> Result:
     except ReproduceError as exc:
         return Result({"error": str(exc)}, f"stickslip reproduce: {exc}", status=1)
     except KeyboardInterrupt:
-        import sys
-
-        sys.stderr.write(
-            f"stickslip reproduce: interrupted; run the same command again to continue (finished results in "
-            f"{out} are kept, chain runs continue from their last checkpoint)\n"
+        return interrupted(
+            "reproduce", out, f"finished results in {out} are kept, chain runs continue from their last checkpoint"
         )
-        return Result({"interrupted": True, "out": str(out)}, "", status=130)
     except OSError as exc:  # e.g. no scheduler at the given address
         raise CommandError(f"cannot run the chain runs: {exc}") from None
     return Result(result, _text(result))

@@ -19,6 +19,7 @@ from stickslip.cli._common import (
     add_dask_options,
     add_json_option,
     dask_options,
+    interrupted,
     prepare_out_dir,
     sigterm_as_interrupt,
 )
@@ -74,13 +75,9 @@ def run(args: argparse.Namespace) -> Result:
                 args.name, out, args.mode, scheduler=args.scheduler, n_workers=workers, progress=not args.no_progress
             )
     except KeyboardInterrupt:
-        import sys
-
-        sys.stderr.write(
-            f"stickslip study: interrupted; run the same command again to continue "
-            f"(finished points in {out} are kept, chain runs continue from their checkpoints)\n"
+        return interrupted(
+            "study", out, f"finished points in {out} are kept, chain runs continue from their checkpoints"
         )
-        return Result({"interrupted": True, "out": str(out)}, "", status=130)
     except OSError as exc:
         raise CommandError(f"cannot run the study: {exc}") from None
     data = {k: v for k, v in result.items() if k != "figures"}

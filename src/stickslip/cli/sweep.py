@@ -13,7 +13,6 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import itertools
-import sys
 from pathlib import Path
 from typing import Any
 
@@ -25,6 +24,7 @@ from stickslip.cli._common import (
     add_json_option,
     add_overwrite_option,
     dask_options,
+    interrupted,
     owned_out_dir,
     sigterm_as_interrupt,
 )
@@ -216,11 +216,7 @@ def run(args: argparse.Namespace) -> Result:
                     progress=not args.no_progress,
                 )
         except KeyboardInterrupt:
-            sys.stderr.write(
-                f"stickslip sweep: interrupted; run the same command again to continue "
-                f"(finished points in {out} are kept)\n"
-            )
-            return Result({"interrupted": True, "out": str(out)}, "", status=130)
+            return interrupted("sweep", out, f"finished points in {out} are kept")
         except OSError as exc:  # e.g. no scheduler at the given address
             raise CommandError(f"cannot run the sweep: {exc}") from None
     data = {"model": args.model, "common": common, **result.to_dict()}

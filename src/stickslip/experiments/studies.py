@@ -447,13 +447,6 @@ def lyapunov_point(cfg: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     }
 
 
-def _run(params, t_end: float, options: dict[str, Any], point_dir: Path):
-    """Run the chain into ``point_dir``, continuing from a checkpoint there if one is usable."""
-    from stickslip.run import driver
-
-    return driver.continue_or_run(params, t_end, point_dir, checkpoint_interval=CHECKPOINT_INTERVAL, **options)
-
-
 def study_point_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     """One point of a study: the chain run and its analysis (a task of ``run_sweep``).
 
@@ -461,12 +454,14 @@ def study_point_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     ``"lyapunov"``: :func:`lyapunov_point` (no chain run record, only the exponent's data).
     Returns the summary stored in the point's ``done.json``.
     """
+    from stickslip.run import driver
+
     if point.get("analysis") == "lyapunov":
         return lyapunov_point(point, point_dir)
     params = point_params(point)
     t_end, options = point_run_options(point, params)
     point_dir = Path(point_dir)
-    run = _run(params, t_end, options, point_dir)
+    run = driver.continue_or_run(params, t_end, point_dir, checkpoint_interval=CHECKPOINT_INTERVAL, **options)
     base = {
         "model": params.model,
         "t_end": t_end,

@@ -341,16 +341,16 @@ def continue_or_run(
 ) -> ChainRun:
     """The chain of eq. (4) (or a relative) into ``run_dir``, continued from the checkpoint there
     when one is usable (:func:`resume_chain` with ``expect_params``), else run afresh
-    (:func:`run_chain` with ``options``); an unusable checkpoint is removed. A point of a sweep,
-    study or reproduction that is interrupted so loses at most ``checkpoint_interval`` seconds."""
+    (:func:`run_chain` with ``options``); an unusable checkpoint is removed. A point of a study
+    or reproduction that is interrupted so loses at most ``checkpoint_interval`` seconds."""
     import shutil
 
-    run_dir = Path(run_dir)
-    if (run_dir / "checkpoint" / "state.npz").is_file():
+    ckpt = Checkpointer(Path(run_dir))
+    if ckpt.state_path.is_file():
         try:
             return resume_chain(run_dir, checkpoint_interval=checkpoint_interval, expect_params=params)
         except ChainRunError:
-            shutil.rmtree(run_dir / "checkpoint", ignore_errors=True)
+            shutil.rmtree(ckpt.dir, ignore_errors=True)
     return run_chain(params, t_end, out_dir=run_dir, checkpoint_interval=checkpoint_interval, **options)
 
 
