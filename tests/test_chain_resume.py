@@ -92,6 +92,27 @@ def test_frequent_checkpoints_do_not_change_the_result(tmp_path, full):
     assert_same_run(resume_chain(tmp_path), ref)
 
 
+def test_a_run_stopped_on_request_checkpoints_and_resumes_to_the_same_bits(tmp_path, full):
+    """``stop_requested`` (how a study's point learns that the study was interrupted) stops the
+    run as a signal does: a checkpoint at the step reached, Interrupted, then a resume that ends
+    exactly where the uninterrupted run does."""
+    calls = []
+
+    def stop_on_the_third_call() -> bool:
+        calls.append(1)
+        return len(calls) == 3
+
+    opts = dict(OPTS, snapshot_times=tuple(float(t) for t in np.arange(50.0, T2, 50.0)))
+    ref = run_chain(P, T2, **opts)
+    with pytest.raises(C.Interrupted) as stopped:
+        run_chain(P, T2, out_dir=tmp_path, stop_requested=stop_on_the_third_call, **opts)
+    assert 0 < stopped.value.t < T2
+    assert (tmp_path / "checkpoint" / "state.npz").is_file()
+    assert not (tmp_path / "run.json").exists()
+    assert len(calls) == 3
+    assert_same_run(C.continue_or_run(P, T2, tmp_path, checkpoint_interval=60.0, **opts), ref)
+
+
 def test_continue_from_a_returned_state(full):
     t1 = 1230.0
     first = run_chain(P, t1, **OPTS)

@@ -224,6 +224,46 @@ def test_existing_scheduler_gives_the_local_result(tmp_path):
                 proc.wait(timeout=30)
 
 
+def test_an_interrupted_study_checkpoints_its_running_point(tmp_path):
+    """SIGTERM to `stickslip study` (as a batch system's stop or `kill` sends it) while its worker
+    runs a point: the point writes its checkpoint before the command ends (exit 130, one line),
+    where before it lost the work since its last periodic checkpoint (120 s)."""
+    import signal
+
+    from chain_helpers import cli_env, stickslip_cmd
+    from stickslip.experiments.sweep import STOP_FILE
+    from stickslip.models.params import ChainParams
+    from stickslip.run.driver import run_chain
+
+    run_chain(ChainParams(N=5, beta=1.4), 1.0)  # compile the point's kernel here, not in the worker
+    out = tmp_path / "studies"
+    # the quick transition starts with its dearest point, N = 199 at beta = 1.4: minutes of work
+    cmd = stickslip_cmd() + ["study", "transition", "--quick", "--workers", "1", "--out", str(out), "--no-progress"]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=cli_env())
+    try:
+        deadline = time.monotonic() + 120
+        while not list(out.glob("runs/*/points/*/point.json")):
+            assert proc.poll() is None, proc.communicate()
+            assert time.monotonic() < deadline, "no point started within 120 s"
+            time.sleep(0.05)
+        time.sleep(3.0)  # into the run
+        assert proc.poll() is None
+        proc.send_signal(signal.SIGTERM)
+        stdout, stderr = proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    assert proc.returncode == 130, stderr
+    assert stdout == ""
+    assert len(stderr.splitlines()) == 1 and "interrupted" in stderr, stderr
+    (point,) = [p.parent for p in out.glob("runs/*/points/*/point.json")]
+    assert point.name.startswith("beta=1.4_N=199")
+    assert (point / "checkpoint" / "state.npz").is_file()
+    assert not (point / "error.json").exists() and not (point / "done.json").exists()
+    assert not (point.parent / STOP_FILE).exists()
+
+
 def test_sample_moving_leaves_the_run_unchanged(tmp_path):
     from stickslip.models.presets import chain_params
     from stickslip.run.driver import load_run, run_chain

@@ -264,6 +264,30 @@ def test_an_interrupted_sweep_says_so_in_one_line_and_resumes(tmp_path, signame)
     assert (out / "beta=1.5" / "point.json").is_file()  # the point's spec stays for the next call
 
 
+def test_a_point_stopped_on_request_is_left_for_the_next_sweep(tmp_path):
+    """A task that stops because its sweep was interrupted (Interrupted, after its checkpoint)
+    gets neither done.json nor error.json; with the stop file present a point does not start."""
+    from stickslip.experiments.sweep import STOP_FILE, _run_point, stop_requested
+    from stickslip.run.errors import Interrupted
+
+    seen = []
+
+    def task(point: dict, point_dir: Path) -> dict:
+        seen.append(stop_requested(point_dir)())
+        (tmp_path / STOP_FILE).touch()  # the sweep is interrupted while the point runs
+        assert stop_requested(point_dir)()
+        raise Interrupted(point_dir / "checkpoint" / "state.npz", 12.5)
+
+    record = _run_point(task, {"x": 1}, {}, str(tmp_path / "x=1"), {"x": 1})
+    assert record["status"] == "interrupted"
+    assert seen == [False]
+    assert not (tmp_path / "x=1" / "done.json").exists()
+    assert not (tmp_path / "x=1" / "error.json").exists()
+    assert _run_point(task, {"x": 2}, {}, str(tmp_path / "x=2"), {"x": 2})["status"] == "interrupted"
+    assert seen == [False]  # the second point never started
+    assert not (tmp_path / "x=2").exists()
+
+
 def log_an_error_on_the_worker(point: dict, point_dir: Path) -> dict:
     """Logs as a worker does when its scheduler is gone (at every Ctrl-C during a point)."""
     import logging

@@ -327,15 +327,24 @@ def chain_point_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     once the chain slides steadily; the runs at N = ``profile_N`` and beta in ``profile_betas``
     also store the displacement over windows of ``profile_window`` for Fig. 6. The run
     checkpoints into ``point_dir`` every :data:`CHECKPOINT_INTERVAL` seconds and, if a
-    checkpoint is there, continues from it.
+    checkpoint is there, continues from it; when the reproduction is interrupted it checkpoints and
+    stops (:func:`stickslip.experiments.sweep.stop_requested`).
     Returns the run's summary with <L> and its batch-means error (Fig. 5b) and the final state
     ("steady sliding" or "stick-slip", section 3).
     """
     from stickslip.analysis.statistics import time_average
+    from stickslip.experiments.sweep import stop_requested
     from stickslip.run import driver as chain
 
     params, t_end, options = _point_settings(point)
-    run = chain.continue_or_run(params, t_end, point_dir, checkpoint_interval=CHECKPOINT_INTERVAL, **options)
+    run = chain.continue_or_run(
+        params,
+        t_end,
+        point_dir,
+        checkpoint_interval=CHECKPOINT_INTERVAL,
+        stop_requested=stop_requested(point_dir),
+        **options,
+    )
     s = dict(run.summary)
     stopped_early = bool(s.get("stopped_early", False))
     avg_from = options["average_from"]
@@ -356,7 +365,7 @@ def chain_point_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
 
 def _compute_chain_runs(exp: Experiment, run_dir: Path, *, scheduler=None, n_workers=None, log=None) -> dict[str, Any]:
     """All chain runs of the experiment as one Dask sweep (Figs. 5-8)."""
-    from stickslip.experiments.sweep import run_sweep
+    from stickslip.experiments.sweep import STOP_WAIT_SECONDS, run_sweep
 
     points = [dict(p) for p in exp.options["points"]]
     common = _chain_common(exp)
@@ -374,6 +383,7 @@ def _compute_chain_runs(exp: Experiment, run_dir: Path, *, scheduler=None, n_wor
         common=common,
         scheduler=scheduler,
         n_workers=n_workers,
+        stop_wait=STOP_WAIT_SECONDS,
         progress=bool(getattr(log, "enabled", False)),
     )
     failed = result.table[result.table["status"] != "ok"]

@@ -454,6 +454,7 @@ def study_point_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     ``"lyapunov"``: :func:`lyapunov_point` (no chain run record, only the exponent's data).
     Returns the summary stored in the point's ``done.json``.
     """
+    from stickslip.experiments.sweep import stop_requested
     from stickslip.run import driver
 
     if point.get("analysis") == "lyapunov":
@@ -461,7 +462,14 @@ def study_point_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     params = point_params(point)
     t_end, options = point_run_options(point, params)
     point_dir = Path(point_dir)
-    run = driver.continue_or_run(params, t_end, point_dir, checkpoint_interval=CHECKPOINT_INTERVAL, **options)
+    run = driver.continue_or_run(
+        params,
+        t_end,
+        point_dir,
+        checkpoint_interval=CHECKPOINT_INTERVAL,
+        stop_requested=stop_requested(point_dir),
+        **options,
+    )
     base = {
         "model": params.model,
         "t_end": t_end,

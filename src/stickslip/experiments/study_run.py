@@ -118,7 +118,7 @@ def run_study(
     Progress goes to stderr when ``progress`` and stderr is a terminal. Returns the table as
     records, the conclusions, failed points with their errors, paths and times.
     """
-    from stickslip.experiments.sweep import _on_terminal, run_sweep
+    from stickslip.experiments.sweep import STOP_WAIT_SECONDS, _on_terminal, run_sweep
 
     t0 = time.perf_counter()
     spec = study(spec, mode) if isinstance(spec, str) else spec
@@ -145,6 +145,7 @@ def run_study(
         scheduler=scheduler,
         n_workers=n_workers,
         progress=show,
+        stop_wait=STOP_WAIT_SECONDS,
     )
     table = _study_table(spec, result.table)
     failed = table[table["status"] != "ok"]

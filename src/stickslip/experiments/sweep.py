@@ -6,7 +6,10 @@ outputs there and returns a summary dict. When a point finishes, ``done.json`` i
 its directory atomically; a later sweep over the same points finds it and skips the point, so
 an interrupted sweep resumes where it stopped. A point whose task raises gets ``error.json``
 (message and traceback), is reported in the summary table and does not stop the others; it is
-run again by the next sweep.
+run again by the next sweep. With ``stop_wait`` > 0, an interrupted sweep (SIGINT, or SIGTERM where
+the command turns it into one) asks its running points to stop (:data:`STOP_FILE`) and waits for
+them: a task that passes :func:`stop_requested` to the chain driver (studies, reproductions)
+writes its checkpoint and stops, so the point loses nothing.
 
 The points run on ``dask.distributed``: a local cluster of worker processes (one per core,
 one thread each) by default, or an existing cluster given by its scheduler address. With a
@@ -55,12 +58,20 @@ __all__ = [
     "DONE_FILE",
     "ERROR_FILE",
     "POINT_FILE",
+    "STOP_FILE",
+    "STOP_WAIT_SECONDS",
+    "stop_requested",
 ]
 
 DONE_FILE = "done.json"
 ERROR_FILE = "error.json"
 POINT_FILE = "point.json"  # a point's spec, written first: marks the folder as the sweep's
 SUMMARY_NAME = "summary"
+# In the sweep's directory while an interrupted sweep waits for its running points to stop.
+STOP_FILE = "stop-requested"
+# How long an interrupted study or reproduction waits for its running points to checkpoint and
+# stop (each does within about a second); a second interrupt ends the wait at once.
+STOP_WAIT_SECONDS = 60.0
 
 # Keys of a point that are options of the run rather than model parameters.
 CHAIN_RUN_OPTIONS = (
@@ -134,11 +145,26 @@ def _read_done(point_dir: Path, spec: dict[str, Any]) -> dict[str, Any] | None:
     return record if record.get("spec") == spec else None
 
 
+def stop_requested(point_dir: str | Path) -> Callable[[], bool]:
+    """Whether the sweep that runs the point in ``point_dir`` was interrupted (its
+    :data:`STOP_FILE` exists): a task passes this to the chain driver
+    (:func:`stickslip.run.driver.continue_or_run`), which then checkpoints and stops."""
+    flag = Path(point_dir).parent / STOP_FILE
+    return flag.exists
+
+
 def _run_point(
     task: Task, point: dict[str, Any], common: dict[str, Any], point_dir: str, spec: dict[str, Any]
 ) -> dict[str, Any]:
-    """Run one point on a worker: call the task, record done.json or error.json, never raise."""
+    """Run one point on a worker: call the task, record done.json or error.json, never raise.
+
+    A point stopped because the sweep was interrupted gets neither file: the next sweep runs it.
+    """
+    from stickslip.run.errors import Interrupted
+
     directory = Path(point_dir)
+    if stop_requested(directory)():
+        return {"spec": spec, "status": "interrupted", "error": None, "wall_seconds": 0.0}
     directory.mkdir(parents=True, exist_ok=True)
     for stale in (DONE_FILE, ERROR_FILE):
         (directory / stale).unlink(missing_ok=True)
@@ -147,6 +173,8 @@ def _run_point(
     try:
         summary = task({**common, **point}, directory)
         summary = {} if summary is None else dict(summary)
+    except Interrupted as exc:
+        return {"spec": spec, "status": "interrupted", "error": str(exc), "wall_seconds": time.perf_counter() - start}
     except Exception as exc:  # a failing point is data, not a reason to stop the sweep
         record = {
             "spec": spec,
@@ -243,6 +271,7 @@ def run_sweep(
     scheduler: str | None = None,
     n_workers: int | None = None,
     progress: bool = True,
+    stop_wait: float = 0.0,
 ) -> SweepResult:
     """Run ``task`` at every point of a parameter grid, each point an independent Dask task.
 
@@ -256,6 +285,8 @@ def run_sweep(
     ``summary.csv`` in ``out_dir``: one row per point with its parameters, the fixed settings of
     ``common``, ``status``
     ("ok"/"failed"), ``reused``, ``error``, ``wall_seconds`` and the task's summary fields.
+    Interrupted (KeyboardInterrupt), it waits up to ``stop_wait`` seconds for the running points
+    to stop on request (:func:`stop_requested`) before it closes the cluster and re-raises.
     """
     start = time.perf_counter()
     points = [dict(p) for p in points]
@@ -289,6 +320,7 @@ def run_sweep(
             scheduler=scheduler,
             n_workers=n_workers,
             progress=progress,
+            stop_wait=stop_wait,
         )
 
     rows = [_row(p, n, r, u, common) for p, n, r, u in zip(points, names, records, reused, strict=False)]  # type: ignore[arg-type]
@@ -306,10 +338,17 @@ def run_sweep(
     )
 
 
-def _compute(task, points, common, out, names, specs, pending, records, *, scheduler, n_workers, progress):
-    """Submit the pending points and collect their records as they finish (fills ``records``)."""
+def _compute(task, points, common, out, names, specs, pending, records, *, scheduler, n_workers, progress, stop_wait):
+    """Submit the pending points and collect their records as they finish (fills ``records``).
+
+    On KeyboardInterrupt the running points are asked to stop and waited for, at most
+    ``stop_wait`` seconds (:func:`_stop_points`), before the cluster is closed; the interrupt then
+    goes on to the caller.
+    """
     from dask.distributed import Client, LocalCluster, as_completed
 
+    stop_file = out / STOP_FILE
+    stop_file.unlink(missing_ok=True)  # left by a sweep that was killed while it waited
     cluster = None
     if scheduler is None:
         workers = n_workers or os.cpu_count() or 1
@@ -324,8 +363,8 @@ def _compute(task, points, common, out, names, specs, pending, records, *, sched
     else:
         client = Client(scheduler)
     bar = _progress_bar(len(points), len(points) - len(pending), progress)
+    futures = {}
     try:
-        futures = {}
         for k in pending:
             future = client.submit(
                 _run_point,
@@ -355,12 +394,30 @@ def _compute(task, points, common, out, names, specs, pending, records, *, sched
                 bar.update(1)
                 if records[k]["status"] != "ok":
                     bar.write(f"point {names[k]} failed: {records[k]['error']}", file=sys.stderr)
+    except KeyboardInterrupt:
+        if stop_wait > 0:
+            _stop_points(stop_file, list(futures), stop_wait)
+        raise
     finally:
         if bar is not None:
             bar.close()
         client.close()
         if cluster is not None:
             cluster.close()
+        stop_file.unlink(missing_ok=True)
+
+
+def _stop_points(stop_file: Path, futures: list, timeout: float) -> None:
+    """Ask the running points to stop (they checkpoint first) and wait for them, at most
+    ``timeout`` seconds; points not yet started then return at once. A second interrupt ends
+    the wait."""
+    from dask.distributed import wait
+
+    stop_file.touch()
+    try:
+        wait(futures, timeout=timeout)
+    except (Exception, KeyboardInterrupt):  # a point that does not stop, a lost worker, a second interrupt
+        pass
 
 
 def _progress_bar(total: int, done: int, enabled: bool):

@@ -29,7 +29,7 @@ import signal
 import sys
 import time
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -206,6 +206,7 @@ def run_chain(
     handle_signals: bool = False,
     run_id: str | None = None,
     keep_checkpoint: bool = False,
+    stop_requested: Callable[[], bool] | None = None,
 ) -> ChainRun:
     """Integrate the chain of eq. (4) from ``start`` to ``t_end`` (MODEL.md, "Chain").
 
@@ -219,7 +220,9 @@ def run_chain(
     seconds and on SIGINT/SIGTERM (``handle_signals``), and the results at the end; ``run_id``
     (that of the run directory, :func:`rundir.owned_run_dir`) goes into every checkpoint. A
     finished run removes its checkpoint unless ``keep_checkpoint`` (needed only to continue it to
-    a later t_end with :func:`resume_chain`).
+    a later t_end with :func:`resume_chain`). ``stop_requested``, called between chunks of about
+    a quarter second, stops the run as a signal does: checkpoint, then :class:`Interrupted`
+    (how a sweep's worker learns that the sweep was interrupted).
     """
     if integrator not in INTEGRATORS:
         raise ParameterError(f"integrator must be one of {', '.join(INTEGRATORS)} (got {integrator!r})")
@@ -262,6 +265,7 @@ def run_chain(
         handle_signals=handle_signals,
         wall_before=0.0,
         keep_checkpoint=keep_checkpoint,
+        stop_requested=stop_requested,
     )
 
 
@@ -274,12 +278,14 @@ def resume_chain(
     handle_signals: bool = False,
     expect_params: ChainParams | None = None,
     keep_checkpoint: bool | None = None,
+    stop_requested: Callable[[], bool] | None = None,
 ) -> ChainRun:
     """Continue the run in ``run_dir`` from its checkpoint to its t_end (or a later ``t_end``).
 
     A corrupt checkpoint, one of another format, or one whose parameters differ from
     ``expect_params`` is refused with :class:`ChainRunError`. The checkpoint is kept at the end
-    if ``keep_checkpoint``, or (None) if the run was started keeping it.
+    if ``keep_checkpoint``, or (None) if the run was started keeping it. ``stop_requested`` as
+    for :func:`run_chain`.
     """
     run_dir = Path(run_dir)
     ckpt = Checkpointer(run_dir)
@@ -333,25 +339,42 @@ def resume_chain(
         handle_signals=handle_signals,
         wall_before=float(header.get("wall_seconds", 0.0)),
         keep_checkpoint=keep_checkpoint,
+        stop_requested=stop_requested,
     )
 
 
 def continue_or_run(
-    params: ChainParams, t_end: float, run_dir: str | Path, *, checkpoint_interval: float, **options: Any
+    params: ChainParams,
+    t_end: float,
+    run_dir: str | Path,
+    *,
+    checkpoint_interval: float,
+    stop_requested: Callable[[], bool] | None = None,
+    **options: Any,
 ) -> ChainRun:
     """The chain of eq. (4) (or a relative) into ``run_dir``, continued from the checkpoint there
     when one is usable (:func:`resume_chain` with ``expect_params``), else run afresh
     (:func:`run_chain` with ``options``); an unusable checkpoint is removed. A point of a study
-    or reproduction that is interrupted so loses at most ``checkpoint_interval`` seconds."""
+    or reproduction that is killed so loses at most ``checkpoint_interval`` seconds; one stopped
+    through ``stop_requested`` loses nothing."""
     import shutil
 
     ckpt = Checkpointer(Path(run_dir))
     if ckpt.state_path.is_file():
         try:
-            return resume_chain(run_dir, checkpoint_interval=checkpoint_interval, expect_params=params)
+            return resume_chain(
+                run_dir, checkpoint_interval=checkpoint_interval, expect_params=params, stop_requested=stop_requested
+            )
         except ChainRunError:
             shutil.rmtree(ckpt.dir, ignore_errors=True)
-    return run_chain(params, t_end, out_dir=run_dir, checkpoint_interval=checkpoint_interval, **options)
+    return run_chain(
+        params,
+        t_end,
+        out_dir=run_dir,
+        checkpoint_interval=checkpoint_interval,
+        stop_requested=stop_requested,
+        **options,
+    )
 
 
 def _drive(
@@ -370,6 +393,7 @@ def _drive(
     wall_before,
     run_id=None,
     keep_checkpoint=False,
+    stop_requested=None,
 ) -> ChainRun:
     par = _par(params)
     N = params.N
@@ -461,13 +485,14 @@ def _drive(
                     chunk = int(min(max(chunk * 0.25 / elapsed, 10_000), 50_000_000))
                 now = time.perf_counter()
                 bar.update(state.step * params.dt, int(state.ist[K.N_EVENTS]))
+                stop = flag.set or (stop_requested is not None and stop_requested())
                 if checkpointer is not None and (
-                    flag.set or (checkpoint_interval is not None and now - last_ckpt >= checkpoint_interval)
+                    stop or (checkpoint_interval is not None and now - last_ckpt >= checkpoint_interval)
                 ):
                     outputs.flush(state.ist)
                     checkpointer.write(state, outputs, dict(header, wall_seconds=wall_before + now - t0))
                     last_ckpt = now
-                if flag.set:
+                if stop:
                     raise Interrupted(checkpointer.state_path if checkpointer else None, state.step * params.dt)
         finally:
             bar.close()
