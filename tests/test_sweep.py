@@ -117,23 +117,30 @@ def test_sweep_rejects_repeated_points(tmp_path):
 
 
 def test_chain_task_calls_the_simulator_with_the_point(tmp_path, monkeypatch):
+    from stickslip.experiments.sweep import STOP_FILE
+
     calls = {}
 
-    def run_chain(params, t_end, **kwargs):
-        calls.update(params=params, t_end=t_end, **kwargs)
+    def continue_or_run(params, t_end, run_dir, **kwargs):
+        calls.update(params=params, t_end=t_end, run_dir=run_dir, **kwargs)
         return types.SimpleNamespace(summary={"n_events": 3, "L_mean": 12.5})
 
     def write_run(run, out_dir):
         calls["written"] = Path(out_dir)
 
     fake = types.ModuleType("stickslip.run.driver")
-    fake.run_chain, fake.write_run = run_chain, write_run
+    fake.continue_or_run, fake.write_run = continue_or_run, write_run
     monkeypatch.setitem(sys.modules, "stickslip.run.driver", fake)
     monkeypatch.setattr("stickslip.run.driver", fake, raising=False)
-    summary = chain_task({"beta": 0.9, "N": 19, "t_end": 100.0, "average_from": 50.0}, tmp_path)
+    point_dir = tmp_path / "beta=0.9"
+    summary = chain_task({"beta": 0.9, "N": 19, "t_end": 100.0, "average_from": 50.0}, point_dir)
     assert summary == {"n_events": 3, "L_mean": 12.5}
     assert calls["params"].beta == 0.9 and calls["params"].N == 19 and calls["params"].K == 10.0
-    assert calls["t_end"] == 100.0 and calls["average_from"] == 50.0 and calls["out_dir"] == tmp_path
+    assert calls["t_end"] == 100.0 and calls["average_from"] == 50.0 and calls["run_dir"] == point_dir
+    assert calls["checkpoint_interval"] == 120.0
+    assert calls["stop_requested"]() is False
+    (tmp_path / STOP_FILE).touch()
+    assert calls["stop_requested"]() is True
     with pytest.raises(ValueError, match="unknown"):
         chain_task({"gamma": 1.0, "t_end": 1.0}, tmp_path)
 
@@ -258,10 +265,13 @@ def test_an_interrupted_sweep_says_so_in_one_line_and_resumes(tmp_path, signame)
     assert proc.returncode == 130, stderr
     assert stdout == ""
     assert stderr.splitlines() == [
-        f"stickslip sweep: interrupted; run the same command again to continue (finished points in {out} are kept)"
+        "stickslip sweep: interrupted; run the same command again to continue "
+        f"(finished points in {out} are kept, chain runs continue from their checkpoints)"
     ], stderr
     assert not (out / "summary.parquet").exists()
     assert (out / "beta=1.5" / "point.json").is_file()  # the point's spec stays for the next call
+    assert (out / "beta=1.5" / "checkpoint" / "state.npz").is_file()  # written on the way out
+    assert not (out / "stop-requested").exists()
 
 
 def test_a_point_stopped_on_request_is_left_for_the_next_sweep(tmp_path):
@@ -286,6 +296,51 @@ def test_a_point_stopped_on_request_is_left_for_the_next_sweep(tmp_path):
     assert _run_point(task, {"x": 2}, {}, str(tmp_path / "x=2"), {"x": 2})["status"] == "interrupted"
     assert seen == [False]  # the second point never started
     assert not (tmp_path / "x=2").exists()
+
+
+def test_a_chain_point_stopped_on_request_continues_to_the_uninterrupted_result(tmp_path):
+    """A sweep's chain point stopped through the stop file checkpoints; run again it continues
+    from there and ends with the bits of one uninterrupted run."""
+    from stickslip.experiments.sweep import STOP_FILE
+    from stickslip.models.params import ChainParams
+    from stickslip.run.driver import run_chain
+    from stickslip.run.errors import Interrupted
+
+    point = {"beta": 0.9, "N": 9, "t_end": 3000.0}  # 6e5 steps: stopped after the first call's 2e5
+    ref = run_chain(ChainParams(beta=0.9, N=9), 3000.0)
+    (tmp_path / STOP_FILE).touch()
+    with pytest.raises(Interrupted) as stopped:
+        chain_task(point, tmp_path / "beta=0.9")
+    assert 0 < stopped.value.t < 3000.0
+    assert (tmp_path / "beta=0.9" / "checkpoint" / "state.npz").is_file()
+    (tmp_path / STOP_FILE).unlink()
+    summary = chain_task(point, tmp_path / "beta=0.9")
+    assert summary["state_sha256"] == ref.summary["state_sha256"]
+    assert summary["n_events"] == ref.summary["n_events"] > 0
+    assert not (tmp_path / "beta=0.9" / "checkpoint").exists()
+
+
+def test_a_checkpoint_of_other_settings_is_not_continued(tmp_path):
+    """A point whose point.json holds another spec (say another --t-end) loses its checkpoint
+    before the task runs; with the same spec the checkpoint stays for the task to continue."""
+    from stickslip.experiments.sweep import _run_point
+
+    seen = []
+
+    def task(point: dict, point_dir: Path) -> dict:
+        seen.append((point_dir / "checkpoint" / "state.npz").is_file())
+        return {}
+
+    def old_checkpoint(spec):
+        (tmp_path / "x=1" / "checkpoint").mkdir(parents=True, exist_ok=True)
+        (tmp_path / "x=1" / "checkpoint" / "state.npz").write_bytes(b"state")
+        (tmp_path / "x=1" / "point.json").write_text(json.dumps({"spec": spec}))
+
+    old_checkpoint({"x": 1, "t_end": 10.0})
+    assert _run_point(task, {"x": 1}, {}, str(tmp_path / "x=1"), {"x": 1, "t_end": 10.0})["status"] == "ok"
+    old_checkpoint({"x": 1, "t_end": 10.0})
+    assert _run_point(task, {"x": 1}, {}, str(tmp_path / "x=1"), {"x": 1, "t_end": 20.0})["status"] == "ok"
+    assert seen == [True, False]
 
 
 def log_an_error_on_the_worker(point: dict, point_dir: Path) -> dict:

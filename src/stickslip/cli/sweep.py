@@ -197,7 +197,7 @@ def _check_options(model: str, params, settings: dict[str, Any]) -> None:
 
 def run(args: argparse.Namespace) -> Result:
     """Handler of ``stickslip sweep``."""
-    from stickslip.experiments.sweep import block_task, chain_task, run_sweep
+    from stickslip.experiments.sweep import STOP_WAIT_SECONDS, block_task, chain_task, run_sweep
 
     points, common = parse_grid(args.model, args.grid, args.fixed, args.t_end)
     _, workers = dask_options(args)
@@ -214,9 +214,12 @@ def run(args: argparse.Namespace) -> Result:
                     scheduler=args.scheduler,
                     n_workers=workers,
                     progress=not args.no_progress,
+                    stop_wait=STOP_WAIT_SECONDS if task is chain_task else 0.0,  # block points keep no checkpoint
                 )
         except KeyboardInterrupt:
-            return interrupted("sweep", out, f"finished points in {out} are kept")
+            return interrupted(
+                "sweep", out, f"finished points in {out} are kept, chain runs continue from their checkpoints"
+            )
         except OSError as exc:  # e.g. no scheduler at the given address
             raise CommandError(f"cannot run the sweep: {exc}") from None
     data = {"model": args.model, "common": common, **result.to_dict()}
@@ -224,11 +227,12 @@ def run(args: argparse.Namespace) -> Result:
 
 
 def _sweep_files(out: str):
-    """What a sweep's directory may hold: its summary tables and the folders of its points
-    (each with its point.json); a sweep run again into it reuses the finished points."""
-    from stickslip.experiments.sweep import POINT_FILE
+    """What a sweep's directory may hold: its summary tables, the folders of its points (each
+    with its point.json) and the stop file of an interrupted sweep killed while it waited; a
+    sweep run again into it reuses the finished points."""
+    from stickslip.experiments.sweep import POINT_FILE, STOP_FILE
 
-    return lambda name: name in OUT_FILES["sweep"] or (Path(out) / name / POINT_FILE).is_file()
+    return lambda name: name in OUT_FILES["sweep"] or name == STOP_FILE or (Path(out) / name / POINT_FILE).is_file()
 
 
 def _text(result) -> str:

@@ -28,6 +28,7 @@ import logging
 import math
 import os
 import re
+import shutil
 import sys
 import time
 import traceback
@@ -72,6 +73,7 @@ STOP_FILE = "stop-requested"
 # How long an interrupted study or reproduction waits for its running points to checkpoint and
 # stop (each does within about a second); a second interrupt ends the wait at once.
 STOP_WAIT_SECONDS = 60.0
+CHECKPOINT_INTERVAL = 120.0  # wall-clock seconds between a chain point's checkpoints
 
 # Keys of a point that are options of the run rather than model parameters.
 CHAIN_RUN_OPTIONS = (
@@ -153,6 +155,15 @@ def stop_requested(point_dir: str | Path) -> Callable[[], bool]:
     return flag.exists
 
 
+def _spec_before(point_dir: Path) -> dict[str, Any] | None:
+    """The spec in the point's point.json (that of the sweep that last ran it), or None."""
+    try:
+        record = read_json(point_dir / POINT_FILE)
+    except (OSError, ValueError):
+        return None
+    return record.get("spec") if isinstance(record, dict) else None
+
+
 def _run_point(
     task: Task, point: dict[str, Any], common: dict[str, Any], point_dir: str, spec: dict[str, Any]
 ) -> dict[str, Any]:
@@ -168,6 +179,11 @@ def _run_point(
     directory.mkdir(parents=True, exist_ok=True)
     for stale in (DONE_FILE, ERROR_FILE):
         (directory / stale).unlink(missing_ok=True)
+    if _spec_before(directory) != spec:
+        # a checkpoint of other settings (run length, start, package version) is not continued
+        from stickslip.run.checkpoint import Checkpointer
+
+        shutil.rmtree(Checkpointer(directory).dir, ignore_errors=True)
     write_json(directory / POINT_FILE, {"spec": spec})
     start = time.perf_counter()
     try:
@@ -502,7 +518,14 @@ def chain_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
 
     params, t_end, options = _chain_run_args(point)
     with short_runs_expected():  # said once, by run_sweep, before the points run
-        run = chain.run_chain(params, t_end, out_dir=point_dir, **options)
+        run = chain.continue_or_run(
+            params,
+            t_end,
+            point_dir,
+            checkpoint_interval=CHECKPOINT_INTERVAL,
+            stop_requested=stop_requested(point_dir),
+            **options,
+        )
     if not (Path(point_dir) / "run.json").exists():
         chain.write_run(run, point_dir)
     return dict(run.summary)
