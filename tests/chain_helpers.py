@@ -220,6 +220,37 @@ def run_cli_subprocess(*argv: str, timeout: float = 120.0) -> subprocess.Complet
                           env=cli_env())  # fmt: skip
 
 
+def signal_when_running(argv: list[str], started, signum, *, settle: float = 1.0, timeout: float = 120.0):
+    """Run ``stickslip ARGV``; once ``started()`` holds (a point began) and ``settle`` seconds more
+    have passed, send ``signum`` to the command alone; return (exit status, stdout, stderr)."""
+    import signal
+    import time
+
+    proc = subprocess.Popen(
+        stickslip_cmd() + list(argv),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=cli_env(),
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),  # even where a shell ignores it
+    )
+    try:
+        deadline = time.monotonic() + timeout
+        while not started():
+            assert proc.poll() is None, proc.communicate()
+            assert time.monotonic() < deadline, f"nothing started within {timeout:g} s"
+            time.sleep(0.05)
+        time.sleep(settle)  # into the run
+        assert proc.poll() is None
+        proc.send_signal(signum)
+        stdout, stderr = proc.communicate(timeout=timeout)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    return proc.returncode, stdout, stderr
+
+
 # --------------------------------------------------------------------------------------
 # Plain-Python Heun step of any model of the family (MODEL.md, "The family the paper
 # stands in"), written from its text: ghost cells from the drive and the ends, the force with

@@ -230,7 +230,7 @@ def test_an_interrupted_study_checkpoints_its_running_point(tmp_path):
     where before it lost the work since its last periodic checkpoint (120 s)."""
     import signal
 
-    from chain_helpers import cli_env, stickslip_cmd
+    from chain_helpers import signal_when_running
     from stickslip.experiments.sweep import STOP_FILE
     from stickslip.models.params import ChainParams
     from stickslip.run.driver import run_chain
@@ -238,23 +238,11 @@ def test_an_interrupted_study_checkpoints_its_running_point(tmp_path):
     run_chain(ChainParams(N=5, beta=1.4), 1.0)  # compile the point's kernel here, not in the worker
     out = tmp_path / "studies"
     # the quick transition starts with its dearest point, N = 199 at beta = 1.4: minutes of work
-    cmd = stickslip_cmd() + ["study", "transition", "--quick", "--workers", "1", "--out", str(out), "--no-progress"]
-    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=cli_env())
-    try:
-        deadline = time.monotonic() + 120
-        while not list(out.glob("runs/*/points/*/point.json")):
-            assert proc.poll() is None, proc.communicate()
-            assert time.monotonic() < deadline, "no point started within 120 s"
-            time.sleep(0.05)
-        time.sleep(3.0)  # into the run
-        assert proc.poll() is None
-        proc.send_signal(signal.SIGTERM)
-        stdout, stderr = proc.communicate(timeout=120)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.communicate()
-    assert proc.returncode == 130, stderr
+    argv = ["study", "transition", "--quick", "--workers", "1", "--out", str(out), "--no-progress"]
+    status, stdout, stderr = signal_when_running(
+        argv, lambda: bool(list(out.glob("runs/*/points/*/point.json"))), signal.SIGTERM, settle=3.0
+    )
+    assert status == 130, stderr
     assert stdout == ""
     assert len(stderr.splitlines()) == 1 and "interrupted" in stderr, stderr
     (point,) = [p.parent for p in out.glob("runs/*/points/*/point.json")]

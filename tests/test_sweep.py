@@ -231,38 +231,17 @@ def test_an_interrupted_sweep_says_so_in_one_line_and_resumes(tmp_path, signame)
     """SIGINT or SIGTERM to the command alone (as ``timeout`` or ``kill`` send them) while its worker
     runs a chain: exit 130, one line on stderr, the directory left to the next call."""
     import signal
-    import subprocess
-    import time
 
-    from chain_helpers import cli_env, stickslip_cmd
+    from chain_helpers import signal_when_running
 
     out = tmp_path / "sweep"
     # a sliding N = 199 chain to t = 1e7 runs for hours: the worker is busy when the signal comes
-    cmd = stickslip_cmd() + ["sweep", "chain", "--grid", "beta=1.5", "--set", "N=199", "--t-end", "1e7",
-                             "--workers", "1", "--out", str(out), "--no-progress"]  # fmt: skip
-    proc = subprocess.Popen(
-        cmd,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        env=cli_env(),
-        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),  # even where a shell ignores it
+    argv = ["sweep", "chain", "--grid", "beta=1.5", "--set", "N=199", "--t-end", "1e7",
+            "--workers", "1", "--out", str(out), "--no-progress"]  # fmt: skip
+    status, stdout, stderr = signal_when_running(
+        argv, (out / "beta=1.5" / "point.json").is_file, getattr(signal, signame)
     )
-    try:
-        deadline = time.monotonic() + 120
-        while not (out / "beta=1.5" / "point.json").is_file():
-            assert proc.poll() is None, proc.communicate()
-            assert time.monotonic() < deadline, "the point did not start within 120 s"
-            time.sleep(0.05)
-        time.sleep(1.0)  # into the run
-        assert proc.poll() is None
-        proc.send_signal(getattr(signal, signame))
-        stdout, stderr = proc.communicate(timeout=120)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.communicate()
-    assert proc.returncode == 130, stderr
+    assert status == 130, stderr
     assert stdout == ""
     assert stderr.splitlines() == [
         "stickslip sweep: interrupted; run the same command again to continue "

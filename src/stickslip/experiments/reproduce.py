@@ -64,12 +64,9 @@ __all__ = [
     "report_rows",
     "ReproduceError",
     "RESULT_FILE",
-    "CHECKPOINT_INTERVAL",
 ]
 
 RESULT_FILE = "result.json"
-#: Wall-clock seconds between checkpoints of a chain run (an interrupted run loses at most this).
-CHECKPOINT_INTERVAL = 120.0
 
 
 class ReproduceError(RuntimeError):
@@ -326,25 +323,16 @@ def chain_point_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     :func:`stickslip.experiments.specs.experiments`). Runs at beta above ``until_steady_above`` stop
     once the chain slides steadily; the runs at N = ``profile_N`` and beta in ``profile_betas``
     also store the displacement over windows of ``profile_window`` for Fig. 6. The run
-    checkpoints into ``point_dir`` every :data:`CHECKPOINT_INTERVAL` seconds and, if a
-    checkpoint is there, continues from it; when the reproduction is interrupted it checkpoints and
-    stops (:func:`stickslip.experiments.sweep.stop_requested`).
+    checkpoints into ``point_dir``, continues from a checkpoint there, and checkpoints and stops
+    when the reproduction is interrupted (:func:`stickslip.experiments.sweep.run_chain_point`).
     Returns the run's summary with <L> and its batch-means error (Fig. 5b) and the final state
     ("steady sliding" or "stick-slip", section 3).
     """
     from stickslip.analysis.statistics import time_average
-    from stickslip.experiments.sweep import stop_requested
-    from stickslip.run import driver as chain
+    from stickslip.experiments.sweep import run_chain_point
 
     params, t_end, options = _point_settings(point)
-    run = chain.continue_or_run(
-        params,
-        t_end,
-        point_dir,
-        checkpoint_interval=CHECKPOINT_INTERVAL,
-        stop_requested=stop_requested(point_dir),
-        **options,
-    )
+    run = run_chain_point(params, t_end, point_dir, **options)
     s = dict(run.summary)
     stopped_early = bool(s.get("stopped_early", False))
     avg_from = options["average_from"]

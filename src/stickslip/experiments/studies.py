@@ -46,14 +46,11 @@ __all__ = [
     "check_point",
     "lyapunov_point",
     "loading_time",
-    "CHECKPOINT_INTERVAL",
 ]
 
 STUDIES = ("transition", "phase-diagram", "exponents", "chaos")
 #: ``tiny`` runs every study on chains of a few blocks in seconds (tests); its numbers mean nothing.
 MODES = ("quick", "full", "tiny")
-#: Wall-clock seconds between checkpoints of a chain run.
-CHECKPOINT_INTERVAL = 120.0
 #: Tolerance of the stop at steady sliding (largest deviation of v, theta, springs).
 UNTIL_STEADY = 1e-6
 
@@ -454,22 +451,14 @@ def study_point_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     ``"lyapunov"``: :func:`lyapunov_point` (no chain run record, only the exponent's data).
     Returns the summary stored in the point's ``done.json``.
     """
-    from stickslip.experiments.sweep import stop_requested
-    from stickslip.run import driver
+    from stickslip.experiments.sweep import run_chain_point
 
     if point.get("analysis") == "lyapunov":
         return lyapunov_point(point, point_dir)
     params = point_params(point)
     t_end, options = point_run_options(point, params)
     point_dir = Path(point_dir)
-    run = driver.continue_or_run(
-        params,
-        t_end,
-        point_dir,
-        checkpoint_interval=CHECKPOINT_INTERVAL,
-        stop_requested=stop_requested(point_dir),
-        **options,
-    )
+    run = run_chain_point(params, t_end, point_dir, **options)
     base = {
         "model": params.model,
         "t_end": t_end,

@@ -61,6 +61,8 @@ __all__ = [
     "POINT_FILE",
     "STOP_FILE",
     "STOP_WAIT_SECONDS",
+    "CHECKPOINT_INTERVAL",
+    "run_chain_point",
     "stop_requested",
 ]
 
@@ -508,6 +510,24 @@ def _warn_short_chain_runs(points: list[dict[str, Any]], common: dict[str, Any],
             warnings.warn(f"{name}: {message}", ShortRunWarning, stacklevel=3)
 
 
+def run_chain_point(params: ChainParams, t_end: float, point_dir: str | Path, **options: Any):
+    """The chain run (eq. 4 or a relative) of one sweep point, in ``point_dir``: continued from
+    its checkpoint when there is one, checkpointed every :data:`CHECKPOINT_INTERVAL` seconds, and
+    stopped after a checkpoint when the sweep is interrupted (:func:`stop_requested`). ``options``
+    go to :func:`stickslip.run.driver.run_chain`. The chain points of sweeps, studies and the
+    reproduction all run so."""
+    from stickslip.run import driver  # imported here: workers load the simulator only when needed
+
+    return driver.continue_or_run(
+        params,
+        t_end,
+        point_dir,
+        checkpoint_interval=CHECKPOINT_INTERVAL,
+        stop_requested=stop_requested(point_dir),
+        **options,
+    )
+
+
 def chain_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     """Run the chain of eq. (4) at one point; its outputs go to ``point_dir``; returns its summary.
 
@@ -518,14 +538,7 @@ def chain_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
 
     params, t_end, options = _chain_run_args(point)
     with short_runs_expected():  # said once, by run_sweep, before the points run
-        run = chain.continue_or_run(
-            params,
-            t_end,
-            point_dir,
-            checkpoint_interval=CHECKPOINT_INTERVAL,
-            stop_requested=stop_requested(point_dir),
-            **options,
-        )
+        run = run_chain_point(params, t_end, point_dir, **options)
     if not (Path(point_dir) / "run.json").exists():
         chain.write_run(run, point_dir)
     return dict(run.summary)
