@@ -534,13 +534,9 @@ def chain_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     ``point`` holds :class:`~stickslip.models.params.ChainParams` fields, ``t_end`` and optionally the
     run options in :data:`CHAIN_RUN_OPTIONS`.
     """
-    from stickslip.run import driver as chain  # imported here: workers load the simulator only when needed
-
     params, t_end, options = _chain_run_args(point)
     with short_runs_expected():  # said once, by run_sweep, before the points run
-        run = run_chain_point(params, t_end, point_dir, **options)
-    if not (Path(point_dir) / "run.json").exists():
-        chain.write_run(run, point_dir)
+        run = run_chain_point(params, t_end, point_dir, **options)  # writes run.json, as every run with a directory
     return dict(run.summary)
 
 
