@@ -1,11 +1,15 @@
 """Writing and reading results: JSON metadata, labelled arrays (NetCDF/HDF5), event tables (Parquet).
 
 Every write is atomic (written to a temporary file in the same directory, then renamed), so an
-interrupted run never leaves a half-written file under the final name.
+interrupted run, or one that meets a full disk, never leaves a half-written file under the final
+name. NetCDF files are built in memory and written as plain bytes, so that no HDF5 library state
+is left to flush onto a full disk at close or in a finalizer. A full disk surfaces as
+:class:`OSError` with errno ``ENOSPC`` naming the file (:func:`disk_full`).
 """
 
 from __future__ import annotations
 
+import errno
 import json
 import os
 import platform
@@ -35,16 +39,46 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
     try:
         yield tmp_path
         os.replace(tmp_path, path)
+    except OSError as exc:
+        if disk_full(exc) is not None and not exc.filename:
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(path)) from exc
+        raise
     finally:
         if tmp_path.exists():
             tmp_path.unlink()
 
 
+#: errno values that mean the disk (or the user's quota) is full.
+FULL_DISK_ERRNOS = frozenset({errno.ENOSPC, errno.EDQUOT})
+
+
+def disk_full(exc: BaseException) -> OSError | None:
+    """The OSError meaning "no space left" in ``exc`` or in the exceptions it was raised from
+    (HDF5, PIL and Dask wrap it), or None."""
+    seen = set()
+    while exc is not None and id(exc) not in seen:
+        seen.add(id(exc))
+        if isinstance(exc, OSError) and (
+            exc.errno in FULL_DISK_ERRNOS or "No space left on device" in str(exc) or "Disk quota exceeded" in str(exc)
+        ):
+            return exc
+        exc = exc.__cause__ or exc.__context__
+    return None
+
+
+def write_bytes(path: str | Path, data: bytes) -> Path:
+    """Write ``data`` to ``path`` atomically, flushed to the disk before the rename."""
+    with atomic_path(path) as tmp:
+        with open(tmp, "wb") as fh:
+            fh.write(data)
+            fh.flush()
+            os.fsync(fh.fileno())
+    return Path(path)
+
+
 def write_json(path: str | Path, data: Any) -> Path:
     """Write one JSON document atomically (NaN and inf become null)."""
-    with atomic_path(path) as tmp:
-        tmp.write_text(json.dumps(to_jsonable(data), indent=2, allow_nan=False) + "\n")
-    return Path(path)
+    return write_bytes(path, (json.dumps(to_jsonable(data), indent=2, allow_nan=False) + "\n").encode())
 
 
 def read_json(path: str | Path) -> Any:
@@ -52,10 +86,9 @@ def read_json(path: str | Path) -> Any:
 
 
 def write_dataset(path: str | Path, ds: xr.Dataset) -> Path:
-    """Write labelled arrays to NetCDF4/HDF5 (h5netcdf engine), atomically."""
-    with atomic_path(path) as tmp:
-        ds.to_netcdf(tmp, engine="h5netcdf")
-    return Path(path)
+    """Write labelled arrays to NetCDF4/HDF5 (h5netcdf engine), atomically: the file is built in
+    memory, so HDF5 never writes to the disk itself (a full disk is then a plain OSError)."""
+    return write_bytes(path, bytes(ds.to_netcdf(engine="h5netcdf")))
 
 
 def read_dataset(path: str | Path) -> xr.Dataset:
@@ -92,16 +125,14 @@ def write_table(
         arrow = arrow.replace_schema_metadata(
             {**(arrow.schema.metadata or {}), b"stickslip": json.dumps(to_jsonable(metadata)).encode()}
         )
-    with atomic_path(path) as tmp:
-        pq.write_table(arrow, tmp)
-    return Path(path)
+    sink = pa.BufferOutputStream()
+    pq.write_table(arrow, sink)
+    return write_bytes(path, sink.getvalue().to_pybytes())
 
 
 def write_csv(path: str | Path, table: pd.DataFrame) -> Path:
     """Write a table as CSV (no index), atomically."""
-    with atomic_path(path) as tmp:
-        table.to_csv(tmp, index=False)
-    return Path(path)
+    return write_bytes(path, table.to_csv(index=False).encode())
 
 
 def write_table_files(

@@ -86,7 +86,28 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         sys.stderr.write("stickslip: interrupted\n")
         return 130
+    except Exception as exc:
+        full = _full_disk_line(exc, args)
+        if full is None:
+            raise
+        sys.stderr.write(f"stickslip {name}: error: {full}\n")
+        return 1
     return emit(result, as_json=getattr(args, "json", False))
+
+
+def _full_disk_line(exc: BaseException, args: argparse.Namespace) -> str | None:
+    """The one line for a write that met a full disk (:func:`stickslip.io.disk_full`), naming the
+    file, or the output directory where the error names none; None for any other error."""
+    from stickslip.io import disk_full
+
+    full = disk_full(exc)
+    if full is None:
+        return None
+    where = full.filename or getattr(args, "out", None) or getattr(args, "resume", None) or "."
+    return (
+        f"the disk is full: no space left to write {where}; free some space and run the same command "
+        "again (nothing half-written was kept)"
+    )
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -74,8 +74,11 @@ def dask_options(args: argparse.Namespace) -> tuple[str | None, int | None]:
 
     workers = None if args.workers is None else int(check_number("--workers", args.workers, low=1, integer=True))
     address = args.scheduler
-    if address is not None and not re.fullmatch(r"([a-z+]+://)?[^\s:/]+:\d{1,5}", address.strip()):
+    match = None if address is None else re.fullmatch(r"([a-z+]+://)?[^\s:/]+:(\d{1,5})", address.strip())
+    if address is not None and match is None:
         raise CommandError(f"--scheduler must be an address HOST:PORT, e.g. tcp://127.0.0.1:8786 (got {address!r})")
+    if match is not None and not 1 <= int(match.group(2)) <= 65535:
+        raise CommandError(f"--scheduler port must be in [1, 65535] (got {match.group(2)})")
     return address, workers
 
 
@@ -255,7 +258,6 @@ def owned_out_dir(
     from stickslip.run.rundir import RunDirBusy, owned_run_dir, remove_own_files
 
     out = check_out_owned(path, own, what, overwrite=overwrite)
-    out = prepare_out_dir(out)
     if out is None:
         if overwrite:
             raise CommandError("--overwrite needs --out")
@@ -269,6 +271,12 @@ def owned_out_dir(
             yield out
     except RunDirBusy as exc:
         raise CommandError(str(exc)) from None
+    except OSError as exc:
+        from stickslip.io import disk_full
+
+        if disk_full(exc) is not None or out.is_dir():
+            raise
+        raise CommandError(f"cannot create output directory {out}: {exc.strerror}") from None
 
 
 def add_overwrite_option(parser: argparse.ArgumentParser) -> None:
@@ -390,3 +398,11 @@ def block_params_from_args(args: argparse.Namespace, **overrides: Any):
 
         raise ParameterError("--Fs is not a parameter of batista-carlson (its threshold is sigma theta)")
     return block_params(model, **values)
+
+
+def is_disk_full(exc: BaseException) -> bool:
+    """Whether ``exc`` comes from a full disk (:func:`stickslip.io.disk_full`); such an error goes
+    on to the command line's one line and exit status 1, not to a refusal of the input."""
+    from stickslip.io import disk_full
+
+    return disk_full(exc) is not None

@@ -136,7 +136,7 @@ def run_block(args: argparse.Namespace) -> Result:
     p = block_params_from_args(args)
     every = int(check_number("every", args.every, low=1, high=MAX_STEPS, integer=True))
     if args.t_end is not None:
-        check_number("t_end", args.t_end, low=0.0)
+        check_number("t_end", args.t_end, low=0.0, low_open=True)
     if args.fig3 and args.out is None:
         raise CommandError("--fig3 writes figures and needs --out DIR")
     law = _law_or_none(p)

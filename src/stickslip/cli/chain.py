@@ -237,7 +237,11 @@ def run_chain_command(args: argparse.Namespace) -> Result:
     from stickslip.run import driver as chain
 
     progress = not args.no_progress
-    if args.resume:
+    if args.resume is not None:
+        if not args.resume.strip():
+            raise CommandError("--resume must name a run directory (got '')")
+        if not Path(args.resume).is_dir():
+            raise CommandError(f"--resume {args.resume}: no such run directory")
         if args.out and Path(args.out) != Path(args.resume):
             raise CommandError("--out and --resume name different directories; give only --resume")
         fixed = [
@@ -255,9 +259,9 @@ def run_chain_command(args: argparse.Namespace) -> Result:
         if args.overwrite:
             raise CommandError("--overwrite cannot be combined with --resume")
         if args.t_end is not None:
-            check_number("t-end", args.t_end, low=0.0)
+            check_number("t-end", args.t_end, low=0.0, low_open=True)
         try:
-            with owned_run_dir(args.resume):
+            with owned_run_dir(args.resume, new_id=False):
                 run = chain.resume_chain(
                     args.resume,
                     t_end=args.t_end,
@@ -294,7 +298,7 @@ def run_chain_command(args: argparse.Namespace) -> Result:
     ):
         if getattr(args, name) is None:
             setattr(args, name, default)
-    check_number("t-end", t_end, low=0.0)
+    check_number("t-end", t_end, low=0.0, low_open=True)
     steps_for(t_end, params.dt, "t-end")
     if args.out is None:
         for flag, value in (

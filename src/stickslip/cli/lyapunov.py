@@ -130,13 +130,18 @@ def run_lyapunov_command(args: argparse.Namespace) -> Result:
         args.start = preset.start
     if args.perturbation is None:
         args.perturbation = preset.start_options.get("amplitude", 0.0) if args.start == "rest" else 0.0
+    if args.seed is not None and args.start == "paper":
+        raise CommandError("--seed goes with --start steady or --start rest (the paper's start draws no numbers)")
     if args.seed is None:
         args.seed = preset.start_options.get("seed", 0)
     check_number("perturbation", args.perturbation, low=0.0)
     check_number("seed", args.seed, low=0, integer=True)
-    if args.plot and not args.betas:
+    check_number("direction-seed", args.direction_seed, low=0, integer=True)
+    if args.betas is not None:
+        _betas(args.betas)  # refused before any run, '' included
+    if args.plot and args.betas is None:
         raise CommandError("--plot needs --betas")
-    if args.convergence and args.betas:
+    if args.convergence and args.betas is not None:
         raise CommandError("give either --convergence or --betas, not both")
     kw = dict(
         interval=args.interval,
@@ -160,7 +165,7 @@ def run_lyapunov_command(args: argparse.Namespace) -> Result:
             "norm": ly.NORM,
         }
         return Result(data, table.to_string(index=False))
-    if args.betas:
+    if args.betas is not None:
         betas = _betas(args.betas)
         table = ly.lyapunov_vs_beta(params, betas, args.t_end, progress=not args.no_progress, **kw)
         data = {
@@ -175,9 +180,18 @@ def run_lyapunov_command(args: argparse.Namespace) -> Result:
             from stickslip.plotting.lyapunov import plot_lyapunov_beta
 
             fig = plot_lyapunov_beta(table, params)
+            import io as _io
+            from pathlib import Path
+
+            from stickslip.io import disk_full, write_bytes
+
+            buf = _io.BytesIO()
             try:
-                fig.savefig(args.plot)
+                fig.savefig(buf, format=Path(args.plot).suffix.lstrip(".") or None)
+                write_bytes(args.plot, buf.getvalue())
             except (OSError, ValueError) as exc:
+                if disk_full(exc) is not None:
+                    raise
                 raise CommandError(f"cannot write plot {args.plot}: {exc}") from None
             data["plot"] = args.plot
             text += f"\nplot written to {args.plot}"

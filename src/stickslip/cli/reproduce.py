@@ -22,6 +22,7 @@ from stickslip.cli._common import (
     add_overwrite_option,
     dask_options,
     interrupted,
+    is_disk_full,
     owned_out_dir,
     sigterm_as_interrupt,
 )
@@ -95,6 +96,8 @@ def _run(out, args: argparse.Namespace, workers: int | None) -> Result:
             "reproduce", out, f"finished results in {out} are kept, chain runs continue from their last checkpoint"
         )
     except OSError as exc:  # e.g. no scheduler at the given address
+        if is_disk_full(exc):
+            raise
         raise CommandError(f"cannot run the chain runs: {exc}") from None
     return Result(result, _text(result))
 

@@ -20,6 +20,7 @@ from stickslip.cli._common import (
     add_json_option,
     dask_options,
     interrupted,
+    is_disk_full,
     prepare_out_dir,
     sigterm_as_interrupt,
 )
@@ -79,6 +80,8 @@ def run(args: argparse.Namespace) -> Result:
             "study", out, f"finished points in {out} are kept, chain runs continue from their checkpoints"
         )
     except OSError as exc:
+        if is_disk_full(exc):
+            raise
         raise CommandError(f"cannot run the study: {exc}") from None
     data = {k: v for k, v in result.items() if k != "figures"}
     data["figures"] = [f["image"] for f in result["figures"]]

@@ -25,6 +25,7 @@ from stickslip.cli._common import (
     add_overwrite_option,
     dask_options,
     interrupted,
+    is_disk_full,
     owned_out_dir,
     sigterm_as_interrupt,
 )
@@ -221,6 +222,8 @@ def run(args: argparse.Namespace) -> Result:
                 "sweep", out, f"finished points in {out} are kept, chain runs continue from their checkpoints"
             )
         except OSError as exc:  # e.g. no scheduler at the given address
+            if is_disk_full(exc):
+                raise
             raise CommandError(f"cannot run the sweep: {exc}") from None
     data = {"model": args.model, "common": common, **result.to_dict()}
     return Result(data=data, text=_text(result), status=1 if result.n_failed else 0)

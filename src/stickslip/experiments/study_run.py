@@ -285,5 +285,4 @@ def _write_page(
         cls = ' class="failed"' if r.get("status") != "ok" else ""
         parts.append(f"<tr{cls}>" + "".join(f"<td>{_cell(r.get(c))}</td>" for c in cols) + "</tr>")
     parts.append("</tbody></table></body></html>\n")
-    with io.atomic_path(path) as tmp:
-        tmp.write_text("\n".join(parts), encoding="utf-8")
+    io.write_bytes(path, "\n".join(parts).encode("utf-8"))

@@ -42,7 +42,7 @@ import numpy as np
 import pandas as pd
 
 from stickslip import __version__
-from stickslip.io import read_json, run_metadata, write_dataset, write_json, write_table, write_table_files
+from stickslip.io import disk_full, read_json, run_metadata, write_dataset, write_json, write_table, write_table_files
 from stickslip.jsonable import to_jsonable
 from stickslip.models.params import BlockParams, ChainParams
 from stickslip.run.errors import ShortRunWarning, short_runs_expected
@@ -194,6 +194,8 @@ def _run_point(
     except Interrupted as exc:
         return {"spec": spec, "status": "interrupted", "error": str(exc), "wall_seconds": time.perf_counter() - start}
     except Exception as exc:  # a failing point is data, not a reason to stop the sweep
+        if disk_full(exc) is not None:  # but a full disk stops every point: the command says so
+            raise
         record = {
             "spec": spec,
             "status": "failed",
@@ -400,6 +402,8 @@ def _compute(task, points, common, out, names, specs, pending, records, *, sched
             try:
                 records[k] = future.result()
             except Exception as exc:  # the worker itself died (memory, signal): record it here
+                if disk_full(exc) is not None:
+                    raise
                 records[k] = {
                     "spec": specs[k],
                     "status": "failed",

@@ -39,14 +39,22 @@ FIGURE_FORMATS = ("png", "pdf")
 
 
 def save_figure(fig: Figure, path: str | Path, *, formats: tuple[str, ...] = FIGURE_FORMATS) -> list[Path]:
-    """Save ``fig`` as PATH.png and PATH.pdf (or ``formats``); returns the written paths."""
+    """Save ``fig`` as PATH.png and PATH.pdf (or ``formats``); returns the written paths. Each file
+    is rendered in memory and written atomically (:func:`stickslip.io.write_bytes`), so a full
+    disk leaves no half-written image."""
+    import io as _io
+
+    from stickslip.io import write_bytes
+
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     written = []
     with matplotlib.rc_context(RC):
         for fmt in formats:
             out = path.with_suffix(f".{fmt}")
-            fig.savefig(out)
+            buf = _io.BytesIO()
+            fig.savefig(buf, format=fmt)
+            write_bytes(out, buf.getvalue())
             written.append(out)
     return written
 

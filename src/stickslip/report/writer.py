@@ -20,7 +20,7 @@ from pathlib import Path
 from typing import Any
 
 from stickslip import __version__
-from stickslip.io import atomic_path, read_json, write_json
+from stickslip.io import read_json, write_bytes, write_json
 from stickslip.jsonable import to_jsonable
 
 __all__ = ["ReportRow", "ReportFigure", "Report", "write_report", "read_report", "agreement_text"]
@@ -158,8 +158,7 @@ def write_report(
     )
     json_path = write_json(out / "report.json", report.to_dict())
     html_path = out / "report.html"
-    with atomic_path(html_path) as tmp:
-        tmp.write_text(render_html(report, out, embed=embed, title=title), encoding="utf-8")
+    write_bytes(html_path, render_html(report, out, embed=embed, title=title).encode("utf-8"))
     return {"json": json_path, "html": html_path}
 
 

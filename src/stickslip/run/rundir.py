@@ -212,17 +212,22 @@ def read_run_id(run_dir: str | Path) -> str | None:
 
 
 @contextlib.contextmanager
-def owned_run_dir(run_dir: str | Path | None, *, run_id: bool = True) -> Iterator[str | None]:
+def owned_run_dir(run_dir: str | Path | None, *, run_id: bool = True, new_id: bool = True) -> Iterator[str | None]:
     """Hold the lock of ``run_dir`` for the life of a run and yield its run id (a new one for a
-    directory without; None with ``run_id=False``, for outputs without checkpoints). A second
-    holder is refused at once with :class:`RunDirBusy`; files left by a killed write are removed."""
+    directory without, unless ``new_id`` is false; None with ``run_id=False``, for outputs without
+    checkpoints). A second holder is refused at once with :class:`RunDirBusy`; files left by a
+    killed write are removed. On a full disk (:func:`stickslip.io.disk_full`) what the block
+    added is removed again (:func:`_undo_on_full_disk`): the directory is left as it was, or
+    with a resumable checkpoint."""
     if run_dir is None:
         yield None
         return
     from filelock import FileLock, Timeout
 
     run_dir = Path(run_dir)
+    created = not run_dir.exists()
     run_dir.mkdir(parents=True, exist_ok=True)
+    before = {p.name for p in run_dir.iterdir()}
     lock = FileLock(str(run_dir / ".lock"))
     info = run_dir / ".lock.json"
     try:
@@ -239,10 +244,14 @@ def owned_run_dir(run_dir: str | Path | None, *, run_id: bool = True) -> Iterato
         raise RunDirBusy(
             f"{run_dir} is in use by another run ({who}); wait for it or choose another directory"
         ) from None
+    except OSError:
+        _remove_if_empty(run_dir, created)
+        raise
     try:
-        info.write_text(
-            json.dumps({"pid": os.getpid(), "host": socket.gethostname(), "since": time.strftime("%Y-%m-%dT%H:%M:%S")})
-        )
+        from stickslip.io import write_bytes
+
+        record = {"pid": os.getpid(), "host": socket.gethostname(), "since": time.strftime("%Y-%m-%dT%H:%M:%S")}
+        write_bytes(info, json.dumps(record).encode())
         for stale in run_dir.glob(".*.tmp"):  # left by a write that was killed
             with contextlib.suppress(OSError):
                 stale.unlink()
@@ -250,10 +259,16 @@ def owned_run_dir(run_dir: str | Path | None, *, run_id: bool = True) -> Iterato
             yield None
             return
         rid = read_run_id(run_dir)
-        if rid is None and not (run_dir / "checkpoint").exists():
+        if rid is None and new_id and not (run_dir / "checkpoint").exists():
             rid = uuid.uuid4().hex
-            (run_dir / RUN_ID_FILE).write_text(rid + "\n")
+            write_bytes(run_dir / RUN_ID_FILE, (rid + "\n").encode())
         yield rid
+    except BaseException as exc:
+        from stickslip.io import disk_full
+
+        if disk_full(exc) is not None:
+            _undo_on_full_disk(run_dir, before)
+        raise
     finally:
         # Unlinked while held, so a directory left behind is as it was (the check above
         # keeps a waiter from holding the unlinked file).
@@ -261,6 +276,38 @@ def owned_run_dir(run_dir: str | Path | None, *, run_id: bool = True) -> Iterato
             with contextlib.suppress(OSError):
                 path.unlink()
         lock.release()
+        _remove_if_empty(run_dir, created)
+
+
+def _remove_if_empty(run_dir: Path, created: bool) -> None:
+    """Remove ``run_dir`` again if this run created it and left nothing in it."""
+    if created:
+        with contextlib.suppress(OSError):
+            run_dir.rmdir()
+
+
+def _undo_on_full_disk(run_dir: Path, before: set[str]) -> None:
+    """Remove what a run that met a full disk added to ``run_dir``: new files, a new checkpoint
+    without its state file (with the new run id) and new empty folders. Kept: a checkpoint that
+    can be resumed (and its run id), and new folders with content (a sweep's points, each reused
+    only when its done.json is whole)."""
+    from stickslip.run.checkpoint import Checkpointer
+
+    resumable = (Checkpointer(run_dir).dir / "state.npz").is_file()
+    for path in run_dir.iterdir():
+        name = path.name
+        if name in before or name in LOCK_FILES:
+            continue
+        if name == RUN_ID_FILE and resumable:
+            continue
+        with contextlib.suppress(OSError):
+            if path.is_dir():
+                if name == "checkpoint" and not resumable:
+                    shutil.rmtree(path)
+                elif not any(path.iterdir()):
+                    path.rmdir()
+            else:
+                path.unlink()
 
 
 def _same_file(lock, path: Path) -> bool:
