@@ -88,7 +88,13 @@ def read_json(path: str | Path) -> Any:
 def write_dataset(path: str | Path, ds: xr.Dataset) -> Path:
     """Write labelled arrays to NetCDF4/HDF5 (h5netcdf engine), atomically: the file is built in
     memory, so HDF5 never writes to the disk itself (a full disk is then a plain OSError)."""
-    return write_bytes(path, bytes(ds.to_netcdf(engine="h5netcdf")))
+    import dask
+
+    # On a Dask worker xarray would take a cluster-wide lock named after the in-memory target,
+    # which the cluster does not know; the data are in memory, so no lock is needed.
+    with dask.config.set(scheduler="synchronous"):
+        data = bytes(ds.to_netcdf(engine="h5netcdf"))
+    return write_bytes(path, data)
 
 
 def read_dataset(path: str | Path) -> xr.Dataset:

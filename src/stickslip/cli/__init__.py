@@ -103,11 +103,15 @@ def _full_disk_line(exc: BaseException, args: argparse.Namespace) -> str | None:
     full = disk_full(exc)
     if full is None:
         return None
-    where = full.filename or getattr(args, "out", None) or getattr(args, "resume", None) or "."
-    return (
-        f"the disk is full: no space left to write {where}; free some space and run the same command "
-        "again (nothing half-written was kept)"
-    )
+    from pathlib import Path
+
+    run_dir = getattr(args, "resume", None) or getattr(args, "out", None)
+    where = full.filename or run_dir or "."
+    if args.command == "chain" and run_dir and (Path(run_dir) / "checkpoint" / "state.npz").is_file():
+        then = f"continue with: stickslip chain --resume {run_dir} (its last checkpoint is kept)"
+    else:
+        then = "run the same command again (nothing half-written was kept)"
+    return f"the disk is full: no space left to write {where}; free some space and {then}"
 
 
 if __name__ == "__main__":  # pragma: no cover
