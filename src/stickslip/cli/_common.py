@@ -50,9 +50,10 @@ def add_json_option(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--json", action="store_true", help="print one JSON document on stdout")
 
 
-def add_dask_options(parser: argparse.ArgumentParser, *, what: str = "") -> None:
-    """``--scheduler``, ``--workers`` and ``--no-progress`` of the commands that run on Dask
-    (sweep, study, reproduce); ``what`` says what runs there. Read back by :func:`dask_options`."""
+def add_dask_options(parser: argparse.ArgumentParser, *, what: str = "", dashboard: bool = True) -> None:
+    """``--scheduler``, ``--workers``, ``--no-progress`` and (with ``dashboard``) ``--dashboard`` of
+    the commands that run on Dask (sweep, study, reproduce); ``what`` says what runs there. Read
+    back by :func:`dask_options`. The local cluster listens on 127.0.0.1 only."""
     parser.add_argument(
         "--scheduler",
         default=None,
@@ -63,6 +64,13 @@ def add_dask_options(parser: argparse.ArgumentParser, *, what: str = "") -> None
         "--workers", default=None, metavar="N", help="worker processes of the local cluster (default: one per core)"
     )
     parser.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
+    if not dashboard:
+        return
+    parser.add_argument(
+        "--dashboard",
+        action="store_true",
+        help="serve the local cluster's dashboard on 127.0.0.1 and print its address (default: none)",
+    )
 
 
 def dask_options(args: argparse.Namespace) -> tuple[str | None, int | None]:
@@ -79,7 +87,25 @@ def dask_options(args: argparse.Namespace) -> tuple[str | None, int | None]:
         raise CommandError(f"--scheduler must be an address HOST:PORT, e.g. tcp://127.0.0.1:8786 (got {address!r})")
     if match is not None and not 1 <= int(match.group(2)) <= 65535:
         raise CommandError(f"--scheduler port must be in [1, 65535] (got {match.group(2)})")
+    if match is not None:
+        _check_reachable(address.strip())
     return address, workers
+
+
+def _check_reachable(address: str, timeout: float = 5.0) -> None:
+    """Refuse a TCP scheduler address nobody answers at, before anything is written (Dask itself
+    would wait 30 s, then fail after the command had made its folders)."""
+    import socket
+
+    scheme, _, rest = address.rpartition("://")
+    if scheme not in ("", "tcp"):
+        return  # tls, ucx, ...: left to Dask
+    host, _, port = rest.rpartition(":")
+    try:
+        with socket.create_connection((host, int(port)), timeout=timeout):
+            pass
+    except OSError as exc:
+        raise CommandError(f"--scheduler {address}: no scheduler answers there ({exc.strerror or exc})") from None
 
 
 @contextlib.contextmanager

@@ -66,7 +66,7 @@ def register(sub) -> None:
         metavar="DIR",
         help=f"output directory (default {DEFAULT_OUT}); stored results in it are reused",
     )
-    add_dask_options(p, what=" for the chain runs")
+    add_dask_options(p, what=" for the chain runs", dashboard=False)
     add_overwrite_option(p)
     add_json_option(p)
     p.set_defaults(handler=run)

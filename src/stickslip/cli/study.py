@@ -5,23 +5,29 @@
 NAME is ``transition`` (order parameter against beta and N), ``phase-diagram`` (final state over
 (alpha, beta) and (D, beta), two starts), ``exponents`` (slip-size exponent against beta, and
 Carlson-Langer) or ``chaos`` (largest Lyapunov exponent against beta, two blocks, Carlson-Langer).
-Every point is cached and reused; an interrupted study resumes; a failed point
-is reported and retried by the next call. See docs/studies/.
+Every point is cached and reused (only if its files are whole: a damaged point runs again); an
+interrupted study resumes; a failed point is reported and retried by the next call. DIR is owned
+as a chain's run directory is: no foreign files (``--overwrite`` removes this study's own files
+only), one writer at a time. See docs/studies/ and docs/limits.md.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
+from collections.abc import Iterator
+from pathlib import Path
 
 from stickslip.cli._common import (
     CommandError,
     Result,
     add_dask_options,
     add_json_option,
+    add_overwrite_option,
+    check_out_dir,
     dask_options,
     interrupted,
     is_disk_full,
-    prepare_out_dir,
     sigterm_as_interrupt,
 )
 
@@ -59,33 +65,79 @@ def register(sub) -> None:
     mode.add_argument("--tiny", dest="mode", action="store_const", const="tiny", help=argparse.SUPPRESS)
     p.set_defaults(mode="quick")
     p.add_argument("--out", default=DEFAULT_OUT, metavar="DIR", help=f"output directory (default {DEFAULT_OUT})")
+    add_overwrite_option(p)
     add_dask_options(p)
     add_json_option(p)
     p.set_defaults(handler=run)
 
 
 def run(args: argparse.Namespace) -> Result:
-    """Handler of ``stickslip study``."""
+    """Handler of ``stickslip study``: the output folder is checked and locked before the first
+    point starts (:func:`_claim`)."""
+    from stickslip.experiments.studies import study
     from stickslip.experiments.study_run import run_study
 
     _, workers = dask_options(args)
-    out = prepare_out_dir(args.out)
-    try:
-        with sigterm_as_interrupt():
-            result = run_study(
-                args.name, out, args.mode, scheduler=args.scheduler, n_workers=workers, progress=not args.no_progress
+    spec = study(args.name, args.mode)
+    with _claim(args.out, spec, overwrite=args.overwrite) as out:
+        try:
+            with sigterm_as_interrupt():
+                result = run_study(
+                    spec,
+                    out,
+                    scheduler=args.scheduler,
+                    n_workers=workers,
+                    progress=not args.no_progress,
+                    dashboard=args.dashboard,
+                )
+        except KeyboardInterrupt:
+            return interrupted(
+                "study", out, f"finished points in {out} are kept, chain runs continue from their checkpoints"
             )
-    except KeyboardInterrupt:
-        return interrupted(
-            "study", out, f"finished points in {out} are kept, chain runs continue from their checkpoints"
-        )
-    except OSError as exc:
-        if is_disk_full(exc):
-            raise
-        raise CommandError(f"cannot run the study: {exc}") from None
+        except OSError as exc:
+            if is_disk_full(exc):
+                raise
+            raise CommandError(f"cannot run the study: {exc}") from None
     data = {k: v for k, v in result.items() if k != "figures"}
     data["figures"] = [f["image"] for f in result["figures"]]
     return Result(data, _text(result), status=1 if result["failed"] else 0)
+
+
+@contextlib.contextmanager
+def _claim(path: str, spec, *, overwrite: bool) -> Iterator[Path]:
+    """Own the study's output folder as a chain run owns its directory: refuse it if it holds
+    files no study of this package wrote (:func:`~stickslip.experiments.study_run.foreign_files`;
+    with ``overwrite`` only those where this study writes: its page and runs folders), hold its
+    lock for the whole study (a second writer is refused at once, naming the holder) and, with
+    ``overwrite``, remove this study's own files first. Every output path is checked here,
+    before the first point starts."""
+    from stickslip.experiments.study_run import foreign_files, remove_study_files
+    from stickslip.run.rundir import RunDirBusy, owned_run_dir
+
+    out = check_out_dir(path)
+    foreign = foreign_files(out, spec)
+    if overwrite:  # other files may stay, but nothing of somebody else's where this study writes
+        mine = (f"{spec.name}/", f"runs/{spec.dirname}/")
+        foreign = [f for f in foreign if f.startswith(mine)]
+    if foreign:
+        shown = ", ".join(foreign[:3]) + (", ..." if len(foreign) > 3 else "")
+        hint = "" if overwrite else ", or --overwrite to replace this study's own files there"
+        raise CommandError(
+            f"--out {out} holds files that `stickslip study` did not write ({shown}); choose an empty directory{hint}"
+        )
+    try:
+        with owned_run_dir(out, run_id=False):
+            if foreign_files(out, spec) and not overwrite:  # put there while the lock was taken
+                raise CommandError(f"--out {out} changed while the study started; run it again")
+            if overwrite:
+                remove_study_files(out, spec)
+            yield out
+    except RunDirBusy as exc:
+        raise CommandError(str(exc)) from None
+    except OSError as exc:
+        if is_disk_full(exc) or out.is_dir():
+            raise
+        raise CommandError(f"cannot create output directory {out}: {exc.strerror}") from None
 
 
 def _text(result: dict) -> str:

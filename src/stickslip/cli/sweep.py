@@ -214,6 +214,7 @@ def run(args: argparse.Namespace) -> Result:
                     common=common,
                     scheduler=args.scheduler,
                     n_workers=workers,
+                    dashboard=args.dashboard,
                     progress=not args.no_progress,
                     stop_wait=STOP_WAIT_SECONDS if task is chain_task else 0.0,  # block points keep no checkpoint
                 )

@@ -110,12 +110,14 @@ def run_study(
     scheduler: str | None = None,
     n_workers: int | None = None,
     progress: bool = True,
+    dashboard: bool = False,
 ) -> dict[str, Any]:
     """Run (or reuse) every point of a study and write its table, figures and page under ``out_dir``.
 
     ``spec`` is a :class:`Study` or a study name (then ``mode`` picks its spec set). Points run
     on a local Dask cluster of ``n_workers`` processes or on the cluster at ``scheduler``.
-    Progress goes to stderr when ``progress`` and stderr is a terminal. Returns the table as
+    Progress goes to stderr when ``progress`` and stderr is a terminal; ``dashboard`` serves the
+    local cluster's dashboard on 127.0.0.1 (its address on stderr). Returns the table as
     records, the conclusions, failed points with their errors, paths and times.
     """
     from stickslip.experiments.sweep import STOP_WAIT_SECONDS, _on_terminal, run_sweep
@@ -146,16 +148,20 @@ def run_study(
         n_workers=n_workers,
         progress=show,
         stop_wait=STOP_WAIT_SECONDS,
+        dashboard=dashboard,
     )
     table = _study_table(spec, result.table)
     failed = table[table["status"] != "ok"]
     page_dir.mkdir(parents=True, exist_ok=True)
+    record_outputs(out, [page_dir / name for name in PAGE_FILES])
     io.write_table_files(page_dir / "table", table)
     ok = table[table["status"] == "ok"]
     from stickslip.experiments import study_findings
 
     findings = study_findings.conclusions(spec, ok)
     figures = study_findings.draw(spec, ok, page_dir)
+    # the page folder held only the manifest's files when the study began (foreign_files)
+    record_outputs(out, [p for p in page_dir.iterdir() if p.is_file() and not p.name.startswith(".")])
     wall = time.perf_counter() - t0
     meta = {
         "study": spec.name,
@@ -286,3 +292,105 @@ def _write_page(
         parts.append(f"<tr{cls}>" + "".join(f"<td>{_cell(r.get(c))}</td>" for c in cols) + "</tr>")
     parts.append("</tbody></table></body></html>\n")
     io.write_bytes(path, "\n".join(parts).encode("utf-8"))
+
+
+# ---------------------------------------------------------------------------------------------
+# The study's folder: what it owns
+
+#: The record, at the top of a study's output folder, of every page file its studies wrote.
+MANIFEST = ".stickslip-study.json"
+#: The files of a study's page besides its figures.
+PAGE_FILES = ("table.parquet", "table.csv", "study.json", "index.html")
+#: What a study's runs folder (runs/<name>-<key>/) holds besides its points folder.
+RUNS_FILES = frozenset({"study-spec.json", "points"})
+
+
+def read_manifest(out: Path) -> set[str]:
+    """The paths (relative to ``out``, with ``/``) that studies recorded as written there."""
+    try:
+        data = io.read_json(Path(out) / MANIFEST)
+        return {str(p) for p in data["files"]}
+    except (OSError, ValueError, KeyError, TypeError):
+        return set()
+
+
+def record_outputs(out: Path, paths: list[Path]) -> None:
+    """Add ``paths`` (under ``out``) to the manifest, before they are written: a file at an output
+    path not in the manifest is somebody else's and is never written over."""
+    out = Path(out)
+    files = read_manifest(out) | {p.relative_to(out).as_posix() for p in paths}
+    io.write_json(out / MANIFEST, {"files": sorted(files)})
+
+
+def foreign_files(out: str | Path, spec: Study) -> list[str]:
+    """The entries of the output folder ``out`` that no study of this package wrote (relative
+    paths): at its top anything but the runs folder, the study pages and the manifest; in a page
+    folder anything not in the manifest; in the runs folder anything but the folders of studies
+    (``<name>-<key>``) holding their spec, their points (each with its point.json) and the sweep's
+    summary. ``spec`` is the study about to run (its page names are checked even before the page
+    folder exists)."""
+    from stickslip.experiments.studies import STUDIES
+    from stickslip.experiments.sweep import POINT_FILE, STOP_FILE, SUMMARY_NAME
+    from stickslip.run.rundir import LOCK_FILES, is_temporary
+
+    out = Path(out)
+    if not out.is_dir():
+        return []
+    own = read_manifest(out)
+    foreign: list[str] = []
+
+    def walk(folder: Path, test) -> None:
+        for path in sorted(folder.iterdir()):
+            rel = path.relative_to(out).as_posix()
+            if is_temporary(path.name):
+                continue
+            sub = test(path, rel)
+            if sub is False:
+                foreign.append(rel)
+            elif callable(sub):
+                walk(path, sub)
+
+    def page(path: Path, rel: str):
+        return rel in own and path.is_file()
+
+    def points(path: Path, rel: str):
+        summary = {f"{SUMMARY_NAME}.parquet", f"{SUMMARY_NAME}.csv", STOP_FILE}
+        return (path.is_file() and path.name in summary) or (path / POINT_FILE).is_file()
+
+    def study_runs(path: Path, rel: str):
+        if path.name == "points" and path.is_dir():
+            return points
+        return path.name == "study-spec.json" and path.is_file()
+
+    def runs(path: Path, rel: str):
+        ok = path.is_dir() and any(path.name.startswith(f"{name}-") for name in STUDIES)
+        return study_runs if ok else False
+
+    def top(path: Path, rel: str):
+        if path.name in LOCK_FILES or (path.name == MANIFEST and path.is_file()):
+            return True
+        if path.name == "runs" and path.is_dir():
+            return runs
+        if path.name in STUDIES and path.is_dir():
+            return page
+        return False
+
+    walk(out, top)
+    return foreign
+
+
+def remove_study_files(out: str | Path, spec: Study) -> None:
+    """``--overwrite``: remove what this study wrote under ``out`` (its page files and its runs
+    folder); every other file stays."""
+    import shutil
+
+    out = Path(out)
+    own = read_manifest(out)
+    page_dir = out / spec.name
+    for rel in sorted(own):
+        path = out / rel
+        if path.parent == page_dir and path.is_file():
+            path.unlink()
+    shutil.rmtree(out / "runs" / spec.dirname, ignore_errors=True)
+    if own:
+        io.write_json(out / MANIFEST, {"files": sorted(p for p in own if (out / p).exists())})

@@ -292,6 +292,7 @@ def run_sweep(
     n_workers: int | None = None,
     progress: bool = True,
     stop_wait: float = 0.0,
+    dashboard: bool = False,
 ) -> SweepResult:
     """Run ``task`` at every point of a parameter grid, each point an independent Dask task.
 
@@ -305,6 +306,8 @@ def run_sweep(
     ``summary.csv`` in ``out_dir``: one row per point with its parameters, the fixed settings of
     ``common``, ``status``
     ("ok"/"failed"), ``reused``, ``error``, ``wall_seconds`` and the task's summary fields.
+    The local cluster listens on 127.0.0.1 only and serves no dashboard unless ``dashboard``
+    (then on 127.0.0.1, its address printed on stderr).
     Interrupted (KeyboardInterrupt), it waits up to ``stop_wait`` seconds for the running points
     to stop on request (:func:`stop_requested`) before it closes the cluster and re-raises.
     """
@@ -341,6 +344,7 @@ def run_sweep(
             n_workers=n_workers,
             progress=progress,
             stop_wait=stop_wait,
+            dashboard=dashboard,
         )
 
     rows = [_row(p, n, r, u, common) for p, n, r, u in zip(points, names, records, reused, strict=False)]  # type: ignore[arg-type]
@@ -358,7 +362,9 @@ def run_sweep(
     )
 
 
-def _compute(task, points, common, out, names, specs, pending, records, *, scheduler, n_workers, progress, stop_wait):
+def _compute(
+    task, points, common, out, names, specs, pending, records, *, scheduler, n_workers, progress, stop_wait, dashboard
+):
     """Submit the pending points and collect their records as they finish (fills ``records``).
 
     On KeyboardInterrupt the running points are asked to stop and waited for, at most
@@ -376,10 +382,15 @@ def _compute(task, points, common, out, names, specs, pending, records, *, sched
             n_workers=min(workers, len(pending)),
             threads_per_worker=1,
             processes=True,
-            dashboard_address=":0",  # any free port: never clash with another cluster
+            host="127.0.0.1",  # scheduler and workers: nothing listens beyond this machine
+            # any free port (never clash with another cluster), on the loopback, only when asked
+            dashboard_address="127.0.0.1:0" if dashboard else None,
             silence_logs=logging.CRITICAL,  # failures are in error.json; keep worker heartbeats off a Ctrl-C
         )
         client = Client(cluster)
+        if dashboard:
+            sys.stderr.write(f"dashboard: {cluster.dashboard_link}\n")
+            sys.stderr.flush()
     else:
         client = Client(scheduler)
     bar = _progress_bar(len(points), len(points) - len(pending), progress)
