@@ -145,6 +145,8 @@ def _text(result: dict) -> str:
         f"stickslip study {result['study']} --{result['mode']}: {result['points']} points "
         f"({result['run']} run, {result['reused']} reused, {result['failed']} failed), {result['wall_seconds']} s"
     ]
+    if result.get("damaged"):
+        lines.append(f"  {result['damaged']} cached points ran again: their files were damaged (see the page)")
     lines += [f"  {s}" for s in result["findings"].get("statements", [])]
     for f in result["failed_points"]:
         lines.append(f"  failed: {f['point']}: {f['error']}")

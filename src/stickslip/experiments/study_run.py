@@ -173,6 +173,7 @@ def run_study(
         "points": len(table),
         "run": result.n_run,
         "reused": result.n_reused,
+        "damaged": result.n_damaged,
         "failed": int(len(failed)),
         "wall_seconds": round(wall, 1),
         "compute_seconds": round(float(np.nansum(table["wall_seconds"].to_numpy(dtype=float))), 1),
@@ -264,8 +265,15 @@ def _write_page(
         f"<p>{meta['points']} points: {meta['run']} run now, {meta['reused']} reused, {meta['failed']} failed; "
         f"{meta['wall_seconds']} s wall, {meta['compute_seconds']} s of point runs; stickslip {__version__}; "
         f"runs in <code>{html.escape(meta['runs'])}</code>.</p>",
-        "<h2>What the data say</h2><ul>",
     ]
+    if "note" in table.columns and table["note"].notna().any():
+        notes = [f"{r.point_dir}: {r.note}" for r in table.itertuples() if isinstance(r.note, str)]
+        parts.append(
+            f"<p>{len(notes)} cached points ran again because their files were damaged:</p><ul>"
+            + "".join(f"<li>{html.escape(n)}</li>" for n in notes)
+            + "</ul>"
+        )
+    parts.append("<h2>What the data say</h2><ul>")
     for line in findings.get("statements", []):
         parts.append(f"<li>{html.escape(line)}</li>")
     parts.append("</ul><h2>Figures</h2>")

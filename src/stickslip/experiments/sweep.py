@@ -42,7 +42,9 @@ import numpy as np
 import pandas as pd
 
 from stickslip import __version__
-from stickslip.io import disk_full, read_json, run_metadata, write_dataset, write_json, write_table, write_table_files
+from stickslip.experiments.point_cache import read_done as _read_done
+from stickslip.experiments.point_cache import spec_before as _spec_before
+from stickslip.io import disk_full, run_metadata, write_dataset, write_json, write_table, write_table_files
 from stickslip.jsonable import to_jsonable
 from stickslip.models.params import BlockParams, ChainParams
 from stickslip.run.errors import ShortRunWarning, short_runs_expected
@@ -90,7 +92,7 @@ CHAIN_RUN_OPTIONS = (
 BLOCK_RUN_OPTIONS = ("t_end", "every")
 
 # Columns of the summary table that are not parameters or task results.
-_STATUS_COLUMNS = ("point_dir", "status", "reused", "error", "wall_seconds")
+_STATUS_COLUMNS = ("point_dir", "status", "reused", "error", "wall_seconds", "note")
 
 Task = Callable[[dict[str, Any], Path], dict[str, Any]]
 
@@ -137,33 +139,12 @@ def _spec(task: Task, point: dict[str, Any], common: dict[str, Any]) -> dict[str
     return _jsonable({"task": _task_name(task), "point": point, "common": common, "version": __version__})
 
 
-def _read_done(point_dir: Path, spec: dict[str, Any]) -> dict[str, Any] | None:
-    """The stored record of a finished point with this spec, or None."""
-    path = point_dir / DONE_FILE
-    if not path.is_file():
-        return None
-    try:
-        record = read_json(path)
-    except (OSError, ValueError):
-        return None
-    return record if record.get("spec") == spec else None
-
-
 def stop_requested(point_dir: str | Path) -> Callable[[], bool]:
     """Whether the sweep that runs the point in ``point_dir`` was interrupted (its
     :data:`STOP_FILE` exists): a task passes this to the chain driver
     (:func:`stickslip.run.driver.continue_or_run`), which then checkpoints and stops."""
     flag = Path(point_dir).parent / STOP_FILE
     return flag.exists
-
-
-def _spec_before(point_dir: Path) -> dict[str, Any] | None:
-    """The spec in the point's point.json (that of the sweep that last ran it), or None."""
-    try:
-        record = read_json(point_dir / POINT_FILE)
-    except (OSError, ValueError):
-        return None
-    return record.get("spec") if isinstance(record, dict) else None
 
 
 def _run_point(
@@ -205,12 +186,15 @@ def _run_point(
         }
         write_json(directory / ERROR_FILE, record)
         return record
+    from stickslip.experiments.point_cache import file_digests
+
     record = {
         "spec": spec,
         "status": "ok",
         "error": None,
         "wall_seconds": time.perf_counter() - start,
         "summary": _jsonable(summary),
+        "files": file_digests(directory),  # a later sweep reuses the point only if these match
     }
     write_json(directory / DONE_FILE, record)
     return record
@@ -229,6 +213,8 @@ def _row(
         error=record.get("error"),
         wall_seconds=record.get("wall_seconds", math.nan),
     )
+    if record.get("note"):
+        row["note"] = record["note"]
     for key, value in (record.get("summary") or {}).items():
         # a result named like a parameter or a status column keeps both, prefixed
         row[f"result_{key}" if key in row else key] = value
@@ -270,6 +256,7 @@ class SweepResult:
     n_reused: int
     n_failed: int
     wall_seconds: float
+    n_damaged: int = 0  # cached points run again because their files were damaged
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-able form (the table as a list of records)."""
@@ -300,12 +287,13 @@ def run_sweep(
     (:func:`point_name`). ``common`` holds settings shared by every point (fixed parameters,
     run length); the task receives ``{**common, **point}``. A point whose directory holds a
     ``done.json`` for the same task, point, common settings and package version is not run
-    again. Points run on a new local cluster (``n_workers`` processes, default one per core,
-    one thread each) or, with ``scheduler`` = address, on an existing cluster. Progress
-    (points done / total, time left) goes to stderr. Writes ``summary.parquet`` and
-    ``summary.csv`` in ``out_dir``: one row per point with its parameters, the fixed settings of
-    ``common``, ``status``
-    ("ok"/"failed"), ``reused``, ``error``, ``wall_seconds`` and the task's summary fields.
+    again, unless its files are damaged (:mod:`stickslip.experiments.point_cache`: then it runs
+    again and its row's ``note`` says why). Points run on a new local cluster (``n_workers``
+    processes, default one per core, one thread each) or, with ``scheduler`` = address, on an
+    existing cluster. Progress (points done / total, time left) goes to stderr. Writes
+    ``summary.parquet`` and ``summary.csv`` in ``out_dir``: one row per point with its
+    parameters, the fixed settings of ``common``, ``status`` ("ok"/"failed"), ``reused``,
+    ``error``, ``wall_seconds`` and the task's summary fields.
     The local cluster listens on 127.0.0.1 only and serves no dashboard unless ``dashboard``
     (then on 127.0.0.1, its address printed on stderr).
     Interrupted (KeyboardInterrupt), it waits up to ``stop_wait`` seconds for the running points
@@ -326,7 +314,9 @@ def run_sweep(
     if task is chain_task:
         _warn_short_chain_runs(points, common, names)
     specs = [_spec(task, p, common) for p in points]
-    records: list[dict[str, Any] | None] = [_read_done(out / n, s) for n, s in zip(names, specs, strict=False)]
+    found = [_read_done(out / n, s) for n, s in zip(names, specs, strict=False)]
+    records: list[dict[str, Any] | None] = [r for r, _ in found]
+    damaged = {k: why for k, (_, why) in enumerate(found) if why}
     reused = [r is not None for r in records]
     pending = [k for k, r in enumerate(records) if r is None]
 
@@ -347,6 +337,8 @@ def run_sweep(
             dashboard=dashboard,
         )
 
+    for k, why in damaged.items():  # the table says why a cached point ran again
+        records[k] = {**(records[k] or {"status": "failed"}), "note": f"cached result damaged ({why}): run again"}
     rows = [_row(p, n, r, u, common) for p, n, r, u in zip(points, names, records, reused, strict=False)]  # type: ignore[arg-type]
     table = _table(rows, points + [common])
     write_table_files(out / SUMMARY_NAME, table)
@@ -359,6 +351,7 @@ def run_sweep(
         n_reused=sum(reused),
         n_failed=n_failed,
         wall_seconds=time.perf_counter() - start,
+        n_damaged=len(damaged),
     )
 
 
