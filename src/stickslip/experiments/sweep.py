@@ -143,8 +143,10 @@ def stop_requested(point_dir: str | Path) -> Callable[[], bool]:
     """Whether the sweep that runs the point in ``point_dir`` was interrupted (its
     :data:`STOP_FILE` exists): a task passes this to the chain driver
     (:func:`stickslip.run.driver.continue_or_run`), which then checkpoints and stops."""
+    from stickslip.experiments.worker_signals import signalled
+
     flag = Path(point_dir).parent / STOP_FILE
-    return flag.exists
+    return lambda: flag.exists() or signalled()  # or its worker got SIGINT/SIGTERM
 
 
 def _run_point(
@@ -381,6 +383,9 @@ def _compute(
             silence_logs=logging.CRITICAL,  # failures are in error.json; keep worker heartbeats off a Ctrl-C
         )
         client = Client(cluster)
+        from stickslip.experiments.worker_signals import StopOnSignal
+
+        client.register_plugin(StopOnSignal())  # a signal to the process group stops the points cleanly
         if dashboard:
             sys.stderr.write(f"dashboard: {cluster.dashboard_link}\n")
             sys.stderr.flush()
