@@ -38,7 +38,7 @@ def register(sub) -> None:
 def run_plot_command(args: argparse.Namespace) -> Result:
     """Handler of `stickslip plot`."""
     from stickslip.plotting.run import draw_run_figures
-    from stickslip.run.rundir import load_run
+    from stickslip.run.rundir import RunDirDamaged, load_run
 
     run_dir = Path(args.run_dir)
     if not (run_dir / "run.json").is_file() or not (run_dir / "state.nc").is_file():
@@ -50,7 +50,10 @@ def run_plot_command(args: argparse.Namespace) -> Result:
             "their own (default RUN_DIR/figures)"
         )
     formats = tuple(dict.fromkeys(args.format or ("png", "pdf")))
-    run = load_run(run_dir)
+    try:
+        run = load_run(run_dir)
+    except RunDirDamaged as exc:
+        raise CommandError(f"cannot plot {run_dir}: {exc}") from None
     with owned_out_dir(out, _FIGURE.fullmatch, "stickslip plot", overwrite=args.overwrite) as out:
         records = draw_run_figures(run, out, formats=formats)
     lines = []

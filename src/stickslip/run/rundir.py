@@ -143,13 +143,40 @@ def write_run(run: ChainRun, out_dir: str | Path) -> Path:
     return out
 
 
+class RunDirDamaged(ValueError):
+    """A file of a run directory is missing, truncated or not what :func:`write_run` writes."""
+
+
+def _read(path: Path, reader):
+    """``reader(path)``, any failure of it a :class:`RunDirDamaged` naming the file."""
+    try:
+        return reader(path)
+    except FileNotFoundError:
+        raise RunDirDamaged(f"{path} is missing") from None
+    except Exception as exc:  # truncated, overwritten, another format: all the same to a reader
+        why = str(exc).strip().splitlines()[0][:120] if str(exc).strip() else type(exc).__name__
+        raise RunDirDamaged(f"{path} is damaged or not a file of this package ({why})") from None
+
+
 def load_run(run_dir: str | Path) -> ChainRun:
-    """Read a run directory written by :func:`write_run` back into a :class:`ChainRun`."""
+    """Read a run directory written by :func:`write_run` back into a :class:`ChainRun`; a
+    missing or damaged file raises :class:`RunDirDamaged` naming it."""
+    run_dir = Path(run_dir)
+    try:
+        return _load_run(run_dir)
+    except RunDirDamaged:
+        raise
+    except (KeyError, TypeError, ValueError, IndexError, AttributeError) as exc:
+        raise RunDirDamaged(
+            f"{run_dir} does not hold a whole chain run ({type(exc).__name__}: {str(exc)[:80]})"
+        ) from None
+
+
+def _load_run(run_dir: Path) -> ChainRun:
     from stickslip import io
 
-    run_dir = Path(run_dir)
-    meta = io.read_json(run_dir / "run.json")
-    ds = io.read_dataset(run_dir / "state.nc")
+    meta = _read(run_dir / "run.json", io.read_json)
+    ds = _read(run_dir / "state.nc", io.read_dataset)
     params = ChainParams(**meta["params"])
     state = ChainState.from_blocks(
         ds["x"].values, ds["v"].values, ds["theta"].values, ds["stopped"].values.astype(bool)
@@ -175,8 +202,8 @@ def load_run(run_dir: str | Path) -> ChainRun:
         meta["integrator"],
         meta["start"],
         state,
-        io.read_table(run_dir / "events.parquet"),
-        io.read_table(run_dir / "first_move.parquet"),
+        _read(run_dir / "events.parquet", io.read_table),
+        _read(run_dir / "first_move.parquet", io.read_table),
         samples,
         snapshots,
         profiles,
