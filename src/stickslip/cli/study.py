@@ -111,7 +111,7 @@ def _claim(path: str, spec, *, overwrite: bool) -> Iterator[Path]:
     lock for the whole study (a second writer is refused at once, naming the holder) and, with
     ``overwrite``, remove this study's own files first. Every output path is checked here,
     before the first point starts."""
-    from stickslip.experiments.study_run import foreign_files, remove_study_files
+    from stickslip.experiments.study_run import MANIFEST, foreign_files, remove_study_files
     from stickslip.run.rundir import RunDirBusy, owned_run_dir
 
     out = check_out_dir(path)
@@ -126,7 +126,7 @@ def _claim(path: str, spec, *, overwrite: bool) -> Iterator[Path]:
             f"--out {out} holds files that `stickslip study` did not write ({shown}); choose an empty directory{hint}"
         )
     try:
-        with owned_run_dir(out, run_id=False):
+        with owned_run_dir(out, run_id=False, keep={MANIFEST}):  # it names the page files kept
             if foreign_files(out, spec) and not overwrite:  # put there while the lock was taken
                 raise CommandError(f"--out {out} changed while the study started; run it again")
             if overwrite:

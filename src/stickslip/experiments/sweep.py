@@ -378,8 +378,10 @@ def _compute(
             threads_per_worker=1,
             processes=True,
             host="127.0.0.1",  # scheduler and workers: nothing listens beyond this machine
-            # any free port (never clash with another cluster), on the loopback, only when asked
-            dashboard_address="127.0.0.1:0" if dashboard else None,
+            # its web server on any free port (never clash with another cluster), on the loopback;
+            # the dashboard's pages only when asked
+            dashboard_address="127.0.0.1:0",
+            scheduler_kwargs={"dashboard": dashboard},
             silence_logs=logging.CRITICAL,  # failures are in error.json; keep worker heartbeats off a Ctrl-C
         )
         client = Client(cluster)

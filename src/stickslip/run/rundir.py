@@ -17,7 +17,7 @@ import shutil
 import socket
 import time
 import uuid
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Collection, Iterator
 from pathlib import Path
 
 import numpy as np
@@ -239,13 +239,15 @@ def read_run_id(run_dir: str | Path) -> str | None:
 
 
 @contextlib.contextmanager
-def owned_run_dir(run_dir: str | Path | None, *, run_id: bool = True, new_id: bool = True) -> Iterator[str | None]:
+def owned_run_dir(
+    run_dir: str | Path | None, *, run_id: bool = True, new_id: bool = True, keep: Collection[str] = ()
+) -> Iterator[str | None]:
     """Hold the lock of ``run_dir`` for the life of a run and yield its run id (a new one for a
     directory without, unless ``new_id`` is false; None with ``run_id=False``, for outputs without
     checkpoints). A second holder is refused at once with :class:`RunDirBusy`; files left by a
     killed write are removed. On a full disk (:func:`stickslip.io.disk_full`) what the block
-    added is removed again (:func:`_undo_on_full_disk`): the directory is left as it was, or
-    with a resumable checkpoint."""
+    added is removed again (:func:`_undo_on_full_disk`; the names in ``keep`` stay): the
+    directory is left as it was, or with a resumable checkpoint."""
     if run_dir is None:
         yield None
         return
@@ -294,7 +296,7 @@ def owned_run_dir(run_dir: str | Path | None, *, run_id: bool = True, new_id: bo
         from stickslip.io import disk_full
 
         if disk_full(exc) is not None:
-            _undo_on_full_disk(run_dir, before)
+            _undo_on_full_disk(run_dir, before | set(keep))
         raise
     finally:
         # Unlinked while held, so a directory left behind is as it was (the check above
