@@ -87,6 +87,21 @@ BAD = [
     ("hysteresis --time-per-step 10 --overwrite", "--overwrite"),
     ("chain --keep-checkpoint --t-end 10", "--keep-checkpoint"),
     ("models --bogus", "--bogus"),
+    ("chain --t-end 0", "t-end"),
+    ("chain --t-end 0 --out o", "t-end"),
+    ("block --t-end 0", "t_end"),
+    ("chain --resume ''", "--resume"),
+    ("chain --resume nope", "no such run directory"),
+    ("chain --resume afile", "no such run directory"),
+    ("lyapunov --direction-seed -1", "direction-seed"),
+    ("lyapunov --seed 3", "--seed"),
+    ("lyapunov --betas ''", "betas"),
+    ("lyapunov --betas , --plot p.png", "betas"),
+    ("sweep block --t-end 10 --out o --scheduler 127.0.0.1:65536", "port"),
+    ("sweep block --t-end 10 --out o --scheduler tcp://127.0.0.1:1", "no scheduler answers"),
+    ("study chaos --tiny --out o --scheduler tcp://127.0.0.1:1", "no scheduler answers"),
+    ("study chaos --tiny --out foreign", "notes.txt"),
+    ("reproduce --smoke --out o --scheduler 127.0.0.1:99999", "port"),
     ("lyapunov --N 0", "N"),
     ("reproduce --bogus", "--bogus"),
     ("--bogus", "--bogus"),
@@ -450,3 +465,54 @@ def test_start_removes_files_of_a_killed_write(tmp_path):
     (out / ".state.nc.k1ll3d.tmp").write_bytes(b"half a netCDF file")
     assert main(["chain", "--N", "3", "--t-end", "10", "--out", str(out), "--no-progress"]) == 0
     assert not list(out.glob(".*.tmp")) and (out / "state.nc").is_file()
+
+
+# A damaged run directory given to `plot`: one line naming the file, exit 2, nothing written.
+
+
+def _damage_truncate(name):
+    def damage(run):
+        data = (run / name).read_bytes()
+        (run / name).write_bytes(data[: len(data) // 3])
+
+    return damage
+
+
+def _damage_garbage(name):
+    return lambda run: (run / name).write_bytes(b"not what stickslip writes\n" * 40)
+
+
+PLOT_DAMAGE = [
+    ("state.nc truncated", _damage_truncate("state.nc"), "state.nc"),
+    ("state.nc garbage", _damage_garbage("state.nc"), "state.nc"),
+    ("events.parquet truncated", _damage_truncate("events.parquet"), "events.parquet"),
+    ("events.parquet missing", lambda run: (run / "events.parquet").unlink(), "events.parquet"),
+    ("first_move.parquet garbage", _damage_garbage("first_move.parquet"), "first_move.parquet"),
+    ("run.json truncated", _damage_truncate("run.json"), "run.json"),
+    ("run.json without its summary", lambda run: (run / "run.json").write_text('{"params": {}}'), "whole chain run"),
+]
+
+
+@pytest.mark.parametrize("what, damage, named", PLOT_DAMAGE, ids=[d[0] for d in PLOT_DAMAGE])
+def test_plot_of_a_damaged_run_is_one_line(what, damage, named, small_run, tmp_path, capsys):
+    import shutil
+
+    run = tmp_path / "run"
+    shutil.copytree(small_run, run)
+    shutil.rmtree(run / "figures", ignore_errors=True)
+    damage(run)
+    before = _tree(tmp_path)
+    capsys.readouterr()
+    assert main(["plot", str(run)]) == 2
+    stdout, err = capsys.readouterr()
+    assert stdout == "" and err.count("\n") == 1 and "Traceback" not in err and named in err, err
+    assert _tree(tmp_path) == before
+
+
+def test_resume_of_a_missing_directory_creates_nothing(tmp_path, capsys):
+    assert main(["chain", "--resume", str(tmp_path / "nope"), "--no-progress"]) == 2
+    assert not (tmp_path / "nope").exists()
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    assert main(["chain", "--resume", str(empty), "--no-progress"]) == 2
+    assert list(empty.iterdir()) == [], "no .run_id left in a directory that holds no run"
