@@ -89,7 +89,7 @@ def test_block_out_writes_run_and_figures(capsys, tmp_path):
         (["block", "--V", "nan"], "V", ">= 0"),
         (["block", "--beta", "inf"], "beta", ">= 0"),
         (["block", "--Fs", "0"], "Fs", "> 0"),
-        (["block", "--t-end", "-1"], "t_end", ">= 0"),
+        (["block", "--t-end", "-1"], "t_end", "> 0"),
         (["block", "--every", "0"], "every", ">= 1"),
         (["block", "--fig3"], "--fig3", "--out"),
         (["slip-limit", "--Fs", "0.5"], "Fs", "> sigma"),
