@@ -31,6 +31,7 @@ def build_parser() -> argparse.ArgumentParser:
     from stickslip.cli import (
         block,
         chain,
+        compile,
         lyapunov,
         models,
         plot,
@@ -49,7 +50,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"stickslip {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
-    for module in (block, stability, chain, models, sweep, reproduce, study, lyapunov, plot):
+    for module in (block, stability, chain, models, sweep, reproduce, study, lyapunov, plot, compile):
         module.register(sub)
     return parser
 

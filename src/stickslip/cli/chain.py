@@ -143,7 +143,9 @@ def _add_run_options(p: argparse.ArgumentParser) -> None:
         type=float_arg("t-end"),
         default=None,
         metavar="T",
-        help="end time (default 2e4; the paper's runs use 2e7)",
+        help="end time; without it a first look: a chain loaded from one end from x_i = 0 gets "
+        "N = 49 (unless --N) and runs for four loading times L_ss / V, rounded up (5e5 for N = 49), other "
+        "chains to 2e4. The paper's runs: --t-end 2e7 (N = 399, the preset's)",
     )
     p.add_argument(
         "--start",
@@ -280,8 +282,8 @@ def run_chain_command(args: argparse.Namespace) -> Result:
         )
 
     params = chain_params_from_args(args)
-    t_end = 2e4 if args.t_end is None else args.t_end
     start, amplitude, seed = _start_of(params, args)
+    params, t_end = _first_look(params, args, start) if args.t_end is None else (params, args.t_end)
     args.start, args.perturbation, args.seed = start, amplitude, seed
     for name, default in (
         ("integrator", "exact"),
@@ -353,7 +355,25 @@ def run_chain_command(args: argparse.Namespace) -> Result:
         return Result({"error": str(exc)}, "", status=1)
     except chain.Interrupted as exc:
         return _interrupted(exc, out)
-    return Result(_json_summary(run.summary, out), _summary_text(run.summary, out, params.N))
+    text = _summary_text(run.summary, out, params.N)
+    if args.t_end is None:
+        text = f"N              {params.N}  (without --t-end a first look; the paper's run is --t-end 2e7)\n" + text
+    return Result(_json_summary(run.summary, out), text)
+
+
+def _first_look(params, args, start: str):
+    """Without ``--t-end``, a first look that shows the stick-slip state within seconds: a chain
+    loaded from one end from x_i = 0 gets N = 49 blocks (unless ``--N`` is given) and runs for a
+    few of its loading times (:func:`stickslip.models.physics.first_look_t_end`); other chains
+    run to t = 2e4. The paper's run (N = 399 to t = 2e7) is ``--t-end 2e7``."""
+    from stickslip.models import physics
+
+    if start in ("paper", "rest") and params.drive == "end":
+        looked = params if args.param_N is not None else chain_params_from_args(args, N=physics.FIRST_LOOK_N)
+        t_end = physics.first_look_t_end(looked)
+        if t_end == t_end:
+            return looked, t_end
+    return params, 2e4
 
 
 def _start_of(params, args) -> tuple[str, float, int]:
