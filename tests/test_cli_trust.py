@@ -30,7 +30,7 @@ BAD = [
     ("chain --ends periodic", "periodic"),
     ("chain --model train --threshold state", "threshold"),
     ("chain --model nosuch", "--model"),
-    ("chain --model carlson-langer --amplitude -1", "amplitude"),
+    ("chain --model carlson-langer --perturbation -1", "perturbation"),
     ("block --model carlson-langer", "--model"),
     ("bench --model carlson-langer --l 0", "l"),
     ("lyapunov --model two-blocks --d0 1", "d0"),

@@ -160,15 +160,11 @@ def _add_run_options(p: argparse.ArgumentParser) -> None:
         type=float_arg("perturbation"),
         default=None,
         metavar="A",
-        help="with --start steady: uniform perturbation of x and v in [-A, A] (default 0)",
+        help="size A of the start's perturbation: with --start steady uniform in [-A, A] on x and v (default 0); "
+        "with --start rest x_i = -A u_i, u_i uniform in [0, 1) (default the model's, 0.01 for CL)",
     )
-    p.add_argument(
-        "--amplitude",
-        type=float_arg("amplitude"),
-        default=None,
-        metavar="A",
-        help="with --start rest: x_i = -A u_i, u_i uniform in [0, 1) (default the model's, 0.01 for CL)",
-    )
+    # The former name of --perturbation with --start rest; kept so that old scripts run.
+    p.add_argument("--amplitude", dest="perturbation", type=float_arg("perturbation"), help=argparse.SUPPRESS)
     p.add_argument(
         "--seed", type=int_arg("seed", ">= 0"), default=None, help="seed of the perturbation or of u_i (default 0)"
     )
@@ -382,15 +378,13 @@ def _start_of(params, args) -> tuple[str, float, int]:
 
     preset = PRESETS[params.model]
     start = args.start or preset.start
-    if args.amplitude is not None and start != "rest":
-        raise CommandError("--amplitude goes with --start rest (use --perturbation with --start steady)")
-    if args.perturbation is not None and start != "steady":
-        raise CommandError("--perturbation goes with --start steady (use --amplitude with --start rest)")
+    if args.perturbation is not None and start == "paper":
+        raise CommandError("--perturbation goes with --start steady or --start rest (the paper's start has none)")
     if args.seed is not None and start == "paper":
         raise CommandError("--seed goes with --start steady or --start rest (the paper's start draws no numbers)")
     if start == "rest":
-        amplitude = args.amplitude if args.amplitude is not None else preset.start_options.get("amplitude", 0.0)
-        check_number("amplitude", amplitude, low=0.0)
+        amplitude = args.perturbation if args.perturbation is not None else preset.start_options.get("amplitude", 0.0)
+        check_number("perturbation", amplitude, low=0.0)
     else:
         amplitude = args.perturbation if args.perturbation is not None else 0.0
     seed = args.seed if args.seed is not None else preset.start_options.get("seed", 0)
@@ -418,7 +412,6 @@ def run_bench_command(args: argparse.Namespace) -> Result:
     check_number("t-end", t_end, low=0.0, low_open=True)
     steps_for(t_end, params.dt, "t-end")
     args.perturbation = getattr(args, "perturbation", None)
-    args.amplitude = None
     args.seed = None
     start, amplitude, seed = _start_of(params, args)
     if args.profile:

@@ -38,7 +38,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from stickslip import io
+from stickslip import heartbeat, io
 from stickslip.analysis.chain_runs import chain_analysis, final_state
 from stickslip.experiments.specs import (
     UNTIL_STEADY,
@@ -85,6 +85,7 @@ class _Log:
     t0: float = field(default_factory=time.perf_counter)
 
     def __call__(self, text: str) -> None:
+        heartbeat.note(text)
         if self.enabled:
             sys.stderr.write(f"[reproduce {time.perf_counter() - self.t0:6.1f} s] {text}\n")
             sys.stderr.flush()

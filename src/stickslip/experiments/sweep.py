@@ -41,7 +41,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from stickslip import __version__
+from stickslip import __version__, heartbeat
 from stickslip.io import read_json, run_metadata, write_dataset, write_json, write_table, write_table_files
 from stickslip.jsonable import to_jsonable
 from stickslip.models.params import BlockParams, ChainParams
@@ -381,6 +381,8 @@ def _compute(task, points, common, out, names, specs, pending, records, *, sched
     else:
         client = Client(scheduler)
     bar = _progress_bar(len(points), len(points) - len(pending), progress)
+    done = len(points) - len(pending)
+    heartbeat.note(f"{done} of {len(points)} points done ({out.name})")
     futures = {}
     try:
         for k in pending:
@@ -408,6 +410,8 @@ def _compute(task, points, common, out, names, specs, pending, records, *, sched
                     "wall_seconds": math.nan,
                 }
                 write_json(out / names[k] / ERROR_FILE, records[k])
+            done += 1
+            heartbeat.note(f"{done} of {len(points)} points done ({out.name})")
             if bar is not None:
                 bar.update(1)
                 if records[k]["status"] != "ok":
