@@ -382,7 +382,7 @@ def _compute(task, points, common, out, names, specs, pending, records, *, sched
         client = Client(scheduler)
     bar = _progress_bar(len(points), len(points) - len(pending), progress)
     done = len(points) - len(pending)
-    heartbeat.note(f"{done} of {len(points)} points done ({out.name})")
+    heartbeat.note(f"{done} of {len(points)} points done in {out.parent.name}/{out.name}")
     futures = {}
     try:
         for k in pending:
@@ -411,7 +411,7 @@ def _compute(task, points, common, out, names, specs, pending, records, *, sched
                 }
                 write_json(out / names[k] / ERROR_FILE, records[k])
             done += 1
-            heartbeat.note(f"{done} of {len(points)} points done ({out.name})")
+            heartbeat.note(f"{done} of {len(points)} points done in {out.parent.name}/{out.name}")
             if bar is not None:
                 bar.update(1)
                 if records[k]["status"] != "ok":
