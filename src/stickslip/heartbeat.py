@@ -32,10 +32,14 @@ def _elapsed(seconds: float) -> str:
 
 
 @contextlib.contextmanager
-def heartbeat(command: str, *, interval: float = INTERVAL, enabled: bool | None = None, stream=None) -> Iterator[None]:
+def heartbeat(
+    command: str, *, interval: float | None = None, enabled: bool | None = None, stream=None
+) -> Iterator[None]:
     """Within the block, write ``stickslip COMMAND: running for 2 min 00 s; <latest note>`` on
-    ``stream`` (stderr) every ``interval`` seconds; by default only when stderr is not a terminal."""
+    ``stream`` (stderr) every ``interval`` seconds (default :data:`INTERVAL`); by default only when
+    the stream is not a terminal."""
     stream = sys.stderr if stream is None else stream
+    interval = INTERVAL if interval is None else interval
     if enabled is None:
         enabled = not (hasattr(stream, "isatty") and stream.isatty())
     if not enabled:
