@@ -10,7 +10,7 @@ import time
 
 import pytest
 
-from chain_helpers import cli_env, run_cli_subprocess, stickslip_cmd
+from chain_helpers import cli_env, error_lines, run_cli_subprocess, stickslip_cmd
 from stickslip.cli import main
 
 BAD = [
@@ -111,7 +111,7 @@ def test_bad_input_one_line_exit_2(argv, name, tmp_path, monkeypatch, capsys):
     out, err = capsys.readouterr()
     assert status == 2, err
     assert out == ""
-    assert err.count("\n") == 1 and "Traceback" not in err, err
+    assert len(error_lines(err)) == 1 and err.endswith("\n") and "Traceback" not in err, err
     assert name in err, err
     assert _tree(tmp_path) == before
 
@@ -121,7 +121,7 @@ def test_bad_input_subprocess(argv, tmp_path):
     proc = subprocess.run(
         stickslip_cmd() + shlex.split(argv), capture_output=True, text=True, cwd=tmp_path, env=cli_env(), timeout=120
     )
-    assert proc.returncode == 2 and proc.stdout == "" and proc.stderr.count("\n") == 1, proc.stderr
+    assert proc.returncode == 2 and proc.stdout == "" and len(error_lines(proc.stderr)) == 1, proc.stderr
     assert list(tmp_path.iterdir()) == []
 
 
