@@ -236,7 +236,8 @@ def _assemble(params, options, integrator, start_info, state, outputs, wall, ste
     if options.sample_moving:
         mv = parts["moving"]
         samples["n_moving"] = xr.DataArray(mv[:, 1], dims="t_moving", attrs={"long_name": "blocks moving"})
-        samples = samples.assign_coords(t_moving=("t_moving", mv[:, 0] * dt, {"long_name": "time t (dimensionless model units)", "units": "1"}))
+        time_attrs = {"long_name": "time t (dimensionless model units)", "units": "1"}
+        samples = samples.assign_coords(t_moving=("t_moving", mv[:, 0] * dt, time_attrs))
     blocks = np.arange(1, params.N + 1)
     snap_steps = list(parts["snap_step"]) + [state.step]
     snap_x = np.vstack([parts["snap_x"].reshape(-1, params.N), state.x[1:-1][None, :]])
