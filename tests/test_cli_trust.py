@@ -364,7 +364,9 @@ def test_finished_run_drops_its_checkpoint_and_still_loads(tmp_path, capsys):
     assert not (run / "checkpoint").exists()
     assert sorted(p.name for p in run.iterdir()) == [
         ".run_id",
+        "events.csv",
         "events.parquet",
+        "first_move.csv",
         "first_move.parquet",
         "run.json",
         "state.nc",

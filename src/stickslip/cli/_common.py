@@ -192,7 +192,9 @@ def _figures(*stems: str) -> frozenset[str]:
 
 #: What each command writes into its ``--out`` (a directory may hold only its command's files).
 OUT_FILES: dict[str, frozenset[str]] = {
-    "block": frozenset({"series.nc", "slips.parquet", "run.json", "fig1.nc", "fig2.nc", "fig3.parquet", "fig3.csv"})
+    "block": frozenset(
+        {"series.nc", "slips.parquet", "slips.csv", "run.json", "fig1.nc", "fig2.nc", "fig3.parquet", "fig3.csv"}
+    )
     | _figures("fig1", "fig2", "fig3"),
     "stability block": frozenset({"stability_map.nc", "stability_block.json"}) | _figures("stability_map"),
     "stability chain": frozenset({"fig4.nc", "mode_growth.nc", "stability_chain.json"})

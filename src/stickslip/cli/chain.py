@@ -209,10 +209,13 @@ def _summary_text(summary: dict, out: Path | None, N: int | None = None) -> str:
 
 
 def _json_summary(summary: dict, out: Path | None) -> dict:
+    from stickslip.run.rundir import RUN_FILES
+
     data = dict(summary)
     data["events"] = summary["n_events"]
     if out is not None:
         data["out"] = str(out)
+        data["outputs"] = [str(out / name) for name in RUN_FILES if (out / name).exists()]
     return data
 
 

@@ -42,7 +42,7 @@ import numpy as np
 import pandas as pd
 
 from stickslip import __version__, heartbeat
-from stickslip.io import read_json, run_metadata, write_dataset, write_json, write_table, write_table_files
+from stickslip.io import read_json, run_metadata, write_dataset, write_json, write_table_files
 from stickslip.jsonable import to_jsonable
 from stickslip.models.params import BlockParams, ChainParams
 from stickslip.run.errors import ShortRunWarning, short_runs_expected
@@ -559,7 +559,7 @@ def block_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     summary = dict(run.summary())
     directory = Path(point_dir)
     write_dataset(directory / "series.nc", run.series)
-    write_table(directory / "slips.parquet", run.slips)
+    write_table_files(directory / "slips", run.slips)
     write_json(directory / "run.json", run_metadata(params, integrator="heun", t_end=t_end, summary=summary, **options))
     return summary
 

@@ -95,7 +95,8 @@ def _param_attrs(params: ChainParams) -> dict[str, object]:
 
 
 def write_run(run: ChainRun, out_dir: str | Path) -> Path:
-    """Write a run directory: run.json, state.nc (labelled arrays), events.parquet, first_move.parquet."""
+    """Write a run directory: run.json, state.nc (labelled arrays), the tables events and
+    first_move (each as .parquet and .csv, :data:`RUN_FILES`)."""
     from stickslip import io
 
     out = Path(out_dir)
@@ -138,8 +139,8 @@ def write_run(run: ChainRun, out_dir: str | Path) -> Path:
     io.write_dataset(out / "state.nc", ds)
     # The model, its pieces and every parameter travel with each table too.
     model = {"params": run.params.to_dict(), "integrator": run.integrator}
-    io.write_table(out / "events.parquet", run.events, EVENT_DOCS, metadata=model)
-    io.write_table(out / "first_move.parquet", run.first_move, FIRST_MOVE_DOCS, metadata=model)
+    io.write_table_files(out / "events", run.events, EVENT_DOCS, metadata=model)
+    io.write_table_files(out / "first_move", run.first_move, FIRST_MOVE_DOCS, metadata=model)
     meta = io.run_metadata(
         run.params, integrator=run.integrator, options=run.options.to_dict(), start=run.start, summary=run.summary
     )
@@ -192,9 +193,9 @@ def load_run(run_dir: str | Path) -> ChainRun:
 LOCK_FILES = frozenset({".lock", ".lock.json"})
 RUN_ID_FILE = ".run_id"
 #: The files and folders a chain run writes into its run directory.
-OWN_FILES = frozenset(
-    {"run.json", "state.nc", "events.parquet", "first_move.parquet", "checkpoint", RUN_ID_FILE, *LOCK_FILES}
-)
+#: The results of a finished chain run, as :func:`write_run` writes them.
+RUN_FILES = ("run.json", "state.nc", "events.parquet", "events.csv", "first_move.parquet", "first_move.csv")
+OWN_FILES = frozenset({*RUN_FILES, "checkpoint", RUN_ID_FILE, *LOCK_FILES})
 
 
 def is_temporary(name: str) -> bool:
