@@ -11,8 +11,6 @@ any of them recompiles them all, and says on stderr when kernels are being compi
 
 from stickslip.kernels import _cache
 
+# numba picks a function's cache directory when the function is decorated, that is when its kernel
+# module is imported, always after this package.
 _cache.install()
-
-# numba picks a function's cache directory when it is decorated: import every kernel module here.
-with _cache.kernel_cache():
-    from stickslip.kernels import block, chain, common, plate  # noqa: F401

@@ -4,9 +4,11 @@ numba stamps a cached function with its own source file only, so a kernel that i
 calls functions of another module is loaded stale after that module changes (a documented
 numba limitation). The kernels of the chain span several modules, so every kernel is cached in
 a directory named after a digest of all of them, given to numba through its documented cache
-setting (``NUMBA_CACHE_DIR``, :data:`numba.config.CACHE_DIR`) while the kernel modules are
-imported: an edit to any kernel module leads to a new directory, and every kernel is compiled
-afresh. A user's ``NUMBA_CACHE_DIR`` is kept as the place of these directories.
+setting (``NUMBA_CACHE_DIR``, :data:`numba.config.CACHE_DIR`), set when this package is imported:
+an edit to any kernel module leads to a new directory, and every kernel is compiled afresh. A
+user's ``NUMBA_CACHE_DIR`` is kept as the place of these directories. (Other numba functions with
+``cache=True`` decorated later in the same process are cached under the same directory, each with
+numba's own stamp of its source file.)
 
 numba announces each compilation (not a load from the cache) through its event API
 (:mod:`numba.core.event`, ``"numba:compile"``); the first one of a kernel in a process writes one
@@ -15,12 +17,10 @@ line on stderr, so that the first run of a model does not sit silent for half a 
 
 from __future__ import annotations
 
-import contextlib
 import hashlib
 import os
 import sys
 import threading
-from collections.abc import Iterator
 from pathlib import Path
 
 import numba
@@ -71,18 +71,13 @@ def cache_dir() -> Path:
     return _DIR / "__pycache__" / name  # nothing writable: numba then caches nothing and says so
 
 
-@contextlib.contextmanager
-def kernel_cache() -> Iterator[Path]:
-    """Within the block, numba caches functions decorated with ``cache=True`` in :func:`cache_dir`
-    (numba picks a function's cache directory when it is decorated); numba's setting is restored
-    after."""
+def use_cache_dir() -> Path:
+    """Point numba's cache setting at :func:`cache_dir`, so that the kernels decorated from now on
+    (``cache=True``) are cached there; numba picks a function's cache directory when it is
+    decorated."""
     path = cache_dir()
-    previous = numba.config.CACHE_DIR
     numba.config.CACHE_DIR = str(path)
-    try:
-        yield path
-    finally:
-        numba.config.CACHE_DIR = previous
+    return path
 
 
 class _CompileNotice(event.Listener):
@@ -113,7 +108,8 @@ NOTICE = _CompileNotice()
 
 
 def install() -> None:
-    """Listen for compilations of the kernels (once per process)."""
+    """Cache the kernels in :func:`cache_dir` and listen for their compilations (once per process)."""
     if not getattr(install, "done", False):
+        use_cache_dir()
         event.register("numba:compile", NOTICE)
         install.done = True
