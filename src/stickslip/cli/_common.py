@@ -107,8 +107,11 @@ def interrupted(command: str, out: Path | None, kept: str) -> Result:
     return Result({"interrupted": True, "out": str(out)}, "", status=130)
 
 
-def add_param_options(parser: argparse.ArgumentParser, params_cls: type, skip: tuple[str, ...] = ()) -> None:
-    """One ``--NAME`` option per field of a parameter dataclass (default: the dataclass's)."""
+def add_param_options(
+    parser: argparse.ArgumentParser, params_cls: type, skip: tuple[str, ...] = (), helps: dict[str, str] | None = None
+) -> None:
+    """One ``--NAME`` option per field of a parameter dataclass (default: the dataclass's); ``helps``
+    replaces the help text of some."""
     docs = params_cls.field_docs()
     group = parser.add_argument_group("model parameters")
     for f in dataclasses.fields(params_cls):
@@ -125,7 +128,7 @@ def add_param_options(parser: argparse.ArgumentParser, params_cls: type, skip: t
             type=_number(kind, f.name, allowed),
             default=None,
             metavar=f.name,
-            help=f"{docs[f.name]} (default {f.default})",
+            help=(helps or {}).get(f.name, f"{docs[f.name]} (default {f.default})"),
         )
 
 
@@ -294,7 +297,7 @@ def prepare_out_dir(path: str | Path | None) -> Path | None:
     return out
 
 
-def add_model_options(parser: argparse.ArgumentParser) -> None:
+def add_model_options(parser: argparse.ArgumentParser, helps: dict[str, str] | None = None) -> None:
     """``--model`` (a preset), the four pieces to compose a model, CL's own symbols, and one
     ``--NAME`` per parameter of :class:`ChainParams`."""
     from stickslip.models.params import ChainParams
@@ -324,7 +327,7 @@ def add_model_options(parser: argparse.ArgumentParser) -> None:
         default=None,
         help="Carlson-Langer's plate velocity nu (sets V)",
     )
-    add_param_options(parser, ChainParams)
+    add_param_options(parser, ChainParams, helps=helps)
 
 
 def chain_params_from_args(args: argparse.Namespace, **overrides: Any):

@@ -29,7 +29,9 @@ def register(sub) -> None:
         description="Integrate the chain of eq. (4) (MODEL.md), or a relative chosen with --model or "
         "composed with --drive/--friction/--threshold/--ends, and record its slip events.",
     )
-    add_model_options(p)
+    add_model_options(
+        p, helps={"N": "number of blocks N (default the preset's: 399 for the paper's chain; 49 without --t-end)"}
+    )
     _add_run_options(p)
     p.add_argument(
         "--integrator",
