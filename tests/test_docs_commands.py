@@ -35,7 +35,7 @@ def _commands(page: Path) -> list[tuple[int, list[str]]]:
             while text.endswith("\\") and k + 1 < len(lines):
                 k += 1
                 text = text[:-1] + " " + lines[k].strip()
-            if not _SYNOPSIS.search(text):
+            if not _SYNOPSIS.search(text) and not text.split()[0].endswith(":"):  # not a line of output
                 found.append((start + 1, shlex.split(text)))
         k += 1
     return found
