@@ -31,7 +31,7 @@ _DIR = Path(__file__).resolve().parent
 #: What the first compilation in a process says (stderr).
 COMPILE_NOTICE = (
     "stickslip: compiling the numba kernels of this model (once per model and version of the "
-    "kernels; usually 20-40 s, a few minutes on a busy machine; `stickslip compile` does it ahead of time)"
+    "kernels; usually 10-40 s, a few minutes on a busy machine; `stickslip compile` does it ahead of time)"
 )
 
 
