@@ -338,3 +338,15 @@ def model_heun_step(x, v, th, moving, n, p):
             vn.append(0.0)
             mn.append(False)
     return xn, vn, thn, mn, mid
+
+
+def error_lines(err: str) -> list[str]:
+    """The lines of stderr after argparse's usage block (``usage: ...`` and its indented
+    continuation lines): a bad input must leave exactly one there."""
+    lines = err.rstrip("\n").splitlines()
+    k = 0
+    if lines and lines[0].startswith("usage: "):
+        k = 1
+        while k < len(lines) and lines[k].startswith(" "):
+            k += 1
+    return lines[k:]

@@ -10,6 +10,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from chain_helpers import error_lines
 from stickslip import io
 from stickslip.cli import main
 
@@ -113,7 +114,7 @@ def test_unknown_option_exits_2(capsys, tmp_path):
         main(["block", "--bogus", "1", "--out", str(tmp_path / "out")])
     assert exc.value.code == 2
     err = capsys.readouterr().err
-    assert len(err.strip().splitlines()) == 1 and "--bogus" in err
+    assert len(error_lines(err)) == 1 and "--bogus" in err
     assert not (tmp_path / "out").exists()
 
 

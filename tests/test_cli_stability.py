@@ -8,6 +8,7 @@ import sys
 
 import pytest
 
+from chain_helpers import error_lines
 from stickslip import io
 from stickslip.cli import main
 
@@ -105,7 +106,7 @@ def test_parse_errors_exit_2(capsys, argv):
     with pytest.raises(SystemExit) as exc:
         main(argv)
     assert exc.value.code == 2
-    assert len(capsys.readouterr().err.strip().splitlines()) == 1
+    assert len(error_lines(capsys.readouterr().err)) == 1
 
 
 def test_console_script():

@@ -10,7 +10,7 @@ import time
 
 import pytest
 
-from chain_helpers import cli_env, run_cli_subprocess, stickslip_cmd
+from chain_helpers import cli_env, error_lines, run_cli_subprocess, stickslip_cmd
 from stickslip.cli import main
 
 BAD = [
@@ -30,7 +30,7 @@ BAD = [
     ("chain --ends periodic", "periodic"),
     ("chain --model train --threshold state", "threshold"),
     ("chain --model nosuch", "--model"),
-    ("chain --model carlson-langer --amplitude -1", "amplitude"),
+    ("chain --model carlson-langer --perturbation -1", "perturbation"),
     ("block --model carlson-langer", "--model"),
     ("bench --model carlson-langer --l 0", "l"),
     ("lyapunov --model two-blocks --d0 1", "d0"),
@@ -126,7 +126,7 @@ def test_bad_input_one_line_exit_2(argv, name, tmp_path, monkeypatch, capsys):
     out, err = capsys.readouterr()
     assert status == 2, err
     assert out == ""
-    assert err.count("\n") == 1 and "Traceback" not in err, err
+    assert len(error_lines(err)) == 1 and err.endswith("\n") and "Traceback" not in err, err
     assert name in err, err
     assert _tree(tmp_path) == before
 
@@ -136,7 +136,7 @@ def test_bad_input_subprocess(argv, tmp_path):
     proc = subprocess.run(
         stickslip_cmd() + shlex.split(argv), capture_output=True, text=True, cwd=tmp_path, env=cli_env(), timeout=120
     )
-    assert proc.returncode == 2 and proc.stdout == "" and proc.stderr.count("\n") == 1, proc.stderr
+    assert proc.returncode == 2 and proc.stdout == "" and len(error_lines(proc.stderr)) == 1, proc.stderr
     assert list(tmp_path.iterdir()) == []
 
 
@@ -379,7 +379,9 @@ def test_finished_run_drops_its_checkpoint_and_still_loads(tmp_path, capsys):
     assert not (run / "checkpoint").exists()
     assert sorted(p.name for p in run.iterdir()) == [
         ".run_id",
+        "events.csv",
         "events.parquet",
+        "first_move.csv",
         "first_move.parquet",
         "run.json",
         "state.nc",

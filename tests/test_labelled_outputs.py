@@ -23,7 +23,7 @@ def test_state_variables_carry_long_name_and_units(run_dir):
         for name in ("x", "v", "theta", "stopped", "L", "snapshot_x", "profile_dx", "t_sample"):
             assert ds[name].attrs.get("long_name"), name
             assert "units" in ds[name].attrs, name
-        assert "model units" in ds["x"].attrs["units"]
+        assert ds["x"].attrs["units"] == "1" and "M = sigma = 1" in ds["x"].attrs["comment"]
         assert list(ds["stopped"].attrs["flag_values"]) == [0, 1]
         assert ds["stopped"].attrs["flag_meanings"] == "moving stopped"
         assert ds.attrs["Conventions"].startswith("CF-")
@@ -47,3 +47,32 @@ def test_sweep_table_holds_the_fixed_settings():
     table = _table(rows, [{"beta": 0.6}, common])
     assert list(table.columns[:3]) == ["beta", "N", "t_end"]
     assert table["N"].tolist() == [49, 49] and table["result_t_end"].tolist() == [2e5, 2e5]
+
+
+def _cf_units_of(path):
+    """Every ``units`` attribute (variables and coordinates) of a NetCDF file."""
+    with xr.open_dataset(path, decode_times=False) as ds:
+        return {name: ds[name].attrs["units"] for name in [*ds.variables] if "units" in ds[name].attrs}
+
+
+def test_every_units_string_is_cf(run_dir, tmp_path):
+    """The CF conventions' own parser (cf-units) reads every units string the package writes."""
+    cf_units = pytest.importorskip("cf_units")
+    from stickslip.cli import main
+
+    for argv in (
+        ["block", "--t-end", "300", "--out", str(tmp_path / "block")],
+        ["stability", "block", "--out", str(tmp_path / "stab")],
+        ["stability", "chain", "--out", str(tmp_path / "modes")],
+    ):
+        assert main(argv) == 0, argv
+    files = [run_dir / "state.nc", *sorted(tmp_path.rglob("*.nc"))]
+    assert len(files) >= 4
+    seen = 0
+    for path in files:
+        for name, units in _cf_units_of(path).items():
+            unit = cf_units.Unit(units)  # raises on a string CF tools cannot read
+            assert not unit.is_unknown(), (path.name, name, units)
+            seen += 1
+    assert seen >= 10
+    assert _cf_units_of(run_dir / "state.nc")["L"] == "1"

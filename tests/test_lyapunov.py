@@ -256,8 +256,10 @@ def test_cli_text_and_beta_table_with_plot(capsys, tmp_path):
         str(png),
         "--json",
     )
-    assert status == 0 and png.is_file()
-    assert [row["beta"] for row in json.loads(out)["table"]] == [0.5, 1.0]
+    assert status == 0 and png.is_file() and png.with_suffix(".pdf").is_file()
+    data = json.loads(out)
+    assert data["outputs"] == [str(png), str(png.with_suffix(".pdf"))]
+    assert [row["beta"] for row in data["table"]] == [0.5, 1.0]
 
 
 @pytest.mark.parametrize(

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import pytest
 
+from chain_helpers import error_lines
 from stickslip.cli import main
 from stickslip.experiments import reproduce as rp
 from stickslip.experiments import specs as ex
@@ -269,7 +270,7 @@ def test_bad_input_exits_2_and_writes_nothing(argv, tmp_path, capsys):
     except SystemExit as exc:
         status = exc.code
     assert status == 2
-    err = capsys.readouterr().err.strip().splitlines()
+    err = error_lines(capsys.readouterr().err)
     assert len(err) == 1 and "error" in err[0]
     assert not out.exists()
 

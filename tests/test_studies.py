@@ -16,6 +16,7 @@ import pandas as pd
 import pytest
 from scipy.signal import lfilter
 
+from chain_helpers import error_lines
 from stickslip.analysis.order import (
     batch_means,
     classify_final_state,
@@ -321,7 +322,7 @@ def test_bad_study_input_is_one_line_and_exit_2(tmp_path):
             timeout=120,
         )
         assert proc.returncode == 2, (argv, proc.stderr)
-        assert len(proc.stderr.strip().splitlines()) == 1, (argv, proc.stderr)
+        assert len(error_lines(proc.stderr)) == 1, (argv, proc.stderr)
         assert proc.stdout == ""
     assert not (tmp_path / "o").exists()  # refused before the output folder is made
 

@@ -117,7 +117,7 @@ def size_distribution(
     centre = np.sqrt(edges[:-1] * edges[1:])
     return xr.Dataset(
         {
-            "density": ("bin", density, {"long_name": "probability density of S", "units": "1/S"}),
+            "density": ("bin", density, {"long_name": "probability density of S (per unit of S)", "units": "1"}),
             "count": ("bin", counts.astype(np.int64), {"long_name": "events in bin"}),
             "width": ("bin", width, {"long_name": "bin width"}),
             "lower": ("bin", edges[:-1], {"long_name": "lower bin edge"}),

@@ -13,17 +13,38 @@ import sys
 import warnings
 
 from stickslip.cli._common import CommandError, Result, emit
+from stickslip.heartbeat import heartbeat
 from stickslip.models.params import ParameterError
 
 __all__ = ["main", "build_parser", "Result", "CommandError"]
 
 
 class _Parser(argparse.ArgumentParser):
-    """An ArgumentParser whose errors are one line and exit with status 2."""
+    """An ArgumentParser whose errors are argparse's usage line and one line of error (with a
+    "did you mean" for a misspelt choice or option), exit status 2."""
 
     def error(self, message: str):  # type: ignore[override]
-        sys.stderr.write(f"{self.prog}: error: {message}\n")
+        self.print_usage(sys.stderr)
+        sys.stderr.write(f"{self.prog}: error: {message}{_did_you_mean(self, message)}\n")
         raise SystemExit(2)
+
+
+def _did_you_mean(parser: argparse.ArgumentParser, message: str) -> str:
+    """``; did you mean 'chain'?`` for an invalid choice or an unrecognised option close to a valid one."""
+    import difflib
+    import re
+
+    choice = re.search(r"invalid choice: '([^']*)' \(choose from (.*)\)$", message)
+    if choice:
+        word, options = choice.group(1), re.findall(r"'([^']*)'", choice.group(2))
+    else:
+        unknown = re.search(r"unrecognized arguments?:? (--?[\w-]+)", message)
+        if not unknown:
+            return ""
+        word = unknown.group(1)
+        options = [s for action in parser._actions for s in action.option_strings]
+    close = difflib.get_close_matches(word, options, n=1, cutoff=0.6)
+    return f"; did you mean '{close[0]}'?" if close else ""
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -31,6 +52,7 @@ def build_parser() -> argparse.ArgumentParser:
     from stickslip.cli import (
         block,
         chain,
+        compile,
         lyapunov,
         models,
         plot,
@@ -49,8 +71,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"stickslip {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
-    for module in (block, stability, chain, models, sweep, reproduce, study, lyapunov, plot):
+    for module in (block, stability, chain, models, sweep, reproduce, study, lyapunov, plot, compile):
         module.register(sub)
+    parser.commands = sub.choices
     return parser
 
 
@@ -63,6 +86,12 @@ def _one_line_warning(command: str):
     return show
 
 
+def _beats(args: argparse.Namespace) -> bool:
+    """Heartbeat lines (every minute, what runs and how far) when stderr is not a terminal and
+    progress is not switched off; a short command ends before the first."""
+    return not sys.stderr.isatty() and not getattr(args, "no_progress", False)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``stickslip`` command; returns the exit status."""
     from stickslip.run.errors import NonFiniteBlock
@@ -71,10 +100,12 @@ def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     if argv and argv[0].startswith("-") and argv[0] not in ("-h", "--help", "--version"):
         parser.error(f"unrecognized argument {argv[0]} (options follow a COMMAND; see stickslip --help)")
-    args = parser.parse_args(argv)
+    args, extra = parser.parse_known_args(argv)
+    if extra:  # refused by the command's own parser: its usage line, and its options to suggest from
+        parser.commands[args.command].error(f"unrecognized arguments: {' '.join(extra)}")
     name = " ".join(v for v in (args.command, getattr(args, "stability_command", None)) if v)
     try:
-        with warnings.catch_warnings():
+        with warnings.catch_warnings(), heartbeat(name, enabled=_beats(args)):
             warnings.showwarning = _one_line_warning(args.command)
             result = args.handler(args)
     except (ParameterError, CommandError) as exc:

@@ -136,8 +136,11 @@ def interrupted(command: str, out: Path | None, kept: str) -> Result:
     return Result({"interrupted": True, "out": str(out)}, "", status=130)
 
 
-def add_param_options(parser: argparse.ArgumentParser, params_cls: type, skip: tuple[str, ...] = ()) -> None:
-    """One ``--NAME`` option per field of a parameter dataclass (default: the dataclass's)."""
+def add_param_options(
+    parser: argparse.ArgumentParser, params_cls: type, skip: tuple[str, ...] = (), helps: dict[str, str] | None = None
+) -> None:
+    """One ``--NAME`` option per field of a parameter dataclass (default: the dataclass's); ``helps``
+    replaces the help text of some."""
     docs = params_cls.field_docs()
     group = parser.add_argument_group("model parameters")
     for f in dataclasses.fields(params_cls):
@@ -154,7 +157,7 @@ def add_param_options(parser: argparse.ArgumentParser, params_cls: type, skip: t
             type=_number(kind, f.name, allowed),
             default=None,
             metavar=f.name,
-            help=f"{docs[f.name]} (default {f.default})",
+            help=(helps or {}).get(f.name, f"{docs[f.name]} (default {f.default})"),
         )
 
 
@@ -221,7 +224,9 @@ def _figures(*stems: str) -> frozenset[str]:
 
 #: What each command writes into its ``--out`` (a directory may hold only its command's files).
 OUT_FILES: dict[str, frozenset[str]] = {
-    "block": frozenset({"series.nc", "slips.parquet", "run.json", "fig1.nc", "fig2.nc", "fig3.parquet", "fig3.csv"})
+    "block": frozenset(
+        {"series.nc", "slips.parquet", "slips.csv", "run.json", "fig1.nc", "fig2.nc", "fig3.parquet", "fig3.csv"}
+    )
     | _figures("fig1", "fig2", "fig3"),
     "stability block": frozenset({"stability_map.nc", "stability_block.json"}) | _figures("stability_map"),
     "stability chain": frozenset({"fig4.nc", "mode_growth.nc", "stability_chain.json"})
@@ -326,7 +331,7 @@ def prepare_out_dir(path: str | Path | None) -> Path | None:
     return out
 
 
-def add_model_options(parser: argparse.ArgumentParser) -> None:
+def add_model_options(parser: argparse.ArgumentParser, helps: dict[str, str] | None = None) -> None:
     """``--model`` (a preset), the four pieces to compose a model, CL's own symbols, and one
     ``--NAME`` per parameter of :class:`ChainParams`."""
     from stickslip.models.params import ChainParams
@@ -356,7 +361,7 @@ def add_model_options(parser: argparse.ArgumentParser) -> None:
         default=None,
         help="Carlson-Langer's plate velocity nu (sets V)",
     )
-    add_param_options(parser, ChainParams)
+    add_param_options(parser, ChainParams, helps=helps)
 
 
 def chain_params_from_args(args: argparse.Namespace, **overrides: Any):

@@ -229,7 +229,7 @@ def write_block_outputs(out: Path, run: BlockRun, law: SlipLimit | None, *, fig3
 
     written = [
         io.write_dataset(out / "series.nc", run.series),
-        io.write_table(out / "slips.parquet", run.slips),
+        *io.write_table_files(out / "slips", run.slips),
     ]
     written += save_figure(fig1_position(run), out / "fig1")
     source = _fig2_source(run) if law is not None else None

@@ -29,7 +29,9 @@ def register(sub) -> None:
         description="Integrate the chain of eq. (4) (MODEL.md), or a relative chosen with --model or "
         "composed with --drive/--friction/--threshold/--ends, and record its slip events.",
     )
-    add_model_options(p)
+    add_model_options(
+        p, helps={"N": "number of blocks N (default the preset's: 399 for the paper's chain; 49 without --t-end)"}
+    )
     _add_run_options(p)
     p.add_argument(
         "--integrator",
@@ -143,7 +145,9 @@ def _add_run_options(p: argparse.ArgumentParser) -> None:
         type=float_arg("t-end"),
         default=None,
         metavar="T",
-        help="end time (default 2e4; the paper's runs use 2e7)",
+        help="end time; without it a first look: a chain loaded from one end from x_i = 0 gets "
+        "N = 49 (unless --N) and runs for four loading times L_ss / V, rounded up (5e5 for N = 49), other "
+        "chains to 2e4. The paper's runs: --t-end 2e7 (N = 399, the preset's)",
     )
     p.add_argument(
         "--start",
@@ -158,15 +162,11 @@ def _add_run_options(p: argparse.ArgumentParser) -> None:
         type=float_arg("perturbation"),
         default=None,
         metavar="A",
-        help="with --start steady: uniform perturbation of x and v in [-A, A] (default 0)",
+        help="size A of the start's perturbation: with --start steady uniform in [-A, A] on x and v (default 0); "
+        "with --start rest x_i = -A u_i, u_i uniform in [0, 1) (default the model's, 0.01 for CL)",
     )
-    p.add_argument(
-        "--amplitude",
-        type=float_arg("amplitude"),
-        default=None,
-        metavar="A",
-        help="with --start rest: x_i = -A u_i, u_i uniform in [0, 1) (default the model's, 0.01 for CL)",
-    )
+    # The former name of --perturbation with --start rest; kept so that old scripts run.
+    p.add_argument("--amplitude", dest="perturbation", type=float_arg("perturbation"), help=argparse.SUPPRESS)
     p.add_argument(
         "--seed", type=int_arg("seed", ">= 0"), default=None, help="seed of the perturbation or of u_i (default 0)"
     )
@@ -211,10 +211,13 @@ def _summary_text(summary: dict, out: Path | None, N: int | None = None) -> str:
 
 
 def _json_summary(summary: dict, out: Path | None) -> dict:
+    from stickslip.run.rundir import RUN_FILES
+
     data = dict(summary)
     data["events"] = summary["n_events"]
     if out is not None:
         data["out"] = str(out)
+        data["outputs"] = [str(out / name) for name in RUN_FILES if (out / name).exists()]
     return data
 
 
@@ -284,8 +287,8 @@ def run_chain_command(args: argparse.Namespace) -> Result:
         )
 
     params = chain_params_from_args(args)
-    t_end = 2e4 if args.t_end is None else args.t_end
     start, amplitude, seed = _start_of(params, args)
+    params, t_end = _first_look(params, args, start) if args.t_end is None else (params, args.t_end)
     args.start, args.perturbation, args.seed = start, amplitude, seed
     for name, default in (
         ("integrator", "exact"),
@@ -357,7 +360,25 @@ def run_chain_command(args: argparse.Namespace) -> Result:
         return Result({"error": str(exc)}, "", status=1)
     except chain.Interrupted as exc:
         return _interrupted(exc, out)
-    return Result(_json_summary(run.summary, out), _summary_text(run.summary, out, params.N))
+    text = _summary_text(run.summary, out, params.N)
+    if args.t_end is None:
+        text = f"N              {params.N}  (without --t-end a first look; the paper's run is --t-end 2e7)\n" + text
+    return Result(_json_summary(run.summary, out), text)
+
+
+def _first_look(params, args, start: str):
+    """Without ``--t-end``, a first look that shows the stick-slip state within seconds: a chain
+    loaded from one end from x_i = 0 gets N = 49 blocks (unless ``--N`` is given) and runs for a
+    few of its loading times (:func:`stickslip.models.physics.first_look_t_end`); other chains
+    run to t = 2e4. The paper's run (N = 399 to t = 2e7) is ``--t-end 2e7``."""
+    from stickslip.models import physics
+
+    if start in ("paper", "rest") and params.drive == "end":
+        looked = params if args.param_N is not None else chain_params_from_args(args, N=physics.FIRST_LOOK_N)
+        t_end = physics.first_look_t_end(looked)
+        if t_end == t_end:
+            return looked, t_end
+    return params, 2e4
 
 
 def _start_of(params, args) -> tuple[str, float, int]:
@@ -366,15 +387,13 @@ def _start_of(params, args) -> tuple[str, float, int]:
 
     preset = PRESETS[params.model]
     start = args.start or preset.start
-    if args.amplitude is not None and start != "rest":
-        raise CommandError("--amplitude goes with --start rest (use --perturbation with --start steady)")
-    if args.perturbation is not None and start != "steady":
-        raise CommandError("--perturbation goes with --start steady (use --amplitude with --start rest)")
+    if args.perturbation is not None and start == "paper":
+        raise CommandError("--perturbation goes with --start steady or --start rest (the paper's start has none)")
     if args.seed is not None and start == "paper":
         raise CommandError("--seed goes with --start steady or --start rest (the paper's start draws no numbers)")
     if start == "rest":
-        amplitude = args.amplitude if args.amplitude is not None else preset.start_options.get("amplitude", 0.0)
-        check_number("amplitude", amplitude, low=0.0)
+        amplitude = args.perturbation if args.perturbation is not None else preset.start_options.get("amplitude", 0.0)
+        check_number("perturbation", amplitude, low=0.0)
     else:
         amplitude = args.perturbation if args.perturbation is not None else 0.0
     seed = args.seed if args.seed is not None else preset.start_options.get("seed", 0)
@@ -402,7 +421,6 @@ def run_bench_command(args: argparse.Namespace) -> Result:
     check_number("t-end", t_end, low=0.0, low_open=True)
     steps_for(t_end, params.dt, "t-end")
     args.perturbation = getattr(args, "perturbation", None)
-    args.amplitude = None
     args.seed = None
     start, amplitude, seed = _start_of(params, args)
     if args.profile:

@@ -8,6 +8,7 @@ tabulates the exponent against d0, the renormalisation interval and the run leng
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 from stickslip.cli._common import (
     CommandError,
@@ -86,7 +87,12 @@ def register(sub) -> None:
     p.add_argument(
         "--betas", default=None, metavar="B1,B2,...", help="tabulate the exponent against these values of beta"
     )
-    p.add_argument("--plot", default=None, metavar="FILE", help="with --betas: draw lambda(beta) to FILE (.png, .pdf)")
+    p.add_argument(
+        "--plot",
+        default=None,
+        metavar="FILE",
+        help="with --betas: draw lambda(beta) as FILE.png and FILE.pdf (a suffix .png or .pdf is dropped)",
+    )
     p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     add_json_option(p)
     p.set_defaults(handler=run_lyapunov_command)
@@ -177,24 +183,23 @@ def run_lyapunov_command(args: argparse.Namespace) -> Result:
         }
         text = table.to_string(index=False)
         if args.plot:
+            from stickslip.io import disk_full
             from stickslip.plotting.lyapunov import plot_lyapunov_beta
+            from stickslip.plotting.style import FIGURE_FORMATS, save_figure
 
             fig = plot_lyapunov_beta(table, params)
-            import io as _io
-            from pathlib import Path
-
-            from stickslip.io import disk_full, write_bytes
-
-            buf = _io.BytesIO()
+            stem = Path(args.plot)
+            if stem.suffix.lower().lstrip(".") in FIGURE_FORMATS:
+                stem = stem.with_suffix("")
             try:
-                fig.savefig(buf, format=Path(args.plot).suffix.lstrip(".") or None)
-                write_bytes(args.plot, buf.getvalue())
+                written = save_figure(fig, stem)
             except (OSError, ValueError) as exc:
                 if disk_full(exc) is not None:
                     raise
                 raise CommandError(f"cannot write plot {args.plot}: {exc}") from None
-            data["plot"] = args.plot
-            text += f"\nplot written to {args.plot}"
+            data["plot"] = str(stem)
+            data["outputs"] = [str(p) for p in written]
+            text += f"\nplot written to {', '.join(data['outputs'])}"
         return Result(data, text)
     res = ly.largest_lyapunov(params, args.t_end, progress=not args.no_progress, **kw)
     data = res.to_dict()

@@ -38,7 +38,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from stickslip import io
+from stickslip import heartbeat, io
 from stickslip.analysis.chain_runs import chain_analysis, final_state
 from stickslip.experiments.specs import (
     UNTIL_STEADY,
@@ -85,6 +85,7 @@ class _Log:
     t0: float = field(default_factory=time.perf_counter)
 
     def __call__(self, text: str) -> None:
+        heartbeat.note(text)
         if self.enabled:
             sys.stderr.write(f"[reproduce {time.perf_counter() - self.t0:6.1f} s] {text}\n")
             sys.stderr.flush()
@@ -151,7 +152,7 @@ def _compute_block_run(exp: Experiment, run_dir: Path, **_: Any) -> dict[str, An
 
     run = simulate_block(BlockParams(**exp.params), exp.t_end, every=1)
     io.write_dataset(run_dir / "series.nc", run.series)
-    io.write_table(run_dir / "slips.parquet", run.slips)
+    io.write_table_files(run_dir / "slips", run.slips)
     f = run.final
     return {**run.summary(), "final": {"x": f.x, "v": f.v, "theta": f.theta, "stopped": f.stopped}}
 
@@ -214,7 +215,7 @@ def _compute_period_sweep(exp: Experiment, run_dir: Path, **_: Any) -> dict[str,
     table = period_sweep(
         BlockParams(**exp.params), paper_V_values(o["n"], o["V_min"], o["V_max"]), periods=o["periods"]
     )
-    io.write_table(run_dir / "periods.parquet", table)
+    io.write_table_files(run_dir / "periods", table)
     return {
         "max_abs_rel_dev": float(np.nanmax(np.abs(table["rel_dev"]))),
         "n_V": int(len(table)),

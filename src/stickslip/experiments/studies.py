@@ -405,8 +405,8 @@ def lyapunov_point(cfg: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     point_dir.mkdir(parents=True, exist_ok=True)
     import pandas as pd
 
-    io.write_table(
-        point_dir / "renormalisations.parquet",
+    io.write_table_files(
+        point_dir / "renormalisations",
         pd.DataFrame({"t": res.times, "log_growth": res.log_growth, "duration": res.durations, "counted": res.counted}),
         descriptions={
             "t": "end of the interval",

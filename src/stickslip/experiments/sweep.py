@@ -41,10 +41,10 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from stickslip import __version__
+from stickslip import __version__, heartbeat
 from stickslip.experiments.point_cache import read_done as _read_done
 from stickslip.experiments.point_cache import spec_before as _spec_before
-from stickslip.io import disk_full, run_metadata, write_dataset, write_json, write_table, write_table_files
+from stickslip.io import disk_full, run_metadata, write_dataset, write_json, write_table_files
 from stickslip.jsonable import to_jsonable
 from stickslip.models.params import BlockParams, ChainParams
 from stickslip.run.errors import ShortRunWarning, short_runs_expected
@@ -394,6 +394,8 @@ def _compute(
     else:
         client = Client(scheduler)
     bar = _progress_bar(len(points), len(points) - len(pending), progress)
+    done = len(points) - len(pending)
+    heartbeat.note(f"{done} of {len(points)} points done in {out.parent.name}/{out.name}")
     futures = {}
     try:
         for k in pending:
@@ -423,6 +425,8 @@ def _compute(
                     "wall_seconds": math.nan,
                 }
                 write_json(out / names[k] / ERROR_FILE, records[k])
+            done += 1
+            heartbeat.note(f"{done} of {len(points)} points done in {out.parent.name}/{out.name}")
             if bar is not None:
                 bar.update(1)
                 if records[k]["status"] != "ok":
@@ -570,7 +574,7 @@ def block_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     summary = dict(run.summary())
     directory = Path(point_dir)
     write_dataset(directory / "series.nc", run.series)
-    write_table(directory / "slips.parquet", run.slips)
+    write_table_files(directory / "slips", run.slips)
     write_json(directory / "run.json", run_metadata(params, integrator="heun", t_end=t_end, summary=summary, **options))
     return summary
 

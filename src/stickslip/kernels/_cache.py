@@ -1,20 +1,38 @@
-"""The on-disk cache of the kernels, kept fresh across their modules.
+"""The on-disk cache of the kernels, kept fresh across their modules, and a word when they compile.
 
 numba stamps a cached function with its own source file only, so a kernel that inlines or
 calls functions of another module is loaded stale after that module changes (a documented
-numba limitation). The kernels of the chain span several modules, so here every kernel's
-stamp is a digest of all of them: an edit to any kernel module recompiles every kernel.
+numba limitation). The kernels of the chain span several modules, so every kernel is cached in
+a directory named after a digest of all of them, given to numba through its documented cache
+setting (``NUMBA_CACHE_DIR``, :data:`numba.config.CACHE_DIR`), set when this package is imported:
+an edit to any kernel module leads to a new directory, and every kernel is compiled afresh. A
+user's ``NUMBA_CACHE_DIR`` is kept as the place of these directories. (Other numba functions with
+``cache=True`` decorated later in the same process are cached under the same directory, each with
+numba's own stamp of its source file.)
+
+numba announces each compilation (not a load from the cache) through its event API
+(:mod:`numba.core.event`, ``"numba:compile"``); the first one of a kernel in a process writes one
+line on stderr, so that the first run of a model does not sit silent for half a minute.
 """
 
 from __future__ import annotations
 
 import hashlib
+import os
+import sys
+import threading
 from pathlib import Path
 
-from numba.core import caching
+import numba
+from numba.core import event
 
 _DIR = Path(__file__).resolve().parent
-_IMPL = getattr(caching, "CacheImpl", None) or getattr(caching, "_CacheImpl", None)
+
+#: What the first compilation in a process says (stderr).
+COMPILE_NOTICE = (
+    "stickslip: compiling the numba kernels of this model (once per model and version of the "
+    "kernels; usually 10-40 s, a few minutes on a busy machine; `stickslip compile` does it ahead of time)"
+)
 
 
 def modules_digest(paths) -> str:
@@ -28,45 +46,70 @@ def modules_digest(paths) -> str:
     return h.hexdigest()
 
 
-_DIGEST = modules_digest(_DIR.glob("*.py"))
+DIGEST = modules_digest(_DIR.glob("*.py"))
 
 
-class KernelsLocator(caching._CacheLocator):
-    """numba's own locator for a function of this package (same cache folder and name), with
-    a source stamp that covers every kernel module, its own included."""
-
-    def __init__(self, inner):
-        self._inner = inner
-
-    def ensure_cache_path(self):
-        self._inner.ensure_cache_path()
-
-    def get_cache_path(self):
-        return self._inner.get_cache_path()
-
-    def get_source_stamp(self):
-        return _DIGEST
-
-    def get_disambiguator(self):
-        return self._inner.get_disambiguator()
-
-    @classmethod
-    def from_function(cls, py_func, py_file):
-        if Path(py_file).resolve().parent != _DIR:
-            return None
-        for other in _IMPL._locator_classes:
-            if other is not cls:
-                inner = other.from_function(py_func, py_file)
-                if inner is not None:
-                    return cls(inner)
-        return None
-
-
-def install() -> bool:
-    """Put :class:`KernelsLocator` first among numba's locators (once); False where this numba
-    has no such hook, and its own per-file stamps apply."""
-    if _IMPL is None or not hasattr(_IMPL, "_locator_classes"):
+def _writable(path: Path) -> bool:
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError:
         return False
-    if KernelsLocator not in _IMPL._locator_classes:
-        _IMPL._locator_classes.insert(0, KernelsLocator)
-    return True
+    return os.access(path, os.W_OK | os.X_OK)
+
+
+def cache_dir() -> Path:
+    """The directory of this version of the kernels: ``stickslip-<digest>`` under the user's
+    ``NUMBA_CACHE_DIR`` if set, else under the kernels' own ``__pycache__`` (or, where that is
+    read-only, under ``~/.cache/stickslip-numba``)."""
+    name = f"stickslip-{DIGEST[:20]}"
+    user = os.environ.get("NUMBA_CACHE_DIR", "").strip()
+    if user:
+        return Path(user).expanduser() / name
+    for base in (_DIR / "__pycache__", Path.home() / ".cache" / "stickslip-numba"):
+        if _writable(base):
+            return base / name
+    return _DIR / "__pycache__" / name  # nothing writable: numba then caches nothing and says so
+
+
+def use_cache_dir() -> Path:
+    """Point numba's cache setting at :func:`cache_dir`, so that the kernels decorated from now on
+    (``cache=True``) are cached there; numba picks a function's cache directory when it is
+    decorated."""
+    path = cache_dir()
+    numba.config.CACHE_DIR = str(path)
+    return path
+
+
+class _CompileNotice(event.Listener):
+    """Writes :data:`COMPILE_NOTICE` once, at the first compilation of a kernel of this package."""
+
+    def __init__(self):
+        self.said = False
+        self.lock = threading.Lock()
+
+    def on_start(self, ev):
+        if self.said:
+            return
+        dispatcher = (ev.data or {}).get("dispatcher")
+        module = getattr(getattr(dispatcher, "py_func", None), "__module__", "") or ""
+        if not module.startswith(__name__.rpartition(".")[0]):
+            return
+        with self.lock:
+            if not self.said:
+                self.said = True
+                sys.stderr.write(COMPILE_NOTICE + "\n")
+                sys.stderr.flush()
+
+    def on_end(self, ev):
+        pass
+
+
+NOTICE = _CompileNotice()
+
+
+def install() -> None:
+    """Cache the kernels in :func:`cache_dir` and listen for their compilations (once per process)."""
+    if not getattr(install, "done", False):
+        use_cache_dir()
+        event.register("numba:compile", NOTICE)
+        install.done = True

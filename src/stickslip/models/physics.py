@@ -123,3 +123,23 @@ def loading_time(p: ChainParams) -> float:
     if p.drive != "end" or not p.V > 0 or not has_steady_state(p):
         return float("nan")
     return chain_steady_length(p) / p.V
+
+
+#: Blocks of the first-look chain (``stickslip chain`` without ``--t-end``): long enough for
+#: avalanches of many sizes, short enough to load in t ~ 1.2e5 (loading_time).
+FIRST_LOOK_N = 49
+#: How many loading times a first look runs: the second half, where <L> is averaged, lies past
+#: the loading with room to spare.
+FIRST_LOOK_LOADINGS = 4.0
+
+
+def first_look_t_end(p: ChainParams) -> float:
+    """End time of a first look at a chain: :data:`FIRST_LOOK_LOADINGS` loading times
+    (:func:`loading_time`, L_ss / V from the paper's start x_i = 0), rounded up to one significant
+    digit (5e5 for N = 49 with the paper's parameters); NaN where the chain does not load from one
+    end (plate drive, no steady sliding)."""
+    t = FIRST_LOOK_LOADINGS * loading_time(p)
+    if not np.isfinite(t) or t <= 0:
+        return float("nan")
+    scale = 10.0 ** np.floor(np.log10(t))
+    return float(np.ceil(t / scale) * scale)

@@ -36,6 +36,7 @@ from typing import Any
 
 import numpy as np
 
+from stickslip import heartbeat
 from stickslip.kernels import chain as K
 from stickslip.models.params import ChainParams, ParameterError, check_number, steps_for
 
@@ -98,6 +99,7 @@ class _Progress:
             )
 
     def update(self, t: float, n_events: int) -> None:
+        heartbeat.note(f"chain t = {t:.4g} of {self.t_end:.4g}, {n_events} events")
         if self.bar is not None:
             self.bar.update(t - self.t_last)
             self.bar.set_postfix(events=n_events, refresh=False)

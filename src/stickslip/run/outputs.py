@@ -231,12 +231,13 @@ def _assemble(params, options, integrator, start_info, state, outputs, wall, ste
     t_samples = parts["samp_step"] * dt
     samples = xr.Dataset(
         {"L": ("t", parts["samp_L"], {"long_name": "total length x_1 - x_N"})},
-        coords={"t": ("t", t_samples, {"units": "model time"})},
+        coords={"t": ("t", t_samples, {"long_name": "time t (dimensionless model units)", "units": "1"})},
     )
     if options.sample_moving:
         mv = parts["moving"]
         samples["n_moving"] = xr.DataArray(mv[:, 1], dims="t_moving", attrs={"long_name": "blocks moving"})
-        samples = samples.assign_coords(t_moving=("t_moving", mv[:, 0] * dt, {"units": "model time"}))
+        time_attrs = {"long_name": "time t (dimensionless model units)", "units": "1"}
+        samples = samples.assign_coords(t_moving=("t_moving", mv[:, 0] * dt, time_attrs))
     blocks = np.arange(1, params.N + 1)
     snap_steps = list(parts["snap_step"]) + [state.step]
     snap_x = np.vstack([parts["snap_x"].reshape(-1, params.N), state.x[1:-1][None, :]])

@@ -29,35 +29,39 @@ from stickslip.models.params import ChainParams
 from stickslip.run.outputs import ChainRun, RunOptions
 from stickslip.run.state import ChainState
 
-UNITS = "model units"  # eq. (4) scaled to M = sigma = 1 (MODEL.md, "Units")
+UNITS = "model units"  # eq. (4) scaled to M = sigma = 1 (the Parquet column descriptions say so)
 
-#: long_name and units of the variables of state.nc (CF attributes).
+#: Every quantity of the model is dimensionless (eq. 4 scaled to M = sigma = 1, docs/model.md,
+#: "Units"): CF units "1", with the scale said in the comment.
+SCALE = "dimensionless model units: eq. (4) scaled to M = sigma = 1 (docs/model.md, Units)"
+
+
+def _model(long_name: str, **extra) -> dict:
+    """CF attributes of a dimensionless model quantity."""
+    return {"long_name": long_name, "units": "1", "comment": SCALE, **extra}
+
+
+#: long_name, units and comment of the variables of state.nc (CF attributes).
 VARIABLE_ATTRS = {
     "block": {"long_name": "block index i (1 = pulled end, N = free end)", "units": "1"},
-    "x": {"long_name": "block position x_i at the end of the run", "units": f"length ({UNITS})"},
-    "v": {"long_name": "block velocity v_i at the end of the run", "units": f"length/time ({UNITS})"},
-    "theta": {
-        "long_name": "state variable theta_i of the friction at the end of the run",
-        "units": "1 (dimensionless)",
-    },
+    "x": _model("block position x_i at the end of the run"),
+    "v": _model("block velocity v_i at the end of the run"),
+    "theta": _model("state variable theta_i of the friction at the end of the run"),
     "stopped": {
         "long_name": "block stuck (start and stop rules of eq. 4) at the end of the run",
         "units": "1",
         "flag_values": np.array([0, 1], dtype=np.int8),
         "flag_meanings": "moving stopped",
     },
-    "t_sample": {"long_name": "sampling time of L", "units": f"time ({UNITS})"},
-    "L": {"long_name": "chain length L = x_1 - x_N (Fig. 5b)", "units": f"length ({UNITS})"},
-    "snapshot_time": {"long_name": "time of the snapshot", "units": f"time ({UNITS})"},
-    "snapshot_x": {"long_name": "block positions x_i at the snapshot time (Fig. 5a)", "units": f"length ({UNITS})"},
-    "profile_dx": {
-        "long_name": "displacement Delta x_i = x_i(t_next) - x_i(t) over one window (Fig. 6)",
-        "units": f"length ({UNITS})",
-    },
+    "t_sample": _model("sampling time of L"),
+    "L": _model("chain length L = x_1 - x_N (Fig. 5b)"),
+    "snapshot_time": _model("time of the snapshot"),
+    "snapshot_x": _model("block positions x_i at the snapshot time (Fig. 5a)"),
+    "profile_dx": _model("displacement Delta x_i = x_i(t_next) - x_i(t) over one window (Fig. 6)"),
     "profile_event": {"long_name": "slip event of the profile row (events.parquet column event)", "units": "1"},
-    "profile_t": {"long_name": "start of the profile window", "units": f"time ({UNITS})"},
-    "profile_t_next": {"long_name": "end of the profile window", "units": f"time ({UNITS})"},
-    "t": {"long_name": "start of the profile window", "units": f"time ({UNITS})"},
+    "profile_t": _model("start of the profile window"),
+    "profile_t_next": _model("end of the profile window"),
+    "t": _model("start of the profile window"),
 }
 
 #: Descriptions of the columns of events.parquet and first_move.parquet (Parquet field metadata).
@@ -91,7 +95,8 @@ def _param_attrs(params: ChainParams) -> dict[str, object]:
 
 
 def write_run(run: ChainRun, out_dir: str | Path) -> Path:
-    """Write a run directory: run.json, state.nc (labelled arrays), events.parquet, first_move.parquet."""
+    """Write a run directory: run.json, state.nc (labelled arrays), the tables events and
+    first_move (each as .parquet and .csv, :data:`RUN_FILES`)."""
     from stickslip import io
 
     out = Path(out_dir)
@@ -134,8 +139,8 @@ def write_run(run: ChainRun, out_dir: str | Path) -> Path:
     io.write_dataset(out / "state.nc", ds)
     # The model, its pieces and every parameter travel with each table too.
     model = {"params": run.params.to_dict(), "integrator": run.integrator}
-    io.write_table(out / "events.parquet", run.events, EVENT_DOCS, metadata=model)
-    io.write_table(out / "first_move.parquet", run.first_move, FIRST_MOVE_DOCS, metadata=model)
+    io.write_table_files(out / "events", run.events, EVENT_DOCS, metadata=model)
+    io.write_table_files(out / "first_move", run.first_move, FIRST_MOVE_DOCS, metadata=model)
     meta = io.run_metadata(
         run.params, integrator=run.integrator, options=run.options.to_dict(), start=run.start, summary=run.summary
     )
@@ -215,9 +220,9 @@ def _load_run(run_dir: Path) -> ChainRun:
 LOCK_FILES = frozenset({".lock", ".lock.json"})
 RUN_ID_FILE = ".run_id"
 #: The files and folders a chain run writes into its run directory.
-OWN_FILES = frozenset(
-    {"run.json", "state.nc", "events.parquet", "first_move.parquet", "checkpoint", RUN_ID_FILE, *LOCK_FILES}
-)
+#: The results of a finished chain run, as :func:`write_run` writes them.
+RUN_FILES = ("run.json", "state.nc", "events.parquet", "events.csv", "first_move.parquet", "first_move.csv")
+OWN_FILES = frozenset({*RUN_FILES, "checkpoint", RUN_ID_FILE, *LOCK_FILES})
 
 
 def is_temporary(name: str) -> bool:
