@@ -123,7 +123,9 @@ def run_rung(params, state, cfg: dict[str, Any], *, leave_stops: bool = False, s
         elapsed = state.step * dt - t_start
         if run.summary.get("stopped_early"):
             final, reached = "steady", True
-            reason = f"steady sliding reached at t = {float(run.summary['t_steady']):.6g} (deviation <= {UNTIL_STEADY:g})"
+            reason = (
+                f"steady sliding reached at t = {float(run.summary['t_steady']):.6g} (deviation <= {UNTIL_STEADY:g})"
+            )
             break
         t_all, L_all, n_all = (np.concatenate(x) for x in (t_s, L_s, n_s))
         m = 1.0 - L_all / L_ss
@@ -137,7 +139,8 @@ def run_rung(params, state, cfg: dict[str, Any], *, leave_stops: bool = False, s
             final = "stick-slip"
             reason = f"left steady sliding: {params.N - int(n_s[-1].min())} blocks stuck at once"
             break
-        if a.decided and a.phi.mean >= STUCK_SLIDING:
+        # a window shorter than half a loading time may hold no event at all (m constant, error 0)
+        if a.decided and a.phi.mean >= STUCK_SLIDING and t_all[-1] - a.t_cut >= 0.5 * t_load:
             final, reason = "stick-slip", a.reason
             break
         if elapsed >= cap - 1e-9:
@@ -182,7 +185,8 @@ def run_rung(params, state, cfg: dict[str, Any], *, leave_stops: bool = False, s
 
 
 def _rung_settings(cfg: dict[str, Any]) -> dict[str, Any]:
-    keys = ("target", "cap_loads", "segment_loads", "first_segment_loads", "samples_per_load", "perturbation", "seed")
+    keys = ("target", "cap_loads", "segment_loads", "first_segment_loads", "samples_per_load")
+    keys += ("perturbation", "down_perturbation", "seed")
     return {k: cfg[k] for k in keys} | {k: cfg.get(k, v) for k, v in _PAPER.items()}
 
 
@@ -224,7 +228,9 @@ def ladder_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     cfg, d = dict(point), Path(point_dir)
     up = cfg["direction"] == "up"
     betas = sorted((float(b) for b in cfg["betas"]), reverse=not up)
-    amp, seed = float(cfg["perturbation"]), int(cfg["seed"])
+    # The down ladder's perturbation stays well below V: a kick of v by V stops blocks at once.
+    amp = float(cfg["perturbation"] if up else cfg["down_perturbation"])
+    seed = int(cfg["seed"])
     kw = {"leave_stops": not up, "stop_requested": stop_requested(d)}
     state = ChainState.steady(params_at(cfg, betas[0]), amp, seed)
     start = f"steady sliding + uniform perturbation {amp:g} (seed {seed})"
@@ -239,7 +245,9 @@ def ladder_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
             break
         inside = (b, r["state"])
         state = r["state"] if up else perturbed(r["state"], amp, seed + len(rows))
-        start = f"final state of beta = {b:g}" + ("" if up else f" + uniform perturbation {amp:g} (seed {seed + len(rows)})")
+        start = f"final state of beta = {b:g}" + (
+            "" if up else f" + uniform perturbation {amp:g} (seed {seed + len(rows)})"
+        )
     for _ in range(int(cfg["bisections"]) if inside is not None and outside is not None else 0):
         b_in, s_in = inside
         mid = round(0.5 * (b_in + outside), 6)
