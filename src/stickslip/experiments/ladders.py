@@ -131,7 +131,10 @@ def run_rung(params, state, cfg: dict[str, Any], *, leave_stops: bool = False, s
         m = 1.0 - L_all / L_ss
         phi = 1.0 - n_all / params.N
         a = assess(t_all, m, phi, target)
-        if not seg_stuck and len(devs) >= 2 and math.isfinite(devs[-2]) and devs[-1] < 0.5 * devs[-2]:
+        # Leaving stick-slip (up), a falling deviation says sliding; near beta = 1 from below (down)
+        # fast modes decay while the slow one grows, so there only reaching steady sliding counts.
+        falling = len(devs) >= 2 and math.isfinite(devs[-2]) and devs[-1] < 0.5 * devs[-2]
+        if not leave_stops and not seg_stuck and falling:
             final = "steady"
             reason = f"every block slides, deviation from steady sliding falling ({devs[-2]:.2g} -> {devs[-1]:.2g})"
             break

@@ -55,7 +55,17 @@ ROW_COLUMNS = [
     "final_reason",
     "wall_seconds",
 ]
-PER_N_COLUMNS = ["N", "beta_t", "beta_t_err", "lower_edge", "lower_edge_err", "step", "step_err", "step_phi"]
+PER_N_COLUMNS = [
+    "N",
+    "beta_t",
+    "beta_t_err",
+    "lower_edge",
+    "lower_edge_err",
+    "step",
+    "step_err",
+    "step_phi",
+    "step_phi_err",
+]
 _PAPER = {"K": 10.0, "D": 5.0, "V": 0.001, "Fs": 3.0, "alpha": 1.0, "dt": 0.005}
 
 
@@ -65,10 +75,10 @@ def _cap_loads(N: int) -> float:
     if N <= 199:
         return 4.0
     if N <= 399:
-        return 1.5
+        return 2.5
     if N <= 799:
-        return 0.4
-    return 0.15
+        return 1.2
+    return 0.3
 
 
 def _grids(N: int, mode: str) -> tuple[list[float], list[float]]:
@@ -78,14 +88,14 @@ def _grids(N: int, mode: str) -> tuple[list[float], list[float]]:
     above = [round(1.0 + k / N, 6) for k in ks]
     if mode == "tiny":
         return [0.8, 2.0, 4.0], [2.0, 1.2, 0.8]
-    below_up = [0.8, 0.9, 1.0] if N <= 199 else [0.9, 1.0]
+    below_up = [0.8, 0.9, 1.0] if N <= 199 else [0.95, 1.0]
     down = sorted(above[:4] + [round(1.0 + 2.0 / N, 6), 1.0, 0.97, 0.9], reverse=True)
     return below_up + above, down
 
 
 def ladder_points(mode: str, extra_Ns: tuple[int, ...] = ()) -> tuple[dict[str, Any], list[dict[str, Any]]]:
-    """The shared settings and the ladders (one per N and direction) of a mode; small N first, so
-    that an interrupted study has its cheap chains finished."""
+    """The shared settings and the ladders (one per N and direction) of a mode; large N first (the
+    up ladder of the largest chain is the longest task: it sets the wall time on a few workers)."""
     Ns = tuple(sorted(set(LADDER_NS[mode]) | set(int(n) for n in extra_Ns)))
     common = {
         **_PAPER,
@@ -100,7 +110,7 @@ def ladder_points(mode: str, extra_Ns: tuple[int, ...] = ()) -> tuple[dict[str, 
         "bisections": 3 if mode != "tiny" else 1,
     }
     points = []
-    for N in Ns:
+    for N in sorted(Ns, reverse=True):
         up, down = _grids(N, mode)
         cap = _cap_loads(N) if mode != "tiny" else 1.0
         points.append({"N": N, "direction": "up", "betas": up, "cap_loads": cap})
@@ -130,6 +140,7 @@ def per_n_summary(rows: pd.DataFrame) -> pd.DataFrame:
             rec["step"] = float(at["order_parameter"])
             rec["step_err"] = float(at["order_parameter_err"])
             rec["step_phi"] = float(at["stuck_fraction"])
+            rec["step_phi_err"] = float(at["stuck_fraction_err"])
             rec["m_at_beta_t_reliable"] = bool(at["err_reliable"])
             rec["tau_int_loads_at_beta_t"] = float(at["tau_int_loads"])
         left = down[down["branch_state"] == "stick-slip"]
