@@ -31,6 +31,7 @@ from typing import Any
 import numpy as np
 
 from stickslip import io
+from stickslip.jsonable import to_jsonable
 
 __all__ = ["ladder_task", "run_rung", "perturbed", "ladder_rows", "UNTIL_STEADY", "DIRECTIONS"]
 
@@ -212,6 +213,7 @@ def _rung(
     res = run_rung(params_at(cfg, beta), state, cfg, **kw)
     row = {**res["row"], "branch": cfg["direction"], "rung": index, "role": role, "start": start, "start_sha256": sha}
     row["final_sha256"] = res["state"].sha256()
+    row = to_jsonable(row)  # as a replay reads it back (NaN and inf become None)
     rdir.mkdir(parents=True, exist_ok=True)
     _save_state(rdir / "state.npz", res["state"])
     with io.atomic_path(rdir / "samples.npz") as tmp, open(tmp, "wb") as fh:
