@@ -115,3 +115,42 @@ def longer_check(ladder_dir: str | Path, index: int, cfg: dict[str, Any], factor
         "z": (res["order_parameter"] - row["order_parameter"]) / comb if comb > 0 else math.nan,
         "long_wall_seconds": res["wall_seconds"],
     }
+
+
+def write_checks(
+    study_json: str | Path,
+    runs_dir: str | Path,
+    path: str | Path,
+    *,
+    paper_Ns: tuple[int, ...] = (49, 99, 199),
+    longer: tuple[tuple[int, float], ...] = (),
+    factor: float = 4.0,
+    n_workers: int = 2,
+) -> dict[str, Any]:
+    """Both checks for a finished study (its ``study.json`` and ``runs`` folder), in parallel on a
+    local process pool, written to ``path`` as JSON: the paper-start comparison for the up
+    ladders of ``paper_Ns`` below beta = 0.95 and the longer runs of the up-ladder grid rungs
+    (N, beta) in ``longer``."""
+    from concurrent.futures import ProcessPoolExecutor
+
+    from stickslip.experiments.sweep import point_name
+
+    data = io.read_json(study_json)
+    spec = io.read_json(Path(runs_dir) / "study-spec.json")
+    rows = [r for r in data["rows"] if r["N"] in paper_Ns]
+    jobs = []
+    with ProcessPoolExecutor(n_workers) as pool:
+        paper = [pool.submit(paper_start_check, [r]) for r in rows if r["branch"] == "up" and r["beta"] < 0.95]
+        for N, beta in longer:
+            (lad,) = [p for p in spec["ladders"] if p["N"] == N and p["direction"] == "up"]
+            cfg = {**spec["common"], **lad}
+            ldir = Path(runs_dir) / "ladders" / point_name(lad)
+            (row,) = [r for r in data["rows"] if r["N"] == N and r["branch"] == "up" and r["beta"] == beta]
+            jobs.append(pool.submit(longer_check, ldir, int(row["rung"]), cfg, factor))
+        out = {
+            "paper_start": [c for f in paper for c in f.result()],
+            "longer": [f.result() for f in jobs],
+            "factor": factor,
+        }
+    io.write_json(path, out)
+    return out
