@@ -11,7 +11,40 @@ from typing import Any
 
 from stickslip import io
 
-__all__ = ["write_page"]
+__all__ = ["write_page", "ROW_COLUMNS", "PER_N_COLUMNS"]
+
+#: The leading columns of the study's rows and of its per-N table.
+ROW_COLUMNS = [
+    "N",
+    "beta",
+    "branch",
+    "order_parameter",
+    "order_parameter_err",
+    "stuck_fraction",
+    "stuck_fraction_err",
+    "final_state",
+    "branch_state",
+    "t_end",
+    "loads",
+    "tau_int_loads",
+    "t_cut_loads",
+    "err_reliable",
+    "role",
+    "start",
+    "final_reason",
+    "wall_seconds",
+]
+PER_N_COLUMNS = [
+    "N",
+    "beta_t",
+    "beta_t_err",
+    "lower_edge",
+    "lower_edge_err",
+    "step",
+    "step_err",
+    "step_phi",
+    "step_phi_err",
+]
 
 _CSS = """
 body { font-family: system-ui, sans-serif; margin: 2em auto; max-width: 76em; padding: 0 1em; color: #222; }
@@ -39,8 +72,6 @@ def _table(records: list[dict[str, Any]], cols: list[str], mark: str | None = No
 
 def write_page(path: Path, data: dict[str, Any]) -> None:
     """Write the page of one run of the study (``data`` as in ``study.json``)."""
-    from stickslip.experiments.transition_study import PER_N_COLUMNS, ROW_COLUMNS
-
     meta = data["meta"]
     parts = [
         "<!DOCTYPE html>",

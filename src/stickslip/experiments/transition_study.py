@@ -30,42 +30,12 @@ from typing import Any
 import pandas as pd
 
 from stickslip import __version__, io
+from stickslip.experiments.transition_page import PER_N_COLUMNS, ROW_COLUMNS, write_page
 
 __all__ = ["ladder_points", "run_transition", "per_n_summary", "ROW_COLUMNS", "PER_N_COLUMNS", "LADDER_NS"]
 
 #: N of each mode; ``extra_Ns`` (for example 1599) adds chains.
 LADDER_NS = {"tiny": (9,), "quick": (49, 99, 199), "full": (49, 99, 199, 399, 799)}
-ROW_COLUMNS = [
-    "N",
-    "beta",
-    "branch",
-    "order_parameter",
-    "order_parameter_err",
-    "stuck_fraction",
-    "stuck_fraction_err",
-    "final_state",
-    "branch_state",
-    "t_end",
-    "loads",
-    "tau_int_loads",
-    "t_cut_loads",
-    "err_reliable",
-    "role",
-    "start",
-    "final_reason",
-    "wall_seconds",
-]
-PER_N_COLUMNS = [
-    "N",
-    "beta_t",
-    "beta_t_err",
-    "lower_edge",
-    "lower_edge_err",
-    "step",
-    "step_err",
-    "step_phi",
-    "step_phi_err",
-]
 _PAPER = {"K": 10.0, "D": 5.0, "V": 0.001, "Fs": 3.0, "alpha": 1.0, "dt": 0.005}
 
 
@@ -274,8 +244,6 @@ def run_transition(
     }
     io.write_table_files(page / "table", table)
     io.write_json(page / "study.json", data)
-    from stickslip.experiments.transition_page import write_page
-
     write_page(page / "index.html", data)
     return {**data, "page": str(page / "index.html"), "failed": len(failed)}
 
