@@ -178,3 +178,26 @@ def test_up_ladder_agrees_with_paper_start_runs_at_n49(tmp_path):
     assert [c["beta"] for c in checks] == [0.8, 0.9]
     for c in checks:
         assert abs(c["z"]) < 3.0, c
+
+
+def test_chain_from_the_final_state_of_another_run(tmp_path):
+    """`stickslip chain --from DIR` starts from a run directory's final state and goes on in time:
+    run to 2000 then --from to 4000 ends where one run to 4000 from the same state does."""
+    first = tmp_path / "first"
+    r = run_cli_subprocess(
+        "chain", "--N", "6", "--beta", "0.8", "--t-end", "2000", "--out", str(first), "--json", "--no-progress"
+    )
+    assert r.returncode == 0, r.stderr
+    r2 = run_cli_subprocess("chain", "--N", "6", "--beta", "0.8", "--from", str(first), "--t-end", "4000", "--json")
+    assert r2.returncode == 0, r2.stderr
+    from stickslip.run.driver import run_chain
+    from stickslip.run.rundir import final_state
+
+    state = final_state(first)
+    assert state.step == 400_000
+    direct = run_chain(chain_params("sakaguchi", N=6, beta=0.8), 4000.0, start=state)
+    assert json.loads(r2.stdout)["state_sha256"] == direct.summary["state_sha256"]
+    bad = run_cli_subprocess("chain", "--N", "7", "--from", str(first), "--t-end", "4000")
+    assert bad.returncode == 2 and len(bad.stderr.strip().splitlines()) == 1
+    bad = run_cli_subprocess("chain", "--N", "6", "--from", str(first), "--start", "steady")
+    assert bad.returncode == 2
