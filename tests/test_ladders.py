@@ -89,11 +89,25 @@ def test_up_ladder_hands_states_on_and_bisects(tmp_path):
 def test_down_ladder_leaves_steady_sliding_below_one(tmp_path):
     """Linear stability of steady sliding: above beta = 1 a small kick decays, below it grows and
     blocks stick. The down ladder brackets that edge."""
+    from scipy.optimize import brentq
+
+    from stickslip.analysis.stability import chain_finite_eigenvalues
+
     res = ladder_task(_tiny_ladder("down", [2.0, 1.2, 0.8]), tmp_path)
     states = {r["beta"]: r["branch_state"] for r in res["rows"]}
     assert states[2.0] == states[1.2] == "sliding" and states[0.8] == "stick-slip"
     assert all(r["final_state"] == "steady" for r in res["rows"] if r["branch_state"] == "sliding")
-    assert 0.8 <= res["outside"] < 1.0 <= res["inside"] <= 1.2
+    # the bracket holds the linear threshold of the finite chain (0.8255 at N = 9: the longest
+    # wave it holds, k ~ pi / (2N), is stabilised by the springs), found here from its eigenvalues
+    cfg = _tiny_ladder("down", [1.0])
+
+    def growth(beta):
+        p = chain_params("sakaguchi", N=9, beta=beta, **{k: cfg[k] for k in ("K", "D", "V", "Fs", "alpha", "dt")})
+        return float(np.max(chain_finite_eigenvalues(p).real))
+
+    beta_c = brentq(growth, 0.5, 1.5, xtol=1e-9)
+    assert beta_c == pytest.approx(0.8255, abs=1e-3)
+    assert res["outside"] < beta_c < res["inside"]
 
 
 def test_per_n_summary_reads_the_loop():
