@@ -179,7 +179,6 @@ def test_run_transition_resumes_a_ladder_from_its_finished_rungs(tmp_path):
 # --- the faster method measures the same thing --------------------------------------------------
 
 
-@pytest.mark.slow
 def test_up_ladder_agrees_with_paper_start_runs_at_n49(tmp_path):
     """Below beta = 0.95 the up ladder's m at N = 49 agrees with runs of 4 loading times from the
     paper's start (second half) within 3 combined errors."""

@@ -11,7 +11,7 @@ and retried, an interrupted one continues from its last finished rung). From the
   ``lower_edge_err``; linear stability of steady sliding puts it at beta = 1;
 * ``step`` of the order parameter m at beta_t (the up ladder's m there minus steady sliding's 0)
   with ``step_err``, and ``step_phi`` of the stuck fraction;
-* power laws beta_t - 1 ~ N^b and |step| ~ N^b (:func:`stickslip.analysis.order.power_law_fit`).
+* power laws beta_t - 1 ~ N^b and (size of the step) ~ N^b (:func:`stickslip.analysis.order.power_law_fit`).
 
 Layout: ``OUT/runs/transition-<key>/ladders/<ladder>/rungs/...`` and ``OUT/transition/`` (table,
 figures, ``study.json``, ``index.html``).

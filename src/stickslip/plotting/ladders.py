@@ -61,7 +61,7 @@ def loops_figure(rows: pd.DataFrame) -> Figure:
 
 
 def scaling_figure(per_n: pd.DataFrame, fits: dict) -> Figure:
-    """beta_t(N) - 1 (left) and |step of m at beta_t| (right) against N on log axes, with the
+    """beta_t(N) - 1 (left) and the size of the step of m at beta_t (right) against N on log axes, with the
     fitted power laws A N^b."""
     fig, (ax_b, ax_s) = new_figure(1, 2, width=4.6, height=3.8)
     N = per_n["N"].to_numpy(dtype=float)
