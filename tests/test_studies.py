@@ -225,32 +225,29 @@ def test_existing_scheduler_gives_the_local_result(tmp_path):
                 proc.wait(timeout=30)
 
 
-def test_an_interrupted_study_checkpoints_its_running_point(tmp_path):
+def test_an_interrupted_study_stops_its_running_ladder(tmp_path):
     """SIGTERM to `stickslip study` (as a batch system's stop or `kill` sends it) while its worker
-    runs a point: the point writes its checkpoint before the command ends (exit 130, one line),
-    where before it lost the work since its last periodic checkpoint (120 s)."""
+    runs a ladder of the transition study: the command ends (exit 130, one line), the ladder is
+    left unfinished (no done.json, no error.json) and the next call continues it from its
+    finished rungs (tests/test_ladders.py)."""
     import signal
 
     from chain_helpers import signal_when_running
     from stickslip.experiments.sweep import STOP_FILE
-    from stickslip.models.params import ChainParams
-    from stickslip.run.driver import run_chain
 
-    run_chain(ChainParams(N=5, beta=1.4), 1.0)  # compile the point's kernel here, not in the worker
     out = tmp_path / "studies"
-    # the quick transition starts with its dearest point, N = 199 at beta = 1.4: minutes of work
+    # the quick transition starts with its dearest ladder, N = 199 up: minutes of work
     argv = ["study", "transition", "--quick", "--workers", "1", "--out", str(out), "--no-progress"]
     status, stdout, stderr = signal_when_running(
-        argv, lambda: bool(list(out.glob("runs/*/points/*/point.json"))), signal.SIGTERM, settle=3.0
+        argv, lambda: bool(list(out.glob("runs/*/ladders/*/point.json"))), signal.SIGTERM, settle=3.0
     )
     assert status == 130, stderr
     assert stdout == ""
     assert len(stderr.splitlines()) == 1 and "interrupted" in stderr, stderr
-    (point,) = [p.parent for p in out.glob("runs/*/points/*/point.json")]
-    assert point.name.startswith("beta=1.4_N=199")
-    assert (point / "checkpoint" / "state.npz").is_file()
-    assert not (point / "error.json").exists() and not (point / "done.json").exists()
-    assert not (point.parent / STOP_FILE).exists()
+    (ladder,) = [p.parent for p in out.glob("runs/*/ladders/*/point.json")]
+    assert ladder.name.endswith("direction=up_N=199")
+    assert not (ladder / "error.json").exists() and not (ladder / "done.json").exists()
+    assert not (ladder.parent / STOP_FILE).exists()
 
 
 def test_sample_moving_leaves_the_run_unchanged(tmp_path):

@@ -33,6 +33,7 @@ def register(sub) -> None:
         p, helps={"N": "number of blocks N (default the preset's: 399 for the paper's chain; 49 without --t-end)"}
     )
     _add_run_options(p)
+    _add_from_option(p)
     p.add_argument(
         "--integrator",
         choices=("exact", "dense"),
@@ -172,6 +173,17 @@ def _add_run_options(p: argparse.ArgumentParser) -> None:
     )
 
 
+def _add_from_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--from",
+        dest="from_dir",
+        default=None,
+        metavar="DIR",
+        help="start from the final state of another run: a run directory or a rung of the transition "
+        "study (DIR/state.npz); its time goes on, so --t-end is the end time, not a duration",
+    )
+
+
 def _events_text(summary: dict, N: int | None) -> str:
     """The events line; a chain with every block moving in an unfinished event is said to slide."""
     text = f"events         {summary['n_events']}"
@@ -222,6 +234,7 @@ def _json_summary(summary: dict, out: Path | None) -> dict:
 
 
 _FIXED_BY_CHECKPOINT = (
+    "from_dir",
     "integrator",
     "start",
     "perturbation",
@@ -287,6 +300,7 @@ def run_chain_command(args: argparse.Namespace) -> Result:
         )
 
     params = chain_params_from_args(args)
+    from_state = _from_state(params, args)
     start, amplitude, seed = _start_of(params, args)
     params, t_end = _first_look(params, args, start) if args.t_end is None else (params, args.t_end)
     args.start, args.perturbation, args.seed = start, amplitude, seed
@@ -339,7 +353,7 @@ def run_chain_command(args: argparse.Namespace) -> Result:
                 params,
                 t_end,
                 integrator=args.integrator,
-                start=args.start,
+                start=args.start if from_state is None else from_state,
                 perturbation=args.perturbation,
                 seed=args.seed,
                 sample_interval=args.sample_interval,
@@ -379,6 +393,33 @@ def _first_look(params, args, start: str):
         if t_end == t_end:
             return looked, t_end
     return params, 2e4
+
+
+def _from_state(params, args):
+    """The state named by --from, checked against the run's N and --t-end; None without --from."""
+    if getattr(args, "from_dir", None) is None:
+        return None
+    from stickslip.run.rundir import final_state
+
+    for flag, value in (
+        ("--start", args.start),
+        ("--perturbation", args.perturbation),
+        ("--amplitude", args.amplitude),
+    ):
+        if value is not None:
+            raise CommandError(f"{flag} cannot be combined with --from (the state of the run named there is the start)")
+    try:
+        state = final_state(args.from_dir)
+    except (OSError, ValueError, KeyError) as exc:
+        raise CommandError(f"--from: {exc}") from None
+    if state.N != params.N:
+        raise CommandError(f"--from: the state there has {state.N} blocks, the run N = {params.N} (give --N {state.N})")
+    t0 = state.step * params.dt
+    if args.t_end is not None and args.t_end <= t0:
+        raise CommandError(f"--t-end must be after the start state's time {t0:g} (got {args.t_end:g})")
+    if args.t_end is None:
+        args.t_end = t0 + 2e4
+    return state
 
 
 def _start_of(params, args) -> tuple[str, float, int]:

@@ -64,6 +64,14 @@ def register(sub) -> None:
     )
     mode.add_argument("--tiny", dest="mode", action="store_const", const="tiny", help=argparse.SUPPRESS)
     p.set_defaults(mode="quick")
+    p.add_argument(
+        "--extra-n",
+        type=int,
+        action="append",
+        default=[],
+        metavar="N",
+        help="transition only: add a chain of N blocks (both ladders), e.g. 1599; repeatable",
+    )
     p.add_argument("--out", default=DEFAULT_OUT, metavar="DIR", help=f"output directory (default {DEFAULT_OUT})")
     add_overwrite_option(p)
     add_dask_options(p)
@@ -74,12 +82,15 @@ def register(sub) -> None:
 def run(args: argparse.Namespace) -> Result:
     """Handler of ``stickslip study``: the output folder is checked and locked before the first
     point starts (:func:`_claim`)."""
-    from stickslip.experiments.studies import study
     from stickslip.experiments.study_run import run_study
 
     _, workers = dask_options(args)
-    spec = study(args.name, args.mode)
+    if args.extra_n and (args.name != "transition" or min(args.extra_n) < 3):
+        raise CommandError("--extra-n takes chains of at least 3 blocks, for the transition study only")
+    spec = _spec(args)
     with _claim(args.out, spec, overwrite=args.overwrite) as out:
+        if args.name == "transition":
+            return _transition(args, out, workers)
         try:
             with sigterm_as_interrupt():
                 result = run_study(
@@ -138,6 +149,54 @@ def _claim(path: str, spec, *, overwrite: bool) -> Iterator[Path]:
         if is_disk_full(exc) or out.is_dir():
             raise
         raise CommandError(f"cannot create output directory {out}: {exc.strerror}") from None
+
+
+def _spec(args: argparse.Namespace):
+    """The spec whose folder the study owns: the study's, or for ``transition`` (run by
+    continuation in beta) its name and runs folder."""
+    from stickslip.experiments.studies import study
+
+    if args.name == "transition":
+        from stickslip.experiments.transition_study import study_folder
+
+        return study_folder(args.mode, tuple(args.extra_n))
+    return study(args.name, args.mode)
+
+
+def _transition(args: argparse.Namespace, out, workers) -> Result:
+    """The transition study by continuation in beta (:mod:`stickslip.experiments.transition_study`)."""
+    import shlex
+    import sys
+
+    from stickslip.experiments.transition_study import run_transition
+
+    command = "stickslip " + " ".join(shlex.quote(a) for a in sys.argv[1:])
+    try:
+        with sigterm_as_interrupt():
+            result = run_transition(
+                out,
+                args.mode,
+                extra_Ns=tuple(args.extra_n),
+                scheduler=args.scheduler,
+                n_workers=workers,
+                progress=not args.no_progress,
+                command=command,
+                dashboard=args.dashboard,
+            )
+    except KeyboardInterrupt:
+        return interrupted("study", out, f"finished rungs in {out} are kept; the ladders continue from them")
+    except OSError as exc:
+        if is_disk_full(exc):
+            raise
+        raise CommandError(f"cannot run the study: {exc}") from None
+    meta = result["meta"]
+    lines = [
+        f"stickslip study transition --{meta['mode']}: {meta['ladders']} ladders ({meta['failed']} failed), "
+        f"{meta['rungs']} rungs, {meta['wall_seconds']} s"
+    ]
+    lines += [f"  {s}" for s in result["statements"]]
+    lines.append(f"page: {result['page']}")
+    return Result(result, "\n".join(lines), status=1 if result["failed"] else 0)
 
 
 def _text(result: dict) -> str:

@@ -310,7 +310,7 @@ MANIFEST = ".stickslip-study.json"
 #: The files of a study's page besides its figures.
 PAGE_FILES = ("table.parquet", "table.csv", "study.json", "index.html")
 #: What a study's runs folder (runs/<name>-<key>/) holds besides its points folder.
-RUNS_FILES = frozenset({"study-spec.json", "points"})
+RUNS_FILES = frozenset({"study-spec.json", "points", "ladders"})
 
 
 def read_manifest(out: Path) -> set[str]:
@@ -366,7 +366,7 @@ def foreign_files(out: str | Path, spec: Study) -> list[str]:
         return (path.is_file() and path.name in summary) or (path / POINT_FILE).is_file()
 
     def study_runs(path: Path, rel: str):
-        if path.name == "points" and path.is_dir():
+        if path.name in ("points", "ladders") and path.is_dir():  # a transition study's are ladders
             return points
         return path.name == "study-spec.json" and path.is_file()
 

@@ -225,6 +225,19 @@ RUN_FILES = ("run.json", "state.nc", "events.parquet", "events.csv", "first_move
 OWN_FILES = frozenset({*RUN_FILES, "checkpoint", RUN_ID_FILE, *LOCK_FILES})
 
 
+def final_state(path: str | Path) -> ChainState:
+    """The final state of another run, as a start: a run directory (its ``state.nc``: x, v, theta,
+    stopped and the step count, so the time goes on) or a rung of the transition study (its
+    ``state.npz``, every array of the state). Raises ValueError (one line) if there is neither."""
+    path = Path(path)
+    if (path / "state.npz").is_file():
+        with np.load(path / "state.npz") as z:
+            return ChainState(**{k: z[k].copy() for k in ChainState.ARRAYS})
+    if (path / "run.json").is_file() and (path / "state.nc").is_file():
+        return load_run(path).state
+    raise ValueError(f"{path} holds no finished run (run.json and state.nc) and no study rung (state.npz)")
+
+
 def is_temporary(name: str) -> bool:
     """A file name of :func:`stickslip.io.atomic_path` (``.NAME.XXXX.tmp``), left only by a killed write."""
     return name.startswith(".") and name.endswith(".tmp")

@@ -1,0 +1,99 @@
+"""When a run of the chain (eq. 4) has measured its order parameter: transient, error, stop.
+
+A point of the transition study runs in segments; after each one :func:`assess` looks at the
+samples so far and says whether the point may stop. Three pieces:
+
+* the transient after a start or a hand-over is found and dropped by the marginal standard
+  error rule (MSER, White 1997; MSER-5: on means of 5 samples): the cut d minimises
+  var(x[d:]) / (n - d)^2 over the first half of the series, so a drift at the start is cut
+  exactly as long as it raises the error of the mean more than the lost samples do;
+* the order parameter m = 1 - <L>/L_ss (:mod:`stickslip.analysis.order`) and the second order
+  parameter, the time-averaged fraction of stuck blocks ``phi = 1 - <n_moving>/N``, which is zero
+  in steady sliding by construction (every block moves) and positive in stick-slip;
+* the stop rule: the batch-means error of m below a target with at least
+  :data:`~stickslip.analysis.order.MIN_BATCHES` batches of
+  :data:`~stickslip.analysis.order.BATCH_TAUS` tau_int each.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+from typing import Any
+
+import numpy as np
+
+from stickslip.analysis.order import MeanEstimate, mean_with_error
+
+__all__ = ["mser_cut", "Assessment", "assess", "STUCK_SLIDING"]
+
+#: A kept window whose time-averaged stuck fraction is below this is sliding (no block sticks).
+STUCK_SLIDING = 1e-3
+#: Samples per block of the MSER rule (MSER-5).
+MSER_BLOCK = 5
+
+
+def mser_cut(x: np.ndarray, block: int = MSER_BLOCK) -> int:
+    """Number of leading samples of ``x`` to drop as transient (MSER-``block``, White 1997).
+
+    The series is cut into means of ``block`` samples y_j; the cut d (in blocks) minimises
+    sum_{j>=d} (y_j - mean(y[d:]))^2 / (n - d)^2 over d <= n / 2. Returns d * block samples.
+    A constant series gives 0.
+    """
+    x = np.asarray(x, dtype=float)
+    n = x.size // block
+    if n < 4:
+        return 0
+    y = x[: n * block].reshape(n, block).mean(axis=1)
+    # suffix sums give every tail's mean and sum of squares at once
+    s1 = np.cumsum(y[::-1])[::-1]
+    s2 = np.cumsum((y * y)[::-1])[::-1]
+    k = np.arange(n, 0, -1, dtype=float)
+    ss = s2 - s1 * s1 / k
+    half = n // 2 + 1
+    crit = ss[:half] / (k[:half] * k[:half])
+    return int(np.argmin(crit)) * block
+
+
+@dataclass(frozen=True)
+class Assessment:
+    """What the samples of one point say: ``m`` and ``phi`` (estimates over the kept window),
+    ``t_cut`` (start of the kept window), ``decided`` (the stop rule holds), ``sliding`` (no block
+    stuck in the kept window), ``reason`` (one line)."""
+
+    m: MeanEstimate
+    phi: MeanEstimate
+    t_cut: float
+    decided: bool
+    sliding: bool
+    reason: str
+
+    def to_dict(self) -> dict[str, Any]:
+        out = {f"m_{k}": v for k, v in asdict(self.m).items()}
+        out.update({f"phi_{k}": v for k, v in asdict(self.phi).items()})
+        out.update(t_cut=self.t_cut, decided=self.decided, sliding=self.sliding, reason=self.reason)
+        return out
+
+
+def assess(t: np.ndarray, m: np.ndarray, phi: np.ndarray, target: float) -> Assessment:
+    """Drop the transient of the order parameter ``m`` sampled at times ``t`` (MSER on m and on
+    the stuck fraction ``phi``, the later cut wins) and test the stop rule: batch-means error of m
+    below ``target`` from at least 8 batches of 10 tau_int."""
+    t, m, phi = (np.asarray(a, dtype=float) for a in (t, m, phi))
+    if t.size < 4 * MSER_BLOCK:
+        empty = mean_with_error(m)
+        return Assessment(empty, mean_with_error(phi), float(t[0]) if t.size else 0.0, False, False, "too few samples")
+    cut = max(mser_cut(m), mser_cut(phi))
+    m_est, phi_est = mean_with_error(m[cut:]), mean_with_error(phi[cut:])
+    sliding = bool(phi_est.mean < STUCK_SLIDING)
+    decided = bool(m_est.reliable and math.isfinite(m_est.err) and m_est.err < target)
+    if decided:
+        reason = (
+            f"error of m {m_est.err:.2g} < {target:g} from {m_est.n_batches} batches of "
+            f"{m_est.batch} samples (tau_int {m_est.tau_int:.3g} samples)"
+        )
+    elif not m_est.reliable:
+        reason = f"fewer than 8 batches of 10 tau_int (tau_int {m_est.tau_int:.3g} samples, {m_est.n} kept)"
+    else:
+        reason = f"error of m {m_est.err:.2g} above the target {target:g}"
+    return Assessment(m_est, phi_est, float(t[cut]), decided, sliding, reason)

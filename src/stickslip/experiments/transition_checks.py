@@ -1,0 +1,156 @@
+"""Checks that the transition study by continuation measures what the runs from the paper's start
+measure (:mod:`stickslip.experiments.transition_study`).
+
+* :func:`paper_start_check`: m = 1 - <L>/L_ss from the paper's start (x_i = 0, section 3) over the
+  second half of a run of 4 loading times (the old study's estimator,
+  :func:`stickslip.experiments.studies.order_summary`) against the up ladder's m at the same
+  (N, beta): the difference in units of the combined error.
+* :func:`longer_check`: a rung run again from the same start state for ``factor`` times its
+  adaptive length, without the stop rule; its m against the adaptive one.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+from stickslip import io
+
+__all__ = ["paper_start_m", "paper_start_check", "longer_check", "rung_start_state"]
+
+
+def paper_start_m(N: int, beta: float, loads: float = 4.0) -> dict[str, Any]:
+    """m and its batch-means error over the second half of a run of ``loads`` loading times of the
+    chain of eq. (4) from the paper's start (the estimator of the point-by-point study)."""
+    from stickslip.experiments.studies import _PAPER, _t_end, order_summary
+    from stickslip.models.presets import chain_params
+    from stickslip.run.driver import run_chain
+
+    p = chain_params("sakaguchi", N=N, beta=beta, **_PAPER)
+    t_end = _t_end(N, loads)
+    run = run_chain(
+        p,
+        t_end,
+        start="paper",
+        sample_interval=t_end / 20000,
+        average_from=0.5 * t_end,
+        sample_moving=True,
+        until_steady=1e-6,
+    )
+    s = order_summary(run, p, 0.5 * t_end)
+    return {
+        "N": N,
+        "beta": beta,
+        "paper_m": s["order_parameter"],
+        "paper_m_err": s["order_parameter_err"],
+        "paper_stuck_any": s["stuck_fraction"],
+        "paper_t_end": t_end,
+        "paper_wall_seconds": float(run.summary["wall_seconds"]),
+    }
+
+
+def paper_start_check(
+    rows: list[dict[str, Any]], betas_below: float = 0.95, loads: float = 4.0
+) -> list[dict[str, Any]]:
+    """For every up-ladder row below ``betas_below``: its m, the paper-start m of
+    :func:`paper_start_m`, and the difference over the combined error (``z``)."""
+    out = []
+    for r in rows:
+        if r["branch"] != "up" or r["beta"] >= betas_below:
+            continue
+        ref = paper_start_m(int(r["N"]), float(r["beta"]), loads)
+        comb = math.hypot(r["order_parameter_err"], ref["paper_m_err"])
+        out.append(
+            {
+                **ref,
+                "ladder_m": r["order_parameter"],
+                "ladder_m_err": r["order_parameter_err"],
+                "ladder_loads": r["loads"],
+                "ladder_wall_seconds": r["wall_seconds"],
+                "z": (r["order_parameter"] - ref["paper_m"]) / comb if comb > 0 else math.nan,
+            }
+        )
+    return out
+
+
+def rung_start_state(ladder_dir: str | Path, index: int, cfg: dict[str, Any]):
+    """The state rung ``index`` of an up ladder started from: the loaded start for rung 0, else the
+    final state of rung ``index - 1`` (grid rungs of the up ladder hand over so); checked against
+    the SHA-256 the rung recorded."""
+    from stickslip.experiments.ladders import _load_state, params_at
+    from stickslip.run.state import ChainState
+
+    rungs = sorted((Path(ladder_dir) / "rungs").iterdir())
+    rec = io.read_json(rungs[index] / "rung.json")
+    if index == 0:
+        state = ChainState.steady(params_at(cfg, rec["row"]["beta"]), float(cfg["perturbation"]), int(cfg["seed"]))
+    else:
+        state = _load_state(rungs[index - 1] / "state.npz")
+    if state.sha256() != rec["start_sha256"]:
+        raise ValueError(f"rung {index} in {ladder_dir} did not start from the state before it")
+    return state, rec["row"]
+
+
+def longer_check(ladder_dir: str | Path, index: int, cfg: dict[str, Any], factor: float = 4.0) -> dict[str, Any]:
+    """Rung ``index`` run again from its start for ``factor`` times its adaptive length (no stop
+    rule, the same transient cut): its m and error against the adaptive ones."""
+    from stickslip.experiments.ladders import params_at, run_rung
+
+    state, row = rung_start_state(ladder_dir, index, cfg)
+    long_cfg = {**cfg, "target": 0.0, "cap_loads": factor * float(row["loads"])}
+    res = run_rung(params_at(cfg, row["beta"]), state, long_cfg)["row"]
+    comb = math.hypot(row["order_parameter_err"], res["order_parameter_err"])
+    return {
+        "N": row["N"],
+        "beta": row["beta"],
+        "adaptive_m": row["order_parameter"],
+        "adaptive_m_err": row["order_parameter_err"],
+        "adaptive_loads": row["loads"],
+        "long_m": res["order_parameter"],
+        "long_m_err": res["order_parameter_err"],
+        "long_loads": res["loads"],
+        "adaptive_phi": row["stuck_fraction"],
+        "long_phi": res["stuck_fraction"],
+        "z": (res["order_parameter"] - row["order_parameter"]) / comb if comb > 0 else math.nan,
+        "long_wall_seconds": res["wall_seconds"],
+    }
+
+
+def write_checks(
+    study_json: str | Path,
+    runs_dir: str | Path,
+    path: str | Path,
+    *,
+    paper_Ns: tuple[int, ...] = (49, 99, 199),
+    longer: tuple[tuple[int, float], ...] = (),
+    factor: float = 4.0,
+    n_workers: int = 2,
+) -> dict[str, Any]:
+    """Both checks for a finished study (its ``study.json`` and ``runs`` folder), in parallel on a
+    local process pool, written to ``path`` as JSON: the paper-start comparison for the up
+    ladders of ``paper_Ns`` below beta = 0.95 and the longer runs of the up-ladder grid rungs
+    (N, beta) in ``longer``."""
+    from concurrent.futures import ProcessPoolExecutor
+
+    from stickslip.experiments.sweep import point_name
+
+    data = io.read_json(study_json)
+    spec = io.read_json(Path(runs_dir) / "study-spec.json")
+    rows = [r for r in data["rows"] if r["N"] in paper_Ns]
+    jobs = []
+    with ProcessPoolExecutor(n_workers) as pool:
+        paper = [pool.submit(paper_start_check, [r]) for r in rows if r["branch"] == "up" and r["beta"] < 0.95]
+        for N, beta in longer:
+            (lad,) = [p for p in spec["ladders"] if p["N"] == N and p["direction"] == "up"]
+            cfg = {**spec["common"], **lad}
+            ldir = Path(runs_dir) / "ladders" / point_name(lad)
+            (row,) = [r for r in data["rows"] if r["N"] == N and r["branch"] == "up" and r["beta"] == beta]
+            jobs.append(pool.submit(longer_check, ldir, int(row["rung"]), cfg, factor))
+        out = {
+            "paper_start": [c for f in paper for c in f.result()],
+            "longer": [f.result() for f in jobs],
+            "factor": factor,
+        }
+    io.write_json(path, out)
+    return out

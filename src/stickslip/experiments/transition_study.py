@@ -1,0 +1,271 @@
+"""``stickslip study transition``: the stick-slip transition of eq. (4) at beta = 1 as N grows, by
+continuation in beta (:mod:`stickslip.experiments.ladders`).
+
+For each N an ``up`` and a ``down`` ladder run as independent Dask tasks
+(:func:`stickslip.experiments.sweep.run_sweep`: a finished ladder is reused, a failed one recorded
+and retried, an interrupted one continues from its last finished rung). From the rungs:
+
+* ``beta_t`` (last beta where the up ladder stick-slips) and ``beta_t_err`` (half the bracket to the
+  first sliding beta, after bisection);
+* ``lower_edge`` (middle of the bracket where the down ladder first leaves steady sliding) and
+  ``lower_edge_err``; linear stability of steady sliding puts it at beta = 1;
+* ``step`` of the order parameter m at beta_t (the up ladder's m there minus steady sliding's 0)
+  with ``step_err``, and ``step_phi`` of the stuck fraction;
+* power laws beta_t - 1 ~ N^b and (size of the step) ~ N^b (:func:`stickslip.analysis.order.power_law_fit`).
+
+Layout: ``OUT/runs/transition-<key>/ladders/<ladder>/rungs/...`` and ``OUT/transition/`` (table,
+figures, ``study.json``, ``index.html``).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import os
+import time
+from pathlib import Path
+from types import SimpleNamespace
+from typing import Any
+
+import pandas as pd
+
+from stickslip import __version__, io
+from stickslip.experiments.study_run import PAGE_FILES, record_outputs
+from stickslip.experiments.transition_page import PER_N_COLUMNS, ROW_COLUMNS, write_page
+
+__all__ = ["ladder_points", "run_transition", "per_n_summary", "ROW_COLUMNS", "PER_N_COLUMNS", "LADDER_NS"]
+
+#: N of each mode; ``extra_Ns`` (for example 1599) adds chains.
+LADDER_NS = {"tiny": (9,), "quick": (49, 99, 199), "full": (49, 99, 199, 399, 799)}
+_PAPER = {"K": 10.0, "D": 5.0, "V": 0.001, "Fs": 3.0, "alpha": 1.0, "dt": 0.005}
+
+
+def _cap_loads(N: int) -> float:
+    """The cap of one rung in loading times: long enough for 8 batches of 10 tau_int at small N
+    (tau_int of L is 0.013-0.04 loading times), shorter where a loading time costs minutes."""
+    if N <= 199:
+        return 4.0
+    if N <= 399:
+        return 2.5
+    if N <= 799:
+        return 1.2
+    return 0.3
+
+
+def _grids(N: int, mode: str) -> tuple[list[float], list[float]]:
+    """Coarse grids in beta of the up and down ladders: steps in 1 + k / N, where beta_t(N) lies
+    for small N (about 1 + 15 / N), and a few points below 1."""
+    ks = (5, 10, 20, 40, 80)
+    above = [round(1.0 + k / N, 6) for k in ks]
+    if mode == "tiny":
+        return [0.8, 2.0, 4.0], [2.0, 1.2, 0.8]
+    below_up = [0.8, 0.9, 1.0] if N <= 199 else [0.95, 1.0]
+    down = sorted(above[:4] + [round(1.0 + 2.0 / N, 6), 1.0, 0.97, 0.9], reverse=True)
+    return below_up + above, down
+
+
+def ladder_points(mode: str, extra_Ns: tuple[int, ...] = ()) -> tuple[dict[str, Any], list[dict[str, Any]]]:
+    """The shared settings and the ladders (one per N and direction) of a mode; large N first (the
+    up ladder of the largest chain is the longest task: it sets the wall time on a few workers)."""
+    Ns = tuple(sorted(set(LADDER_NS[mode]) | set(int(n) for n in extra_Ns)))
+    common = {
+        **_PAPER,
+        "model": "sakaguchi",
+        "target": 0.006,
+        "segment_loads": 0.25,
+        "first_segment_loads": 0.02,
+        "samples_per_load": 2000 if mode != "tiny" else 400,
+        "perturbation": 1e-3,
+        "down_perturbation": 1e-5,
+        "seed": 0,
+        "bisections": 3 if mode != "tiny" else 1,
+    }
+    points = []
+    for N in sorted(Ns, reverse=True):
+        up, down = _grids(N, mode)
+        cap = _cap_loads(N) if mode != "tiny" else 1.0
+        points.append({"N": N, "direction": "up", "betas": up, "cap_loads": cap})
+        points.append({"N": N, "direction": "down", "betas": down, "cap_loads": cap})
+    return common, points
+
+
+def study_folder(mode: str, extra_Ns: tuple[int, ...] = ()) -> SimpleNamespace:
+    """What the study of ``mode`` owns in its output folder: the page folder ``name`` and the runs
+    folder ``runs/<dirname>`` (the :class:`~stickslip.experiments.studies.Study` fields the
+    folder's owner reads)."""
+    common, _ = ladder_points(mode, extra_Ns)
+    return SimpleNamespace(name="transition", dirname=f"transition-{_key(common)}")
+
+
+def _key(common: dict[str, Any]) -> str:
+    text = json.dumps({"study": "transition-ladders", "common": common, "version": __version__}, sort_keys=True)
+    return hashlib.sha256(text.encode()).hexdigest()[:12]
+
+
+def per_n_summary(rows: pd.DataFrame) -> pd.DataFrame:
+    """Per N: beta_t, its error, the lower edge, its error, the step of m at beta_t and its error."""
+    out = []
+    for N, g in rows.groupby("N"):
+        up, down = g[g["branch"] == "up"], g[g["branch"] == "down"]
+        rec: dict[str, Any] = {"N": int(N), **{k: math.nan for k in PER_N_COLUMNS[1:]}}
+        stick = up[up["branch_state"] == "stick-slip"]
+        if len(stick):
+            bt = float(stick["beta"].max())
+            above = up[(up["branch_state"] == "sliding") & (up["beta"] > bt)]
+            rec["beta_t"] = bt
+            if len(above):
+                rec["beta_t_err"] = 0.5 * (float(above["beta"].min()) - bt)
+            at = stick[stick["beta"] == bt].iloc[-1]
+            rec["step"] = float(at["order_parameter"])
+            rec["step_err"] = float(at["order_parameter_err"])
+            rec["step_phi"] = float(at["stuck_fraction"])
+            rec["step_phi_err"] = float(at["stuck_fraction_err"])
+            rec["m_at_beta_t_reliable"] = bool(at["err_reliable"])
+            rec["tau_int_loads_at_beta_t"] = float(at["tau_int_loads"])
+        left = down[down["branch_state"] == "stick-slip"]
+        if len(left):
+            lo = float(left["beta"].max())
+            above = down[(down["branch_state"] == "sliding") & (down["beta"] > lo)]
+            if len(above):
+                hi = float(above["beta"].min())
+                rec["lower_edge"], rec["lower_edge_err"] = 0.5 * (lo + hi), 0.5 * (hi - lo)
+        rec["undecided"] = int((g["final_state"] == "undecided").sum())
+        rec["rungs"] = len(g)
+        out.append(rec)
+    return pd.DataFrame(out)
+
+
+def _fits(per_n: pd.DataFrame) -> dict[str, Any]:
+    from stickslip.analysis.order import power_law_fit
+
+    fits = {}
+    ok = per_n.dropna(subset=["beta_t"])
+    fits["beta_t_minus_1"] = power_law_fit(ok["N"], ok["beta_t"] - 1.0, ok["beta_t_err"].fillna(ok["beta_t"] - 1.0))
+    ok = per_n.dropna(subset=["step"])
+    fits["step"] = power_law_fit(ok["N"], ok["step"].abs(), ok["step_err"])
+    return fits
+
+
+def _statements(per_n: pd.DataFrame, fits: dict[str, Any], rows: pd.DataFrame) -> list[str]:
+    say = []
+    for r in per_n.itertuples():
+        say.append(
+            f"N = {r.N}: beta_t = {r.beta_t:.4g} +- {r.beta_t_err:.2g}, lower edge {r.lower_edge:.4g} "
+            f"+- {r.lower_edge_err:.2g}, step of m at beta_t {r.step:.3g} +- {r.step_err:.2g}, "
+            f"stuck fraction there {r.step_phi:.3g}"
+        )
+    for name, label in (("beta_t_minus_1", "beta_t - 1"), ("step", "|step of m|")):
+        f = fits[name]
+        if math.isfinite(f["b"]):
+            say.append(f"{label} ~ N^b with b = {f['b']:.2f} +- {f['b_err']:.2f} ({f['n']} values of N)")
+    n_und = int((rows["final_state"] == "undecided").sum())
+    say.append(f"{n_und} of {len(rows)} rungs undecided at their cap (reasons in the table)")
+    return say
+
+
+def _figures(rows: pd.DataFrame, per_n: pd.DataFrame, fits: dict[str, Any], out: Path) -> list[str]:
+    from stickslip.plotting.ladders import loops_figure, scaling_figure
+    from stickslip.plotting.style import FIGURE_FORMATS, save_figure
+
+    names = []
+    for name, fig in (("loops", loops_figure(rows)), ("scaling", scaling_figure(per_n, fits))):
+        record_outputs(out.parent, [out / f"{name}.{fmt}" for fmt in FIGURE_FORMATS])
+        save_figure(fig, out / name)  # atomic: a full disk leaves no half-written image
+        names.append(f"{name}.png")
+    return names
+
+
+def run_transition(
+    out_dir: str | Path,
+    mode: str = "quick",
+    *,
+    extra_Ns: tuple[int, ...] = (),
+    scheduler: str | None = None,
+    n_workers: int | None = None,
+    progress: bool = True,
+    command: str | None = None,
+    dashboard: bool = False,
+) -> dict[str, Any]:
+    """Run (or resume) every ladder of the transition study and write its table, figures and page
+    under ``out_dir/transition``. Returns the rows, the per-N summary, the fits and the run's
+    wall time, workers and cores."""
+    from stickslip.experiments.ladders import ladder_task
+    from stickslip.experiments.sweep import STOP_WAIT_SECONDS, _on_terminal, point_name, run_sweep
+
+    t0 = time.perf_counter()
+    common, points = ladder_points(mode, extra_Ns)
+    out = Path(out_dir)
+    run_dir = out / "runs" / f"transition-{_key(common)}"
+    page = out / "transition"
+    io.write_json(run_dir / "study-spec.json", {"common": common, "ladders": points, "version": __version__})
+    result = run_sweep(
+        ladder_task,
+        points,
+        run_dir / "ladders",
+        common=common,
+        scheduler=scheduler,
+        n_workers=n_workers,
+        progress=progress and _on_terminal(),
+        stop_wait=STOP_WAIT_SECONDS,
+        dashboard=dashboard,
+    )
+    rows: list[dict[str, Any]] = []
+    failed = []
+    for p in points:
+        d = run_dir / "ladders" / point_name(p)
+        try:
+            rec = io.read_json(d / "done.json")
+            rows += rec["summary"]["rows"]
+        except (OSError, ValueError, KeyError):
+            err = d / "error.json"
+            failed.append({"ladder": point_name(p), "error": io.read_json(err).get("error") if err.is_file() else None})
+    table = pd.DataFrame(rows)
+    if len(table):
+        table = table[[c for c in ROW_COLUMNS if c in table] + [c for c in table if c not in ROW_COLUMNS]]
+        table = table.sort_values(["N", "branch", "beta"], kind="stable").reset_index(drop=True)
+    per_n = per_n_summary(table) if len(table) else pd.DataFrame(columns=PER_N_COLUMNS)
+    fits = _fits(per_n) if len(per_n) else {}
+    page.mkdir(parents=True, exist_ok=True)
+    figures = _figures(table, per_n, fits, page) if len(table) else []
+    wall = time.perf_counter() - t0
+    meta = {
+        "study": "transition",
+        "mode": mode,
+        "command": command or f"stickslip study transition --{mode}",
+        "version": __version__,
+        "wall_seconds": round(wall, 1),
+        "workers": n_workers or os.cpu_count(),
+        "cores": os.cpu_count(),
+        "ladders": len(points),
+        "ladders_run": result.n_run,
+        "ladders_reused": result.n_reused,
+        "ladders_damaged": result.n_damaged,  # cached ladders run again: their files were damaged
+        "failed": len(failed),
+        "rungs": len(table),
+        "undecided": int((table["final_state"] == "undecided").sum()) if len(table) else 0,
+        "runs": str(run_dir),
+    }
+    statements = _statements(per_n, fits, table) if len(table) else []
+    data = {
+        "meta": meta,
+        "statements": statements,
+        "fits": fits,
+        "per_N": _records(per_n),
+        "rows": _records(table),
+        "figures": figures,
+        "failed_ladders": failed,
+    }
+    record_outputs(out, [page / n for n in PAGE_FILES])
+    io.write_table_files(page / "table", table)
+    io.write_json(page / "study.json", data)
+    write_page(page / "index.html", data)
+    return {**data, "page": str(page / "index.html"), "failed": len(failed)}
+
+
+def _records(table: pd.DataFrame) -> list[dict[str, Any]]:
+    from stickslip.jsonable import to_jsonable
+
+    if not len(table):
+        return []
+    return to_jsonable(table.astype(object).where(table.notna(), None).to_dict(orient="records"))

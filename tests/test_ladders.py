@@ -1,0 +1,216 @@
+"""The transition study by continuation in beta: transient cut, stop rule, ladders, resume, checks."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+from scipy.signal import lfilter
+
+from chain_helpers import run_cli_subprocess
+from stickslip.analysis.adaptive import assess, mser_cut
+from stickslip.experiments.ladders import ladder_task, perturbed
+from stickslip.experiments.transition_study import PER_N_COLUMNS, ladder_points, per_n_summary, run_transition
+from stickslip.models.presets import chain_params
+from stickslip.run.state import ChainState
+
+
+def _ar1(rng, phi: float, n: int) -> np.ndarray:
+    return lfilter([1.0], [1.0, -phi], rng.normal(size=n + 2000))[2000:]
+
+
+# --- the transient and the stop rule -----------------------------------------------------------
+
+
+def test_mser_cuts_a_decaying_start_and_nothing_of_a_stationary_series():
+    rng = np.random.default_rng(1)
+    noise = _ar1(rng, 0.5, 4000)
+    drift = np.concatenate([np.linspace(30.0, 0.0, 600), np.zeros(3400)])
+    cut = mser_cut(noise + drift)
+    assert 400 <= cut <= 900  # the drift (600 samples, 30 sigma at its start) is dropped
+    assert mser_cut(noise) < 400  # a stationary series keeps nearly everything
+    assert mser_cut(np.full(1000, 2.5)) == 0
+
+
+def test_stop_rule_needs_eight_batches_of_ten_tau_and_the_target():
+    rng = np.random.default_rng(2)
+    x = 0.01 * _ar1(rng, 0.9, 20000)  # tau_int = 19 samples
+    t = np.arange(x.size, dtype=float)
+    phi = np.full(x.size, 0.9)
+    ok = assess(t, x, phi, target=1e-2)
+    assert ok.decided and ok.m.reliable and ok.m.n_batches >= 8 and not ok.sliding
+    assert not assess(t, x, phi, target=1e-6).decided  # error above the target
+    short = assess(t[:120], x[:120], phi[:120], target=1.0)  # fewer than 8 batches of 10 tau_int
+    assert not short.decided and "fewer than 8 batches" in short.reason
+    assert assess(t, x, np.zeros(x.size), target=1e-2).sliding  # no block stuck: phi = 0
+
+
+def test_perturbed_moves_only_moving_blocks_and_is_seeded():
+    p = chain_params("sakaguchi", N=7, beta=1.2)
+    s = ChainState.steady(p)
+    s.mov[3] = 0.0
+    a, b = perturbed(s, 1e-5, 4), perturbed(s, 1e-5, 4)
+    assert a.sha256() == b.sha256() != perturbed(s, 1e-5, 5).sha256()
+    d = a.x[1:-1] - s.x[1:-1]
+    assert d[2] == 0.0 and np.all(np.abs(d) <= 1e-5) and np.count_nonzero(d) == 6
+    assert perturbed(s, 0.0, 4).sha256() == s.sha256()
+
+
+# --- ladders ------------------------------------------------------------------------------------
+
+
+def _tiny_ladder(direction, betas):
+    common, _ = ladder_points("tiny")
+    return {**common, "N": 9, "direction": direction, "betas": betas, "cap_loads": 1.0}
+
+
+def test_up_ladder_hands_states_on_and_bisects(tmp_path):
+    """Rung k + 1 of the up ladder starts from rung k's final state; the bisection starts from the
+    last stick-slip state; beta_t lies between the last stick-slip and the first sliding beta."""
+    cfg = _tiny_ladder("up", [0.8, 2.0, 4.0])
+    res = ladder_task(cfg, tmp_path)
+    rows = res["rows"]
+    assert [r["branch_state"] for r in rows[:2]] == ["stick-slip", "stick-slip"]
+    assert rows[2]["beta"] == 4.0 and rows[2]["branch_state"] == "sliding"
+    assert rows[1]["start_sha256"] == rows[0]["final_sha256"]
+    assert rows[3]["role"] == "bisection" and rows[3]["beta"] == 3.0
+    assert rows[3]["start_sha256"] == rows[1]["final_sha256"]
+    assert res["inside"] < res["outside"]
+    # steady sliding has m = phi = 0 by construction; stick-slip has blocks stuck
+    assert rows[2]["order_parameter"] == 0.0 and rows[2]["stuck_fraction"] == 0.0
+    assert rows[0]["stuck_fraction"] > 0.5
+    # a ladder started again replays its finished rungs (same rows, no new work)
+    again = ladder_task(cfg, tmp_path)
+    assert again["rows"] == rows
+
+
+def test_down_ladder_leaves_steady_sliding_below_one(tmp_path):
+    """Linear stability of steady sliding: above beta = 1 a small kick decays, below it grows and
+    blocks stick. The down ladder brackets that edge."""
+    from scipy.optimize import brentq
+
+    from stickslip.analysis.stability import chain_finite_eigenvalues
+
+    res = ladder_task(_tiny_ladder("down", [2.0, 1.2, 0.8]), tmp_path)
+    states = {r["beta"]: r["branch_state"] for r in res["rows"]}
+    assert states[2.0] == states[1.2] == "sliding" and states[0.8] == "stick-slip"
+    assert all(r["final_state"] == "steady" for r in res["rows"] if r["branch_state"] == "sliding")
+    # the bracket holds the linear threshold of the finite chain (0.8255 at N = 9: the longest
+    # wave it holds, k ~ pi / (2N), is stabilised by the springs), found here from its eigenvalues
+    cfg = _tiny_ladder("down", [1.0])
+
+    def growth(beta):
+        p = chain_params("sakaguchi", N=9, beta=beta, **{k: cfg[k] for k in ("K", "D", "V", "Fs", "alpha", "dt")})
+        return float(np.max(chain_finite_eigenvalues(p).real))
+
+    beta_c = brentq(growth, 0.5, 1.5, xtol=1e-9)
+    assert beta_c == pytest.approx(0.8255, abs=1e-3)
+    assert res["outside"] < beta_c < res["inside"]
+
+
+def test_per_n_summary_reads_the_loop():
+    import pandas as pd
+
+    rows = pd.DataFrame(
+        [
+            {"N": 9, "beta": 1.0, "branch": "up", "branch_state": "stick-slip", "order_parameter": -0.02,
+             "order_parameter_err": 0.01, "stuck_fraction": 0.9, "stuck_fraction_err": 0.01, "err_reliable": True,
+             "tau_int_loads": 0.02, "final_state": "stick-slip"},
+            {"N": 9, "beta": 1.2, "branch": "up", "branch_state": "stick-slip", "order_parameter": -0.05,
+             "order_parameter_err": 0.01, "stuck_fraction": 0.9, "stuck_fraction_err": 0.01, "err_reliable": True,
+             "tau_int_loads": 0.02, "final_state": "stick-slip"},
+            {"N": 9, "beta": 1.4, "branch": "up", "branch_state": "sliding", "order_parameter": 0.0,
+             "order_parameter_err": 0.0, "stuck_fraction": 0.0, "stuck_fraction_err": 0.0, "err_reliable": True,
+             "tau_int_loads": math.nan, "final_state": "steady"},
+            {"N": 9, "beta": 1.1, "branch": "down", "branch_state": "sliding", "order_parameter": 0.0,
+             "order_parameter_err": 0.0, "stuck_fraction": 0.0, "stuck_fraction_err": 0.0, "err_reliable": True,
+             "tau_int_loads": math.nan, "final_state": "steady"},
+            {"N": 9, "beta": 0.9, "branch": "down", "branch_state": "stick-slip", "order_parameter": 0.01,
+             "order_parameter_err": 0.01, "stuck_fraction": 0.5, "stuck_fraction_err": 0.01, "err_reliable": False,
+             "tau_int_loads": 0.01, "final_state": "stick-slip"},
+        ]
+    )  # fmt: skip
+    s = per_n_summary(rows).iloc[0]
+    assert s["beta_t"] == 1.2 and s["beta_t_err"] == pytest.approx(0.1)
+    assert s["lower_edge"] == pytest.approx(1.0) and s["lower_edge_err"] == pytest.approx(0.1)
+    assert s["step"] == -0.05 and s["step_err"] == 0.01 and s["step_phi"] == 0.9
+
+
+def test_tiny_transition_study_and_its_json(tmp_path):
+    """The CLI end to end: rows and per-N fields in --json; a second call reuses every ladder."""
+    out = tmp_path / "studies"
+    argv = ("study", "transition", "--tiny", "--workers", "1", "--out", str(out), "--no-progress", "--json")
+    first = run_cli_subprocess(*argv, timeout=300)
+    assert first.returncode == 0, first.stderr
+    data = json.loads(first.stdout)
+    assert data["meta"]["ladders"] == 2 and data["meta"]["workers"] == 1 and data["meta"]["cores"] >= 1
+    row_keys = {"N", "beta", "branch", "order_parameter", "order_parameter_err", "stuck_fraction",
+                "stuck_fraction_err", "final_state", "t_end", "start"}  # fmt: skip
+    assert all(row_keys <= set(r) for r in data["rows"])
+    assert {r["branch"] for r in data["rows"]} == {"up", "down"}
+    assert set(PER_N_COLUMNS) <= set(data["per_N"][0])
+    assert all(r["final_reason"] for r in data["rows"] if r["final_state"] == "undecided")
+    assert (out / "transition" / "loops.png").is_file() and (out / "transition" / "index.html").is_file()
+    second = json.loads(run_cli_subprocess(*argv, timeout=300).stdout)
+    assert second["meta"]["ladders_reused"] == 2 and second["rows"] == data["rows"]
+
+
+def test_extra_n_only_for_the_transition_study(tmp_path):
+    r = run_cli_subprocess("study", "chaos", "--extra-n", "1599", "--out", str(tmp_path))
+    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1
+
+
+def test_run_transition_resumes_a_ladder_from_its_finished_rungs(tmp_path):
+    """A ladder whose task was interrupted (no done.json) replays its finished rungs: the rows come
+    back bit for bit and the rungs are not run again."""
+    first = run_transition(tmp_path, "tiny", n_workers=1, progress=False)
+    ladders = sorted((tmp_path / "runs").glob("*/ladders/*/done.json"))
+    assert len(ladders) == 2
+    for done in ladders:
+        done.unlink()
+    stamps = {p: p.stat().st_mtime_ns for p in tmp_path.glob("runs/*/ladders/*/rungs/*/rung.json")}
+    second = run_transition(tmp_path, "tiny", n_workers=1, progress=False)
+    assert second["meta"]["ladders_run"] == 2 and second["rows"] == first["rows"]
+    assert {p: p.stat().st_mtime_ns for p in stamps} == stamps
+
+
+# --- the faster method measures the same thing --------------------------------------------------
+
+
+def test_up_ladder_agrees_with_paper_start_runs_at_n49(tmp_path):
+    """Below beta = 0.95 the up ladder's m at N = 49 agrees with runs of 4 loading times from the
+    paper's start (second half) within 3 combined errors."""
+    from stickslip.experiments.transition_checks import paper_start_check
+
+    common, _ = ladder_points("quick")
+    cfg = {**common, "N": 49, "direction": "up", "betas": [0.8, 0.9, 1.0], "cap_loads": 4.0, "bisections": 0}
+    rows = ladder_task(cfg, tmp_path)["rows"]
+    checks = paper_start_check(rows)
+    assert [c["beta"] for c in checks] == [0.8, 0.9]
+    for c in checks:
+        assert abs(c["z"]) < 3.0, c
+
+
+def test_chain_from_the_final_state_of_another_run(tmp_path):
+    """`stickslip chain --from DIR` starts from a run directory's final state and goes on in time:
+    run to 2000 then --from to 4000 ends where one run to 4000 from the same state does."""
+    first = tmp_path / "first"
+    r = run_cli_subprocess(
+        "chain", "--N", "6", "--beta", "0.8", "--t-end", "2000", "--out", str(first), "--json", "--no-progress"
+    )
+    assert r.returncode == 0, r.stderr
+    r2 = run_cli_subprocess("chain", "--N", "6", "--beta", "0.8", "--from", str(first), "--t-end", "4000", "--json")
+    assert r2.returncode == 0, r2.stderr
+    from stickslip.run.driver import run_chain
+    from stickslip.run.rundir import final_state
+
+    state = final_state(first)
+    assert state.step == 400_000
+    direct = run_chain(chain_params("sakaguchi", N=6, beta=0.8), 4000.0, start=state)
+    assert json.loads(r2.stdout)["state_sha256"] == direct.summary["state_sha256"]
+    bad = run_cli_subprocess("chain", "--N", "7", "--from", str(first), "--t-end", "4000")
+    assert bad.returncode == 2 and len(bad.stderr.strip().splitlines()) == 1
+    bad = run_cli_subprocess("chain", "--N", "6", "--from", str(first), "--start", "steady")
+    assert bad.returncode == 2
