@@ -80,7 +80,8 @@ def write_page(path: Path, data: dict[str, Any]) -> None:
         f"<h1>Study: transition at beta = 1 by continuation ({html.escape(meta['mode'])})</h1>",
         f"<p><code>{html.escape(meta['command'])}</code>: {meta['ladders']} ladders ({meta['ladders_run']} run, "
         f"{meta['ladders_reused']} reused, "
-        f"{meta.get('ladders_damaged', 0)} run again because their files were damaged, {meta['failed']} failed), {meta['rungs']} rungs, {meta['undecided']} "
+        f"{meta.get('ladders_damaged', 0)} run again because their files were damaged, "
+        f"{meta['failed']} failed), {meta['rungs']} rungs, {meta['undecided']} "
         f"undecided; {meta['wall_seconds']} s wall on {meta['workers']} workers, {meta['cores']} cores; "
         f"stickslip {html.escape(meta['version'])}.</p><h2>What the data say</h2><ul>",
     ]
