@@ -75,7 +75,7 @@ WRITES = [
     ("sweep block --t-end 10 --grid K=8,10 --workers 1 --no-progress --json --out {out}", "summary.parquet"),
     ("sweep block --t-end 10 --grid K=8,10 --workers 1 --no-progress --json --out {out}", "summary.csv"),
     ("study transition --tiny --workers 1 --no-progress --json --out {out}", "table.parquet"),
-    ("study transition --tiny --workers 1 --no-progress --json --out {out}", "order_parameter.png"),
+    ("study transition --tiny --workers 1 --no-progress --json --out {out}", "loops.png"),
     ("study transition --tiny --workers 1 --no-progress --json --out {out}", "index.html"),
     ("study transition --tiny --workers 1 --no-progress --json --out {out}", ".stickslip-study.json"),
 ]
@@ -124,22 +124,24 @@ def test_chain_after_a_full_disk_resumes_to_the_same_run(name, full_at, tmp_path
     assert json.loads(capsys.readouterr().out)["state_sha256"] == expected
 
 
-@pytest.mark.parametrize("name", ["summary.parquet", "order_parameter.png"])
-def test_sweep_and_study_after_a_full_disk_continue(name, full_at, tmp_path, monkeypatch, capsys):
-    argv = (
-        ["sweep", "block", "--t-end", "10", "--grid", "K=8,10"]
-        if name.startswith("summary")
-        else ["study", "transition", "--tiny"]
-    )
-    argv += ["--workers", "1", "--no-progress", "--json", "--out", str(tmp_path / "out")]
+CONTINUED = [
+    ("summary.parquet", ["sweep", "block", "--t-end", "10", "--grid", "K=8,10"], 2),
+    ("phase_alpha_beta.png", ["study", "phase-diagram", "--tiny"], 4),
+    ("loops.png", ["study", "transition", "--tiny"], 2),  # its two ladders
+]
+
+
+@pytest.mark.parametrize("name, argv, n_points", CONTINUED, ids=[c[0] for c in CONTINUED])
+def test_sweep_and_study_after_a_full_disk_continue(name, argv, n_points, full_at, tmp_path, monkeypatch, capsys):
+    argv = [*argv, "--workers", "1", "--no-progress", "--json", "--out", str(tmp_path / "out")]
     full_at(name)
     assert main(argv) == 1
     capsys.readouterr()
     monkeypatch.undo()
     assert main(argv) == 0
     data = json.loads(capsys.readouterr().out)
-    reused = data.get("n_reused", data.get("reused"))
-    assert reused == 2, "the points finished before the disk filled are reused"
+    reused = data.get("n_reused", data.get("reused", data.get("meta", {}).get("ladders_reused")))
+    assert reused == n_points, "the points finished before the disk filled are reused"
 
 
 # ---------------------------------------------------------------------------------------------

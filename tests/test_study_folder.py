@@ -18,8 +18,8 @@ from stickslip.cli import main
 from stickslip.experiments.studies import study
 from stickslip.experiments.study_run import MANIFEST, run_study
 
-TINY = study("transition", "tiny")
-ARGV = ["study", "transition", "--tiny", "--workers", "1", "--no-progress", "--json"]
+TINY = study("phase-diagram", "tiny")
+ARGV = ["study", "phase-diagram", "--tiny", "--workers", "1", "--no-progress", "--json"]
 
 
 def _tree(path):
@@ -28,7 +28,7 @@ def _tree(path):
 
 @pytest.fixture(scope="module")
 def finished(tmp_path_factory):
-    """A folder holding the tiny transition study, finished."""
+    """A folder holding the tiny phase-diagram study, finished."""
     out = tmp_path_factory.mktemp("study") / "out"
     assert main([*ARGV, "--out", str(out)]) == 0
     return out
@@ -46,10 +46,16 @@ def _put(rel: str):
 # (what is in the folder, extra options, what the one line names)
 REFUSED = [
     ("notes.txt beside a fresh study", None, _put("notes.txt"), [], "notes.txt"),
-    ("the user's table.csv where the page goes", None, _put("transition/table.csv"), [], "transition/table.csv"),
-    ("the user's index.html", None, _put("transition/index.html"), [], "transition/index.html"),
+    ("the user's table.csv where the page goes", None, _put("phase-diagram/table.csv"), [], "phase-diagram/table.csv"),
+    ("the user's index.html", None, _put("phase-diagram/index.html"), [], "phase-diagram/index.html"),
     ("a file in the runs folder", None, _put("runs/mine.txt"), [], "runs/mine.txt"),
-    ("a file beside a finished study's page", "finished", _put("transition/notes.txt"), [], "transition/notes.txt"),
+    (
+        "a file beside a finished study's page",
+        "finished",
+        _put("phase-diagram/notes.txt"),
+        [],
+        "phase-diagram/notes.txt",
+    ),
     (
         "a file among the points",
         "finished",
@@ -60,9 +66,9 @@ REFUSED = [
     (
         "--overwrite never writes over the user's table.csv",
         None,
-        _put("transition/table.csv"),
+        _put("phase-diagram/table.csv"),
         ["--overwrite"],
-        "transition/table.csv",
+        "phase-diagram/table.csv",
     ),
 ]
 
@@ -96,7 +102,7 @@ def test_overwrite_removes_only_the_studys_own_files(tmp_path, finished, capsys)
     data = json.loads(capsys.readouterr().out)
     assert data["run"] == len(TINY.points) and data["reused"] == 0, "the study's own files were replaced"
     assert (out / "notes.txt").read_text() == "mine"
-    assert (out / "transition" / "table.csv").is_file() and (out / MANIFEST).is_file()
+    assert (out / "phase-diagram" / "table.csv").is_file() and (out / MANIFEST).is_file()
 
 
 def test_a_study_run_again_reuses_its_own_folder(tmp_path, finished, capsys):
@@ -203,7 +209,7 @@ def test_damaged_cached_point_runs_again(what, damage, why, tmp_path, finished):
     result = run_study(TINY, out, n_workers=1, progress=False)
     assert result["run"] == 1 and result["reused"] == len(TINY.points) - 1 and result["damaged"] == 1
     assert all(r["order_parameter"] is not None and r["status"] == "ok" for r in result["rows"])
-    page = (out / "transition" / "index.html").read_text()
+    page = (out / "phase-diagram" / "index.html").read_text()
     assert "ran again because their files were damaged" in page and why in page
     again = run_study(TINY, out, n_workers=1, progress=False)
     assert again["run"] == 0 and again["damaged"] == 0, "the point run again is whole"
@@ -254,3 +260,25 @@ def test_local_sweep_listens_on_loopback_only(dashboard, tmp_path, capsys):
         assert "dashboard: http://127.0.0.1:" in err
     else:
         assert "dashboard" not in err
+
+
+# ---------------------------------------------------------------------------------------------
+# The transition study (run by continuation in beta) owns its folder the same way
+
+
+def test_transition_study_owns_its_folder(tmp_path, capsys):
+    argv = ["study", "transition", "--tiny", "--workers", "1", "--no-progress", "--json"]
+    out = tmp_path / "out"
+    _put("transition/table.csv")(out)
+    assert main([*argv, "--out", str(out)]) == 2, "the user's table.csv where the page goes is refused"
+    assert "transition/table.csv" in capsys.readouterr().err
+    assert (out / "transition" / "table.csv").read_text() == "the user's own"
+    (out / "transition" / "table.csv").unlink()
+    assert main([*argv, "--out", str(out)]) == 0
+    first = json.loads(capsys.readouterr().out)["meta"]
+    assert first["ladders_run"] == 2 and first["ladders_reused"] == 0
+    assert main([*argv, "--out", str(out)]) == 0, "its own page, manifest and ladders are not foreign"
+    again = json.loads(capsys.readouterr().out)["meta"]
+    assert again["ladders_run"] == 0 and again["ladders_reused"] == 2
+    assert main([*argv, "--out", str(out), "--overwrite"]) == 0
+    assert json.loads(capsys.readouterr().out)["meta"]["ladders_run"] == 2, "--overwrite ran its ladders again"

@@ -404,7 +404,6 @@ def _from_state(params, args):
     for flag, value in (
         ("--start", args.start),
         ("--perturbation", args.perturbation),
-        ("--amplitude", args.amplitude),
     ):
         if value is not None:
             raise CommandError(f"{flag} cannot be combined with --from (the state of the run named there is the start)")

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import math
 import time
+from io import BytesIO
 from pathlib import Path
 from typing import Any
 
@@ -64,9 +65,14 @@ def perturbed(state, amplitude: float, seed: int):
 
 
 def _save_state(path: Path, state) -> None:
-    with io.atomic_path(path) as tmp:
-        with open(tmp, "wb") as fh:
-            np.savez(fh, **{k: getattr(state, k) for k in state.ARRAYS})
+    _save_npz(path, {k: getattr(state, k) for k in state.ARRAYS})
+
+
+def _save_npz(path: Path, arrays: dict) -> None:
+    """Arrays to ``path``, built in memory and written atomically (a full disk leaves no half file)."""
+    buf = BytesIO()
+    np.savez(buf, **arrays)
+    io.write_bytes(path, buf.getvalue())
 
 
 def _load_state(path: Path):
@@ -216,8 +222,7 @@ def _rung(
     row = to_jsonable(row)  # as a replay reads it back (NaN and inf become None)
     rdir.mkdir(parents=True, exist_ok=True)
     _save_state(rdir / "state.npz", res["state"])
-    with io.atomic_path(rdir / "samples.npz") as tmp, open(tmp, "wb") as fh:
-        np.savez(fh, **res["samples"])
+    _save_npz(rdir / "samples.npz", res["samples"])
     io.write_json(path, {"row": row, "start_sha256": sha, "settings": settings})
     return {"row": row, "state": res["state"]}
 

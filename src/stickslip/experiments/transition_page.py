@@ -97,5 +97,4 @@ def write_page(path: Path, data: dict[str, Any]) -> None:
     )
     parts.append('<a href="study.json">study.json</a>.</p>' + _table(data["rows"], ROW_COLUMNS, "final_state"))
     parts.append("</body></html>\n")
-    with io.atomic_path(path) as tmp:
-        tmp.write_text("\n".join(parts), encoding="utf-8")
+    io.write_bytes(path, "\n".join(parts).encode("utf-8"))
