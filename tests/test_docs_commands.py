@@ -36,7 +36,7 @@ def _commands(page: Path) -> list[tuple[int, list[str]]]:
                 k += 1
                 text = text[:-1] + " " + lines[k].strip()
             if not _SYNOPSIS.search(text) and not text.split()[0].endswith(":"):  # not a line of output
-                found.append((start + 1, shlex.split(text)))
+                found.append((start + 1, shlex.split(text, comments=True)))
         k += 1
     return found
 
