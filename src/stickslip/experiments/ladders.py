@@ -150,11 +150,13 @@ def run_rung(params, state, cfg: dict[str, Any], *, leave_stops: bool = False, s
             reason = f"left steady sliding: {params.N - int(n_s[-1].min())} blocks stuck at once"
             break
         # a window shorter than half a loading time may hold no event at all (m constant, error 0)
-        if a.decided and a.phi.mean >= STUCK_SLIDING and t_all[-1] - a.t_cut >= 0.5 * t_load:
+        long_enough = t_all[-1] - a.t_cut >= 0.5 * t_load
+        if a.decided and a.phi.mean >= STUCK_SLIDING and long_enough:
             final, reason = "stick-slip", a.reason
             break
         if elapsed >= cap - 1e-9:
-            reason = f"cap of {cfg['cap_loads']:g} loading times: {a.reason}"
+            why = a.reason if not a.decided or long_enough else "kept window shorter than half a loading time"
+            reason = f"cap of {cfg['cap_loads']:g} loading times: {why}"
             break
         seg = min(2.0 * seg, seg_max, cap - elapsed) if cap - elapsed > 0 else seg
     t_all = np.concatenate(t_s) if t_s else np.zeros(0)
