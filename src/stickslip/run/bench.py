@@ -252,7 +252,7 @@ def partly_stuck(params: ChainParams, *, t_prepare: float, t_timed: float, repea
     )
     steps = d.state.step - prep.state.step
     block_steps = params.N * steps
-    updates = e.summary["block_updates"]
+    updates = e.summary["block_updates"] - prep.summary["block_updates"]  # counted from t = 0
     ns_exact = 1e9 * best["exact"] / max(updates, 1)
     ns_dense = 1e9 * best["dense"] / max(block_steps, 1)
     return {
