@@ -135,7 +135,7 @@ def register(sub) -> None:
         choices=("default", "partly-stuck"),
         default="default",
         help="partly-stuck: the paper's chain loading at beta = 1.3 with part of its blocks stuck "
-        "(N, beta and t-end as given, else 199, 1.3 and 4e4 after a prepared 4e5)",
+        "(N, beta and t-end as given, else 199, 1.3 and 1e4 after a prepared 4e5)",
     )
     b.add_argument(
         "--profile", action="store_true", help="instead: where the exact integrator spends its time on this workload"
