@@ -154,3 +154,8 @@ def test_bench_partly_stuck_json(capsys):
     assert data["ratio"] == pytest.approx(data["ns_per_update_exact"] / data["ns_per_block_step_dense"])
     assert data["workload"]["steps"] == 40000 and data["workload"]["N"] == 20 and data["workload"]["beta"] == 1.3
     assert 0 < data["exact_block_updates"] <= 20 * 40000
+
+
+def test_bench_partly_stuck_refuses_a_start(capsys):
+    status, out, err = run_cli(capsys, "bench", "--workload", "partly-stuck", "--start", "steady", "--json")
+    assert status == 2 and out == "" and err.count("\n") == 1 and "partly-stuck" in err

@@ -421,6 +421,8 @@ def _partly_stuck(args: argparse.Namespace) -> Result:
     """`stickslip bench --workload partly-stuck`: exact per block update against dense per block-step."""
     from stickslip.run import bench
 
+    if args.profile or args.start is not None:
+        raise CommandError("--workload partly-stuck prepares its own start and has no --profile")
     w = bench.PARTLY_STUCK
     overrides = {k: w[k] for k in ("N", "beta") if getattr(args, f"param_{k}", None) is None}
     params = chain_params_from_args(args, **overrides)
