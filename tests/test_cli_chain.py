@@ -142,3 +142,20 @@ def test_bench_does_not_warn_about_its_own_workload():
 def test_bench_bad_input(capsys, argv, name):
     status, out, err = run_cli(capsys, "bench", "--t-end", "10", *argv, "--json")
     assert status == 2 and out == "" and err.count("\n") == 1 and name in err
+
+
+def test_bench_partly_stuck_json(capsys):
+    status, out, _ = run_cli(capsys, "bench", "--workload", "partly-stuck", "--N", "20", "--t-end", "200", "--json")
+    assert status == 0
+    data = json.loads(out)
+    assert data["identical"] is True
+    for key in ("ns_per_update_exact", "ns_per_block_step_dense", "ratio", "moving_fraction"):
+        assert data[key] >= 0
+    assert data["ratio"] == pytest.approx(data["ns_per_update_exact"] / data["ns_per_block_step_dense"])
+    assert data["workload"]["steps"] == 40000 and data["workload"]["N"] == 20 and data["workload"]["beta"] == 1.3
+    assert 0 < data["exact_block_updates"] <= 20 * 40000
+
+
+def test_bench_partly_stuck_refuses_a_start(capsys):
+    status, out, err = run_cli(capsys, "bench", "--workload", "partly-stuck", "--start", "steady", "--json")
+    assert status == 2 and out == "" and err.count("\n") == 1 and "partly-stuck" in err

@@ -134,6 +134,13 @@ def register(sub) -> None:
         help="time each integrator this many times, keep the fastest",
     )
     b.add_argument(
+        "--workload",
+        choices=("default", "partly-stuck"),
+        default="default",
+        help="partly-stuck: the paper's chain loading at beta = 1.3 with part of its blocks stuck "
+        "(N, beta and t-end as given, else 199, 1.3 and 1e4 after a prepared 4e5)",
+    )
+    b.add_argument(
         "--profile", action="store_true", help="instead: where the exact integrator spends its time on this workload"
     )
     add_json_option(b)
@@ -456,6 +463,8 @@ def run_bench_command(args: argparse.Namespace) -> Result:
     from stickslip.run import bench
 
     check_number("repeat", args.repeat, low=1, integer=True)
+    if args.workload == "partly-stuck":
+        return _partly_stuck(args)
     params = chain_params_from_args(args)
     t_end = args.t_end if args.t_end is not None else (2e4 if params.drive == "plate" else 2e5)
     check_number("t-end", t_end, low=0.0, low_open=True)
@@ -468,3 +477,19 @@ def run_bench_command(args: argparse.Namespace) -> Result:
         return Result(result, bench.format_profile(result))
     result = bench.compare(params, t_end, start=start, repeat=args.repeat, perturbation=amplitude, seed=seed)
     return Result(result, bench.format_result(result))
+
+
+def _partly_stuck(args: argparse.Namespace) -> Result:
+    """`stickslip bench --workload partly-stuck`: exact per block update against dense per block-step."""
+    from stickslip.run import bench
+
+    if args.profile or args.start is not None:
+        raise CommandError("--workload partly-stuck prepares its own start and has no --profile")
+    w = bench.PARTLY_STUCK
+    overrides = {k: w[k] for k in ("N", "beta") if getattr(args, f"param_{k}", None) is None}
+    params = chain_params_from_args(args, **overrides)
+    t_timed = args.t_end if args.t_end is not None else w["t_timed"]
+    check_number("t-end", t_timed, low=0.0, low_open=True)
+    t_prepare = w["t_prepare"] * (params.N / w["N"]) ** 2  # loading time grows as L_ss ~ N^2
+    result = bench.partly_stuck(params, t_prepare=t_prepare, t_timed=t_timed, repeat=args.repeat)
+    return Result(result, bench.format_partly_stuck(result))

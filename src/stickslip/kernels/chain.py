@@ -288,7 +288,7 @@ def _first_trigger(x, N, V, dt, K, thr, n_lo, n_hi, ends):
     return lo
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, _nrt=False, inline="always")
 def _stage1(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, p, mp, dt, drive, friction, threshold):
     """Start rule, stage-1 derivatives and predictor for blocks lo..hi (branch-free).
 
@@ -371,7 +371,7 @@ def _stage2_all(x, v, th, xs, vs, ths, a1, b1, N, p, mp, h2, drive, friction):
     return stops
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, _nrt=False, inline="always")
 def _stage1_theta(x, v, th, xs, vs, ths, mm, b1, lo, hi, mp, dt, friction):
     """Stage 1 for blocks lo..hi known to stay stopped in this step (mid-step mask 0).
 
@@ -412,7 +412,7 @@ def _stage1_theta_only(v, th, ths, b1, lo, hi, mp, dt, friction):
         ths[j] = th[j] + dt * b
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, _nrt=False, inline="always")
 def _stage2_theta(th, ths, v, b1, lo, hi, mp, h2, friction):
     """Stage 2 and corrector of the state variable alone, for blocks lo..hi that stay stopped.
 
@@ -438,7 +438,7 @@ def _stage2_theta(th, ths, v, b1, lo, hi, mp, h2, friction):
     return c_lo + lo - 1, c_hi + lo - 1
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, _nrt=False, inline="always")
 def _stage2(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, p, mp, h2, drive, friction):
     """Stage 2, corrector and stop rule for blocks lo..hi (branch-free, on views as _stage1).
 

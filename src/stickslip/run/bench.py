@@ -215,3 +215,88 @@ def format_profile(r: dict[str, Any]) -> str:
     for name, sec in r["seconds"].items():
         lines.append(f"  {name:32s} {sec:8.3f} s  {100 * sec / total:5.1f}%")
     return "\n".join(lines)
+
+
+#: The partly stuck workload: the paper's chain loading at beta = 1.3, where a few tens of
+#: percent of the blocks slide and the rest stick (docs/performance.md, "A partly stuck chain").
+PARTLY_STUCK = {"N": 199, "beta": 1.3, "t_prepare": 4e5, "t_timed": 1e4}
+
+
+@short_runs_expected()  # the loading phase on purpose
+def partly_stuck(params: ChainParams, *, t_prepare: float, t_timed: float, repeat: int = 1) -> dict[str, Any]:
+    """Time ``dense`` and ``exact`` on a chain of eq. (4) that loads while partly stuck.
+
+    The state is prepared by the exact integrator from the paper's start to ``t_prepare``;
+    both integrators then continue it for ``t_timed``. The exact path's cost is per block
+    update (what it computes), the dense path's per block-step (N per step): their ratio is
+    the cost of the exact path's bookkeeping and general step on a partly stuck chain.
+    """
+    t0 = time.perf_counter()
+    prep = run_chain(params, t_prepare, start="paper")
+    prepare_seconds = time.perf_counter() - t0
+    _warm(params, "paper")
+    best: dict[str, float] = {}
+    runs = {}
+    t_end = t_prepare + t_timed
+    # Alternated, and in CPU time of this process: on a shared machine the other processes'
+    # load then changes the two integrators' times alike.
+    for _ in range(repeat):
+        for integrator in ("dense", "exact"):
+            t0 = time.process_time()
+            run = run_chain(params, t_end, integrator=integrator, start=prep.state, sample_moving=True)
+            best[integrator] = min(best.get(integrator, float("inf")), time.process_time() - t0)
+            runs[integrator] = run
+    d, e = runs["dense"], runs["exact"]
+    identical = (
+        d.summary["state_sha256"] == e.summary["state_sha256"]
+        and d.events.equals(e.events)
+        and bool((d.samples["L"].values == e.samples["L"].values).all())
+    )
+    steps = d.state.step - prep.state.step
+    block_steps = params.N * steps
+    updates = e.summary["block_updates"] - prep.summary["block_updates"]  # counted from t = 0
+    ns_exact = 1e9 * best["exact"] / max(updates, 1)
+    ns_dense = 1e9 * best["dense"] / max(block_steps, 1)
+    return {
+        "workload": {
+            "name": "partly-stuck",
+            "model": params.model,
+            "N": params.N,
+            "beta": params.beta,
+            "t_prepare": t_prepare,
+            "t_timed": t_timed,
+            "steps": steps,
+            "block_steps": block_steps,
+        },
+        "prepare_seconds": prepare_seconds,
+        "timer": "process CPU time, best of repeat, the integrators alternated",
+        "moving_fraction": float(e.samples["n_moving"].values.mean()) / params.N,
+        "dense_seconds": best["dense"],
+        "exact_seconds": best["exact"],
+        "exact_block_updates": updates,
+        "updates_per_step": updates / max(steps, 1),
+        "ns_per_update_exact": ns_exact,
+        "ns_per_block_step_dense": ns_dense,
+        "ratio": ns_exact / ns_dense,
+        "identical": identical,
+        "n_events": e.summary["n_events"],
+        "state_sha256": e.summary["state_sha256"],
+        "machine": platform.processor() or platform.machine(),
+    }
+
+
+def format_partly_stuck(r: dict[str, Any]) -> str:
+    """Human-readable lines of :func:`partly_stuck`'s result."""
+    w = r["workload"]
+    return "\n".join(
+        [
+            f"workload   partly stuck: {w['model']} N={w['N']} beta={w['beta']:g}, prepared to t={w['t_prepare']:g} "
+            f"in {r['prepare_seconds']:.1f} s, timed {w['t_timed']:g} ({w['steps']} steps, {r['n_events']} events)",
+            f"moving     {100 * r['moving_fraction']:.1f}% of the blocks on average, "
+            f"{r['updates_per_step']:.1f} block updates per step",
+            f"dense      {r['dense_seconds']:.3f} s CPU   {r['ns_per_block_step_dense']:.3g} ns/block-step",
+            f"exact      {r['exact_seconds']:.3f} s CPU   {r['ns_per_update_exact']:.3g} ns/block update",
+            f"ratio      {r['ratio']:.3f} (exact per update / dense per block-step)",
+            f"identical  {'yes' if r['identical'] else 'NO'}   sha256 {r['state_sha256'][:16]}...",
+        ]
+    )
