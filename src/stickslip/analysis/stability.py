@@ -39,6 +39,7 @@ import pandas as pd
 import xarray as xr
 from scipy.optimize import brentq
 
+from stickslip.models import pieces
 from stickslip.models.params import BlockParams, ChainParams
 from stickslip.models.physics import block_steady_state
 
@@ -520,16 +521,15 @@ def friction_slope(p: ChainParams) -> float:
     Weakening (CL), phi(v) = (1 - sigma) / (1 + 2 alpha v / (1 - sigma)): phi'(V) = -2 alpha g
     with g = (1 + 2 alpha V / (1 - sigma))^-2. Strengthening (train), F0 + beta v: beta.
     """
-    if p.friction == "weakening":
-        return -2.0 * p.alpha * weakening_g(p)
-    if p.friction == "strengthening":
-        return float(p.beta)
+    slope = p.friction_piece.slope
+    if slope is not None:
+        return slope(p)
     raise ValueError(f"friction {p.friction} has a state variable: use chain_mode_matrix (eq. 5)")
 
 
 def weakening_g(p: ChainParams) -> float:
     """g = (1 + 2 alpha V / (1 - sigma))^-2 of CL's velocity weakening; -phi'(V) = 2 alpha g."""
-    return float((1.0 + 2.0 * p.alpha * p.V / (1.0 - p.sigma)) ** -2)
+    return pieces.weakening_g(p)
 
 
 def normal_modes(p: ChainParams) -> tuple[np.ndarray, str]:
@@ -541,18 +541,18 @@ def normal_modes(p: ChainParams) -> tuple[np.ndarray, str]:
     Fixed ends have no steady sliding (a spring to a fixed wall stretches for ever): refused.
     """
     N = p.N
-    if p.ends == "fixed":
-        raise ValueError("ends fixed have no steady sliding (the springs to the walls stretch without bound)")
-    if p.drive == "plate" and p.ends == "periodic":
+    if not p.ends_piece.steady_sliding:
+        raise ValueError(f"ends {p.ends} have no steady sliding (the springs to the walls stretch without bound)")
+    if p.drive_piece.leaf_spring and p.ends_piece.ring:
         return 2.0 * np.pi * np.arange(N) / N, "periodic: exp(i k j), k = 2 pi j / N, j = 0..N-1"
-    if p.drive == "plate":
+    if p.drive_piece.leaf_spring:
         return np.pi * np.arange(N) / N, "free ends: cos(k (i - 1/2)), k = pi j / N, j = 0..N-1"
     return finite_chain_wavenumbers(N), "end drive, free end: sin(k i), k = (2m - 1) pi / (2N + 1), m = 1..N"
 
 
 def mode_frequency_squared(p: ChainParams, k: np.ndarray | float) -> np.ndarray:
     """w_k^2 = Kp + 4 K sin^2(k/2) for the plate drive, 4 K sin^2(k/2) for the end drive."""
-    return (p.Kp if p.drive == "plate" else 0.0) + p.K * lattice_q(k)
+    return (p.Kp if p.drive_piece.leaf_spring else 0.0) + p.K * lattice_q(k)
 
 
 def mode_roots(p: ChainParams, k: np.ndarray | float) -> np.ndarray:
@@ -593,17 +593,17 @@ def chain_jacobian_2n(p: ChainParams) -> np.ndarray:
     dx_{N+1} = dx_N). Built from the ends directly, not from :func:`normal_modes`.
     """
     N = p.N
-    if p.ends == "fixed":
-        raise ValueError("ends fixed have no steady sliding")
+    if not p.ends_piece.steady_sliding:
+        raise ValueError(f"ends {p.ends} have no steady sliding")
     L = -2.0 * np.eye(N) + np.eye(N, k=1) + np.eye(N, k=-1)
-    if p.ends == "periodic":
+    if p.ends_piece.ring:
         L[0, -1] += 1.0
         L[-1, 0] += 1.0
     else:
         L[-1, -1] += 1.0  # x_{N+1} = x_N
-        if p.drive == "plate":
+        if p.drive_piece.leaf_spring:
             L[0, 0] += 1.0  # x_0 = x_1
-    A = p.K * L - (p.Kp if p.drive == "plate" else 0.0) * np.eye(N)
+    A = p.K * L - (p.Kp if p.drive_piece.leaf_spring else 0.0) * np.eye(N)
     return np.block([[np.zeros((N, N)), np.eye(N)], [A, -friction_slope(p) * np.eye(N)]])
 
 
