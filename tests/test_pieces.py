@@ -113,3 +113,33 @@ def test_leaf_spring_adds_kp_to_every_mode():
 def test_only_model_notes_marked_for_runs():
     marked = {name for name, pr in PRESETS.items() if pr.note_in_runs}
     assert marked == {"batista-carlson", "train"}
+
+
+def _theta_law(theta, v, alpha):
+    """eq. (4)'s theta law without diffusion, written from docs/model.md."""
+    return theta * (1.0 - theta) - alpha * theta * v
+
+
+@pytest.mark.parametrize(("alpha", "V"), [(1.0, 0.001), (1.0, 0.3), (2.0, 0.1), (1.0, 1.5)])
+def test_state_law_linearisation_against_the_law(alpha, V):
+    theta0, d_v, d_theta = pieces.piece("friction", "state").theta_terms(alpha, V)
+    assert theta0 == max(1.0 - alpha * V, 0.0)
+    if theta0 > 0:
+        assert _theta_law(theta0, V, alpha) == pytest.approx(0.0, abs=1e-15)  # a steady state
+    h = 1e-6
+    num_v = (_theta_law(theta0, V + h, alpha) - _theta_law(theta0, V - h, alpha)) / (2 * h)
+    num_t = (_theta_law(theta0 + h, V, alpha) - _theta_law(theta0 - h, V, alpha)) / (2 * h)
+    assert d_v == pytest.approx(num_v, rel=1e-7, abs=1e-12)
+    assert d_theta == pytest.approx(num_t, rel=1e-7, abs=1e-12)
+    assert pieces.piece("friction", "weakening").theta_terms is None
+
+
+def test_paper_stability_numbers_unchanged():
+    # docs/stability.md and the paper: long waves of eq. (5) are unstable exactly for beta < alpha
+    # (K = 10, D = 5); Fig. 4's beta = 0.5 has a growing band, beta = 1.5 none.
+    p = chain_params("sakaguchi")
+    assert st.chain_critical_beta(p) == 1.0
+    assert st.chain_stability(p.replace(beta=0.5)).max_growth_rate > 0.0
+    assert st.chain_stability(p.replace(beta=1.5)).max_growth_rate < 0.0
+    with pytest.raises(ValueError, match="no state variable"):
+        st.chain_mode_matrix(chain_params("train"), 0.3)

@@ -276,6 +276,14 @@ def block_growth_map(p: BlockParams, beta: np.ndarray, V: np.ndarray) -> xr.Data
 # ---------------------------------------------------------------------------------------------
 
 
+def _theta_terms(p: ChainParams) -> tuple[float, float, float]:
+    """The friction piece's theta law linearised at steady sliding; refused for laws without theta."""
+    terms = p.friction_piece.theta_terms
+    if terms is None:
+        raise ValueError(f"friction {p.friction} has no state variable: use mode_stability")
+    return terms(p.alpha, p.V)
+
+
 def chain_mode_matrix(p: ChainParams, k: np.ndarray | float) -> np.ndarray:
     """The 3 x 3 matrix of eq. (5) for the Fourier mode exp(i k j), shape (..., 3, 3).
 
@@ -284,14 +292,14 @@ def chain_mode_matrix(p: ChainParams, k: np.ndarray | float) -> np.ndarray:
     dtheta' = (1 - 2 theta_0 - alpha V - D q) dtheta - alpha theta_0 dv.
     """
     q = lattice_q(k)
-    theta0 = steady_theta(p.V, p.alpha)
+    _, d_v, d_theta = _theta_terms(p)
     A = np.zeros(q.shape + (3, 3))
     A[..., 0, 1] = 1.0
     A[..., 1, 0] = -p.K * q
     A[..., 1, 1] = -p.beta
     A[..., 1, 2] = -1.0
-    A[..., 2, 1] = -p.alpha * theta0
-    A[..., 2, 2] = 1.0 - 2.0 * theta0 - p.alpha * p.V - p.D * q
+    A[..., 2, 1] = d_v
+    A[..., 2, 2] = d_theta - p.D * q
     return A
 
 
@@ -426,7 +434,7 @@ def chain_jacobian(p: ChainParams) -> np.ndarray:
     ends, dtheta_0 = dtheta_1 and dtheta_{N+1} = dtheta_N.
     """
     N = p.N
-    theta0 = steady_theta(p.V, p.alpha)
+    _, d_v, d_theta = _theta_terms(p)
     lap_x = -2.0 * np.eye(N) + np.eye(N, k=1) + np.eye(N, k=-1)
     lap_x[-1, -1] = -1.0  # free end
     lap_t = -2.0 * np.eye(N) + np.eye(N, k=1) + np.eye(N, k=-1)
@@ -438,7 +446,7 @@ def chain_jacobian(p: ChainParams) -> np.ndarray:
         [
             [zero, eye, zero],
             [p.K * lap_x, -p.beta * eye, -eye],
-            [zero, -p.alpha * theta0 * eye, (1.0 - 2.0 * theta0 - p.alpha * p.V) * eye + p.D * lap_t],
+            [zero, d_v * eye, d_theta * eye + p.D * lap_t],
         ]
     )
 

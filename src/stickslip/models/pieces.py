@@ -36,6 +36,17 @@ def _weakening_slope(p: Any) -> float:
     return -2.0 * p.alpha * weakening_g(p)
 
 
+def _state_theta_terms(alpha: float, V: float) -> tuple[float, float, float]:
+    """eq. (4)'s theta law linearised about steady sliding at v = V (eq. 2, eq. 5).
+
+    Returns (theta_0, d/dv, d/dtheta) of g = theta (1 - theta) - alpha theta v at the stable
+    steady state theta_0 = max(1 - alpha V, 0): d/dv = -alpha theta_0 and
+    d/dtheta = 1 - 2 theta_0 - alpha V (the diffusion term -D q is the chain's, not the law's).
+    """
+    theta0 = max(1.0 - alpha * V, 0.0)
+    return theta0, -alpha * theta0, 1.0 - 2.0 * theta0 - alpha * V
+
+
 def _weakening_extras(p: Any) -> dict[str, float]:
     """alpha g, the number CL's stability criterion compares with the springs (docs/model.md)."""
     return {"alpha_g": p.alpha * weakening_g(p)}
@@ -68,6 +79,8 @@ class Piece:
     #: lambda^2 + phi'(V) lambda + w_k^2 = 0 reads (docs/model.md); None for the state law,
     #: whose linearisation is the 3 x 3 block of eq. (5)
     slope: Callable[[Any], float] | None = None
+    #: friction with theta: (theta_0, d/dv, d/dtheta) of its law at steady sliding, from (alpha, V)
+    theta_terms: Callable[[float, float], tuple[float, float, float]] | None = None
     #: friction without theta: extra numbers the mode-stability report shows for this law
     stability_extras: Callable[[Any], dict[str, float]] | None = None
     #: ends: steady sliding exists (a spring to a fixed wall stretches without bound)
@@ -101,6 +114,7 @@ PIECES: dict[str, tuple[Piece, ...]] = {
             ("beta", "alpha", "D"),
             has_state=True,
             theta0=0.1,
+            theta_terms=_state_theta_terms,
         ),
         Piece(
             "friction",
