@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
-import html
 import json
 import re
+import shlex
 
 import pytest
+from markupsafe import escape
 from matplotlib.figure import Figure
 
+from stickslip.cli import build_parser
 from stickslip.plotting.style import save_figure
 from stickslip.report.writer import ReportFigure, ReportRow, read_report, write_report
 
@@ -21,7 +23,7 @@ ROWS = [
         0.10612,
         True,
         "|V_c - 0.106| <= 0.001",
-        "stickslip stability hopf --K 10 --beta 0.08",
+        "stickslip stability block --K 10 --beta 0.08",
     ),
     ReportRow(
         "sec. 2",
@@ -30,7 +32,7 @@ ROWS = [
         "max Re(lambda) < 0 for 1e-4 <= V <= 10",
         True,
         "all V on the grid",
-        "stickslip stability scan",
+        "stickslip stability block --K 10 --beta 1",
     ),
     ReportRow(
         "sec. 2",
@@ -39,7 +41,7 @@ ROWS = [
         0.29,
         False,
         "|V - 0.345| <= 0.01",
-        "stickslip block ramp --V-from 0.2 --V-to 0.4",
+        "stickslip hysteresis --K 10 --beta 1 --V-min 0.2 --V-max 0.4 --json",
     ),
     ReportRow(
         "eq. 3",
@@ -48,7 +50,7 @@ ROWS = [
         "1.0348, -0.4318",
         True,
         "3 digits",
-        "stickslip block limit",
+        "stickslip slip-limit --json",
     ),
     ReportRow(
         "Fig. 3",
@@ -57,7 +59,7 @@ ROWS = [
         "max rel. dev. 0.2 %",
         True,
         "1 %",
-        "stickslip block periods",
+        "stickslip block --fig3 --out DIR",
     ),
     ReportRow(
         "Fig. 4",
@@ -75,7 +77,7 @@ ROWS = [
         None,
         None,
         "",
-        "stickslip reproduce --full",
+        "stickslip reproduce --full --out DIR",
         na_reason="quick run",
     ),
     ReportRow(
@@ -85,7 +87,7 @@ ROWS = [
         None,
         None,
         "",
-        "stickslip reproduce --full",
+        "stickslip reproduce --full --out DIR",
         na_reason="quick run: t = 2e5, not 2e7",
     ),
     ReportRow(
@@ -104,7 +106,7 @@ ROWS = [
         1.47,
         True,
         "|c - 1.43| <= 0.15",
-        "stickslip reproduce --only fig6",
+        "stickslip reproduce --quick --out DIR",
     ),
     ReportRow(
         "Fig. 7",
@@ -113,7 +115,7 @@ ROWS = [
         "tau = 1.52 +- 0.03",
         True,
         "|tau - 1.5| <= 0.1",
-        "stickslip reproduce --only fig7",
+        "stickslip reproduce --quick --out DIR",
     ),
     ReportRow(
         "Fig. 8",
@@ -122,10 +124,44 @@ ROWS = [
         "tau = 1.63 +- 0.05",
         True,
         "|tau - 1.6| <= 0.15",
-        "stickslip reproduce --only fig8",
+        "stickslip reproduce --quick --out DIR",
         note="the paper's text says 'Figure 7' here; it means Fig. 8",
     ),
 ]
+
+
+def _esc(text: str) -> str:
+    """Text as the page writes it (jinja2's autoescape)."""
+    return str(escape(text))
+
+
+def _parses(command: str) -> bool:
+    """Whether each ``stickslip ...`` part of ``command`` is accepted by the real CLI parser.
+
+    Parts are joined by ``&&``; a trailing ``(...)`` remark is not part of the command.
+    """
+    for part in command.split(" && "):
+        words = shlex.split(part.split("  (")[0])
+        if not words or words[0] != "stickslip":
+            return False
+        try:
+            build_parser().parse_args(words[1:])
+        except SystemExit:
+            return False
+    return True
+
+
+def test_commands_are_real(figures):
+    for command in [r.command for r in ROWS] + [f.command for f in figures]:
+        assert _parses(command), command
+
+
+@pytest.mark.parametrize(
+    "command",
+    ["stickslip stability hopf --K 10", "stickslip block limit", "stickslip reproduce --only fig6", "make all"],
+)
+def test_command_check_refuses_what_does_not_exist(command):
+    assert not _parses(command)
 
 
 @pytest.fixture()
@@ -144,7 +180,7 @@ def figures(tmp_path):
                 f"caption of {name} <x_i>",
                 pdf=f"figures/{name}.pdf",
                 data=(f"data/{name}.nc",),
-                command=f"stickslip reproduce --only {name}",
+                command=f"stickslip chain --t-end 2e5 --out DIR && stickslip plot DIR  (DIR/figures/{name}.png)",
             )
         )
     return out
@@ -176,10 +212,10 @@ def test_html_has_every_row_and_figure(tmp_path, figures):
     body = re.search(r"<tbody>(.*)</tbody>", page, re.S).group(1)
     assert body.count("<tr>") == len(ROWS)
     for row in ROWS:
-        assert html.escape(row.quantity) in page
-        assert html.escape(row.paper) in page
-        assert html.escape(row.command) in page
-        assert html.escape(row.agreement) in page
+        assert _esc(row.quantity) in page
+        assert _esc(row.paper) in page
+        assert _esc(row.command) in page
+        assert _esc(row.agreement) in page
     assert "1.47" in page and "not computed" in page
     assert 'class="no"' in page and page.count('class="na"') == 2
     assert "12 stated numbers: 9 agree, 1 disagree, 2 not settled at this run length." in page
@@ -201,7 +237,7 @@ def test_html_escapes_everything(tmp_path):
     page = write_report(tmp_path, [row], [fig], {"note": nasty})["html"].read_text()
     assert "<script>" not in page and "<i>" not in page
     assert 'onerror="x.png' not in page
-    assert html.escape(nasty) in page
+    assert _esc(nasty) in page
 
 
 def test_rows_may_be_plain_dicts(tmp_path):

@@ -154,7 +154,7 @@ def separation(ref: ChainState, twin: ChainState, params: ChainParams) -> np.nda
     With the plate drive y = (sqrt(Kp) dx, v, theta) (module docstring).
     """
     dx = twin.x[1:-1] - ref.x[1:-1]
-    if params.drive == "plate":
+    if params.drive_piece.leaf_spring:
         return np.concatenate((math.sqrt(params.Kp) * dx, twin.v[1:-1] - ref.v[1:-1], twin.th[1:-1] - ref.th[1:-1]))
     de = np.concatenate(([0.0], dx[:-1])) - dx
     dv = twin.v[1:-1] - ref.v[1:-1]
@@ -223,13 +223,13 @@ def twin_state(ref: ChainState, direction: np.ndarray, d0: float, params: ChainP
     b = ref.blocks()
     N = b["x"].shape[0]
     u = _project(direction, b["stopped"])
-    if params.friction != "state":
+    if not params.friction_piece.has_state:
         u[2 * N :] = 0.0  # no state variable: theta is not a coordinate of these models
     norm = float(np.linalg.norm(u))
     if not norm > 0.0:
         raise ValueError("the separation vanished on the reference's branch; cannot renormalise")
     u = u * (d0 / norm)
-    if params.drive == "plate":
+    if params.drive_piece.leaf_spring:
         x = b["x"] + u[:N] / math.sqrt(params.Kp)
     else:
         x = b["x"] - np.cumsum(u[:N] / math.sqrt(params.K))

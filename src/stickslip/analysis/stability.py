@@ -39,18 +39,23 @@ import pandas as pd
 import xarray as xr
 from scipy.optimize import brentq
 
+from stickslip.analysis.linear import GROWTH_TOL, _sorted_by_real_part, finite_chain_wavenumbers, lattice_q
+
+# The relatives without a state variable live in stability_modes; their names stay importable here.
+from stickslip.analysis.stability_modes import (  # noqa: F401
+    ModeStability,
+    chain_jacobian_2n,
+    friction_slope,
+    mode_dispersion,
+    mode_frequency_squared,
+    mode_growth_rates,
+    mode_roots,
+    mode_stability,
+    normal_modes,
+    weakening_g,
+)
 from stickslip.models.params import BlockParams, ChainParams
 from stickslip.models.physics import block_steady_state
-
-#: A growth rate below this (in absolute value) counts as zero: the round-off of a 3 x 3 or
-#: 3N x 3N eigenvalue problem with entries of order K is far below it.
-GROWTH_TOL = 1e-10
-
-
-def _sorted_by_real_part(eig: np.ndarray) -> np.ndarray:
-    """Eigenvalues along the last axis, largest real part first (ties: positive imag first)."""
-    order = np.lexsort((-eig.imag, -eig.real), axis=-1)
-    return np.take_along_axis(eig, order, axis=-1)
 
 
 def steady_theta(V: float, alpha: float) -> float:
@@ -271,9 +276,12 @@ def block_growth_map(p: BlockParams, beta: np.ndarray, V: np.ndarray) -> xr.Data
 # ---------------------------------------------------------------------------------------------
 
 
-def lattice_q(k: np.ndarray | float) -> np.ndarray:
-    """Eigenvalue -q of the discrete Laplacian on exp(i k j): q = 2 (1 - cos k) = 4 sin^2(k/2)."""
-    return 4.0 * np.sin(0.5 * np.asarray(k, dtype=float)) ** 2
+def _theta_terms(p: ChainParams) -> tuple[float, float, float]:
+    """The friction piece's theta law linearised at steady sliding; refused for laws without theta."""
+    terms = p.friction_piece.theta_terms
+    if terms is None:
+        raise ValueError(f"friction {p.friction} has no state variable: use mode_stability")
+    return terms(p.alpha, p.V)
 
 
 def chain_mode_matrix(p: ChainParams, k: np.ndarray | float) -> np.ndarray:
@@ -284,14 +292,14 @@ def chain_mode_matrix(p: ChainParams, k: np.ndarray | float) -> np.ndarray:
     dtheta' = (1 - 2 theta_0 - alpha V - D q) dtheta - alpha theta_0 dv.
     """
     q = lattice_q(k)
-    theta0 = steady_theta(p.V, p.alpha)
+    _, d_v, d_theta = _theta_terms(p)
     A = np.zeros(q.shape + (3, 3))
     A[..., 0, 1] = 1.0
     A[..., 1, 0] = -p.K * q
     A[..., 1, 1] = -p.beta
     A[..., 1, 2] = -1.0
-    A[..., 2, 1] = -p.alpha * theta0
-    A[..., 2, 2] = 1.0 - 2.0 * theta0 - p.alpha * p.V - p.D * q
+    A[..., 2, 1] = d_v
+    A[..., 2, 2] = d_theta - p.D * q
     return A
 
 
@@ -426,7 +434,7 @@ def chain_jacobian(p: ChainParams) -> np.ndarray:
     ends, dtheta_0 = dtheta_1 and dtheta_{N+1} = dtheta_N.
     """
     N = p.N
-    theta0 = steady_theta(p.V, p.alpha)
+    _, d_v, d_theta = _theta_terms(p)
     lap_x = -2.0 * np.eye(N) + np.eye(N, k=1) + np.eye(N, k=-1)
     lap_x[-1, -1] = -1.0  # free end
     lap_t = -2.0 * np.eye(N) + np.eye(N, k=1) + np.eye(N, k=-1)
@@ -438,7 +446,7 @@ def chain_jacobian(p: ChainParams) -> np.ndarray:
         [
             [zero, eye, zero],
             [p.K * lap_x, -p.beta * eye, -eye],
-            [zero, -p.alpha * theta0 * eye, (1.0 - 2.0 * theta0 - p.alpha * p.V) * eye + p.D * lap_t],
+            [zero, d_v * eye, d_theta * eye + p.D * lap_t],
         ]
     )
 
@@ -446,16 +454,6 @@ def chain_jacobian(p: ChainParams) -> np.ndarray:
 def chain_finite_eigenvalues(p: ChainParams) -> np.ndarray:
     """Eigenvalues of the finite linearised chain (:func:`chain_jacobian`), largest real part first."""
     return _sorted_by_real_part(np.linalg.eigvals(chain_jacobian(p)))
-
-
-def finite_chain_wavenumbers(N: int) -> np.ndarray:
-    """Wavenumbers k_m = (2m - 1) pi / (2N + 1), m = 1..N, of the spring Laplacian of the chain.
-
-    With dx_0 = 0 and dx_{N+1} = dx_N the eigenvectors are sin(k_m i); the smallest,
-    k_1 ~ pi / (2N), is the longest wave the finite chain holds.
-    """
-    m = np.arange(1, N + 1)
-    return (2 * m - 1) * np.pi / (2 * N + 1)
 
 
 def compare_fourier_finite(p: ChainParams, Ns: list[int] | tuple[int, ...]) -> pd.DataFrame:
@@ -501,169 +499,3 @@ def fig4_data(p: ChainParams, betas=FIG4_BETAS, k: np.ndarray | None = None) -> 
     ds = xr.concat(parts, dim=xr.DataArray(np.asarray(betas, dtype=float), dims="beta", name="beta"))
     ds.attrs.pop("beta", None)
     return ds
-
-
-# ---------------------------------------------------------------------------------------------
-# The relatives without a state variable: plate drive (Carlson-Langer) and the train model
-# ---------------------------------------------------------------------------------------------
-#
-# With friction weakening (CL's phi) or strengthening (F0 + beta v) a moving block has no state
-# variable, and steady sliding v_i = V of every block, linearised, is
-#     d dx_i/dt = dv_i,  d dv_i/dt = K (dx_{i-1} - 2 dx_i + dx_{i+1}) - Kp dx_i - phi'(V) dv_i
-# (the Kp term only for the plate drive). A normal mode of the spring Laplacian with -q_k,
-# q_k = 4 sin^2(k/2), has w_k^2 = Kp + K q_k and obeys lambda^2 + phi'(V) lambda + w_k^2 = 0.
-
-
-def friction_slope(p: ChainParams) -> float:
-    """phi'(V): slope of the moving friction at steady sliding (weakening or strengthening).
-
-    Weakening (CL), phi(v) = (1 - sigma) / (1 + 2 alpha v / (1 - sigma)): phi'(V) = -2 alpha g
-    with g = (1 + 2 alpha V / (1 - sigma))^-2. Strengthening (train), F0 + beta v: beta.
-    """
-    if p.friction == "weakening":
-        return -2.0 * p.alpha * weakening_g(p)
-    if p.friction == "strengthening":
-        return float(p.beta)
-    raise ValueError(f"friction {p.friction} has a state variable: use chain_mode_matrix (eq. 5)")
-
-
-def weakening_g(p: ChainParams) -> float:
-    """g = (1 + 2 alpha V / (1 - sigma))^-2 of CL's velocity weakening; -phi'(V) = 2 alpha g."""
-    return float((1.0 + 2.0 * p.alpha * p.V / (1.0 - p.sigma)) ** -2)
-
-
-def normal_modes(p: ChainParams) -> tuple[np.ndarray, str]:
-    """Wavenumbers k of the normal modes of the finite chain's spring Laplacian, and their kind.
-
-    Plate drive: periodic ends k = 2 pi j / N (j = 0..N-1, ``exp(i k j)``); free ends
-    (x_0 = x_1, x_{N+1} = x_N) the cosine modes k = pi j / N (j = 0..N-1). End drive, free end
-    (dx_0 = 0, dx_{N+1} = dx_N): the sine modes k_m = (2m - 1) pi / (2N + 1), m = 1..N.
-    Fixed ends have no steady sliding (a spring to a fixed wall stretches for ever): refused.
-    """
-    N = p.N
-    if p.ends == "fixed":
-        raise ValueError("ends fixed have no steady sliding (the springs to the walls stretch without bound)")
-    if p.drive == "plate" and p.ends == "periodic":
-        return 2.0 * np.pi * np.arange(N) / N, "periodic: exp(i k j), k = 2 pi j / N, j = 0..N-1"
-    if p.drive == "plate":
-        return np.pi * np.arange(N) / N, "free ends: cos(k (i - 1/2)), k = pi j / N, j = 0..N-1"
-    return finite_chain_wavenumbers(N), "end drive, free end: sin(k i), k = (2m - 1) pi / (2N + 1), m = 1..N"
-
-
-def mode_frequency_squared(p: ChainParams, k: np.ndarray | float) -> np.ndarray:
-    """w_k^2 = Kp + 4 K sin^2(k/2) for the plate drive, 4 K sin^2(k/2) for the end drive."""
-    return (p.Kp if p.drive == "plate" else 0.0) + p.K * lattice_q(k)
-
-
-def mode_roots(p: ChainParams, k: np.ndarray | float) -> np.ndarray:
-    """Both roots of lambda^2 + phi'(V) lambda + w_k^2 = 0, shape (..., 2), larger real part first."""
-    b = friction_slope(p)
-    w2 = np.asarray(mode_frequency_squared(p, k), dtype=float)
-    disc = np.sqrt((0.25 * b * b - w2).astype(complex))
-    roots = np.stack([-0.5 * b + disc, -0.5 * b - disc], axis=-1)
-    return _sorted_by_real_part(roots)
-
-
-def mode_growth_rates(p: ChainParams) -> pd.DataFrame:
-    """Growth rates of steady sliding mode by mode (plate drive or train model; no state variable).
-
-    One row per normal mode of :func:`normal_modes`: ``j``, ``k``, ``omega2`` (w_k^2),
-    ``growth_rate`` (largest Re lambda), ``growth_rate_2`` (the other root's) and ``frequency``
-    (``|Im lambda|``).
-    """
-    k, _ = normal_modes(p)
-    roots = mode_roots(p, k)
-    return pd.DataFrame(
-        {
-            "j": np.arange(k.size),
-            "k": k,
-            "omega2": mode_frequency_squared(p, k),
-            "growth_rate": roots[:, 0].real,
-            "growth_rate_2": roots[:, 1].real,
-            "frequency": np.abs(roots[:, 0].imag),
-        }
-    )
-
-
-def chain_jacobian_2n(p: ChainParams) -> np.ndarray:
-    """The 2N x 2N matrix of the linearised chain without state variable, variables (dx, dv).
-
-    dv' = K L dx - Kp dx [plate] - phi'(V) dv with L the spring Laplacian under the model's ends
-    (periodic: circulant; plate, free: x_0 = x_1 and x_{N+1} = x_N; end drive: dx_0 = 0,
-    dx_{N+1} = dx_N). Built from the ends directly, not from :func:`normal_modes`.
-    """
-    N = p.N
-    if p.ends == "fixed":
-        raise ValueError("ends fixed have no steady sliding")
-    L = -2.0 * np.eye(N) + np.eye(N, k=1) + np.eye(N, k=-1)
-    if p.ends == "periodic":
-        L[0, -1] += 1.0
-        L[-1, 0] += 1.0
-    else:
-        L[-1, -1] += 1.0  # x_{N+1} = x_N
-        if p.drive == "plate":
-            L[0, 0] += 1.0  # x_0 = x_1
-    A = p.K * L - (p.Kp if p.drive == "plate" else 0.0) * np.eye(N)
-    return np.block([[np.zeros((N, N)), np.eye(N)], [A, -friction_slope(p) * np.eye(N)]])
-
-
-@dataclass(frozen=True)
-class ModeStability:
-    """Stability of steady sliding over the normal modes (plate drive or train model).
-
-    ``growth`` is :func:`mode_growth_rates`; ``max_growth_rate`` and ``min_growth_rate`` are the
-    largest and smallest of the modes' growth rates; ``all_unstable`` says every mode grows,
-    ``stable`` that every mode decays.
-    """
-
-    friction_slope: float
-    modes: str
-    growth: pd.DataFrame
-    max_growth_rate: float
-    k_at_max: float
-    min_growth_rate: float
-    k_at_min: float
-    all_unstable: bool
-    stable: bool
-
-
-def mode_stability(p: ChainParams) -> ModeStability:
-    """Growth rates of steady sliding of a chain without state variable, mode by mode.
-
-    lambda^2 + phi'(V) lambda + w_k^2 = 0 for each normal mode: with CL's weakening every mode
-    grows (Re lambda >= alpha g > 0), with strengthening (train) every mode decays for beta > 0.
-    """
-    _, modes = normal_modes(p)
-    df = mode_growth_rates(p)
-    i_max, i_min = int(df["growth_rate"].idxmax()), int(df["growth_rate"].idxmin())
-    return ModeStability(
-        friction_slope=friction_slope(p),
-        modes=modes,
-        growth=df,
-        max_growth_rate=float(df["growth_rate"].iloc[i_max]),
-        k_at_max=float(df["k"].iloc[i_max]),
-        min_growth_rate=float(df["growth_rate"].iloc[i_min]),
-        k_at_min=float(df["k"].iloc[i_min]),
-        all_unstable=bool((df["growth_rate"] > GROWTH_TOL).all()),
-        stable=bool((df["growth_rate"] < -GROWTH_TOL).all()),
-    )
-
-
-def mode_dispersion(p: ChainParams, k: np.ndarray | None = None) -> xr.Dataset:
-    """Re and Im of both roots of lambda^2 + phi'(V) lambda + w_k^2 = 0 against k in [0, pi].
-
-    The curve of the figure like Fig. 4 for the plate drive and the train model; the finite
-    chain's modes (:func:`normal_modes`) lie on it (folded into [0, pi] on the periodic chain).
-    """
-    k = np.linspace(0.0, np.pi, 629) if k is None else np.asarray(k, dtype=float)
-    roots = mode_roots(p, k)
-    return xr.Dataset(
-        {
-            "real": (("k", "branch"), roots.real, {"long_name": "Re(lambda)"}),
-            "imag": (("k", "branch"), roots.imag, {"long_name": "Im(lambda)"}),
-        },
-        coords={"k": ("k", k, {"long_name": "lattice wavenumber k"}), "branch": ("branch", np.arange(2))},
-        attrs={
-            name: v if isinstance(v, str) else float(v) for name, v in p.to_dict().items() if name not in ("Fs", "dt")
-        },
-    )

@@ -393,7 +393,7 @@ def chain_params_from_args(args: argparse.Namespace, **overrides: Any):
             f"--{unused[0]} is not a parameter of this model ({params.model}: "
             f"{', '.join(f'{k} {v}' for k, v in params.pieces.items())}); it reads {', '.join(params.used())}"
         )
-    if ("l" in values or "nu" in values) and params.drive != "plate":
+    if ("l" in values or "nu" in values) and not params.drive_piece.leaf_spring:
         raise ParameterError("--l and --nu are Carlson-Langer's symbols: they need drive plate")
     return params
 

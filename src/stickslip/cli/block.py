@@ -109,7 +109,7 @@ def _law_or_none(p: BlockParams) -> SlipLimit | None:
     """The accurate eq. (3) at these parameters, or None where it has no slip that ends (or one
     too stiff or too long to resolve: sqrt(K/M) > 1e4 or Fs > 1000 sigma; or where the threshold
     is not the constant Fs that eq. (3) starts from)."""
-    if p.threshold != "constant" or math.sqrt(p.K / p.M) > 1e4 or p.Fs / p.sigma > 1e3:
+    if p.threshold_piece.has_state or math.sqrt(p.K / p.M) > 1e4 or p.Fs / p.sigma > 1e3:
         return None
     try:
         return solve_slip_limit(p)
@@ -122,10 +122,10 @@ def default_t_end(p: BlockParams, law: SlipLimit | None) -> float:
     if p.V <= 0.0:
         raise ParameterError("t_end must be given when V = 0 (the block never starts)")
     # Without eq. (3): the spring must be loaded by about twice the threshold per cycle.
-    threshold = p.Fs if p.threshold == "constant" else p.sigma
+    threshold = p.sigma if p.threshold_piece.has_state else p.Fs
     period = law.period(p.V) if law is not None else 2.0 * threshold / (p.K * p.V)
     # A state threshold sigma theta is at most sigma: the first start comes no later than that.
-    if p.threshold == "constant":
+    if not p.threshold_piece.has_state:
         return first_start_time(p) + DEFAULT_PERIODS * float(period)
     return p.sigma / (p.K * p.V) + 20 * DEFAULT_PERIODS * float(period)
 
@@ -167,7 +167,7 @@ def block_report(run: BlockRun, law: SlipLimit | None) -> dict[str, Any]:
     data: dict[str, Any] = run.summary()
     data["params"] = run.params.to_dict()
     data["integrator"] = INTEGRATOR
-    if run.params.threshold == "state":
+    if run.params.threshold_piece.has_state:
         from stickslip.models.presets import PRESETS
 
         data["model"] = "batista-carlson"

@@ -466,7 +466,7 @@ def run_bench_command(args: argparse.Namespace) -> Result:
     if args.workload == "partly-stuck":
         return _partly_stuck(args)
     params = chain_params_from_args(args)
-    t_end = args.t_end if args.t_end is not None else (2e4 if params.drive == "plate" else 2e5)
+    t_end = args.t_end if args.t_end is not None else (2e4 if params.drive_piece.leaf_spring else 2e5)
     check_number("t-end", t_end, low=0.0, low_open=True)
     steps_for(t_end, params.dt, "t-end")
     args.perturbation = getattr(args, "perturbation", None)

@@ -243,9 +243,9 @@ def run_stability_chain(args: argparse.Namespace) -> Result:
     # dt is never read by the linear analysis; keep ChainParams' explicit-step check out of the way.
     overrides = {"dt": 1.0 / (2.0 * D + 1.0)} if D is not None and D > 0.0 and (2.0 * D + 1.0) * 0.005 > 1.0 else {}
     p = chain_params_from_args(args, **overrides)
-    if p.friction != "state":
+    if not p.friction_piece.has_state:
         return run_stability_modes(args, p)
-    if p.drive != "end":
+    if p.drive_piece.leaf_spring:
         raise CommandError(
             "friction state with drive plate is not covered: use friction weakening or "
             "strengthening with the plate drive"
@@ -323,8 +323,8 @@ def run_stability_modes(args: argparse.Namespace, p: ChainParams) -> Result:
     """
     if p.V <= 0.0:
         raise CommandError(f"steady sliding needs V > 0 (got V={p.V:g})")
-    if p.ends == "fixed":
-        raise CommandError("ends fixed have no steady sliding (the springs to the walls stretch without bound)")
+    if not p.ends_piece.steady_sliding:
+        raise CommandError(f"ends {p.ends} have no steady sliding (the springs to the walls stretch without bound)")
     if p.N > MAX_FINITE_N:
         raise CommandError(f"N must be <= {MAX_FINITE_N} for the mode table (got N={p.N})")
     check_out_owned(args.out, _CHAIN_MAP, "stickslip stability chain", overwrite=args.overwrite)
@@ -341,8 +341,9 @@ def run_stability_modes(args: argparse.Namespace, p: ChainParams) -> Result:
         "min_growth_rate": s.min_growth_rate,
         "k_at_min": s.k_at_min,
     }
-    if p.friction == "weakening":
-        data["alpha_g"] = p.alpha * st.weakening_g(p)
+    extras = p.friction_piece.stability_extras
+    if extras is not None:
+        data.update(extras(p))
     data["mode_table"] = s.growth.to_dict(orient="records")
     with owned_out_dir(args.out, _CHAIN_MAP, "stickslip stability chain", overwrite=args.overwrite) as out:
         if out is not None:

@@ -203,6 +203,7 @@ def run(args: argparse.Namespace) -> Result:
     points, common = parse_grid(args.model, args.grid, args.fixed, args.t_end)
     _, workers = dask_options(args)
     own = _sweep_files(args.out)
+    # Not a model piece: the user's choice of system (chain or single block) picks the task.
     task = chain_task if args.model == "chain" else block_task
     with owned_out_dir(args.out, own, "stickslip sweep", overwrite=args.overwrite) as out:
         try:

@@ -174,6 +174,7 @@ def _exponents(table: pd.DataFrame) -> dict[str, Any]:
     out: dict[str, Any] = {"statements": []}
     say = out["statements"].append
     for r in table.sort_values(["model", "beta"]).itertuples():
+        # Not a piece test: a table row's preset picks its label (the paper's beta or CL's N).
         label = f"beta = {r.beta:g}" if r.model == "sakaguchi" else f"Carlson-Langer (N = {r.N})"
         say(
             f"{label}: tau = {_g(r.tau)} +- {_g(getattr(r, 'tau_err', math.nan), 2)} on S in "

@@ -12,6 +12,8 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
+from stickslip.models.pieces import Piece, piece
+
 
 class ParameterError(ValueError):
     """A parameter is outside its allowed range; the message is one line."""
@@ -161,6 +163,11 @@ class BlockParams(_Validated):
             d.pop("Fs")
         return d
 
+    @property
+    def threshold_piece(self) -> Piece:
+        """The static threshold as a :class:`~stickslip.models.pieces.Piece`."""
+        return piece("threshold", self.threshold)
+
     def scaled(self) -> BlockParams:
         """The same system in the units M = sigma = 1 of section 2 (see :func:`scale_block`)."""
         return scale_block(self)
@@ -241,7 +248,7 @@ class ChainParams(_Validated):
         except CompositionError as exc:
             raise ParameterError(str(exc)) from None
         # Heun keeps every theta_i in [0, 1] if (2 D + 1) dt <= 1 (docs/limits.md).
-        if self.friction == "state" and (2.0 * self.D + 1.0) * self.dt > 1.0:
+        if self.friction_piece.has_state and (2.0 * self.D + 1.0) * self.dt > 1.0:
             raise ParameterError(
                 f"D*dt must be <= (1 - dt)/2 = {(1.0 - self.dt) / 2:g} so that theta stays in [0, 1] "
                 f"(got D={self.D:g}, dt={self.dt:g})"
@@ -251,6 +258,26 @@ class ChainParams(_Validated):
     def pieces(self) -> dict[str, str]:
         """The four pieces of the model."""
         return {"drive": self.drive, "friction": self.friction, "threshold": self.threshold, "ends": self.ends}
+
+    @property
+    def drive_piece(self) -> Piece:
+        """The drive as a :class:`~stickslip.models.pieces.Piece` (what it reads, its code)."""
+        return piece("drive", self.drive)
+
+    @property
+    def friction_piece(self) -> Piece:
+        """The friction law as a :class:`~stickslip.models.pieces.Piece`."""
+        return piece("friction", self.friction)
+
+    @property
+    def threshold_piece(self) -> Piece:
+        """The static threshold as a :class:`~stickslip.models.pieces.Piece`."""
+        return piece("threshold", self.threshold)
+
+    @property
+    def ends_piece(self) -> Piece:
+        """The end condition as a :class:`~stickslip.models.pieces.Piece`."""
+        return piece("ends", self.ends)
 
     @property
     def codes(self) -> tuple[int, int, int, int]:

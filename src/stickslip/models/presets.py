@@ -26,6 +26,8 @@ class Preset:
     equations: str = ""
     source: str = ""
     note: str = ""
+    #: the note is a caveat on the model itself, so every run of it records the note
+    note_in_runs: bool = False
     symbols: dict[str, str] = field(default_factory=dict)  # the model's own names -> ChainParams fields
 
     def describe(self) -> dict[str, Any]:
@@ -94,6 +96,7 @@ PRESETS: dict[str, Preset] = {
         ),
         source="F.-J. Elmer; here the paper's chain with alpha = 0 and theta = F0 = 1",
         note="Elmer's own parametrisation was not available; this is one member of the model",
+        note_in_runs=True,
     ),
     "batista-carlson": Preset(
         "batista-carlson",
@@ -109,6 +112,7 @@ PRESETS: dict[str, Preset] = {
         ),
         source="after A. A. Batista and J. M. Carlson, Phys. Rev. E 57, 4986 (1998)",
         note=_BC_NOTE,
+        note_in_runs=True,
     ),
     "two-blocks": Preset(
         "two-blocks",

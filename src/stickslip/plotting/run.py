@@ -41,7 +41,7 @@ def length_series(samples, params) -> Figure:
     """L(t) = x_1 - x_N of a run against the exact steady length L_ss and the loading time L_ss / V."""
     fig, ax = new_figure(1, 1, width=6.0, height=3.2)
     ax.plot(samples["t"].values, samples["L"].values, color=SIM["color"], lw=0.7, label="$L(t) = x_1 - x_N$")
-    if has_steady_state(params) and params.drive == "end":
+    if has_steady_state(params) and not params.drive_piece.leaf_spring:
         ax.axhline(chain_steady_length(params), **THEORY, label="steady sliding $L_{ss}$")
         t_load = loading_time(params)
         if math.isfinite(t_load) and t_load <= float(samples["t"].values[-1]) * 1.05:
@@ -61,7 +61,7 @@ def run_figures(run, *, max_snapshots: int = 4) -> list[RunFigure]:
         out.append(RunFigure("length", "L(t)", length_series(run.samples, p)))
     else:
         out.append(RunFigure("length", "L(t)", None, "fewer than two samples of L"))
-    steady = has_steady_state(p) and p.drive == "end"
+    steady = has_steady_state(p) and not p.drive_piece.leaf_spring
     t_end = float(run.summary["t_end"])
     if steady:
         out.append(

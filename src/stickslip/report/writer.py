@@ -12,12 +12,13 @@ from __future__ import annotations
 
 import base64
 import datetime as _dt
-import html
 import math
 from collections.abc import Iterable, Mapping
 from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 from typing import Any
+
+import jinja2
 
 from stickslip import __version__
 from stickslip.io import read_json, write_bytes, write_json
@@ -171,22 +172,7 @@ def read_report(path: str | Path) -> Report:
 
 
 # ---------------------------------------------------------------------------------------------
-# HTML
-
-_CSS = """
-body { font-family: system-ui, sans-serif; margin: 2em auto; max-width: 72em; padding: 0 1em; color: #222; }
-h1 { font-size: 1.4em; } h2 { font-size: 1.15em; margin-top: 2em; }
-table { border-collapse: collapse; width: 100%; font-size: 0.92em; }
-th, td { border: 1px solid #ccc; padding: 0.35em 0.5em; text-align: left; vertical-align: top; }
-th { background: #f3f3f3; }
-td.yes { background: #e6f4e6; } td.no { background: #f9e0e0; } td.na { background: #f4f4f4; color: #555; }
-code { font-size: 0.9em; word-break: break-all; }
-figure { display: inline-block; vertical-align: top; margin: 0.8em; max-width: 46em; }
-figure img { max-width: 100%; border: 1px solid #ddd; }
-figcaption { font-size: 0.9em; }
-dl.meta { display: grid; grid-template-columns: max-content auto; gap: 0.2em 1em; font-size: 0.9em; }
-dl.meta dt { font-weight: 600; } dl.meta dd { margin: 0; }
-"""
+# HTML: templates/report.html.j2, rendered by jinja2 with autoescape on
 
 
 def _format_value(value: Any) -> str:
@@ -213,58 +199,20 @@ def _image_src(image: str, out: Path, embed: bool) -> str:
     return image
 
 
-def _meta_html(meta: Mapping[str, Any]) -> str:
-    items = []
-    for key, value in meta.items():
-        text = value if isinstance(value, str) else _json_text(value)
-        items.append(f"<dt>{html.escape(str(key))}</dt><dd>{html.escape(text)}</dd>")
-    return '<dl class="meta">' + "".join(items) + "</dl>"
-
-
 def _json_text(value: Any) -> str:
     import json
 
     return json.dumps(to_jsonable(value), allow_nan=False)
 
 
-def _rows_html(rows: Iterable[ReportRow]) -> str:
-    head = ("where", "quantity", "paper", "this run", "agreement", "command")
-    out = ["<table>", "<thead><tr>" + "".join(f"<th>{h}</th>" for h in head) + "</tr></thead>", "<tbody>"]
-    for row in rows:
-        quantity = html.escape(row.quantity)
-        if row.note:
-            quantity += f"<br><small>{html.escape(row.note)}</small>"
-        out.append(
-            "<tr>"
-            f"<td>{html.escape(row.where)}</td>"
-            f"<td>{quantity}</td>"
-            f"<td>{html.escape(row.paper)}</td>"
-            f"<td>{html.escape(_format_value(row.value))}</td>"
-            f'<td class="{_agreement_class(row.agrees)}">{html.escape(row.agreement)}</td>'
-            f"<td><code>{html.escape(row.command)}</code></td>"
-            "</tr>"
-        )
-    out.append("</tbody></table>")
-    return "\n".join(out)
-
-
-def _figures_html(figures: Iterable[ReportFigure], out: Path, embed: bool) -> str:
-    parts = []
-    for fig in figures:
-        links = []
-        if fig.pdf:
-            links.append(f'<a href="{html.escape(fig.pdf, quote=True)}">PDF</a>')
-        links.extend(f'<a href="{html.escape(d, quote=True)}">{html.escape(Path(d).name)}</a>' for d in fig.data)
-        extra = f"<br>files: {', '.join(links)}" if links else ""
-        command = f"<br><code>{html.escape(fig.command)}</code>" if fig.command else ""
-        parts.append(
-            "<figure>"
-            f'<img src="{html.escape(_image_src(fig.image, out, embed), quote=True)}" '
-            f'alt="{html.escape(fig.figure, quote=True)}">'
-            f"<figcaption><b>{html.escape(fig.figure)}.</b> {html.escape(fig.caption)}{extra}{command}"
-            "</figcaption></figure>"
-        )
-    return "\n".join(parts)
+def _templates() -> jinja2.Environment:
+    """The report's templates (package data), every value escaped."""
+    return jinja2.Environment(
+        loader=jinja2.PackageLoader("stickslip.report", "templates"),
+        autoescape=True,
+        keep_trailing_newline=True,
+        undefined=jinja2.StrictUndefined,
+    )
 
 
 def render_html(report: Report, out_dir: str | Path, *, embed: bool = True, title: str = "Report") -> str:
@@ -277,20 +225,36 @@ def render_html(report: Report, out_dir: str | Path, *, embed: bool = True, titl
         f"{len(report.rows)} stated numbers: {counts['yes']} agree, {counts['no']} disagree, "
         f"{counts['na']} not settled at this run length."
     )
-    return "\n".join(
-        [
-            "<!DOCTYPE html>",
-            '<html lang="en"><head><meta charset="utf-8">',
-            f"<title>{html.escape(title)}</title>",
-            f"<style>{_CSS}</style></head><body>",
-            f"<h1>{html.escape(title)}</h1>",
-            _meta_html(report.meta),
-            "<h2>Numbers the paper states</h2>",
-            f"<p>{html.escape(verdict)}</p>",
-            _rows_html(report.rows),
-            "<h2>Figures</h2>",
-            _figures_html(report.figures, out, embed),
-            "</body></html>",
-            "",
-        ]
+    meta = [(str(k), v if isinstance(v, str) else _json_text(v)) for k, v in report.meta.items()]
+    rows = [
+        {
+            "where": r.where,
+            "quantity": r.quantity,
+            "note": r.note,
+            "paper": r.paper,
+            "value": _format_value(r.value),
+            "cls": _agreement_class(r.agrees),
+            "agreement": r.agreement,
+            "command": r.command,
+        }
+        for r in report.rows
+    ]
+    figures = []
+    for fig in report.figures:
+        links = [{"href": fig.pdf, "text": "PDF"}] if fig.pdf else []
+        links += [{"href": d, "text": Path(d).name} for d in fig.data]
+        figures.append(
+            {
+                "src": _image_src(fig.image, out, embed),
+                "figure": fig.figure,
+                "caption": fig.caption,
+                "links": links,
+                "command": fig.command,
+            }
+        )
+    head = ("where", "quantity", "paper", "this run", "agreement", "command")
+    return (
+        _templates()
+        .get_template("report.html.j2")
+        .render(title=title, meta=meta, verdict=verdict, head=head, rows=rows, figures=figures)
     )

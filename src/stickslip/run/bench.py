@@ -138,7 +138,7 @@ def _unit_costs(params: ChainParams) -> dict[str, float]:
     t2, s2 = timed(slide, 200.0, "steady")
     per_full = max(t2 - s2["steps_computed"] * per_step, 0.0) / s2["block_updates"]
     per_theta = 0.0
-    if params.friction == "state":
+    if params.friction_piece.has_state:
         # Without a state variable a stopped block never changes: no such updates.
         still = params.replace(V=0.0)
         rng = np.random.default_rng(0)
@@ -188,7 +188,7 @@ def profile(
         "full_block_updates": s["full_block_updates"],
         "theta_only_updates": theta_updates,
         # Without a state variable the other updates are stopped candidates: start rule alone.
-        "partial_updates": "state variable only" if params.friction == "state" else "start rule only (stopped)",
+        "partial_updates": "state variable only" if params.friction_piece.has_state else "start rule only (stopped)",
         "n_events": s["n_events"],
         "unit_costs_ns": {k: 1e9 * v for k, v in costs.items()},
         "seconds": parts,

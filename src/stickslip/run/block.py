@@ -170,7 +170,7 @@ def simulate_block(
             params.K, params.V, params.beta, params.alpha, params.Fs, params.M, params.sigma,
             params.dt,
             out_t, out_x, out_v, out_theta, out_stopped,
-            slip_start, slip_end, slip_x_start, slip_x_end, params.threshold == "state",
+            slip_start, slip_end, slip_x_start, slip_x_end, params.threshold_piece.has_state,
         )  # fmt: skip
         if n_slips <= capacity:
             break

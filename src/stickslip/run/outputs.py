@@ -310,8 +310,8 @@ def _model_note(params) -> dict[str, str]:
     """The preset's caveat (Batista-Carlson: the paper's reading; train: one member), if any."""
     from stickslip.models.presets import PRESETS
 
-    note = PRESETS[params.model].note
-    return {"model_note": note} if note and params.model in ("batista-carlson", "train") else {}
+    preset = PRESETS[params.model]
+    return {"model_note": preset.note} if preset.note and preset.note_in_runs else {}
 
 
 def _profiles(parts, events, options, params) -> xr.Dataset:

@@ -1,0 +1,258 @@
+"""Rupture fronts of a chain run (Fig. 6): front speed, leading-edge speed, their intervals.
+
+Blocks are numbered 1..N (docs/model.md); the functions take the labelled tables of a chain run
+(``events``, ``first_move``) and return frozen dataclasses. Importable also from
+:mod:`stickslip.analysis.statistics`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+from typing import Any
+
+import numpy as np
+import pandas as pd
+import xarray as xr
+
+# ---------------------------------------------------------------------------------------------
+# Rupture fronts (Fig. 6)
+
+
+@dataclass(frozen=True)
+class FrontSpeed:
+    """Speed of a rupture front fitted from first-motion times (Fig. 6).
+
+    Least squares of block index i against first-move time t over blocks i_min..i_max:
+    i = i_0 + speed (t - t_start). ``speed`` is in blocks per time unit (the paper: c = 1.43 in
+    large events at beta = 1, below the sound speed sqrt(K) = 3.16); ``speed_err`` is the
+    standard error of the slope; ``t_start`` the event's first first-move time; ``intercept``
+    is i_0; ``rms`` the residual root mean square in blocks; ``n_blocks`` the blocks fitted.
+    """
+
+    event: int
+    speed: float
+    speed_err: float
+    intercept: float
+    t_start: float
+    i_min: int
+    i_max: int
+    n_blocks: int
+    rms: float
+
+    def arrival_time(self, i: Any) -> np.ndarray:
+        """First-move time of block i on the fitted line (absolute time)."""
+        return self.t_start + (np.asarray(i, dtype=np.float64) - self.intercept) / self.speed
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+def front_speed(
+    first_move: pd.DataFrame,
+    event: int,
+    *,
+    i_min: int | None = None,
+    i_max: int | None = None,
+) -> FrontSpeed:
+    """Rupture-front speed of one event from the time each block first moved (Fig. 6).
+
+    ``first_move`` is the run's long table (event, block, t_first), blocks numbered 1..N;
+    blocks that did not move are absent or have NaN ``t_first``. The paper measures the leading
+    edge "for large i", away from the pulled end where the rupture starts, so by default the
+    fit uses the far half of the blocks the event reached: i_min = ceil(i_far / 2),
+    i_max = i_far, with i_far the farthest block that moved.
+    """
+    rows = first_move[(first_move["event"] == event) & np.isfinite(first_move["t_first"])]
+    if rows.empty:
+        raise ValueError(f"event {event} has no first-move times")
+    blocks = rows["block"].to_numpy(dtype=np.int64)
+    times = rows["t_first"].to_numpy(dtype=np.float64)
+    i_far = int(blocks.max())
+    lo = int(math.ceil(i_far / 2)) if i_min is None else int(i_min)
+    hi = i_far if i_max is None else int(i_max)
+    use = (blocks >= lo) & (blocks <= hi)
+    n = int(use.sum())
+    if n < 3:
+        raise ValueError(f"event {event}: need at least 3 moved blocks in [{lo}, {hi}] (got {n})")
+    t0 = float(times.min())
+    t = times[use] - t0
+    i = blocks[use].astype(np.float64)
+    design = np.column_stack([np.ones(n), t])
+    coef, *_ = np.linalg.lstsq(design, i, rcond=None)
+    residual = i - design @ coef
+    dof = n - 2
+    s2 = float(residual @ residual) / dof if dof > 0 else math.nan
+    t_centred = t - t.mean()
+    sxx = float(t_centred @ t_centred)
+    slope_err = math.sqrt(s2 / sxx) if sxx > 0 and dof > 0 else math.nan
+    return FrontSpeed(
+        event=int(event),
+        speed=float(coef[1]),
+        speed_err=slope_err,
+        intercept=float(coef[0]),
+        t_start=t0,
+        i_min=lo,
+        i_max=hi,
+        n_blocks=n,
+        rms=float(np.sqrt(np.mean(residual**2))),
+    )
+
+
+@dataclass(frozen=True)
+class EdgeSpeed:
+    """Speed of the leading edge of the Delta x_i windows of one event, as the paper reads Fig. 6.
+
+    For each stored window (Delta x_i = x_i(t + Delta t) - x_i(t)) the edge is the farthest block
+    whose Delta x_i is at least ``edge_fraction`` of that window's largest Delta x_i; ``edges``
+    and ``times`` (window ends) are those of every window. The speed is the least-squares slope
+    of edge against time over the windows whose edge lies in [i_min, i_max) (the far half, as
+    :func:`front_speed`; a window whose edge has reached i_max is left out: it only says the
+    front got there within the window, and so are the windows after it). ``n_windows``: windows
+    fitted; ``speed_err`` NaN with 2.
+    """
+
+    event: int
+    speed: float
+    speed_err: float
+    i_min: int
+    i_max: int
+    n_windows: int
+    edge_fraction: float
+    edges: tuple[int, ...]
+    times: tuple[float, ...]
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+def leading_edge_speed(
+    profiles: xr.Dataset,
+    event: int,
+    *,
+    edge_fraction: float = 0.05,
+    i_min: int | None = None,
+    i_max: int | None = None,
+) -> EdgeSpeed:
+    """Rupture-front speed of one event from the leading edge of its Delta x_i windows (Fig. 6).
+
+    ``profiles``: the run's stored windows (dim ``row`` with ``event``, ``t`` (window start),
+    optionally ``t_next`` (window end), ``dx(row, block)``). Default range: the far half of the
+    blocks the event reached, i_min = ceil(i_far / 2), i_max = i_far (i_far: the farthest edge).
+    """
+    rows = np.flatnonzero(profiles["event"].values == event)
+    if rows.size == 0:
+        raise ValueError(f"no displacement profiles stored for event {event}")
+    sub = profiles.isel(row=rows)
+    order = np.argsort(sub["t"].values, kind="stable")
+    dx = sub["dx"].transpose("row", "block").values[order]
+    blocks = sub["block"].values if "block" in sub.coords else np.arange(1, dx.shape[1] + 1)
+    t_end = (sub["t_next"] if "t_next" in sub.coords else sub["t"]).values[order]
+    if "t_next" not in sub.coords or np.all(t_end == sub["t"].values[order]):
+        # window ends: the next window's start, the last one as long as the one before it
+        starts = sub["t"].values[order]
+        width = float(np.median(np.diff(starts))) if starts.size > 1 else 0.0
+        t_end = np.append(starts[1:], starts[-1] + width)
+    edges = np.zeros(dx.shape[0], dtype=np.int64)
+    for k in range(dx.shape[0]):
+        peak = float(np.nanmax(dx[k])) if np.isfinite(dx[k]).any() else 0.0
+        moved = np.flatnonzero(dx[k] >= edge_fraction * peak) if peak > 0 else np.array([], dtype=int)
+        edges[k] = int(blocks[moved.max()]) if moved.size else 0
+    i_far = int(edges.max())
+    lo = int(math.ceil(i_far / 2)) if i_min is None else int(i_min)
+    hi = i_far if i_max is None else int(i_max)
+    # only the advance: windows before the edge first reaches its farthest block
+    advancing = np.arange(edges.size) < int(np.argmax(edges))
+    use = advancing & (edges >= lo) & (edges < hi)
+    n = int(use.sum())
+    if n < 2:
+        raise ValueError(f"event {event}: need at least 2 windows with the edge in [{lo}, {hi}) (got {n})")
+    t, i = t_end[use], edges[use].astype(np.float64)
+    design = np.column_stack([np.ones(n), t - t[0]])
+    coef, *_ = np.linalg.lstsq(design, i, rcond=None)
+    err = math.nan
+    if n > 2:
+        residual = i - design @ coef
+        tc = t - t.mean()
+        err = math.sqrt(float(residual @ residual) / (n - 2) / float(tc @ tc))
+    return EdgeSpeed(
+        event=int(event),
+        speed=float(coef[1]),
+        speed_err=err,
+        i_min=lo,
+        i_max=hi,
+        n_windows=n,
+        edge_fraction=float(edge_fraction),
+        edges=tuple(int(e) for e in edges),
+        times=tuple(float(x) for x in t_end),
+    )
+
+
+@dataclass(frozen=True)
+class CentralInterval:
+    """Where a stated value lies in a per-event distribution (Fig. 6: the paper's c = 1.43).
+
+    ``percentile``: the share of the sample below ``value`` (ties count half), in percent;
+    ``lo``, ``hi``: the bounds of the central ``level`` of the sample (5th and 95th percentiles
+    for level 0.9); ``inside``: lo <= value <= hi; ``median``, ``quartiles``, ``n``.
+    """
+
+    value: float
+    level: float
+    lo: float
+    hi: float
+    inside: bool
+    percentile: float
+    median: float
+    quartiles: tuple[float, float]
+    n: int
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+def central_interval(sample: Any, value: float, *, level: float = 0.9) -> CentralInterval:
+    """Is ``value`` inside the central ``level`` of ``sample`` (Fig. 6's row), and at which percentile."""
+    x = np.asarray(sample, dtype=np.float64)
+    x = x[np.isfinite(x)]
+    if x.size == 0:
+        raise ValueError("empty sample")
+    if not 0.0 < level < 1.0:
+        raise ValueError(f"level must lie in (0, 1) (got {level!r})")
+    tail = (1.0 - level) / 2.0
+    lo, hi = (float(q) for q in np.quantile(x, [tail, 1.0 - tail]))
+    pct = 100.0 * (np.count_nonzero(x < value) + 0.5 * np.count_nonzero(x == value)) / x.size
+    q1, q3 = (float(q) for q in np.quantile(x, [0.25, 0.75]))
+    return CentralInterval(
+        value=float(value),
+        level=float(level),
+        lo=lo,
+        hi=hi,
+        inside=bool(lo <= value <= hi),
+        percentile=float(pct),
+        median=float(np.median(x)),
+        quartiles=(q1, q3),
+        n=int(x.size),
+    )
+
+
+def pick_front_events(events: pd.DataFrame, N: int, *, intermediate: tuple[float, float] = (0.3, 0.7)) -> pd.DataFrame:
+    """One large and one intermediate event for the rupture-front figure (Fig. 6).
+
+    Large: the largest-S event whose rupture reached block N (the paper's event near t = 19100).
+    Intermediate: among events whose farthest moved block lies in ``intermediate`` * N, the one
+    closest to N/2 (the paper's event near t = 40400). Returns the chosen rows of ``events``
+    with a ``kind`` column ("large", "intermediate"); a kind with no candidate is left out.
+    """
+    chosen = []
+    reached = events[events["max_block"] >= N]
+    if not reached.empty:
+        chosen.append(reached.loc[[reached["S"].idxmax()]].assign(kind="large"))
+    lo, hi = intermediate[0] * N, intermediate[1] * N
+    middle = events[(events["max_block"] >= lo) & (events["max_block"] <= hi)]
+    if not middle.empty:
+        distance = (middle["max_block"] - N / 2.0).abs()
+        chosen.append(middle.loc[[distance.idxmin()]].assign(kind="intermediate"))
+    if not chosen:
+        return events.iloc[0:0].assign(kind=pd.Series(dtype=str))
+    return pd.concat(chosen).reset_index(drop=True)
