@@ -1,5 +1,5 @@
 """Shared pieces of the chain tests: an independent plain-Python Heun step of eq. (4) with
-its slip events (MODEL.md), bitwise comparison of two chain runs, and the command line."""
+its slip events (docs/model.md), bitwise comparison of two chain runs, and the command line."""
 
 from __future__ import annotations
 
@@ -83,7 +83,7 @@ def assert_same_run(a, b, *, state: bool = True) -> None:
 
 
 # --------------------------------------------------------------------------------------
-# Plain-Python Heun step of eq. (4), written from MODEL.md and the kernel module's docstring.
+# Plain-Python Heun step of eq. (4), written from docs/model.md and the kernel module's docstring.
 
 
 def heun_step(x, v, th, moving, n, p):
@@ -153,7 +153,7 @@ class OracleRun:
 
 
 def oracle_run(x, v, th, moving, p, n_steps: int, step=None) -> OracleRun:
-    """Step :func:`heun_step` n_steps times from step 0 and find the slip events (MODEL.md):
+    """Step :func:`heun_step` n_steps times from step 0 and find the slip events (docs/model.md):
     an event starts with the first step in which any block moves after a step that ended with
     every block stopped (the initial state counts as such), and ends with the first step that
     ends with every block stopped again; S = sum_i (x_i(end) - x_i(start))."""
@@ -252,7 +252,7 @@ def signal_when_running(argv: list[str], started, signum, *, settle: float = 1.0
 
 
 # --------------------------------------------------------------------------------------
-# Plain-Python Heun step of any model of the family (MODEL.md, "The family the paper
+# Plain-Python Heun step of any model of the family (docs/model.md, "The family the paper
 # stands in"), written from its text: ghost cells from the drive and the ends, the force with
 # the plate's leaf spring, the three friction laws and the two thresholds.
 

@@ -39,7 +39,7 @@ def _assert_same(a, b):
 
 
 def plain_heun_step(x, v, theta, moving, n, p: BlockParams):
-    """One step of eq. (1), written from MODEL.md independently of the kernel.
+    """One step of eq. (1), written from docs/model.md independently of the kernel.
 
     Returns the new state and whether the step started / stopped the block.
     """

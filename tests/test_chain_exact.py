@@ -144,7 +144,7 @@ def test_a_block_whose_start_rule_fires_without_moving(V):
     """With Fs < theta a stopped block with Fs < f < theta starts, is pushed back by friction and
     stops again within each step; once the step's displacement is below half an ulp of x it
     changes nothing (alpha = D = 0 keep theta at its fixed point 1), yet it moves in every step
-    by the start rule, so every step is a slip event (MODEL.md). The exact integrator, which
+    by the start rule, so every step is a slip event (docs/model.md). The exact integrator, which
     skips blocks whose neighbourhood did not change, must still record every one of them."""
     p = ChainParams(N=5, K=1000.0, Fs=0.5, V=V, D=0.0, alpha=0.0)
     x = np.array([1e6, 1e6, 1e6 - 4e-4, 1e6, 1e6])
@@ -162,7 +162,7 @@ def test_a_block_whose_start_rule_fires_without_moving(V):
 def test_every_block_whose_start_rule_fires_is_in_the_event(integrator):
     """Two stopped blocks with f = 1 > Fs = 0.5 and friction theta = 1: both start in every step
     (start rule) and stop again without moving, so every step is an event of both blocks
-    (MODEL.md), as the plain-Python oracle finds. Block 2 lies outside the range of blocks
+    (docs/model.md), as the plain-Python oracle finds. Block 2 lies outside the range of blocks
     whose neighbourhood changed, which must not hide its start."""
     p = ChainParams(N=2, K=1.0, D=0.0, V=0.0, beta=0.0, alpha=0.0, Fs=0.5)
     x = [-2.0, -3.0]

@@ -1,6 +1,6 @@
 """Both chain integrators against an independent plain-Python Heun step of eq. (4).
 
-The oracle (tests/chain_helpers.py) is written from MODEL.md ("Chain, eq. (4)", "Slip events
+The oracle (tests/chain_helpers.py) is written from docs/model.md ("Chain, eq. (4)", "Slip events
 of the chain") with the ghost cells and expression order of the kernel module's docstring;
 it shares no code with the package. Final state and L = x_1 - x_N after every step must agree
 bit for bit, and the event and first-move tables must be those derived from the oracle's own

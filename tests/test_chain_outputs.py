@@ -140,7 +140,7 @@ def test_steady_sliding_stays_steady(integrator, N, t_end, beta):
     assert np.max(np.abs(b["v"] - p.V)) < 1e-9
     assert np.max(np.abs(b["theta"] - (1.0 - p.V))) < 1e-9
     L_ss = physics.chain_steady_length(p)
-    c = 1.0 - (1.0 - beta) * p.V  # MODEL.md: friction of steady sliding
+    c = 1.0 - (1.0 - beta) * p.V  # docs/model.md: friction of steady sliding
     assert L_ss == pytest.approx(c / p.K * N * (N - 1) / 2, rel=1e-14)
     tol_L = run.steps * 4 * np.finfo(float).eps * L_ss
     assert abs(run.summary["L_final"] - L_ss) < tol_L

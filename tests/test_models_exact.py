@@ -1,6 +1,6 @@
 """Every model of the family on the one engine: dense = exact = plain Python, bit for bit.
 
-The oracle (``model_heun_step`` in tests/chain_helpers.py) is written from MODEL.md, section
+The oracle (``model_heun_step`` in tests/chain_helpers.py) is written from docs/model.md, section
 "The family the paper stands in": ghost cells from the drive and the ends, the plate's leaf
 spring, the three friction laws and the two thresholds. It shares no code with the package.
 Presets run at their own parameters (shortened); hypothesis draws compositions and values.
@@ -171,7 +171,7 @@ def test_plate_drive_exact_skips_stuck_blocks_and_jumps():
 
 
 def test_train_model_is_the_paper_chain_with_alpha_zero_and_theta_one():
-    # MODEL.md: the train model is the paper's chain with alpha = 0 and theta = F0 = 1.
+    # docs/model.md: the train model is the paper's chain with alpha = 0 and theta = F0 = 1.
     train = chain_params("train", N=9)
     paper = ChainParams(N=9, alpha=0.0, D=0.0)
     a = run_chain(

@@ -23,7 +23,7 @@ def line(ax, label_part: str):
 
 
 def steady_x(p: ChainParams, t: float) -> np.ndarray:
-    """x_i = V t - (c/K) sum_{j<=i} (N - j + 1), written out from MODEL.md."""
+    """x_i = V t - (c/K) sum_{j<=i} (N - j + 1), written out from docs/model.md."""
     c = 1.0 - (1.0 - p.beta) * p.V
     return np.array([p.V * t - c / p.K * sum(p.N - j + 1 for j in range(1, i + 1)) for i in range(1, p.N + 1)])
 

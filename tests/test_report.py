@@ -14,7 +14,7 @@ from stickslip.cli import build_parser
 from stickslip.plotting.style import save_figure
 from stickslip.report.writer import ReportFigure, ReportRow, read_report, write_report
 
-# The last table of MODEL.md, as the reproduction reports it (values of an imagined run).
+# The last table of docs/model.md, as the reproduction reports it (values of an imagined run).
 ROWS = [
     ReportRow(
         "sec. 2",

@@ -17,7 +17,7 @@ from stickslip.experiments import reproduce as rp
 from stickslip.experiments import specs as ex
 from stickslip.io import read_json
 
-#: MODEL.md, last table: (where, a word of the quantity) for every number the paper states;
+#: docs/model.md, last table: (where, a word of the quantity) for every number the paper states;
 #: eq. 3 states two numbers and gets two rows.
 MODEL_ROWS = [
     ("sec. 2", "Hopf point"),

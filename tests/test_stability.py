@@ -232,7 +232,7 @@ def test_periodic_chain_spectrum_is_the_union_of_fourier_modes(N):
 
 
 def _chain_rhs(y, p: ChainParams):
-    """Eq. (4) while every block moves, with the ends of MODEL.md, in the frame x_0 = 0.
+    """Eq. (4) while every block moves, with the ends of docs/model.md, in the frame x_0 = 0.
 
     y = (u_1..u_N, v_1..v_N, theta_1..theta_N), u_i = x_i - V t.
     """
@@ -335,7 +335,7 @@ def test_fig4_uniform_mode_growth_rate():
 @pytest.mark.parametrize("beta", [0.5, 0.8, 1.2, 1.5])
 @pytest.mark.parametrize("N", [50, 100])
 def test_finite_chain_agrees_with_fourier(beta, N):
-    """The finite chain (3N x 3N, ends of MODEL.md) is unstable exactly when beta < 1 for
+    """The finite chain (3N x 3N, ends of docs/model.md) is unstable exactly when beta < 1 for
     long chains, and its least stable eigenvalue follows the Fourier branch at k_1."""
     df = st.compare_fourier_finite(ChainParams(K=10, D=5, V=0.001, beta=beta), [N])
     row = df.iloc[0]

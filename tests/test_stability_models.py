@@ -1,6 +1,6 @@
 """Growth rates of steady sliding of the plate drive (Carlson-Langer) and the train model.
 
-Each normal mode obeys lambda^2 + phi'(V) lambda + w_k^2 = 0; the numbers are MODEL.md's
+Each normal mode obeys lambda^2 + phi'(V) lambda + w_k^2 = 0; the numbers are docs/model.md's
 ("The family the paper stands in", CL linear stability).
 """
 
@@ -17,7 +17,7 @@ from stickslip.cli import main
 from stickslip.models.presets import chain_params
 from stickslip.plotting.stability import plot_mode_growth
 
-#: MODEL.md, CL at l = 10, alpha = 2.5, sigma = 0.01, nu = 0.01 (quoted to the digits given there).
+#: docs/model.md, CL at l = 10, alpha = 2.5, sigma = 0.01, nu = 0.01 (quoted to the digits given there).
 MODEL_ALPHA_G = 2.2653
 MODEL_K0_GROWTH = 4.298
 

@@ -7,7 +7,7 @@ order parameter here is
     m = 1 - <L> / L_ss,
 
 zero in steady sliding and positive in stick-slip (L_ss: the exact discrete steady length,
-MODEL.md). Its samples L(t) are strongly correlated in time (the chain loads for ~L_ss / V
+docs/model.md). Its samples L(t) are strongly correlated in time (the chain loads for ~L_ss / V
 between large events), so its error bar comes from batch means whose batch length is set by
 the integrated autocorrelation time (:func:`integrated_time`), not from the naive formula.
 

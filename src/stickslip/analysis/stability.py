@@ -22,9 +22,9 @@ Chain. A Fourier mode exp(i k j) of eq. (5), k the lattice wavenumber in [0, pi]
 discrete Laplacians into -q with q = 2 (1 - cos k); its 3 x 3 mode matrix gives Fig. 4. At
 k -> 0 one eigenvalue vanishes like -K k^2 / (beta - alpha), so long waves are unstable
 exactly for beta < alpha, independent of K, D and V (the derivation is in docs/stability.md).
-The finite chain with the ends of MODEL.md has a 3N x 3N matrix, :func:`chain_jacobian`.
+The finite chain with the ends of docs/model.md has a 3N x 3N matrix, :func:`chain_jacobian`.
 
-Relatives without state variable (MODEL.md, "The family the paper stands in"): the plate drive
+Relatives without state variable (docs/model.md, "The family the paper stands in"): the plate drive
 of Carlson-Langer (weakening friction) and the train model (strengthening friction). Each normal
 mode obeys lambda^2 + phi'(V) lambda + w_k^2 = 0, w_k^2 = Kp + 4 K sin^2(k/2) (no Kp for the end
 drive): :func:`mode_stability`, checked against the 2N x 2N matrix :func:`chain_jacobian_2n`.
@@ -427,7 +427,7 @@ def chain_stability(p: ChainParams, k: np.ndarray | None = None) -> ChainStabili
 
 
 def chain_jacobian(p: ChainParams) -> np.ndarray:
-    """The 3N x 3N matrix of eq. (5) for the finite chain with the ends of MODEL.md.
+    """The 3N x 3N matrix of eq. (5) for the finite chain with the ends of docs/model.md.
 
     Variables ordered (dx_1..dx_N, dv_1..dv_N, dtheta_1..dtheta_N). The pulling point moves
     with the steady state, so dx_0 = 0; the free end has dx_{N+1} = dx_N; theta has no-flux

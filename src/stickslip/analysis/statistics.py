@@ -1,6 +1,6 @@
 """Analysis of chain runs: slip-size statistics (Figs. 7, 8), rupture fronts (Fig. 6), time averages (Fig. 5b).
 
-Conventions (MODEL.md): a slip event's size is S = sum_i (x_i(end) - x_i(start)); blocks are
+Conventions (docs/model.md): a slip event's size is S = sum_i (x_i(end) - x_i(start)); blocks are
 numbered 1..N. The functions here take the labelled tables of a chain run (``events``,
 ``first_move``, ``samples``) and return labelled results: xarray Datasets and frozen dataclasses.
 

@@ -69,7 +69,7 @@ def register(sub) -> None:
         "block",
         help="run the single block and spring, eq. (1); Figs. 1-3",
         description=(
-            "Integrate eq. (1) (Heun, start/stop rules of MODEL.md) from x = v = 0, theta = 0.1 "
+            "Integrate eq. (1) (Heun, start/stop rules of docs/model.md) from x = v = 0, theta = 0.1 "
             "and report the slips. Without --t-end the run lasts until the first start plus "
             f"{DEFAULT_PERIODS:g} periods of the law T(V) of eq. (3)."
         ),

@@ -26,7 +26,7 @@ def register(sub) -> None:
     p = sub.add_parser(
         "chain",
         help="run the chain of eq. (4) or any model of its family (--model)",
-        description="Integrate the chain of eq. (4) (MODEL.md), or a relative chosen with --model or "
+        description="Integrate the chain of eq. (4) (docs/model.md), or a relative chosen with --model or "
         "composed with --drive/--friction/--threshold/--ends, and record its slip events.",
     )
     add_model_options(
@@ -394,7 +394,7 @@ def _first_look(params, args, start: str):
     run to t = 2e4. The paper's run (N = 399 to t = 2e7) is ``--t-end 2e7``."""
     from stickslip.models import physics
 
-    if start in ("paper", "rest") and params.drive == "end":
+    if start in ("paper", "rest") and not params.drive_piece.leaf_spring:  # loaded from one end
         looked = params if args.param_N is not None else chain_params_from_args(args, N=physics.FIRST_LOOK_N)
         t_end = physics.first_look_t_end(looked)
         if t_end == t_end:

@@ -12,7 +12,7 @@ def register(sub) -> None:
     p = sub.add_parser(
         "models",
         help="list the models: the paper's chain and its relatives (presets and pieces)",
-        description="The presets of MODEL.md's model family, and the pieces any composition is made of.",
+        description="The presets of docs/model.md's model family, and the pieces any composition is made of.",
     )
     add_json_option(p)
     p.set_defaults(handler=run_models_command)

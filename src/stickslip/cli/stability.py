@@ -87,7 +87,7 @@ def register(sub) -> None:
         description=(
             "Fourier modes of the linearised chain, eq. (5): critical beta (closed form and "
             "numerical), largest growth rate over 0 < k <= pi; with --N the eigenvalues of the "
-            "finite chain with the ends of MODEL.md. --out DIR writes Fig. 4. With --model "
+            "finite chain with the ends of docs/model.md. --out DIR writes Fig. 4. With --model "
             "carlson-langer, train or two-blocks (or friction weakening/strengthening composed "
             "with the pieces): the growth rate of each normal mode of the finite chain, "
             "lambda^2 + phi'(V) lambda + w_k^2 = 0; --out DIR writes the growth rate against k."

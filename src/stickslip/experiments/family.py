@@ -1,4 +1,4 @@
-"""Experiments across the model family (MODEL.md, "The family the paper stands in").
+"""Experiments across the model family (docs/model.md, "The family the paper stands in").
 
 :func:`cl_statistics`: what the paper says of Carlson-Langer ("all sizes of events, a power law
 at small sizes, and great events more frequent than that power law predicts"), measured, beside

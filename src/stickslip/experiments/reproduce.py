@@ -440,7 +440,7 @@ def reproduce(
 
     Runs (or reuses) every experiment of ``mode`` (:func:`stickslip.experiments.specs.experiments`),
     draws every figure as PNG and PDF with its data, and writes ``report.json`` and
-    ``report.html`` with one row per number of MODEL.md's last table. Chain runs go through
+    ``report.html`` with one row per number of docs/model.md's last table. Chain runs go through
     :func:`stickslip.experiments.sweep.run_sweep` on a local Dask cluster (``n_workers`` processes, default
     one per core) or on the cluster at ``scheduler``. Progress goes to stderr when ``progress``.
     Returns what the command prints: mode, paths, the rows, the figures, and per experiment

@@ -94,7 +94,7 @@ class Study:
 
 def loading_time(N: int, K: float = 10.0, V: float = 0.001) -> float:
     """L_ss / V at c = 1: the time the pulling point takes to stretch the chain to its steady
-    length, ``N (N - 1) / (2 K V)`` (MODEL.md, "Steady sliding")."""
+    length, ``N (N - 1) / (2 K V)`` (docs/model.md, "Steady sliding")."""
     return N * (N - 1) / (2.0 * K * V)
 
 

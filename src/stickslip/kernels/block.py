@@ -38,7 +38,7 @@ def heun_block(
     slip_x_end,
     state_threshold=False,
 ):
-    """Advance eq. (1) by ``n_steps`` Heun steps with the start and stop rules of MODEL.md.
+    """Advance eq. (1) by ``n_steps`` Heun steps with the start and stop rules of docs/model.md.
 
     State (x, v, theta, stopped); spring force f = K (V t - x) with t_n = n dt taken from the
     integer step count.

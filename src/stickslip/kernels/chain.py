@@ -1,7 +1,7 @@
 """Numba kernels of the chain of eq. (4) and its relatives: the reference (`dense`) and the
 fast (`exact`) Heun.
 
-A model is a choice of four pieces (MODEL.md, "The family the paper stands in"), passed to
+A model is a choice of four pieces (docs/model.md, "The family the paper stands in"), passed to
 every kernel as compile-time constants (numba integer literals), so that each composition is
 compiled into its own machine code with the branches on pieces removed:
 
@@ -21,7 +21,7 @@ th[0] = th[1] and th[N+1] = th[N] (periodic ends: th[0] = th[N], th[N+1] = th[1]
 without a state variable leave theta untouched. ``mov`` holds 1.0 for a moving block and 0.0
 for a stopped one, so a stopped block's acceleration is ``0 * (...)``.
 
-One Heun step from t_n = n dt to t_{n+1} (MODEL.md):
+One Heun step from t_n = n dt to t_{n+1} (docs/model.md):
 
 1. start rule: a stopped block with f_i > threshold moves (with v = 0) for this step; ``mm``
    is this mid-step mask;
@@ -57,7 +57,7 @@ Which stopped blocks can start:
 * state threshold: a block whose theta changes may start without any neighbour moving, so
   every block whose state variable may change is a candidate.
 
-Events (MODEL.md): an event starts with the first step in which any block moves after a
+Events (docs/model.md): an event starts with the first step in which any block moves after a
 step that ended with every block stopped, and ends with the first step that ends with every
 block stopped again; S = sum_i (x_i(end) - x_i(start)) over the blocks that moved, summed in
 block order.

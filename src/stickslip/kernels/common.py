@@ -110,7 +110,7 @@ def _threshold(th, Fs, threshold):
 
 @njit(cache=True, inline="always")
 def _pull(V, n, dt):
-    """Pulling point (or plate) V t_n with t_n = n dt from the integer step count (MODEL.md)."""
+    """Pulling point (or plate) V t_n with t_n = n dt from the integer step count (docs/model.md)."""
     return V * (np.float64(n) * dt)
 
 

@@ -1,5 +1,5 @@
 """Sparse exact steps of the plate drive for frictions without a state variable
-(weakening, strengthening): the Carlson-Langer and train models (MODEL.md, "The family the
+(weakening, strengthening): the Carlson-Langer and train models (docs/model.md, "The family the
 paper stands in").
 
 There a stopped block does not change at all, and the plate's start of a stopped block is

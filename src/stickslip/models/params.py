@@ -71,7 +71,7 @@ def _shown(value: Any) -> str:
     return text if len(text) <= 40 else text[:37] + "..."
 
 
-#: Largest number of time steps of one run (MODEL.md's longest run, t = 2e7 at dt = 0.005, is 4e9):
+#: Largest number of time steps of one run (docs/model.md's longest run, t = 2e7 at dt = 0.005, is 4e9):
 #: far inside int64, and times n dt stay exact to the step.
 MAX_STEPS = 10**12
 #: Largest chain (blocks).
@@ -206,7 +206,7 @@ def _choice(default: str, kind: str, doc: str) -> Any:
 
 @dataclass(frozen=True)
 class ChainParams(_Validated):
-    """Parameters of the chain of eq. (4) and of its relatives, pinned down in MODEL.md.
+    """Parameters of the chain of eq. (4) and of its relatives, pinned down in docs/model.md.
 
     N blocks on a line joined by springs K. The defaults are the paper's model and run
     (section 3): the end drive (only the first block pulled, x_0 = V t), state friction with

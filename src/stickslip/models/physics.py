@@ -1,6 +1,6 @@
 """Model equations that have closed forms: steady sliding of the block and of the chain.
 
-Conventions (MODEL.md): blocks are numbered i = 1..N in the paper and in every output of this
+Conventions (docs/model.md): blocks are numbered i = 1..N in the paper and in every output of this
 package; arrays hold block i at index i - 1. The pulling point is x_0 = V t.
 """
 
@@ -55,7 +55,7 @@ def has_steady_state(p: ChainParams) -> bool:
 
 
 def chain_steady_state(p: ChainParams, t: float = 0.0) -> dict[str, np.ndarray]:
-    """Exact discrete steady sliding of the chain, eq. (4) with the ends of MODEL.md.
+    """Exact discrete steady sliding of the chain, eq. (4) with the ends of docs/model.md.
 
     End drive: v_i = V, theta_i = 1 - alpha V (= 1 - V for alpha = 1), friction
     c = theta_0 + beta V; every block is pulled by the spring behind it with the friction of all
@@ -83,7 +83,7 @@ def chain_steady_state(p: ChainParams, t: float = 0.0) -> dict[str, np.ndarray]:
 
 
 def chain_steady_length(p: ChainParams) -> float:
-    """Total length L = x_1 - x_N of steady sliding, exact discrete form (MODEL.md).
+    """Total length L = x_1 - x_N of steady sliding, exact discrete form (docs/model.md).
 
     L_ss = (c / K) N (N - 1) / 2 with c = theta_0 + beta V; 7940.1 for the paper's chain. Zero for
     the plate drive (every block lags the plate equally); NaN where there is no steady sliding.
@@ -107,7 +107,7 @@ def chain_steady_profile_paper(p: ChainParams, t: float = 0.0) -> np.ndarray:
 
 
 def chain_steady_length_paper(p: ChainParams) -> float:
-    """The paper's L = {1 - (1 - beta) V} N^2 / 2 as printed (it lacks the factor 1/K; MODEL.md)."""
+    """The paper's L = {1 - (1 - beta) V} N^2 / 2 as printed (it lacks the factor 1/K; docs/model.md)."""
     return sliding_friction(p.V, p.beta) * p.N**2 / 2.0
 
 

@@ -1,4 +1,4 @@
-"""The four pieces a block-spring model is made of (MODEL.md, "The family the paper stands in").
+"""The four pieces a block-spring model is made of (docs/model.md, "The family the paper stands in").
 
 The chain of eq. (4) and its relatives share blocks on a line, nearest-neighbour springs K,
 the start and stop rules and Heun with t_n = n dt. They differ in
@@ -13,7 +13,7 @@ threshold  ``constant``: Fs; ``state``: theta_i (the paper's reading of Batista-
 ends       ``free``, ``fixed``, ``periodic`` (plate drive only)
 ========== ==========================================================================
 
-A composition is valid when MODEL.md allows it: periodic ends need the plate drive (the end
+A composition is valid when docs/model.md allows it: periodic ends need the plate drive (the end
 drive pulls block 1 only, so the ring has no place for the pulling point), and the state
 threshold needs the state friction (it reads theta). :func:`check_composition` says so in one
 line. Each piece lists the parameters it reads, so a run records exactly those.
@@ -58,7 +58,7 @@ def _strengthening_slope(p: Any) -> float:
 
 
 class CompositionError(ValueError):
-    """A choice of pieces that MODEL.md does not allow; the message is one line."""
+    """A choice of pieces that docs/model.md does not allow; the message is one line."""
 
 
 @dataclass(frozen=True)
@@ -170,7 +170,7 @@ def code(kind: str, name: str) -> int:
 
 
 def check_composition(drive: str, friction: str, threshold: str, ends: str) -> None:
-    """Refuse a composition MODEL.md does not allow, in one line."""
+    """Refuse a composition docs/model.md does not allow, in one line."""
     for kind, name in zip(KINDS, (drive, friction, threshold, ends), strict=False):
         piece(kind, name)
     if ends == "periodic" and drive != "plate":

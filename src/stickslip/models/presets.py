@@ -1,8 +1,8 @@
-"""Named models: the paper's chain and the relatives it cites (MODEL.md, "Preset defaults").
+"""Named models: the paper's chain and the relatives it cites (docs/model.md, "Preset defaults").
 
 A preset is data: its four pieces (:mod:`stickslip.models.pieces`), its parameters, its start
 and the equations in words. :func:`chain_params` turns a preset plus overrides into validated
-:class:`~stickslip.models.params.ChainParams`; any composition MODEL.md allows can be built the
+:class:`~stickslip.models.params.ChainParams`; any composition docs/model.md allows can be built the
 same way by overriding the pieces. Adding a model means adding an entry here.
 """
 

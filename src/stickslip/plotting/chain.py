@@ -80,7 +80,7 @@ def fig5b_length(table: pd.DataFrame, params: ChainParams, *, beta_c: float = 1.
     bars, and ``final_state``), e.g. a sweep's summary. The dashed line is the exact discrete
     steady sliding length L_ss = (c/K) N (N - 1) / 2 with the steady friction
     c = 1 - (1 - beta) V (:func:`~stickslip.models.physics.chain_steady_length`) for the other
-    parameters of ``params``; the paper's printed L = c N^2 / 2 lacks the factor 1/K (MODEL.md)
+    parameters of ``params``; the paper's printed L = c N^2 / 2 lacks the factor 1/K (docs/model.md)
     and is not drawn. The dotted vertical line marks beta_c = 1, where the long-wave
     instability sets in (Fig. 4). With ``final_state``, runs above beta_c that had not settled
     into steady sliding by their end are drawn with open symbols.

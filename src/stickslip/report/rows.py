@@ -1,4 +1,4 @@
-"""The table of the paper's stated numbers (MODEL.md, last table) as rows of the report.
+"""The table of the paper's stated numbers (docs/model.md, last table) as rows of the report.
 
 One :class:`~stickslip.report.writer.ReportRow` per stated number: section 2 (Hopf point,
 stability at beta = 1, the inverse transition), eq. (3) (duration and force at stop), Fig. 3
@@ -22,7 +22,7 @@ from stickslip.report.commands import chain_command, hysteresis_command, sweep_c
 from stickslip.report.commands import g as _g
 from stickslip.report.writer import ReportRow
 
-#: The paper's stated numbers (MODEL.md, last table) that the report compares with.
+#: The paper's stated numbers (docs/model.md, last table) that the report compares with.
 PAPER = {
     "hopf_V": 0.106,
     "V_up": 0.345,
@@ -424,10 +424,10 @@ def _chain_rows(o: Outcome, a: dict[str, Any], mode: str) -> list[ReportRow]:
 
 
 def report_rows(outcomes: dict[str, Outcome], analysis: dict[str, Any] | None, mode: str) -> list[ReportRow]:
-    """One :class:`~stickslip.report.writer.ReportRow` per number of MODEL.md's last table (eq. 3 gives two)."""
+    """One :class:`~stickslip.report.writer.ReportRow` per number of docs/model.md's last table (eq. 3 gives two)."""
     rows = _section2_rows(outcomes)
     if analysis is not None:
         chain_rows = _chain_rows(outcomes["chain-runs"], analysis, mode)
-        # report order of MODEL.md: sec. 2 rows, eq. 3, Fig. 3, Fig. 4, sec. 3, Figs. 5-8
+        # report order of docs/model.md: sec. 2 rows, eq. 3, Fig. 3, Fig. 4, sec. 3, Figs. 5-8
         rows += chain_rows
     return rows

@@ -1,7 +1,7 @@
 """The reproduction report: ``report.json`` and a self-contained ``report.html``.
 
 The report holds the figures of a reproduction run (each panel's image, with links to its
-PDF and data) and a table with one row per number the paper states (MODEL.md, last table):
+PDF and data) and a table with one row per number the paper states (docs/model.md, last table):
 where the paper states it, the quantity, the paper's value, this run's value, whether they
 agree within the stated tolerance, and the command that reproduces the row. A row whose
 number is not settled at the run's length (a quick run) says so ("n/a (...)") rather than
@@ -29,7 +29,7 @@ __all__ = ["ReportRow", "ReportFigure", "Report", "write_report", "read_report",
 
 @dataclass(frozen=True)
 class ReportRow:
-    """One number the paper states (MODEL.md, last table) and how this run compares.
+    """One number the paper states (docs/model.md, last table) and how this run compares.
 
     - ``where``: the place in the paper ("sec. 2", "eq. 3", "Fig. 6");
     - ``quantity``: what is measured ("rupture front speed in large events, beta = 1");

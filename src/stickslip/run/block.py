@@ -1,7 +1,7 @@
 """The single block and spring of section 2: runs of eq. (1) and their slips.
 
 A run starts at t = 0 from a :class:`BlockState` and advances eq. (1) with the compiled Heun
-step of :mod:`stickslip.kernels.block` (start and stop rules of MODEL.md). It returns a
+step of :mod:`stickslip.kernels.block` (start and stop rules of docs/model.md). It returns a
 :class:`BlockRun`: the time series as an xarray Dataset, the table of slips as a pandas
 DataFrame, the final state and a few statistics gathered over every step. The period sweep of
 Fig. 3 is :func:`stickslip.analysis.slip_limit.period_sweep`.
@@ -20,7 +20,7 @@ import xarray as xr
 from stickslip.kernels.block import heun_block
 from stickslip.models.params import BlockParams, ParameterError, check_number, steps_for
 
-INTEGRATOR = "heun (explicit trapezoid, fixed dt) with the start/stop rules of MODEL.md"
+INTEGRATOR = "heun (explicit trapezoid, fixed dt) with the start/stop rules of docs/model.md"
 
 SLIP_COLUMNS = ("t_c", "t_e", "duration", "slip", "force_at_stop", "period")
 

@@ -1,13 +1,13 @@
 """The chain of eq. (4): running it, its slip events, and long resumable runs.
 
-:func:`run_chain` integrates the chain of N blocks pulled at one end (MODEL.md, section
+:func:`run_chain` integrates the chain of N blocks pulled at one end (docs/model.md, section
 "Chain") with one of two integrators that give the same answer bit for bit:
 
 * ``dense``: the reference, Heun over every block at every step;
 * ``exact`` (default): the same arithmetic, skipping only work whose result is known in
   advance (see :mod:`stickslip.kernels.chain`).
 
-A run returns a :class:`ChainRun`: the slip-event table (MODEL.md, "Slip events"), the time
+A run returns a :class:`ChainRun`: the slip-event table (docs/model.md, "Slip events"), the time
 each block first moved in each event (rupture fronts, Fig. 6), L(t) = x_1 - x_N sampled at a
 fixed interval (Fig. 5b), snapshots of x_i (Fig. 5a), optional displacement profiles over
 windows (Fig. 6), and the final state with its SHA-256.
@@ -210,7 +210,7 @@ def run_chain(
     keep_checkpoint: bool = False,
     stop_requested: Callable[[], bool] | None = None,
 ) -> ChainRun:
-    """Integrate the chain of eq. (4) from ``start`` to ``t_end`` (MODEL.md, "Chain").
+    """Integrate the chain of eq. (4) from ``start`` to ``t_end`` (docs/model.md, "Chain").
 
     ``integrator`` is 'exact' (default) or 'dense'; both give the same result bit for bit.
     ``start`` is 'paper' (x = 0, v = 0.1, theta = 0.1, all moving), 'steady' (exact steady

@@ -1,7 +1,7 @@
 """What a chain run (eq. 4) records and returns: :class:`RunOptions`, :class:`ChainRun`, the output buffers.
 
 The kernels fill fixed-size buffers (:class:`_Outputs`) that are flushed into Python-side parts;
-:func:`_assemble` turns the parts into the event table (MODEL.md, "Slip events"), the first moves
+:func:`_assemble` turns the parts into the event table (docs/model.md, "Slip events"), the first moves
 (rupture fronts, Fig. 6), L(t) (Fig. 5b), the snapshots (Fig. 5a), the displacement profiles
 (Fig. 6) and the run's summary.
 """

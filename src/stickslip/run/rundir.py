@@ -121,7 +121,7 @@ def write_run(run: ChainRun, out_dir: str | Path) -> Path:
             "Conventions": "CF-1.10",
             "title": "chain of eq. (4): final state, L(t), snapshots, profiles",
             "source": f"stickslip {__version__}, {run.integrator} integrator",
-            "units_note": "model units: eq. (4) scaled to M = sigma = 1 (MODEL.md)",
+            "units_note": "model units: eq. (4) scaled to M = sigma = 1 (docs/model.md)",
             "params": json.dumps(run.params.to_dict()),
             **_param_attrs(run.params),
             "integrator": run.integrator,

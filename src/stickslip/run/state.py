@@ -1,7 +1,7 @@
 """The state of the chain of eq. (4): :class:`ChainState`, the initial states, the distance from steady sliding.
 
 The arrays carry ghost cells at index 0 and N + 1 (see :mod:`stickslip.kernels.chain`); the
-initial states are the paper's (section 3) and exact discrete steady sliding (MODEL.md).
+initial states are the paper's (section 3) and exact discrete steady sliding (docs/model.md).
 """
 
 from __future__ import annotations
@@ -81,7 +81,7 @@ class ChainState:
 
     @classmethod
     def steady(cls, p: ChainParams, amplitude: float = 0.0, seed: int = 0) -> ChainState:
-        """Exact discrete steady sliding (MODEL.md) at t = 0, all blocks moving.
+        """Exact discrete steady sliding (docs/model.md) at t = 0, all blocks moving.
 
         With ``amplitude`` > 0, x_i and v_i get independent uniform perturbations in
         [-amplitude, amplitude] drawn from numpy's default generator with ``seed``.
@@ -97,7 +97,7 @@ class ChainState:
     @classmethod
     def rest(cls, p: ChainParams, amplitude: float = 0.01, seed: int = 0) -> ChainState:
         """Every block stuck: v_i = 0, x_i = -A u_i with u_i = ``default_rng(seed).random(N)``
-        (Carlson-Langer's start, MODEL.md), theta_i = 0.1 (the paper's) for state friction."""
+        (Carlson-Langer's start, docs/model.md), theta_i = 0.1 (the paper's) for state friction."""
         x = -amplitude * np.random.default_rng(seed).random(p.N) if amplitude > 0 else np.zeros(p.N)
         theta = np.full(p.N, p.friction_piece.theta0)
         return cls.from_blocks(x, np.zeros(p.N), theta, np.ones(p.N, bool))
@@ -124,8 +124,8 @@ class ChainState:
 
 
 def initial_state(p: ChainParams, start: str = "paper", *, amplitude: float = 0.0, seed: int = 0) -> ChainState:
-    """The initial state named by ``start``: 'paper' (section 3), 'steady' (MODEL.md) or 'rest'
-    (every block stuck, x_i = -A u_i: Carlson-Langer's start, MODEL.md)."""
+    """The initial state named by ``start``: 'paper' (section 3), 'steady' (docs/model.md) or 'rest'
+    (every block stuck, x_i = -A u_i: Carlson-Langer's start, docs/model.md)."""
     if start == "paper":
         return ChainState.paper(p)
     if start == "steady":
@@ -136,7 +136,7 @@ def initial_state(p: ChainParams, start: str = "paper", *, amplitude: float = 0.
 
 
 def steady_deviation(state: ChainState, p: ChainParams) -> float:
-    """Distance of a state from steady sliding of the chain (MODEL.md), in the frame moving with V.
+    """Distance of a state from steady sliding of the chain (docs/model.md), in the frame moving with V.
 
     The largest of ``|v_i - V|``, ``|theta_i - theta_0|`` and ``|e_i - e_i^ss|`` over all blocks, where
     e_i = x_{i-1} - x_i are the spring extensions (x_0 = V t_n) and e_i^ss = (c/K)(N - i + 1)
