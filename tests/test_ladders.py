@@ -34,16 +34,20 @@ def test_mser_cuts_a_decaying_start_and_nothing_of_a_stationary_series():
     assert mser_cut(np.full(1000, 2.5)) == 0
 
 
-def test_stop_rule_needs_eight_batches_of_ten_tau_and_the_target():
+def test_stop_rule_needs_sixteen_batches_of_ten_tau_and_the_target():
     rng = np.random.default_rng(2)
     x = 0.01 * _ar1(rng, 0.9, 20000)  # tau_int = 19 samples
     t = np.arange(x.size, dtype=float)
     phi = np.full(x.size, 0.9)
     ok = assess(t, x, phi, target=1e-2)
-    assert ok.decided and ok.m.reliable and ok.m.n_batches >= 8 and not ok.sliding
+    assert ok.decided and ok.m.reliable and ok.m.n_batches >= 16 and not ok.sliding
+    # about 12 batches of 10 tau_int: reliable (>= 8) but not enough for the stop rule
+    twelve = assess(t[:2300], x[:2300], phi[:2300], target=1.0)
+    assert twelve.m.reliable and 8 <= twelve.m.n_batches < 16
+    assert not twelve.decided and "fewer than 16 batches" in twelve.reason
     assert not assess(t, x, phi, target=1e-6).decided  # error above the target
-    short = assess(t[:120], x[:120], phi[:120], target=1.0)  # fewer than 8 batches of 10 tau_int
-    assert not short.decided and "fewer than 8 batches" in short.reason
+    short = assess(t[:120], x[:120], phi[:120], target=1.0)  # fewer than 16 batches of 10 tau_int
+    assert not short.decided and "fewer than 16 batches" in short.reason
     assert assess(t, x, np.zeros(x.size), target=1e-2).sliding  # no block stuck: phi = 0
 
 

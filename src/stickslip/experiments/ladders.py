@@ -13,7 +13,7 @@ runs points ("rungs") one after the other, each starting from the final state of
   then bisects. Linear stability puts that lower edge at beta = 1.
 
 A rung runs in segments and stops when its answer is known (:func:`stickslip.analysis.adaptive.assess`):
-the error of m below the target from at least 8 batches of 10 tau_int; steady sliding reached
+the error of m below the target from at least 16 batches of 10 tau_int; steady sliding reached
 (every block within :data:`UNTIL_STEADY` of it) or every block sliding with the deviation falling;
 on the down ladder, a block stuck (it left steady sliding); or the cap, then ``undecided`` with the
 reason. Each finished rung is written to ``<ladder>/rungs/<k>-beta<b>/`` (``rung.json``, the final

@@ -42,15 +42,19 @@ _PAPER = {"K": 10.0, "D": 5.0, "V": 0.001, "Fs": 3.0, "alpha": 1.0, "dt": 0.005}
 
 
 def _cap_loads(N: int) -> float:
-    """The cap of one rung in loading times: long enough for 8 batches of 10 tau_int at small N
-    (tau_int of L is 0.013-0.04 loading times), shorter where a loading time costs minutes."""
+    """The cap of one rung in loading times: long enough for 16 batches of 10 tau_int where a
+    loading time costs seconds (the largest events of a short chain come once per loading time,
+    so its m needs several), shorter where a loading time costs minutes (there tau_int is a few
+    thousandths of a loading time)."""
+    if N <= 99:
+        return 16.0
     if N <= 199:
-        return 4.0
+        return 8.0
     if N <= 399:
-        return 2.5
+        return 3.0
     if N <= 799:
-        return 1.2
-    return 0.3
+        return 1.5
+    return 0.8
 
 
 def _grids(N: int, mode: str) -> tuple[list[float], list[float]]:
