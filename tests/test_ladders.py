@@ -142,6 +142,39 @@ def test_per_n_summary_reads_the_loop():
     assert s["step"] == -0.05 and s["step_err"] == 0.01 and s["step_phi"] == 0.9
 
 
+def _up(replica, beta, state, m=0.0, m_err=0.0):
+    stick = state == "stick-slip"
+    # fmt: off
+    return {"N": 9, "beta": beta, "branch": "up", "replica": replica, "branch_state": state,
+            "order_parameter": m, "order_parameter_err": m_err, "stuck_fraction": 0.9 if stick else 0.0,
+            "stuck_fraction_err": 0.01 if stick else 0.0, "err_reliable": True,
+            "tau_int_loads": 0.02 if stick else math.nan, "final_state": "stick-slip" if stick else "steady"}
+    # fmt: on
+
+
+def test_per_n_summary_averages_the_replicas_of_the_up_ladder():
+    """beta_t is the mean of the replicas' last stick-slip beta, its error the standard error of
+    that mean when the replicas scatter more than their brackets; the step likewise."""
+    import pandas as pd
+
+    rows = pd.DataFrame(
+        [
+            _up(0, 1.0, "stick-slip", -0.02, 0.001), _up(0, 1.1, "stick-slip", -0.04, 0.001), _up(0, 1.12, "sliding"),
+            _up(1, 1.0, "stick-slip", -0.02, 0.001), _up(1, 1.2, "stick-slip", -0.06, 0.001), _up(1, 1.22, "sliding"),
+            _up(2, 1.0, "stick-slip", -0.02, 0.001), _up(2, 1.3, "stick-slip", -0.08, 0.001), _up(2, 1.32, "sliding"),
+        ]
+    )  # fmt: skip
+    s = per_n_summary(rows).iloc[0]
+    # beta_t of the replicas 1.1, 1.2, 1.3: mean 1.2, sample std 0.1, standard error 0.1 / sqrt(3)
+    assert s["beta_t"] == pytest.approx(1.2) and s["beta_t_err"] == pytest.approx(0.1 / math.sqrt(3))
+    assert s["beta_t_spread"] == pytest.approx(0.1) and s["replicas"] == 3
+    # m there -0.04, -0.06, -0.08: mean -0.06, sample std 0.02
+    assert s["step"] == pytest.approx(-0.06) and s["step_err"] == pytest.approx(0.02 / math.sqrt(3))
+    # one replica: its half bracket and its own error are all there is
+    one = per_n_summary(rows[rows["replica"] == 0]).iloc[0]
+    assert one["beta_t"] == 1.1 and one["beta_t_err"] == pytest.approx(0.01) and one["step_err"] == pytest.approx(0.001)
+
+
 def test_tiny_transition_study_and_its_json(tmp_path):
     """The CLI end to end: rows and per-N fields in --json; a second call reuses every ladder."""
     out = tmp_path / "studies"
@@ -149,7 +182,9 @@ def test_tiny_transition_study_and_its_json(tmp_path):
     first = run_cli_subprocess(*argv, timeout=300)
     assert first.returncode == 0, first.stderr
     data = json.loads(first.stdout)
-    assert data["meta"]["ladders"] == 2 and data["meta"]["workers"] == 1 and data["meta"]["cores"] >= 1
+    assert (
+        data["meta"]["ladders"] == 3 and data["meta"]["workers"] == 1
+    )  # two up replicas, one down and data["meta"]["cores"] >= 1
     row_keys = {"N", "beta", "branch", "order_parameter", "order_parameter_err", "stuck_fraction",
                 "stuck_fraction_err", "final_state", "t_end", "start"}  # fmt: skip
     assert all(row_keys <= set(r) for r in data["rows"])
@@ -157,8 +192,10 @@ def test_tiny_transition_study_and_its_json(tmp_path):
     assert set(PER_N_COLUMNS) <= set(data["per_N"][0])
     assert all(r["final_reason"] for r in data["rows"] if r["final_state"] == "undecided")
     assert (out / "transition" / "loops.png").is_file() and (out / "transition" / "index.html").is_file()
+    assert {r["replica"] for r in data["rows"] if r["branch"] == "up"} == {0, 1}
+    assert data["per_N"][0]["replicas"] == 2
     second = json.loads(run_cli_subprocess(*argv, timeout=300).stdout)
-    assert second["meta"]["ladders_reused"] == 2 and second["rows"] == data["rows"]
+    assert second["meta"]["ladders_reused"] == 3 and second["rows"] == data["rows"]
 
 
 def test_extra_n_only_for_the_transition_study(tmp_path):
@@ -171,12 +208,12 @@ def test_run_transition_resumes_a_ladder_from_its_finished_rungs(tmp_path):
     back bit for bit and the rungs are not run again."""
     first = run_transition(tmp_path, "tiny", n_workers=1, progress=False)
     ladders = sorted((tmp_path / "runs").glob("*/ladders/*/done.json"))
-    assert len(ladders) == 2
+    assert len(ladders) == 3
     for done in ladders:
         done.unlink()
     stamps = {p: p.stat().st_mtime_ns for p in tmp_path.glob("runs/*/ladders/*/rungs/*/rung.json")}
     second = run_transition(tmp_path, "tiny", n_workers=1, progress=False)
-    assert second["meta"]["ladders_run"] == 2 and second["rows"] == first["rows"]
+    assert second["meta"]["ladders_run"] == 3 and second["rows"] == first["rows"]
     assert {p: p.stat().st_mtime_ns for p in stamps} == stamps
 
 

@@ -219,7 +219,8 @@ def _rung(
         except (OSError, ValueError, KeyError):
             pass
     res = run_rung(params_at(cfg, beta), state, cfg, **kw)
-    row = {**res["row"], "branch": cfg["direction"], "rung": index, "role": role, "start": start, "start_sha256": sha}
+    row = {**res["row"], "branch": cfg["direction"], "replica": int(cfg.get("replica", 0)), "seed": int(cfg["seed"])}
+    row.update(rung=index, role=role, start=start, start_sha256=sha)
     row["final_sha256"] = res["state"].sha256()
     row = to_jsonable(row)  # as a replay reads it back (NaN and inf become None)
     rdir.mkdir(parents=True, exist_ok=True)

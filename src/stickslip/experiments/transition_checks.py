@@ -57,7 +57,7 @@ def paper_start_check(
     :func:`paper_start_m`, and the difference over the combined error (``z``)."""
     out = []
     for r in rows:
-        if r["branch"] != "up" or r["beta"] >= betas_below:
+        if r["branch"] != "up" or r.get("replica", 0) != 0 or r["beta"] >= betas_below:
             continue
         ref = paper_start_m(int(r["N"]), float(r["beta"]), loads)
         comb = math.hypot(r["order_parameter_err"], ref["paper_m_err"])
@@ -137,15 +137,24 @@ def write_checks(
 
     data = io.read_json(study_json)
     spec = io.read_json(Path(runs_dir) / "study-spec.json")
-    rows = [r for r in data["rows"] if r["N"] in paper_Ns]
+    # replica 0 of each up ladder: the one whose rungs the longer runs restart
+    rows = [r for r in data["rows"] if r["N"] in paper_Ns and r.get("replica", 0) == 0]
     jobs = []
     with ProcessPoolExecutor(n_workers) as pool:
-        paper = [pool.submit(paper_start_check, [r]) for r in rows if r["branch"] == "up" and r["beta"] < 0.95]
+        paper = [
+            pool.submit(paper_start_check, [r])
+            for r in rows
+            if r["branch"] == "up" and r.get("replica", 0) == 0 and r["beta"] < 0.95
+        ]
         for N, beta in longer:
-            (lad,) = [p for p in spec["ladders"] if p["N"] == N and p["direction"] == "up"]
+            (lad,) = [p for p in spec["ladders"] if p["N"] == N and p["direction"] == "up" and p.get("replica", 0) == 0]
             cfg = {**spec["common"], **lad}
             ldir = Path(runs_dir) / "ladders" / point_name(lad)
-            (row,) = [r for r in data["rows"] if r["N"] == N and r["branch"] == "up" and r["beta"] == beta]
+            (row,) = [
+                r
+                for r in data["rows"]
+                if r["N"] == N and r["branch"] == "up" and r.get("replica", 0) == 0 and r["beta"] == beta
+            ]
             jobs.append(pool.submit(longer_check, ldir, int(row["rung"]), cfg, factor))
         out = {
             "paper_start": [c for f in paper for c in f.result()],

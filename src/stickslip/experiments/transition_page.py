@@ -18,6 +18,7 @@ ROW_COLUMNS = [
     "N",
     "beta",
     "branch",
+    "replica",
     "order_parameter",
     "order_parameter_err",
     "stuck_fraction",
@@ -44,6 +45,8 @@ PER_N_COLUMNS = [
     "step_err",
     "step_phi",
     "step_phi_err",
+    "beta_t_spread",
+    "replicas",
 ]
 
 _CSS = """

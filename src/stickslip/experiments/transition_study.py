@@ -28,6 +28,7 @@ from pathlib import Path
 from types import SimpleNamespace
 from typing import Any
 
+import numpy as np
 import pandas as pd
 
 from stickslip import __version__, io
@@ -38,6 +39,10 @@ __all__ = ["ladder_points", "run_transition", "per_n_summary", "ROW_COLUMNS", "P
 
 #: N of each mode; ``extra_Ns`` (for example 1599) adds chains.
 LADDER_NS = {"tiny": (9,), "quick": (49, 99, 199), "full": (49, 99, 199, 399, 799)}
+#: Up ladders per N, each from its own seeded start: where the up ladder leaves stick-slip is a
+#: random event near beta_t (at N = 99 five seeds gave beta_t from 1.11 to 1.20), so beta_t and
+#: the step are means over replicas with the spread between them as their error.
+REPLICAS = {"tiny": 2, "quick": 4, "full": 4}
 _PAPER = {"K": 10.0, "D": 5.0, "V": 0.001, "Fs": 3.0, "alpha": 1.0, "dt": 0.005}
 
 
@@ -84,13 +89,15 @@ def ladder_points(mode: str, extra_Ns: tuple[int, ...] = ()) -> tuple[dict[str, 
         "down_perturbation": 1e-5,
         "seed": 0,
         "bisections": 3 if mode != "tiny" else 1,
+        "replicas": REPLICAS[mode],
     }
     points = []
     for N in sorted(Ns, reverse=True):
         up, down = _grids(N, mode)
         cap = _cap_loads(N) if mode != "tiny" else 1.0
-        points.append({"N": N, "direction": "up", "betas": up, "cap_loads": cap})
-        points.append({"N": N, "direction": "down", "betas": down, "cap_loads": cap})
+        for r in range(REPLICAS[mode]):
+            points.append({"N": N, "direction": "up", "betas": up, "cap_loads": cap, "seed": r, "replica": r})
+        points.append({"N": N, "direction": "down", "betas": down, "cap_loads": cap, "seed": 0, "replica": 0})
     return common, points
 
 
@@ -107,26 +114,58 @@ def _key(common: dict[str, Any]) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:12]
 
 
+def _replica_edge(up: pd.DataFrame) -> dict[str, Any] | None:
+    """One up ladder's upper edge: the last stick-slip beta, half the bracket to the first sliding
+    beta above it, and m and phi there (None when the ladder never stick-slipped)."""
+    stick = up[up["branch_state"] == "stick-slip"]
+    if not len(stick):
+        return None
+    bt = float(stick["beta"].max())
+    above = up[(up["branch_state"] == "sliding") & (up["beta"] > bt)]
+    at = stick[stick["beta"] == bt].iloc[-1]
+    return {
+        "beta_t": bt,
+        "half_bracket": 0.5 * (float(above["beta"].min()) - bt) if len(above) else math.nan,
+        "m": float(at["order_parameter"]),
+        "m_err": float(at["order_parameter_err"]),
+        "phi": float(at["stuck_fraction"]),
+        "phi_err": float(at["stuck_fraction_err"]),
+        "reliable": bool(at["err_reliable"]),
+        "tau": float(at["tau_int_loads"]) if at["tau_int_loads"] is not None else math.nan,
+    }
+
+
+def _mean_err(values: list[float], errs: list[float]) -> tuple[float, float]:
+    """Mean of the replicas' values; its error the larger of the spread between them (standard
+    error of the mean) and their own errors combined (which is all there is for one replica)."""
+    v, e = np.asarray(values, dtype=float), np.asarray(errs, dtype=float)
+    own = float(np.sqrt(np.nanmean(e * e) / v.size)) if np.isfinite(e).any() else math.nan
+    spread = float(np.std(v, ddof=1) / math.sqrt(v.size)) if v.size > 1 else 0.0
+    return float(v.mean()), float(np.nanmax([own, spread]))
+
+
 def per_n_summary(rows: pd.DataFrame) -> pd.DataFrame:
-    """Per N: beta_t, its error, the lower edge, its error, the step of m at beta_t and its error."""
+    """Per N: beta_t and the step of m (and of phi) at beta_t, averaged over the up ladders'
+    replicas with their errors (:func:`_mean_err`), the spread of beta_t between replicas, and the
+    lower edge of the down ladder with half its bracket as error."""
     out = []
+    if "replica" not in rows:
+        rows = rows.assign(replica=0)
     for N, g in rows.groupby("N"):
         up, down = g[g["branch"] == "up"], g[g["branch"] == "down"]
         rec: dict[str, Any] = {"N": int(N), **{k: math.nan for k in PER_N_COLUMNS[1:]}}
-        stick = up[up["branch_state"] == "stick-slip"]
-        if len(stick):
-            bt = float(stick["beta"].max())
-            above = up[(up["branch_state"] == "sliding") & (up["beta"] > bt)]
-            rec["beta_t"] = bt
-            if len(above):
-                rec["beta_t_err"] = 0.5 * (float(above["beta"].min()) - bt)
-            at = stick[stick["beta"] == bt].iloc[-1]
-            rec["step"] = float(at["order_parameter"])
-            rec["step_err"] = float(at["order_parameter_err"])
-            rec["step_phi"] = float(at["stuck_fraction"])
-            rec["step_phi_err"] = float(at["stuck_fraction_err"])
-            rec["m_at_beta_t_reliable"] = bool(at["err_reliable"])
-            rec["tau_int_loads_at_beta_t"] = float(at["tau_int_loads"])
+        edges = [e for _, u in up.groupby("replica") if (e := _replica_edge(u)) is not None]
+        if edges:
+            rec["beta_t"], rec["beta_t_err"] = _mean_err(
+                [e["beta_t"] for e in edges], [e["half_bracket"] for e in edges]
+            )
+            rec["beta_t_spread"] = float(np.std([e["beta_t"] for e in edges], ddof=1)) if len(edges) > 1 else math.nan
+            rec["beta_t_replicas"] = [e["beta_t"] for e in edges]
+            rec["step"], rec["step_err"] = _mean_err([e["m"] for e in edges], [e["m_err"] for e in edges])
+            rec["step_phi"], rec["step_phi_err"] = _mean_err([e["phi"] for e in edges], [e["phi_err"] for e in edges])
+            rec["m_at_beta_t_reliable"] = all(e["reliable"] for e in edges)
+            rec["tau_int_loads_at_beta_t"] = float(np.nanmean([e["tau"] for e in edges]))
+            rec["replicas"] = len(edges)
         left = down[down["branch_state"] == "stick-slip"]
         if len(left):
             lo = float(left["beta"].max())
@@ -227,7 +266,7 @@ def run_transition(
     table = pd.DataFrame(rows)
     if len(table):
         table = table[[c for c in ROW_COLUMNS if c in table] + [c for c in table if c not in ROW_COLUMNS]]
-        table = table.sort_values(["N", "branch", "beta"], kind="stable").reset_index(drop=True)
+        table = table.sort_values(["N", "branch", "replica", "beta"], kind="stable").reset_index(drop=True)
     per_n = per_n_summary(table) if len(table) else pd.DataFrame(columns=PER_N_COLUMNS)
     fits = _fits(per_n) if len(per_n) else {}
     page.mkdir(parents=True, exist_ok=True)

@@ -19,36 +19,31 @@ __all__ = ["loops_figure", "scaling_figure"]
 
 def loops_figure(rows: pd.DataFrame) -> Figure:
     """m = 1 - <L>/L_ss (left) and the stuck fraction phi (right) against beta: the up ladder
-    (filled, solid) and the down ladder (open, dashed) of every N; undecided rungs in grey edges."""
+    (filled, solid; one line per replica) and the down ladder (open, dashed) of every N."""
     fig, (ax_m, ax_p) = new_figure(1, 2, width=5.6, height=4.0)
     for k, (N, g) in enumerate(rows.groupby("N")):
         colour = f"C{k % 10}"
         for branch, style, face in (("up", "-", colour), ("down", "--", "none")):
-            b = g[g["branch"] == branch].sort_values("beta")
-            if not len(b):
-                continue
-            label = f"N = {N} {branch}"
-            ax_m.errorbar(
-                b["beta"],
-                b["order_parameter"],
-                yerr=b["order_parameter_err"],
-                fmt="o" + style,
-                ms=4,
-                color=colour,
-                mfc=face,
-                label=label,
-                lw=1,
-            )
-            ax_p.errorbar(
-                b["beta"],
-                b["stuck_fraction"],
-                yerr=b["stuck_fraction_err"],
-                fmt="o" + style,
-                ms=4,
-                color=colour,
-                mfc=face,
-                lw=1,
-            )
+            mine = g[g["branch"] == branch]
+            reps = mine.groupby("replica") if "replica" in mine else [(0, mine)]
+            for j, (_, b) in enumerate(reps):  # each replica's ladder its own line
+                b = b.sort_values("beta")
+                if not len(b):
+                    continue
+                label = f"N = {N} {branch}" if j == 0 else None
+                for ax, col in ((ax_m, "order_parameter"), (ax_p, "stuck_fraction")):
+                    ax.errorbar(
+                        b["beta"],
+                        b[col],
+                        yerr=b[f"{col}_err"],
+                        fmt="o" + style,
+                        ms=4,
+                        color=colour,
+                        mfc=face,
+                        label=label if ax is ax_m else None,
+                        lw=1,
+                        alpha=1.0 if j == 0 else 0.55,
+                    )
     for ax in (ax_m, ax_p):
         ax.axvline(1.0, color="0.6", lw=0.8, ls=":")
         ax.set_xlabel(r"$\beta$")
