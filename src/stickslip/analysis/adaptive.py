@@ -81,10 +81,10 @@ class Assessment:
         return out
 
 
-def assess(t: np.ndarray, m: np.ndarray, phi: np.ndarray, target: float) -> Assessment:
+def assess(t: np.ndarray, m: np.ndarray, phi: np.ndarray, target: float, min_batches: int = STOP_BATCHES) -> Assessment:
     """Drop the transient of the order parameter ``m`` sampled at times ``t`` (MSER on m and on
     the stuck fraction ``phi``, the later cut wins) and test the stop rule: batch-means error of m
-    below ``target`` from at least :data:`STOP_BATCHES` batches of 10 tau_int."""
+    below ``target`` from at least ``min_batches`` (:data:`STOP_BATCHES`) batches of 10 tau_int."""
     t, m, phi = (np.asarray(a, dtype=float) for a in (t, m, phi))
     if t.size < 4 * MSER_BLOCK:
         empty = mean_with_error(m)
@@ -92,7 +92,7 @@ def assess(t: np.ndarray, m: np.ndarray, phi: np.ndarray, target: float) -> Asse
     cut = max(mser_cut(m), mser_cut(phi))
     m_est, phi_est = mean_with_error(m[cut:]), mean_with_error(phi[cut:])
     sliding = bool(phi_est.mean < STUCK_SLIDING)
-    enough = m_est.reliable and m_est.n_batches >= STOP_BATCHES
+    enough = m_est.reliable and m_est.n_batches >= min_batches
     decided = bool(enough and math.isfinite(m_est.err) and m_est.err < target)
     if decided:
         reason = (
@@ -100,9 +100,7 @@ def assess(t: np.ndarray, m: np.ndarray, phi: np.ndarray, target: float) -> Asse
             f"{m_est.batch} samples (tau_int {m_est.tau_int:.3g} samples)"
         )
     elif not enough:
-        reason = (
-            f"fewer than {STOP_BATCHES} batches of 10 tau_int (tau_int {m_est.tau_int:.3g} samples, {m_est.n} kept)"
-        )
+        reason = f"fewer than {min_batches} batches of 10 tau_int (tau_int {m_est.tau_int:.3g} samples, {m_est.n} kept)"
     else:
         reason = f"error of m {m_est.err:.2g} above the target {target:g}"
     return Assessment(m_est, phi_est, float(t[cut]), decided, sliding, reason)

@@ -87,7 +87,7 @@ def run_rung(params, state, cfg: dict[str, Any], *, leave_stops: bool = False, s
     known (module docstring). Returns the row (m, its error, the stuck fraction phi and its error,
     final state and reason, times in model time and loading times) with ``state`` (the final
     :class:`~stickslip.run.state.ChainState`) and ``samples`` (arrays t, L, n_moving)."""
-    from stickslip.analysis.adaptive import STUCK_SLIDING, assess
+    from stickslip.analysis.adaptive import STOP_BATCHES, STUCK_SLIDING, assess
     from stickslip.models.physics import chain_steady_length, loading_time
     from stickslip.run.driver import run_chain
     from stickslip.run.state import steady_deviation
@@ -137,7 +137,7 @@ def run_rung(params, state, cfg: dict[str, Any], *, leave_stops: bool = False, s
         t_all, L_all, n_all = (np.concatenate(x) for x in (t_s, L_s, n_s))
         m = 1.0 - L_all / L_ss
         phi = 1.0 - n_all / params.N
-        a = assess(t_all, m, phi, target)
+        a = assess(t_all, m, phi, target, int(cfg.get("stop_batches", STOP_BATCHES)))
         # Leaving stick-slip (up), a falling deviation says sliding; near beta = 1 from below (down)
         # fast modes decay while the slow one grows, so there only reaching steady sliding counts.
         falling = len(devs) >= 2 and math.isfinite(devs[-2]) and devs[-1] < 0.5 * devs[-2]
@@ -197,9 +197,16 @@ def run_rung(params, state, cfg: dict[str, Any], *, leave_stops: bool = False, s
 
 
 def _rung_settings(cfg: dict[str, Any]) -> dict[str, Any]:
+    from stickslip.analysis.adaptive import STOP_BATCHES
+
     keys = ("target", "cap_loads", "segment_loads", "first_segment_loads", "samples_per_load")
     keys += ("perturbation", "down_perturbation", "seed")
-    return {k: cfg[k] for k in keys} | {k: cfg.get(k, v) for k, v in _PAPER.items()}
+    # a rung of another stop rule is not this rung: it is run again, not replayed
+    return (
+        {k: cfg[k] for k in keys}
+        | {k: cfg.get(k, v) for k, v in _PAPER.items()}
+        | {"stop_batches": int(cfg.get("stop_batches", STOP_BATCHES))}
+    )
 
 
 def _rung(

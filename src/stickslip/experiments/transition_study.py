@@ -32,6 +32,7 @@ import numpy as np
 import pandas as pd
 
 from stickslip import __version__, io
+from stickslip.analysis.adaptive import STOP_BATCHES
 from stickslip.experiments.study_run import PAGE_FILES, record_outputs
 from stickslip.experiments.transition_page import PER_N_COLUMNS, ROW_COLUMNS, write_page
 
@@ -90,6 +91,7 @@ def ladder_points(mode: str, extra_Ns: tuple[int, ...] = ()) -> tuple[dict[str, 
         "seed": 0,
         "bisections": 3 if mode != "tiny" else 1,
         "replicas": REPLICAS[mode],
+        "stop_batches": STOP_BATCHES,
     }
     points = []
     for N in sorted(Ns, reverse=True):
