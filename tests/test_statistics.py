@@ -16,6 +16,7 @@ import pytest
 import xarray as xr
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from scipy import stats
 
 from stickslip.analysis.statistics import (
     fit_power_law,
@@ -160,6 +161,78 @@ def test_bootstrap_is_reproducible_from_its_seed():
     S = bounded_power_law(1_000, 1.5, 1.0, 100.0, seed=8)
     assert fit_power_law(S, seed=3).tau_err == fit_power_law(S, seed=3).tau_err
     assert fit_power_law(S, seed=3).tau_err != fit_power_law(S, seed=4).tau_err
+
+
+def _junk_and_power_law() -> np.ndarray:
+    """A fixed sample: 3001 events of tau = 1.6 on [1, 1e3] above 400 of uniform junk below 1."""
+    rng = np.random.default_rng(2024)
+    u = rng.random(3001)
+    e = 1.0 - 1.6
+    return np.concatenate([(1.0 + u * (1e3**e - 1.0)) ** (1.0 / e), rng.uniform(0.01, 1.0, 400)])
+
+
+# (keywords of fit_power_law, tau, tau_err, ks_distance, s_min, n): the values the hand-written KS
+# distance and bootstrap loop gave on _junk_and_power_law() before scipy.stats took them over
+REGRESSION = [
+    ({}, 1.5754763128768638, 0.010466400479238684, 0.017787975901909583, 0.9656812090451317, 3016),
+    ({"s_min": 2.0}, 1.594015055862196, 0.01669676461851616, 0.012477106222560652, 2.0, 1994),
+    (
+        {"truncated": False, "s_min": 1.0, "s_max": 1e3},
+        1.6331043125824554,
+        0.00898001123168779,
+        0.026457507575145978,
+        1.0,
+        3001,
+    ),
+    (
+        {"cutoff": 500.0, "bootstrap": 50, "seed": 7},
+        1.5717571783944853,
+        0.012948352953286318,
+        0.017756833160408627,
+        0.9656812090451317,
+        2993,
+    ),
+]
+
+
+@pytest.mark.parametrize("kwargs, tau, tau_err, ks, s_min, n", REGRESSION, ids=[str(r[0]) for r in REGRESSION])
+def test_fit_keeps_its_values_on_a_fixed_sample(kwargs, tau, tau_err, ks, s_min, n):
+    fit = fit_power_law(_junk_and_power_law(), **kwargs)
+    assert (fit.s_min, fit.n) == (s_min, n)
+    assert fit.tau == pytest.approx(tau, rel=1e-12)
+    # far inside their own errors; the bootstrap draws the same resamples as before
+    assert fit.tau_err == pytest.approx(tau_err, rel=1e-12)
+    assert fit.ks_distance == pytest.approx(ks, rel=1e-9)
+
+
+def test_untruncated_fit_is_the_closed_form_mle_with_a_plain_bootstrap_and_ks_distance():
+    S = _junk_and_power_law()
+    fit = fit_power_law(S, s_min=1.0, s_max=1e3, truncated=False, bootstrap=30, seed=11)
+    x = S[(S >= 1.0) & (S <= 1e3)]  # in the order of the sample: the resamples index it
+    n = x.size
+    # Clauset, Shalizi and Newman (2009), eq. (3.1): tau = 1 + n / sum log(x / s_min)
+    tau = 1.0 + n / np.log(x).sum()
+    assert fit.tau == pytest.approx(tau, rel=1e-12)
+    # bootstrap written from its definition: resample the events with replacement, refit
+    rng = np.random.default_rng(11)
+    logs = np.log(x)
+    taus = [1.0 + n / logs[rng.integers(0, n, size=n)].sum() for _ in range(30)]
+    assert fit.tau_err == pytest.approx(np.std(taus, ddof=1), rel=1e-10)
+    # KS distance to the untruncated CDF 1 - x^(1 - tau) at the fitted tau
+    cdf = 1.0 - np.sort(x) ** (1.0 - tau)
+    steps = np.arange(1, n + 1) / n
+    assert fit.ks_distance == pytest.approx(max(np.max(steps - cdf), np.max(cdf - steps + 1.0 / n)), rel=1e-9)
+
+
+@pytest.mark.parametrize("tau, ratio, seed", [(1.5, 1e3, 1), (1.6, 1e2, 2), (2.2, 1e4, 3)])
+def test_truncated_fit_equals_scipys_truncpareto_fit(tau, ratio, seed):
+    # scipy.stats.truncpareto (b = tau - 1, c = s_max / s_min) solves the same score equation by
+    # its own root finder when tau > 1; below that it falls back to a generic numerical search
+    S = bounded_power_law(5000, tau, 2.0, 2.0 * ratio, seed)
+    fit = fit_power_law(S, s_min=2.0, s_max=2.0 * ratio, bootstrap=0)
+    b, c, loc, scale = stats.truncpareto.fit(S, fc=ratio, floc=0.0, fscale=2.0)
+    assert (c, loc, scale) == (ratio, 0.0, 2.0)
+    assert fit.tau == pytest.approx(b + 1.0, abs=1e-10)
 
 
 def test_truncated_pdf_integrates_to_one():
