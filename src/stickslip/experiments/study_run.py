@@ -265,8 +265,6 @@ def _write_page(
 MANIFEST = ".stickslip-study.json"
 #: The files of a study's page besides its figures.
 PAGE_FILES = ("table.parquet", "table.csv", "study.json", "index.html")
-#: What a study's runs folder (runs/<name>-<key>/) holds besides its points folder.
-RUNS_FILES = frozenset({"study-spec.json", "points", "ladders"})
 
 
 def read_manifest(out: Path) -> set[str]:
