@@ -295,6 +295,21 @@ def test_front_speed_is_exact_on_a_noiseless_front_and_ignores_unmoved_blocks():
     np.testing.assert_allclose(front.arrival_time([100, 300]), [40 / 3 + 60 / 1.43, 40 / 3 + 260 / 1.43])
 
 
+def test_front_speed_keeps_its_values_on_a_fixed_front():
+    # the values of the hand-written least squares before scipy.stats.linregress took it over
+    front = front_speed(synthetic_front(1.43, 399, 19_100.0, 0.2, seed=1, event=7), 7)
+    assert front.speed == pytest.approx(1.4293040070889855, rel=1e-12)
+    assert front.speed_err == pytest.approx(0.0004481497983172533, rel=1e-10)
+    assert front.intercept == pytest.approx(21.672586747604484, rel=1e-12)
+    assert front.rms == pytest.approx(0.2547187449800156, rel=1e-12)
+
+
+def test_front_speed_of_blocks_that_started_together_is_refused():
+    table = pd.DataFrame({"event": 7, "block": np.arange(1, 11), "t_first": np.r_[0.0, np.full(9, 3.0)]})
+    with pytest.raises(ValueError, match="one time"):
+        front_speed(table, 7, i_min=2)
+
+
 def test_front_speed_needs_moved_blocks():
     table = synthetic_front(1.43, 10, 0.0, 0.0, seed=0)
     with pytest.raises(ValueError):
@@ -373,6 +388,15 @@ def test_central_interval_places_a_value_in_a_known_distribution():
     low = central_interval(sample, 3.0)
     assert not low.inside and low.percentile == pytest.approx(2.5)
     assert central_interval(sample, 3.0, level=0.98).inside
+
+
+def test_central_interval_percentile_counts_ties_half():
+    from stickslip.analysis.statistics import central_interval
+
+    sample = [1.0, 2.0, 2.0, 3.0, 4.0]
+    # 1 below, 2 equal: (1 + 2 / 2) / 5
+    assert central_interval(sample, 2.0).percentile == pytest.approx(40.0, rel=1e-15)
+    assert central_interval(sample, 0.5).percentile == 0.0 and central_interval(sample, 5.0).percentile == 100.0
 
 
 def test_leading_edge_speed_of_a_known_front():
