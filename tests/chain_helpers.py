@@ -350,3 +350,26 @@ def error_lines(err: str) -> list[str]:
         while k < len(lines) and lines[k].startswith(" "):
             k += 1
     return lines[k:]
+
+
+def is_real_command(command: str) -> bool:
+    """Whether each ``stickslip ...`` part of ``command`` is accepted by the real CLI parser.
+
+    Parts are joined by ``&&``; a trailing ``(...)`` remark is not part of the command.
+    """
+    import contextlib
+    import io
+    import shlex
+
+    from stickslip.cli import build_parser
+
+    for part in command.split(" && "):
+        words = shlex.split(part.split("  (")[0])
+        if not words or words[0] != "stickslip":
+            return False
+        try:
+            with contextlib.redirect_stderr(io.StringIO()):
+                build_parser().parse_args(words[1:])
+        except SystemExit:
+            return False
+    return True

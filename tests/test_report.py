@@ -4,13 +4,12 @@ from __future__ import annotations
 
 import json
 import re
-import shlex
 
 import pytest
 from markupsafe import escape
 from matplotlib.figure import Figure
 
-from stickslip.cli import build_parser
+from chain_helpers import is_real_command
 from stickslip.plotting.style import save_figure
 from stickslip.report.writer import ReportFigure, ReportRow, read_report, write_report
 
@@ -135,25 +134,9 @@ def _esc(text: str) -> str:
     return str(escape(text))
 
 
-def _parses(command: str) -> bool:
-    """Whether each ``stickslip ...`` part of ``command`` is accepted by the real CLI parser.
-
-    Parts are joined by ``&&``; a trailing ``(...)`` remark is not part of the command.
-    """
-    for part in command.split(" && "):
-        words = shlex.split(part.split("  (")[0])
-        if not words or words[0] != "stickslip":
-            return False
-        try:
-            build_parser().parse_args(words[1:])
-        except SystemExit:
-            return False
-    return True
-
-
 def test_commands_are_real(figures):
     for command in [r.command for r in ROWS] + [f.command for f in figures]:
-        assert _parses(command), command
+        assert is_real_command(command), command
 
 
 @pytest.mark.parametrize(
@@ -161,7 +144,7 @@ def test_commands_are_real(figures):
     ["stickslip stability hopf --K 10", "stickslip block limit", "stickslip reproduce --only fig6", "make all"],
 )
 def test_command_check_refuses_what_does_not_exist(command):
-    assert not _parses(command)
+    assert not is_real_command(command)
 
 
 @pytest.fixture()

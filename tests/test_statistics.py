@@ -16,6 +16,7 @@ import pytest
 import xarray as xr
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from scipy import stats
 
 from stickslip.analysis.statistics import (
     fit_power_law,
@@ -162,6 +163,78 @@ def test_bootstrap_is_reproducible_from_its_seed():
     assert fit_power_law(S, seed=3).tau_err != fit_power_law(S, seed=4).tau_err
 
 
+def _junk_and_power_law() -> np.ndarray:
+    """A fixed sample: 3001 events of tau = 1.6 on [1, 1e3] above 400 of uniform junk below 1."""
+    rng = np.random.default_rng(2024)
+    u = rng.random(3001)
+    e = 1.0 - 1.6
+    return np.concatenate([(1.0 + u * (1e3**e - 1.0)) ** (1.0 / e), rng.uniform(0.01, 1.0, 400)])
+
+
+# (keywords of fit_power_law, tau, tau_err, ks_distance, s_min, n): the values the hand-written KS
+# distance and bootstrap loop gave on _junk_and_power_law() before scipy.stats took them over
+REGRESSION = [
+    ({}, 1.5754763128768638, 0.010466400479238684, 0.017787975901909583, 0.9656812090451317, 3016),
+    ({"s_min": 2.0}, 1.594015055862196, 0.01669676461851616, 0.012477106222560652, 2.0, 1994),
+    (
+        {"truncated": False, "s_min": 1.0, "s_max": 1e3},
+        1.6331043125824554,
+        0.00898001123168779,
+        0.026457507575145978,
+        1.0,
+        3001,
+    ),
+    (
+        {"cutoff": 500.0, "bootstrap": 50, "seed": 7},
+        1.5717571783944853,
+        0.012948352953286318,
+        0.017756833160408627,
+        0.9656812090451317,
+        2993,
+    ),
+]
+
+
+@pytest.mark.parametrize("kwargs, tau, tau_err, ks, s_min, n", REGRESSION, ids=[str(r[0]) for r in REGRESSION])
+def test_fit_keeps_its_values_on_a_fixed_sample(kwargs, tau, tau_err, ks, s_min, n):
+    fit = fit_power_law(_junk_and_power_law(), **kwargs)
+    assert (fit.s_min, fit.n) == (s_min, n)
+    assert fit.tau == pytest.approx(tau, rel=1e-12)
+    # far inside their own errors; the bootstrap draws the same resamples as before
+    assert fit.tau_err == pytest.approx(tau_err, rel=1e-12)
+    assert fit.ks_distance == pytest.approx(ks, rel=1e-9)
+
+
+def test_untruncated_fit_is_the_closed_form_mle_with_a_plain_bootstrap_and_ks_distance():
+    S = _junk_and_power_law()
+    fit = fit_power_law(S, s_min=1.0, s_max=1e3, truncated=False, bootstrap=30, seed=11)
+    x = S[(S >= 1.0) & (S <= 1e3)]  # in the order of the sample: the resamples index it
+    n = x.size
+    # Clauset, Shalizi and Newman (2009), eq. (3.1): tau = 1 + n / sum log(x / s_min)
+    tau = 1.0 + n / np.log(x).sum()
+    assert fit.tau == pytest.approx(tau, rel=1e-12)
+    # bootstrap written from its definition: resample the events with replacement, refit
+    rng = np.random.default_rng(11)
+    logs = np.log(x)
+    taus = [1.0 + n / logs[rng.integers(0, n, size=n)].sum() for _ in range(30)]
+    assert fit.tau_err == pytest.approx(np.std(taus, ddof=1), rel=1e-10)
+    # KS distance to the untruncated CDF 1 - x^(1 - tau) at the fitted tau
+    cdf = 1.0 - np.sort(x) ** (1.0 - tau)
+    steps = np.arange(1, n + 1) / n
+    assert fit.ks_distance == pytest.approx(max(np.max(steps - cdf), np.max(cdf - steps + 1.0 / n)), rel=1e-9)
+
+
+@pytest.mark.parametrize("tau, ratio, seed", [(1.5, 1e3, 1), (1.6, 1e2, 2), (2.2, 1e4, 3)])
+def test_truncated_fit_equals_scipys_truncpareto_fit(tau, ratio, seed):
+    # scipy.stats.truncpareto (b = tau - 1, c = s_max / s_min) solves the same score equation by
+    # its own root finder when tau > 1; below that it falls back to a generic numerical search
+    S = bounded_power_law(5000, tau, 2.0, 2.0 * ratio, seed)
+    fit = fit_power_law(S, s_min=2.0, s_max=2.0 * ratio, bootstrap=0)
+    b, c, loc, scale = stats.truncpareto.fit(S, fc=ratio, floc=0.0, fscale=2.0)
+    assert (c, loc, scale) == (ratio, 0.0, 2.0)
+    assert fit.tau == pytest.approx(b + 1.0, abs=1e-10)
+
+
 def test_truncated_pdf_integrates_to_one():
     from scipy import integrate
 
@@ -220,6 +293,21 @@ def test_front_speed_is_exact_on_a_noiseless_front_and_ignores_unmoved_blocks():
     assert front.speed == pytest.approx(1.43, rel=1e-12)
     assert front.rms < 1e-9
     np.testing.assert_allclose(front.arrival_time([100, 300]), [40 / 3 + 60 / 1.43, 40 / 3 + 260 / 1.43])
+
+
+def test_front_speed_keeps_its_values_on_a_fixed_front():
+    # the values of the hand-written least squares before scipy.stats.linregress took it over
+    front = front_speed(synthetic_front(1.43, 399, 19_100.0, 0.2, seed=1, event=7), 7)
+    assert front.speed == pytest.approx(1.4293040070889855, rel=1e-12)
+    assert front.speed_err == pytest.approx(0.0004481497983172533, rel=1e-10)
+    assert front.intercept == pytest.approx(21.672586747604484, rel=1e-12)
+    assert front.rms == pytest.approx(0.2547187449800156, rel=1e-12)
+
+
+def test_front_speed_of_blocks_that_started_together_is_refused():
+    table = pd.DataFrame({"event": 7, "block": np.arange(1, 11), "t_first": np.r_[0.0, np.full(9, 3.0)]})
+    with pytest.raises(ValueError, match="one time"):
+        front_speed(table, 7, i_min=2)
 
 
 def test_front_speed_needs_moved_blocks():
@@ -300,6 +388,15 @@ def test_central_interval_places_a_value_in_a_known_distribution():
     low = central_interval(sample, 3.0)
     assert not low.inside and low.percentile == pytest.approx(2.5)
     assert central_interval(sample, 3.0, level=0.98).inside
+
+
+def test_central_interval_percentile_counts_ties_half():
+    from stickslip.analysis.statistics import central_interval
+
+    sample = [1.0, 2.0, 2.0, 3.0, 4.0]
+    # 1 below, 2 equal: (1 + 2 / 2) / 5
+    assert central_interval(sample, 2.0).percentile == pytest.approx(40.0, rel=1e-15)
+    assert central_interval(sample, 0.5).percentile == 0.0 and central_interval(sample, 5.0).percentile == 100.0
 
 
 def test_leading_edge_speed_of_a_known_front():

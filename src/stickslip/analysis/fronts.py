@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 import xarray as xr
+from scipy import stats
 
 # ---------------------------------------------------------------------------------------------
 # Rupture fronts (Fig. 6)
@@ -78,19 +79,15 @@ def front_speed(
     t0 = float(times.min())
     t = times[use] - t0
     i = blocks[use].astype(np.float64)
-    design = np.column_stack([np.ones(n), t])
-    coef, *_ = np.linalg.lstsq(design, i, rcond=None)
-    residual = i - design @ coef
-    dof = n - 2
-    s2 = float(residual @ residual) / dof if dof > 0 else math.nan
-    t_centred = t - t.mean()
-    sxx = float(t_centred @ t_centred)
-    slope_err = math.sqrt(s2 / sxx) if sxx > 0 and dof > 0 else math.nan
+    if np.ptp(t) == 0.0:
+        raise ValueError(f"event {event}: the blocks in [{lo}, {hi}] first moved at one time: no speed")
+    fit = stats.linregress(t, i)  # least squares; stderr = sqrt(s^2 / sum (t - mean t)^2)
+    residual = i - (fit.intercept + fit.slope * t)
     return FrontSpeed(
         event=int(event),
-        speed=float(coef[1]),
-        speed_err=slope_err,
-        intercept=float(coef[0]),
+        speed=float(fit.slope),
+        speed_err=float(fit.stderr),
+        intercept=float(fit.intercept),
         t_start=t0,
         i_min=lo,
         i_max=hi,
@@ -168,17 +165,11 @@ def leading_edge_speed(
     if n < 2:
         raise ValueError(f"event {event}: need at least 2 windows with the edge in [{lo}, {hi}) (got {n})")
     t, i = t_end[use], edges[use].astype(np.float64)
-    design = np.column_stack([np.ones(n), t - t[0]])
-    coef, *_ = np.linalg.lstsq(design, i, rcond=None)
-    err = math.nan
-    if n > 2:
-        residual = i - design @ coef
-        tc = t - t.mean()
-        err = math.sqrt(float(residual @ residual) / (n - 2) / float(tc @ tc))
+    fit = stats.linregress(t - t[0], i)  # window ends differ: the edge advances in time
     return EdgeSpeed(
         event=int(event),
-        speed=float(coef[1]),
-        speed_err=err,
+        speed=float(fit.slope),
+        speed_err=float(fit.stderr) if n > 2 else math.nan,  # two windows fix a line, not its error
         i_min=lo,
         i_max=hi,
         n_windows=n,
@@ -221,7 +212,7 @@ def central_interval(sample: Any, value: float, *, level: float = 0.9) -> Centra
         raise ValueError(f"level must lie in (0, 1) (got {level!r})")
     tail = (1.0 - level) / 2.0
     lo, hi = (float(q) for q in np.quantile(x, [tail, 1.0 - tail]))
-    pct = 100.0 * (np.count_nonzero(x < value) + 0.5 * np.count_nonzero(x == value)) / x.size
+    pct = stats.percentileofscore(x, value, kind="mean")  # ties count half
     q1, q3 = (float(q) for q in np.quantile(x, [0.25, 0.75]))
     return CentralInterval(
         value=float(value),

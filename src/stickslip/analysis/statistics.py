@@ -11,7 +11,11 @@ the largest possible event, so the fit is the maximum-likelihood estimate for a 
 
     p(S) = S^-tau / Z(tau),   Z(tau) = (s_min^(1-tau) - s_max^(1-tau)) / (tau - 1),
 
-computed here in closed form (the score equation is solved by bracketing). The ``powerlaw``
+computed here in closed form (the score equation is solved by bracketing). For tau > 1
+``scipy.stats.truncpareto.fit`` with c and scale fixed solves the same equation (the tests check
+that they agree); it is not called because for tau <= 1, which a fit range of junk can give, it
+falls back to a generic numerical search. The Kolmogorov-Smirnov distance is
+``scipy.stats.ks_1samp``'s and the bootstrap resampling ``scipy.stats.bootstrap``'s. The ``powerlaw``
 package (2.0) was checked and is not used for the estimate: ``powerlaw.Fit(..., xmax=...)``
 keeps the untruncated closed-form estimate 1 + n / sum log(S / s_min) whenever that estimate
 lies in (1.5, 3], i.e. it ignores ``xmax`` exactly in the range of exponents the paper reports
@@ -27,6 +31,7 @@ from the smallest S is rejected outright (KS distance about 0.5).
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import asdict, dataclass
 from typing import Any
@@ -34,7 +39,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 import xarray as xr
-from scipy import optimize
+from scipy import optimize, stats
 
 # Rupture fronts (Fig. 6) live in fronts; their names stay importable here.
 from stickslip.analysis.fronts import (
@@ -219,13 +224,24 @@ def _truncated_mle(mean_log: float, span: float) -> float:
     return 1.0 - e
 
 
-def _fit_tau(log_ratio: np.ndarray, span: float) -> float:
-    """tau from log(S/s_min) of the events in range: truncated MLE, or the closed form if span = inf."""
-    mean_log = float(log_ratio.mean())
+def _tau_from_mean(mean_log: float, span: float) -> float:
+    """tau from the mean of log(S/s_min) over the events in range: truncated MLE, or the closed
+    form if span = inf."""
     if math.isinf(span):
         # untruncated continuous power law: tau = 1 + n / sum log(S/s_min)
         return 1.0 + 1.0 / mean_log if mean_log > 0.0 else math.inf
     return _truncated_mle(mean_log, span)
+
+
+def _fit_tau(log_ratio: np.ndarray, span: float) -> float:
+    """tau from log(S/s_min) of the events in range (:func:`_tau_from_mean` of their mean)."""
+    return _tau_from_mean(float(log_ratio.mean()), span)
+
+
+def _resampled_taus(log_ratio: np.ndarray, span: float, axis: int = -1) -> np.ndarray:
+    """tau of each resample along ``axis``: the vectorised statistic of ``scipy.stats.bootstrap``."""
+    means = np.mean(log_ratio, axis=axis)
+    return np.reshape([_tau_from_mean(float(m), span) for m in np.ravel(means)], np.shape(means))
 
 
 @dataclass(frozen=True)
@@ -302,11 +318,9 @@ def _range_fit(values: np.ndarray, lo: float, hi: float, truncated: bool) -> tup
 
 def _ks_distance(x: np.ndarray, tau: float, lo: float, hi: float) -> float:
     """Kolmogorov-Smirnov distance between the fitted CDF on [lo, hi] and the sample x."""
-    n = x.size
-    xs = np.sort(x)
-    model = _truncated_cdf(xs, tau, lo, hi)
-    upper = np.arange(1, n + 1) / n
-    return float(max(np.max(upper - model), np.max(model - (upper - 1.0 / n))))
+    cdf = functools.partial(_truncated_cdf, tau=tau, s_min=lo, s_max=hi)
+    # the distance only: the p-value would assume tau was not fitted to x
+    return float(stats.ks_1samp(x, cdf, method="asymp").statistic)
 
 
 def s_min_scan(
@@ -422,11 +436,19 @@ def fit_power_law(
 
     tau_err = math.nan
     if bootstrap > 0:
-        rng = np.random.default_rng(seed)
-        estimates = np.empty(bootstrap)
-        for k in range(bootstrap):
-            estimates[k] = _fit_tau(log_ratio[rng.integers(0, n, size=n)], span)
-        finite = estimates[np.isfinite(estimates)]
+        # one resample per batch keeps memory at n; "percentile" needs no jackknife (BCa would
+        # refit n times)
+        res = stats.bootstrap(
+            (log_ratio,),
+            functools.partial(_resampled_taus, span=span),
+            n_resamples=bootstrap,
+            batch=1,
+            vectorized=True,
+            method="percentile",
+            rng=np.random.default_rng(seed),
+        )
+        estimates = np.asarray(res.bootstrap_distribution, dtype=np.float64)
+        finite = estimates[np.isfinite(estimates)]  # a resample with every event at one end has no fit
         tau_err = float(finite.std(ddof=1)) if finite.size > 1 else math.nan
 
     if math.isfinite(tau):

@@ -319,18 +319,6 @@ def add_overwrite_option(parser: argparse.ArgumentParser) -> None:
     )
 
 
-def prepare_out_dir(path: str | Path | None) -> Path | None:
-    """Create the output directory (after all validation has passed)."""
-    if path is None:
-        return None
-    out = check_out_dir(path)
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise CommandError(f"cannot create output directory {out}: {exc.strerror}") from None
-    return out
-
-
 def add_model_options(parser: argparse.ArgumentParser, helps: dict[str, str] | None = None) -> None:
     """``--model`` (a preset), the four pieces to compose a model, CL's own symbols, and one
     ``--NAME`` per parameter of :class:`ChainParams`."""

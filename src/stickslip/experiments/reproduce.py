@@ -40,6 +40,7 @@ import pandas as pd
 
 from stickslip import heartbeat, io
 from stickslip.analysis.chain_runs import chain_analysis, final_state
+from stickslip.experiments.cache import read_record
 from stickslip.experiments.specs import (
     UNTIL_STEADY,
     Experiment,
@@ -97,14 +98,7 @@ class _Log:
 
 def _stored(run_dir: Path, exp: Experiment) -> dict[str, Any] | None:
     """The stored ``result.json`` of ``exp`` if it is there and made from the same spec."""
-    path = run_dir / RESULT_FILE
-    if not path.is_file():
-        return None
-    try:
-        record = io.read_json(path)
-    except (OSError, ValueError):
-        return None
-    return record if record.get("spec") == exp.spec() else None
+    return read_record(run_dir / RESULT_FILE, exp.spec())
 
 
 def run_experiment(

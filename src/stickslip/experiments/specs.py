@@ -26,8 +26,6 @@ every block moves every step and nothing changes but the position of the pulling
 
 from __future__ import annotations
 
-import hashlib
-import json
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -35,7 +33,7 @@ from pathlib import Path
 from typing import Any
 
 from stickslip import __version__
-from stickslip.jsonable import to_jsonable
+from stickslip.experiments.cache import canonical, spec_key
 from stickslip.models.params import ChainParams
 
 __all__ = [
@@ -80,24 +78,6 @@ FIGURES = (
 )
 
 
-def _canonical(value: Any) -> Any:
-    """A JSON round trip with sorted keys: tuples become lists, whole floats become ints.
-
-    So ``K = 10`` and ``K = 10.0``, or ``(0.5, 1.0)`` and ``[0.5, 1]``, give the same spec.
-    """
-
-    def whole(v: Any) -> Any:
-        if isinstance(v, dict):
-            return {k: whole(x) for k, x in v.items()}
-        if isinstance(v, list):
-            return [whole(x) for x in v]
-        if isinstance(v, float) and v.is_integer() and abs(v) < 2**53:
-            return int(v)
-        return v
-
-    return whole(json.loads(json.dumps(to_jsonable(value), sort_keys=True)))
-
-
 @dataclass(frozen=True)
 class Experiment:
     """One computation of the reproduction, as data.
@@ -127,12 +107,12 @@ class Experiment:
         if self.kind not in KINDS:
             raise ValueError(f"kind must be one of {', '.join(KINDS)} (got {self.kind!r})")
         # Store plain, canonical copies: the spec cannot change behind the caller's back.
-        object.__setattr__(self, "params", _canonical(dict(self.params)))
-        object.__setattr__(self, "options", _canonical(dict(self.options)))
+        object.__setattr__(self, "params", canonical(dict(self.params)))
+        object.__setattr__(self, "options", canonical(dict(self.options)))
 
     def spec(self) -> dict[str, Any]:
         """What the result depends on: kind, parameters, run length, options, package version."""
-        return _canonical(
+        return canonical(
             {
                 "kind": self.kind,
                 "params": self.params,
@@ -143,7 +123,8 @@ class Experiment:
         )
 
     def key(self) -> str:
-        """First 12 hex digits of the SHA-256 of :meth:`spec` as canonical JSON.
+        """First 12 hex digits of the SHA-256 of :meth:`spec` as canonical JSON
+        (:func:`stickslip.experiments.cache.spec_key`).
 
         ``options["points"]`` (the chain runs of a sweep) is left out of the key: each point is
         stored and reused on its own (:func:`stickslip.experiments.sweep.run_sweep`), so adding a point to a
@@ -151,8 +132,7 @@ class Experiment:
         """
         spec = self.spec()
         spec["options"] = {k: v for k, v in spec["options"].items() if k != "points"}
-        text = json.dumps(spec, sort_keys=True, separators=(",", ":"))
-        return hashlib.sha256(text.encode()).hexdigest()[:12]
+        return spec_key(spec)
 
     @property
     def dirname(self) -> str:

@@ -24,8 +24,6 @@ The runners that turn the points' results into tables, figures and pages are in
 
 from __future__ import annotations
 
-import hashlib
-import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -34,7 +32,7 @@ from typing import Any
 import numpy as np
 
 from stickslip import __version__
-from stickslip.experiments.specs import _canonical
+from stickslip.experiments.cache import canonical, spec_key
 
 __all__ = [
     "Study",
@@ -71,12 +69,12 @@ class Study:
     note: str = ""
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "common", _canonical(dict(self.common)))
-        object.__setattr__(self, "points", tuple(_canonical(dict(p)) for p in self.points))
+        object.__setattr__(self, "common", canonical(dict(self.common)))
+        object.__setattr__(self, "points", tuple(canonical(dict(p)) for p in self.points))
 
     def spec(self) -> dict[str, Any]:
         """What the results depend on: name, shared settings, points, package version."""
-        return _canonical(
+        return canonical(
             {"study": self.name, "common": self.common, "points": list(self.points), "version": __version__}
         )
 
@@ -84,8 +82,7 @@ class Study:
         """First 12 hex digits of the SHA-256 of the spec without its points."""
         spec = self.spec()
         spec.pop("points")
-        text = json.dumps(spec, sort_keys=True, separators=(",", ":"))
-        return hashlib.sha256(text.encode()).hexdigest()[:12]
+        return spec_key(spec)
 
     @property
     def dirname(self) -> str:

@@ -14,8 +14,6 @@ figures (:mod:`stickslip.plotting.studies`) and writes its page. Layout::
 
 from __future__ import annotations
 
-import html
-import math
 import sys
 import time
 from pathlib import Path
@@ -27,6 +25,7 @@ import pandas as pd
 from stickslip import __version__, io
 from stickslip.experiments.studies import Study, study, study_command, study_point_task
 from stickslip.jsonable import to_jsonable
+from stickslip.pages import image_src, write_page
 
 __all__ = ["run_study", "study_command", "TABLE_COLUMNS"]
 
@@ -226,24 +225,7 @@ def _records(table: pd.DataFrame) -> list[dict[str, Any]]:
 
 
 # ---------------------------------------------------------------------------------------------
-# The page
-
-_CSS = """
-body { font-family: system-ui, sans-serif; margin: 2em auto; max-width: 76em; padding: 0 1em; color: #222; }
-table { border-collapse: collapse; font-size: 0.85em; } th, td { border: 1px solid #ccc; padding: 0.25em 0.45em; }
-th { background: #f3f3f3; } code { font-size: 0.9em; }
-figure { display: inline-block; margin: 0.8em; max-width: 46em; }
-figure img { max-width: 100%; border: 1px solid #ddd; } figcaption { font-size: 0.9em; }
-td.failed { background: #f9e0e0; }
-"""
-
-
-def _cell(value: Any) -> str:
-    if value is None or (isinstance(value, float) and not math.isfinite(value)):
-        return ""
-    if isinstance(value, float):
-        return f"{value:.4g}"
-    return html.escape(str(value))
+# The page: stickslip/templates/study.html.j2
 
 
 def _write_page(
@@ -254,52 +236,26 @@ def _write_page(
     figures: list[dict[str, Any]],
     table: pd.DataFrame,
 ) -> None:
-    import base64
-
-    parts = [
-        "<!DOCTYPE html>",
-        '<html lang="en"><head><meta charset="utf-8">',
-        f"<title>Study: {html.escape(spec.name)}</title><style>{_CSS}</style></head><body>",
-        f"<h1>Study: {html.escape(spec.name)} ({html.escape(spec.mode)})</h1>",
-        f"<p><code>{html.escape(meta['command'])}</code> &mdash; {html.escape(spec.note)}</p>",
-        f"<p>{meta['points']} points: {meta['run']} run now, {meta['reused']} reused, {meta['failed']} failed; "
-        f"{meta['wall_seconds']} s wall, {meta['compute_seconds']} s of point runs; stickslip {__version__}; "
-        f"runs in <code>{html.escape(meta['runs'])}</code>.</p>",
-    ]
+    """Write the study's ``index.html``: the command, the counts, what the data say, the figures
+    (embedded) and the table, failed points marked."""
+    damaged = []
     if "note" in table.columns and table["note"].notna().any():
-        notes = [f"{r.point_dir}: {r.note}" for r in table.itertuples() if isinstance(r.note, str)]
-        parts.append(
-            f"<p>{len(notes)} cached points ran again because their files were damaged:</p><ul>"
-            + "".join(f"<li>{html.escape(n)}</li>" for n in notes)
-            + "</ul>"
-        )
-    parts.append("<h2>What the data say</h2><ul>")
-    for line in findings.get("statements", []):
-        parts.append(f"<li>{html.escape(line)}</li>")
-    parts.append("</ul><h2>Figures</h2>")
-    for fig in figures:
-        png = path.parent / fig["image"]
-        src = (
-            ("data:image/png;base64," + base64.b64encode(png.read_bytes()).decode()) if png.is_file() else fig["image"]
-        )
-        parts.append(
-            f'<figure><img src="{src}" alt="{html.escape(fig["name"])}"><figcaption>'
-            f'{html.escape(fig["caption"])} <a href="{html.escape(fig["pdf"])}">PDF</a><br>'
-            f"<code>{html.escape(fig['command'])}</code></figcaption></figure>"
-        )
-    parts.append(
-        '<h2>Table</h2><p>Data: <a href="table.parquet">table.parquet</a>, <a href="table.csv">table.csv</a>, '
-        '<a href="study.json">study.json</a>; each point\'s run (state.nc, events.parquet) in its '
-        "directory under the runs folder.</p><table><thead><tr>"
-    )
+        damaged = [f"{r.point_dir}: {r.note}" for r in table.itertuples() if isinstance(r.note, str)]
     cols = [c for c in TABLE_COLUMNS[spec.name] if c in table.columns] + ["status", "error"]
-    parts.append("".join(f"<th>{html.escape(c)}</th>" for c in cols) + "</tr></thead><tbody>")
-    for row in table.itertuples(index=False):
-        r = row._asdict()
-        cls = ' class="failed"' if r.get("status") != "ok" else ""
-        parts.append(f"<tr{cls}>" + "".join(f"<td>{_cell(r.get(c))}</td>" for c in cols) + "</tr>")
-    parts.append("</tbody></table></body></html>\n")
-    io.write_bytes(path, "\n".join(parts).encode("utf-8"))
+    rows = [{**r, "_class": "failed" if r.get("status") != "ok" else ""} for r in table.to_dict(orient="records")]
+    write_page(
+        path,
+        "study.html.j2",
+        name=spec.name,
+        mode=spec.mode,
+        note=spec.note,
+        meta=meta,
+        damaged=damaged,
+        statements=findings.get("statements", []),
+        figures=[{**fig, "src": image_src(fig["image"], path.parent)} for fig in figures],
+        cols=cols,
+        rows=rows,
+    )
 
 
 # ---------------------------------------------------------------------------------------------
@@ -309,8 +265,6 @@ def _write_page(
 MANIFEST = ".stickslip-study.json"
 #: The files of a study's page besides its figures.
 PAGE_FILES = ("table.parquet", "table.csv", "study.json", "index.html")
-#: What a study's runs folder (runs/<name>-<key>/) holds besides its points folder.
-RUNS_FILES = frozenset({"study-spec.json", "points", "ladders"})
 
 
 def read_manifest(out: Path) -> set[str]:

@@ -42,8 +42,9 @@ import numpy as np
 import pandas as pd
 
 from stickslip import __version__, heartbeat
-from stickslip.experiments.point_cache import read_done as _read_done
-from stickslip.experiments.point_cache import spec_before as _spec_before
+from stickslip.experiments.cache import file_digests
+from stickslip.experiments.cache import read_done as _read_done
+from stickslip.experiments.cache import spec_before as _spec_before
 from stickslip.io import disk_full, run_metadata, write_dataset, write_json, write_table_files
 from stickslip.jsonable import to_jsonable
 from stickslip.models.params import BlockParams, ChainParams
@@ -188,8 +189,6 @@ def _run_point(
         }
         write_json(directory / ERROR_FILE, record)
         return record
-    from stickslip.experiments.point_cache import file_digests
-
     record = {
         "spec": spec,
         "status": "ok",
@@ -289,7 +288,7 @@ def run_sweep(
     (:func:`point_name`). ``common`` holds settings shared by every point (fixed parameters,
     run length); the task receives ``{**common, **point}``. A point whose directory holds a
     ``done.json`` for the same task, point, common settings and package version is not run
-    again, unless its files are damaged (:mod:`stickslip.experiments.point_cache`: then it runs
+    again, unless its files are damaged (:mod:`stickslip.experiments.cache`: then it runs
     again and its row's ``note`` says why). Points run on a new local cluster (``n_workers``
     processes, default one per core, one thread each) or, with ``scheduler`` = address, on an
     existing cluster. Progress (points done / total, time left) goes to stderr. Writes

@@ -19,8 +19,6 @@ figures, ``study.json``, ``index.html``).
 
 from __future__ import annotations
 
-import hashlib
-import json
 import math
 import os
 import time
@@ -33,6 +31,7 @@ import pandas as pd
 
 from stickslip import __version__, io
 from stickslip.analysis.adaptive import STOP_BATCHES
+from stickslip.experiments.cache import spec_key
 from stickslip.experiments.study_run import PAGE_FILES, record_outputs
 from stickslip.experiments.transition_page import PER_N_COLUMNS, ROW_COLUMNS, write_page
 
@@ -112,8 +111,8 @@ def study_folder(mode: str, extra_Ns: tuple[int, ...] = ()) -> SimpleNamespace:
 
 
 def _key(common: dict[str, Any]) -> str:
-    text = json.dumps({"study": "transition-ladders", "common": common, "version": __version__}, sort_keys=True)
-    return hashlib.sha256(text.encode()).hexdigest()[:12]
+    # json's default separators, as when the first runs were written: their folders keep their names
+    return spec_key({"study": "transition-ladders", "common": common, "version": __version__}, separators=(", ", ": "))
 
 
 def _replica_edge(up: pd.DataFrame) -> dict[str, Any] | None:

@@ -168,10 +168,6 @@ class BlockParams(_Validated):
         """The static threshold as a :class:`~stickslip.models.pieces.Piece`."""
         return piece("threshold", self.threshold)
 
-    def scaled(self) -> BlockParams:
-        """The same system in the units M = sigma = 1 of section 2 (see :func:`scale_block`)."""
-        return scale_block(self)
-
 
 def scale_block(p: BlockParams) -> BlockParams:
     """Rescale eq. (1) to M = sigma = 1 (section 2 of the paper).

@@ -106,11 +106,6 @@ def chain_steady_profile_paper(p: ChainParams, t: float = 0.0) -> np.ndarray:
     return p.V * t - c / p.K * (p.N**2 - (i - p.N) ** 2) / 2.0
 
 
-def chain_steady_length_paper(p: ChainParams) -> float:
-    """The paper's L = {1 - (1 - beta) V} N^2 / 2 as printed (it lacks the factor 1/K; docs/model.md)."""
-    return sliding_friction(p.V, p.beta) * p.N**2 / 2.0
-
-
 def loading_time(p: ChainParams) -> float:
     """Time the end drive takes to stretch the chain to its steady length from x_i = 0: L_ss / V.
 

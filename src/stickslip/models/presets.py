@@ -8,7 +8,6 @@ same way by overriding the pieces. Adding a model means adding an entry here.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -161,17 +160,6 @@ def chain_params(model: str = "sakaguchi", **overrides: Any):
         values["V"] = overrides.pop("nu")
     values.update(overrides)
     return ChainParams(model=model, **values)
-
-
-def model_symbols(p) -> dict[str, float]:
-    """The parameters in the model's own symbols where they differ (l and nu of CL)."""
-    pr = PRESETS[p.model]
-    out: dict[str, float] = {}
-    if "l" in pr.symbols:
-        out["l"] = math.sqrt(p.K)
-    if "nu" in pr.symbols:
-        out["nu"] = p.V
-    return out
 
 
 # Presets that are a single block of eq. (1): their chain form has N = 1, the end drive, state

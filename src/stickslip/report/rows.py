@@ -139,7 +139,7 @@ def _section2_rows(o: dict[str, Outcome]) -> list[ReportRow]:
             f"{100 * ps['max_abs_rel_dev']:.1f}% of it for V in [1e-3, 1e-1]",
             ok,
             "|a - 1.035| <= dt, |b - 3.432| <= 0.0005, simulated periods within 3% of the law",
-            "stickslip slip-limit --json; stickslip block --fig3 --out DIR",
+            "stickslip slip-limit --json && stickslip block --fig3 --out DIR",
         )
     )
     cm = o["chain-modes"].summary

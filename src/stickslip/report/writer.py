@@ -10,7 +10,6 @@ claiming agreement or disagreement.
 
 from __future__ import annotations
 
-import base64
 import datetime as _dt
 import math
 from collections.abc import Iterable, Mapping
@@ -18,11 +17,10 @@ from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
-import jinja2
-
 from stickslip import __version__
-from stickslip.io import read_json, write_bytes, write_json
+from stickslip.io import read_json, write_json
 from stickslip.jsonable import to_jsonable
+from stickslip.pages import image_src, write_page
 
 __all__ = ["ReportRow", "ReportFigure", "Report", "write_report", "read_report", "agreement_text"]
 
@@ -159,7 +157,7 @@ def write_report(
     )
     json_path = write_json(out / "report.json", report.to_dict())
     html_path = out / "report.html"
-    write_bytes(html_path, render_html(report, out, embed=embed, title=title).encode("utf-8"))
+    write_page(html_path, "report.html.j2", **_page_context(report, out, embed=embed, title=title))
     return {"json": json_path, "html": html_path}
 
 
@@ -172,7 +170,7 @@ def read_report(path: str | Path) -> Report:
 
 
 # ---------------------------------------------------------------------------------------------
-# HTML: templates/report.html.j2, rendered by jinja2 with autoescape on
+# HTML: stickslip/templates/report.html.j2 (see stickslip.pages)
 
 
 def _format_value(value: Any) -> str:
@@ -191,33 +189,14 @@ def _agreement_class(agrees: bool | None) -> str:
     return "na" if agrees is None else ("yes" if agrees else "no")
 
 
-def _image_src(image: str, out: Path, embed: bool) -> str:
-    path = out / image
-    if embed and path.is_file() and path.suffix.lower() == ".png":
-        encoded = base64.b64encode(path.read_bytes()).decode("ascii")
-        return f"data:image/png;base64,{encoded}"
-    return image
-
-
 def _json_text(value: Any) -> str:
     import json
 
     return json.dumps(to_jsonable(value), allow_nan=False)
 
 
-def _templates() -> jinja2.Environment:
-    """The report's templates (package data), every value escaped."""
-    return jinja2.Environment(
-        loader=jinja2.PackageLoader("stickslip.report", "templates"),
-        autoescape=True,
-        keep_trailing_newline=True,
-        undefined=jinja2.StrictUndefined,
-    )
-
-
-def render_html(report: Report, out_dir: str | Path, *, embed: bool = True, title: str = "Report") -> str:
-    """The report as one HTML page (no scripts, no external resources when ``embed``)."""
-    out = Path(out_dir)
+def _page_context(report: Report, out: Path, *, embed: bool, title: str) -> dict[str, Any]:
+    """What report.html.j2 shows: the meta list, the verdict line, the rows and the figures."""
     counts = {"yes": 0, "no": 0, "na": 0}
     for row in report.rows:
         counts[_agreement_class(row.agrees)] += 1
@@ -245,7 +224,7 @@ def render_html(report: Report, out_dir: str | Path, *, embed: bool = True, titl
         links += [{"href": d, "text": Path(d).name} for d in fig.data]
         figures.append(
             {
-                "src": _image_src(fig.image, out, embed),
+                "src": image_src(fig.image, out, embed),
                 "figure": fig.figure,
                 "caption": fig.caption,
                 "links": links,
@@ -253,8 +232,4 @@ def render_html(report: Report, out_dir: str | Path, *, embed: bool = True, titl
             }
         )
     head = ("where", "quantity", "paper", "this run", "agreement", "command")
-    return (
-        _templates()
-        .get_template("report.html.j2")
-        .render(title=title, meta=meta, verdict=verdict, head=head, rows=rows, figures=figures)
-    )
+    return {"title": title, "meta": meta, "verdict": verdict, "head": head, "rows": rows, "figures": figures}

@@ -1,0 +1,144 @@
+"""How an experiment is described and cached, for ``reproduce``, sweeps and studies alike.
+
+An experiment (an :class:`~stickslip.experiments.specs.Experiment` of ``reproduce``, a
+:class:`~stickslip.experiments.studies.Study`, one point of a sweep) is a *spec*: a plain JSON
+document of everything its result depends on, the package version included.
+
+- :func:`canonical` puts a spec in one form (sorted keys, tuples as lists, whole floats as ints),
+  so ``K = 10`` and ``K = 10.0`` are the same spec;
+- :func:`spec_key` names it: the first 12 hex digits of the SHA-256 of its JSON text, the stem of
+  its run directory (``<name>-<key>``);
+- :func:`read_record` gives a stored result (``result.json`` of ``reproduce``, ``done.json`` of a
+  sweep's point) only if it was made from the same spec: anything else is computed again;
+- a finished point of a sweep records the checksum of every file it wrote
+  (:func:`file_digests`); it is reused only if its summary is there and every file matches
+  (:func:`damage`, :func:`read_done`), otherwise it runs again and the table and the study's page
+  say why; :func:`spec_before` tells whether an interrupted point's checkpoint was made from the
+  same spec and may be continued.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from pathlib import Path
+from typing import Any
+
+from stickslip.io import read_json
+from stickslip.jsonable import to_jsonable
+
+__all__ = ["canonical", "spec_key", "read_record", "read_done", "spec_before", "file_digests", "damage"]
+
+#: The separators of :func:`spec_key`'s JSON text: compact, as ``reproduce`` and the studies use.
+COMPACT = (",", ":")
+
+
+def canonical(value: Any) -> Any:
+    """A JSON round trip with sorted keys: tuples become lists, whole floats become ints.
+
+    So ``K = 10`` and ``K = 10.0``, or ``(0.5, 1.0)`` and ``[0.5, 1]``, give the same spec.
+    """
+
+    def whole(v: Any) -> Any:
+        if isinstance(v, dict):
+            return {k: whole(x) for k, x in v.items()}
+        if isinstance(v, list):
+            return [whole(x) for x in v]
+        if isinstance(v, float) and v.is_integer() and abs(v) < 2**53:
+            return int(v)
+        return v
+
+    return whole(json.loads(json.dumps(to_jsonable(value), sort_keys=True)))
+
+
+def spec_key(spec: dict[str, Any], *, separators: tuple[str, str] = COMPACT) -> str:
+    """First 12 hex digits of the SHA-256 of ``spec`` as JSON with sorted keys.
+
+    ``separators`` are json's; a run directory named with other separators keeps its name only if
+    its key is computed with the same ones (the transition study's use json's default).
+    """
+    text = json.dumps(spec, sort_keys=True, separators=separators)
+    return hashlib.sha256(text.encode()).hexdigest()[:12]
+
+
+def read_record(path: str | Path, spec: dict[str, Any]) -> dict[str, Any] | None:
+    """The JSON record stored at ``path`` if it is there, readable and made from ``spec`` (its
+    ``"spec"`` field equal to it), else None."""
+    try:
+        record = read_json(path)
+    except (OSError, ValueError):
+        return None
+    return record if isinstance(record, dict) and record.get("spec") == spec else None
+
+
+#: Files of a point's folder that are not part of its result (the sweep's own bookkeeping).
+BOOKKEEPING = frozenset({"done.json", "error.json", "point.json"})
+
+
+def read_done(point_dir: Path, spec: dict[str, Any]) -> tuple[dict[str, Any] | None, str | None]:
+    """The stored record of a finished point with this spec, or None; and why a record of this
+    spec is not reused (its files damaged, :func:`damage`)."""
+    path = point_dir / "done.json"
+    if not path.is_file():
+        return None, None
+    try:
+        record = read_json(path)
+    except (OSError, ValueError):
+        return None, "done.json is unreadable"
+    if not isinstance(record, dict) or record.get("spec") != spec:
+        return None, None
+    reason = damage(point_dir, record)
+    return (None, reason) if reason else (record, None)
+
+
+def spec_before(point_dir: Path) -> dict[str, Any] | None:
+    """The spec in the point's point.json (that of the sweep that last ran it), or None."""
+    try:
+        record = read_json(point_dir / "point.json")
+    except (OSError, ValueError):
+        return None
+    return record.get("spec") if isinstance(record, dict) else None
+
+
+def _sha256(path: Path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def file_digests(point_dir: str | Path) -> dict[str, str]:
+    """SHA-256 of every file under ``point_dir`` (relative paths with ``/``), the sweep's
+    bookkeeping and files of killed writes left out."""
+    from stickslip.run.rundir import LOCK_FILES, is_temporary
+
+    root = Path(point_dir)
+    digests = {}
+    for path in sorted(root.rglob("*")):
+        rel = path.relative_to(root).as_posix()
+        if not path.is_file() or rel in BOOKKEEPING or path.name in LOCK_FILES or is_temporary(path.name):
+            continue
+        digests[rel] = _sha256(path)
+    return digests
+
+
+def damage(point_dir: str | Path, record: dict[str, Any]) -> str | None:
+    """Why the finished point in ``point_dir`` (its done.json ``record``) cannot be reused, or None
+    when its summary is there and every file it recorded is present with its checksum."""
+    summary, files = record.get("summary"), record.get("files")
+    if not isinstance(summary, dict):
+        return "its summary is missing"
+    if not isinstance(files, dict):
+        return "it records no checksums of its files"
+    root = Path(point_dir)
+    for rel, digest in sorted(files.items()):
+        path = root / rel
+        if not path.is_file():
+            return f"{rel} is missing"
+        try:
+            if _sha256(path) != digest:
+                return f"{rel} does not match its checksum"
+        except OSError as exc:
+            return f"{rel} cannot be read ({exc.strerror})"
+    return None

@@ -1,0 +1,83 @@
+"""Spec hashing and the cache store shared by ``reproduce``, sweeps and studies.
+
+The keys are checked against SHA-256 of JSON text written out here by hand: a run directory's
+name is what lets a later command find and reuse its results, so it must not move.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+
+import pytest
+
+from stickslip import __version__
+from stickslip.experiments.cache import canonical, read_record, spec_key
+from stickslip.experiments.specs import Experiment
+from stickslip.experiments.studies import Study
+from stickslip.experiments.transition_study import ladder_points, study_folder
+
+
+def _sha12(text: str) -> str:
+    return hashlib.sha256(text.encode()).hexdigest()[:12]
+
+
+def test_canonical_form_of_a_spec():
+    assert canonical({"b": (0.5, 1.0), "a": 10.0, "c": {"z": 2.5, "y": True}}) == {
+        "a": 10,
+        "b": [0.5, 1],
+        "c": {"y": True, "z": 2.5},
+    }
+    assert list(canonical({"b": 1, "a": 2})) == ["a", "b"]
+
+
+def test_spec_key_is_the_sha256_of_compact_sorted_json():
+    assert spec_key({"b": [1, 2], "a": "x"}) == _sha12('{"a":"x","b":[1,2]}')
+    assert spec_key({"b": [1, 2], "a": "x"}, separators=(", ", ": ")) == _sha12('{"a": "x", "b": [1, 2]}')
+
+
+def test_experiment_key_leaves_out_its_points():
+    exp = Experiment(
+        "chain-runs", "chain_runs", params={"K": 10.0, "beta": 0.5}, t_end=2e6, options={"points": [1], "w": (1, 2)}
+    )
+    text = (
+        '{"kind":"chain_runs","options":{"w":[1,2]},"params":{"K":10,"beta":0.5},"t_end":2000000,'
+        f'"version":"{__version__}"}}'
+    )
+    assert exp.key() == _sha12(text) and exp.dirname == f"chain-runs-{_sha12(text)}"
+    assert (
+        Experiment("chain-runs", "chain_runs", params={"K": 10, "beta": 0.5}, t_end=2e6, options={"w": [1, 2]}).key()
+        == exp.key()
+    )
+
+
+def test_study_key_leaves_out_its_points():
+    spec = Study("exponents", "quick", common={"N": 199, "K": 10.0}, points=({"beta": 0.2},))
+    text = f'{{"common":{{"K":10,"N":199}},"study":"exponents","version":"{__version__}"}}'
+    assert spec.key() == _sha12(text)
+    assert Study("exponents", "full", common={"K": 10, "N": 199}).dirname == f"exponents-{_sha12(text)}"
+
+
+def test_transition_folder_keeps_the_name_its_first_runs_were_written_under():
+    common, _ = ladder_points("tiny")
+    text = json.dumps({"study": "transition-ladders", "common": common, "version": __version__}, sort_keys=True)
+    assert ", " in text  # json's default separators
+    assert study_folder("tiny").dirname == f"transition-{_sha12(text)}"
+
+
+def test_read_record_only_for_the_same_spec(tmp_path):
+    spec = {"kind": "block_run", "version": __version__}
+    path = tmp_path / "result.json"
+    assert read_record(path, spec) is None  # not there
+    path.write_text(json.dumps({"spec": spec, "summary": {"x": 1}}))
+    assert read_record(path, spec) == {"spec": spec, "summary": {"x": 1}}
+    assert read_record(path, {**spec, "version": "other"}) is None
+    path.write_text('{"spec": ')
+    assert read_record(path, spec) is None  # unreadable
+    path.write_text("[1, 2]")
+    assert read_record(path, spec) is None
+
+
+@pytest.mark.parametrize("value", [1.5, 2**53 + 2.0])
+def test_canonical_keeps_floats_that_are_not_small_whole_numbers(value):
+    assert canonical({"x": value})["x"] == value and isinstance(canonical({"x": value})["x"], float)
