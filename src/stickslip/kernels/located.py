@@ -58,7 +58,7 @@ EVF_SIZE = 2
 DONE, EVENTS_FULL, NONFINITE = 0, 1, 2
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _ghosts(u, th, N, t, V, drive, ends):
     """Ghost cells 0 and N + 1 of u = x - V t and theta (docs/model.md, the ends)."""
     if drive == DRIVE_END:
@@ -79,7 +79,7 @@ def _ghosts(u, th, N, t, V, drive, ends):
         th[N + 1] = th[N]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _force(u, i, par, drive):
     """Spring force on block i (eq. 4), plus -Kp u_i from the plate with the plate drive."""
     f = par[P_K] * ((u[i - 1] - u[i]) - (u[i] - u[i + 1]))
@@ -88,7 +88,7 @@ def _force(u, i, par, drive):
     return f
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _friction(v, th, par, friction):
     """Friction of a moving block: theta + beta v, phi(v) (CL) or F0 + beta v."""
     if friction == FRICTION_WEAKENING:
@@ -99,14 +99,14 @@ def _friction(v, th, par, friction):
     return th + par[P_BETA] * v
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _gap(u, th, i, par, drive, threshold):
     """g_i = f_i - threshold_i: a stuck block starts where it turns positive."""
     thr = th[i] if threshold == THRESHOLD_STATE else par[P_FS]
     return _force(u, i, par, drive) - thr
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _rates(u, v, th, mov, N, t, par, drive, friction, ends, du, dv, dth):
     """Right-hand side at time t: du = v - V, dv = (f - friction) while moving, dtheta of eq. (4)."""
     V = par[P_V]
@@ -124,7 +124,7 @@ def _rates(u, v, th, mov, N, t, par, drive, friction, ends, du, dv, dth):
             dth[i] = 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _heun(h, t, u, v, th, mov, N, par, drive, friction, ends, sc):
     """One Heun step of length h from (u, v, theta) at t; sc holds the rates k1 at t (given), the
     predictor p*, the rates k2 and the result o*."""

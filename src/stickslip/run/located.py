@@ -107,7 +107,8 @@ class LocatedState:
         return LocatedState(**{k: getattr(self, k).copy() for k in ("u", "v", "th", "mov", "moved", "ist", "evf")})
 
 
-def _par(p: ChainParams) -> np.ndarray:
+def parameter_vector(p: ChainParams) -> np.ndarray:
+    """The kernel's parameter vector (indices P_* of :mod:`stickslip.kernels.located`)."""
     par = np.zeros(L.PAR_SIZE)
     par[L.P_K], par[L.P_D], par[L.P_V], par[L.P_BETA], par[L.P_ALPHA] = p.K, p.D, p.V, p.beta, p.alpha
     par[L.P_FS], par[L.P_DT], par[L.P_KP], par[L.P_SIGMA], par[L.P_F0] = p.Fs, p.dt, p.Kp, p.sigma, p.F0
@@ -119,7 +120,7 @@ class LocatedStepper:
 
     def __init__(self, params: ChainParams, capacity: int = 4096):
         self.params = params
-        self.par = _par(params)
+        self.par = parameter_vector(params)
         self.codes = params.codes
         N = params.N
         self.sc = tuple(np.zeros(N + 2) for _ in range(12))
@@ -127,8 +128,9 @@ class LocatedStepper:
         self.ev_t = np.zeros((capacity, 3))
         self.ev_i = np.zeros((capacity, 2), dtype=np.int64)
 
-    def advance(self, state: LocatedState, step: int) -> tuple[LocatedState, pd.DataFrame]:
-        """The state at grid ``step`` and the slip events completed on the way (docs/model.md)."""
+    def advance(self, state: LocatedState, step: int) -> tuple[LocatedState, np.ndarray]:
+        """The state at grid ``step`` and the slip events completed on the way (docs/model.md),
+        one row (columns :data:`EVENT_COLUMNS`) per event; :func:`events_frame` labels them."""
         if state.N != self.params.N:
             raise ParameterError(f"the state has {state.N} blocks, the parameters N = {self.params.N}")
         drive, friction, threshold, ends = self.codes
@@ -161,10 +163,16 @@ class LocatedStepper:
                 raise FloatingPointError(f"the located integrator met a non-finite value at step {state.step}")
             if status == L.DONE:
                 break
-        rows = np.concatenate(parts) if parts else np.zeros((0, 5))
-        ev = pd.DataFrame(rows, columns=EVENT_COLUMNS)
-        ev[["start_block", "n_blocks"]] = ev[["start_block", "n_blocks"]].astype(np.int64)
-        return state, ev
+        if len(parts) == 1:
+            return state, parts[0]
+        return state, (np.concatenate(parts) if parts else np.zeros((0, len(EVENT_COLUMNS))))
+
+
+def events_frame(rows: np.ndarray) -> pd.DataFrame:
+    """Event rows of :meth:`LocatedStepper.advance` as a table (times and sizes, block numbers)."""
+    ev = pd.DataFrame(rows, columns=EVENT_COLUMNS)
+    ev[["start_block", "n_blocks"]] = ev[["start_block", "n_blocks"]].astype(np.int64)
+    return ev
 
 
 @dataclass(frozen=True)
@@ -208,4 +216,4 @@ def run_located(
     state = start_state(params, start, perturbation=perturbation, seed=seed)
     n_end = steps_for(t_end, params.dt)
     state, events = LocatedStepper(params).advance(state, n_end)
-    return LocatedRun(params, state, events)
+    return LocatedRun(params, state, events_frame(events))
