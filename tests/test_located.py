@@ -158,3 +158,20 @@ def test_events_and_state_bookkeeping():
     ev = run.events
     assert list(ev["start_block"]) == [1] * len(ev) and list(ev["n_blocks"]) == [1] * len(ev)
     assert np.all(np.diff(ev["t_start"]) > 0) and np.all(ev["t_end"] > ev["t_start"])
+
+
+def test_restarting_the_clock_changes_nothing_in_the_frame_of_the_drive():
+    from stickslip.models.params import ParameterError
+    from stickslip.run.driver import run_chain
+
+    p = chain_params("sakaguchi", N=6, V=0.1)
+    engine = run_chain(p, 200.0).state
+    kept = LocatedState.from_chain_state(engine, p)
+    restarted = LocatedState.from_chain_state(engine, p, restart_clock=True)
+    assert kept.step == engine.step and restarted.step == 0
+    a = run_located(p, 300.0, start=kept).state.blocks(p)
+    b = run_located(p, 100.0, start=restarted).state.blocks(p)
+    for k in ("u", "v", "theta", "stopped"):
+        assert np.array_equal(a[k], b[k])
+    with pytest.raises(ParameterError, match="fixed ends"):
+        LocatedState.from_chain_state(engine, p.replace(ends="fixed"), restart_clock=True)

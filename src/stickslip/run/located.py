@@ -86,11 +86,24 @@ class LocatedState:
         return cls(mov=mov, moved=moved, ist=ist, evf=evf, **arrays)
 
     @classmethod
-    def from_chain_state(cls, state: ChainState, params: ChainParams) -> LocatedState:
-        """The engine's state (absolute positions x at step n) in the located integrator's frame."""
+    def from_chain_state(
+        cls, state: ChainState, params: ChainParams, *, restart_clock: bool = False, dt: float | None = None
+    ) -> LocatedState:
+        """The engine's state (absolute positions x at step n of ``dt``, default params.dt) in the
+        located integrator's frame, u = x - V t.
+
+        With ``restart_clock`` the state is put at t = 0 (step 0): in the frame of the drive the
+        equations do not read t, so the continuation is the same, and runs at any dt can start
+        from it. Fixed ends read t (x_{N+1} = 0), so they refuse it.
+        """
         b = state.blocks()
-        t = state.step * params.dt
-        return cls.from_blocks(b["x"] - params.V * t, b["v"], b["theta"], b["stopped"], state.step, t)
+        t = state.step * (params.dt if dt is None else dt)
+        u = b["x"] - params.V * t
+        if restart_clock:
+            if params.ends_piece.wall:
+                raise ParameterError("restart_clock needs ends that do not read t (fixed ends do)")
+            return cls.from_blocks(u, b["v"], b["theta"], b["stopped"], 0, 0.0)
+        return cls.from_blocks(u, b["v"], b["theta"], b["stopped"], state.step, t)
 
     def blocks(self, params: ChainParams) -> dict[str, np.ndarray]:
         """Per-block copies: x = u + V t, u, v, theta and stopped, block i at index i - 1."""
