@@ -2,7 +2,9 @@
 
 Benettin et al. (1980) two-trajectory method (:mod:`stickslip.analysis.lyapunov`). ``--convergence``
 tabulates the exponent against d0, the renormalisation interval and the run length;
-``--betas`` tabulates it against beta, and ``--plot FILE`` draws that table.
+``--betas`` tabulates it against beta, and ``--plot FILE`` draws that table. ``--switches located``
+measures the exponent of the flow instead (:mod:`stickslip.analysis.lyapunov_flow`): located
+switches, the time-shift direction removed, at dt, dt/2, dt/4 and extrapolated to dt -> 0.
 """
 
 from __future__ import annotations
@@ -93,6 +95,35 @@ def register(sub) -> None:
         metavar="FILE",
         help="with --betas: draw lambda(beta) as FILE.png and FILE.pdf (a suffix .png or .pdf is dropped)",
     )
+    p.add_argument(
+        "--switches",
+        choices=("grid", "located"),
+        default="grid",
+        help="grid: the engine's map, starts and stops on the time grid (default); located: the flow, "
+        "switches located inside the step, at dt, dt/2, dt/4 extrapolated to dt -> 0",
+    )
+    p.add_argument(
+        "--neutral",
+        choices=("remove", "keep"),
+        default="remove",
+        help="with --switches located: remove the separation's component along the flow (a shift in "
+        "time, neutral) before measuring and renormalising (default), or keep it",
+    )
+    p.add_argument(
+        "--levels", type=int, default=3, metavar="L", help="with --switches located: rungs dt .. dt/2^(L-1) (default 3)"
+    )
+    p.add_argument(
+        "--finite-size",
+        action="store_true",
+        help="with --switches located: finite-size exponents, the mean time for a separation to grow "
+        "from delta to 2 delta, delta from --delta-min to --delta-max (JSON key fsle)",
+    )
+    p.add_argument("--delta-min", type=float_arg("delta-min"), default=1e-10, metavar="D", help="(default 1e-10)")
+    p.add_argument("--delta-max", type=float_arg("delta-max"), default=0.1, metavar="D", help="(default 0.1)")
+    p.add_argument("--cycles", type=int, default=20, metavar="C", help="finite-size cycles counted (default 20)")
+    p.add_argument(
+        "--check", type=float_arg("check"), default=0.1, metavar="TAU", help="finite-size: time between distance checks"
+    )
     p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     add_json_option(p)
     p.set_defaults(handler=run_lyapunov_command)
@@ -162,6 +193,10 @@ def run_lyapunov_command(args: argparse.Namespace) -> Result:
     )
     # Validate every option before the first (possibly long) run.
     ly._check_run(params, args.t_end, args.interval, args.d0, args.transient, args.align, args.segments)
+    if args.switches == "located":
+        return _located(params, args, kw)
+    if args.finite_size:
+        raise CommandError("--finite-size goes with --switches located")
     if args.convergence:
         table = ly.lyapunov_convergence(params, args.t_end, **kw)
         data = {
@@ -212,3 +247,59 @@ def run_lyapunov_command(args: argparse.Namespace) -> Result:
             "try a larger --d0\n"
         )
     return Result(data, _result_text(data))
+
+
+def _ladder_text(d: dict) -> str:
+    lines = [f"{'dt':>10} {'lyapunov':>12} {'err':>9} {'renorm':>7} {'events':>7} {'wall s':>7}"]
+    for r in d["ladder"]:
+        lines.append(
+            f"{r['dt']:>10.6g} {r['lyapunov']:>12.6g} {r['lyapunov_err']:>9.2g} {r['renormalisations']:>7d} "
+            f"{r['events']:>7d} {r['wall_seconds']:>7.3g}"
+        )
+    lines.append(
+        f"dt -> 0      {d['lyapunov_dt0']:.6g} +- {d['lyapunov_dt0_err']:.2g}   (per unit time; {d['extrapolation']})"
+    )
+    lines.append(f"neutral      {d['neutral']} (the time-shift direction along the flow)")
+    return "\n".join(lines)
+
+
+def _located(params, args, kw) -> Result:
+    """`--switches located`: the ladder of :func:`stickslip.analysis.lyapunov_flow.flow_ladder`."""
+    from stickslip.analysis.lyapunov_flow import flow_ladder
+
+    if args.convergence or args.betas is not None:
+        raise CommandError("--switches located runs one ladder; --convergence and --betas go with --switches grid")
+    if args.finite_size:
+        return _finite_size(params, args)
+    check_number("levels", args.levels, low=2, high=6, integer=True)
+    ladder = flow_ladder(params, args.t_end, levels=args.levels, neutral=args.neutral, **kw)
+    data = ladder.to_dict()
+    return Result(data, _ladder_text(data))
+
+
+def _finite_size(params, args) -> Result:
+    """`--switches located --finite-size`: :func:`stickslip.analysis.fsle.finite_size_exponents`."""
+    from stickslip.analysis.fsle import LocatedPair, finite_size_exponents, thresholds
+    from stickslip.models.params import steps_for
+    from stickslip.run.located import LocatedStepper, start_state
+
+    deltas = thresholds(args.delta_min, args.delta_max)
+    check_number("cycles", args.cycles, low=1, integer=True)
+    check = max(1, int(round(check_number("check", args.check, low=params.dt) / params.dt)))
+    ref = start_state(params, args.start, perturbation=args.perturbation, seed=args.seed)
+    ref, _ = LocatedStepper(params).advance(ref, steps_for(args.transient, params.dt))
+    pair = LocatedPair(params, ref, neutral=args.neutral, direction_seed=args.direction_seed)
+    res = finite_size_exponents(
+        pair, deltas, cycles=args.cycles, check_steps=check, max_cycle_time=args.t_end, pooled_below=1e-6
+    )
+    data = {"params": params.to_dict(), "switches": "located", "neutral": args.neutral, "transient": args.transient}
+    data.update(res.to_dict())
+    lines = [f"{'delta':>10} {'rate':>10} {'err':>9} {'cycles':>6}"]
+    for r in res.rows:
+        lines.append(f"{r['delta']:>10.3g} {r['rate']:>10.4g} {r['rate_err']:>9.2g} {r['cycles']:>6d}")
+    if "pooled_rate" in res.extra:
+        e = res.extra
+        lines.append(f"pooled up to {e['pooled_below']:.3g}: {e['pooled_rate']:.4g} +- {e['pooled_rate_err']:.2g}")
+    if res.unfinished:
+        lines.append(f"{res.unfinished} cycles did not reach {deltas[-1]:g} within t = {args.t_end:g}")
+    return Result(data, "\n".join(lines))

@@ -87,6 +87,9 @@ class Piece:
     steady_sliding: bool = True
     #: ends: the chain closes into a ring (x_0 = x_N, x_{N+1} = x_1)
     ring: bool = False
+    #: ends: a spring to a wall at x = 0, which moves at -V in the frame of the drive, so the
+    #: equations read t there (the other ends leave them autonomous in that frame)
+    wall: bool = False
 
     @property
     def code(self) -> int:
@@ -143,7 +146,7 @@ PIECES: dict[str, tuple[Piece, ...]] = {
     ),
     "ends": (
         Piece("ends", "free", "x_{N+1} = x_N (plate drive: also x_0 = x_1)"),
-        Piece("ends", "fixed", "x_{N+1} = 0 (plate drive: also x_0 = 0)", steady_sliding=False),
+        Piece("ends", "fixed", "x_{N+1} = 0 (plate drive: also x_0 = 0)", steady_sliding=False, wall=True),
         Piece("ends", "periodic", "x_0 = x_N, x_{N+1} = x_1 (plate drive only)", ring=True),
     ),
 }

@@ -1,0 +1,375 @@
+"""The largest Lyapunov exponent of the flow: the equations with switches, dt -> 0.
+
+:mod:`stickslip.analysis.lyapunov` measures the exponent of the gridded map the engine integrates
+(starts tested at the beginning of a step, stops at its end, docs/model.md). Here the same
+two-trajectory method (Benettin, Galgani, Giorgilli and Strelcyn, Meccanica 15, 9, 1980) runs on
+the integrator with located switches (:mod:`stickslip.run.located`): reference and twin each
+start and stop their blocks at the times their own forces and velocities say, so a perturbation
+that shifts a switch is carried across it as the saltation of the flow carries it (no tangent
+equations and no saltation matrices are formed: the two trajectories are the method). The
+exponent is measured at dt, dt/2, dt/4 and extrapolated to dt -> 0 (:func:`flow_ladder`).
+
+Separation. As in the gridded method, y = (sqrt(K) e_i, v_i, theta_i) with e_i = u_{i-1} - u_i,
+u = x - V t and u_0 = 0 (end drive), or y = (sqrt(Kp) u_i, v_i, theta_i) (plate drive); theta
+counts only for the state friction. Positions relative to the drive keep their precision however
+long the run.
+
+The neutral direction. In the frame of the drive the equations are autonomous (fixed ends
+apart), so a perturbation along the flow, F(y), is a shift in time: it neither grows nor decays
+on average, and it makes d swing with |F| between sticking (|F| ~ V) and slipping (|F| ~ 1).
+With ``neutral='remove'`` (the default) the separation is measured and renormalised after its
+component along F(y_ref) is removed: d is the distance of the twin from the reference's orbit,
+not from the reference's point. The exponent is then the largest one transverse to the flow; the
+flow's own spectrum adds the zero of the time shift, so the largest exponent of the flow is
+max(0, lambda) on an attractor other than a fixed point. A periodic orbit gives lambda < 0,
+a chaotic attractor lambda > 0. Near a fixed point (steady sliding) F(y) -> 0 and its direction
+carries no time shift; the removal is skipped where |F| < ``flow_floor``.
+
+Renormalisation waits until both trajectories have the same blocks stuck (at most
+``max_wait`` steps past the planned time), so the twin is always rebuilt on the reference's
+branch: its stuck blocks have v = 0 and the separation no velocity on them.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from stickslip.analysis.lyapunov import _check_run, _estimate
+from stickslip.kernels import located as L
+from stickslip.models.params import ChainParams, ParameterError, check_number, steps_for
+from stickslip.run.located import LocatedState, LocatedStepper, parameter_vector, start_state
+from stickslip.run.state import ChainState
+
+NORM = "Euclidean norm of (sqrt(K) e_i, v_i, theta_i), e_i = u_{i-1} - u_i, u = x - V t, u_0 = 0"
+NEUTRAL = ("remove", "keep")
+METHOD = (
+    "Benettin et al. (1980) two-trajectory method on Heun with located switches "
+    "(each trajectory locates its own starts and stops)"
+)
+
+
+@dataclass(frozen=True)
+class FlowLyapunovResult:
+    """The largest exponent of the flow at one dt (two trajectories, located switches).
+
+    As :class:`stickslip.analysis.lyapunov.LyapunovResult`; ``neutral`` says whether the time
+    shift was removed, ``waits`` counts renormalisations delayed until the stuck blocks agreed.
+    """
+
+    lyapunov: float
+    lyapunov_err: float
+    dt: float
+    t_end: float
+    transient: float
+    align: float
+    interval: float
+    d0: float
+    renormalisations: int
+    segments: int
+    segment_means: tuple[float, ...]
+    events: int
+    neutral: str
+    waits: int
+    wall_seconds: float
+    params: ChainParams
+    start: str
+    times: np.ndarray = field(repr=False)
+    log_growth: np.ndarray = field(repr=False)
+    durations: np.ndarray = field(repr=False)
+    counted: np.ndarray = field(repr=False)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Scalars, parameters and method as a plain dict for JSON."""
+        return {
+            "lyapunov": self.lyapunov,
+            "lyapunov_err": self.lyapunov_err,
+            "dt": self.dt,
+            "t_end": self.t_end,
+            "transient": self.transient,
+            "align": self.align,
+            "interval": self.interval,
+            "d0": self.d0,
+            "renormalisations": self.renormalisations,
+            "segments": self.segments,
+            "segment_means": list(self.segment_means),
+            "events": self.events,
+            "neutral": self.neutral,
+            "waits": self.waits,
+            "wall_seconds": self.wall_seconds,
+            "params": self.params.to_dict(),
+            "start": self.start,
+            "method": METHOD,
+            "norm": NORM,
+        }
+
+
+def separation(ref: LocatedState, twin: LocatedState, params: ChainParams) -> np.ndarray:
+    """twin - ref in y coordinates (module docstring), length 3N."""
+    du = twin.u[1:-1] - ref.u[1:-1]
+    dv = twin.v[1:-1] - ref.v[1:-1]
+    dth = twin.th[1:-1] - ref.th[1:-1]
+    if not params.friction_piece.has_state:
+        dth = np.zeros_like(dth)
+    if params.drive_piece.leaf_spring:
+        return np.concatenate((math.sqrt(params.Kp) * du, dv, dth))
+    de = np.concatenate(([0.0], du[:-1])) - du
+    return np.concatenate((math.sqrt(params.K) * de, dv, dth))
+
+
+def flow_direction(state: LocatedState, params: ChainParams) -> np.ndarray:
+    """F(y) = dy/dt at ``state`` in y coordinates: the direction of a shift in time."""
+    N = state.N
+    du, dv, dth = np.zeros(N + 2), np.zeros(N + 2), np.zeros(N + 2)
+    drive, friction, _, ends = params.codes
+    t = state.step * params.dt
+    par = parameter_vector(params)
+    L.rates(state.u.copy(), state.v, state.th.copy(), state.mov, t, par, drive, friction, ends, du, dv, dth)
+    fth = dth[1:-1] if params.friction_piece.has_state else np.zeros(N)
+    if params.drive_piece.leaf_spring:
+        return np.concatenate((math.sqrt(params.Kp) * du[1:-1], dv[1:-1], fth))
+    fe = np.concatenate(([0.0], du[1:-2])) - du[1:-1]
+    return np.concatenate((math.sqrt(params.K) * fe, dv[1:-1], fth))
+
+
+def remove_flow(dy: np.ndarray, flow: np.ndarray, floor: float) -> np.ndarray:
+    """dy less its component along ``flow`` (left as it is where |flow| < floor)."""
+    norm = float(np.linalg.norm(flow))
+    if not norm > floor:
+        return dy
+    f = flow / norm
+    return dy - float(np.dot(dy, f)) * f
+
+
+def _on_branch(dy: np.ndarray, stopped: np.ndarray, params: ChainParams) -> np.ndarray:
+    """No velocity on the reference's stuck blocks; no theta without a state variable."""
+    N = stopped.shape[0]
+    out = dy.copy()
+    out[N : 2 * N][stopped] = 0.0
+    if not params.friction_piece.has_state:
+        out[2 * N :] = 0.0
+    return out
+
+
+def twin_state(ref: LocatedState, direction: np.ndarray, d0: float, params: ChainParams) -> LocatedState:
+    """ref + d0 * direction (y coordinates), on the reference's branch (same stuck blocks).
+
+    Moving blocks keep v >= 0 (a stop is a switch, not a perturbation).
+    """
+    stopped = ref.stopped
+    N = ref.N
+    u = _on_branch(direction, stopped, params)
+    norm = float(np.linalg.norm(u))
+    if not norm > 0.0:
+        raise ValueError("the separation vanished on the reference's branch; cannot renormalise")
+    u = u * (d0 / norm)
+    if params.drive_piece.leaf_spring:
+        du = u[:N] / math.sqrt(params.Kp)
+    else:
+        du = -np.cumsum(u[:N] / math.sqrt(params.K))
+    twin = ref.copy()
+    twin.u[1:-1] += du
+    twin.v[1:-1] = np.where(stopped, 0.0, np.maximum(ref.v[1:-1] + u[N : 2 * N], 0.0))
+    twin.th[1:-1] += u[2 * N :]
+    return twin
+
+
+def flow_lyapunov(
+    params: ChainParams,
+    t_end: float,
+    *,
+    interval: float = 10.0,
+    d0: float = 1e-10,
+    transient: float = 0.0,
+    align: float | None = None,
+    start: str | ChainState | LocatedState = "paper",
+    perturbation: float = 0.0,
+    seed: int = 0,
+    direction_seed: int = 0,
+    segments: int = 10,
+    neutral: str = "remove",
+    flow_floor: float = 1e-9,
+    max_wait: int | None = None,
+) -> FlowLyapunovResult:
+    """Largest Lyapunov exponent of the equations with switches at the step ``params.dt``.
+
+    The reference runs with located switches (:func:`stickslip.run.located.run_located`) from
+    ``start`` to ``transient``; a twin is placed d0 away in a random direction
+    (``default_rng(direction_seed)``); both advance by ``interval`` (then step by step until they
+    have the same stuck blocks, at most ``max_wait`` steps, default one interval); the separation
+    (less its component along the flow with ``neutral='remove'``, module docstring) gives
+    ln(d / d0) and the twin is put back d0 away along it. Counted and averaged as in
+    :func:`stickslip.analysis.lyapunov.largest_lyapunov`.
+    """
+    t_end, interval, d0, transient, align, segments = _check_run(
+        params, t_end, interval, d0, transient, align, segments
+    )
+    if neutral not in NEUTRAL:
+        raise ParameterError(f"neutral must be one of {', '.join(NEUTRAL)} (got {neutral!r})")
+    dt = params.dt
+    m = int(round(interval / dt))
+    if max_wait is None:
+        max_wait = m
+    n0 = steps_for(transient, dt)
+    n_end = steps_for(t_end, dt)
+    n_count = steps_for(transient + align, dt)
+    wall0 = time.perf_counter()
+    stepper = LocatedStepper(params)
+    ref = start_state(params, start, perturbation=perturbation, seed=seed)
+    ref, _ = stepper.advance(ref, n0)
+    start_name = start if isinstance(start, str) else "state"
+    rng = np.random.default_rng(direction_seed)
+
+    def measured(ref, twin):
+        dy = separation(ref, twin, params)
+        if neutral == "remove":
+            dy = remove_flow(dy, flow_direction(ref, params), flow_floor)
+        return dy
+
+    twin = twin_state(ref, rng.standard_normal(3 * params.N), d0, params)
+    d_start = float(np.linalg.norm(measured(ref, twin)))
+    times, logs, taus = [], [], []
+    events = waits = 0
+    n = ref.step
+    while n < n_end:
+        n_next = min(n + m, n_end)
+        ref, ev = stepper.advance(ref, n_next)
+        twin, _ = stepper.advance(twin, n_next)
+        n_ev = len(ev)
+        extra = 0
+        while extra < max_wait and not np.array_equal(ref.mov, twin.mov):
+            ref, ev = stepper.advance(ref, ref.step + 1)
+            twin, _ = stepper.advance(twin, twin.step + 1)
+            n_ev += len(ev)
+            extra += 1
+        waits += extra > 0
+        n_next = ref.step
+        if n_next > n_count:
+            events += n_ev
+        dy = measured(ref, twin)
+        d = float(np.linalg.norm(dy))
+        times.append(n_next * dt)
+        taus.append((n_next - n) * dt)
+        logs.append(math.log(d / d_start) if d > 0.0 and d_start > 0.0 else -math.inf)
+        if d > 0.0 and np.any(_on_branch(dy, ref.stopped, params) != 0.0):
+            twin = twin_state(ref, dy, d0, params)
+        else:
+            twin = twin_state(ref, rng.standard_normal(3 * params.N), d0, params)
+        d_start = float(np.linalg.norm(measured(ref, twin)))
+        n = n_next
+    times_a, logs_a, taus_a = np.array(times), np.array(logs), np.array(taus)
+    counted = times_a > n_count * dt + 0.5 * dt
+    lam, err, means = _estimate(logs_a, taus_a, counted, segments)
+    return FlowLyapunovResult(
+        lyapunov=lam,
+        lyapunov_err=err,
+        dt=dt,
+        t_end=t_end,
+        transient=transient,
+        align=align,
+        interval=interval,
+        d0=d0,
+        renormalisations=int(np.count_nonzero(counted)),
+        segments=segments,
+        segment_means=means,
+        events=events,
+        neutral=neutral,
+        waits=waits,
+        wall_seconds=time.perf_counter() - wall0,
+        params=params,
+        start=start_name,
+        times=times_a,
+        log_growth=logs_a,
+        durations=taus_a,
+        counted=counted,
+    )
+
+
+def extrapolate(dts, values, errors, order: int = 2) -> tuple[float, float, float]:
+    """Weighted least-squares fit of lambda(dt) = lambda_0 + c dt^order (Richardson's model).
+
+    Returns (lambda_0, its error, c). The error is the fit's standard error, scaled up by
+    sqrt(chi^2 / dof) when the points scatter more than their error bars say (dof = points - 2);
+    with two points, the propagated error bars.
+    """
+    h = np.asarray(dts, dtype=float) ** order
+    y = np.asarray(values, dtype=float)
+    e = np.asarray(errors, dtype=float)
+    floor = 1e-12 * max(1.0, float(np.max(np.abs(y))))
+    e = np.where(np.isfinite(e) & (e > floor), e, floor)
+    A = np.column_stack((np.ones_like(h), h)) / e[:, None]
+    b = y / e
+    coef, *_ = np.linalg.lstsq(A, b, rcond=None)
+    cov = np.linalg.inv(A.T @ A)
+    dof = len(y) - 2
+    scale = 1.0
+    if dof > 0:
+        chi2 = float(np.sum((A @ coef - b) ** 2))
+        scale = max(1.0, math.sqrt(chi2 / dof))
+    return float(coef[0]), float(math.sqrt(cov[0, 0]) * scale), float(coef[1])
+
+
+LADDER_COLUMNS = ["dt", "lyapunov", "lyapunov_err", "renormalisations", "events", "waits", "wall_seconds"]
+
+
+@dataclass(frozen=True)
+class FlowLadder:
+    """The exponent of the flow at dt, dt/2, ... and its extrapolation to dt -> 0."""
+
+    rows: list[dict[str, Any]]
+    lyapunov_dt0: float
+    lyapunov_dt0_err: float
+    slope: float
+    results: list[FlowLyapunovResult] = field(repr=False)
+
+    def to_dict(self) -> dict[str, Any]:
+        """``lyapunov_dt0``, ``lyapunov_dt0_err``, ``ladder`` rows and the run's settings."""
+        first = self.results[0]
+        d = first.to_dict()
+        for k in ("lyapunov", "lyapunov_err", "dt", "renormalisations", "segment_means", "events", "waits"):
+            d.pop(k)
+        d["wall_seconds"] = float(sum(r.wall_seconds for r in self.results))
+        d.update(
+            {
+                "switches": "located",
+                "lyapunov_dt0": self.lyapunov_dt0,
+                "lyapunov_dt0_err": self.lyapunov_dt0_err,
+                "dt2_slope": self.slope,
+                "extrapolation": "weighted least squares of lambda = lambda_0 + c dt^2 (Heun's order)",
+                "ladder": self.rows,
+            }
+        )
+        return d
+
+
+def flow_ladder(params: ChainParams, t_end: float, *, levels: int = 3, **kwargs: Any) -> FlowLadder:
+    """:func:`flow_lyapunov` at dt = params.dt, dt/2, ..., dt/2^(levels-1), extrapolated to dt -> 0.
+
+    The same start, transient, interval (in time) and twin direction at every rung; the
+    extrapolation assumes lambda(dt) = lambda_0 + c dt^2, the order of the integrator.
+    """
+    levels = int(check_number("levels", levels, low=2, integer=True))
+    results = []
+    for k in range(levels):
+        p = params.replace(dt=params.dt / 2**k)
+        results.append(flow_lyapunov(p, t_end, **kwargs))
+    rows = [
+        {
+            "dt": r.dt,
+            "lyapunov": r.lyapunov,
+            "lyapunov_err": r.lyapunov_err,
+            "renormalisations": r.renormalisations,
+            "events": r.events,
+            "waits": r.waits,
+            "wall_seconds": r.wall_seconds,
+        }
+        for r in results
+    ]
+    lam0, err0, slope = extrapolate(
+        [r.dt for r in results], [r.lyapunov for r in results], [r.lyapunov_err for r in results]
+    )
+    return FlowLadder(rows, lam0, err0, slope, results)

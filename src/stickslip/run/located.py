@@ -1,0 +1,232 @@
+"""Runs with located switches: the reference integrator of the equations with switches.
+
+:func:`run_located` integrates any model of the family (docs/model.md, "The family the paper
+stands in") with Heun's method in which a block starts at the time its force reaches the
+threshold and stops at the time its velocity reaches zero, both located inside the step to
+round-off (:mod:`stickslip.kernels.located`). Its trajectories converge to the solution of the
+equations with switches at second order in dt. It is a reference for studies (the exponent of
+the flow, :mod:`stickslip.analysis.lyapunov_flow`), not the engine: :func:`stickslip.run_chain`
+keeps the gridded rules of docs/model.md and its bit-exact results.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from stickslip.kernels import located as L
+from stickslip.models.params import ChainParams, ParameterError, steps_for
+from stickslip.run.state import ChainState, initial_state
+
+INTEGRATOR = "heun with located switches (start at f_i = threshold, stop at v_i = 0, to round-off)"
+
+EVENT_COLUMNS = ["t_start", "t_end", "size", "start_block", "n_blocks"]
+
+
+@dataclass
+class LocatedState:
+    """State of the located integrator at the grid step ``step`` (t = step dt).
+
+    u = x - V t (positions relative to the drive), v, th, mov (1.0 moving, 0.0 stuck), with ghost
+    cells 0 and N + 1 as in the kernels; ist, evf, moved: the event bookkeeping of
+    :mod:`stickslip.kernels.located`.
+    """
+
+    u: np.ndarray
+    v: np.ndarray
+    th: np.ndarray
+    mov: np.ndarray
+    moved: np.ndarray
+    ist: np.ndarray
+    evf: np.ndarray
+
+    @property
+    def N(self) -> int:
+        return self.u.shape[0] - 2
+
+    @property
+    def step(self) -> int:
+        return int(self.ist[L.I_STEP])
+
+    @property
+    def stopped(self) -> np.ndarray:
+        """Stuck flags of blocks 1..N."""
+        return self.mov[1:-1] == 0.0
+
+    @classmethod
+    def from_blocks(cls, u, v, theta, stopped, step: int = 0, t: float = 0.0) -> LocatedState:
+        """A state from per-block arrays of u = x - V t, v, theta and stuck flags at grid ``step``
+        (time t = step dt); stuck blocks get v = 0, and an event is open if any block moves."""
+        u = np.asarray(u, dtype=np.float64)
+        N = u.shape[0]
+        stopped = np.asarray(stopped, dtype=bool)
+        arrays = {}
+        for name, values in (("u", u), ("v", v), ("th", theta)):
+            a = np.zeros(N + 2)
+            a[1:-1] = np.asarray(values, dtype=np.float64)
+            arrays[name] = a
+        arrays["v"][1:-1][stopped] = 0.0
+        mov = np.zeros(N + 2)
+        mov[1:-1] = np.where(stopped, 0.0, 1.0)
+        ist = np.zeros(L.IST_SIZE, dtype=np.int64)
+        ist[L.I_STEP] = step
+        n_moving = int(np.count_nonzero(~stopped))
+        ist[L.I_MOVING] = n_moving
+        moved = np.zeros(N + 2, dtype=np.int64)
+        evf = np.zeros(L.EVF_SIZE)
+        if n_moving:
+            ist[L.I_ACTIVE] = 1
+            ist[L.I_FIRST] = int(np.argmax(~stopped)) + 1
+            ist[L.I_NMOVED] = n_moving
+            moved[1:-1] = (~stopped).astype(np.int64)
+            evf[L.F_T_START] = t
+            evf[L.F_SUM_START] = float(np.sum(arrays["u"][1:-1]))
+        return cls(mov=mov, moved=moved, ist=ist, evf=evf, **arrays)
+
+    @classmethod
+    def from_chain_state(
+        cls, state: ChainState, params: ChainParams, *, restart_clock: bool = False, dt: float | None = None
+    ) -> LocatedState:
+        """The engine's state (absolute positions x at step n of ``dt``, default params.dt) in the
+        located integrator's frame, u = x - V t.
+
+        With ``restart_clock`` the state is put at t = 0 (step 0): in the frame of the drive the
+        equations do not read t, so the continuation is the same, and runs at any dt can start
+        from it. Fixed ends read t (x_{N+1} = 0), so they refuse it.
+        """
+        b = state.blocks()
+        t = state.step * (params.dt if dt is None else dt)
+        u = b["x"] - params.V * t
+        if restart_clock:
+            if params.ends_piece.wall:
+                raise ParameterError("restart_clock needs ends that do not read t (fixed ends do)")
+            return cls.from_blocks(u, b["v"], b["theta"], b["stopped"], 0, 0.0)
+        return cls.from_blocks(u, b["v"], b["theta"], b["stopped"], state.step, t)
+
+    def blocks(self, params: ChainParams) -> dict[str, np.ndarray]:
+        """Per-block copies: x = u + V t, u, v, theta and stopped, block i at index i - 1."""
+        t = self.step * params.dt
+        return {
+            "x": self.u[1:-1] + params.V * t,
+            "u": self.u[1:-1].copy(),
+            "v": self.v[1:-1].copy(),
+            "theta": self.th[1:-1].copy(),
+            "stopped": self.stopped,
+        }
+
+    def copy(self) -> LocatedState:
+        return LocatedState(**{k: getattr(self, k).copy() for k in ("u", "v", "th", "mov", "moved", "ist", "evf")})
+
+
+def parameter_vector(p: ChainParams) -> np.ndarray:
+    """The kernel's parameter vector (indices P_* of :mod:`stickslip.kernels.located`)."""
+    par = np.zeros(L.PAR_SIZE)
+    par[L.P_K], par[L.P_D], par[L.P_V], par[L.P_BETA], par[L.P_ALPHA] = p.K, p.D, p.V, p.beta, p.alpha
+    par[L.P_FS], par[L.P_DT], par[L.P_KP], par[L.P_SIGMA], par[L.P_F0] = p.Fs, p.dt, p.Kp, p.sigma, p.F0
+    return par
+
+
+class LocatedStepper:
+    """Advances :class:`LocatedState` objects of one model with located switches (in place)."""
+
+    def __init__(self, params: ChainParams, capacity: int = 4096):
+        self.params = params
+        self.par = parameter_vector(params)
+        self.codes = params.codes
+        N = params.N
+        self.sc = tuple(np.zeros(N + 2) for _ in range(12))
+        self.cand = np.zeros(N + 2, dtype=np.int64)
+        self.ev_t = np.zeros((capacity, 3))
+        self.ev_i = np.zeros((capacity, 2), dtype=np.int64)
+
+    def advance(self, state: LocatedState, step: int) -> tuple[LocatedState, np.ndarray]:
+        """The state at grid ``step`` and the slip events completed on the way (docs/model.md),
+        one row (columns :data:`EVENT_COLUMNS`) per event; :func:`events_frame` labels them."""
+        if state.N != self.params.N:
+            raise ParameterError(f"the state has {state.N} blocks, the parameters N = {self.params.N}")
+        drive, friction, threshold, ends = self.codes
+        parts = []
+        while True:
+            state.ist[L.I_EVENTS] = 0
+            status = L.advance(
+                state.u,
+                state.v,
+                state.th,
+                state.mov,
+                np.int64(step),
+                self.par,
+                drive,
+                friction,
+                threshold,
+                ends,
+                self.sc,
+                self.cand,
+                state.moved,
+                state.ist,
+                state.evf,
+                self.ev_t,
+                self.ev_i,
+            )
+            r = int(state.ist[L.I_EVENTS])
+            if r:
+                parts.append(np.column_stack((self.ev_t[:r], self.ev_i[:r])))
+            if status == L.NONFINITE:
+                raise FloatingPointError(f"the located integrator met a non-finite value at step {state.step}")
+            if status == L.DONE:
+                break
+        if len(parts) == 1:
+            return state, parts[0]
+        return state, (np.concatenate(parts) if parts else np.zeros((0, len(EVENT_COLUMNS))))
+
+
+def events_frame(rows: np.ndarray) -> pd.DataFrame:
+    """Event rows of :meth:`LocatedStepper.advance` as a table (times and sizes, block numbers)."""
+    ev = pd.DataFrame(rows, columns=EVENT_COLUMNS)
+    ev[["start_block", "n_blocks"]] = ev[["start_block", "n_blocks"]].astype(np.int64)
+    return ev
+
+
+@dataclass(frozen=True)
+class LocatedRun:
+    """A run with located switches: its final state and its slip events (located times)."""
+
+    params: ChainParams
+    state: LocatedState
+    events: pd.DataFrame
+
+    @property
+    def t_end(self) -> float:
+        return self.state.step * self.params.dt
+
+
+def start_state(
+    params: ChainParams, start: str | ChainState | LocatedState = "paper", *, perturbation: float = 0.0, seed: int = 0
+) -> LocatedState:
+    """The initial state: a name of :func:`stickslip.run.state.initial_state`, an engine state or
+    a located state (copied)."""
+    if isinstance(start, LocatedState):
+        return start.copy()
+    if isinstance(start, str):
+        start = initial_state(params, start, amplitude=perturbation, seed=seed)
+    return LocatedState.from_chain_state(start, params)
+
+
+def run_located(
+    params: ChainParams,
+    t_end: float,
+    *,
+    start: str | ChainState | LocatedState = "paper",
+    perturbation: float = 0.0,
+    seed: int = 0,
+) -> LocatedRun:
+    """Integrate the model of ``params`` (eq. (4) or a relative, docs/model.md) to ``t_end`` with
+    Heun and located switches (:mod:`stickslip.kernels.located`), from ``start``.
+
+    Second order in dt up to and across switches; the events carry located start and end times.
+    """
+    state = start_state(params, start, perturbation=perturbation, seed=seed)
+    n_end = steps_for(t_end, params.dt)
+    state, events = LocatedStepper(params).advance(state, n_end)
+    return LocatedRun(params, state, events_frame(events))
