@@ -127,7 +127,7 @@ def test_chain_after_a_full_disk_resumes_to_the_same_run(name, full_at, tmp_path
 CONTINUED = [
     ("summary.parquet", ["sweep", "block", "--t-end", "10", "--grid", "K=8,10"], 2),
     ("phase_alpha_beta.png", ["study", "phase-diagram", "--tiny"], 4),
-    ("loops.png", ["study", "transition", "--tiny"], 2),  # its two ladders
+    ("loops.png", ["study", "transition", "--tiny"], 3),  # its three ladders (two up replicas, one down)
 ]
 
 
