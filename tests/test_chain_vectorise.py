@@ -13,7 +13,7 @@ import numba
 import numpy as np
 import pytest
 
-from stickslip.kernels import chain as K
+from stickslip.kernels import dense, exact, layout, stages
 from stickslip.models.params import ChainParams
 from stickslip.run.driver import run_chain
 
@@ -46,7 +46,7 @@ def _example_args(name: str) -> tuple:
     dt, p = 0.005, 0.0
     # The paper's model: K, Kp, beta, alpha, D, Fs, 1 - sigma, 2 alpha, F0; pieces as literals.
     mp = (10.0, 1.0, 1.0, 1.0, 5.0, 3.0, 0.99, 2.0, 1.0)
-    end, state, constant = K.DRIVE_END, K.FRICTION_STATE, K.THRESHOLD_CONSTANT
+    end, state, constant = layout.DRIVE_END, layout.FRICTION_STATE, layout.THRESHOLD_CONSTANT
     return {
         "_stage1": (*a, lo, hi, p, mp, dt, end, state, constant),
         "_stage2": (*a, lo, hi, p, mp, 0.5 * dt, end, state),
@@ -60,9 +60,9 @@ def _example_args(name: str) -> tuple:
 def irs() -> dict[str, str]:
     run_chain(ChainParams(N=8), 1.0, integrator="exact")
     run_chain(ChainParams(N=8), 1.0, integrator="dense")
-    out = {name: _fresh_ir(getattr(K, name), _example_args(name)) for name in STAGES}
-    out["run_exact"] = _fresh_ir(K.run_exact)
-    out["run_dense"] = _fresh_ir(K.run_dense)
+    out = {name: _fresh_ir(getattr(stages, name), _example_args(name)) for name in STAGES}
+    out["run_exact"] = _fresh_ir(exact.run_exact)
+    out["run_dense"] = _fresh_ir(dense.run_dense)
     return out
 
 
