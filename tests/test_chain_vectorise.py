@@ -18,7 +18,7 @@ from stickslip.models.params import ChainParams
 from stickslip.run.driver import run_chain
 
 # The block loops: separate compiled functions, and the all-moving ones inlined in run_exact.
-STAGES = ("_stage1", "_stage2", "_stage1_theta", "_stage1_theta_only", "_stage2_theta")
+STAGES = ("_stage1", "_stage2", "_stage1_theta", "_stage1_theta_only", "_stage2_theta", "_stage1_run", "_stage2_run")
 
 
 def _fresh_ir(kernel, args=None) -> str:
@@ -53,6 +53,8 @@ def _example_args(name: str) -> tuple:
         "_stage1_theta": (*a[:8], lo, hi, mp, dt, state),
         "_stage1_theta_only": (*a[:4], lo, hi, mp, dt, state),
         "_stage2_theta": (*a[:4], lo, hi, mp, 0.5 * dt, state),
+        "_stage1_run": (*a[:9], lo, hi, p, mp, dt, end, state),
+        "_stage2_run": (*a[:8], lo, hi, p, mp, 0.5 * dt, end, state),
     }[name]
 
 

@@ -20,6 +20,12 @@ Which stopped blocks can start:
   (:mod:`stickslip.kernels.plate`).
 * state threshold: a block whose theta changes may start without any neighbour moving, so
   every block whose state variable may change is a candidate.
+
+A run of blocks that all move at t_n (the longest such run, kept across steps while none of
+it stops) is updated by the stages of :mod:`stickslip.kernels.stages` that skip the start rule
+and the bookkeeping of changes, as when the whole chain slides: in a partly stuck chain most of
+a step's work is one such run. Its blocks are counted as changed, which can only widen the
+interval of the next step; a wider interval gives the same bits.
 """
 
 from __future__ import annotations
@@ -56,12 +62,15 @@ from stickslip.kernels.layout import (
 )
 from stickslip.kernels.plate import run_sparse
 from stickslip.kernels.stages import (
+    _longest_run,
     _stage1,
     _stage1_all,
+    _stage1_run,
     _stage1_theta,
     _stage1_theta_only,
     _stage2,
     _stage2_all,
+    _stage2_run,
     _stage2_theta,
 )
 from stickslip.kernels.triggers import _first_trigger, _plate_triggers
@@ -150,6 +159,9 @@ def run_exact(
     K, Kp, Fs = mp[0], mp[1], mp[5]
     h2 = 0.5 * dt
     cap_ev, cap_fm, cap_p = ev_int.shape[0], fm.shape[0], prof_x.shape[0]
+    # A run of blocks moving at t_n (empty if ra > rb): updated without the start rule and the
+    # bookkeeping of changes (stages._stage1_run, _stage2_run).
+    ra, rb = _longest_run(mov, 1, N)
     t_next = _NEVER  # plate drive: no stopped block starts before this step unless listed in trig
     if drive == DRIVE_PLATE:
         _set_ghosts(x, th, N, 0.0, drive, ends)
@@ -227,12 +239,14 @@ def run_exact(
             ist[ACT_HI] = N
             ist[MECH_LO] = 1
             ist[MECH_HI] = N
+            ra, rb = 1, N
             if stops:
                 n_moving = 0
                 for i in range(1, N + 1):
                     mov[i] = 1.0 if v[i] > 0.0 else 0.0
                     n_moving += 1 if v[i] > 0.0 else 0
                 ist[N_MOVING] = n_moving
+                ra, rb = _longest_run(mov, 1, N)
                 if drive == DRIVE_PLATE:
                     # The blocks that stopped need their first start step under the plate.
                     _set_ghosts(x, th, N, 0.0, drive, ends)
@@ -268,9 +282,31 @@ def run_exact(
         last = l1 - 1
         starts = False
         if fl <= fh:
-            first, last, starts = _stage1(
-                x, v, th, mov, xs, vs, ths, mm, a1, b1, fl, fh, p1, mp, dt, drive, friction, threshold
-            )
+            # The run within [fl, fh] (its blocks move: no start rule), the general stage on
+            # either side of it.
+            qa = ra if ra > fl else fl
+            qb = rb if rb < fh else fh
+            if qa <= qb:
+                first = qa
+                last = qb
+                if fl < qa:
+                    f_, l_, starts = _stage1(
+                        x, v, th, mov, xs, vs, ths, mm, a1, b1, fl, qa - 1, p1, mp, dt, drive, friction, threshold
+                    )
+                    if f_ <= l_:
+                        first = f_
+                _stage1_run(x, v, th, xs, vs, ths, mm, a1, b1, qa, qb, p1, mp, dt, drive, friction)
+                if qb < fh:
+                    f_, l_, s_ = _stage1(
+                        x, v, th, mov, xs, vs, ths, mm, a1, b1, qb + 1, fh, p1, mp, dt, drive, friction, threshold
+                    )
+                    starts |= s_
+                    if f_ <= l_:
+                        last = l_
+            else:
+                first, last, starts = _stage1(
+                    x, v, th, mov, xs, vs, ths, mm, a1, b1, fl, fh, p1, mp, dt, drive, friction, threshold
+                )
             if l1 < fl:
                 _stage1_theta(x, v, th, xs, vs, ths, mm, b1, l1, fl - 1, mp, dt, friction)
             if fh < h1:
@@ -291,10 +327,39 @@ def run_exact(
         c_hi = lo - 1
         moved_before = 0
         moved_after = 0
+        stops_run = False
+        whole = False  # the whole run went through _stage2_run
         if sl <= sh:
-            c_lo, c_hi, moved_before, moved_after = _stage2(
-                x, v, th, mov, xs, vs, ths, mm, a1, b1, sl, sh, p2, mp, h2, drive, friction
-            )
+            qa = ra if ra > sl else sl
+            qb = rb if rb < sh else sh
+            whole = qa == ra and qb == rb
+            if qa <= qb:
+                if sl < qa:
+                    c_lo, c_hi, moved_before, moved_after = _stage2(
+                        x, v, th, mov, xs, vs, ths, mm, a1, b1, sl, qa - 1, p2, mp, h2, drive, friction
+                    )
+                stops_run = _stage2_run(x, v, th, xs, vs, ths, a1, b1, qa, qb, p2, mp, h2, drive, friction)
+                # Every block of the run moved: count it as changed.
+                c_lo, c_hi = _merge(c_lo, c_hi, qa, qb)
+                moved_before += qb - qa + 1
+                if stops_run:
+                    for i in range(qa, qb + 1):
+                        keep = v[i] > 0.0
+                        mov[i] = 1.0 if keep else 0.0
+                        moved_after += 1 if keep else 0
+                else:
+                    moved_after += qb - qa + 1
+                if qb < sh:
+                    t_lo, t_hi, mb, ma = _stage2(
+                        x, v, th, mov, xs, vs, ths, mm, a1, b1, qb + 1, sh, p2, mp, h2, drive, friction
+                    )
+                    c_lo, c_hi = _merge(c_lo, c_hi, t_lo, t_hi)
+                    moved_before += mb
+                    moved_after += ma
+            else:
+                c_lo, c_hi, moved_before, moved_after = _stage2(
+                    x, v, th, mov, xs, vs, ths, mm, a1, b1, sl, sh, p2, mp, h2, drive, friction
+                )
             ist[FULL_UPDATES] += sh - sl + 1
             if friction == FRICTION_STATE:
                 if lo < sl:
@@ -320,6 +385,18 @@ def run_exact(
             ist[MECH_HI] = 0
         n_moving = ist[N_MOVING] + moved_after - moved_before
         ist[N_MOVING] = n_moving
+        # The run of the next step: while none of it stops, it grows by the blocks that joined
+        # it at either end; otherwise the longest run among this step's movers.
+        if stops_run or not whole or ra > rb:
+            if first <= last:
+                ra, rb = _longest_run(mov, first, last)
+            else:
+                ra, rb = 1, 0
+        else:
+            while ra > 1 and mov[ra - 1] != 0.0:
+                ra -= 1
+            while rb < N and mov[rb + 1] != 0.0:
+                rb += 1
         ist[BLOCK_UPDATES] += hi - lo + 1
         ist[STEPS_COMPUTED] += 1
         ist[STEP] = n + 1
