@@ -12,14 +12,14 @@ from pathlib import Path
 
 import numpy as np
 
-from stickslip.kernels import chain as K
+from stickslip.kernels import layout
 
 # Integer state entries that describe the model (not how much work an integrator did).
 IST_MODEL = {
-    "STEP": K.STEP, "N_MOVING": K.N_MOVING, "EV_ACTIVE": K.EV_ACTIVE,
-    "EV_START_STEP": K.EV_START_STEP, "EV_START_BLOCK": K.EV_START_BLOCK,
-    "EV_MAX_BLOCK": K.EV_MAX_BLOCK, "EV_N_MOVED": K.EV_N_MOVED, "N_EVENTS": K.N_EVENTS,
-    "NEXT_SAMPLE": K.NEXT_SAMPLE, "NEXT_PROFILE": K.NEXT_PROFILE,
+    "STEP": layout.STEP, "N_MOVING": layout.N_MOVING, "EV_ACTIVE": layout.EV_ACTIVE,
+    "EV_START_STEP": layout.EV_START_STEP, "EV_START_BLOCK": layout.EV_START_BLOCK,
+    "EV_MAX_BLOCK": layout.EV_MAX_BLOCK, "EV_N_MOVED": layout.EV_N_MOVED, "N_EVENTS": layout.N_EVENTS,
+    "NEXT_SAMPLE": layout.NEXT_SAMPLE, "NEXT_PROFILE": layout.NEXT_PROFILE,
 }  # fmt: skip
 
 # Summary entries that depend on the integrator or the machine, not on the model.

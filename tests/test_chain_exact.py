@@ -14,7 +14,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from chain_helpers import assert_same_run, oracle_run
-from stickslip.kernels import chain as K
+from stickslip.kernels import layout
 from stickslip.models.params import ChainParams
 from stickslip.run.driver import ChainRunError, ChainState, run_chain
 
@@ -78,8 +78,8 @@ def test_a_run_ending_inside_an_event_matches():
     t_mid = (big["step_start"] + big["step_end"]) // 2 * p.dt
     dense, exact = _both(p, t_mid, profile_window=0.1)
     assert_same_run(dense, exact)
-    assert dense.state.ist[K.EV_ACTIVE] == 1 and dense.summary["event_in_progress"]
-    assert (dense.state.first_step[1:-1] >= 0).sum() == dense.state.ist[K.EV_N_MOVED] > 0
+    assert dense.state.ist[layout.EV_ACTIVE] == 1 and dense.summary["event_in_progress"]
+    assert (dense.state.first_step[1:-1] >= 0).sum() == dense.state.ist[layout.EV_N_MOVED] > 0
     # the event in progress is not in the table yet
     assert len(dense.events) == big["event"]
 

@@ -17,7 +17,7 @@ import pytest
 
 from chain_helpers import assert_bits_equal, assert_same_run, assert_same_state, run_cli_subprocess
 from stickslip.cli import main
-from stickslip.kernels import chain as K
+from stickslip.kernels import layout
 from stickslip.models.params import ChainParams, ParameterError
 from stickslip.run import driver as C
 from stickslip.run.driver import ChainRunError, resume_chain, run_chain
@@ -139,7 +139,7 @@ def test_continue_from_a_returned_state(full):
 def test_continue_from_a_state_inside_an_event(full):
     t1 = _mid_event_time(full, -1)
     first = run_chain(P, t1, **OPTS)
-    assert first.state.ist[K.EV_ACTIVE] == 1
+    assert first.state.ist[layout.EV_ACTIVE] == 1
     second = run_chain(P, T2, start=first.state, **dict(OPTS, snapshot_times=()))
     # a new run samples L from its own start (t1 is off the grid here): all else carries over
     assert_same_state(second.state, full.state, skip=("NEXT_SAMPLE",))
@@ -306,7 +306,7 @@ def test_checkpoint_arrays_that_do_not_fit_are_refused(tmp_path, run_dir, mismat
 def test_stray_part_files_are_ignored(run_dir, resumed_reference):
     """A part written by a checkpoint that was killed before its state file is not used."""
     ckpt = run_dir / "checkpoint"
-    bogus = {"ev_int": np.zeros((3, K.EV_INT_COLS), dtype=np.int64), "ev_S": np.ones(3)}
+    bogus = {"ev_int": np.zeros((3, layout.EV_INT_COLS), dtype=np.int64), "ev_S": np.ones(3)}
     C._write_npz(ckpt / "part-000001.npz", bogus, {"format": C.CHECKPOINT_FORMAT})
     assert_same_run(resume_chain(run_dir, t_end=200.0), resumed_reference)
 

@@ -13,12 +13,12 @@ import numba
 import numpy as np
 import pytest
 
-from stickslip.kernels import chain as K
+from stickslip.kernels import dense, exact, layout, stages
 from stickslip.models.params import ChainParams
 from stickslip.run.driver import run_chain
 
 # The block loops: separate compiled functions, and the all-moving ones inlined in run_exact.
-STAGES = ("_stage1", "_stage2", "_stage1_theta", "_stage1_theta_only", "_stage2_theta")
+STAGES = ("_stage1", "_stage2", "_stage1_theta", "_stage1_theta_only", "_stage2_theta", "_stage1_run", "_stage2_run")
 
 
 def _fresh_ir(kernel, args=None) -> str:
@@ -46,13 +46,15 @@ def _example_args(name: str) -> tuple:
     dt, p = 0.005, 0.0
     # The paper's model: K, Kp, beta, alpha, D, Fs, 1 - sigma, 2 alpha, F0; pieces as literals.
     mp = (10.0, 1.0, 1.0, 1.0, 5.0, 3.0, 0.99, 2.0, 1.0)
-    end, state, constant = K.DRIVE_END, K.FRICTION_STATE, K.THRESHOLD_CONSTANT
+    end, state, constant = layout.DRIVE_END, layout.FRICTION_STATE, layout.THRESHOLD_CONSTANT
     return {
         "_stage1": (*a, lo, hi, p, mp, dt, end, state, constant),
         "_stage2": (*a, lo, hi, p, mp, 0.5 * dt, end, state),
         "_stage1_theta": (*a[:8], lo, hi, mp, dt, state),
         "_stage1_theta_only": (*a[:4], lo, hi, mp, dt, state),
         "_stage2_theta": (*a[:4], lo, hi, mp, 0.5 * dt, state),
+        "_stage1_run": (*a[:9], lo, hi, p, mp, dt, end, state),
+        "_stage2_run": (*a[:8], lo, hi, p, mp, 0.5 * dt, end, state),
     }[name]
 
 
@@ -60,9 +62,9 @@ def _example_args(name: str) -> tuple:
 def irs() -> dict[str, str]:
     run_chain(ChainParams(N=8), 1.0, integrator="exact")
     run_chain(ChainParams(N=8), 1.0, integrator="dense")
-    out = {name: _fresh_ir(getattr(K, name), _example_args(name)) for name in STAGES}
-    out["run_exact"] = _fresh_ir(K.run_exact)
-    out["run_dense"] = _fresh_ir(K.run_dense)
+    out = {name: _fresh_ir(getattr(stages, name), _example_args(name)) for name in STAGES}
+    out["run_exact"] = _fresh_ir(exact.run_exact)
+    out["run_dense"] = _fresh_ir(dense.run_dense)
     return out
 
 

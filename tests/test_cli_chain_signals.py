@@ -19,7 +19,7 @@ import pytest
 
 from chain_helpers import assert_bits_equal, assert_same_run, cli_env, run_cli_subprocess, stickslip_cmd
 from stickslip import io
-from stickslip.kernels import chain as K
+from stickslip.kernels import layout
 from stickslip.models.params import ChainParams, steps_for
 from stickslip.run import driver as C
 
@@ -59,7 +59,7 @@ def _launch_and_signal(out_dir, sig, delay):
 
 def _checkpoint_step(out_dir) -> int:
     arrays, _, _ = C._read_npz(out_dir / "checkpoint" / "state.npz")
-    return int(arrays["ist"][K.STEP])
+    return int(arrays["ist"][layout.STEP])
 
 
 def _assert_outputs_match(out_dir, reference, sha):

@@ -194,7 +194,7 @@ def test_swapped_checkpoint_refused(tmp_path, capsys):
 
 @pytest.mark.parametrize("craft", ["step", "act", "count", "parts", "integrator", "sample"])
 def test_crafted_checkpoint_refused(craft, tmp_path, capsys):
-    from stickslip.kernels import chain as K
+    from stickslip.kernels import layout
     from stickslip.run.checkpoint import _read_npz, _write_npz
 
     run = _finished_run(tmp_path / "r")
@@ -202,14 +202,14 @@ def test_crafted_checkpoint_refused(craft, tmp_path, capsys):
     arrays, header, _ = _read_npz(path)
     ist = arrays["ist"]
     if craft == "step":
-        ist[K.STEP] = -5
+        ist[layout.STEP] = -5
     elif craft == "act":
-        ist[K.ACT_LO], ist[K.ACT_HI] = 1, 10**9
+        ist[layout.ACT_LO], ist[layout.ACT_HI] = 1, 10**9
     elif craft == "count":
-        ist[K.EV_COUNT] = 7
+        ist[layout.EV_COUNT] = 7
     elif craft == "parts":
         header["parts"] = []
-        ist[K.N_EVENTS] = max(1, int(ist[K.N_EVENTS]))
+        ist[layout.N_EVENTS] = max(1, int(ist[layout.N_EVENTS]))
     elif craft == "integrator":
         header["integrator"] = "bogus"
     else:

@@ -22,8 +22,8 @@ from stickslip.models.presets import chain_params
 
 _SCRIPT = """
 import numpy as np
-from stickslip.kernels import chain as K
-print(K._first_trigger(np.zeros(5), 3, 1.0, 0.01, 1.0, 0.5, 0, 1000, 0))
+from stickslip.kernels import triggers
+print(triggers._first_trigger(np.zeros(5), 3, 1.0, 0.01, 1.0, 0.5, 0, 1000, 0))
 """
 
 

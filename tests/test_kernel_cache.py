@@ -12,9 +12,9 @@ from stickslip.kernels._cache import modules_digest
 
 _SCRIPT = """
 import numpy as np
-from stickslip.kernels import chain as K
+from stickslip.kernels import triggers
 # End drive, blocks 1 and 2 at rest: f_1 = K V n dt exceeds 0.5 first at n = 51.
-print(K._first_trigger(np.zeros(5), 3, 1.0, 0.01, 1.0, 0.5, 0, 1000, 0))
+print(triggers._first_trigger(np.zeros(5), 3, 1.0, 0.01, 1.0, 0.5, 0, 1000, 0))
 """
 
 
@@ -26,17 +26,17 @@ def _run(root: Path) -> str:
 
 
 def test_editing_a_called_module_recompiles_the_cached_kernel(tmp_path):
-    # _first_trigger lives in chain.py and inlines _pull from common.py; numba's own stamp
-    # covers chain.py only and would load the kernel compiled before the edit.
+    # _first_trigger lives in triggers.py and inlines _pull from laws.py; numba's own stamp
+    # covers triggers.py only and would load the kernel compiled before the edit.
     src = Path(stickslip.__file__).parent
     shutil.copytree(src, tmp_path / "stickslip", ignore=shutil.ignore_patterns("__pycache__"))
     assert _run(tmp_path) == "51"
     assert _run(tmp_path) == "51"  # from the cache
-    common = tmp_path / "stickslip" / "kernels" / "common.py"
-    text = common.read_text()
+    laws = tmp_path / "stickslip" / "kernels" / "laws.py"
+    text = laws.read_text()
     old = "return V * (np.float64(n) * dt)"
     assert old in text
-    common.write_text(text.replace(old, "return 2.0 * V * (np.float64(n) * dt)"))
+    laws.write_text(text.replace(old, "return 2.0 * V * (np.float64(n) * dt)"))
     assert _run(tmp_path) == "26"
 
 

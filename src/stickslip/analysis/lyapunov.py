@@ -207,7 +207,7 @@ def _with_step(state: ChainState, step: int) -> ChainState:
     from_blocks marks every block as possibly changing, so the fast integrator continues it
     correctly; only the step count, which places the pulling point, has to be carried over.
     """
-    from stickslip.kernels.chain import STEP
+    from stickslip.kernels.layout import STEP
 
     state.ist[STEP] = step
     return state

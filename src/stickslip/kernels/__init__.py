@@ -1,7 +1,11 @@
 """Numba kernels: the single block (:mod:`~stickslip.kernels.block`) and the chain, whose kernels
-span several modules (:mod:`~stickslip.kernels.common` shared pieces, :mod:`~stickslip.kernels.chain`
-reference and exact integrators and entry points, :mod:`~stickslip.kernels.plate` sparse exact steps
-of the plate drive).
+show their parts: :mod:`~stickslip.kernels.layout` (arrays, pieces' codes, status codes),
+:mod:`~stickslip.kernels.laws` (the step's expressions), :mod:`~stickslip.kernels.events`
+(outputs and events), :mod:`~stickslip.kernels.triggers` (the drive's starts),
+:mod:`~stickslip.kernels.dense` (the reference), :mod:`~stickslip.kernels.stages` and
+:mod:`~stickslip.kernels.exact` (the fast interval path), :mod:`~stickslip.kernels.plate` (the
+fast sparse path of the plate drive) and :mod:`~stickslip.kernels.entry` (a compiled entry point
+per model).
 
 numba's on-disk cache (``cache=True``) stamps a kernel with its own module only, and would load
 a kernel compiled from an older version of a module it calls. :mod:`~stickslip.kernels._cache`

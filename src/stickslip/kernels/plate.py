@@ -3,7 +3,7 @@
 paper stands in").
 
 There a stopped block does not change at all, and the plate's start of a stopped block is
-known in advance (``trig``, see :mod:`stickslip.kernels.chain`). So a step touches only
+known in advance (``trig``, see :mod:`stickslip.kernels.triggers`). So a step touches only
 
 * the moving blocks,
 * the stopped blocks next to a block that moved in the last step (their force changed), and
@@ -45,7 +45,7 @@ Block indices in the lists are unsigned: numba then indexes the arrays without t
 wraparound code of negative indices. The kernel uses numpy's error model (a float division
 by zero is not checked, so the packed loops have no exit): the only divisor, 1 - sigma, is
 positive since ChainParams holds sigma in [0, 1), and 1 + 2 alpha max(v, 0) / (1 - sigma)
-is at least 1. Every quantity uses the expressions of :mod:`stickslip.kernels.common`, so
+is at least 1. Every quantity uses the expressions of :mod:`stickslip.kernels.laws`, so
 the result equals run_dense bit for bit.
 """
 
@@ -54,7 +54,37 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from stickslip.kernels import common as c
+from stickslip.kernels.events import _end_event, _overflow, _service
+from stickslip.kernels.laws import _accel, _force, _pull, _set_ghosts, _threshold
+from stickslip.kernels.layout import (
+    _NEVER,
+    ACT_HI,
+    ACT_LO,
+    BLOCK_UPDATES,
+    DONE,
+    ENDS_FIXED,
+    ENDS_PERIODIC,
+    EV_ACTIVE,
+    EV_COUNT,
+    EV_MAX_BLOCK,
+    EV_N_MOVED,
+    EV_P_FIRST,
+    EV_START_BLOCK,
+    EV_START_STEP,
+    FM_COUNT,
+    FULL_UPDATES,
+    MECH_HI,
+    MECH_LO,
+    N_EVENTS,
+    N_MOVING,
+    NEXT_PROFILE,
+    NEXT_SAMPLE,
+    P_COUNT,
+    STEP,
+    STEPS_COMPUTED,
+    _unpack,
+)
+from stickslip.kernels.triggers import _plate_trigger
 
 _QUEUED = np.int64(-1)  # trig of a stopped block queued as a candidate of the next step
 _FEW = 8  # up to this many movers, each stage is one scalar loop (faster than the packed loops: measured)
@@ -62,12 +92,12 @@ _FEW = 8  # up to this many movers, each stage is one scalar loop (faster than t
 
 @njit(cache=True, inline="always")
 def _x_ghosts(x, N, ends):
-    """Ghost cells of x under the plate drive, as common._set_ghosts sets them (theta's do not
+    """Ghost cells of x under the plate drive, as laws._set_ghosts sets them (theta's do not
     change here)."""
-    if ends == c.ENDS_PERIODIC:
+    if ends == ENDS_PERIODIC:
         x[0] = x[N]
         x[N + 1] = x[1]
-    elif ends == c.ENDS_FIXED:
+    elif ends == ENDS_FIXED:
         x[0] = 0.0
         x[N + 1] = 0.0
     else:
@@ -142,20 +172,20 @@ def run_sparse(
     threshold,
     ends,
 ):
-    """:func:`stickslip.kernels.chain.run_exact` for the plate drive with weakening or
+    """:func:`stickslip.kernels.exact.run_exact` for the plate drive with weakening or
     strengthening friction: same arguments, state and status codes (module docstring).
 
     ``mm``, ``a1``, ``b1``, ``vs`` and ``ths`` are not used: the mask is 1 on the movers' list,
     and the stage-1 accelerations and predicted velocities are kept in the list's order.
     """
     N = x.shape[0] - 2
-    mp, V, dt = c._unpack(par)
+    mp, V, dt = _unpack(par)
     K, Kp, Fs = mp[0], mp[1], mp[5]
     h2 = 0.5 * dt
     cap_ev, cap_fm, cap_p = ev_int.shape[0], fm.shape[0], prof_x.shape[0]
     one = np.uint64(1)
     uN = np.uint64(N)
-    periodic = ends == c.ENDS_PERIODIC
+    periodic = ends == ENDS_PERIODIC
     movers = np.empty(N, np.uint64)  # moving blocks, then this step's starters
     nxt = np.empty(N, np.uint64)  # the movers of the next step
     queue = np.empty(N + 1, np.uint64)  # stopped candidates of the next step (a spare slot: _enqueue)
@@ -168,14 +198,14 @@ def run_sparse(
     vsb = np.empty(N)  # packed: predicted v of movers[k]
     kept = np.empty(N, np.bool_)  # packed: movers[k] still moves after the step
     # The interval bookkeeping of run_exact is not used here: leave it conservative.
-    ist[c.ACT_LO], ist[c.ACT_HI], ist[c.MECH_LO], ist[c.MECH_HI] = 1, N, 1, N
-    c._set_ghosts(x, th, N, 0.0, drive, ends)
-    n0 = ist[c.STEP]
+    ist[ACT_LO], ist[ACT_HI], ist[MECH_LO], ist[MECH_HI] = 1, N, 1, N
+    _set_ghosts(x, th, N, 0.0, drive, ends)
+    n0 = ist[STEP]
     nmov = 0
     nq = 0
-    t_next = c._NEVER  # no stopped block outside the queue starts before this step
+    t_next = _NEVER  # no stopped block outside the queue starts before this step
     for i in range(1, N + 1):
-        trig[i] = c._NEVER
+        trig[i] = _NEVER
         if mov[i] != 0.0:
             movers[nmov] = i
             nmov += 1
@@ -186,7 +216,7 @@ def run_sparse(
             xs[i] = x[i] + dt * v[i]
     for i in range(1, N + 1):
         if mov[i] == 0.0:
-            m = c._plate_trigger(x[i - 1], x[i], x[i + 1], c._threshold(th[i], Fs, threshold), K, Kp, V, dt, n0, n_end)
+            m = _plate_trigger(x[i - 1], x[i], x[i + 1], _threshold(th[i], Fs, threshold), K, Kp, V, dt, n0, n_end)
             nq, t_next = _settle(i, m, n0, trig, queue, nq, t_next)
     if n0 < n_end:
         # run_dense adds dt/2 (0 + 0) to every theta in each step (no state variable); nothing
@@ -196,37 +226,37 @@ def run_sparse(
     steps_computed = 0
     block_updates = 0
     full_updates = 0
-    active = ist[c.EV_ACTIVE] == 1
+    active = ist[EV_ACTIVE] == 1
     # The queue holds the stopped neighbours of the movers (and the plate's due starts); while
     # no block starts or stops it stays so, and the next step's queue is this one.
     qexact = False
     full = True  # the next rebuild of the queue looks at every mover
     n = n0
     n_chk = n0  # outputs, the end and the buffers are looked at from this step on
-    st = c.DONE
+    st = DONE
     while True:
         if n >= n_chk:
             # Outputs due, the end, buffers that could overflow. These change only at the steps
             # named here or when an event starts or ends, after which n_chk is the next step.
-            ist[c.STEP] = n
-            if n == ist[c.NEXT_SAMPLE] or (profile_every > 0 and active and n == ist[c.NEXT_PROFILE]):
-                st = c._service(n, x, N, ist, samp_L, samp_step, prof_x, prof_meta, sample_every, profile_every)
-                if st != c.DONE:
+            ist[STEP] = n
+            if n == ist[NEXT_SAMPLE] or (profile_every > 0 and active and n == ist[NEXT_PROFILE]):
+                st = _service(n, x, N, ist, samp_L, samp_step, prof_x, prof_meta, sample_every, profile_every)
+                if st != DONE:
                     break
             if n >= n_end:
-                st = c.DONE
+                st = DONE
                 break
             if (
-                ist[c.EV_COUNT] >= cap_ev
-                or ist[c.FM_COUNT] + N > cap_fm
-                or (profile_every > 0 and ist[c.P_COUNT] + 2 > cap_p)
+                ist[EV_COUNT] >= cap_ev
+                or ist[FM_COUNT] + N > cap_fm
+                or (profile_every > 0 and ist[P_COUNT] + 2 > cap_p)
             ):
-                st = c._overflow(ist, N, cap_ev, cap_fm)
+                st = _overflow(ist, N, cap_ev, cap_fm)
                 break
-            n_chk = n_end if n_end < ist[c.NEXT_SAMPLE] else ist[c.NEXT_SAMPLE]
-            if profile_every > 0 and active and ist[c.NEXT_PROFILE] < n_chk:
-                n_chk = ist[c.NEXT_PROFILE]
-        p1 = c._pull(V, n, dt)
+            n_chk = n_end if n_end < ist[NEXT_SAMPLE] else ist[NEXT_SAMPLE]
+            if profile_every > 0 and active and ist[NEXT_PROFILE] < n_chk:
+                n_chk = ist[NEXT_PROFILE]
+        p1 = _pull(V, n, dt)
         # Start rule of the stopped candidates: the queue, and (rarely) the plate's due starts.
         # Each goes to the starters (after the movers) or to the blocks that stay stopped; the
         # latter stay marked as queued.
@@ -235,13 +265,13 @@ def run_sparse(
         fired = False
         for k in range(nq):
             i = queue[k]
-            f = c._force(x[i - one], x[i], x[i + one], K, Kp, p1, drive)
-            fired |= f > c._threshold(th[i], Fs, threshold)
+            f = _force(x[i - one], x[i], x[i + one], K, Kp, p1, drive)
+            fired |= f > _threshold(th[i], Fs, threshold)
         if fired:
             for k in range(nq):
                 i = queue[k]
-                f = c._force(x[i - one], x[i], x[i + one], K, Kp, p1, drive)
-                fire = f > c._threshold(th[i], Fs, threshold)
+                f = _force(x[i - one], x[i], x[i + one], K, Kp, p1, drive)
+                fire = f > _threshold(th[i], Fs, threshold)
                 movers[nmov + nst] = i
                 still[nsl] = i
                 nst += 1 if fire else 0
@@ -251,18 +281,18 @@ def run_sparse(
             still, queue = queue, still
             nsl = nq
         for k in range(nmov, nmov + nst):
-            trig[movers[k]] = c._NEVER
+            trig[movers[k]] = _NEVER
         scanned = n >= t_next
         if scanned:
-            t_next = c._NEVER
+            t_next = _NEVER
             for j in range(1, N + 1):
                 if mov[j] == 0.0:
                     t = trig[j]
                     if 0 <= t and t <= n:
                         i = np.uint64(j)
-                        trig[i] = c._NEVER
-                        f = c._force(x[i - one], x[i], x[i + one], K, Kp, p1, drive)
-                        if f > c._threshold(th[i], Fs, threshold):
+                        trig[i] = _NEVER
+                        f = _force(x[i - one], x[i], x[i + one], K, Kp, p1, drive)
+                        if f > _threshold(th[i], Fs, threshold):
                             movers[nmov + nst] = i
                             nst += 1
                         else:
@@ -274,10 +304,10 @@ def run_sparse(
         if na + nsl == 0:
             # Nothing can change before the plate starts a block: jump, but stop at due outputs.
             target = n_end
-            if ist[c.NEXT_SAMPLE] < target:
-                target = ist[c.NEXT_SAMPLE]
-            if profile_every > 0 and active and ist[c.NEXT_PROFILE] < target:
-                target = ist[c.NEXT_PROFILE]
+            if ist[NEXT_SAMPLE] < target:
+                target = ist[NEXT_SAMPLE]
+            if profile_every > 0 and active and ist[NEXT_PROFILE] < target:
+                target = ist[NEXT_PROFILE]
             n = t_next if t_next < target else target
             continue
 
@@ -287,27 +317,27 @@ def run_sparse(
         if packed:
             for k in range(na):
                 i = movers[k]
-                fb[k] = c._force(x[i - one], x[i], x[i + one], K, Kp, p1, drive)
+                fb[k] = _force(x[i - one], x[i], x[i + one], K, Kp, p1, drive)
                 vi = v[i]
                 vb[k] = vi
                 xs[i] = x[i] + dt * vi
             for k in range(na):
-                a = c._accel(fb[k], 0.0, vb[k], 1.0, mp, friction)
+                a = _accel(fb[k], 0.0, vb[k], 1.0, mp, friction)
                 acc[k] = a
                 vsb[k] = vb[k] + dt * a
         else:
             for k in range(na):
                 i = movers[k]
-                f = c._force(x[i - one], x[i], x[i + one], K, Kp, p1, drive)
+                f = _force(x[i - one], x[i], x[i + one], K, Kp, p1, drive)
                 vi = v[i]
-                a = c._accel(f, 0.0, vi, 1.0, mp, friction)
+                a = _accel(f, 0.0, vi, 1.0, mp, friction)
                 vb[k] = vi
                 acc[k] = a
                 vsb[k] = vi + dt * a
                 xs[i] = x[i] + dt * vi
         _x_ghosts(xs, N, ends)
-        p2 = c._pull(V, n + 1, dt)
-        # Event start and first moves (as common._start_and_first_moves): a block moves for
+        p2 = _pull(V, n + 1, dt)
+        # Event start and first moves (as events._start_and_first_moves): a block moves for
         # the first time in an event only in the step it starts.
         if nst > 0 and (active or nmov == 0):
             if not active:
@@ -316,37 +346,37 @@ def run_sparse(
                     first = min(first, np.int64(movers[k]))
                 active = True
                 n_chk = n + 1
-                ist[c.EV_ACTIVE] = 1
-                ist[c.EV_START_STEP] = n
-                ist[c.EV_START_BLOCK] = first
-                ist[c.EV_MAX_BLOCK] = 0
-                ist[c.EV_N_MOVED] = 0
+                ist[EV_ACTIVE] = 1
+                ist[EV_START_STEP] = n
+                ist[EV_START_BLOCK] = first
+                ist[EV_MAX_BLOCK] = 0
+                ist[EV_N_MOVED] = 0
                 if profile_every > 0:
-                    r = ist[c.P_COUNT]
-                    ist[c.EV_P_FIRST] = r
+                    r = ist[P_COUNT]
+                    ist[EV_P_FIRST] = r
                     for j in range(1, N + 1):
                         prof_x[r, j - 1] = x[j]
-                    prof_meta[r, 0] = ist[c.N_EVENTS]
+                    prof_meta[r, 0] = ist[N_EVENTS]
                     prof_meta[r, 1] = n
-                    ist[c.P_COUNT] = r + 1
-                    ist[c.NEXT_PROFILE] = n + profile_every
+                    ist[P_COUNT] = r + 1
+                    ist[NEXT_PROFILE] = n + profile_every
             for k in range(nmov, na):
                 i = movers[k]
                 if first_step[i] < 0:
                     first_step[i] = n
                     x0ev[i] = x[i]
-                    ist[c.EV_N_MOVED] += 1
-                    if np.int64(i) > ist[c.EV_MAX_BLOCK]:
-                        ist[c.EV_MAX_BLOCK] = np.int64(i)
+                    ist[EV_N_MOVED] += 1
+                    if np.int64(i) > ist[EV_MAX_BLOCK]:
+                        ist[EV_MAX_BLOCK] = np.int64(i)
         # Stage 2, corrector and stop rule of the movers (stopped blocks keep every bit).
         # Theta is left as run_dense leaves it (both derivatives 0, no state variable).
         ns = 0
         if packed:
             for k in range(na):
                 i = movers[k]
-                fb[k] = c._force(xs[i - one], xs[i], xs[i + one], K, Kp, p2, drive)
+                fb[k] = _force(xs[i - one], xs[i], xs[i + one], K, Kp, p2, drive)
             for k in range(na):
-                a2 = c._accel(fb[k], 0.0, vsb[k], 1.0, mp, friction)
+                a2 = _accel(fb[k], 0.0, vsb[k], 1.0, mp, friction)
                 vn = vb[k] + h2 * (acc[k] + a2)
                 keep = vn > 0.0
                 vb[k] = vn if keep else 0.0
@@ -361,10 +391,10 @@ def run_sparse(
         else:
             for k in range(na):
                 i = movers[k]
-                f2 = c._force(xs[i - one], xs[i], xs[i + one], K, Kp, p2, drive)
+                f2 = _force(xs[i - one], xs[i], xs[i + one], K, Kp, p2, drive)
                 sv = vsb[k]
                 vo = vb[k]
-                vn = vo + h2 * (acc[k] + c._accel(f2, 0.0, sv, 1.0, mp, friction))
+                vn = vo + h2 * (acc[k] + _accel(f2, 0.0, sv, 1.0, mp, friction))
                 keep = vn > 0.0
                 x[i] = x[i] + h2 * (vo + sv)
                 v[i] = vn if keep else 0.0
@@ -404,7 +434,7 @@ def run_sparse(
                 cnt[l] -= 1
                 cnt[r] -= 1
             for k in range(nsl):
-                trig[still[k]] = c._NEVER
+                trig[still[k]] = _NEVER
             # Stopped blocks next to a block that moved: their force changed, so evaluate their
             # start rule in the next step (cheaper than finding a start step while a front passes).
             nq = 0
@@ -436,8 +466,8 @@ def run_sparse(
             for k in range(nsl + ns):
                 i = still[k] if k < nsl else stopped[k - nsl]
                 if trig[i] != _QUEUED:
-                    m = c._plate_trigger(
-                        x[i - one], x[i], x[i + one], c._threshold(th[i], Fs, threshold), K, Kp, V, dt, n + 1, n_end
+                    m = _plate_trigger(
+                        x[i - one], x[i], x[i + one], _threshold(th[i], Fs, threshold), K, Kp, V, dt, n + 1, n_end
                     )
                     nq, t_next = _settle(i, m, n + 1, trig, queue, nq, t_next)
             if ns > 0:
@@ -445,7 +475,7 @@ def run_sparse(
             qexact = ns == 0
         nmov = na - ns
         if active and nmov == 0:
-            c._end_event(
+            _end_event(
                 n, x, first_step, x0ev, ist, ev_int, ev_S, fm, prof_x, prof_meta, N, profile_every, profile_min_blocks
             )
             active = False
@@ -453,9 +483,9 @@ def run_sparse(
         n += 1
     if steps_computed > 0:
         # Ghost cells of theta as run_dense leaves them (x's are set).
-        c._set_ghosts(x, th, N, 0.0, drive, ends)
-        ist[c.N_MOVING] = nmov
-    ist[c.BLOCK_UPDATES] += block_updates
-    ist[c.FULL_UPDATES] += full_updates
-    ist[c.STEPS_COMPUTED] += steps_computed
+        _set_ghosts(x, th, N, 0.0, drive, ends)
+        ist[N_MOVING] = nmov
+    ist[BLOCK_UPDATES] += block_updates
+    ist[FULL_UPDATES] += full_updates
+    ist[STEPS_COMPUTED] += steps_computed
     return st

@@ -16,12 +16,12 @@ from typing import Any
 import numpy as np
 
 from stickslip import __version__
-from stickslip.kernels import chain as K
+from stickslip.kernels import layout
 from stickslip.run.errors import ChainRunError
 from stickslip.run.outputs import PART_KEYS, _Outputs
 from stickslip.run.state import ChainState
 
-# Bump whenever the layout of the state arrays (kernels.chain.IST_SIZE included) changes.
+# Bump whenever the layout of the state arrays (kernels.layout.IST_SIZE included) changes.
 CHECKPOINT_FORMAT = 2
 
 
@@ -79,7 +79,7 @@ def _check_layout(arrays: dict[str, np.ndarray], header: dict[str, Any]) -> None
         "mov": (np.float64, (N + 2,)),
         "x0ev": (np.float64, (N + 2,)),
         "first_step": (np.int64, (N + 2,)),
-        "ist": (np.int64, (K.IST_SIZE,)),
+        "ist": (np.int64, (layout.IST_SIZE,)),
     }
     for name, (dtype, shape) in expected.items():
         a = arrays[name]
@@ -115,7 +115,9 @@ class Checkpointer:
         digest = _write_npz(self.dir / name, new, {"format": CHECKPOINT_FORMAT})
         self.parts.append({"file": name, "sha256": digest})
         arrays = {k: getattr(state, k) for k in ChainState.ARRAYS}
-        full_header = dict(header, format=CHECKPOINT_FORMAT, parts=self.parts, version=__version__, ist_size=K.IST_SIZE)
+        full_header = dict(
+            header, format=CHECKPOINT_FORMAT, parts=self.parts, version=__version__, ist_size=layout.IST_SIZE
+        )
         _write_npz(self.state_path, arrays, full_header)
         return self.state_path
 

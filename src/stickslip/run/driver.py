@@ -5,7 +5,7 @@
 
 * ``dense``: the reference, Heun over every block at every step;
 * ``exact`` (default): the same arithmetic, skipping only work whose result is known in
-  advance (see :mod:`stickslip.kernels.chain`).
+  advance (see :mod:`stickslip.kernels.laws` and :mod:`stickslip.kernels.exact`).
 
 A run returns a :class:`ChainRun`: the slip-event table (docs/model.md, "Slip events"), the time
 each block first moved in each event (rupture fronts, Fig. 6), L(t) = x_1 - x_N sampled at a
@@ -37,7 +37,7 @@ from typing import Any
 import numpy as np
 
 from stickslip import heartbeat
-from stickslip.kernels import chain as K
+from stickslip.kernels import dense, entry, exact, layout
 from stickslip.models.params import ChainParams, ParameterError, check_number, steps_for
 
 # The checkpoint file helpers (_read_npz, _write_npz) are named here too, for checks of the files.
@@ -71,7 +71,7 @@ __all__ = [
 
 INTEGRATORS = ("exact", "dense")
 
-_KERNELS = {"dense": K.run_dense, "exact": K.run_exact}
+_KERNELS = {"dense": dense.run_dense, "exact": exact.run_exact}
 
 
 @dataclass
@@ -144,17 +144,17 @@ def _finite(state: ChainState) -> bool:
 
 
 def _par(p: ChainParams) -> np.ndarray:
-    par = np.zeros(K.PAR_SIZE)
-    par[K.P_K], par[K.P_D], par[K.P_V] = p.K, p.D, p.V
-    par[K.P_BETA], par[K.P_ALPHA], par[K.P_FS], par[K.P_DT] = p.beta, p.alpha, p.Fs, p.dt
-    par[K.P_KP], par[K.P_SIGMA], par[K.P_F0] = p.Kp, p.sigma, p.F0
+    par = np.zeros(layout.PAR_SIZE)
+    par[layout.P_K], par[layout.P_D], par[layout.P_V] = p.K, p.D, p.V
+    par[layout.P_BETA], par[layout.P_ALPHA], par[layout.P_FS], par[layout.P_DT] = p.beta, p.alpha, p.Fs, p.dt
+    par[layout.P_KP], par[layout.P_SIGMA], par[layout.P_F0] = p.Kp, p.sigma, p.F0
     return par
 
 
 class _Kernel:
     """One integrator compiled for one model: ``kernel(state, target)`` advances the state.
 
-    The model's pieces are compile-time constants of the kernels (:func:`kernels.chain.specialise`).
+    The model's pieces are compile-time constants of the kernels (:func:`stickslip.kernels.entry.specialise`).
     """
 
     def __init__(self, name, params, state, scratch, par, outputs, sample_every, profile_every, min_blocks):
@@ -163,7 +163,7 @@ class _Kernel:
         self.tail = (sample_every, profile_every, min_blocks)
         self.pieces = params.codes
         probe = self._args(state) + (np.int64(0),) + tuple(np.int64(t) for t in self.tail)
-        self.entry = K.specialise(_KERNELS[name], probe, self.pieces)
+        self.entry = entry.specialise(_KERNELS[name], probe, self.pieces)
 
     def _args(self, state):
         return (
@@ -250,7 +250,7 @@ def run_chain(
         start_info = {"kind": start, "perturbation": perturbation, "seed": seed}
         for message in loading_warnings(params, options.t_end, options.average_from, start):
             warnings.warn(message, ShortRunWarning, stacklevel=2)
-    state.ist[K.NEXT_SAMPLE] = state.step
+    state.ist[layout.NEXT_SAMPLE] = state.step
     outputs = _Outputs(params.N, options.profile_window is not None)
     return _drive(
         params,
@@ -449,7 +449,7 @@ def _drive(
                 if n >= n_end:
                     # One more call services outputs due at the final step (its sample).
                     status = kernel(state, n_end)
-                    if status != K.DONE and status != K.NONFINITE:
+                    if status != layout.DONE and status != layout.NONFINITE:
                         outputs.flush(state.ist)
                         continue
                     break
@@ -474,19 +474,19 @@ def _drive(
                         options.profile_min_blocks,
                     )
                     status = reference(state, target)
-                if status == K.NONFINITE:
-                    bad = int(state.ist[K.BAD_BLOCK])
+                if status == layout.NONFINITE:
+                    bad = int(state.ist[layout.BAD_BLOCK])
                     raise NonFiniteState(
                         f"state became non-finite at t = {state.step * params.dt:.6g} (step {state.step}) "
                         f"in block {bad}"
                     )
-                if status != K.DONE:
+                if status != layout.DONE:
                     outputs.flush(state.ist)
                 # Aim at about a quarter second per call: responsive to signals and progress.
-                if status == K.DONE and elapsed > 0:
+                if status == layout.DONE and elapsed > 0:
                     chunk = int(min(max(chunk * 0.25 / elapsed, 10_000), 50_000_000))
                 now = time.perf_counter()
-                bar.update(state.step * params.dt, int(state.ist[K.N_EVENTS]))
+                bar.update(state.step * params.dt, int(state.ist[layout.N_EVENTS]))
                 stop = flag.set or (stop_requested is not None and stop_requested())
                 if checkpointer is not None and (
                     stop or (checkpoint_interval is not None and now - last_ckpt >= checkpoint_interval)
@@ -543,23 +543,23 @@ class Stepper:
     def advance(self, state: ChainState, step: int) -> tuple[ChainState, int]:
         """Advance ``state`` in place to ``step``; returns it and the slip events completed."""
         ist = state.ist
-        events0 = int(ist[K.N_EVENTS])
-        ist[K.NEXT_SAMPLE] = np.iinfo(np.int64).max
+        events0 = int(ist[layout.N_EVENTS])
+        ist[layout.NEXT_SAMPLE] = np.iinfo(np.int64).max
         while True:
             before = state.copy() if self.integrator == "exact" else None
             status = self._kernel(self.integrator, state)(state, step)
             if before is not None and not _finite(state):
                 state.__dict__.update(before.__dict__)
                 status = self._kernel("dense", state)(state, step)
-            if status == K.NONFINITE:
+            if status == layout.NONFINITE:
                 raise NonFiniteState(
                     f"state became non-finite at t = {state.step * self.params.dt:.6g} "
-                    f"(step {state.step}) in block {int(ist[K.BAD_BLOCK])}"
+                    f"(step {state.step}) in block {int(ist[layout.BAD_BLOCK])}"
                 )
-            ist[K.EV_COUNT] = ist[K.FM_COUNT] = ist[K.S_COUNT] = ist[K.P_COUNT] = 0
-            ist[K.EV_P_FIRST] = 0
-            if status == K.DONE:
-                return state, int(ist[K.N_EVENTS]) - events0
+            ist[layout.EV_COUNT] = ist[layout.FM_COUNT] = ist[layout.S_COUNT] = ist[layout.P_COUNT] = 0
+            ist[layout.EV_P_FIRST] = 0
+            if status == layout.DONE:
+                return state, int(ist[layout.N_EVENTS]) - events0
 
 
 def drop_checkpoint(run_dir: str | Path) -> None:

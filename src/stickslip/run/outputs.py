@@ -15,7 +15,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from stickslip.kernels import chain as K
+from stickslip.kernels import layout
 from stickslip.models import physics
 from stickslip.models.params import MAX_STEPS, ChainParams, ParameterError, check_number, steps_for
 from stickslip.run.state import ChainState
@@ -127,7 +127,7 @@ class _Outputs:
     """Output buffers shared with the kernels, and what has been flushed from them."""
 
     def __init__(self, N: int, profiling: bool):
-        self.ev_int = np.zeros((4096, K.EV_INT_COLS), dtype=np.int64)
+        self.ev_int = np.zeros((4096, layout.EV_INT_COLS), dtype=np.int64)
         self.ev_S = np.zeros(4096)
         self.fm = np.zeros((max(65536, 4 * (N + 1)), 3), dtype=np.int64)
         self.samp_L = np.zeros(65536)
@@ -142,7 +142,12 @@ class _Outputs:
 
     def flush(self, ist: np.ndarray) -> None:
         """Move filled buffer rows into Python-side lists and reset the counts."""
-        ne, nf, ns, npr = (int(ist[K.EV_COUNT]), int(ist[K.FM_COUNT]), int(ist[K.S_COUNT]), int(ist[K.P_COUNT]))
+        ne, nf, ns, npr = (
+            int(ist[layout.EV_COUNT]),
+            int(ist[layout.FM_COUNT]),
+            int(ist[layout.S_COUNT]),
+            int(ist[layout.P_COUNT]),
+        )
         if ne:
             self.parts["ev_int"].append(self.ev_int[:ne].copy())
             self.parts["ev_S"].append(self.ev_S[:ne].copy())
@@ -154,8 +159,8 @@ class _Outputs:
         if npr:
             self.parts["prof_x"].append(self.prof_x[:npr].copy())
             self.parts["prof_meta"].append(self.prof_meta[:npr].copy())
-        ist[K.EV_COUNT] = ist[K.FM_COUNT] = ist[K.S_COUNT] = ist[K.P_COUNT] = 0
-        ist[K.EV_P_FIRST] = 0
+        ist[layout.EV_COUNT] = ist[layout.FM_COUNT] = ist[layout.S_COUNT] = ist[layout.P_COUNT] = 0
+        ist[layout.EV_P_FIRST] = 0
 
     def add_snapshot(self, step: int, x: np.ndarray) -> None:
         self.parts["snap_step"].append(np.array([step], dtype=np.int64))
@@ -180,7 +185,7 @@ class _Outputs:
 PART_KEYS = ("ev_int", "ev_S", "fm", "samp_L", "samp_step", "prof_x", "prof_meta", "snap_step", "snap_x", "moving")
 _PART_SHAPES = {
     "moving": (0, 2),
-    "ev_int": (0, K.EV_INT_COLS),
+    "ev_int": (0, layout.EV_INT_COLS),
     "ev_S": (0,),
     "fm": (0, 3),
     "samp_L": (0,),
@@ -213,16 +218,16 @@ def _assemble(params, options, integrator, start_info, state, outputs, wall, ste
     ev = parts["ev_int"]
     events = pd.DataFrame(
         {
-            "event": ev[:, K.E_ID],
-            "step_start": ev[:, K.E_START_STEP],
-            "step_end": ev[:, K.E_END_STEP],
-            "t_start": ev[:, K.E_START_STEP] * dt,
-            "t_end": (ev[:, K.E_END_STEP] + 1) * dt,
-            "duration": (ev[:, K.E_END_STEP] + 1 - ev[:, K.E_START_STEP]) * dt,
+            "event": ev[:, layout.E_ID],
+            "step_start": ev[:, layout.E_START_STEP],
+            "step_end": ev[:, layout.E_END_STEP],
+            "t_start": ev[:, layout.E_START_STEP] * dt,
+            "t_end": (ev[:, layout.E_END_STEP] + 1) * dt,
+            "duration": (ev[:, layout.E_END_STEP] + 1 - ev[:, layout.E_START_STEP]) * dt,
             "S": parts["ev_S"],
-            "start_block": ev[:, K.E_START_BLOCK],
-            "max_block": ev[:, K.E_MAX_BLOCK],
-            "n_blocks": ev[:, K.E_N_BLOCKS],
+            "start_block": ev[:, layout.E_START_BLOCK],
+            "max_block": ev[:, layout.E_MAX_BLOCK],
+            "n_blocks": ev[:, layout.E_N_BLOCKS],
         },
         columns=EVENT_COLUMNS,
     )
@@ -282,7 +287,7 @@ def _assemble(params, options, integrator, start_info, state, outputs, wall, ste
         **params.pieces,
         **_model_note(params),
         "n_events": int(len(events)),
-        "event_in_progress": bool(state.ist[K.EV_ACTIVE]),
+        "event_in_progress": bool(state.ist[layout.EV_ACTIVE]),
         "L_final": L_final,
         "L_mean": L_mean,
         "L_mean_from": avg_from,
@@ -290,12 +295,12 @@ def _assemble(params, options, integrator, start_info, state, outputs, wall, ste
         "t_end": options.t_end if steady_at else state.step * dt,
         "t_reached": state.step * dt,
         "steps": state.step,
-        "steps_computed": int(state.ist[K.STEPS_COMPUTED]),
-        "block_updates": int(state.ist[K.BLOCK_UPDATES]),
-        "full_block_updates": int(state.ist[K.FULL_UPDATES])
+        "steps_computed": int(state.ist[layout.STEPS_COMPUTED]),
+        "block_updates": int(state.ist[layout.BLOCK_UPDATES]),
+        "full_block_updates": int(state.ist[layout.FULL_UPDATES])
         if integrator == "exact"
-        else int(state.ist[K.BLOCK_UPDATES]),
-        "n_moving": int(state.ist[K.N_MOVING]),
+        else int(state.ist[layout.BLOCK_UPDATES]),
+        "n_moving": int(state.ist[layout.N_MOVING]),
         "wall_seconds": wall,
         "integrator": integrator,
         "state_sha256": state.sha256(),

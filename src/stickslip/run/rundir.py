@@ -24,7 +24,7 @@ import numpy as np
 import xarray as xr
 
 from stickslip import __version__
-from stickslip.kernels import chain as K
+from stickslip.kernels import layout
 from stickslip.models.params import ChainParams
 from stickslip.run.outputs import ChainRun, RunOptions
 from stickslip.run.state import ChainState
@@ -186,7 +186,7 @@ def _load_run(run_dir: Path) -> ChainRun:
     state = ChainState.from_blocks(
         ds["x"].values, ds["v"].values, ds["theta"].values, ds["stopped"].values.astype(bool)
     )
-    state.ist[K.STEP] = int(meta["summary"]["steps"])
+    state.ist[layout.STEP] = int(meta["summary"]["steps"])
     samples = xr.Dataset({"L": ("t", ds["L"].values)}, coords={"t": ds["t_sample"].values})
     if "n_moving" in ds:
         samples["n_moving"] = xr.DataArray(ds["n_moving"].values, dims="t_moving")

@@ -1,6 +1,6 @@
 """The state of the chain of eq. (4): :class:`ChainState`, the initial states, the distance from steady sliding.
 
-The arrays carry ghost cells at index 0 and N + 1 (see :mod:`stickslip.kernels.chain`); the
+The arrays carry ghost cells at index 0 and N + 1 (see :mod:`stickslip.kernels.layout`); the
 initial states are the paper's (section 3) and exact discrete steady sliding (docs/model.md).
 """
 
@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from stickslip.kernels import chain as K
+from stickslip.kernels import layout
 from stickslip.models import physics
 from stickslip.models.params import ChainParams, ParameterError
 
@@ -43,7 +43,7 @@ class ChainState:
 
     @property
     def step(self) -> int:
-        return int(self.ist[K.STEP])
+        return int(self.ist[layout.STEP])
 
     @classmethod
     def from_blocks(cls, x, v, theta, stopped) -> ChainState:
@@ -60,10 +60,10 @@ class ChainState:
         mov = np.zeros(N + 2)
         mov[1:-1] = np.where(stopped, 0.0, 1.0)
         arrays["v"][1:-1] = np.where(stopped, 0.0, arrays["v"][1:-1])
-        ist = np.zeros(K.IST_SIZE, dtype=np.int64)
-        ist[K.N_MOVING] = int(np.count_nonzero(~stopped))
-        ist[K.ACT_LO], ist[K.ACT_HI] = 1, N
-        ist[K.MECH_LO], ist[K.MECH_HI] = 1, N
+        ist = np.zeros(layout.IST_SIZE, dtype=np.int64)
+        ist[layout.N_MOVING] = int(np.count_nonzero(~stopped))
+        ist[layout.ACT_LO], ist[layout.ACT_HI] = 1, N
+        ist[layout.MECH_LO], ist[layout.MECH_HI] = 1, N
         return cls(
             first_step=np.full(N + 2, -1, dtype=np.int64),
             x0ev=np.zeros(N + 2),

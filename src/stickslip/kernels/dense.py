@@ -1,0 +1,137 @@
+"""The reference integrator of the chain (eq. 4 and its relatives, docs/model.md): Heun over every
+block at every step, written plainly. The fast paths (:mod:`stickslip.kernels.exact`,
+:mod:`stickslip.kernels.plate`) give its answer bit for bit.
+"""
+
+from __future__ import annotations
+
+from numba import njit
+
+from stickslip.kernels.events import _end_event, _overflow, _service, _start_and_first_moves
+from stickslip.kernels.laws import _accel, _dtheta, _force, _pull, _set_ghosts, _threshold
+from stickslip.kernels.layout import (
+    _BIG,
+    BAD_BLOCK,
+    BLOCK_UPDATES,
+    DONE,
+    EV_ACTIVE,
+    EV_COUNT,
+    FM_COUNT,
+    N_MOVING,
+    NEXT_PROFILE,
+    NEXT_SAMPLE,
+    NONFINITE,
+    P_COUNT,
+    STEP,
+    STEPS_COMPUTED,
+    _unpack,
+)
+
+
+@njit(cache=True)
+def run_dense(
+    x,
+    v,
+    th,
+    mov,
+    xs,
+    vs,
+    ths,
+    mm,
+    a1,
+    b1,
+    trig,
+    first_step,
+    x0ev,
+    ist,
+    par,
+    ev_int,
+    ev_S,
+    fm,
+    samp_L,
+    samp_step,
+    prof_x,
+    prof_meta,
+    n_end,
+    sample_every,
+    profile_every,
+    profile_min_blocks,
+    drive,
+    friction,
+    threshold,
+    ends,
+):
+    """Reference integrator of the chain (eq. 4 and its relatives): Heun over every block at
+    every step, written plainly.
+
+    Advances the state arrays to step ``n_end`` or until an output buffer is full; returns a
+    status code (:mod:`stickslip.kernels.layout`, which also lists the pieces). The step is in
+    :mod:`stickslip.kernels.laws`, the events in :mod:`stickslip.kernels.events`. ``trig`` is
+    scratch of :func:`stickslip.kernels.exact.run_exact`, unused here.
+    """
+    N = x.shape[0] - 2
+    mp, V, dt = _unpack(par)
+    K, Kp, Fs = mp[0], mp[1], mp[5]
+    h2 = 0.5 * dt
+    cap_ev, cap_fm, cap_p = ev_int.shape[0], fm.shape[0], prof_x.shape[0]
+    while True:
+        n = ist[STEP]
+        # Outputs due, the end, buffers that could overflow. Written out here rather than in a
+        # helper: as a function this costs several times a short step (measured).
+        if n == ist[NEXT_SAMPLE] or (profile_every > 0 and ist[EV_ACTIVE] == 1 and n == ist[NEXT_PROFILE]):
+            st = _service(n, x, N, ist, samp_L, samp_step, prof_x, prof_meta, sample_every, profile_every)
+            if st != DONE:
+                return st
+        if n >= n_end:
+            return DONE
+        if ist[EV_COUNT] >= cap_ev or ist[FM_COUNT] + N > cap_fm or (profile_every > 0 and ist[P_COUNT] + 2 > cap_p):
+            return _overflow(ist, N, cap_ev, cap_fm)
+        p1 = _pull(V, n, dt)
+        _set_ghosts(x, th, N, p1, drive, ends)
+        for i in range(1, N + 1):
+            f = _force(x[i - 1], x[i], x[i + 1], K, Kp, p1, drive)
+            if mov[i] != 0.0 or f > _threshold(th[i], Fs, threshold):
+                mm[i] = 1.0
+            else:
+                mm[i] = 0.0
+            a1[i] = _accel(f, th[i], v[i], mm[i], mp, friction)
+            b1[i] = _dtheta(th[i - 1], th[i], th[i + 1], v[i], mp, friction)
+            xs[i] = x[i] + dt * v[i]
+            vs[i] = v[i] + dt * a1[i]
+            ths[i] = th[i] + dt * b1[i]
+        p2 = _pull(V, n + 1, dt)
+        _set_ghosts(xs, ths, N, p2, drive, ends)
+        _start_and_first_moves(n, 1, N, x, mm, first_step, x0ev, ist, prof_x, prof_meta, N, profile_every)
+        n_moving = 0
+        bad = 0
+        for i in range(1, N + 1):
+            f2 = _force(xs[i - 1], xs[i], xs[i + 1], K, Kp, p2, drive)
+            a2 = _accel(f2, ths[i], vs[i], mm[i], mp, friction)
+            b2 = _dtheta(ths[i - 1], ths[i], ths[i + 1], vs[i], mp, friction)
+            th[i] = th[i] + h2 * (b1[i] + b2)
+            if mm[i] != 0.0:
+                x[i] = x[i] + h2 * (v[i] + vs[i])
+                vn = v[i] + h2 * (a1[i] + a2)
+                if vn <= 0.0:
+                    v[i] = 0.0
+                    mov[i] = 0.0
+                else:
+                    v[i] = vn
+                    mov[i] = 1.0
+                    n_moving += 1
+            else:
+                v[i] = 0.0
+                mov[i] = 0.0
+            if bad == 0 and not (abs(x[i]) <= _BIG and abs(v[i]) <= _BIG and abs(th[i]) <= _BIG):
+                bad = i
+        ist[N_MOVING] = n_moving
+        ist[BLOCK_UPDATES] += N
+        ist[STEPS_COMPUTED] += 1
+        ist[STEP] = n + 1
+        if bad > 0:
+            ist[BAD_BLOCK] = bad
+            return NONFINITE
+        if ist[EV_ACTIVE] == 1 and n_moving == 0:
+            _end_event(
+                n, x, first_step, x0ev, ist, ev_int, ev_S, fm, prof_x, prof_meta, N, profile_every, profile_min_blocks
+            )

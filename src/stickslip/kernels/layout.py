@@ -1,0 +1,119 @@
+"""Layout of the chain kernels' arrays and codes: the indices of the int64 state vector
+``ist`` and the float64 parameter vector ``par``, the pieces' codes, the event buffer's
+columns and the status codes (eq. 4 and its relatives, docs/model.md).
+
+A model is a choice of four pieces (docs/model.md, "The family the paper stands in"), passed to
+every kernel as compile-time constants (numba integer literals), so that each composition is
+compiled into its own machine code with the branches on pieces removed:
+
+* drive ``DRIVE_END``: a pulling point x_0 = V t joined to block 1 (eq. 4);
+  ``DRIVE_PLATE``: every block joined to a plate at V t by a leaf spring Kp (Burridge-Knopoff,
+  Carlson-Langer): f_i gains Kp (V t - x_i);
+* friction of a moving block ``FRICTION_STATE``: theta_i + beta v_i with the theta equation
+  of eq. (4); ``FRICTION_WEAKENING``: phi(v) = (1 - sigma) / (1 + 2 alpha max(v, 0) / (1 - sigma))
+  (Carlson-Langer); ``FRICTION_STRENGTHENING``: F0 + beta v (train model), no state variable;
+* static threshold ``THRESHOLD_CONSTANT``: Fs; ``THRESHOLD_STATE``: theta_i;
+* ends ``ENDS_FREE``: x_{N+1} = x_N (plate drive: also x_0 = x_1); ``ENDS_FIXED``: x_{N+1} = 0
+  (plate drive: also x_0 = 0); ``ENDS_PERIODIC``: x_0 = x_N, x_{N+1} = x_1 (plate drive only).
+
+Blocks i = 1..N live at index i of arrays of length N + 2; index 0 and N + 1 are ghost cells
+set from the drive and the ends (:func:`stickslip.kernels.laws._set_ghosts`). The state
+variable has no-flux ends, th[0] = th[1] and th[N+1] = th[N] (periodic ends: th[0] = th[N],
+th[N+1] = th[1]); models without a state variable leave theta untouched. ``mov`` holds 1.0
+for a moving block and 0.0 for a stopped one, so a stopped block's acceleration is
+``0 * (...)``.
+
+Kernels return a status code; the driver empties the output buffers and calls again. All
+state lives in the arrays passed in, so a run can stop and resume at any step boundary.
+
+The kernels of the chain: :mod:`~stickslip.kernels.laws` (the step's expressions),
+:mod:`~stickslip.kernels.events` (outputs and event bookkeeping),
+:mod:`~stickslip.kernels.triggers` (which stopped block the drive starts, and when),
+:mod:`~stickslip.kernels.dense` (the reference), :mod:`~stickslip.kernels.stages` and
+:mod:`~stickslip.kernels.exact` (the fast interval path), :mod:`~stickslip.kernels.plate`
+(the fast sparse path of the plate drive) and :mod:`~stickslip.kernels.entry` (one compiled
+entry point per model).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+# Indices into the int64 state vector ``ist``.
+STEP = 0  # n: the state held is at t_n = n dt
+N_MOVING = 1  # blocks moving at t_n
+EV_ACTIVE = 2  # 1 while an event is in progress
+EV_START_STEP = 3  # step in which the event's first block moved
+EV_START_BLOCK = 4
+EV_MAX_BLOCK = 5  # farthest block moved so far in the event
+EV_N_MOVED = 6  # blocks moved so far in the event
+ACT_LO = 7  # blocks that may change in the next step: [ACT_LO, ACT_HI] (empty if lo > hi)
+ACT_HI = 8
+N_EVENTS = 9  # events completed since the start of the run (the next event's id)
+EV_COUNT = 10  # rows filled in the event buffer
+FM_COUNT = 11  # rows filled in the first-move buffer
+S_COUNT = 12  # samples filled in the sample buffer
+P_COUNT = 13  # rows filled in the profile buffer
+EV_P_FIRST = 14  # first profile row of the current event in the buffer
+NEXT_PROFILE = 15  # next step at which a profile row is due
+BAD_BLOCK = 16  # block found non-finite (status NONFINITE)
+BLOCK_UPDATES = 17  # block updates performed (stage 2), for profiling
+STEPS_COMPUTED = 18  # steps actually computed (not jumped over)
+NEXT_SAMPLE = 19  # next step at which L = x_1 - x_N is sampled
+MECH_LO = 20  # blocks that may move in the next step: [MECH_LO, MECH_HI] (exact only)
+MECH_HI = 21
+FULL_UPDATES = 22  # block updates of exact that were full (the rest updated the state variable alone)
+IST_SIZE = 23
+
+# Indices into the float64 parameter vector ``par``.
+P_K, P_D, P_V, P_BETA, P_ALPHA, P_FS, P_DT, P_KP, P_SIGMA, P_F0 = range(10)
+PAR_SIZE = 10
+
+# The pieces of a model (compile-time constants of every kernel).
+DRIVE_END, DRIVE_PLATE = 0, 1
+FRICTION_STATE, FRICTION_WEAKENING, FRICTION_STRENGTHENING = 0, 1, 2
+THRESHOLD_CONSTANT, THRESHOLD_STATE = 0, 1
+ENDS_FREE, ENDS_FIXED, ENDS_PERIODIC = 0, 1, 2
+
+# Columns of the int64 event buffer ``ev_int``.
+E_ID, E_START_STEP, E_END_STEP, E_START_BLOCK, E_MAX_BLOCK, E_N_BLOCKS = range(6)
+EV_INT_COLS = 6
+
+# Status codes returned by the kernels.
+DONE = 0
+EVENTS_FULL = 1
+FIRST_MOVES_FULL = 2
+SAMPLES_FULL = 3
+PROFILES_FULL = 4
+NONFINITE = 5
+
+_BIG = np.float64(1.7976931348623157e308)
+_NEVER = np.int64(9223372036854775807)
+
+
+@njit(cache=True, inline="always")
+def _merge(a_lo, a_hi, b_lo, b_hi):
+    """Hull of two intervals of blocks, either of which may be empty (lo > hi)."""
+    if b_lo > b_hi:
+        return a_lo, a_hi
+    if a_lo > a_hi:
+        return b_lo, b_hi
+    return min(a_lo, b_lo), max(a_hi, b_hi)
+
+
+@njit(cache=True, inline="always")
+def _unpack(par):
+    """(K, Kp, beta, alpha, D, Fs, 1 - sigma, 2 alpha, F0), V and dt from the parameter vector."""
+    mp = (
+        par[P_K],
+        par[P_KP],
+        par[P_BETA],
+        par[P_ALPHA],
+        par[P_D],
+        par[P_FS],
+        1.0 - par[P_SIGMA],
+        2.0 * par[P_ALPHA],
+        par[P_F0],
+    )
+    return mp, par[P_V], par[P_DT]

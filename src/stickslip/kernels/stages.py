@@ -1,0 +1,258 @@
+"""The Heun stages of the fast interval path (:mod:`stickslip.kernels.exact`) over a contiguous
+interval of blocks: the general stages with the start and stop rules, the all-sliding stages,
+and the stages of blocks known to stay stopped, which change their state variable alone
+(eq. 4, docs/model.md; the step is in :mod:`stickslip.kernels.laws`).
+
+Each evaluates every quantity with the expressions of :mod:`stickslip.kernels.laws`, in the
+reference's order, so the result equals :func:`stickslip.kernels.dense.run_dense` bit for bit.
+The loops are branch-free and index the blocks with unsigned integers, so that the compiler
+drops the negative-index handling and vectorises them (views that begin at block lo - 1 do the
+same, but setting up ten views costs more than a short interval's update: measured).
+
+A vectorised loop does 8 blocks per iteration and the rest one at a time, at about four times
+the cost of a block in the vector part; each loop also checks at entry, array pair by array
+pair, that its arrays do not overlap (numba cannot say so). So a few long loops per step are
+cheap, many short ones are not: the exact path runs the blocks that move throughout as one
+run (:func:`_stage1_run`, :func:`_stage2_run`, which skip the start rule and the bookkeeping
+of changes).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from stickslip.kernels.laws import _accel, _dtheta, _force, _threshold
+
+
+@njit(cache=True, _nrt=False, inline="always")
+def _stage1(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, p, mp, dt, drive, friction, threshold):
+    """Start rule, stage-1 derivatives and predictor for blocks lo..hi (branch-free).
+
+    Returns the first and the last block that move in this step (lo > hi if none) and
+    whether a stopped block starts.
+    """
+    K, Kp, Fs = mp[0], mp[1], mp[5]
+    one = np.uint64(1)
+    u0 = np.uint64(lo)
+    n = hi - lo + 1
+    first = n
+    last = -1
+    starts = False
+    for k in range(n):
+        i = u0 + np.uint64(k)
+        f = _force(x[i - one], x[i], x[i + one], K, Kp, p, drive)
+        mo = mov[i]
+        m = 1.0 if f > _threshold(th[i], Fs, threshold) else mo
+        mm[i] = m
+        first = min(first, k if m != 0.0 else n)
+        last = max(last, k if m != 0.0 else -1)
+        starts |= m != mo
+        a = _accel(f, th[i], v[i], m, mp, friction)
+        b = _dtheta(th[i - one], th[i], th[i + one], v[i], mp, friction)
+        a1[i] = a
+        b1[i] = b
+        xs[i] = x[i] + dt * v[i]
+        vs[i] = v[i] + dt * a
+        ths[i] = th[i] + dt * b
+    return first + lo, last + lo, starts
+
+
+@njit(cache=True, inline="always")
+def _stage1_all(x, v, th, xs, vs, ths, a1, b1, N, p, mp, dt, drive, friction):
+    """Stage 1 over the whole chain when every block moves (no start can happen).
+
+    The mid-step mask is 1 everywhere and is not stored: no later use reads it.
+    """
+    K, Kp = mp[0], mp[1]
+    for i in range(1, N + 1):
+        f = _force(x[i - 1], x[i], x[i + 1], K, Kp, p, drive)
+        a = _accel(f, th[i], v[i], 1.0, mp, friction)
+        b = _dtheta(th[i - 1], th[i], th[i + 1], v[i], mp, friction)
+        a1[i] = a
+        b1[i] = b
+        xs[i] = x[i] + dt * v[i]
+        vs[i] = v[i] + dt * a
+        ths[i] = th[i] + dt * b
+
+
+@njit(cache=True, inline="always")
+def _stage2_all(x, v, th, xs, vs, ths, a1, b1, N, p, mp, h2, drive, friction):
+    """Stage 2, corrector and stop rule over the whole chain when every block moves.
+
+    Skips the bookkeeping of changes (every block is kept active) and returns only whether
+    some block stopped. The moving flags are not written: after the step a block moves
+    exactly when its v > 0, and the caller rebuilds them from v when a block stopped.
+    """
+    K, Kp = mp[0], mp[1]
+    stops = False
+    for i in range(1, N + 1):
+        f2 = _force(xs[i - 1], xs[i], xs[i + 1], K, Kp, p, drive)
+        a2 = _accel(f2, ths[i], vs[i], 1.0, mp, friction)
+        b2 = _dtheta(ths[i - 1], ths[i], ths[i + 1], vs[i], mp, friction)
+        x[i] = x[i] + h2 * (v[i] + vs[i])
+        vn = v[i] + h2 * (a1[i] + a2)
+        th[i] = th[i] + h2 * (b1[i] + b2)
+        keep = vn > 0.0
+        v[i] = vn if keep else 0.0
+        stops |= not keep
+    return stops
+
+
+@njit(cache=True, _nrt=False, inline="always")
+def _stage1_theta(x, v, th, xs, vs, ths, mm, b1, lo, hi, mp, dt, friction):
+    """Stage 1 for blocks lo..hi known to stay stopped in this step (mid-step mask 0).
+
+    For such a block v = 0 and the acceleration is 0 * (...), so the full stage gives
+    xs = x, vs = v exactly; only the state variable needs its derivative.
+    """
+    one = np.uint64(1)
+    for i in range(np.uint64(lo), np.uint64(hi) + one):
+        b = _dtheta(th[i - one], th[i], th[i + one], v[i], mp, friction)
+        b1[i] = b
+        xs[i] = x[i] + dt * v[i]
+        vs[i] = v[i]
+        ths[i] = th[i] + dt * b
+        mm[i] = 0.0
+
+
+@njit(cache=True, _nrt=False)
+def _stage1_theta_only(v, th, ths, b1, lo, hi, mp, dt, friction):
+    """Stage 1 for blocks lo..hi in a step in which no block moves.
+
+    Then nothing reads the predictors of x and v or the mask, so only the state variable's
+    derivative and predictor are written (see _stage1_theta for why this is exact).
+    """
+    one = np.uint64(1)
+    for i in range(np.uint64(lo), np.uint64(hi) + one):
+        b = _dtheta(th[i - one], th[i], th[i + one], v[i], mp, friction)
+        b1[i] = b
+        ths[i] = th[i] + dt * b
+
+
+@njit(cache=True, _nrt=False, inline="always")
+def _stage2_theta(th, ths, v, b1, lo, hi, mp, h2, friction):
+    """Stage 2 and corrector of the state variable alone, for blocks lo..hi that stay stopped.
+
+    Their x, v and stopped flag provably keep every bit (see _stage1_theta), and their
+    predicted velocity equals v = 0, which is read instead. Returns the first and last block
+    whose state variable changed (lo > hi if none).
+    """
+    one = np.uint64(1)
+    u0 = np.uint64(lo)
+    n = hi - lo + 1
+    c_lo = n
+    c_hi = -1
+    for k in range(n):
+        i = u0 + np.uint64(k)
+        b2 = _dtheta(ths[i - one], ths[i], ths[i + one], v[i], mp, friction)
+        tho = th[i]
+        thn = tho + h2 * (b1[i] + b2)
+        th[i] = thn
+        ch = thn != tho
+        c_lo = min(c_lo, k if ch else n)
+        c_hi = max(c_hi, k if ch else -1)
+    return c_lo + lo, c_hi + lo
+
+
+@njit(cache=True, _nrt=False, inline="always")
+def _stage2(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, p, mp, h2, drive, friction):
+    """Stage 2, corrector and stop rule for blocks lo..hi (branch-free).
+
+    Returns the first and last block that changed (lo > hi if none) and the number of
+    moving blocks among lo..hi before and after.
+    """
+    K, Kp = mp[0], mp[1]
+    one = np.uint64(1)
+    u0 = np.uint64(lo)
+    n = hi - lo + 1
+    c_lo = n
+    c_hi = -1
+    moved_before = 0
+    moved_after = 0
+    for k in range(n):
+        i = u0 + np.uint64(k)
+        m = mm[i]
+        f2 = _force(xs[i - one], xs[i], xs[i + one], K, Kp, p, drive)
+        a2 = _accel(f2, ths[i], vs[i], m, mp, friction)
+        b2 = _dtheta(ths[i - one], ths[i], ths[i + one], vs[i], mp, friction)
+        xo = x[i]
+        vo = v[i]
+        tho = th[i]
+        mo = mov[i]
+        xn = xo + h2 * (vo + vs[i])
+        vn = vo + h2 * (a1[i] + a2)
+        thn = tho + h2 * (b1[i] + b2)
+        keep = vn > 0.0
+        vn = vn if keep else 0.0
+        mn = m if keep else 0.0
+        x[i] = xn
+        v[i] = vn
+        th[i] = thn
+        mov[i] = mn
+        ch = (xn != xo) | (vn != vo) | (thn != tho) | (mn != mo)
+        c_lo = min(c_lo, k if ch else n)
+        c_hi = max(c_hi, k if ch else -1)
+        moved_before += 1 if mo != 0.0 else 0
+        moved_after += 1 if mn != 0.0 else 0
+    return c_lo + lo, c_hi + lo, moved_before, moved_after
+
+
+@njit(cache=True, _nrt=False, inline="always")
+def _stage1_run(x, v, th, xs, vs, ths, mm, a1, b1, lo, hi, p, mp, dt, drive, friction):
+    """Stage 1 for blocks lo..hi that all move at t_n (a run of sliding blocks).
+
+    A moving block moves in this step whatever its force (start rule), so the mask is 1 and
+    no start is looked for; the expressions are those of :func:`_stage1` with m = 1.
+    """
+    K, Kp = mp[0], mp[1]
+    one = np.uint64(1)
+    for i in range(np.uint64(lo), np.uint64(hi) + one):
+        f = _force(x[i - one], x[i], x[i + one], K, Kp, p, drive)
+        a = _accel(f, th[i], v[i], 1.0, mp, friction)
+        b = _dtheta(th[i - one], th[i], th[i + one], v[i], mp, friction)
+        mm[i] = 1.0
+        a1[i] = a
+        b1[i] = b
+        xs[i] = x[i] + dt * v[i]
+        vs[i] = v[i] + dt * a
+        ths[i] = th[i] + dt * b
+
+
+@njit(cache=True, _nrt=False, inline="always")
+def _stage2_run(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, h2, drive, friction):
+    """Stage 2, corrector and stop rule for a run lo..hi of blocks moving in this step.
+
+    As :func:`_stage2_all` on the run: the moving flags are not written and the changes not
+    tracked (the caller counts the run as changed); returns whether some block stopped.
+    """
+    K, Kp = mp[0], mp[1]
+    one = np.uint64(1)
+    stops = False
+    for i in range(np.uint64(lo), np.uint64(hi) + one):
+        f2 = _force(xs[i - one], xs[i], xs[i + one], K, Kp, p, drive)
+        a2 = _accel(f2, ths[i], vs[i], 1.0, mp, friction)
+        b2 = _dtheta(ths[i - one], ths[i], ths[i + one], vs[i], mp, friction)
+        x[i] = x[i] + h2 * (v[i] + vs[i])
+        vn = v[i] + h2 * (a1[i] + a2)
+        th[i] = th[i] + h2 * (b1[i] + b2)
+        keep = vn > 0.0
+        v[i] = vn if keep else 0.0
+        stops |= not keep
+    return stops
+
+
+@njit(cache=True, _nrt=False)
+def _longest_run(mov, lo, hi):
+    """The longest run of moving blocks within lo..hi (lo > hi if none)."""
+    ba, bb = 1, 0
+    a = -1
+    for i in range(lo, hi + 2):
+        if i <= hi and mov[i] != 0.0:
+            if a < 0:
+                a = i
+        elif a >= 0:
+            if i - a > bb - ba + 1:
+                ba, bb = a, i - 1
+            a = -1
+    return ba, bb

@@ -1,0 +1,124 @@
+"""Which stopped block the drive starts, and at which step (the start rule of docs/model.md
+seen from the drive), for the fast integrators' jumps over steps in which nothing changes.
+
+* end drive: the force on a stopped block changes only when a neighbour moves or, for block
+  1, with the pulling point; when nothing is active, nothing can change until block 1's force
+  exceeds its threshold: :func:`_first_trigger` finds that step with the step's own expression
+  for the force (monotone in n).
+* plate drive: every stopped block is loaded by the plate. For each stopped block the kernels
+  keep the first step at which its force, evaluated with the step's own expression, exceeds
+  its threshold (``trig``, :func:`_plate_trigger`); it is recomputed whenever the block's
+  neighbourhood changes, so a block that starts because of the plate alone is found by
+  comparing the step with these numbers.
+
+Each answer is exact: a bisection on the very expression the step evaluates, not a solved
+inequality.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from stickslip.kernels.laws import _force, _pull, _right_of_first, _threshold
+from stickslip.kernels.layout import _NEVER, DRIVE_END, DRIVE_PLATE
+
+
+@njit(cache=True)
+def _first_trigger(x, N, V, dt, K, thr, n_lo, n_hi, ends):
+    """End drive: first step m in [n_lo, n_hi) at which stopped block 1 starts (f_1 > thr),
+    else n_hi.
+
+    Uses the step's own expression for the force, which is non-decreasing in m for V >= 0.
+    """
+    x1 = x[1]
+    x2 = _right_of_first(x, N, ends)
+    if n_lo >= n_hi or not (_force(_pull(V, n_hi - 1, dt), x1, x2, K, 0.0, 0.0, DRIVE_END) > thr):
+        return n_hi
+    lo = n_lo
+    hi = n_hi - 1  # invariant: fires at hi
+    while lo < hi:
+        mid = lo + (hi - lo) // 2
+        if _force(_pull(V, mid, dt), x1, x2, K, 0.0, 0.0, DRIVE_END) > thr:
+            hi = mid
+        else:
+            lo = mid + 1
+    return lo
+
+
+@njit(cache=True, inline="always")
+def _plate_fires(xl, xc, xr, thr, K, Kp, V, dt, m):
+    return _force(xl, xc, xr, K, Kp, _pull(V, m, dt), DRIVE_PLATE) > thr
+
+
+@njit(cache=True)
+def _plate_trigger(xl, xc, xr, thr, K, Kp, V, dt, n0, n_cap):
+    """Plate drive: first step m in [n0, n_cap) at which a stopped block with neighbours xl, xr
+    starts (f > thr), else n_cap.
+
+    The force, evaluated with the step's own expression, is non-decreasing in m for V, Kp >= 0;
+    a first guess from its rate Kp V dt is refined by bisection, so the answer is exact.
+    """
+    if n0 >= n_cap:
+        return n_cap
+    if _plate_fires(xl, xc, xr, thr, K, Kp, V, dt, n0):
+        return n0
+    if not _plate_fires(xl, xc, xr, thr, K, Kp, V, dt, n_cap - 1):
+        return n_cap
+    lo = n0  # does not fire
+    hi = n_cap - 1  # fires
+    f0 = _force(xl, xc, xr, K, Kp, _pull(V, n0, dt), DRIVE_PLATE)
+    rate = Kp * V * dt
+    if rate > 0.0:
+        guess = (thr - f0) / rate
+        if guess < np.float64(hi - lo):
+            g = lo + 1 + np.int64(guess)
+            if g < hi:
+                if _plate_fires(xl, xc, xr, thr, K, Kp, V, dt, g):
+                    hi = g
+                    if not _plate_fires(xl, xc, xr, thr, K, Kp, V, dt, g - 1):
+                        return g
+                    hi = g - 1
+                else:
+                    lo = g
+                    if _plate_fires(xl, xc, xr, thr, K, Kp, V, dt, g + 1):
+                        return g + 1
+                    lo = g + 1
+    while hi - lo > 1:
+        mid = lo + (hi - lo) // 2
+        if _plate_fires(xl, xc, xr, thr, K, Kp, V, dt, mid):
+            hi = mid
+        else:
+            lo = mid
+    return hi
+
+
+@njit(cache=True)
+def _plate_triggers(x, th, mov, mm, trig, lo, hi, every, n0, n_cap, mp, V, dt, threshold):
+    """Recompute ``trig`` for the stopped blocks lo..hi (ghost cells of x set); returns their
+    smallest value (``_NEVER`` if none).
+
+    Unless ``every``, only blocks whose x or a neighbour's x may have changed in the step just
+    taken are redone: the ends of the interval (neighbours of its outermost movers), and inside
+    it the blocks next to or at a block of the mid-step mask ``mm``, which holds this step's
+    movers on the interval (only they change x).
+    """
+    K, Kp, Fs = mp[0], mp[1], mp[5]
+    N = x.shape[0] - 2
+    t_min = _NEVER
+    for i in range(lo, hi + 1):
+        redo = every or i == lo or i == hi or i == 1 or i == N
+        if not redo:
+            redo = mm[i - 1] != 0.0 or mm[i] != 0.0 or mm[i + 1] != 0.0
+        if not redo:
+            if mov[i] == 0.0 and trig[i] < t_min:
+                t_min = trig[i]
+            continue
+        if mov[i] == 0.0:
+            m = _plate_trigger(x[i - 1], x[i], x[i + 1], _threshold(th[i], Fs, threshold), K, Kp, V, dt, n0, n_cap)
+            trig[i] = m
+            if m < t_min:
+                t_min = m
+        else:
+            trig[i] = _NEVER
+    return t_min
