@@ -269,6 +269,7 @@ def test_sample_moving_leaves_the_run_unchanged(tmp_path):
 
 
 def test_tiny_chaos_study_end_to_end(tmp_path, cluster):
+    from stickslip.analysis.decorrelation import VERDICTS
     from stickslip.analysis.stability import chain_finite_eigenvalues
     from stickslip.models.params import ChainParams
 
@@ -284,6 +285,11 @@ def test_tiny_chaos_study_end_to_end(tmp_path, cluster):
     expected = float(chain_finite_eigenvalues(ChainParams(N=4, beta=1.5, V=0.5))[0].real)
     assert expected < 0 and steady["lyapunov"] < 0
     assert abs(steady["lyapunov"] - expected) <= 0.03 * abs(expected)
+    # the flow (located switches, dt -> 0) has the same eigenvalue; it contracts: regular
+    assert abs(steady["lyapunov_dt0"] - expected) <= 0.05 * abs(expected)
+    assert steady["verdict"] == "regular"
+    assert all(r["verdict"] in VERDICTS for r in rows)
+    assert all(math.isfinite(r["lyapunov_dt0_err"]) for r in rows)
     # (400 - 0.1 * 400) / 5 = 72 counted renormalisations
     assert steady["renormalisations"] == 72
     family = {r["model"]: r for r in rows if r["model"] != "sakaguchi"}
