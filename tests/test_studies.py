@@ -345,3 +345,27 @@ def test_chaos_findings_judge_the_relatives_on_the_exponents_they_have():
     assert "chaotic (positive beyond 3 errors) at d0 = 1e-10, 1e-08" in line
     assert "no exponent at d0 = 1e-11 (the twin fell onto the reference 6 times" in line
     assert "spread over d0 0.0031" in line
+
+
+def test_chaos_findings_name_the_verdict_of_each_point():
+    from stickslip.experiments.study_findings import conclusions
+
+    rows = [
+        {"model": "sakaguchi", "N": 99, "beta": b, "lyapunov": 0.0, "lyapunov_err": 1e-5, "lyapunov_per_event": 0.0}
+        | {"verdict": v}
+        for b, v in ((0.5, "regular"), (1.0, "stable chaos"))
+    ]
+    rows.append(
+        {"model": "two-blocks", "N": 2, "beta": None, "d0": 1e-10, "lyapunov": 0.044, "lyapunov_err": 0.001}
+        | {"verdict": "chaotic", "merges": 0}
+    )
+    out = conclusions(study("chaos", "quick"), pd.DataFrame(rows))
+    assert out["verdicts"] == {
+        "regular": ["beta = 0.5 (N = 99)"],
+        "stable chaos": ["beta = 1 (N = 99)"],
+        "chaotic": ["two-blocks"],
+    }
+    assert (
+        "regular at beta = 0.5 (N = 99); stable chaos at beta = 1 (N = 99); chaotic at two-blocks"
+        in (out["statements"][-1])
+    )

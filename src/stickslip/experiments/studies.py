@@ -269,7 +269,7 @@ def _chaos(mode: str) -> Study:
         d0s = (1e-10,)
     elif mode == "quick":
         chain = [
-            {"N": 99, "beta": b, "t_end": 6e5, "transient": 5e5, "interval": 10.0, **_flow(1e3, 1e4)}
+            {"N": 99, "beta": b, "t_end": 6e5, "transient": 5e5, "interval": 10.0, **_flow(500.0, 5e3)}
             for b in _CHAOS_BETAS_QUICK
         ]
         family = [
