@@ -95,3 +95,20 @@ def test_verdict_on_synthetic_inputs():
     assert verdict(0.003, 0.002, d, log_n, yes, sigmas=1.0) == "chaotic"
     assert verdict(None, None, d, log_n, yes) == "undetermined"
     assert verdict(float("nan"), 0.1, d, log_n, yes) == "undetermined"
+
+
+def test_cli_decorrelation_json(capsys):
+    import json
+
+    from stickslip.cli import main
+
+    status = main(
+        ["lyapunov", "--model", "two-blocks", "--switches", "located", "--decorrelation"]
+        + ["--transient", "500", "--t-end", "2500", "--json"]
+    )
+    out = json.loads(capsys.readouterr().out)
+    assert status in (0, None)
+    rows = out["decorrelation"]
+    assert [r["delta"] for r in rows] == list(DELTAS)
+    assert all(r["decorrelated"] for r in rows) and rows[0]["events"] > rows[-1]["events"]
+    assert main(["lyapunov", "--model", "two-blocks", "--decorrelation"]) == 2
