@@ -269,6 +269,7 @@ def test_sample_moving_leaves_the_run_unchanged(tmp_path):
 
 
 def test_tiny_chaos_study_end_to_end(tmp_path, cluster):
+    from stickslip.analysis.decorrelation import VERDICTS
     from stickslip.analysis.stability import chain_finite_eigenvalues
     from stickslip.models.params import ChainParams
 
@@ -284,6 +285,11 @@ def test_tiny_chaos_study_end_to_end(tmp_path, cluster):
     expected = float(chain_finite_eigenvalues(ChainParams(N=4, beta=1.5, V=0.5))[0].real)
     assert expected < 0 and steady["lyapunov"] < 0
     assert abs(steady["lyapunov"] - expected) <= 0.03 * abs(expected)
+    # the flow (located switches, dt -> 0) has the same eigenvalue; it contracts: regular
+    assert abs(steady["lyapunov_dt0"] - expected) <= 0.05 * abs(expected)
+    assert steady["verdict"] == "regular"
+    assert all(r["verdict"] in VERDICTS for r in rows)
+    assert all(math.isfinite(r["lyapunov_dt0_err"]) for r in rows)
     # (400 - 0.1 * 400) / 5 = 72 counted renormalisations
     assert steady["renormalisations"] == 72
     family = {r["model"]: r for r in rows if r["model"] != "sakaguchi"}
@@ -339,3 +345,27 @@ def test_chaos_findings_judge_the_relatives_on_the_exponents_they_have():
     assert "chaotic (positive beyond 3 errors) at d0 = 1e-10, 1e-08" in line
     assert "no exponent at d0 = 1e-11 (the twin fell onto the reference 6 times" in line
     assert "spread over d0 0.0031" in line
+
+
+def test_chaos_findings_name_the_verdict_of_each_point():
+    from stickslip.experiments.study_findings import conclusions
+
+    rows = [
+        {"model": "sakaguchi", "N": 99, "beta": b, "lyapunov": 0.0, "lyapunov_err": 1e-5, "lyapunov_per_event": 0.0}
+        | {"verdict": v}
+        for b, v in ((0.5, "regular"), (1.0, "stable chaos"))
+    ]
+    rows.append(
+        {"model": "two-blocks", "N": 2, "beta": None, "d0": 1e-10, "lyapunov": 0.044, "lyapunov_err": 0.001}
+        | {"verdict": "chaotic", "merges": 0}
+    )
+    out = conclusions(study("chaos", "quick"), pd.DataFrame(rows))
+    assert out["verdicts"] == {
+        "regular": ["beta = 0.5 (N = 99)"],
+        "stable chaos": ["beta = 1 (N = 99)"],
+        "chaotic": ["two-blocks"],
+    }
+    assert (
+        "regular at beta = 0.5 (N = 99); stable chaos at beta = 1 (N = 99); chaotic at two-blocks"
+        in (out["statements"][-1])
+    )

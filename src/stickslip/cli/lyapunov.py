@@ -118,6 +118,12 @@ def register(sub) -> None:
         help="with --switches located: finite-size exponents, the mean time for a separation to grow "
         "from delta to 2 delta, delta from --delta-min to --delta-max (JSON key fsle)",
     )
+    p.add_argument(
+        "--decorrelation",
+        action="store_true",
+        help="with --switches located: the number of slip events after which runs started delta = 1e-12, "
+        "1e-10, 1e-8, 1e-6 apart stop agreeing, over --t-end minus --transient (JSON key decorrelation)",
+    )
     p.add_argument("--delta-min", type=float_arg("delta-min"), default=1e-10, metavar="D", help="(default 1e-10)")
     p.add_argument("--delta-max", type=float_arg("delta-max"), default=0.1, metavar="D", help="(default 0.1)")
     p.add_argument("--cycles", type=int, default=20, metavar="C", help="finite-size cycles counted (default 20)")
@@ -195,8 +201,9 @@ def run_lyapunov_command(args: argparse.Namespace) -> Result:
     ly._check_run(params, args.t_end, args.interval, args.d0, args.transient, args.align, args.segments)
     if args.switches == "located":
         return _located(params, args, kw)
-    if args.finite_size:
-        raise CommandError("--finite-size goes with --switches located")
+    for flag, given in (("--finite-size", args.finite_size), ("--decorrelation", args.decorrelation)):
+        if given:
+            raise CommandError(f"{flag} goes with --switches located")
     if args.convergence:
         table = ly.lyapunov_convergence(params, args.t_end, **kw)
         data = {
@@ -269,8 +276,12 @@ def _located(params, args, kw) -> Result:
 
     if args.convergence or args.betas is not None:
         raise CommandError("--switches located runs one ladder; --convergence and --betas go with --switches grid")
+    if args.finite_size and args.decorrelation:
+        raise CommandError("give either --finite-size or --decorrelation, not both")
     if args.finite_size:
         return _finite_size(params, args)
+    if args.decorrelation:
+        return _decorrelation(params, args)
     check_number("levels", args.levels, low=2, high=6, integer=True)
     ladder = flow_ladder(params, args.t_end, levels=args.levels, neutral=args.neutral, **kw)
     data = ladder.to_dict()
@@ -302,4 +313,26 @@ def _finite_size(params, args) -> Result:
         lines.append(f"pooled up to {e['pooled_below']:.3g}: {e['pooled_rate']:.4g} +- {e['pooled_rate_err']:.2g}")
     if res.unfinished:
         lines.append(f"{res.unfinished} cycles did not reach {deltas[-1]:g} within t = {args.t_end:g}")
+    return Result(data, "\n".join(lines))
+
+
+def _decorrelation(params, args) -> Result:
+    """`--switches located --decorrelation`: :func:`stickslip.analysis.decorrelation.event_decorrelation`."""
+    from stickslip.analysis.decorrelation import DELTAS, event_decorrelation
+    from stickslip.models.params import steps_for
+    from stickslip.run.located import LocatedStepper, start_state
+
+    if not args.t_end > args.transient:
+        raise CommandError(f"--t-end must exceed --transient (got {args.t_end:g} and {args.transient:g})")
+    ref = start_state(params, args.start, perturbation=args.perturbation, seed=args.seed)
+    ref, _ = LocatedStepper(params).advance(ref, steps_for(args.transient, params.dt))
+    res = event_decorrelation(
+        params, ref, DELTAS, t_max=args.t_end - args.transient, direction_seed=args.direction_seed
+    )
+    data = {"params": params.to_dict(), "switches": "located", "transient": args.transient, **res.to_dict()}
+    lines = [f"{'delta':>8} {'events agreeing':>16}"]
+    for r in res.rows:
+        n = f"{r['events']}" if r["decorrelated"] else f"all {r['events']}"
+        lines.append(f"{r['delta']:>8.0e} {n:>16}")
+    lines.append(f"{res.reference_events} events of the reference; sizes agree to rtol {res.rtol:g}")
     return Result(data, "\n".join(lines))

@@ -33,6 +33,8 @@ import numpy as np
 
 from stickslip import __version__
 from stickslip.experiments.cache import canonical, spec_key
+from stickslip.experiments.chaos_verdict import check_verdict, verdict_once
+from stickslip.experiments.chaos_verdict import flow_lengths as _flow
 
 __all__ = [
     "Study",
@@ -241,7 +243,10 @@ def _chaos(mode: str) -> Study:
     # fluctuates about its mean (docs/lyapunov.md); the plate-driven relatives forget their start
     # within 2e3.
     if mode == "tiny":
-        chain = [{"N": 9, "beta": b, "t_end": 6000.0, "transient": 3000.0, "interval": 10.0} for b in (0.6, 1.2)]
+        chain = [
+            {"N": 9, "beta": b, "t_end": 6000.0, "transient": 3000.0, "interval": 10.0, **_flow(200.0, 300.0)}
+            for b in (0.6, 1.2)
+        ]
         # steady sliding well above the inverse transition: the exponent is the least stable
         # eigenvalue of eq. (5), negative (docs/lyapunov.md, checks with known answers)
         chain.append(
@@ -254,30 +259,39 @@ def _chaos(mode: str) -> Study:
                 "t_end": 400.0,
                 "transient": 0.0,
                 "interval": 5.0,
+                **_flow(100.0, 100.0),
             }
         )
         family = [
-            {"model": "two-blocks", "t_end": 600.0, "transient": 100.0},
-            {"model": "carlson-langer", "N": 16, "t_end": 300.0, "transient": 100.0},
+            {"model": "two-blocks", "t_end": 600.0, "transient": 100.0, **_flow(200.0, 600.0)},
+            {"model": "carlson-langer", "N": 16, "t_end": 300.0, "transient": 100.0, **_flow(100.0, 200.0)},
         ]
         d0s = (1e-10,)
     elif mode == "quick":
-        chain = [{"N": 99, "beta": b, "t_end": 6e5, "transient": 5e5, "interval": 10.0} for b in _CHAOS_BETAS_QUICK]
+        chain = [
+            {"N": 99, "beta": b, "t_end": 6e5, "transient": 5e5, "interval": 10.0, **_flow(500.0, 5e3)}
+            for b in _CHAOS_BETAS_QUICK
+        ]
         family = [
-            {"model": "two-blocks", "t_end": 4.2e4, "transient": 2e3},
-            {"model": "carlson-langer", "t_end": 2.2e4, "transient": 2e3},
+            {"model": "two-blocks", "t_end": 4.2e4, "transient": 2e3, **_flow(2e3, 4e3)},
+            {"model": "carlson-langer", "t_end": 2.2e4, "transient": 2e3, **_flow(500.0, 2e3)},
         ]
         d0s = (1e-10,)
     else:
-        chain = [{"N": 99, "beta": b, "t_end": 1.5e6, "transient": 1e6, "interval": 10.0} for b in _CHAOS_BETAS_FULL]
+        chain = [
+            {"N": 99, "beta": b, "t_end": 1.5e6, "transient": 1e6, "interval": 10.0, **_flow(1e4, 1e5)}
+            for b in _CHAOS_BETAS_FULL
+        ]
         family = [
-            {"model": "two-blocks", "t_end": 2.02e5, "transient": 2e3},
-            {"model": "carlson-langer", "t_end": 1.02e5, "transient": 2e3},
+            {"model": "two-blocks", "t_end": 2.02e5, "transient": 2e3, **_flow(1e4, 2e4)},
+            {"model": "carlson-langer", "t_end": 1.02e5, "transient": 2e3, **_flow(2e3, 1e4)},
         ]
         d0s = (1e-8, 1e-10, 1e-11)  # CL does not settle in d0 (docs/lyapunov.md): show the spread
     points = [{"model": "sakaguchi", "start": "paper", **c, "d0": 1e-10} for c in chain]
     points += [
-        {**f, "interval": 1.0, "start": "rest", "perturbation": 0.01, "seed": 0, "d0": d0} for f in family for d0 in d0s
+        {**verdict_once(f, d0), "interval": 1.0, "start": "rest", "perturbation": 0.01, "seed": 0, "d0": d0}
+        for f in family
+        for d0 in d0s
     ]
     # Longest first: a shorter tail on a few workers.
     points.sort(key=lambda p: -(p["t_end"] - p["transient"]) * p.get("N", 100) / p["interval"])
@@ -382,7 +396,7 @@ def check_point(cfg: dict[str, Any]) -> None:
     """Raise ParameterError (one line) unless a point's merged settings make a valid run."""
     params = point_params(cfg)
     if cfg.get("analysis") == "lyapunov":
-        lyapunov_options(cfg, params)
+        check_verdict(cfg, params, lyapunov_options(cfg, params)[1])
     else:
         point_run_options(cfg, params)
 
@@ -391,7 +405,9 @@ def lyapunov_point(cfg: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     """One point of ``chaos``: the largest Lyapunov exponent of a model of the family
     (Benettin et al. 1980, :func:`stickslip.analysis.lyapunov.largest_lyapunov`), written to
     ``lyapunov.json`` and ``renormalisations.parquet`` (every renormalisation: end time,
-    ln(d/d0), length, counted) in ``point_dir``. Adds the exponent per slip event."""
+    ln(d/d0), length, counted) in ``point_dir``. Adds the exponent per slip event, and with
+    ``flow_t`` the exponent of the flow, n(delta) and the verdict
+    (:func:`stickslip.experiments.chaos_verdict.verdict_point`)."""
     from stickslip import io
     from stickslip.analysis.lyapunov import largest_lyapunov
 
@@ -432,13 +448,18 @@ def lyapunov_point(cfg: dict[str, Any], point_dir: Path) -> dict[str, Any]:
         "reference_sha256",
         "start",
     )
-    return {
+    out = {
         "model": params.model,
         **{k: info[k] for k in keep},
         "counted_time": counted_time,
         "lyapunov_per_event": per_event,
         "run_wall_seconds": float(res.wall_seconds),
     }
+    if "flow_t" in cfg:
+        from stickslip.experiments.chaos_verdict import verdict_point
+
+        out.update(verdict_point(cfg, params, options, point_dir))
+    return out
 
 
 def study_point_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:

@@ -255,7 +255,27 @@ def _chaos(table: pd.DataFrame) -> dict[str, Any]:
         if lost:
             verdict += "; no exponent at " + ", ".join(lost)
         say(f"{model} (N = {int(rows['N'].iloc[0])}): lambda = {vals}: {verdict}.")
+    _verdicts(table, out)
     return out
+
+
+def _verdicts(table: pd.DataFrame, out: dict[str, Any]) -> None:
+    """One statement: which points the flow exponent and the decorrelation of the event sequence
+    call chaotic, stable chaos or regular (:func:`stickslip.analysis.decorrelation.verdict`)."""
+    if "verdict" not in table.columns or not table["verdict"].notna().any():
+        return
+    rows = table[table["verdict"].notna()]
+    out["verdicts"] = {}
+    parts = []
+    for label, g in rows.groupby("verdict", sort=False):
+        names = [f"beta = {r.beta:g} (N = {int(r.N)})" if r.model == "sakaguchi" else r.model for r in g.itertuples()]
+        out["verdicts"][label] = names
+        parts.append(f"{label} at {', '.join(names)}")
+    out["statements"].append(
+        "Verdict (flow exponent at dt -> 0, decorrelation of the event sequence against delta): "
+        + "; ".join(parts)
+        + "."
+    )
 
 
 def draw(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[dict[str, Any]]:
