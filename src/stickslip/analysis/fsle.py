@@ -206,7 +206,7 @@ class LocatedPair:
         self.twin, _ = self.stepper.advance(self.twin, n)
 
     def distance(self) -> float:
-        """|y_twin - y_ref| (less the part along the flow with neutral 'remove')."""
+        """The norm of y_twin - y_ref (less the part along the flow with neutral 'remove')."""
         return float(np.linalg.norm(self._dy()))
 
     def reset(self, delta: float) -> None:

@@ -16,14 +16,14 @@ long the run.
 
 The neutral direction. In the frame of the drive the equations are autonomous (fixed ends
 apart), so a perturbation along the flow, F(y), is a shift in time: it neither grows nor decays
-on average, and it makes d swing with |F| between sticking (|F| ~ V) and slipping (|F| ~ 1).
+on average, and it makes d swing with the norm of F between sticking (about V) and slipping (about 1).
 With ``neutral='remove'`` (the default) the separation is measured and renormalised after its
 component along F(y_ref) is removed: d is the distance of the twin from the reference's orbit,
 not from the reference's point. The exponent is then the largest one transverse to the flow; the
 flow's own spectrum adds the zero of the time shift, so the largest exponent of the flow is
 max(0, lambda) on an attractor other than a fixed point. A periodic orbit gives lambda < 0,
 a chaotic attractor lambda > 0. Near a fixed point (steady sliding) F(y) -> 0 and its direction
-carries no time shift; the removal is skipped where |F| < ``flow_floor``.
+carries no time shift; the removal is skipped where the norm of F is below ``flow_floor``.
 
 Renormalisation waits until both trajectories have the same blocks stuck (at most
 ``max_wait`` steps past the planned time), so the twin is always rebuilt on the reference's
@@ -137,7 +137,7 @@ def flow_direction(state: LocatedState, params: ChainParams) -> np.ndarray:
 
 
 def remove_flow(dy: np.ndarray, flow: np.ndarray, floor: float) -> np.ndarray:
-    """dy less its component along ``flow`` (left as it is where |flow| < floor)."""
+    """dy less its component along ``flow`` (left as it is where the norm of ``flow`` is below ``floor``)."""
     norm = float(np.linalg.norm(flow))
     if not norm > floor:
         return dy
