@@ -373,3 +373,16 @@ def is_real_command(command: str) -> bool:
         except SystemExit:
             return False
     return True
+
+
+def run_cli(capsys, *argv: str) -> tuple[int, str, str]:
+    """``stickslip ARGV`` in this process: (exit status, stdout, stderr) read through ``capsys``;
+    argparse errors, which leave through SystemExit(2), give their status too."""
+    from stickslip.cli import main
+
+    try:
+        status = main(list(argv))
+    except SystemExit as exc:
+        status = exc.code
+    out, err = capsys.readouterr()
+    return status, out, err

@@ -8,19 +8,9 @@ import warnings
 import pandas as pd
 import pytest
 
-from chain_helpers import error_lines, run_cli_subprocess
-from stickslip.cli import main
+from chain_helpers import error_lines, run_cli, run_cli_subprocess
 from stickslip.models.params import ChainParams
 from stickslip.run.driver import run_chain
-
-
-def run_cli(capsys, *argv):
-    try:
-        status = main(list(argv))
-    except SystemExit as exc:  # argparse errors leave through SystemExit(2)
-        status = exc.code
-    out, err = capsys.readouterr()
-    return status, out, err
 
 
 def test_chain_json_is_one_document_with_the_summary(capsys):

@@ -20,6 +20,7 @@ import numpy as np
 import pytest
 from matplotlib.figure import Figure
 
+from chain_helpers import run_cli
 from stickslip.analysis.lyapunov import (
     largest_lyapunov,
     lyapunov_convergence,
@@ -29,21 +30,11 @@ from stickslip.analysis.lyapunov import (
 )
 from stickslip.analysis.slip_limit import solve_slip_limit
 from stickslip.analysis.stability import block_eigenvalues, chain_finite_eigenvalues
-from stickslip.cli import main
 from stickslip.models.params import BlockParams, ChainParams, ParameterError
 from stickslip.plotting.lyapunov import plot_lyapunov_beta
 from stickslip.run.driver import run_chain
 
 PAPER_BLOCK = ChainParams(N=1, K=10.0, V=0.001, beta=1.0, Fs=3.0)
-
-
-def run_cli(capsys, *argv):
-    try:
-        status = main(list(argv))
-    except SystemExit as exc:
-        status = exc.code
-    out, err = capsys.readouterr()
-    return status, out, err
 
 
 # ------------------------------------------------------------------------------------------

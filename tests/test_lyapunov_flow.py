@@ -19,6 +19,7 @@ import json
 import numpy as np
 import pytest
 
+from chain_helpers import run_cli
 from stickslip.analysis.lyapunov_flow import (
     extrapolate,
     flow_direction,
@@ -28,22 +29,12 @@ from stickslip.analysis.lyapunov_flow import (
     twin_state,
 )
 from stickslip.analysis.stability import block_eigenvalues
-from stickslip.cli import main
 from stickslip.models.params import BlockParams, ChainParams, ParameterError
 from stickslip.models.presets import chain_params
 from stickslip.run.located import LocatedStepper, start_state
 
 STEADY = ChainParams(N=1, K=10.0, V=0.5, beta=1.0, Fs=3.0)
 CYCLE = ChainParams(N=1, K=10.0, V=0.05, beta=1.0, Fs=3.0)
-
-
-def run_cli(capsys, *argv):
-    try:
-        status = main(list(argv))
-    except SystemExit as exc:
-        status = exc.code
-    out, err = capsys.readouterr()
-    return status, out, err
 
 
 def test_steady_sliding_of_the_block_decays_at_the_rate_of_eq_2():
