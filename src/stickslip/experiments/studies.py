@@ -35,6 +35,7 @@ from stickslip import __version__
 from stickslip.experiments.cache import canonical, spec_key
 from stickslip.experiments.chaos_verdict import check_verdict, verdict_once
 from stickslip.experiments.chaos_verdict import flow_lengths as _flow
+from stickslip.models.presets import is_paper
 
 __all__ = [
     "Study",
@@ -296,7 +297,7 @@ def _chaos(mode: str) -> Study:
     # Longest first: a shorter tail on a few workers.
     points.sort(key=lambda p: -(p["t_end"] - p["transient"]) * p.get("N", 100) / p["interval"])
     common = {"analysis": "lyapunov", "segments": 10, "direction_seed": 0}
-    n_chain = len([p for p in points if p["model"] == "sakaguchi"])
+    n_chain = len([p for p in points if is_paper(p["model"])])
     return Study(
         "chaos",
         mode,
