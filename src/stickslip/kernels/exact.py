@@ -25,7 +25,10 @@ A run of blocks that all move at t_n (the longest such run, kept across steps wh
 it stops) is updated by the stages of :mod:`stickslip.kernels.stages` that skip the start rule
 and the bookkeeping of changes, as when the whole chain slides: in a partly stuck chain most of
 a step's work is one such run. Its blocks are counted as changed, which can only widen the
-interval of the next step; a wider interval gives the same bits.
+interval of the next step; a wider interval gives the same bits. The steps of one run form an
+inner loop in which the run's bounds are fixed, so that the run stages' overlap checks are made
+once per run; and the kernel works on copies of its arrays with block 1 at the start of a 64-byte
+line, handed back on return (docs/performance.md, "The run's bounds per run, and aligned copies").
 """
 
 from __future__ import annotations
@@ -85,9 +88,18 @@ def _line(work, k, S, o, N):
 
 @njit(cache=True, inline="always")
 def _hand_back(caller, work, S, o, N):
-    """Copy the working arrays back into the caller's."""
-    for k in range(len(caller)):
-        caller[k][:] = _line(work, k, S, o, N)
+    """Copy the working arrays back into the caller's (one statement each: the caller's arrays
+    need not share a type)."""
+    caller[0][:] = _line(work, 0, S, o, N)
+    caller[1][:] = _line(work, 1, S, o, N)
+    caller[2][:] = _line(work, 2, S, o, N)
+    caller[3][:] = _line(work, 3, S, o, N)
+    caller[4][:] = _line(work, 4, S, o, N)
+    caller[5][:] = _line(work, 5, S, o, N)
+    caller[6][:] = _line(work, 6, S, o, N)
+    caller[7][:] = _line(work, 7, S, o, N)
+    caller[8][:] = _line(work, 8, S, o, N)
+    caller[9][:] = _line(work, 9, S, o, N)
 
 
 @njit(cache=True)
@@ -171,16 +183,24 @@ def run_exact(
     N = x.shape[0] - 2
     # Work on copies of the ten float arrays, each with block 1 at the start of a 64-byte line, so
     # that the vector loads and stores of a run from block 1 do not straddle lines; the caller's
-    # arrays get them back on return (measured: see docs/performance.md, "Aligned copies").
+    # arrays get them back on return (docs/performance.md, "... and aligned copies").
     caller = (x, v, th, mov, xs, vs, ths, mm, a1, b1)
     S = (N + 17) // 8 * 8  # room for the shift; a whole number of lines per array
     work = np.empty(10 * S)
     o = (-(work.ctypes.data + 8)) % 64 // 8
-    for k in range(10):
-        _line(work, k, S, o, N)[:] = caller[k]
     x, v, th, mov = _line(work, 0, S, o, N), _line(work, 1, S, o, N), _line(work, 2, S, o, N), _line(work, 3, S, o, N)
     xs, vs, ths = _line(work, 4, S, o, N), _line(work, 5, S, o, N), _line(work, 6, S, o, N)
     mm, a1, b1 = _line(work, 7, S, o, N), _line(work, 8, S, o, N), _line(work, 9, S, o, N)
+    x[:] = caller[0]
+    v[:] = caller[1]
+    th[:] = caller[2]
+    mov[:] = caller[3]
+    xs[:] = caller[4]
+    vs[:] = caller[5]
+    ths[:] = caller[6]
+    mm[:] = caller[7]
+    a1[:] = caller[8]
+    b1[:] = caller[9]
     mp, V, dt = _unpack(par)
     K, Kp, Fs = mp[0], mp[1], mp[5]
     h2 = 0.5 * dt
