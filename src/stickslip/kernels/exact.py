@@ -343,8 +343,8 @@ def run_exact(
             first = h1 + 1
             last = l1 - 1
             starts = False
-            # The run, if it lies within [fl, fh] and [lo, hi] (it does but at a kernel's entry):
-            # its blocks move (no start rule); the general stages on either side of it.
+            # The run, when it lies within [fl, fh] and [lo, hi] (as it should: its blocks moved in
+            # the last step): no start rule there; the general stages on either side of it.
             run_in = ra0 <= rb0 and fl <= ra0 and rb0 <= fh and lo <= ra0 and rb0 <= hi
             if fl <= fh:
                 if run_in:
