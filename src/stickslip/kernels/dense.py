@@ -26,9 +26,10 @@ from stickslip.kernels.layout import (
     STEPS_COMPUTED,
     _unpack,
 )
+from stickslip.kernels.pipeline import PiecesCompiler
 
 
-@njit(cache=True)
+@njit(cache=True, pipeline_class=PiecesCompiler)
 def run_dense(args, drive, friction, threshold, ends):
     """Reference integrator of the chain (eq. 4 and its relatives): Heun over every block at
     every step, written plainly.

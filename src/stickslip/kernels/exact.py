@@ -60,6 +60,7 @@ from stickslip.kernels.layout import (
     _merge,
     _unpack,
 )
+from stickslip.kernels.pipeline import PiecesCompiler
 from stickslip.kernels.stages import (
     _longest_run,
     _stage1,
@@ -75,7 +76,7 @@ from stickslip.kernels.stages import (
 from stickslip.kernels.triggers import _first_trigger, _plate_triggers
 
 
-@njit(cache=True)
+@njit(cache=True, pipeline_class=PiecesCompiler)
 def run_exact(args, drive, friction, threshold, ends):
     """Fast integrator of the chain, bit for bit equal to :func:`~stickslip.kernels.dense.run_dense`.
 

@@ -80,6 +80,7 @@ from stickslip.kernels.layout import (
     STEPS_COMPUTED,
     _unpack,
 )
+from stickslip.kernels.pipeline import PiecesCompiler
 from stickslip.kernels.triggers import _plate_trigger
 
 _QUEUED = np.int64(-1)  # trig of a stopped block queued as a candidate of the next step
@@ -135,7 +136,7 @@ def _settle(i, m, n, trig, queue, nq, t_next):
     return nq, min(t_next, m)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", pipeline_class=PiecesCompiler)
 def run_sparse(args, drive, friction, threshold, ends):
     """:func:`stickslip.kernels.exact.run_exact` for the plate drive with weakening or
     strengthening friction: same arguments, state and status codes (module docstring).
