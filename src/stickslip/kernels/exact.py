@@ -15,9 +15,9 @@ Which stopped blocks can start:
 * plate drive: every stopped block keeps its first start step under the plate (``trig``,
   :mod:`stickslip.kernels.triggers`); a block that starts because of the plate alone is found
   by comparing the step with these numbers, and when nothing is active the kernel jumps to the
-  smallest of them. Without a state variable a stopped block never changes, so the kernel
-  hands over to the sparse path, which updates lists of blocks instead of an interval
-  (:mod:`stickslip.kernels.plate`).
+  smallest of them. Without a state variable a stopped block never changes, and the driver
+  runs the sparse path instead, which updates lists of blocks instead of an interval
+  (:mod:`stickslip.kernels.plate`), so that this kernel does not compile it.
 * state threshold: a block whose theta changes may start without any neighbour moving, so
   every block whose state variable may change is a candidate.
 
@@ -64,7 +64,7 @@ from stickslip.kernels.layout import (
     _merge,
     _unpack,
 )
-from stickslip.kernels.plate import run_sparse
+from stickslip.kernels.pipeline import PiecesCompiler
 from stickslip.kernels.stages import (
     _longest_run,
     _stage1,
@@ -102,84 +102,47 @@ def _hand_back(caller, work, S, o, N):
     caller[9][:] = _line(work, 9, S, o, N)
 
 
-@njit(cache=True)
-def run_exact(
-    x,
-    v,
-    th,
-    mov,
-    xs,
-    vs,
-    ths,
-    mm,
-    a1,
-    b1,
-    trig,
-    first_step,
-    x0ev,
-    ist,
-    par,
-    ev_int,
-    ev_S,
-    fm,
-    samp_L,
-    samp_step,
-    prof_x,
-    prof_meta,
-    n_end,
-    sample_every,
-    profile_every,
-    profile_min_blocks,
-    drive,
-    friction,
-    threshold,
-    ends,
-):
+@njit(cache=True, pipeline_class=PiecesCompiler)
+def run_exact(args, drive, friction, threshold, ends):
     """Fast integrator of the chain, bit for bit equal to :func:`~stickslip.kernels.dense.run_dense`.
 
     Updates only the blocks that can change (see the module docstring), in branch-free
     loops over one contiguous interval, and jumps over steps in which nothing can change.
-    Same arguments, state layout and status codes as ``run_dense``, except that it does not
+    Same arguments (a :class:`~stickslip.kernels.layout.ChainArgs` and the pieces' codes), state
+    layout and status codes as ``run_dense``, except that it does not
     look for non-finite values: the driver checks the state after each call and replays the
     call with ``run_dense``, which does, to name the step and the block. ``trig``
     (int64, N + 2) is scratch: the plate drive's first start step of each stopped block,
     rebuilt on entry.
     """
-    if drive == DRIVE_PLATE:
-        if friction != FRICTION_STATE:
-            # No state variable: stopped blocks never change, so update a list, not an interval.
-            return run_sparse(
-                x,
-                v,
-                th,
-                mov,
-                xs,
-                vs,
-                ths,
-                mm,
-                a1,
-                b1,
-                trig,
-                first_step,
-                x0ev,
-                ist,
-                par,
-                ev_int,
-                ev_S,
-                fm,
-                samp_L,
-                samp_step,
-                prof_x,
-                prof_meta,
-                n_end,
-                sample_every,
-                profile_every,
-                profile_min_blocks,
-                drive,
-                friction,
-                threshold,
-                ends,
-            )
+    (
+        x,
+        v,
+        th,
+        mov,
+        xs,
+        vs,
+        ths,
+        mm,
+        a1,
+        b1,
+        trig,
+        first_step,
+        x0ev,
+        ist,
+        par,
+        ev_int,
+        ev_S,
+        fm,
+        samp_L,
+        samp_step,
+        prof_x,
+        prof_meta,
+        n_end,
+        sample_every,
+        profile_every,
+        profile_min_blocks,
+    ) = args
     N = x.shape[0] - 2
     # Work on copies of the ten float arrays, each with block 1 at the start of a 64-byte line, so
     # that the vector loads and stores of a run from block 1 do not straddle lines; the caller's
