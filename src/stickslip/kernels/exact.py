@@ -27,13 +27,13 @@ and the bookkeeping of changes, as when the whole chain slides: in a partly stuc
 a step's work is one such run. Its blocks are counted as changed, which can only widen the
 interval of the next step; a wider interval gives the same bits. The steps of one run form an
 inner loop in which the run's bounds are fixed, so that the run stages' overlap checks are made
-once per run; and the kernel works on copies of its arrays with block 1 at the start of a 64-byte
-line, handed back on return (docs/performance.md, "The run's bounds per run, and aligned copies").
+once per run. The driver hands over arrays whose block 1 starts a 64-byte line
+(:func:`stickslip.run.state.line_aligned`; docs/performance.md, "The run's bounds per run, and
+aligned arrays").
 """
 
 from __future__ import annotations
 
-import numpy as np
 from numba import njit
 
 from stickslip.kernels.events import _end_event, _overflow, _service, _start_and_first_moves
@@ -80,28 +80,6 @@ from stickslip.kernels.stages import (
 from stickslip.kernels.triggers import _first_trigger, _plate_triggers
 
 
-@njit(cache=True, inline="always")
-def _line(work, k, S, o, N):
-    """The k-th array of N + 2 values in ``work``, from offset k S + o."""
-    return work[k * S + o : k * S + o + N + 2]
-
-
-@njit(cache=True, inline="always")
-def _hand_back(caller, work, S, o, N):
-    """Copy the working arrays back into the caller's (one statement each: the caller's arrays
-    need not share a type)."""
-    caller[0][:] = _line(work, 0, S, o, N)
-    caller[1][:] = _line(work, 1, S, o, N)
-    caller[2][:] = _line(work, 2, S, o, N)
-    caller[3][:] = _line(work, 3, S, o, N)
-    caller[4][:] = _line(work, 4, S, o, N)
-    caller[5][:] = _line(work, 5, S, o, N)
-    caller[6][:] = _line(work, 6, S, o, N)
-    caller[7][:] = _line(work, 7, S, o, N)
-    caller[8][:] = _line(work, 8, S, o, N)
-    caller[9][:] = _line(work, 9, S, o, N)
-
-
 @njit(cache=True, pipeline_class=PiecesCompiler)
 def run_exact(args, drive, friction, threshold, ends):
     """Fast integrator of the chain, bit for bit equal to :func:`~stickslip.kernels.dense.run_dense`.
@@ -144,26 +122,6 @@ def run_exact(args, drive, friction, threshold, ends):
         profile_min_blocks,
     ) = args
     N = x.shape[0] - 2
-    # Work on copies of the ten float arrays, each with block 1 at the start of a 64-byte line, so
-    # that the vector loads and stores of a run from block 1 do not straddle lines; the caller's
-    # arrays get them back on return (docs/performance.md, "... and aligned copies").
-    caller = (x, v, th, mov, xs, vs, ths, mm, a1, b1)
-    S = (N + 17) // 8 * 8  # room for the shift; a whole number of lines per array
-    work = np.empty(10 * S)
-    o = (-(work.ctypes.data + 8)) % 64 // 8
-    x, v, th, mov = _line(work, 0, S, o, N), _line(work, 1, S, o, N), _line(work, 2, S, o, N), _line(work, 3, S, o, N)
-    xs, vs, ths = _line(work, 4, S, o, N), _line(work, 5, S, o, N), _line(work, 6, S, o, N)
-    mm, a1, b1 = _line(work, 7, S, o, N), _line(work, 8, S, o, N), _line(work, 9, S, o, N)
-    x[:] = caller[0]
-    v[:] = caller[1]
-    th[:] = caller[2]
-    mov[:] = caller[3]
-    xs[:] = caller[4]
-    vs[:] = caller[5]
-    ths[:] = caller[6]
-    mm[:] = caller[7]
-    a1[:] = caller[8]
-    b1[:] = caller[9]
     mp, V, dt = _unpack(par)
     K, Kp, Fs = mp[0], mp[1], mp[5]
     h2 = 0.5 * dt
@@ -189,17 +147,14 @@ def run_exact(args, drive, friction, threshold, ends):
             if n == ist[NEXT_SAMPLE] or (profile_every > 0 and ist[EV_ACTIVE] == 1 and n == ist[NEXT_PROFILE]):
                 st = _service(n, x, N, ist, samp_L, samp_step, prof_x, prof_meta, sample_every, profile_every)
                 if st != DONE:
-                    _hand_back(caller, work, S, o, N)
                     return st
             if n >= n_end:
-                _hand_back(caller, work, S, o, N)
                 return DONE
             if (
                 ist[EV_COUNT] >= cap_ev
                 or ist[FM_COUNT] + N > cap_fm
                 or (profile_every > 0 and ist[P_COUNT] + 2 > cap_p)
             ):
-                _hand_back(caller, work, S, o, N)
                 return _overflow(ist, N, cap_ev, cap_fm)
             lo = ist[ACT_LO]
             hi = ist[ACT_HI]

@@ -46,7 +46,7 @@ from stickslip.run.checkpoint import CHECKPOINT_FORMAT, Checkpointer, _read_npz,
 from stickslip.run.errors import ChainRunError, Interrupted, NonFiniteState, ShortRunWarning
 from stickslip.run.outputs import EVENT_COLUMNS, ChainRun, RunOptions, _assemble, _Outputs
 from stickslip.run.rundir import load_run, read_run_id, write_run
-from stickslip.run.state import STARTS, ChainState, initial_state, loading_warnings, steady_deviation
+from stickslip.run.state import STARTS, ChainState, initial_state, line_aligned, loading_warnings, steady_deviation
 from stickslip.run.validate import check_checkpoint_state
 
 __all__ = [
@@ -186,6 +186,12 @@ class _Kernel:
 
     def __call__(self, state, target):
         return self.entry(self._args(state, target), *self.pieces)
+
+
+def _scratch(N: int) -> list[np.ndarray]:
+    """The kernels' scratch arrays (predictors, mask, stage-1 rates; ``trig``), the float ones
+    with block 1 at a line's start like the state's (:func:`~stickslip.run.state.line_aligned`)."""
+    return [line_aligned(np.zeros(N + 2)) for _ in range(6)] + [np.zeros(N + 2, dtype=np.int64)]
 
 
 def _check_state(state: ChainState, p: ChainParams) -> None:
@@ -405,7 +411,7 @@ def _drive(
 ) -> ChainRun:
     par = _par(params)
     N = params.N
-    scratch = [np.zeros(N + 2) for _ in range(6)] + [np.zeros(N + 2, dtype=np.int64)]
+    scratch = _scratch(N)
     n_end = steps_for(options.t_end, params.dt)
     sample_every = int(round(options.sample_interval / params.dt))
     profile_every = int(round(options.profile_window / params.dt)) if options.profile_window else 0
@@ -537,7 +543,7 @@ class Stepper:
         self.params = params
         self.integrator = integrator
         self.par = _par(params)
-        self.scratch = [np.zeros(params.N + 2) for _ in range(6)] + [np.zeros(params.N + 2, dtype=np.int64)]
+        self.scratch = _scratch(params.N)
         self.outputs = _Outputs(params.N, False)
         self._kernels: dict[str, _Kernel] = {}
 

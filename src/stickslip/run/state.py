@@ -18,6 +18,24 @@ from stickslip.models.params import ChainParams, ParameterError
 STARTS = ("paper", "steady", "rest")
 
 
+#: Bytes of a cache line: the exact path's vector loops run fastest from a line's start.
+LINE = 64
+
+
+def line_aligned(a: np.ndarray) -> np.ndarray:
+    """A copy of the 1-d array ``a`` whose element 1 (block 1, after the ghost cell) starts a
+    64-byte line, so that the exact path's vector loads and stores over a run of blocks from block
+    1 do not straddle lines (docs/performance.md, "The run's bounds per run, and aligned arrays").
+    The values are copied exactly."""
+    a = np.asarray(a)
+    per_line = LINE // a.itemsize
+    buf = np.empty(a.size + per_line, dtype=a.dtype)
+    off = (-(buf.ctypes.data + a.itemsize)) % LINE // a.itemsize
+    out = buf[off : off + a.size]
+    out[...] = a
+    return out
+
+
 @dataclass
 class ChainState:
     """Everything the kernels need to continue a run (arrays with ghost cells, see kernels).
@@ -36,6 +54,14 @@ class ChainState:
     ist: np.ndarray
 
     ARRAYS = ("x", "v", "th", "mov", "first_step", "x0ev", "ist")
+
+    def __post_init__(self):
+        # The kernels' float arrays with block 1 at a line's start, wherever they came from.
+        for name in ("x", "v", "th", "mov"):
+            a = getattr(self, name)
+            if isinstance(a, np.ndarray) and a.ndim == 1 and a.dtype == np.float64:
+                if (a.ctypes.data + a.itemsize) % LINE or not a.flags.c_contiguous:
+                    setattr(self, name, line_aligned(a))
 
     @property
     def N(self) -> int:
