@@ -278,7 +278,8 @@ def _verdicts(table: pd.DataFrame, out: dict[str, Any]) -> None:
     if "fsle_unfinished" in rows.columns and rows["fsle_unfinished"].notna().any():
         parts_f = []
         for r in rows[rows["fsle_unfinished"].notna()].itertuples():
-            name = f"beta = {r.beta:g} (N = {int(r.N)})" if r.model == "sakaguchi" else r.model
+            # the relatives have no beta (their friction has none)
+            name = f"beta = {r.beta:g} (N = {int(r.N)})" if _finite(r.beta) else r.model
             pooled = f"{_g(r.fsle_pooled, 2)}" if _finite(r.fsle_pooled) else "no doubling below 1e-6"
             peak = (
                 f"largest {_g(r.fsle_peak, 2)} at delta = {r.fsle_peak_delta:.2g}" if _finite(r.fsle_peak) else "none"
@@ -389,7 +390,7 @@ def chaos_curves(table: pd.DataFrame, points_dir: Path) -> list[dict[str, Any]]:
         path = Path(points_dir) / str(r.point_dir) / "flow.json"
         if not path.is_file():
             continue
-        chain = r.model == "sakaguchi"
+        chain = _finite(r.beta)  # the relatives have no beta
         label = f"eq. (4), N = {int(r.N)}, beta = {r.beta:g}" if chain else f"{r.model}, N = {int(r.N)}"
         key = (0, int(r.N), float(r.beta)) if chain else (1, 0, 0.0)
         curves.append((key, {"label": label, **io.read_json(path)}))
