@@ -221,11 +221,11 @@ def chaos_points(mode: str) -> tuple[list[dict[str, Any]], tuple[float, ...]]:
         d0s = (1e-10,)
     else:
         chain = [
-            {"N": 99, "beta": b, "t_end": 1.2e6, "transient": 1e6, "interval": 10.0, **_flow(2e3, 2e4, 5, 2e3)}
+            {"N": 99, "beta": b, "t_end": 1.2e6, "transient": 1e6, "interval": 10.0, **_flow(2e3, 1e4, 4, 1e3)}
             for b in _CHAOS_BETAS_FULL
         ]
         chain += [
-            {"N": 199, "beta": b, "t_end": 2.1e6, "transient": 2e6, "interval": 10.0, **_flow(1e3, 1e4, 3, 1e3)}
+            {"N": 199, "beta": b, "t_end": 2.1e6, "transient": 2e6, "interval": 10.0, **_flow(1e3, 5e3, 3, 1e3)}
             for b in (0.95, 1.0)
         ]
         family = [
