@@ -412,7 +412,8 @@ def _lifetimes(params, args) -> Result:
         out["loading_time"] = load
         out["t_steady_loads"] = out["t_steady"] / load if out["t_steady"] is not None and load > 0 else None
         rows.append(out)
-    data = {"params": params.to_dict(), "loads": args.loads, "lifetimes": rows}
+    # each row has its own N
+    data = {"params": {k: v for k, v in params.to_dict().items() if k != "N"}, "loads": args.loads, "lifetimes": rows}
     lines = [f"{'N':>6} {'t_steady':>12} {'loading times':>14} {'events':>8} {'wall s':>8}"]
     for r in rows:
         ts = f"{r['t_steady']:.6g}" if r["t_steady"] is not None else f"> {r['t_max']:.3g}"
