@@ -363,10 +363,10 @@ def test_chaos_findings_name_the_verdict_of_each_point():
     assert out["verdicts"] == {
         "regular": ["beta = 0.5 (N = 99)"],
         "stable chaos": ["beta = 1 (N = 99)"],
-        "chaotic": ["two-blocks"],
+        "chaotic": ["two blocks (N = 2)"],
     }
     assert (
-        "regular at beta = 0.5 (N = 99); stable chaos at beta = 1 (N = 99); chaotic at two-blocks"
+        "regular at beta = 0.5 (N = 99); stable chaos at beta = 1 (N = 99); chaotic at two blocks (N = 2)"
         in (out["statements"][-1])
     )
 

@@ -403,7 +403,7 @@ def add_block_model_option(parser: argparse.ArgumentParser) -> None:
 def block_params_from_args(args: argparse.Namespace, **overrides: Any):
     """Validated BlockParams of ``--model`` with the ``--NAME`` options as overrides."""
     from stickslip.models.params import BlockParams
-    from stickslip.models.presets import block_params
+    from stickslip.models.presets import PRESETS, block_params
 
     values = {
         f.name: getattr(args, f"param_{f.name}")
@@ -412,10 +412,10 @@ def block_params_from_args(args: argparse.Namespace, **overrides: Any):
     }
     values.update(overrides)
     model = getattr(args, "model", None) or "sakaguchi"
-    if model == "batista-carlson" and "Fs" in values:
+    if "Fs" in values and "Fs" not in PRESETS[model].reads():
         from stickslip.models.params import ParameterError
 
-        raise ParameterError("--Fs is not a parameter of batista-carlson (its threshold is sigma theta)")
+        raise ParameterError(f"--Fs is not a parameter of {model} (its threshold is sigma theta)")
     return block_params(model, **values)
 
 

@@ -178,7 +178,7 @@ def _check_options(model: str, params, settings: dict[str, Any]) -> None:
     """Validate a point's run options as the point's run will (so nothing fails later)."""
     from stickslip.models.params import ParameterError, steps_for
 
-    if model == "block":
+    if model == "block":  # the system swept (single block or chain), not a model piece
         steps_for(settings["t_end"], params.dt)
         check_number("every", settings.get("every", 1), low=1, high=MAX_STEPS, integer=True)
         return

@@ -34,6 +34,7 @@ import numpy as np
 from stickslip import __version__
 from stickslip.experiments.cache import canonical, spec_key
 from stickslip.experiments.chaos_verdict import chaos_points, check_verdict
+from stickslip.models.presets import is_paper
 
 __all__ = [
     "Study",
@@ -235,7 +236,7 @@ def _exponents(mode: str) -> Study:
 
 def _chaos(mode: str) -> Study:
     points, d0s = chaos_points(mode)
-    chain = [p for p in points if p["model"] == "sakaguchi"]
+    chain = [p for p in points if is_paper(p["model"])]
     Ns = sorted({p["N"] for p in chain})
     transients = sorted({p["transient"] for p in chain})
     common = {"analysis": "lyapunov", "segments": 10, "direction_seed": 0}

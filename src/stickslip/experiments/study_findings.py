@@ -15,6 +15,7 @@ import pandas as pd
 
 from stickslip.analysis.order import power_law_fit, transition_bracket
 from stickslip.experiments.studies import Study, study_command
+from stickslip.models.presets import PRESETS, is_paper
 
 __all__ = ["conclusions", "draw"]
 
@@ -178,8 +179,7 @@ def _exponents(table: pd.DataFrame) -> dict[str, Any]:
     out: dict[str, Any] = {"statements": []}
     say = out["statements"].append
     for r in table.sort_values(["model", "beta"]).itertuples():
-        # Not a piece test: a table row's preset picks its label (the paper's beta or CL's N).
-        label = f"beta = {r.beta:g}" if r.model == "sakaguchi" else f"Carlson-Langer (N = {r.N})"
+        label = PRESETS[r.model].point_label(r.beta, r.N, with_N=False)
         say(
             f"{label}: tau = {_g(r.tau)} +- {_g(getattr(r, 'tau_err', math.nan), 2)} on S in "
             f"[{_g(getattr(r, 's_min', math.nan))}, {_g(getattr(r, 's_max', math.nan))}] "
@@ -187,7 +187,7 @@ def _exponents(table: pd.DataFrame) -> dict[str, Any]:
             f"{_g(getattr(r, 'excess', math.nan))} ({getattr(r, 'observed', 'n/a')} observed / "
             f"{_g(getattr(r, 'expected', math.nan))} expected)."
         )
-    chain = table[table["model"] == "sakaguchi"].sort_values("beta")
+    chain = table[table["model"].map(is_paper)].sort_values("beta")
     ok = chain[np.isfinite(chain["tau"].astype(float))]
     if len(ok) > 1:
         slope = np.polyfit(ok["beta"].astype(float), ok["tau"].astype(float), 1)[0]
@@ -203,7 +203,7 @@ def _chaos(table: pd.DataFrame) -> dict[str, Any]:
     the chain of eq. (4) compares with its plate-driven relatives."""
     out: dict[str, Any] = {"statements": [], "chain": {}, "family": {}}
     say = out["statements"].append
-    chain = table[table["model"] == "sakaguchi"].sort_values("beta")
+    chain = table[table["model"].map(is_paper)].sort_values("beta")
     lam = chain["lyapunov"].to_numpy(float)
     err = chain["lyapunov_err"].to_numpy(float)
     ok = np.isfinite(lam) & np.isfinite(err) & (err > 0)
@@ -227,7 +227,7 @@ def _chaos(table: pd.DataFrame) -> dict[str, Any]:
                 f"eq. (4): per slip event, lambda ranges over [{_g(np.nanmin(per_event), 2)}, "
                 f"{_g(np.nanmax(per_event), 2)}]."
             )
-    for model, g in table[table["model"] != "sakaguchi"].groupby("model"):
+    for model, g in table[~table["model"].map(is_paper)].groupby("model"):
         rows = g.sort_values("d0")
         vals = ", ".join(f"{_g(r.lyapunov)} +- {_g(r.lyapunov_err, 2)} (d0 = {r.d0:g})" for r in rows.itertuples())
         lam_m = rows["lyapunov"].to_numpy(float)
@@ -272,7 +272,7 @@ def _verdicts(table: pd.DataFrame, out: dict[str, Any]) -> None:
     out["verdicts"] = {}
     parts = []
     for label, g in rows.groupby("verdict", sort=False):
-        names = [f"beta = {r.beta:g} (N = {int(r.N)})" if r.model == "sakaguchi" else r.model for r in g.itertuples()]
+        names = [PRESETS[r.model].point_label(r.beta, r.N) for r in g.itertuples()]
         out["verdicts"][label] = names
         parts.append(f"{label} at {', '.join(names)}")
     if "fsle_unfinished" in rows.columns and rows["fsle_unfinished"].notna().any():

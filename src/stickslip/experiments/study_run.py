@@ -224,8 +224,11 @@ def _study_table(spec: Study, sweep_table: pd.DataFrame) -> pd.DataFrame:
             table.loc[missing, "N"] = [PRESETS[m].params["N"] for m in table.loc[missing, "model"]]
             table["N"] = table["N"].astype("int64")
     if "beta" in table.columns and "model" in table.columns:
-        # the plate-driven relatives have no beta (velocity-weakening friction)
-        table.loc[table["model"].isin(["carlson-langer", "two-blocks"]), "beta"] = np.nan
+        # models whose friction reads no beta (velocity weakening) have none
+        from stickslip.models.presets import PRESETS
+
+        no_beta = [m for m in table["model"].unique() if "beta" not in PRESETS[m].reads()]
+        table.loc[table["model"].isin(no_beta), "beta"] = np.nan
     if "final_state" in table.columns:
         table.loc[table["status"] != "ok", "final_state"] = "failed"
     lead = [c for c in TABLE_COLUMNS[spec.name] if c in table.columns]

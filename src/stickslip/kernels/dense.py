@@ -26,49 +26,48 @@ from stickslip.kernels.layout import (
     STEPS_COMPUTED,
     _unpack,
 )
+from stickslip.kernels.pipeline import PiecesCompiler
 
 
-@njit(cache=True)
-def run_dense(
-    x,
-    v,
-    th,
-    mov,
-    xs,
-    vs,
-    ths,
-    mm,
-    a1,
-    b1,
-    trig,
-    first_step,
-    x0ev,
-    ist,
-    par,
-    ev_int,
-    ev_S,
-    fm,
-    samp_L,
-    samp_step,
-    prof_x,
-    prof_meta,
-    n_end,
-    sample_every,
-    profile_every,
-    profile_min_blocks,
-    drive,
-    friction,
-    threshold,
-    ends,
-):
+@njit(cache=True, pipeline_class=PiecesCompiler)
+def run_dense(args, drive, friction, threshold, ends):
     """Reference integrator of the chain (eq. 4 and its relatives): Heun over every block at
     every step, written plainly.
 
-    Advances the state arrays to step ``n_end`` or until an output buffer is full; returns a
-    status code (:mod:`stickslip.kernels.layout`, which also lists the pieces). The step is in
+    ``args`` is a :class:`~stickslip.kernels.layout.ChainArgs` (arrays and integers); the pieces
+    are codes (:mod:`stickslip.kernels.layout`), compile-time constants. Advances the state
+    arrays to step ``n_end`` or until an output buffer is full; returns a status code. The step is in
     :mod:`stickslip.kernels.laws`, the events in :mod:`stickslip.kernels.events`. ``trig`` is
     scratch of :func:`stickslip.kernels.exact.run_exact`, unused here.
     """
+    (
+        x,
+        v,
+        th,
+        mov,
+        xs,
+        vs,
+        ths,
+        mm,
+        a1,
+        b1,
+        trig,
+        first_step,
+        x0ev,
+        ist,
+        par,
+        ev_int,
+        ev_S,
+        fm,
+        samp_L,
+        samp_step,
+        prof_x,
+        prof_meta,
+        n_end,
+        sample_every,
+        profile_every,
+        profile_min_blocks,
+    ) = args
     N = x.shape[0] - 2
     mp, V, dt = _unpack(par)
     K, Kp, Fs = mp[0], mp[1], mp[5]

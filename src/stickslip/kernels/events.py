@@ -75,6 +75,26 @@ def _overflow(ist, N, cap_ev, cap_fm):
     return PROFILES_FULL
 
 
+@njit(cache=True, inline="always")
+def _open_event(n, first, x, ist, prof_x, prof_meta, N, profile_every):
+    """Open an event whose first block to move is ``first``, in step n (x holds t_n): its start
+    and, with profiles, its first profile row."""
+    ist[EV_ACTIVE] = 1
+    ist[EV_START_STEP] = n
+    ist[EV_START_BLOCK] = first
+    ist[EV_MAX_BLOCK] = 0
+    ist[EV_N_MOVED] = 0
+    if profile_every > 0:
+        r = ist[P_COUNT]
+        ist[EV_P_FIRST] = r
+        for i in range(1, N + 1):
+            prof_x[r, i - 1] = x[i]
+        prof_meta[r, 0] = ist[N_EVENTS]
+        prof_meta[r, 1] = n
+        ist[P_COUNT] = r + 1
+        ist[NEXT_PROFILE] = n + profile_every
+
+
 @njit(cache=True)
 def _start_and_first_moves(n, lo, hi, x, mm, first_step, x0ev, ist, prof_x, prof_meta, N, profile_every):
     """Event bookkeeping before stage 2 (x still holds t_n): event start and first moves."""
@@ -88,20 +108,7 @@ def _start_and_first_moves(n, lo, hi, x, mm, first_step, x0ev, ist, prof_x, prof
                 break
         if first < 0:
             return
-        ist[EV_ACTIVE] = 1
-        ist[EV_START_STEP] = n
-        ist[EV_START_BLOCK] = first
-        ist[EV_MAX_BLOCK] = 0
-        ist[EV_N_MOVED] = 0
-        if profile_every > 0:
-            r = ist[P_COUNT]
-            ist[EV_P_FIRST] = r
-            for i in range(1, N + 1):
-                prof_x[r, i - 1] = x[i]
-            prof_meta[r, 0] = ist[N_EVENTS]
-            prof_meta[r, 1] = n
-            ist[P_COUNT] = r + 1
-            ist[NEXT_PROFILE] = n + profile_every
+        _open_event(n, first, x, ist, prof_x, prof_meta, N, profile_every)
     for i in range(lo, hi + 1):
         if mm[i] != 0.0 and first_step[i] < 0:
             first_step[i] = n

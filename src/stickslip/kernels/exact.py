@@ -15,9 +15,9 @@ Which stopped blocks can start:
 * plate drive: every stopped block keeps its first start step under the plate (``trig``,
   :mod:`stickslip.kernels.triggers`); a block that starts because of the plate alone is found
   by comparing the step with these numbers, and when nothing is active the kernel jumps to the
-  smallest of them. Without a state variable a stopped block never changes, so the kernel
-  hands over to the sparse path, which updates lists of blocks instead of an interval
-  (:mod:`stickslip.kernels.plate`).
+  smallest of them. Without a state variable a stopped block never changes, and the driver
+  runs the sparse path instead, which updates lists of blocks instead of an interval
+  (:mod:`stickslip.kernels.plate`), so that this kernel does not compile it.
 * state threshold: a block whose theta changes may start without any neighbour moving, so
   every block whose state variable may change is a candidate.
 
@@ -25,11 +25,15 @@ A run of blocks that all move at t_n (the longest such run, kept across steps wh
 it stops) is updated by the stages of :mod:`stickslip.kernels.stages` that skip the start rule
 and the bookkeeping of changes, as when the whole chain slides: in a partly stuck chain most of
 a step's work is one such run. Its blocks are counted as changed, which can only widen the
-interval of the next step; a wider interval gives the same bits.
+interval of the next step; a wider interval gives the same bits. The steps of one run form an
+inner loop in which the run's bounds are fixed, so that the run stages' overlap checks are made
+once per run; and the kernel works on copies of its arrays with block 1 at the start of a 64-byte
+line, handed back on return (docs/performance.md, "The run's bounds per run, and aligned copies").
 """
 
 from __future__ import annotations
 
+import numpy as np
 from numba import njit
 
 from stickslip.kernels.events import _end_event, _overflow, _service, _start_and_first_moves
@@ -60,7 +64,7 @@ from stickslip.kernels.layout import (
     _merge,
     _unpack,
 )
-from stickslip.kernels.plate import run_sparse
+from stickslip.kernels.pipeline import PiecesCompiler
 from stickslip.kernels.stages import (
     _longest_run,
     _stage1,
@@ -76,85 +80,90 @@ from stickslip.kernels.stages import (
 from stickslip.kernels.triggers import _first_trigger, _plate_triggers
 
 
-@njit(cache=True)
-def run_exact(
-    x,
-    v,
-    th,
-    mov,
-    xs,
-    vs,
-    ths,
-    mm,
-    a1,
-    b1,
-    trig,
-    first_step,
-    x0ev,
-    ist,
-    par,
-    ev_int,
-    ev_S,
-    fm,
-    samp_L,
-    samp_step,
-    prof_x,
-    prof_meta,
-    n_end,
-    sample_every,
-    profile_every,
-    profile_min_blocks,
-    drive,
-    friction,
-    threshold,
-    ends,
-):
+@njit(cache=True, inline="always")
+def _line(work, k, S, o, N):
+    """The k-th array of N + 2 values in ``work``, from offset k S + o."""
+    return work[k * S + o : k * S + o + N + 2]
+
+
+@njit(cache=True, inline="always")
+def _hand_back(caller, work, S, o, N):
+    """Copy the working arrays back into the caller's (one statement each: the caller's arrays
+    need not share a type)."""
+    caller[0][:] = _line(work, 0, S, o, N)
+    caller[1][:] = _line(work, 1, S, o, N)
+    caller[2][:] = _line(work, 2, S, o, N)
+    caller[3][:] = _line(work, 3, S, o, N)
+    caller[4][:] = _line(work, 4, S, o, N)
+    caller[5][:] = _line(work, 5, S, o, N)
+    caller[6][:] = _line(work, 6, S, o, N)
+    caller[7][:] = _line(work, 7, S, o, N)
+    caller[8][:] = _line(work, 8, S, o, N)
+    caller[9][:] = _line(work, 9, S, o, N)
+
+
+@njit(cache=True, pipeline_class=PiecesCompiler)
+def run_exact(args, drive, friction, threshold, ends):
     """Fast integrator of the chain, bit for bit equal to :func:`~stickslip.kernels.dense.run_dense`.
 
     Updates only the blocks that can change (see the module docstring), in branch-free
     loops over one contiguous interval, and jumps over steps in which nothing can change.
-    Same arguments, state layout and status codes as ``run_dense``, except that it does not
+    Same arguments (a :class:`~stickslip.kernels.layout.ChainArgs` and the pieces' codes), state
+    layout and status codes as ``run_dense``, except that it does not
     look for non-finite values: the driver checks the state after each call and replays the
     call with ``run_dense``, which does, to name the step and the block. ``trig``
     (int64, N + 2) is scratch: the plate drive's first start step of each stopped block,
     rebuilt on entry.
     """
-    if drive == DRIVE_PLATE:
-        if friction != FRICTION_STATE:
-            # No state variable: stopped blocks never change, so update a list, not an interval.
-            return run_sparse(
-                x,
-                v,
-                th,
-                mov,
-                xs,
-                vs,
-                ths,
-                mm,
-                a1,
-                b1,
-                trig,
-                first_step,
-                x0ev,
-                ist,
-                par,
-                ev_int,
-                ev_S,
-                fm,
-                samp_L,
-                samp_step,
-                prof_x,
-                prof_meta,
-                n_end,
-                sample_every,
-                profile_every,
-                profile_min_blocks,
-                drive,
-                friction,
-                threshold,
-                ends,
-            )
+    (
+        x,
+        v,
+        th,
+        mov,
+        xs,
+        vs,
+        ths,
+        mm,
+        a1,
+        b1,
+        trig,
+        first_step,
+        x0ev,
+        ist,
+        par,
+        ev_int,
+        ev_S,
+        fm,
+        samp_L,
+        samp_step,
+        prof_x,
+        prof_meta,
+        n_end,
+        sample_every,
+        profile_every,
+        profile_min_blocks,
+    ) = args
     N = x.shape[0] - 2
+    # Work on copies of the ten float arrays, each with block 1 at the start of a 64-byte line, so
+    # that the vector loads and stores of a run from block 1 do not straddle lines; the caller's
+    # arrays get them back on return (docs/performance.md, "... and aligned copies").
+    caller = (x, v, th, mov, xs, vs, ths, mm, a1, b1)
+    S = (N + 17) // 8 * 8  # room for the shift; a whole number of lines per array
+    work = np.empty(10 * S)
+    o = (-(work.ctypes.data + 8)) % 64 // 8
+    x, v, th, mov = _line(work, 0, S, o, N), _line(work, 1, S, o, N), _line(work, 2, S, o, N), _line(work, 3, S, o, N)
+    xs, vs, ths = _line(work, 4, S, o, N), _line(work, 5, S, o, N), _line(work, 6, S, o, N)
+    mm, a1, b1 = _line(work, 7, S, o, N), _line(work, 8, S, o, N), _line(work, 9, S, o, N)
+    x[:] = caller[0]
+    v[:] = caller[1]
+    th[:] = caller[2]
+    mov[:] = caller[3]
+    xs[:] = caller[4]
+    vs[:] = caller[5]
+    ths[:] = caller[6]
+    mm[:] = caller[7]
+    a1[:] = caller[8]
+    b1[:] = caller[9]
     mp, V, dt = _unpack(par)
     K, Kp, Fs = mp[0], mp[1], mp[5]
     h2 = 0.5 * dt
@@ -167,263 +176,288 @@ def run_exact(
         _set_ghosts(x, th, N, 0.0, drive, ends)
         t_next = _plate_triggers(x, th, mov, mm, trig, 1, N, True, ist[STEP], n_end, mp, V, dt, threshold)
     while True:
-        n = ist[STEP]
-        # Outputs due, the end, buffers that could overflow. Written out here rather than in a
-        # helper: as a function this costs several times a short step (measured).
-        if n == ist[NEXT_SAMPLE] or (profile_every > 0 and ist[EV_ACTIVE] == 1 and n == ist[NEXT_PROFILE]):
-            st = _service(n, x, N, ist, samp_L, samp_step, prof_x, prof_meta, sample_every, profile_every)
-            if st != DONE:
-                return st
-        if n >= n_end:
-            return DONE
-        if ist[EV_COUNT] >= cap_ev or ist[FM_COUNT] + N > cap_fm or (profile_every > 0 and ist[P_COUNT] + 2 > cap_p):
-            return _overflow(ist, N, cap_ev, cap_fm)
-        lo = ist[ACT_LO]
-        hi = ist[ACT_HI]
-        # Blocks that may move in this step: those that could last step, plus those the drive
-        # brings to their threshold.
-        ml = ist[MECH_LO]
-        mh = ist[MECH_HI]
-        if drive == DRIVE_END:
-            x2 = _right_of_first(x, N, ends)
-            if mov[1] != 0.0 or _force(_pull(V, n, dt), x[1], x2, K, Kp, 0.0, drive) > _threshold(th[1], Fs, threshold):
-                lo = 1
-                if hi < 1:
-                    hi = 1
-                ml = 1
-                if mh < 1:
-                    mh = 1
-        elif n >= t_next:
-            t_next = _NEVER
-            for i in range(1, N + 1):
-                if mov[i] == 0.0:
-                    if trig[i] <= n:
-                        ml, mh = _merge(ml, mh, i, i)
-                    elif trig[i] < t_next:
-                        t_next = trig[i]
-            lo, hi = _merge(lo, hi, ml, mh)
-        if threshold == THRESHOLD_STATE:
-            # A changing state variable moves the threshold itself.
-            ml, mh = _merge(ml, mh, lo, hi)
-        if ends == ENDS_PERIODIC and lo <= hi and (lo == 1 or hi == N):
-            # Blocks 1 and N read each other's predictors: update the whole ring.
-            lo = 1
-            hi = N
-        if lo > hi:
-            # Nothing can change before the drive starts a block: jump, but stop at due outputs.
-            target = n_end
-            if ist[NEXT_SAMPLE] < target:
-                target = ist[NEXT_SAMPLE]
-            if profile_every > 0 and ist[EV_ACTIVE] == 1 and ist[NEXT_PROFILE] < target:
-                target = ist[NEXT_PROFILE]
+        # The run's bounds, fixed over the inner loop of steps: the compiler then checks the
+        # run stages' arrays for overlap once per run rather than once per step (measured).
+        ra0 = ra
+        rb0 = rb
+        while True:
+            if ra != ra0 or rb != rb0:
+                break
+            n = ist[STEP]
+            # Outputs due, the end, buffers that could overflow. Written out here rather than in a
+            # helper: as a function this costs several times a short step (measured).
+            if n == ist[NEXT_SAMPLE] or (profile_every > 0 and ist[EV_ACTIVE] == 1 and n == ist[NEXT_PROFILE]):
+                st = _service(n, x, N, ist, samp_L, samp_step, prof_x, prof_meta, sample_every, profile_every)
+                if st != DONE:
+                    _hand_back(caller, work, S, o, N)
+                    return st
+            if n >= n_end:
+                _hand_back(caller, work, S, o, N)
+                return DONE
+            if (
+                ist[EV_COUNT] >= cap_ev
+                or ist[FM_COUNT] + N > cap_fm
+                or (profile_every > 0 and ist[P_COUNT] + 2 > cap_p)
+            ):
+                _hand_back(caller, work, S, o, N)
+                return _overflow(ist, N, cap_ev, cap_fm)
+            lo = ist[ACT_LO]
+            hi = ist[ACT_HI]
+            # Blocks that may move in this step: those that could last step, plus those the drive
+            # brings to their threshold.
+            ml = ist[MECH_LO]
+            mh = ist[MECH_HI]
             if drive == DRIVE_END:
-                ist[STEP] = _first_trigger(x, N, V, dt, K, _threshold(th[1], Fs, threshold), n + 1, target, ends)
-            else:
-                ist[STEP] = t_next if t_next < target else target
-            continue
-
-        if ist[N_MOVING] == N and lo == 1 and hi == N:
-            # Every block slides: no start, no first move, nothing to track but stops.
-            p1 = _pull(V, n, dt)
-            _set_ghosts(x, th, N, p1, drive, ends)
-            _stage1_all(x, v, th, xs, vs, ths, a1, b1, N, p1, mp, dt, drive, friction)
-            p2 = _pull(V, n + 1, dt)
-            _set_ghosts(xs, ths, N, p2, drive, ends)
-            stops = _stage2_all(x, v, th, xs, vs, ths, a1, b1, N, p2, mp, h2, drive, friction)
-            ist[BLOCK_UPDATES] += N
-            ist[FULL_UPDATES] += N
-            ist[STEPS_COMPUTED] += 1
-            ist[STEP] = n + 1
-            # Every block changed: all stay candidates for the next step.
-            ist[ACT_LO] = 1
-            ist[ACT_HI] = N
-            ist[MECH_LO] = 1
-            ist[MECH_HI] = N
-            ra, rb = 1, N
-            if stops:
-                n_moving = 0
+                x2 = _right_of_first(x, N, ends)
+                if mov[1] != 0.0 or _force(_pull(V, n, dt), x[1], x2, K, Kp, 0.0, drive) > _threshold(
+                    th[1], Fs, threshold
+                ):
+                    lo = 1
+                    if hi < 1:
+                        hi = 1
+                    ml = 1
+                    if mh < 1:
+                        mh = 1
+            elif n >= t_next:
+                t_next = _NEVER
                 for i in range(1, N + 1):
-                    mov[i] = 1.0 if v[i] > 0.0 else 0.0
-                    n_moving += 1 if v[i] > 0.0 else 0
-                ist[N_MOVING] = n_moving
-                ra, rb = _longest_run(mov, 1, N)
-                if drive == DRIVE_PLATE:
-                    # The blocks that stopped need their first start step under the plate.
-                    _set_ghosts(x, th, N, 0.0, drive, ends)
-                    t = _plate_triggers(x, th, mov, mm, trig, 1, N, True, n + 1, n_end, mp, V, dt, threshold)
-                    if t < t_next:
-                        t_next = t
-                if ist[EV_ACTIVE] == 1 and n_moving == 0:
-                    _end_event(
-                        n,
-                        x,
-                        first_step,
-                        x0ev,
-                        ist,
-                        ev_int,
-                        ev_S,
-                        fm,
-                        prof_x,
-                        prof_meta,
-                        N,
-                        profile_every,
-                        profile_min_blocks,
-                    )
-            continue
-
-        p1 = _pull(V, n, dt)
-        _set_ghosts(x, th, N, p1, drive, ends)
-        l1 = lo - 1 if lo > 1 else 1
-        h1 = hi + 1 if hi < N else N
-        # Stage 1: full over [ml, mh] within [l1, h1], state variable alone elsewhere.
-        fl = ml if ml > l1 else l1
-        fh = mh if mh < h1 else h1
-        first = h1 + 1
-        last = l1 - 1
-        starts = False
-        if fl <= fh:
-            # The run within [fl, fh] (its blocks move: no start rule), the general stage on
-            # either side of it.
-            qa = ra if ra > fl else fl
-            qb = rb if rb < fh else fh
-            if qa <= qb:
-                first = qa
-                last = qb
-                if fl < qa:
-                    f_, l_, starts = _stage1(
-                        x, v, th, mov, xs, vs, ths, mm, a1, b1, fl, qa - 1, p1, mp, dt, drive, friction, threshold
-                    )
-                    if f_ <= l_:
-                        first = f_
-                _stage1_run(x, v, th, xs, vs, ths, mm, a1, b1, qa, qb, p1, mp, dt, drive, friction)
-                if qb < fh:
-                    f_, l_, s_ = _stage1(
-                        x, v, th, mov, xs, vs, ths, mm, a1, b1, qb + 1, fh, p1, mp, dt, drive, friction, threshold
-                    )
-                    starts |= s_
-                    if f_ <= l_:
-                        last = l_
-            else:
-                first, last, starts = _stage1(
-                    x, v, th, mov, xs, vs, ths, mm, a1, b1, fl, fh, p1, mp, dt, drive, friction, threshold
-                )
-            if l1 < fl:
-                _stage1_theta(x, v, th, xs, vs, ths, mm, b1, l1, fl - 1, mp, dt, friction)
-            if fh < h1:
-                _stage1_theta(x, v, th, xs, vs, ths, mm, b1, fh + 1, h1, mp, dt, friction)
-        elif friction == FRICTION_STATE:
-            _stage1_theta_only(v, th, ths, b1, l1, h1, mp, dt, friction)
-        p2 = _pull(V, n + 1, dt)
-        _set_ghosts(xs, ths, N, p2, drive, ends)
-        # Only a block that starts in this step can move for the first time in an event.
-        if (ist[EV_ACTIVE] == 1 and starts) or (ist[N_MOVING] == 0 and first <= last):
-            _start_and_first_moves(
-                n, max(first, lo), min(last, hi), x, mm, first_step, x0ev, ist, prof_x, prof_meta, N, profile_every
-            )
-        # Stage 2: full over the blocks that move, state variable alone elsewhere.
-        sl = first if first > lo else lo
-        sh = last if last < hi else hi
-        c_lo = hi + 1
-        c_hi = lo - 1
-        moved_before = 0
-        moved_after = 0
-        stops_run = False
-        whole = False  # the whole run went through _stage2_run
-        if sl <= sh:
-            qa = ra if ra > sl else sl
-            qb = rb if rb < sh else sh
-            whole = qa == ra and qb == rb
-            if qa <= qb:
-                if sl < qa:
-                    c_lo, c_hi, moved_before, moved_after = _stage2(
-                        x, v, th, mov, xs, vs, ths, mm, a1, b1, sl, qa - 1, p2, mp, h2, drive, friction
-                    )
-                stops_run = _stage2_run(x, v, th, xs, vs, ths, a1, b1, qa, qb, p2, mp, h2, drive, friction)
-                # Every block of the run moved: count it as changed.
-                c_lo, c_hi = _merge(c_lo, c_hi, qa, qb)
-                moved_before += qb - qa + 1
-                if stops_run:
-                    for i in range(qa, qb + 1):
-                        keep = v[i] > 0.0
-                        mov[i] = 1.0 if keep else 0.0
-                        moved_after += 1 if keep else 0
+                    if mov[i] == 0.0:
+                        if trig[i] <= n:
+                            ml, mh = _merge(ml, mh, i, i)
+                        elif trig[i] < t_next:
+                            t_next = trig[i]
+                lo, hi = _merge(lo, hi, ml, mh)
+            if threshold == THRESHOLD_STATE:
+                # A changing state variable moves the threshold itself.
+                ml, mh = _merge(ml, mh, lo, hi)
+            if ends == ENDS_PERIODIC and lo <= hi and (lo == 1 or hi == N):
+                # Blocks 1 and N read each other's predictors: update the whole ring.
+                lo = 1
+                hi = N
+            if lo > hi:
+                # Nothing can change before the drive starts a block: jump, but stop at due outputs.
+                target = n_end
+                if ist[NEXT_SAMPLE] < target:
+                    target = ist[NEXT_SAMPLE]
+                if profile_every > 0 and ist[EV_ACTIVE] == 1 and ist[NEXT_PROFILE] < target:
+                    target = ist[NEXT_PROFILE]
+                if drive == DRIVE_END:
+                    ist[STEP] = _first_trigger(x, N, V, dt, K, _threshold(th[1], Fs, threshold), n + 1, target, ends)
                 else:
-                    moved_after += qb - qa + 1
-                if qb < sh:
-                    t_lo, t_hi, mb, ma = _stage2(
-                        x, v, th, mov, xs, vs, ths, mm, a1, b1, qb + 1, sh, p2, mp, h2, drive, friction
-                    )
-                    c_lo, c_hi = _merge(c_lo, c_hi, t_lo, t_hi)
-                    moved_before += mb
-                    moved_after += ma
-            else:
-                c_lo, c_hi, moved_before, moved_after = _stage2(
-                    x, v, th, mov, xs, vs, ths, mm, a1, b1, sl, sh, p2, mp, h2, drive, friction
-                )
-            ist[FULL_UPDATES] += sh - sl + 1
-            if friction == FRICTION_STATE:
-                if lo < sl:
-                    t_lo, t_hi = _stage2_theta(th, ths, v, b1, lo, sl - 1, mp, h2, friction)
-                    c_lo, c_hi = _merge(c_lo, c_hi, t_lo, t_hi)
-                if sh < hi:
-                    t_lo, t_hi = _stage2_theta(th, ths, v, b1, sh + 1, hi, mp, h2, friction)
-                    c_lo, c_hi = _merge(c_lo, c_hi, t_lo, t_hi)
-        elif friction == FRICTION_STATE:
-            c_lo, c_hi = _stage2_theta(th, ths, v, b1, lo, hi, mp, h2, friction)
-        # Next step's movers: a stopped block starts only if its force or threshold changed;
-        # through the springs that takes a neighbour's move, and only moving blocks change x.
-        # So: this step's movers +- 1 (and, as above, the drive's starts and changing thetas).
-        if first <= last:
-            if ends == ENDS_PERIODIC and (first == 1 or last == N):
+                    ist[STEP] = t_next if t_next < target else target
+                continue
+
+            if ist[N_MOVING] == N and lo == 1 and hi == N:
+                # Every block slides: no start, no first move, nothing to track but stops.
+                p1 = _pull(V, n, dt)
+                _set_ghosts(x, th, N, p1, drive, ends)
+                _stage1_all(x, v, th, xs, vs, ths, a1, b1, N, p1, mp, dt, drive, friction)
+                p2 = _pull(V, n + 1, dt)
+                _set_ghosts(xs, ths, N, p2, drive, ends)
+                stops = _stage2_all(x, v, th, xs, vs, ths, a1, b1, N, p2, mp, h2, drive, friction)
+                ist[BLOCK_UPDATES] += N
+                ist[FULL_UPDATES] += N
+                ist[STEPS_COMPUTED] += 1
+                ist[STEP] = n + 1
+                # Every block changed: all stay candidates for the next step.
+                ist[ACT_LO] = 1
+                ist[ACT_HI] = N
                 ist[MECH_LO] = 1
                 ist[MECH_HI] = N
-            else:
-                ist[MECH_LO] = first - 1 if first > 1 else 1
-                ist[MECH_HI] = last + 1 if last < N else N
-        else:
-            ist[MECH_LO] = 1
-            ist[MECH_HI] = 0
-        n_moving = ist[N_MOVING] + moved_after - moved_before
-        ist[N_MOVING] = n_moving
-        # The run of the next step: while none of it stops, it grows by the blocks that joined
-        # it at either end; otherwise the longest run among this step's movers.
-        if stops_run or not whole or ra > rb:
+                ra, rb = 1, N
+                if stops:
+                    n_moving = 0
+                    for i in range(1, N + 1):
+                        mov[i] = 1.0 if v[i] > 0.0 else 0.0
+                        n_moving += 1 if v[i] > 0.0 else 0
+                    ist[N_MOVING] = n_moving
+                    ra, rb = _longest_run(mov, 1, N)
+                    if drive == DRIVE_PLATE:
+                        # The blocks that stopped need their first start step under the plate.
+                        _set_ghosts(x, th, N, 0.0, drive, ends)
+                        t = _plate_triggers(x, th, mov, mm, trig, 1, N, True, n + 1, n_end, mp, V, dt, threshold)
+                        if t < t_next:
+                            t_next = t
+                    if ist[EV_ACTIVE] == 1 and n_moving == 0:
+                        _end_event(
+                            n,
+                            x,
+                            first_step,
+                            x0ev,
+                            ist,
+                            ev_int,
+                            ev_S,
+                            fm,
+                            prof_x,
+                            prof_meta,
+                            N,
+                            profile_every,
+                            profile_min_blocks,
+                        )
+                continue
+
+            p1 = _pull(V, n, dt)
+            _set_ghosts(x, th, N, p1, drive, ends)
+            l1 = lo - 1 if lo > 1 else 1
+            h1 = hi + 1 if hi < N else N
+            # Stage 1: full over [ml, mh] within [l1, h1], state variable alone elsewhere.
+            fl = ml if ml > l1 else l1
+            fh = mh if mh < h1 else h1
+            first = h1 + 1
+            last = l1 - 1
+            starts = False
+            # The run, when it lies within [fl, fh] and [lo, hi] (as it should: its blocks moved in
+            # the last step): no start rule there; the general stages on either side of it.
+            run_in = ra0 <= rb0 and fl <= ra0 and rb0 <= fh and lo <= ra0 and rb0 <= hi
+            if fl <= fh:
+                if run_in:
+                    first = ra0
+                    last = rb0
+                    if fl < ra0:
+                        f_, l_, starts = _stage1(
+                            x, v, th, mov, xs, vs, ths, mm, a1, b1, fl, ra0 - 1, p1, mp, dt, drive, friction, threshold
+                        )
+                        if f_ <= l_:
+                            first = f_
+                    _stage1_run(x, v, th, xs, vs, ths, mm, a1, b1, ra0, rb0, p1, mp, dt, drive, friction)
+                    if rb0 < fh:
+                        f_, l_, s_ = _stage1(
+                            x, v, th, mov, xs, vs, ths, mm, a1, b1, rb0 + 1, fh, p1, mp, dt, drive, friction, threshold
+                        )
+                        starts |= s_
+                        if f_ <= l_:
+                            last = l_
+                else:
+                    first, last, starts = _stage1(
+                        x, v, th, mov, xs, vs, ths, mm, a1, b1, fl, fh, p1, mp, dt, drive, friction, threshold
+                    )
+                if l1 < fl:
+                    _stage1_theta(x, v, th, xs, vs, ths, mm, b1, l1, fl - 1, mp, dt, friction)
+                if fh < h1:
+                    _stage1_theta(x, v, th, xs, vs, ths, mm, b1, fh + 1, h1, mp, dt, friction)
+            elif friction == FRICTION_STATE:
+                _stage1_theta_only(v, th, ths, b1, l1, h1, mp, dt, friction)
+            p2 = _pull(V, n + 1, dt)
+            _set_ghosts(xs, ths, N, p2, drive, ends)
+            # Only a block that starts in this step can move for the first time in an event.
+            if (ist[EV_ACTIVE] == 1 and starts) or (ist[N_MOVING] == 0 and first <= last):
+                _start_and_first_moves(
+                    n, max(first, lo), min(last, hi), x, mm, first_step, x0ev, ist, prof_x, prof_meta, N, profile_every
+                )
+            # Stage 2: full over the blocks that move, state variable alone elsewhere.
+            sl = first if first > lo else lo
+            sh = last if last < hi else hi
+            c_lo = hi + 1
+            c_hi = lo - 1
+            moved_before = 0
+            moved_after = 0
+            stops_run = False
+            whole = False  # the whole run went through _stage2_run
+            if sl <= sh:
+                whole = run_in
+                if run_in:
+                    if sl < ra0:
+                        c_lo, c_hi, moved_before, moved_after = _stage2(
+                            x, v, th, mov, xs, vs, ths, mm, a1, b1, sl, ra0 - 1, p2, mp, h2, drive, friction
+                        )
+                    stops_run = _stage2_run(x, v, th, xs, vs, ths, a1, b1, ra0, rb0, p2, mp, h2, drive, friction)
+                    # Every block of the run moved: count it as changed.
+                    c_lo, c_hi = _merge(c_lo, c_hi, ra0, rb0)
+                    moved_before += rb0 - ra0 + 1
+                    if stops_run:
+                        for i in range(ra0, rb0 + 1):
+                            keep = v[i] > 0.0
+                            mov[i] = 1.0 if keep else 0.0
+                            moved_after += 1 if keep else 0
+                    else:
+                        moved_after += rb0 - ra0 + 1
+                    if rb0 < sh:
+                        t_lo, t_hi, mb, ma = _stage2(
+                            x, v, th, mov, xs, vs, ths, mm, a1, b1, rb0 + 1, sh, p2, mp, h2, drive, friction
+                        )
+                        c_lo, c_hi = _merge(c_lo, c_hi, t_lo, t_hi)
+                        moved_before += mb
+                        moved_after += ma
+                else:
+                    c_lo, c_hi, moved_before, moved_after = _stage2(
+                        x, v, th, mov, xs, vs, ths, mm, a1, b1, sl, sh, p2, mp, h2, drive, friction
+                    )
+                ist[FULL_UPDATES] += sh - sl + 1
+                if friction == FRICTION_STATE:
+                    if lo < sl:
+                        t_lo, t_hi = _stage2_theta(th, ths, v, b1, lo, sl - 1, mp, h2, friction)
+                        c_lo, c_hi = _merge(c_lo, c_hi, t_lo, t_hi)
+                    if sh < hi:
+                        t_lo, t_hi = _stage2_theta(th, ths, v, b1, sh + 1, hi, mp, h2, friction)
+                        c_lo, c_hi = _merge(c_lo, c_hi, t_lo, t_hi)
+            elif friction == FRICTION_STATE:
+                c_lo, c_hi = _stage2_theta(th, ths, v, b1, lo, hi, mp, h2, friction)
+            # Next step's movers: a stopped block starts only if its force or threshold changed;
+            # through the springs that takes a neighbour's move, and only moving blocks change x.
+            # So: this step's movers +- 1 (and, as above, the drive's starts and changing thetas).
             if first <= last:
-                ra, rb = _longest_run(mov, first, last)
+                if ends == ENDS_PERIODIC and (first == 1 or last == N):
+                    ist[MECH_LO] = 1
+                    ist[MECH_HI] = N
+                else:
+                    ist[MECH_LO] = first - 1 if first > 1 else 1
+                    ist[MECH_HI] = last + 1 if last < N else N
             else:
-                ra, rb = 1, 0
-        else:
-            while ra > 1 and mov[ra - 1] != 0.0:
-                ra -= 1
-            while rb < N and mov[rb + 1] != 0.0:
-                rb += 1
-        ist[BLOCK_UPDATES] += hi - lo + 1
-        ist[STEPS_COMPUTED] += 1
-        ist[STEP] = n + 1
-        # Next step's candidates: changes dilated by two, and every block that may move (a
-        # start rule that fires is an event's move even when it changes no bit).
-        if c_lo <= c_hi:
-            if ends == ENDS_PERIODIC and (c_lo <= 2 or c_hi >= N - 1):
-                c_lo = 1
-                c_hi = N
+                ist[MECH_LO] = 1
+                ist[MECH_HI] = 0
+            n_moving = ist[N_MOVING] + moved_after - moved_before
+            ist[N_MOVING] = n_moving
+            # The run of the next step: while none of it stops, it grows by the blocks that joined
+            # it at either end; otherwise the longest run among this step's movers.
+            if stops_run or not whole or ra > rb:
+                if first <= last:
+                    ra, rb = _longest_run(mov, first, last)
+                else:
+                    ra, rb = 1, 0
             else:
-                c_lo = c_lo - 2 if c_lo > 2 else 1
-                c_hi = c_hi + 2 if c_hi < N - 2 else N
-        ist[ACT_LO], ist[ACT_HI] = _merge(c_lo, c_hi, ist[MECH_LO], ist[MECH_HI])
-        if drive == DRIVE_PLATE:
-            # Stopped blocks whose force or threshold changed: their first start step anew.
-            if threshold == THRESHOLD_STATE:
-                w_lo, w_hi = _merge(ist[MECH_LO], ist[MECH_HI], lo, hi)
-                every = True
-            else:
-                w_lo, w_hi = ist[MECH_LO], ist[MECH_HI]
-                every = False
-            if w_lo <= w_hi:
-                _set_ghosts(x, th, N, 0.0, drive, ends)
-                t = _plate_triggers(x, th, mov, mm, trig, w_lo, w_hi, every, n + 1, n_end, mp, V, dt, threshold)
-                if t < t_next:
-                    t_next = t
-        if ist[EV_ACTIVE] == 1 and n_moving == 0:
-            _end_event(
-                n, x, first_step, x0ev, ist, ev_int, ev_S, fm, prof_x, prof_meta, N, profile_every, profile_min_blocks
-            )
+                while ra > 1 and mov[ra - 1] != 0.0:
+                    ra -= 1
+                while rb < N and mov[rb + 1] != 0.0:
+                    rb += 1
+            ist[BLOCK_UPDATES] += hi - lo + 1
+            ist[STEPS_COMPUTED] += 1
+            ist[STEP] = n + 1
+            # Next step's candidates: changes dilated by two, and every block that may move (a
+            # start rule that fires is an event's move even when it changes no bit).
+            if c_lo <= c_hi:
+                if ends == ENDS_PERIODIC and (c_lo <= 2 or c_hi >= N - 1):
+                    c_lo = 1
+                    c_hi = N
+                else:
+                    c_lo = c_lo - 2 if c_lo > 2 else 1
+                    c_hi = c_hi + 2 if c_hi < N - 2 else N
+            ist[ACT_LO], ist[ACT_HI] = _merge(c_lo, c_hi, ist[MECH_LO], ist[MECH_HI])
+            if drive == DRIVE_PLATE:
+                # Stopped blocks whose force or threshold changed: their first start step anew.
+                if threshold == THRESHOLD_STATE:
+                    w_lo, w_hi = _merge(ist[MECH_LO], ist[MECH_HI], lo, hi)
+                    every = True
+                else:
+                    w_lo, w_hi = ist[MECH_LO], ist[MECH_HI]
+                    every = False
+                if w_lo <= w_hi:
+                    _set_ghosts(x, th, N, 0.0, drive, ends)
+                    t = _plate_triggers(x, th, mov, mm, trig, w_lo, w_hi, every, n + 1, n_end, mp, V, dt, threshold)
+                    if t < t_next:
+                        t_next = t
+            if ist[EV_ACTIVE] == 1 and n_moving == 0:
+                _end_event(
+                    n,
+                    x,
+                    first_step,
+                    x0ev,
+                    ist,
+                    ev_int,
+                    ev_S,
+                    fm,
+                    prof_x,
+                    prof_meta,
+                    N,
+                    profile_every,
+                    profile_min_blocks,
+                )

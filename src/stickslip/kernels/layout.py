@@ -23,6 +23,7 @@ th[N+1] = th[1]); models without a state variable leave theta untouched. ``mov``
 for a moving block and 0.0 for a stopped one, so a stopped block's acceleration is
 ``0 * (...)``.
 
+A kernel takes one :class:`ChainArgs` (the arrays and integers) and the four pieces' codes.
 Kernels return a status code; the driver empties the output buffers and calls again. All
 state lives in the arrays passed in, so a run can stop and resume at any step boundary.
 
@@ -36,6 +37,8 @@ entry point per model).
 """
 
 from __future__ import annotations
+
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
@@ -87,6 +90,39 @@ FIRST_MOVES_FULL = 2
 SAMPLES_FULL = 3
 PROFILES_FULL = 4
 NONFINITE = 5
+
+
+class ChainArgs(NamedTuple):
+    """What a chain kernel works on besides the pieces: the state, scratch, parameter and output
+    arrays and the integers of one call (numba passes a named tuple as one argument)."""
+
+    x: np.ndarray  # float64 (N + 2): positions at t_n, ghost cells at 0 and N + 1
+    v: np.ndarray  # velocities
+    th: np.ndarray  # state variable theta
+    mov: np.ndarray  # 1.0 moving, 0.0 stopped
+    xs: np.ndarray  # scratch: stage-1 predictors of x, v, theta
+    vs: np.ndarray
+    ths: np.ndarray
+    mm: np.ndarray  # scratch: the step's mask of moving blocks
+    a1: np.ndarray  # scratch: stage-1 accelerations and theta derivatives
+    b1: np.ndarray
+    trig: np.ndarray  # int64 scratch: the plate drive's first start step of each stopped block
+    first_step: np.ndarray  # int64: step of each block's first move in the current event (-1: none)
+    x0ev: np.ndarray  # x of each block at its first move
+    ist: np.ndarray  # int64 state vector (indices above)
+    par: np.ndarray  # float64 parameter vector (indices above)
+    ev_int: np.ndarray  # event buffer (columns above) and each event's S
+    ev_S: np.ndarray
+    fm: np.ndarray  # first moves: (event, block, step)
+    samp_L: np.ndarray  # samples of L and their steps
+    samp_step: np.ndarray
+    prof_x: np.ndarray  # profile rows and their (event, step)
+    prof_meta: np.ndarray
+    n_end: int  # the call ends at this step
+    sample_every: int
+    profile_every: int  # 0: no profiles
+    profile_min_blocks: int
+
 
 _BIG = np.float64(1.7976931348623157e308)
 _NEVER = np.int64(9223372036854775807)

@@ -54,7 +54,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from stickslip.kernels.events import _end_event, _overflow, _service
+from stickslip.kernels.events import _end_event, _open_event, _overflow, _service
 from stickslip.kernels.laws import _accel, _force, _pull, _set_ghosts, _threshold
 from stickslip.kernels.layout import (
     _NEVER,
@@ -68,14 +68,10 @@ from stickslip.kernels.layout import (
     EV_COUNT,
     EV_MAX_BLOCK,
     EV_N_MOVED,
-    EV_P_FIRST,
-    EV_START_BLOCK,
-    EV_START_STEP,
     FM_COUNT,
     FULL_UPDATES,
     MECH_HI,
     MECH_LO,
-    N_EVENTS,
     N_MOVING,
     NEXT_PROFILE,
     NEXT_SAMPLE,
@@ -84,6 +80,7 @@ from stickslip.kernels.layout import (
     STEPS_COMPUTED,
     _unpack,
 )
+from stickslip.kernels.pipeline import PiecesCompiler
 from stickslip.kernels.triggers import _plate_trigger
 
 _QUEUED = np.int64(-1)  # trig of a stopped block queued as a candidate of the next step
@@ -139,45 +136,42 @@ def _settle(i, m, n, trig, queue, nq, t_next):
     return nq, min(t_next, m)
 
 
-@njit(cache=True, error_model="numpy")
-def run_sparse(
-    x,
-    v,
-    th,
-    mov,
-    xs,
-    vs,
-    ths,
-    mm,
-    a1,
-    b1,
-    trig,
-    first_step,
-    x0ev,
-    ist,
-    par,
-    ev_int,
-    ev_S,
-    fm,
-    samp_L,
-    samp_step,
-    prof_x,
-    prof_meta,
-    n_end,
-    sample_every,
-    profile_every,
-    profile_min_blocks,
-    drive,
-    friction,
-    threshold,
-    ends,
-):
+@njit(cache=True, error_model="numpy", pipeline_class=PiecesCompiler)
+def run_sparse(args, drive, friction, threshold, ends):
     """:func:`stickslip.kernels.exact.run_exact` for the plate drive with weakening or
     strengthening friction: same arguments, state and status codes (module docstring).
 
     ``mm``, ``a1``, ``b1``, ``vs`` and ``ths`` are not used: the mask is 1 on the movers' list,
     and the stage-1 accelerations and predicted velocities are kept in the list's order.
     """
+    (
+        x,
+        v,
+        th,
+        mov,
+        xs,
+        vs,
+        ths,
+        mm,
+        a1,
+        b1,
+        trig,
+        first_step,
+        x0ev,
+        ist,
+        par,
+        ev_int,
+        ev_S,
+        fm,
+        samp_L,
+        samp_step,
+        prof_x,
+        prof_meta,
+        n_end,
+        sample_every,
+        profile_every,
+        profile_min_blocks,
+    ) = args
     N = x.shape[0] - 2
     mp, V, dt = _unpack(par)
     K, Kp, Fs = mp[0], mp[1], mp[5]
@@ -346,20 +340,7 @@ def run_sparse(
                     first = min(first, np.int64(movers[k]))
                 active = True
                 n_chk = n + 1
-                ist[EV_ACTIVE] = 1
-                ist[EV_START_STEP] = n
-                ist[EV_START_BLOCK] = first
-                ist[EV_MAX_BLOCK] = 0
-                ist[EV_N_MOVED] = 0
-                if profile_every > 0:
-                    r = ist[P_COUNT]
-                    ist[EV_P_FIRST] = r
-                    for j in range(1, N + 1):
-                        prof_x[r, j - 1] = x[j]
-                    prof_meta[r, 0] = ist[N_EVENTS]
-                    prof_meta[r, 1] = n
-                    ist[P_COUNT] = r + 1
-                    ist[NEXT_PROFILE] = n + profile_every
+                _open_event(n, first, x, ist, prof_x, prof_meta, N, profile_every)
             for k in range(nmov, na):
                 i = movers[k]
                 if first_step[i] < 0:

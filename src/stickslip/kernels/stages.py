@@ -14,7 +14,8 @@ the cost of a block in the vector part; each loop also checks at entry, array pa
 pair, that its arrays do not overlap (numba cannot say so). So a few long loops per step are
 cheap, many short ones are not: the exact path runs the blocks that move throughout as one
 run (:func:`_stage1_run`, :func:`_stage2_run`, which skip the start rule and the bookkeeping
-of changes).
+of changes), with the run's bounds fixed over the steps of one run so that the compiler makes
+these checks once per run.
 """
 
 from __future__ import annotations

@@ -182,6 +182,14 @@ def check_composition(drive: str, friction: str, threshold: str, ends: str) -> N
         raise CompositionError(f"threshold state needs friction state (friction {friction} has no theta)")
 
 
+def stopped_blocks_still(drive: Piece, friction: Piece) -> bool:
+    """Whether a stopped block keeps every bit until a neighbour moves or the plate brings it to
+    its threshold: a leaf spring to the plate starts blocks at steps known in advance, and a
+    friction without theta leaves nothing of a stopped block to evolve. The exact integrator
+    then updates lists of blocks (:mod:`stickslip.kernels.plate`) instead of an interval."""
+    return drive.leaf_spring and not friction.has_state
+
+
 def reads(drive: str, friction: str, threshold: str, ends: str) -> tuple[str, ...]:
     """Parameters a composition reads, besides N, K, V and dt that every chain reads."""
     out: list[str] = []

@@ -28,6 +28,21 @@ class Preset:
     #: the note is a caveat on the model itself, so every run of it records the note
     note_in_runs: bool = False
     symbols: dict[str, str] = field(default_factory=dict)  # the model's own names -> ChainParams fields
+    #: a short name for tables and figure labels (the preset's name when empty)
+    label: str = ""
+
+    def reads(self) -> tuple[str, ...]:
+        """Parameters the preset's pieces read besides N, K, V and dt (docs/model.md's family table)."""
+        from stickslip.models.pieces import reads
+
+        return reads(**self.pieces)
+
+    def point_label(self, beta: float, N: int, *, with_N: bool = True) -> str:
+        """How a study names one of its points: by beta where the friction reads beta (eq. 4, the
+        train model), else by the model's short name, with N."""
+        if "beta" in self.reads():
+            return f"beta = {beta:g}" + (f" (N = {int(N)})" if with_N else "")
+        return f"{self.label or self.name} (N = {int(N)})"
 
     def describe(self) -> dict[str, Any]:
         """Everything ``stickslip models`` prints about the preset (JSON-able)."""
@@ -52,6 +67,15 @@ _BC_NOTE = (
     "the paper's reading of Batista-Carlson (a stuck block starts when K (V t - x) > theta), "
     "not Batista and Carlson's published model, which could not be consulted"
 )
+
+#: The paper's chain (eq. 4): the model whose beta the studies scan, beside its relatives.
+PAPER = "sakaguchi"
+
+
+def is_paper(model: str) -> bool:
+    """Whether a study's row is of the paper's chain (eq. 4) rather than one of its relatives."""
+    return model == PAPER
+
 
 PRESETS: dict[str, Preset] = {
     "sakaguchi": Preset(
@@ -82,6 +106,7 @@ PRESETS: dict[str, Preset] = {
         source="J. M. Carlson, J. S. Langer, B. E. Shaw and C. Tang, Phys. Rev. A 44, 884 (1991)",
         note="units of the leaf spring and of the static friction: Kp = 1, Fs = 1; K = l^2, V = nu",
         symbols={"l": "sqrt(K)", "nu": "V", "alpha": "alpha", "sigma": "sigma"},
+        label="Carlson-Langer",
     ),
     "train": Preset(
         "train",
@@ -123,6 +148,7 @@ PRESETS: dict[str, Preset] = {
         equations="as carlson-langer with N = 2 and free ends (x_0 = x_1, x_3 = x_2)",
         source="M. de Sousa Vieira, Phys. Rev. A 46, 6288 (1992); H. Sakaguchi and T. Morita (2013)",
         symbols={"l": "sqrt(K)", "nu": "V", "alpha": "alpha", "sigma": "sigma"},
+        label="two blocks",
     ),
 }
 

@@ -13,6 +13,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
+from stickslip.models.presets import PRESETS, is_paper
 from stickslip.plotting.style import new_figure
 
 __all__ = [
@@ -145,12 +146,13 @@ def exponents_figure(table: pd.DataFrame) -> Figure:
     """tau against beta for eq. (4) (bootstrap errors) with Carlson-Langer's tau as a band, and
     the great-event excess (observed / power-law count at and above the smallest spanning event)."""
     fig, (a1, a2) = new_figure(1, 2, width=4.6, height=3.8)
-    chain = table[table["model"] == "sakaguchi"].sort_values("beta")
-    cl = table[table["model"] == "carlson-langer"]
+    chain = table[table["model"].map(is_paper)].sort_values("beta")
+    cl = table[~table["model"].map(is_paper)]
     a1.errorbar(chain["beta"], chain["tau"], yerr=chain["tau_err"], fmt="o-", ms=4, capsize=2, label="eq. (4)")
     for r in cl.itertuples():
         if np.isfinite(r.tau):
-            a1.axhspan(r.tau - r.tau_err, r.tau + r.tau_err, color="C3", alpha=0.25, label=f"Carlson-Langer, N = {r.N}")
+            label = PRESETS[r.model].point_label(0.0, r.N)
+            a1.axhspan(r.tau - r.tau_err, r.tau + r.tau_err, color="C3", alpha=0.25, label=label)
     a1.plot([1.0], [1.5], "k*", ms=8, label="paper, beta = 1")
     a1.plot([0.2], [1.6], "k^", ms=6, label="paper, beta = 0.2")
     a1.set_xlabel(r"$\beta$")
@@ -158,7 +160,7 @@ def exponents_figure(table: pd.DataFrame) -> Figure:
     a1.legend(fontsize=7)
     a2.plot(chain["beta"], chain["excess"], "o-", ms=4, label="eq. (4)")
     for r in cl.itertuples():
-        a2.axhline(r.excess, color="C3", ls="--", label="Carlson-Langer")
+        a2.axhline(r.excess, color="C3", ls="--", label=PRESETS[r.model].label or r.model)
     a2.axhline(1.0, color="0.5", lw=0.8)
     a2.set_yscale("log")
     a2.set_xlabel(r"$\beta$")
@@ -177,7 +179,7 @@ def chaos_figure(table: pd.DataFrame) -> Figure:
     threshold beta_c = alpha = 1 (Fig. 4) dotted; right panel: two blocks and Carlson-Langer as
     marked points, one per d0 (their exponents are orders of magnitude larger)."""
     fig, (a1, a2) = new_figure(1, 2, width=4.4, height=3.6, gridspec_kw={"width_ratios": [2.2, 1]})
-    chain = table[table["model"] == "sakaguchi"].sort_values("beta")
+    chain = table[table["model"].map(is_paper)].sort_values("beta")
     for k, (N, g) in enumerate(sorted(chain.groupby("N"), key=lambda x: x[0])):
         a1.errorbar(
             g["beta"],
@@ -197,7 +199,7 @@ def chaos_figure(table: pd.DataFrame) -> Figure:
     a1.ticklabel_format(axis="y", style="sci", scilimits=(-3, 3))
     if a1.get_legend_handles_labels()[0]:
         a1.legend(fontsize=7)
-    family = table[table["model"] != "sakaguchi"]
+    family = table[~table["model"].map(is_paper)]
     models = [m for m in FAMILY_MARKERS if m in set(family["model"])]
     models += sorted(set(family["model"]) - set(models))
     for i, model in enumerate(models):

@@ -37,8 +37,9 @@ from typing import Any
 import numpy as np
 
 from stickslip import heartbeat
-from stickslip.kernels import dense, entry, exact, layout
+from stickslip.kernels import dense, entry, exact, layout, plate
 from stickslip.models.params import ChainParams, ParameterError, check_number, steps_for
+from stickslip.models.pieces import stopped_blocks_still
 
 # The checkpoint file helpers (_read_npz, _write_npz) are named here too, for checks of the files.
 from stickslip.run.checkpoint import CHECKPOINT_FORMAT, Checkpointer, _read_npz, _write_npz  # noqa: F401
@@ -71,7 +72,7 @@ __all__ = [
 
 INTEGRATORS = ("exact", "dense")
 
-_KERNELS = {"dense": dense.run_dense, "exact": exact.run_exact}
+_KERNELS = {"dense": dense.run_dense, "exact": exact.run_exact, "sparse": plate.run_sparse}
 
 
 @dataclass
@@ -155,18 +156,21 @@ class _Kernel:
     """One integrator compiled for one model: ``kernel(state, target)`` advances the state.
 
     The model's pieces are compile-time constants of the kernels (:func:`stickslip.kernels.entry.specialise`).
+    Where stopped blocks keep every bit, ``exact`` is the sparse path (:mod:`stickslip.kernels.plate`),
+    so only the kernel a run uses is compiled.
     """
 
     def __init__(self, name, params, state, scratch, par, outputs, sample_every, profile_every, min_blocks):
+        if name == "exact" and stopped_blocks_still(params.drive_piece, params.friction_piece):
+            name = "sparse"
         self.scratch = tuple(scratch)
         self.rest = (par, *outputs.kernel_args())
-        self.tail = (sample_every, profile_every, min_blocks)
+        self.tail = tuple(np.int64(t) for t in (sample_every, profile_every, min_blocks))
         self.pieces = params.codes
-        probe = self._args(state) + (np.int64(0),) + tuple(np.int64(t) for t in self.tail)
-        self.entry = entry.specialise(_KERNELS[name], probe, self.pieces)
+        self.entry = entry.specialise(_KERNELS[name], self._args(state, 0), self.pieces)
 
-    def _args(self, state):
-        return (
+    def _args(self, state, target):
+        return layout.ChainArgs(
             state.x,
             state.v,
             state.th,
@@ -176,10 +180,12 @@ class _Kernel:
             state.x0ev,
             state.ist,
             *self.rest,
+            np.int64(target),
+            *self.tail,
         )
 
     def __call__(self, state, target):
-        return self.entry(*self._args(state), target, *self.tail, *self.pieces)
+        return self.entry(self._args(state, target), *self.pieces)
 
 
 def _check_state(state: ChainState, p: ChainParams) -> None:
