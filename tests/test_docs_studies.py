@@ -62,12 +62,28 @@ def test_exponents_table():
 
 def test_chaos_table():
     ((_, table),) = _tables("chaos")
-    rows = {(r["model"], r["beta"]): r for r in _rows("chaos")}
+    rows = {(r["model"], r["beta"], r["d0"]): r for r in _rows("chaos")}
     assert len(table) == len(rows)
-    for model, N, beta, lam, err, events in table:
-        row = rows[(model, float(beta) if beta else None)]
-        assert int(N) == row["N"] and int(events) == row["events"]
+    columns = ("n_decorr_1e-12", "n_decorr_1e-10", "n_decorr_1e-08", "n_decorr_1e-06")
+    for model, N, beta, d0, lam, err, lam0, err0, n_decorr, compared, pooled, peak, verdict in table:
+        row = rows[(model, float(beta) if beta else None, float(d0))]
+        assert int(N) == row["N"] and verdict == row["verdict"]
         assert _same(lam, row["lyapunov"]) and _same(err, row["lyapunov_err"]), (model, beta)
+        assert _same(lam0, row["lyapunov_dt0"]) and _same(err0, row["lyapunov_dt0_err"]), (model, beta)
+        assert int(compared) == row["decorrelation_compared"]
+        n = [None if c.strip() == "never" else int(c) for c in n_decorr.split(",")]
+        expected = [None if row[c] is None else int(row[c]) for c in columns]
+        assert n == expected or (n == [None] and expected == [None] * 4), (model, beta)
+        if row["fsle_pooled"] is None:
+            assert pooled == "none"
+        else:
+            value, error = pooled.split(" +- ")
+            assert _same(value, row["fsle_pooled"]) and _same(error, row["fsle_pooled_err"])
+        if row["fsle_peak"] is None:
+            assert peak == "none"
+        else:
+            value, at = re.match(r"(\S+) \((\S+)\)", peak).groups()
+            assert _same(value, row["fsle_peak"]) and _same(at, row["fsle_peak_delta"])
 
 
 @pytest.mark.parametrize("which", [0, 1])

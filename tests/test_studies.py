@@ -369,3 +369,21 @@ def test_chaos_findings_name_the_verdict_of_each_point():
         "regular at beta = 0.5 (N = 99); stable chaos at beta = 1 (N = 99); chaotic at two blocks (N = 2)"
         in (out["statements"][-1])
     )
+
+
+def test_chaos_findings_summarise_the_finite_size_exponents():
+    from stickslip.experiments.study_findings import conclusions
+
+    nan = float("nan")
+    rows = [
+        {"model": "sakaguchi", "N": 99, "beta": 1.0, "lyapunov": 0.0, "lyapunov_err": 1e-5, "verdict": "regular"}
+        | {"lyapunov_per_event": 0.0}
+        | {"fsle_pooled": nan, "fsle_pooled_err": nan, "fsle_peak": nan, "fsle_peak_delta": nan, "fsle_unfinished": 4},
+        {"model": "two-blocks", "N": 2, "beta": nan, "d0": 1e-10, "lyapunov": 0.044, "lyapunov_err": 0.001}
+        | {"verdict": "chaotic", "merges": 0, "fsle_pooled": 0.0143, "fsle_pooled_err": 0.002}
+        | {"fsle_peak": 9.47, "fsle_peak_delta": 0.0512, "fsle_unfinished": 0},
+    ]
+    out = conclusions(study("chaos", "quick"), pd.DataFrame(rows))
+    (line,) = [s for s in out["statements"] if s.startswith("Finite-size exponent")]
+    assert "beta = 1 (N = 99): no doubling below 1e-6, none, 4 cycles unfinished" in line
+    assert "two-blocks: 0.014, largest 9.5 at delta = 0.051" in line

@@ -124,6 +124,22 @@ def register(sub) -> None:
         help="with --switches located: the number of slip events after which runs started delta = 1e-12, "
         "1e-10, 1e-8, 1e-6 apart stop agreeing, over --t-end minus --transient (JSON key decorrelation)",
     )
+    p.add_argument(
+        "--fronts",
+        action="store_true",
+        help="with --switches located: how far along the chain perturbations of one block's position "
+        "by delta = 1e-10, 1e-6, 1e-3, 1e-2 spread (blocks differing by more than 1e-2 delta) over "
+        "--t-end minus --transient, from the engine's state at --transient (JSON key fronts)",
+    )
+    p.add_argument("--front-block", type=int, default=0, metavar="B", help="--fronts: the block moved (0-based)")
+    p.add_argument(
+        "--lifetimes",
+        default=None,
+        metavar="N,N,...",
+        help="the time from the paper's start until every block slides steadily, for each N, at most "
+        "--loads loading times (JSON key lifetimes)",
+    )
+    p.add_argument("--loads", type=float_arg("loads"), default=8.0, metavar="L", help="--lifetimes: cap (default 8)")
     p.add_argument("--delta-min", type=float_arg("delta-min"), default=1e-10, metavar="D", help="(default 1e-10)")
     p.add_argument("--delta-max", type=float_arg("delta-max"), default=0.1, metavar="D", help="(default 0.1)")
     p.add_argument("--cycles", type=int, default=20, metavar="C", help="finite-size cycles counted (default 20)")
@@ -199,9 +215,15 @@ def run_lyapunov_command(args: argparse.Namespace) -> Result:
     )
     # Validate every option before the first (possibly long) run.
     ly._check_run(params, args.t_end, args.interval, args.d0, args.transient, args.align, args.segments)
+    if args.lifetimes is not None:
+        return _lifetimes(params, args)
     if args.switches == "located":
         return _located(params, args, kw)
-    for flag, given in (("--finite-size", args.finite_size), ("--decorrelation", args.decorrelation)):
+    for flag, given in (
+        ("--finite-size", args.finite_size),
+        ("--decorrelation", args.decorrelation),
+        ("--fronts", args.fronts),
+    ):
         if given:
             raise CommandError(f"{flag} goes with --switches located")
     if args.convergence:
@@ -276,8 +298,10 @@ def _located(params, args, kw) -> Result:
 
     if args.convergence or args.betas is not None:
         raise CommandError("--switches located runs one ladder; --convergence and --betas go with --switches grid")
-    if args.finite_size and args.decorrelation:
-        raise CommandError("give either --finite-size or --decorrelation, not both")
+    if sum(map(bool, (args.finite_size, args.decorrelation, args.fronts))) > 1:
+        raise CommandError("give one of --finite-size, --decorrelation and --fronts")
+    if args.fronts:
+        return _fronts(params, args)
     if args.finite_size:
         return _finite_size(params, args)
     if args.decorrelation:
@@ -335,4 +359,64 @@ def _decorrelation(params, args) -> Result:
         n = f"{r['events']}" if r["decorrelated"] else f"all {r['events']}"
         lines.append(f"{r['delta']:>8.0e} {n:>16}")
     lines.append(f"{res.reference_events} events of the reference; sizes agree to rtol {res.rtol:g}")
+    return Result(data, "\n".join(lines))
+
+
+def _fronts(params, args) -> Result:
+    """`--switches located --fronts`: :func:`stickslip.analysis.stable_chaos.perturbation_front`."""
+    from stickslip.analysis.stable_chaos import perturbation_front
+    from stickslip.experiments.chaos_verdict import located_start
+
+    if not args.t_end > args.transient:
+        raise CommandError(f"--t-end must exceed --transient (got {args.t_end:g} and {args.transient:g})")
+    check_number("front-block", args.front_block, low=0, high=params.N - 1, integer=True)
+    if params.ends_piece.wall and args.transient > 0:
+        raise CommandError("--fronts restarts the clock after --transient: fixed ends (which read t) are refused")
+    start = located_start(
+        params, {"transient": args.transient, "start": args.start, "perturbation": args.perturbation, "seed": args.seed}
+    )
+    res = perturbation_front(
+        params, start, (1e-10, 1e-6, 1e-3, 1e-2), t_max=args.t_end - args.transient, block=args.front_block
+    )
+    data = {"params": params.to_dict(), "switches": "located", "transient": args.transient, **res.to_dict()}
+    lines = [f"{'delta':>8} {'blocks reached':>15} {'at t':>9} {'speed':>10} {'ln(max diff/delta)':>19}"]
+    for r in res.rows:
+        lines.append(
+            f"{r['delta']:>8.0e} {r['reach']:>15d} {r['t_reach']:>9.4g} {r['speed']:>10.3g} {r['log_growth']:>19.3g}"
+        )
+    lines.append(f"block {res.block} moved; threshold {res.rel:g} delta; t after the transient")
+    return Result(data, "\n".join(lines))
+
+
+def _lifetimes(params, args) -> Result:
+    """`--lifetimes`: :func:`stickslip.analysis.stable_chaos.steady_lifetime` at each N."""
+    from stickslip.analysis.stable_chaos import steady_lifetime
+    from stickslip.experiments.studies import loading_time
+
+    try:
+        Ns = [int(s) for s in args.lifetimes.split(",") if s.strip()]
+    except ValueError:
+        raise CommandError(
+            f"--lifetimes must be a comma-separated list of block numbers (got {args.lifetimes!r})"
+        ) from None
+    if not Ns:
+        raise CommandError("--lifetimes needs at least one N")
+    for n in Ns:
+        check_number("N", n, low=1, integer=True)
+    check_number("loads", args.loads, low=0.0, low_open=True)
+    rows = []
+    for n in Ns:
+        p = params.replace(N=n)
+        load = loading_time(n, p.K, p.V)
+        out = steady_lifetime(p, args.loads * max(load, 1.0))
+        out["loading_time"] = load
+        out["t_steady_loads"] = out["t_steady"] / load if out["t_steady"] is not None and load > 0 else None
+        rows.append(out)
+    # each row has its own N
+    data = {"params": {k: v for k, v in params.to_dict().items() if k != "N"}, "loads": args.loads, "lifetimes": rows}
+    lines = [f"{'N':>6} {'t_steady':>12} {'loading times':>14} {'events':>8} {'wall s':>8}"]
+    for r in rows:
+        ts = f"{r['t_steady']:.6g}" if r["t_steady"] is not None else f"> {r['t_max']:.3g}"
+        tl = f"{r['t_steady_loads']:.3g}" if r["t_steady_loads"] is not None else "-"
+        lines.append(f"{r['N']:>6d} {ts:>12} {tl:>14} {r['events']:>8d} {r['wall_seconds']:>8.3g}")
     return Result(data, "\n".join(lines))

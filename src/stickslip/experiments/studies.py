@@ -33,8 +33,7 @@ import numpy as np
 
 from stickslip import __version__
 from stickslip.experiments.cache import canonical, spec_key
-from stickslip.experiments.chaos_verdict import check_verdict, verdict_once
-from stickslip.experiments.chaos_verdict import flow_lengths as _flow
+from stickslip.experiments.chaos_verdict import chaos_points, check_verdict
 from stickslip.models.presets import is_paper
 
 __all__ = [
@@ -235,77 +234,21 @@ def _exponents(mode: str) -> Study:
     )
 
 
-_CHAOS_BETAS_QUICK = tuple(round(0.2 + 0.1 * k, 3) for k in range(11))
-_CHAOS_BETAS_FULL = tuple(round(0.2 + 0.05 * k, 3) for k in range(21))
-
-
 def _chaos(mode: str) -> Study:
-    # Transients: the chain needs about one loading time (4.85e5 at N = 99) before its length
-    # fluctuates about its mean (docs/lyapunov.md); the plate-driven relatives forget their start
-    # within 2e3.
-    if mode == "tiny":
-        chain = [
-            {"N": 9, "beta": b, "t_end": 6000.0, "transient": 3000.0, "interval": 10.0, **_flow(200.0, 300.0)}
-            for b in (0.6, 1.2)
-        ]
-        # steady sliding well above the inverse transition: the exponent is the least stable
-        # eigenvalue of eq. (5), negative (docs/lyapunov.md, checks with known answers)
-        chain.append(
-            {
-                "N": 4,
-                "beta": 1.5,
-                "V": 0.5,
-                "start": "steady",
-                "perturbation": 1e-3,
-                "t_end": 400.0,
-                "transient": 0.0,
-                "interval": 5.0,
-                **_flow(100.0, 100.0),
-            }
-        )
-        family = [
-            {"model": "two-blocks", "t_end": 600.0, "transient": 100.0, **_flow(200.0, 600.0)},
-            {"model": "carlson-langer", "N": 16, "t_end": 300.0, "transient": 100.0, **_flow(100.0, 200.0)},
-        ]
-        d0s = (1e-10,)
-    elif mode == "quick":
-        chain = [
-            {"N": 99, "beta": b, "t_end": 6e5, "transient": 5e5, "interval": 10.0, **_flow(500.0, 5e3)}
-            for b in _CHAOS_BETAS_QUICK
-        ]
-        family = [
-            {"model": "two-blocks", "t_end": 4.2e4, "transient": 2e3, **_flow(2e3, 4e3)},
-            {"model": "carlson-langer", "t_end": 2.2e4, "transient": 2e3, **_flow(500.0, 2e3)},
-        ]
-        d0s = (1e-10,)
-    else:
-        chain = [
-            {"N": 99, "beta": b, "t_end": 1.5e6, "transient": 1e6, "interval": 10.0, **_flow(1e4, 1e5)}
-            for b in _CHAOS_BETAS_FULL
-        ]
-        family = [
-            {"model": "two-blocks", "t_end": 2.02e5, "transient": 2e3, **_flow(1e4, 2e4)},
-            {"model": "carlson-langer", "t_end": 1.02e5, "transient": 2e3, **_flow(2e3, 1e4)},
-        ]
-        d0s = (1e-8, 1e-10, 1e-11)  # CL does not settle in d0 (docs/lyapunov.md): show the spread
-    points = [{"model": "sakaguchi", "start": "paper", **c, "d0": 1e-10} for c in chain]
-    points += [
-        {**verdict_once(f, d0), "interval": 1.0, "start": "rest", "perturbation": 0.01, "seed": 0, "d0": d0}
-        for f in family
-        for d0 in d0s
-    ]
-    # Longest first: a shorter tail on a few workers.
-    points.sort(key=lambda p: -(p["t_end"] - p["transient"]) * p.get("N", 100) / p["interval"])
+    points, d0s = chaos_points(mode)
+    chain = [p for p in points if is_paper(p["model"])]
+    Ns = sorted({p["N"] for p in chain})
+    transients = sorted({p["transient"] for p in chain})
     common = {"analysis": "lyapunov", "segments": 10, "direction_seed": 0}
-    n_chain = len([p for p in points if is_paper(p["model"])])
+    n_chain = len(chain)
     return Study(
         "chaos",
         mode,
         common,
         tuple(points),
         note=(
-            f"{mode}: eq. (4) at N = {chain[0]['N']}, {n_chain} points in beta, "
-            f"t = {chain[0]['transient']:g} .. {chain[0]['t_end']:g}, d0 = 1e-10; two blocks "
+            f"{mode}: eq. (4) at N = {', '.join(map(str, Ns))}, {n_chain} points in beta, "
+            f"transients {', '.join(f'{t:g}' for t in transients)}, d0 = 1e-10; two blocks "
             f"and Carlson-Langer at standard parameters, d0 = {', '.join(f'{d:g}' for d in d0s)}"
         ),
     )

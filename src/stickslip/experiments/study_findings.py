@@ -20,6 +20,10 @@ from stickslip.models.presets import PRESETS, is_paper
 __all__ = ["conclusions", "draw"]
 
 
+def _finite(x) -> bool:
+    return x is not None and math.isfinite(float(x))
+
+
 def _g(x: float, digits: int = 3) -> str:
     return "n/a" if x is None or not math.isfinite(float(x)) else f"{float(x):.{digits}g}"
 
@@ -271,6 +275,24 @@ def _verdicts(table: pd.DataFrame, out: dict[str, Any]) -> None:
         names = [PRESETS[r.model].point_label(r.beta, r.N) for r in g.itertuples()]
         out["verdicts"][label] = names
         parts.append(f"{label} at {', '.join(names)}")
+    if "fsle_unfinished" in rows.columns and rows["fsle_unfinished"].notna().any():
+        parts_f = []
+        for r in rows[rows["fsle_unfinished"].notna()].itertuples():
+            # the relatives have no beta (their friction has none)
+            name = f"beta = {r.beta:g} (N = {int(r.N)})" if _finite(r.beta) else r.model
+            pooled = f"{_g(r.fsle_pooled, 2)}" if _finite(r.fsle_pooled) else "no doubling below 1e-6"
+            peak = (
+                f"largest {_g(r.fsle_peak, 2)} at delta = {r.fsle_peak_delta:.2g}" if _finite(r.fsle_peak) else "none"
+            )
+            parts_f.append(
+                f"{name}: {pooled}, {peak}"
+                + (
+                    f", {int(r.fsle_unfinished)} cycles unfinished"
+                    if _finite(r.fsle_unfinished) and r.fsle_unfinished
+                    else ""
+                )
+            )
+        out["statements"].append("Finite-size exponent (pooled below 1e-6; largest row): " + "; ".join(parts_f) + ".")
     out["statements"].append(
         "Verdict (flow exponent at dt -> 0, decorrelation of the event sequence against delta): "
         + "; ".join(parts)
@@ -338,6 +360,7 @@ def draw(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[dict[str, Any
                 "Carlson-Langer at standard parameters as marked points.",
             )
         )
+        figs += _flow_figures(spec, table, page_dir)
     else:
         figs.append(
             (
@@ -351,4 +374,60 @@ def draw(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[dict[str, Any
     for name, fig, caption in figs:
         save_figure(fig, page_dir / name)
         out.append({"name": name, "image": f"{name}.png", "pdf": f"{name}.pdf", "caption": caption, "command": cmd})
+    return out
+
+
+def chaos_curves(table: pd.DataFrame, points_dir: Path) -> list[dict[str, Any]]:
+    """The ``flow.json`` of every chaos point that has one (ladder, finite-size exponents,
+    decorrelation: :func:`stickslip.experiments.chaos_verdict.verdict_point`), labelled by model,
+    N and beta; chain points by N then beta, the relatives last."""
+    from stickslip import io
+
+    curves = []
+    if "point_dir" not in table.columns:
+        return curves
+    for r in table.itertuples():
+        path = Path(points_dir) / str(r.point_dir) / "flow.json"
+        if not path.is_file():
+            continue
+        chain = _finite(r.beta)  # the relatives have no beta
+        label = f"eq. (4), N = {int(r.N)}, beta = {r.beta:g}" if chain else f"{r.model}, N = {int(r.N)}"
+        key = (0, int(r.N), float(r.beta)) if chain else (1, 0, 0.0)
+        curves.append((key, {"label": label, **io.read_json(path)}))
+    return [c for _, c in sorted(curves, key=lambda x: x[0])]
+
+
+def _flow_figures(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[tuple[str, Any, str]]:
+    """lambda of the flow against dt, the FSLE against delta and n(delta) against delta, from the
+    points' ``flow.json`` (:mod:`stickslip.plotting.chaos`)."""
+    from stickslip.plotting import chaos as pc
+
+    curves = chaos_curves(table, Path(page_dir).parent / "runs" / spec.dirname / "points")
+    if not curves:
+        return []
+    out = [
+        (
+            "flow_ladder",
+            pc.flow_ladder_figure(curves),
+            "Largest exponent of the flow (located switches, the time shift removed) at dt, dt/2, "
+            "dt/4, with the fit lambda_0 + c dt^2 and lambda_0 (square) at dt = 0.",
+        )
+    ]
+    if any(c.get("finite_size") for c in curves):
+        out.append(
+            (
+                "fsle",
+                pc.fsle_figure(curves),
+                "Finite-size Lyapunov exponent ln 2 / <time from delta to 2 delta> against delta "
+                "(located switches); rows with no finished doubling are left out.",
+            )
+        )
+    out.append(
+        (
+            "decorrelation",
+            pc.decorrelation_figure(curves),
+            "Slip events whose sizes agree (to 1e-3) between runs started delta apart; open "
+            "triangles: still agreeing after all the events compared.",
+        )
+    )
     return out
