@@ -56,6 +56,7 @@ from stickslip.analysis.stability_modes import (  # noqa: F401
 )
 from stickslip.models.params import BlockParams, ChainParams
 from stickslip.models.physics import block_steady_state
+from stickslip.models.piece import Linearisation
 
 
 def steady_theta(V: float, alpha: float) -> float:
@@ -276,30 +277,33 @@ def block_growth_map(p: BlockParams, beta: np.ndarray, V: np.ndarray) -> xr.Data
 # ---------------------------------------------------------------------------------------------
 
 
-def _theta_terms(p: ChainParams) -> tuple[float, float, float]:
-    """The friction piece's theta law linearised at steady sliding; refused for laws without theta."""
-    terms = p.friction_piece.theta_terms
-    if terms is None:
+def _linear(p: ChainParams) -> Linearisation:
+    """The friction law linearised at steady sliding; refused for laws without theta."""
+    linear = p.friction_piece.linear
+    if linear is None:
         raise ValueError(f"friction {p.friction} has no state variable: use mode_stability")
-    return terms(p.alpha, p.V)
+    return linear(p)
 
 
 def chain_mode_matrix(p: ChainParams, k: np.ndarray | float) -> np.ndarray:
     """The 3 x 3 matrix of eq. (5) for the Fourier mode exp(i k j), shape (..., 3, 3).
 
-    Variables (dx, dv, dtheta); both Laplacians give -q = -2 (1 - cos k):
-    dx' = dv, dv' = -K q dx - beta dv - dtheta,
-    dtheta' = (1 - 2 theta_0 - alpha V - D q) dtheta - alpha theta_0 dv.
+    Variables (dx, dv, dtheta); both Laplacians give -q = -2 (1 - cos k). For friction
+    phi(v, theta) and state law g(v, theta) (+ D times the Laplacian) linearised at steady
+    sliding (:class:`~stickslip.models.piece.Linearisation`):
+    dx' = dv, dv' = -K q dx - phi_v dv - phi_theta dtheta,
+    dtheta' = (g_theta - D q) dtheta + g_v dv. For eq. (4)'s law phi_v = beta, phi_theta = 1,
+    g_v = -alpha theta_0, g_theta = 1 - 2 theta_0 - alpha V: eq. (5).
     """
     q = lattice_q(k)
-    _, d_v, d_theta = _theta_terms(p)
+    lin = _linear(p)
     A = np.zeros(q.shape + (3, 3))
     A[..., 0, 1] = 1.0
     A[..., 1, 0] = -p.K * q
-    A[..., 1, 1] = -p.beta
-    A[..., 1, 2] = -1.0
-    A[..., 2, 1] = d_v
-    A[..., 2, 2] = d_theta - p.D * q
+    A[..., 1, 1] = -lin.phi_v
+    A[..., 1, 2] = -lin.phi_theta
+    A[..., 2, 1] = lin.g_v
+    A[..., 2, 2] = lin.g_theta - lin.diffusion * q
     return A
 
 
@@ -434,7 +438,7 @@ def chain_jacobian(p: ChainParams) -> np.ndarray:
     ends, dtheta_0 = dtheta_1 and dtheta_{N+1} = dtheta_N.
     """
     N = p.N
-    _, d_v, d_theta = _theta_terms(p)
+    lin = _linear(p)
     lap_x = -2.0 * np.eye(N) + np.eye(N, k=1) + np.eye(N, k=-1)
     lap_x[-1, -1] = -1.0  # free end
     lap_t = -2.0 * np.eye(N) + np.eye(N, k=1) + np.eye(N, k=-1)
@@ -445,8 +449,8 @@ def chain_jacobian(p: ChainParams) -> np.ndarray:
     return np.block(
         [
             [zero, eye, zero],
-            [p.K * lap_x, -p.beta * eye, -eye],
-            [zero, d_v * eye, d_theta * eye + p.D * lap_t],
+            [p.K * lap_x, -lin.phi_v * eye, -lin.phi_theta * eye],
+            [zero, lin.g_v * eye, lin.g_theta * eye + lin.diffusion * lap_t],
         ]
     )
 
