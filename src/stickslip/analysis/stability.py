@@ -23,6 +23,9 @@ discrete Laplacians into -q with q = 2 (1 - cos k); its 3 x 3 mode matrix gives 
 k -> 0 one eigenvalue vanishes like -K k^2 / (beta - alpha), so long waves are unstable
 exactly for beta < alpha, independent of K, D and V (the derivation is in docs/stability.md).
 The finite chain with the ends of docs/model.md has a 3N x 3N matrix, :func:`chain_jacobian`.
+Both read the friction law's linearisation (:class:`~stickslip.models.piece.Linearisation`), so a
+law with a state variable other than eq. (4)'s (rate-and-state) gets its mode matrices, finite
+Jacobian and critical spring constant (:func:`critical_stiffness`) from the same code.
 
 Relatives without state variable (docs/model.md, "The family the paper stands in"): the plate drive
 of Carlson-Langer (weakening friction) and the train model (strengthening friction). Each normal
@@ -458,6 +461,38 @@ def chain_jacobian(p: ChainParams) -> np.ndarray:
 def chain_finite_eigenvalues(p: ChainParams) -> np.ndarray:
     """Eigenvalues of the finite linearised chain (:func:`chain_jacobian`), largest real part first."""
     return _sorted_by_real_part(np.linalg.eigvals(chain_jacobian(p)))
+
+
+def critical_stiffness(p: ChainParams) -> float:
+    """Critical spring constant K_c of steady sliding of the finite chain (end drive, free end).
+
+    The K at which the largest real part of the eigenvalues of :func:`chain_jacobian` crosses
+    zero (a Hopf point): steady sliding is unstable for K < K_c. For the spring-slider (N = 1)
+    with rate-and-state friction this is k_c = sigma_n (b - a) / D_c (1 + V^2 / (sigma_n a D_c))
+    (Rice & Ruina 1983; docs/models/rate-state.md). Brent's method on K, bracketed by halving and
+    doubling from K = 1; NaN where no bracket is found (steady sliding stable at every K, as with
+    velocity strengthening, or unstable at every K).
+    """
+
+    def growth(K: float) -> float:
+        return float(chain_finite_eigenvalues(p.replace(K=K))[0].real)
+
+    lo, hi = 1.0, 1.0
+    for _ in range(80):
+        if growth(lo) > GROWTH_TOL:  # beyond round-off of the translation mode near K = 0
+            break
+        lo *= 0.5
+    else:
+        return float("nan")
+    for _ in range(80):
+        if growth(hi) < 0.0:
+            break
+        hi *= 2.0
+    else:
+        return float("nan")
+    if hi < lo:
+        return float("nan")
+    return float(brentq(growth, lo, hi, xtol=1e-14, rtol=1e-13))
 
 
 def compare_fourier_finite(p: ChainParams, Ns: list[int] | tuple[int, ...]) -> pd.DataFrame:

@@ -99,7 +99,7 @@ class Piece:
     located: bool = True
     #: friction: the law as a figure label (matplotlib mathtext)
     label: str = ""
-    #: friction without theta: extra numbers the mode-stability report shows for this law
+    #: friction: extra numbers the stability report shows for this law (closed forms to compare)
     stability_extras: Callable[[Any], dict[str, float]] | None = None
     #: ends: steady sliding exists (a spring to a fixed wall stretches without bound)
     steady_sliding: bool = True
