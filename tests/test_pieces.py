@@ -17,7 +17,7 @@ from stickslip.models.presets import PRESETS, chain_params
 #: The kernels' integer codes as the kernels read them (kernels/ compare against these numbers).
 KERNEL_CODES = {
     "drive": {"end": 0, "plate": 1},
-    "friction": {"state": 0, "weakening": 1, "strengthening": 2},
+    "friction": {"state": 0, "weakening": 1, "strengthening": 2, "rate-state": 3},
     "threshold": {"constant": 0, "state": 1},
     "ends": {"free": 0, "fixed": 1, "periodic": 2},
 }

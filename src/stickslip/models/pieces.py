@@ -22,7 +22,7 @@ line. Each piece lists the parameters it reads, so a run records exactly those.
 
 from __future__ import annotations
 
-from stickslip.models.friction import state, strengthening, weakening
+from stickslip.models.friction import rate_state, state, strengthening, weakening
 from stickslip.models.friction.weakening import weakening_g
 from stickslip.models.piece import CompositionError, Linearisation, Param, Piece
 
@@ -41,7 +41,7 @@ PIECES: dict[str, tuple[Piece, ...]] = {
         ),
     ),
     # In the order of the kernels' codes (FRICTION_* in kernels/layout.py).
-    "friction": (state.PIECE, weakening.PIECE, strengthening.PIECE),
+    "friction": (state.PIECE, weakening.PIECE, strengthening.PIECE, rate_state.PIECE),
     "threshold": (
         Piece("threshold", "constant", "a stuck block starts when f_i > Fs", ("Fs",)),
         Piece(
