@@ -10,12 +10,13 @@ sigma (b - a) / D_c as V -> 0.
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
 import pytest
 
-from chain_helpers import assert_same_run
+from chain_helpers import assert_same_run, run_cli
 from stickslip.analysis import stability as st
 from stickslip.kernels.laws import _rate_state_mu
 from stickslip.kernels.layout import _unpack
@@ -230,3 +231,13 @@ def test_parameters_and_composition():
     assert "rs_a" not in ChainParams().to_dict() and "rs_a" in _params().to_dict()
     with pytest.raises(ValueError, match="located"):
         LocatedStepper(_params())
+
+
+def test_command_line(capsys):
+    status, out, _ = run_cli(capsys, "stability", "chain", "--friction", "rate-state", "--V", "0.01", "--json")
+    assert status == 0
+    d = json.loads(out)
+    assert d["params"]["N"] == 1 and d["critical_K"] == pytest.approx(75.0, rel=1e-9)
+    assert d["finite_chain"]["unstable"]  # K = 10 < k_c
+    status, _, err = run_cli(capsys, "lyapunov", "--friction", "rate-state", "--N", "3", "--switches", "located")
+    assert status != 0 and "--switches located has no friction rate-state" in err

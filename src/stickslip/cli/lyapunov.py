@@ -200,6 +200,10 @@ def run_lyapunov_command(args: argparse.Namespace) -> Result:
     # Validate every option before the first (possibly long) run.
     ly._check_run(params, args.t_end, args.interval, args.d0, args.transient, args.align, args.segments)
     if args.switches == "located":
+        if not params.friction_piece.located:
+            raise CommandError(
+                f"--switches located has no friction {params.friction} (kernels/located.py): use --switches grid"
+            )
         return _located(params, args, kw)
     for flag, given in (("--finite-size", args.finite_size), ("--decorrelation", args.decorrelation)):
         if given:
