@@ -17,7 +17,7 @@ from stickslip.models.presets import PRESETS, chain_params
 #: The kernels' integer codes as the kernels read them (kernels/ compare against these numbers).
 KERNEL_CODES = {
     "drive": {"end": 0, "plate": 1},
-    "friction": {"state": 0, "weakening": 1, "strengthening": 2},
+    "friction": {"state": 0, "weakening": 1, "strengthening": 2, "rate-state": 3},
     "threshold": {"constant": 0, "state": 1},
     "ends": {"free": 0, "fixed": 1, "periodic": 2},
 }
@@ -27,7 +27,7 @@ KERNEL_CODES = {
 def test_kernel_codes_unchanged(kind):
     assert pieces.names(kind) == tuple(KERNEL_CODES[kind])
     for name, code in KERNEL_CODES[kind].items():
-        assert pieces.piece(kind, name).code == code
+        assert pieces.PIECES[kind][code] is pieces.piece(kind, name)
         assert pieces.code(kind, name) == code
 
 
@@ -122,7 +122,9 @@ def _theta_law(theta, v, alpha):
 
 @pytest.mark.parametrize(("alpha", "V"), [(1.0, 0.001), (1.0, 0.3), (2.0, 0.1), (1.0, 1.5)])
 def test_state_law_linearisation_against_the_law(alpha, V):
-    theta0, d_v, d_theta = pieces.piece("friction", "state").theta_terms(alpha, V)
+    lin = pieces.piece("friction", "state").linear(ChainParams(alpha=alpha, V=V))
+    theta0, d_v, d_theta = lin.theta0, lin.g_v, lin.g_theta
+    assert (lin.phi_v, lin.phi_theta, lin.diffusion) == (1.0, 1.0, 5.0)  # theta + beta v, beta = 1; D
     assert theta0 == max(1.0 - alpha * V, 0.0)
     if theta0 > 0:
         assert _theta_law(theta0, V, alpha) == pytest.approx(0.0, abs=1e-15)  # a steady state
@@ -131,7 +133,7 @@ def test_state_law_linearisation_against_the_law(alpha, V):
     num_t = (_theta_law(theta0 + h, V, alpha) - _theta_law(theta0 - h, V, alpha)) / (2 * h)
     assert d_v == pytest.approx(num_v, rel=1e-7, abs=1e-12)
     assert d_theta == pytest.approx(num_t, rel=1e-7, abs=1e-12)
-    assert pieces.piece("friction", "weakening").theta_terms is None
+    assert pieces.piece("friction", "weakening").linear is None
 
 
 def test_paper_stability_numbers_unchanged():

@@ -23,6 +23,9 @@ discrete Laplacians into -q with q = 2 (1 - cos k); its 3 x 3 mode matrix gives 
 k -> 0 one eigenvalue vanishes like -K k^2 / (beta - alpha), so long waves are unstable
 exactly for beta < alpha, independent of K, D and V (the derivation is in docs/stability.md).
 The finite chain with the ends of docs/model.md has a 3N x 3N matrix, :func:`chain_jacobian`.
+Both read the friction law's linearisation (:class:`~stickslip.models.piece.Linearisation`), so a
+law with a state variable other than eq. (4)'s (rate-and-state) gets its mode matrices, finite
+Jacobian and critical spring constant (:func:`critical_stiffness`) from the same code.
 
 Relatives without state variable (docs/model.md, "The family the paper stands in"): the plate drive
 of Carlson-Langer (weakening friction) and the train model (strengthening friction). Each normal
@@ -56,6 +59,7 @@ from stickslip.analysis.stability_modes import (  # noqa: F401
 )
 from stickslip.models.params import BlockParams, ChainParams
 from stickslip.models.physics import block_steady_state
+from stickslip.models.piece import Linearisation
 
 
 def steady_theta(V: float, alpha: float) -> float:
@@ -276,30 +280,33 @@ def block_growth_map(p: BlockParams, beta: np.ndarray, V: np.ndarray) -> xr.Data
 # ---------------------------------------------------------------------------------------------
 
 
-def _theta_terms(p: ChainParams) -> tuple[float, float, float]:
-    """The friction piece's theta law linearised at steady sliding; refused for laws without theta."""
-    terms = p.friction_piece.theta_terms
-    if terms is None:
+def _linear(p: ChainParams) -> Linearisation:
+    """The friction law linearised at steady sliding; refused for laws without theta."""
+    linear = p.friction_piece.linear
+    if linear is None:
         raise ValueError(f"friction {p.friction} has no state variable: use mode_stability")
-    return terms(p.alpha, p.V)
+    return linear(p)
 
 
 def chain_mode_matrix(p: ChainParams, k: np.ndarray | float) -> np.ndarray:
     """The 3 x 3 matrix of eq. (5) for the Fourier mode exp(i k j), shape (..., 3, 3).
 
-    Variables (dx, dv, dtheta); both Laplacians give -q = -2 (1 - cos k):
-    dx' = dv, dv' = -K q dx - beta dv - dtheta,
-    dtheta' = (1 - 2 theta_0 - alpha V - D q) dtheta - alpha theta_0 dv.
+    Variables (dx, dv, dtheta); both Laplacians give -q = -2 (1 - cos k). For friction
+    phi(v, theta) and state law g(v, theta) (+ D times the Laplacian) linearised at steady
+    sliding (:class:`~stickslip.models.piece.Linearisation`):
+    dx' = dv, dv' = -K q dx - phi_v dv - phi_theta dtheta,
+    dtheta' = (g_theta - D q) dtheta + g_v dv. For eq. (4)'s law phi_v = beta, phi_theta = 1,
+    g_v = -alpha theta_0, g_theta = 1 - 2 theta_0 - alpha V: eq. (5).
     """
     q = lattice_q(k)
-    _, d_v, d_theta = _theta_terms(p)
+    lin = _linear(p)
     A = np.zeros(q.shape + (3, 3))
     A[..., 0, 1] = 1.0
     A[..., 1, 0] = -p.K * q
-    A[..., 1, 1] = -p.beta
-    A[..., 1, 2] = -1.0
-    A[..., 2, 1] = d_v
-    A[..., 2, 2] = d_theta - p.D * q
+    A[..., 1, 1] = -lin.phi_v
+    A[..., 1, 2] = -lin.phi_theta
+    A[..., 2, 1] = lin.g_v
+    A[..., 2, 2] = lin.g_theta - lin.diffusion * q
     return A
 
 
@@ -434,7 +441,7 @@ def chain_jacobian(p: ChainParams) -> np.ndarray:
     ends, dtheta_0 = dtheta_1 and dtheta_{N+1} = dtheta_N.
     """
     N = p.N
-    _, d_v, d_theta = _theta_terms(p)
+    lin = _linear(p)
     lap_x = -2.0 * np.eye(N) + np.eye(N, k=1) + np.eye(N, k=-1)
     lap_x[-1, -1] = -1.0  # free end
     lap_t = -2.0 * np.eye(N) + np.eye(N, k=1) + np.eye(N, k=-1)
@@ -445,8 +452,8 @@ def chain_jacobian(p: ChainParams) -> np.ndarray:
     return np.block(
         [
             [zero, eye, zero],
-            [p.K * lap_x, -p.beta * eye, -eye],
-            [zero, d_v * eye, d_theta * eye + p.D * lap_t],
+            [p.K * lap_x, -lin.phi_v * eye, -lin.phi_theta * eye],
+            [zero, lin.g_v * eye, lin.g_theta * eye + lin.diffusion * lap_t],
         ]
     )
 
@@ -454,6 +461,38 @@ def chain_jacobian(p: ChainParams) -> np.ndarray:
 def chain_finite_eigenvalues(p: ChainParams) -> np.ndarray:
     """Eigenvalues of the finite linearised chain (:func:`chain_jacobian`), largest real part first."""
     return _sorted_by_real_part(np.linalg.eigvals(chain_jacobian(p)))
+
+
+def critical_stiffness(p: ChainParams) -> float:
+    """Critical spring constant K_c of steady sliding of the finite chain (end drive, free end).
+
+    The K at which the largest real part of the eigenvalues of :func:`chain_jacobian` crosses
+    zero (a Hopf point): steady sliding is unstable for K < K_c. For the spring-slider (N = 1)
+    with rate-and-state friction this is k_c = sigma_n (b - a) / D_c (1 + V^2 / (sigma_n a D_c))
+    (Rice & Ruina 1983; docs/models/rate-state.md). Brent's method on K, bracketed by halving and
+    doubling from K = 1; NaN where no bracket is found (steady sliding stable at every K, as with
+    velocity strengthening, or unstable at every K).
+    """
+
+    def growth(K: float) -> float:
+        return float(chain_finite_eigenvalues(p.replace(K=K))[0].real)
+
+    lo, hi = 1.0, 1.0
+    for _ in range(80):
+        if growth(lo) > GROWTH_TOL:  # beyond round-off of the translation mode near K = 0
+            break
+        lo *= 0.5
+    else:
+        return float("nan")
+    for _ in range(80):
+        if growth(hi) < 0.0:
+            break
+        hi *= 2.0
+    else:
+        return float("nan")
+    if hi < lo:
+        return float("nan")
+    return float(brentq(growth, lo, hi, xtol=1e-14, rtol=1e-13))
 
 
 def compare_fourier_finite(p: ChainParams, Ns: list[int] | tuple[int, ...]) -> pd.DataFrame:

@@ -14,6 +14,7 @@ V_up and V_down; ``--out DIR`` writes the bifurcation diagram.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import math
 from pathlib import Path
 from typing import Any
@@ -245,6 +246,8 @@ def run_stability_chain(args: argparse.Namespace) -> Result:
     p = chain_params_from_args(args, **overrides)
     if not p.friction_piece.has_state:
         return run_stability_modes(args, p)
+    if not p.friction_piece.eq5:
+        return run_stability_law(args, p, with_N)
     if p.drive_piece.leaf_spring:
         raise CommandError(
             "friction state with drive plate is not covered: use friction weakening or "
@@ -282,6 +285,54 @@ def run_stability_chain(args: argparse.Namespace) -> Result:
         if out is not None:
             data["outputs"] = [str(path) for path in _write_fig4(out, p, data)]
     return Result(data=data, text=_chain_text(data))
+
+
+def run_stability_law(args: argparse.Namespace, p: ChainParams, with_N: bool) -> Result:
+    """Steady sliding of a chain whose law has a state variable other than eq. (4)'s (rate-and-state):
+    the 3 x 3 mode matrices and the finite chain's Jacobian from the law's linearisation, and the
+    critical spring constant K_c (analysis.stability.critical_stiffness). Without --N: the
+    spring-slider, N = 1."""
+    if p.drive_piece.leaf_spring or not p.ends_piece.steady_sliding:
+        raise CommandError(f"friction {p.friction} is covered with drive end and ends free only")
+    if p.V <= 0.0:
+        raise CommandError(f"steady sliding needs V > 0 (got V={p.V:g})")
+    if not with_N:
+        p = p.replace(N=1)
+    check_number("N", p.N, low=1, high=MAX_FINITE_N, integer=True)
+    if args.out is not None:
+        raise CommandError(f"--out writes Fig. 4 of eq. (4)'s law; friction {p.friction} has no figure here")
+    lin = p.friction_piece.linear(p)
+    growth, k_max = st._max_fourier_growth(p, st.chain_k_grid())
+    finite = float(st.chain_finite_eigenvalues(p)[0].real)
+    data: dict[str, Any] = {
+        "params": {k: v for k, v in p.to_dict().items() if k not in ("Fs", "dt")},
+        "linearisation": dataclasses.asdict(lin),
+        "max_growth_rate": growth,
+        "k_at_max": k_max,
+        "finite_chain": {"N": p.N, "max_real": finite, "unstable": finite > st.GROWTH_TOL},
+        "critical_K": st.critical_stiffness(p),
+    }
+    extras = p.friction_piece.stability_extras
+    if extras is not None:
+        data.update(extras(p))
+    return Result(data=data, text=_law_text(data))
+
+
+def _law_text(d: dict[str, Any]) -> str:
+    p = d["params"]
+    f = d["finite_chain"]
+    lines = [
+        f"steady sliding of the chain, {p['friction']} friction: "
+        + " ".join(f"{k}={v:g}" for k, v in p.items() if not isinstance(v, str)),
+        "linearised: " + " ".join(f"{k}={v:.6g}" for k, v in d["linearisation"].items()),
+        f"N = {f['N']}: largest Re(lambda) {f['max_real']:.6g}: {'unstable' if f['unstable'] else 'stable'}; "
+        f"critical K = {d['critical_K']:.8g} (unstable below)",
+        f"Fourier modes 0 < k <= pi: largest Re(lambda) {d['max_growth_rate']:.6g} at k = {d['k_at_max']:.4g}",
+    ]
+    closed = {k: v for k, v in d.items() if k.startswith("k_c")}
+    if closed:
+        lines.append("closed forms: " + " ".join(f"{k} = {v:.8g}" for k, v in closed.items()))
+    return "\n".join(lines)
 
 
 def _write_fig4(out: Path, p: ChainParams, data: dict) -> list[Path]:

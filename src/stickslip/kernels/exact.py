@@ -50,7 +50,8 @@ from stickslip.kernels.layout import (
     EV_ACTIVE,
     EV_COUNT,
     FM_COUNT,
-    FRICTION_STATE,
+    FRICTION_STRENGTHENING,
+    FRICTION_WEAKENING,
     FULL_UPDATES,
     MECH_HI,
     MECH_LO,
@@ -290,7 +291,7 @@ def run_exact(args, drive, friction, threshold, ends):
                     _stage1_theta(x, v, th, xs, vs, ths, mm, b1, l1, fl - 1, mp, dt, friction)
                 if fh < h1:
                     _stage1_theta(x, v, th, xs, vs, ths, mm, b1, fh + 1, h1, mp, dt, friction)
-            elif friction == FRICTION_STATE:
+            elif friction != FRICTION_WEAKENING and friction != FRICTION_STRENGTHENING:
                 _stage1_theta_only(v, th, ths, b1, l1, h1, mp, dt, friction)
             p2 = _pull(V, n + 1, dt)
             _set_ghosts(xs, ths, N, p2, drive, ends)
@@ -338,14 +339,14 @@ def run_exact(args, drive, friction, threshold, ends):
                         x, v, th, mov, xs, vs, ths, mm, a1, b1, sl, sh, p2, mp, h2, drive, friction
                     )
                 ist[FULL_UPDATES] += sh - sl + 1
-                if friction == FRICTION_STATE:
+                if friction != FRICTION_WEAKENING and friction != FRICTION_STRENGTHENING:
                     if lo < sl:
                         t_lo, t_hi = _stage2_theta(th, ths, v, b1, lo, sl - 1, mp, h2, friction)
                         c_lo, c_hi = _merge(c_lo, c_hi, t_lo, t_hi)
                     if sh < hi:
                         t_lo, t_hi = _stage2_theta(th, ths, v, b1, sh + 1, hi, mp, h2, friction)
                         c_lo, c_hi = _merge(c_lo, c_hi, t_lo, t_hi)
-            elif friction == FRICTION_STATE:
+            elif friction != FRICTION_WEAKENING and friction != FRICTION_STRENGTHENING:
                 c_lo, c_hi = _stage2_theta(th, ths, v, b1, lo, hi, mp, h2, friction)
             # Next step's movers: a stopped block starts only if its force or threshold changed;
             # through the springs that takes a neighbour's move, and only moving blocks change x.

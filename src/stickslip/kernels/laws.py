@@ -20,6 +20,8 @@ they agree bit for bit. Pieces and layout: :mod:`stickslip.kernels.layout`.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numba import njit
 
@@ -28,6 +30,7 @@ from stickslip.kernels.layout import (
     DRIVE_PLATE,
     ENDS_FIXED,
     ENDS_PERIODIC,
+    FRICTION_RATE_STATE,
     FRICTION_STATE,
     FRICTION_STRENGTHENING,
     FRICTION_WEAKENING,
@@ -44,14 +47,39 @@ def _force(xl, xc, xr, K, Kp, p, drive):
     return K * ((xl - xc) - (xc - xr))
 
 
+_LN2 = math.log(2.0)
+
+
+@njit(cache=True, inline="always")
+def _rate_state_mu(v, th, mp):
+    """mu = a asinh(|v| / (2 v0) exp((mu0 + b ln(v0 theta / D_c)) / a)) of rate-and-state friction,
+    regularised at v = 0 (Rice & Ben-Zion 1996; models/friction/rate_state.py).
+
+    Read at |v|: a moving block has v > 0, and where Heun's predictor dips below 0 within a step
+    the friction keeps braking, so the stop rule catches a block that stops in the step (the odd
+    extension would push it on into a spurious two-step cycle). Through log z: for z > e^20,
+    asinh(z) = ln(2 z) to round-off, and exp cannot overflow.
+    """
+    s = 0.5 * abs(v) / mp[12]
+    if s == 0.0:
+        return 0.0
+    lz = math.log(s) + (mp[13] + mp[10] * math.log(mp[12] * th / mp[11])) / mp[9]
+    if lz > 20.0:
+        return mp[9] * (lz + _LN2)
+    return mp[9] * math.asinh(math.exp(lz))
+
+
 @njit(cache=True, inline="always")
 def _accel(f, th, v, m, mp, friction):
     """dv/dt of a block times the moving mask m (1.0 moving, 0.0 stopped).
 
     state (eq. 4): f - theta - beta v; weakening (Carlson-Langer): f - phi(v) with
     phi(v) = (1 - sigma) / (1 + 2 alpha max(v, 0) / (1 - sigma)); strengthening (train
-    model): f - F0 - beta v. ``mp`` = (K, Kp, beta, alpha, D, Fs, 1 - sigma, 2 alpha, F0).
+    model): f - F0 - beta v; rate-state: f - sigma_n mu(v, theta) (:func:`_rate_state_mu`).
+    ``mp`` = (K, Kp, beta, alpha, D, Fs, 1 - sigma, 2 alpha, F0, a, b, D_c, v0, mu0, sigma_n).
     """
+    if friction == FRICTION_RATE_STATE:
+        return m * (f - mp[14] * _rate_state_mu(v, th, mp))
     if friction == FRICTION_WEAKENING:
         w = mp[6]
         return m * (f - w / (1.0 + mp[7] * max(v, 0.0) / w))
@@ -62,8 +90,10 @@ def _accel(f, th, v, m, mp, friction):
 
 @njit(cache=True, inline="always")
 def _dtheta(thl, th, thr, v, mp, friction):
-    """dtheta/dt of eq. (4) with diffusion D, for moving and stopped blocks alike (0 for
-    frictions without a state variable)."""
+    """dtheta/dt of eq. (4) with diffusion D, for moving and stopped blocks alike; the aging law
+    1 - v theta / D_c of rate-state friction; 0 for frictions without a state variable."""
+    if friction == FRICTION_RATE_STATE:
+        return 1.0 - v * th / mp[11]
     if friction == FRICTION_STATE:
         return th * (1.0 - th) - mp[3] * th * v + mp[4] * ((thl - th) - (th - thr))
     return 0.0

@@ -12,6 +12,9 @@ compiled into its own machine code with the branches on pieces removed:
 * friction of a moving block ``FRICTION_STATE``: theta_i + beta v_i with the theta equation
   of eq. (4); ``FRICTION_WEAKENING``: phi(v) = (1 - sigma) / (1 + 2 alpha max(v, 0) / (1 - sigma))
   (Carlson-Langer); ``FRICTION_STRENGTHENING``: F0 + beta v (train model), no state variable;
+  ``FRICTION_RATE_STATE``: sigma_n mu(v, theta), Dieterich-Ruina with the aging law, regularised
+  at v = 0 (:mod:`stickslip.models.friction.rate_state`); every law but weakening and
+  strengthening has a state variable that changes on stopped blocks too;
 * static threshold ``THRESHOLD_CONSTANT``: Fs; ``THRESHOLD_STATE``: theta_i;
 * ends ``ENDS_FREE``: x_{N+1} = x_N (plate drive: also x_0 = x_1); ``ENDS_FIXED``: x_{N+1} = 0
   (plate drive: also x_0 = 0); ``ENDS_PERIODIC``: x_0 = x_N, x_{N+1} = x_1 (plate drive only).
@@ -71,11 +74,13 @@ IST_SIZE = 23
 
 # Indices into the float64 parameter vector ``par``.
 P_K, P_D, P_V, P_BETA, P_ALPHA, P_FS, P_DT, P_KP, P_SIGMA, P_F0 = range(10)
-PAR_SIZE = 10
+# Rate-and-state friction (models/friction/rate_state.py): a, b, D_c, v0, mu0, sigma_n.
+P_RS_A, P_RS_B, P_DC, P_V0, P_MU0, P_SIGMA_N = range(10, 16)
+PAR_SIZE = 16
 
 # The pieces of a model (compile-time constants of every kernel).
 DRIVE_END, DRIVE_PLATE = 0, 1
-FRICTION_STATE, FRICTION_WEAKENING, FRICTION_STRENGTHENING = 0, 1, 2
+FRICTION_STATE, FRICTION_WEAKENING, FRICTION_STRENGTHENING, FRICTION_RATE_STATE = 0, 1, 2, 3
 THRESHOLD_CONSTANT, THRESHOLD_STATE = 0, 1
 ENDS_FREE, ENDS_FIXED, ENDS_PERIODIC = 0, 1, 2
 
@@ -140,7 +145,8 @@ def _merge(a_lo, a_hi, b_lo, b_hi):
 
 @njit(cache=True, inline="always")
 def _unpack(par):
-    """(K, Kp, beta, alpha, D, Fs, 1 - sigma, 2 alpha, F0), V and dt from the parameter vector."""
+    """(K, Kp, beta, alpha, D, Fs, 1 - sigma, 2 alpha, F0, a, b, D_c, v0, mu0, sigma_n), V and dt
+    from the parameter vector (a .. sigma_n: rate-and-state friction)."""
     mp = (
         par[P_K],
         par[P_KP],
@@ -151,5 +157,11 @@ def _unpack(par):
         1.0 - par[P_SIGMA],
         2.0 * par[P_ALPHA],
         par[P_F0],
+        par[P_RS_A],
+        par[P_RS_B],
+        par[P_DC],
+        par[P_V0],
+        par[P_MU0],
+        par[P_SIGMA_N],
     )
     return mp, par[P_V], par[P_DT]

@@ -200,7 +200,26 @@ def _choice(default: str, kind: str, doc: str) -> Any:
     return field(default=default, metadata={"choices": names(kind), "doc": doc})
 
 
+def _with_piece_params(cls):
+    """Give ``cls`` a field for every parameter a piece declares (:class:`~stickslip.models.piece.Param`).
+
+    So a friction law's parameters, defaults and ranges live in its own module
+    (:mod:`stickslip.models.friction`); the fields follow the class's own, in the pieces' order.
+    """
+    from stickslip.models.pieces import PIECES
+
+    for choices in PIECES.values():
+        for pc in choices:
+            for prm in pc.params:
+                if prm.name in cls.__annotations__:
+                    raise TypeError(f"parameter {prm.name} of {pc.kind} {pc.name} is declared twice")
+                cls.__annotations__[prm.name] = "float"
+                setattr(cls, prm.name, field(default=prm.default, metadata=prm.metadata()))
+    return cls
+
+
 @dataclass(frozen=True)
+@_with_piece_params
 class ChainParams(_Validated):
     """Parameters of the chain of eq. (4) and of its relatives, pinned down in docs/model.md.
 
@@ -213,7 +232,8 @@ class ChainParams(_Validated):
     alpha and sigma), the train model (strengthening friction F0 + beta v), the state
     threshold of Batista-Carlson. ``model`` names the preset the parameters came from
     (:mod:`stickslip.models.presets`). Parameters a composition does not read are kept at
-    their defaults and left out of :meth:`to_dict`.
+    their defaults and left out of :meth:`to_dict`. A piece may declare further parameters
+    (a friction law's own, :mod:`stickslip.models.friction`): they become fields after these.
     """
 
     N: int = field(default=399, metadata={"low": 1, "high": MAX_BLOCKS, "integer": True, "doc": "number of blocks N"})
@@ -243,12 +263,10 @@ class ChainParams(_Validated):
             check_composition(self.drive, self.friction, self.threshold, self.ends)
         except CompositionError as exc:
             raise ParameterError(str(exc)) from None
-        # Heun keeps every theta_i in [0, 1] if (2 D + 1) dt <= 1 (docs/limits.md).
-        if self.friction_piece.has_state and (2.0 * self.D + 1.0) * self.dt > 1.0:
-            raise ParameterError(
-                f"D*dt must be <= (1 - dt)/2 = {(1.0 - self.dt) / 2:g} so that theta stays in [0, 1] "
-                f"(got D={self.D:g}, dt={self.dt:g})"
-            )
+        for pc in (self.drive_piece, self.friction_piece, self.threshold_piece, self.ends_piece):
+            message = pc.check(self) if pc.check is not None else None
+            if message:
+                raise ParameterError(message)
 
     @property
     def pieces(self) -> dict[str, str]:

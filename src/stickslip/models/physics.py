@@ -32,17 +32,12 @@ def block_steady_state(p: BlockParams) -> dict[str, float]:
 def steady_friction(p: ChainParams) -> tuple[float, float]:
     """Friction c of a block sliding steadily at v = V, and its state variable theta_0.
 
-    state (eq. 4): theta_0 = 1 - alpha V, c = theta_0 + beta V; weakening (Carlson-Langer):
+    The friction law says (:attr:`~stickslip.models.piece.Piece.steady`): state (eq. 4):
+    theta_0 = 1 - alpha V, c = theta_0 + beta V; weakening (Carlson-Langer):
     c = phi(V) = (1 - sigma) / (1 + 2 alpha V / (1 - sigma)); strengthening: c = F0 + beta V.
     Models without a state variable report theta_0 = 0 (the value their runs carry).
     """
-    if p.friction == "state":
-        theta0 = 1.0 - p.alpha * p.V
-        return theta0 + p.beta * p.V, theta0
-    if p.friction == "weakening":
-        w = 1.0 - p.sigma
-        return w / (1.0 + 2.0 * p.alpha * p.V / w), 0.0
-    return p.F0 + p.beta * p.V, 0.0
+    return p.friction_piece.steady(p)
 
 
 def has_steady_state(p: ChainParams) -> bool:

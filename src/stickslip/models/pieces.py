@@ -8,7 +8,8 @@ drive      ``end``: a pulling point x_0 = V t joined to block 1 (eq. 4);
            ``plate``: every block joined to a plate at V t by a leaf spring Kp (BK, CL)
 friction   ``state``: theta_i + beta v_i, theta from eq. (4);
            ``weakening``: phi(v) = (1 - sigma) / (1 + 2 alpha max(v, 0) / (1 - sigma)) (CL);
-           ``strengthening``: F0 + beta v, no state variable (train model)
+           ``strengthening``: F0 + beta v, no state variable (train model);
+           one module each in :mod:`stickslip.models.friction`
 threshold  ``constant``: Fs; ``state``: theta_i (the paper's reading of Batista-Carlson)
 ends       ``free``, ``fixed``, ``periodic`` (plate drive only)
 ========== ==========================================================================
@@ -21,80 +22,11 @@ line. Each piece lists the parameters it reads, so a run records exactly those.
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from dataclasses import dataclass
-from typing import Any
+from stickslip.models.friction import rate_state, state, strengthening, weakening
+from stickslip.models.friction.weakening import weakening_g
+from stickslip.models.piece import CompositionError, Linearisation, Param, Piece
 
-
-def weakening_g(p: Any) -> float:
-    """g = (1 + 2 alpha V / (1 - sigma))^-2 of CL's velocity weakening; -phi'(V) = 2 alpha g."""
-    return float((1.0 + 2.0 * p.alpha * p.V / (1.0 - p.sigma)) ** -2)
-
-
-def _weakening_slope(p: Any) -> float:
-    """phi'(V) of CL's weakening, phi(v) = (1 - sigma) / (1 + 2 alpha v / (1 - sigma)): -2 alpha g."""
-    return -2.0 * p.alpha * weakening_g(p)
-
-
-def _state_theta_terms(alpha: float, V: float) -> tuple[float, float, float]:
-    """eq. (4)'s theta law linearised about steady sliding at v = V (eq. 2, eq. 5).
-
-    Returns (theta_0, d/dv, d/dtheta) of g = theta (1 - theta) - alpha theta v at the stable
-    steady state theta_0 = max(1 - alpha V, 0): d/dv = -alpha theta_0 and
-    d/dtheta = 1 - 2 theta_0 - alpha V (the diffusion term -D q is the chain's, not the law's).
-    """
-    theta0 = max(1.0 - alpha * V, 0.0)
-    return theta0, -alpha * theta0, 1.0 - 2.0 * theta0 - alpha * V
-
-
-def _weakening_extras(p: Any) -> dict[str, float]:
-    """alpha g, the number CL's stability criterion compares with the springs (docs/model.md)."""
-    return {"alpha_g": p.alpha * weakening_g(p)}
-
-
-def _strengthening_slope(p: Any) -> float:
-    """phi'(V) of the train model's F0 + beta v: beta."""
-    return float(p.beta)
-
-
-class CompositionError(ValueError):
-    """A choice of pieces that docs/model.md does not allow; the message is one line."""
-
-
-@dataclass(frozen=True)
-class Piece:
-    """One choice for one piece: its name, what it means, and the parameters it reads."""
-
-    kind: str
-    name: str
-    meaning: str
-    reads: tuple[str, ...] = ()
-    #: friction and threshold: the piece carries or reads the state variable theta
-    has_state: bool = False
-    #: friction: theta_i at the start of a run (eq. 4 starts at 0.1; laws without theta at 0)
-    theta0: float = 0.0
-    #: drive: every block is joined to the plate by the leaf spring Kp
-    leaf_spring: bool = False
-    #: friction without theta: phi'(V), the slope at steady sliding that the linearisation
-    #: lambda^2 + phi'(V) lambda + w_k^2 = 0 reads (docs/model.md); None for the state law,
-    #: whose linearisation is the 3 x 3 block of eq. (5)
-    slope: Callable[[Any], float] | None = None
-    #: friction with theta: (theta_0, d/dv, d/dtheta) of its law at steady sliding, from (alpha, V)
-    theta_terms: Callable[[float, float], tuple[float, float, float]] | None = None
-    #: friction without theta: extra numbers the mode-stability report shows for this law
-    stability_extras: Callable[[Any], dict[str, float]] | None = None
-    #: ends: steady sliding exists (a spring to a fixed wall stretches without bound)
-    steady_sliding: bool = True
-    #: ends: the chain closes into a ring (x_0 = x_N, x_{N+1} = x_1)
-    ring: bool = False
-    #: ends: a spring to a wall at x = 0, which moves at -V in the frame of the drive, so the
-    #: equations read t there (the other ends leave them autonomous in that frame)
-    wall: bool = False
-
-    @property
-    def code(self) -> int:
-        """The kernel's integer code of the piece (its position in :data:`PIECES`)."""
-        return names(self.kind).index(self.name)
+__all__ = ["PIECES", "KINDS", "CompositionError", "Linearisation", "Param", "Piece", "weakening_g"]
 
 
 PIECES: dict[str, tuple[Piece, ...]] = {
@@ -108,33 +40,8 @@ PIECES: dict[str, tuple[Piece, ...]] = {
             leaf_spring=True,
         ),
     ),
-    "friction": (
-        Piece(
-            "friction",
-            "state",
-            "theta_i + beta v_i while moving; dtheta_i/dt = theta_i (1 - theta_i) "
-            "- alpha theta_i v_i + D (theta_{i+1} - 2 theta_i + theta_{i-1}) (eq. 4)",
-            ("beta", "alpha", "D"),
-            has_state=True,
-            theta0=0.1,
-            theta_terms=_state_theta_terms,
-        ),
-        Piece(
-            "friction",
-            "weakening",
-            "phi(v) = (1 - sigma) / (1 + 2 alpha max(v, 0) / (1 - sigma)) (Carlson-Langer)",
-            ("alpha", "sigma"),
-            slope=_weakening_slope,
-            stability_extras=_weakening_extras,
-        ),
-        Piece(
-            "friction",
-            "strengthening",
-            "F0 + beta v, no state variable (train model)",
-            ("beta", "F0"),
-            slope=_strengthening_slope,
-        ),
-    ),
+    # In the order of the kernels' codes (FRICTION_* in kernels/layout.py).
+    "friction": (state.PIECE, weakening.PIECE, strengthening.PIECE, rate_state.PIECE),
     "threshold": (
         Piece("threshold", "constant", "a stuck block starts when f_i > Fs", ("Fs",)),
         Piece(

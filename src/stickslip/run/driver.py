@@ -149,6 +149,8 @@ def _par(p: ChainParams) -> np.ndarray:
     par[layout.P_K], par[layout.P_D], par[layout.P_V] = p.K, p.D, p.V
     par[layout.P_BETA], par[layout.P_ALPHA], par[layout.P_FS], par[layout.P_DT] = p.beta, p.alpha, p.Fs, p.dt
     par[layout.P_KP], par[layout.P_SIGMA], par[layout.P_F0] = p.Kp, p.sigma, p.F0
+    par[layout.P_RS_A], par[layout.P_RS_B], par[layout.P_DC] = p.rs_a, p.rs_b, p.Dc
+    par[layout.P_V0], par[layout.P_MU0], par[layout.P_SIGMA_N] = p.v0, p.mu0, p.sigma_n
     return par
 
 

@@ -132,6 +132,8 @@ class LocatedStepper:
     """Advances :class:`LocatedState` objects of one model with located switches (in place)."""
 
     def __init__(self, params: ChainParams, capacity: int = 4096):
+        if not params.friction_piece.located:
+            raise ValueError(f"friction {params.friction} has no located-switch integrator (kernels/located.py)")
         self.params = params
         self.par = parameter_vector(params)
         self.codes = params.codes

@@ -102,7 +102,7 @@ class ChainState:
     def paper(cls, p: ChainParams) -> ChainState:
         """The paper's initial state (section 3): x_i = 0, v_i = 0.1, theta_i = 0.1, all moving."""
         N = p.N
-        theta = np.full(N, p.friction_piece.theta0)
+        theta = np.full(N, p.friction_piece.start_theta(p))
         return cls.from_blocks(np.zeros(N), np.full(N, 0.1), theta, np.zeros(N, bool))
 
     @classmethod
@@ -125,7 +125,7 @@ class ChainState:
         """Every block stuck: v_i = 0, x_i = -A u_i with u_i = ``default_rng(seed).random(N)``
         (Carlson-Langer's start, docs/model.md), theta_i = 0.1 (the paper's) for state friction."""
         x = -amplitude * np.random.default_rng(seed).random(p.N) if amplitude > 0 else np.zeros(p.N)
-        theta = np.full(p.N, p.friction_piece.theta0)
+        theta = np.full(p.N, p.friction_piece.start_theta(p))
         return cls.from_blocks(x, np.zeros(p.N), theta, np.ones(p.N, bool))
 
     def blocks(self) -> dict[str, np.ndarray]:

@@ -1,0 +1,116 @@
+"""The Dieterich-Ruina rate-and-state law, aging form, regularised at v = 0.
+
+Friction force sigma_n mu(v, theta) on a moving block with
+
+    mu(v, theta) = a asinh( v / (2 v0) exp(psi / a) ),   psi = mu0 + b ln(v0 theta / D_c)
+
+(Rice & Ben-Zion 1996; Lapusta et al. 2000): for v >> v0 exp(-psi / a) it equals
+mu0 + a ln(v / v0) + b ln(v0 theta / D_c) up to terms of relative size exp(-2 psi / a), and
+mu = 0 at v = 0, so a block that starts from rest meets no friction at v = 0. Heun's predictor
+may take a moving block's v below 0 within a step; the law is read at |v| there, so friction
+keeps braking and the stop rule (v <= 0 at the end of the step) catches a block that stops.
+The state follows the aging law dtheta/dt = 1 - v theta / D_c on every block: a stuck block
+ages (theta grows by 1 per unit time). No diffusion.
+
+Steady sliding at v = V: theta_0 = D_c / V and mu_ss = mu0 + (a - b) ln(V / v0) (regularised).
+Runs start at theta_0 = D_c / V. The start rule is the constant threshold Fs (the state
+threshold reads eq. (4)'s theta in [0, 1]); the stop rule is the family's (v <= 0 stops).
+The spring-slider (N = 1, end drive, unit mass) is unstable below the critical stiffness
+k_c = sigma_n (b - a) / D_c (1 + V^2 / (sigma_n a D_c)) (Rice & Ruina 1983): docs/models/rate-state.md.
+
+Kernel expressions: ``FRICTION_RATE_STATE`` in :mod:`stickslip.kernels.laws` (with its
+parameters at ``P_RS_A``.. in :mod:`stickslip.kernels.layout`).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from stickslip.models.piece import Linearisation, Param, Piece
+
+
+def psi(p: Any, theta: float) -> float:
+    """psi / a with psi = mu0 + b ln(v0 theta / D_c): the exponent of the regularised law."""
+    return (p.mu0 + p.rs_b * math.log(p.v0 * theta / p.Dc)) / p.rs_a
+
+
+def mu(p: Any, v: float, theta: float) -> float:
+    """mu(|v|, theta) = a asinh(|v| / (2 v0) exp(psi / a)) (module docstring), by its log for large
+    arguments. Read at |v| like the kernels (a moving block's Heun predictor may dip below v = 0)."""
+    if v == 0.0:
+        return 0.0
+    lz = math.log(0.5 * abs(v) / p.v0) + psi(p, theta)
+    return p.rs_a * (lz + math.log(2.0)) if lz > 20.0 else p.rs_a * math.asinh(math.exp(lz))
+
+
+def _steady(p: Any) -> tuple[float, float]:
+    """theta_0 = D_c / V and c = sigma_n mu(V, theta_0)."""
+    theta0 = p.Dc / p.V
+    return p.sigma_n * mu(p, p.V, theta0), theta0
+
+
+def _linear(p: Any) -> Linearisation:
+    """The law linearised about steady sliding at v = V, theta_0 = D_c / V.
+
+    With z = V / (2 v0) exp(psi / a) and r = z / sqrt(1 + z^2) (1 to round-off away from v = 0):
+    dphi/dv = sigma_n a r / V, dphi/dtheta = sigma_n b r / theta_0; the aging law
+    g = 1 - v theta / D_c gives dg/dv = -theta_0 / D_c = -1 / V and dg/dtheta = -V / D_c.
+    """
+    theta0 = p.Dc / p.V
+    inv_z = 2.0 * p.v0 / p.V * math.exp(-psi(p, theta0))
+    r = 1.0 / math.sqrt(1.0 + inv_z * inv_z)
+    return Linearisation(
+        theta0=theta0,
+        phi_v=p.sigma_n * p.rs_a * r / p.V,
+        phi_theta=p.sigma_n * p.rs_b * r / theta0,
+        g_v=-theta0 / p.Dc,
+        g_theta=-p.V / p.Dc,
+    )
+
+
+def critical_stiffness(p: Any) -> float:
+    """k_c = sigma_n (b - a) / D_c (1 + V^2 / (sigma_n a D_c)) of the spring-slider, unit mass
+    (Rice & Ruina 1983; the unregularised law): steady sliding is unstable for K < k_c.
+    Negative for velocity strengthening (a > b): stable at every K."""
+    return p.sigma_n * (p.rs_b - p.rs_a) / p.Dc * (1.0 + p.V**2 / (p.sigma_n * p.rs_a * p.Dc))
+
+
+def _extras(p: Any) -> dict[str, float]:
+    """The spring-slider's critical stiffness in closed form, with and without inertia."""
+    return {
+        "k_c_spring_slider": critical_stiffness(p),
+        "k_c_quasi_static": p.sigma_n * (p.rs_b - p.rs_a) / p.Dc,
+    }
+
+
+def _check(p: Any) -> str | None:
+    """Steady sliding and the start value theta_0 = D_c / V need V > 0."""
+    if not p.V > 0.0:
+        return f"friction rate-state needs V > 0 (runs start at theta = D_c / V; got V={p.V:g})"
+    return None
+
+
+PIECE = Piece(
+    "friction",
+    "rate-state",
+    "sigma_n mu with mu = a asinh(v / (2 v0) exp((mu0 + b ln(v0 theta / D_c)) / a)); "
+    "dtheta_i/dt = 1 - v_i theta_i / D_c (Dieterich-Ruina, aging law, regularised at v = 0)",
+    ("rs_a", "rs_b", "Dc", "v0", "mu0", "sigma_n"),
+    params=(
+        Param("rs_a", 0.01, "direct-effect coefficient a of rate-and-state friction", low=0.0, low_open=True),
+        Param("rs_b", 0.015, "state-effect coefficient b of rate-and-state friction", low=0.0),
+        Param("Dc", 0.001, "characteristic slip distance D_c of rate-and-state friction", low=0.0, low_open=True),
+        Param("v0", 0.001, "reference velocity v0 of rate-and-state friction", low=0.0, low_open=True),
+        Param("mu0", 0.6, "friction coefficient mu0 at v = v0 in steady state (rate-and-state)", low=0.0),
+        Param("sigma_n", 5.0, "normal stress sigma_n times the rate-and-state coefficient mu", low=0.0, low_open=True),
+    ),
+    check=_check,
+    has_state=True,
+    theta0=lambda p: p.Dc / p.V,
+    steady=_steady,
+    linear=_linear,
+    located=False,
+    stability_extras=_extras,
+    label=r"$\sigma_n\,[\mu_0 + a \ln(v/v_0) + b \ln(v_0\theta/D_c)]$",
+)

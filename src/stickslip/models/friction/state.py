@@ -1,0 +1,54 @@
+"""eq. (4)'s friction: theta_i + beta v_i while moving, with the state law of eq. (4).
+
+dtheta_i/dt = theta_i (1 - theta_i) - alpha theta_i v_i + D (theta_{i+1} - 2 theta_i + theta_{i-1}).
+Kernel expressions: ``FRICTION_STATE`` in :mod:`stickslip.kernels.laws`.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from stickslip.models.piece import Linearisation, Piece
+
+
+def _steady(p: Any) -> tuple[float, float]:
+    """theta_0 = 1 - alpha V and c = theta_0 + beta V (sections 2, 3)."""
+    theta0 = 1.0 - p.alpha * p.V
+    return theta0 + p.beta * p.V, theta0
+
+
+def _linear(p: Any) -> Linearisation:
+    """eq. (4)'s law linearised about steady sliding at v = V (eq. 2, eq. 5).
+
+    Friction theta + beta v: dphi/dv = beta, dphi/dtheta = 1. State law
+    g = theta (1 - theta) - alpha theta v at the stable steady state theta_0 = max(1 - alpha V, 0):
+    dg/dv = -alpha theta_0 and dg/dtheta = 1 - 2 theta_0 - alpha V; diffusion D.
+    """
+    theta0 = max(1.0 - p.alpha * p.V, 0.0)
+    return Linearisation(theta0, p.beta, 1.0, -p.alpha * theta0, 1.0 - 2.0 * theta0 - p.alpha * p.V, p.D)
+
+
+def _check(p: Any) -> str | None:
+    """Heun keeps every theta_i in [0, 1] if (2 D + 1) dt <= 1 (docs/limits.md)."""
+    if (2.0 * p.D + 1.0) * p.dt > 1.0:
+        return (
+            f"D*dt must be <= (1 - dt)/2 = {(1.0 - p.dt) / 2:g} so that theta stays in [0, 1] "
+            f"(got D={p.D:g}, dt={p.dt:g})"
+        )
+    return None
+
+
+PIECE = Piece(
+    "friction",
+    "state",
+    "theta_i + beta v_i while moving; dtheta_i/dt = theta_i (1 - theta_i) "
+    "- alpha theta_i v_i + D (theta_{i+1} - 2 theta_i + theta_{i-1}) (eq. 4)",
+    ("beta", "alpha", "D"),
+    check=_check,
+    has_state=True,
+    theta0=0.1,
+    steady=_steady,
+    linear=_linear,
+    eq5=True,
+    label=r"$\theta + \beta v$",
+)

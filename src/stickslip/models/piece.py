@@ -1,0 +1,114 @@
+"""What a piece of a model carries (docs/model.md, "The family the paper stands in").
+
+A :class:`Piece` is one choice for one of the four pieces (drive, friction, threshold, ends):
+its name and meaning, the parameters it reads (and those it declares itself, with their checks),
+and what the package asks of it: the state variable, steady sliding, the linearisation the
+stability analysis reads. The kernels read it through its integer code (its position in
+:data:`stickslip.models.pieces.PIECES`). The friction laws live one per module in
+:mod:`stickslip.models.friction`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+
+class CompositionError(ValueError):
+    """A choice of pieces that docs/model.md does not allow; the message is one line."""
+
+
+@dataclass(frozen=True)
+class Param:
+    """A parameter a piece declares: name, default, allowed range and one-line meaning.
+
+    :class:`~stickslip.models.params.ChainParams` gains a field for each, checked like its own
+    (``low``/``high`` bounds, open or closed), so a law's parameters live with the law.
+    """
+
+    name: str
+    default: float
+    doc: str
+    low: float | None = None
+    high: float | None = None
+    low_open: bool = False
+    high_open: bool = False
+
+    def metadata(self) -> dict[str, Any]:
+        """The field metadata ChainParams validates with."""
+        meta: dict[str, Any] = {"doc": self.doc, "low_open": self.low_open, "high_open": self.high_open}
+        if self.low is not None:
+            meta["low"] = self.low
+        if self.high is not None:
+            meta["high"] = self.high
+        return meta
+
+
+@dataclass(frozen=True)
+class Linearisation:
+    """A friction law with state variable, linearised about steady sliding at v = V.
+
+    Friction force phi(v, theta) of a moving block and state law dtheta/dt = g(v, theta)
+    (+ ``diffusion`` times the discrete Laplacian of theta): ``theta0`` the steady state,
+    ``phi_v`` = dphi/dv, ``phi_theta`` = dphi/dtheta, ``g_v`` = dg/dv, ``g_theta`` = dg/dtheta
+    there. The chain's Fourier mode matrix and finite Jacobian (analysis.stability) read these.
+    """
+
+    theta0: float
+    phi_v: float
+    phi_theta: float
+    g_v: float
+    g_theta: float
+    diffusion: float = 0.0
+
+
+@dataclass(frozen=True)
+class Piece:
+    """One choice for one piece: its name, what it means, and the parameters it reads.
+
+    Its kernel code is its position in :data:`~stickslip.models.pieces.PIECES`
+    (:func:`stickslip.models.pieces.code`).
+    """
+
+    kind: str
+    name: str
+    meaning: str
+    reads: tuple[str, ...] = ()
+    #: parameters the piece declares itself (ChainParams gains a field for each)
+    params: tuple[Param, ...] = ()
+    #: cross-field check of a composition using the piece: an error message, or None
+    check: Callable[[Any], str | None] | None = None
+    #: friction and threshold: the piece carries or reads the state variable theta
+    has_state: bool = False
+    #: friction: theta_i at the start of a run, a number or a function of the parameters
+    #: (eq. 4 starts at 0.1; laws without theta at 0)
+    theta0: float | Callable[[Any], float] = 0.0
+    #: friction: (friction c, theta_0) of steady sliding at v = V
+    steady: Callable[[Any], tuple[float, float]] | None = None
+    #: drive: every block is joined to the plate by the leaf spring Kp
+    leaf_spring: bool = False
+    #: friction without theta: phi'(V), the slope at steady sliding that the linearisation
+    #: lambda^2 + phi'(V) lambda + w_k^2 = 0 reads (docs/model.md); None for laws with theta
+    slope: Callable[[Any], float] | None = None
+    #: friction with theta: its law linearised at steady sliding (the 3 x 3 block per mode)
+    linear: Callable[[Any], Linearisation] | None = None
+    #: friction with theta: the linearisation is eq. (5)'s, with Fig. 4's closed-form critical beta
+    eq5: bool = False
+    #: friction: the located-switch integrator (kernels/located.py) has its expressions
+    located: bool = True
+    #: friction: the law as a figure label (matplotlib mathtext)
+    label: str = ""
+    #: friction: extra numbers the stability report shows for this law (closed forms to compare)
+    stability_extras: Callable[[Any], dict[str, float]] | None = None
+    #: ends: steady sliding exists (a spring to a fixed wall stretches without bound)
+    steady_sliding: bool = True
+    #: ends: the chain closes into a ring (x_0 = x_N, x_{N+1} = x_1)
+    ring: bool = False
+    #: ends: a spring to a wall at x = 0, which moves at -V in the frame of the drive, so the
+    #: equations read t there (the other ends leave them autonomous in that frame)
+    wall: bool = False
+
+    def start_theta(self, p: Any) -> float:
+        """theta_i at the start of a run of the parameters ``p`` (:attr:`theta0`)."""
+        return float(self.theta0(p)) if callable(self.theta0) else self.theta0
