@@ -44,8 +44,9 @@ def _example_args(name: str) -> tuple:
     a = [np.linspace(0.5, 1.5, 12) for _ in range(10)]
     lo, hi = 1, 10
     dt, p = 0.005, 0.0
-    # The paper's model: K, Kp, beta, alpha, D, Fs, 1 - sigma, 2 alpha, F0; pieces as literals.
-    mp = (10.0, 1.0, 1.0, 1.0, 5.0, 3.0, 0.99, 2.0, 1.0)
+    # The paper's model: K, Kp, beta, alpha, D, Fs, 1 - sigma, 2 alpha, F0, then the rate-and-state
+    # a, b, D_c, v0, mu0, sigma_n (unused by its law); pieces as literals.
+    mp = (10.0, 1.0, 1.0, 1.0, 5.0, 3.0, 0.99, 2.0, 1.0, 0.01, 0.015, 0.001, 0.001, 0.6, 5.0)
     end, state, constant = layout.DRIVE_END, layout.FRICTION_STATE, layout.THRESHOLD_CONSTANT
     return {
         "_stage1": (*a, lo, hi, p, mp, dt, end, state, constant),
