@@ -32,6 +32,7 @@ from typing import Any
 import numpy as np
 
 from stickslip import io
+from stickslip.experiments.cache import canonical, read_record
 from stickslip.jsonable import to_jsonable
 
 __all__ = ["ladder_task", "run_rung", "perturbed", "ladder_rows", "UNTIL_STEADY", "DIRECTIONS"]
@@ -218,11 +219,12 @@ def _rung(
     sha = state.sha256()
     settings = _rung_settings(cfg)
     path = rdir / "rung.json"
-    if path.is_file() and (rdir / "state.npz").is_file():
+    # The rung's spec: the state it starts from and its settings (the study cache's record format).
+    spec = canonical({"start_sha256": sha, "settings": settings})
+    rec = read_record(path, spec)
+    if rec is not None and (rdir / "state.npz").is_file():
         try:
-            rec = io.read_json(path)
-            if rec.get("start_sha256") == sha and rec.get("settings") == settings:
-                return {"row": rec["row"], "state": _load_state(rdir / "state.npz")}
+            return {"row": rec["row"], "state": _load_state(rdir / "state.npz")}
         except (OSError, ValueError, KeyError):
             pass
     res = run_rung(params_at(cfg, beta), state, cfg, **kw)
@@ -233,7 +235,7 @@ def _rung(
     rdir.mkdir(parents=True, exist_ok=True)
     _save_state(rdir / "state.npz", res["state"])
     _save_npz(rdir / "samples.npz", res["samples"])
-    io.write_json(path, {"row": row, "start_sha256": sha, "settings": settings})
+    io.write_json(path, {"spec": spec, "row": row})
     return {"row": row, "state": res["state"]}
 
 

@@ -87,7 +87,7 @@ def rung_start_state(ladder_dir: str | Path, index: int, cfg: dict[str, Any]):
         state = ChainState.steady(params_at(cfg, rec["row"]["beta"]), float(cfg["perturbation"]), int(cfg["seed"]))
     else:
         state = _load_state(rungs[index - 1] / "state.npz")
-    if state.sha256() != rec["start_sha256"]:
+    if state.sha256() != rec["row"]["start_sha256"]:
         raise ValueError(f"rung {index} in {ladder_dir} did not start from the state before it")
     return state, rec["row"]
 
