@@ -52,10 +52,10 @@ _LN2 = math.log(2.0)
 
 @njit(cache=True, inline="always")
 def _rate_state_mu(v, th, mp):
-    """mu = a asinh(|v| / (2 v0) exp((mu0 + b ln(v0 theta / D_c)) / a)) of rate-and-state friction,
+    """mu = a asinh(abs(v) / (2 v0) exp((mu0 + b ln(v0 theta / D_c)) / a)) of rate-and-state friction,
     regularised at v = 0 (Rice & Ben-Zion 1996; models/friction/rate_state.py).
 
-    Read at |v|: a moving block has v > 0, and where Heun's predictor dips below 0 within a step
+    Read at abs(v): a moving block has v > 0, and where Heun's predictor dips below 0 within a step
     the friction keeps braking, so the stop rule catches a block that stops in the step (the odd
     extension would push it on into a spurious two-step cycle). Through log z: for z > e^20,
     asinh(z) = ln(2 z) to round-off, and exp cannot overflow.

@@ -7,7 +7,7 @@ Friction force sigma_n mu(v, theta) on a moving block with
 (Rice & Ben-Zion 1996; Lapusta et al. 2000): for v >> v0 exp(-psi / a) it equals
 mu0 + a ln(v / v0) + b ln(v0 theta / D_c) up to terms of relative size exp(-2 psi / a), and
 mu = 0 at v = 0, so a block that starts from rest meets no friction at v = 0. Heun's predictor
-may take a moving block's v below 0 within a step; the law is read at |v| there, so friction
+may take a moving block's v below 0 within a step; the law is read at abs(v) there, so friction
 keeps braking and the stop rule (v <= 0 at the end of the step) catches a block that stops.
 The state follows the aging law dtheta/dt = 1 - v theta / D_c on every block: a stuck block
 ages (theta grows by 1 per unit time). No diffusion.
@@ -36,8 +36,8 @@ def psi(p: Any, theta: float) -> float:
 
 
 def mu(p: Any, v: float, theta: float) -> float:
-    """mu(|v|, theta) = a asinh(|v| / (2 v0) exp(psi / a)) (module docstring), by its log for large
-    arguments. Read at |v| like the kernels (a moving block's Heun predictor may dip below v = 0)."""
+    """mu(abs(v), theta) = a asinh(abs(v) / (2 v0) exp(psi / a)) (module docstring), by its log for large
+    arguments. Read at abs(v) like the kernels (a moving block's Heun predictor may dip below v = 0)."""
     if v == 0.0:
         return 0.0
     lz = math.log(0.5 * abs(v) / p.v0) + psi(p, theta)
