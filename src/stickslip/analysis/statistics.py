@@ -41,7 +41,6 @@ import pandas as pd
 import xarray as xr
 from scipy import optimize, stats
 
-# Rupture fronts (Fig. 6) live in fronts; their names stay importable here.
 from stickslip.analysis.fronts import (
     CentralInterval,
     EdgeSpeed,
@@ -51,6 +50,9 @@ from stickslip.analysis.fronts import (
     leading_edge_speed,
     pick_front_events,
 )
+
+# Rupture fronts (Fig. 6) live in fronts; their names stay importable here.
+from stickslip.analysis.order import batch_means
 
 __all__ = [
     "size_distribution",
@@ -508,7 +510,9 @@ class TimeAverage:
 
 
 def time_average(series: xr.DataArray, t_from: float | None = None, *, n_batches: int = 10) -> TimeAverage:
-    """<L> = time average of L(t) = x_1 - x_N (or any series on coord ``t``) for Fig. 5b."""
+    """<L> = time average of L(t) = x_1 - x_N (or any series on coord ``t``) for Fig. 5b, its error
+    from ``n_batches`` batch means (:func:`stickslip.analysis.order.batch_means`; the samples left
+    over are dropped at the start)."""
     if "t" not in series.coords:
         raise ValueError("series needs a coordinate 't'")
     t = series["t"].to_numpy()
@@ -521,9 +525,8 @@ def time_average(series: xr.DataArray, t_from: float | None = None, *, n_batches
         raise ValueError(f"no samples at t >= {start:g}")
     stderr = math.nan
     if n_batches >= 2 and n >= n_batches:
-        size = n // n_batches
-        means = y[: size * n_batches].reshape(n_batches, size).mean(axis=1)
-        stderr = float(means.std(ddof=1) / math.sqrt(n_batches))
+        # The project's one batch-means estimator (the order parameter's too).
+        stderr, _ = batch_means(y, n // n_batches)
     return TimeAverage(
         mean=float(y.mean()),
         stderr=stderr,
