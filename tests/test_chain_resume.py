@@ -15,8 +15,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from chain_helpers import assert_bits_equal, assert_same_run, assert_same_state, run_cli_subprocess
-from stickslip.cli import main
+from chain_helpers import assert_bits_equal, assert_same_run, assert_same_state, run_cli, run_cli_subprocess
 from stickslip.kernels import layout
 from stickslip.models.params import ChainParams, ParameterError
 from stickslip.run import driver as C
@@ -311,21 +310,12 @@ def test_stray_part_files_are_ignored(run_dir, resumed_reference):
     assert_same_run(resume_chain(run_dir, t_end=200.0), resumed_reference)
 
 
-def _cli(capsys, *argv):
-    try:
-        status = main(list(argv))
-    except SystemExit as exc:
-        status = exc.code
-    out, err = capsys.readouterr()
-    return status, out, err
-
-
 def test_cli_refuses_a_corrupt_checkpoint(capsys, run_dir):
     path = run_dir / "checkpoint" / "state.npz"
     arrays, _, _ = C._read_npz(path)
     _flip(path, _array_offset(path, arrays["x"]))
     before = _digest_tree(run_dir)
-    status, out, err = _cli(capsys, "chain", "--resume", str(run_dir), "--json", "--no-progress")
+    status, out, err = run_cli(capsys, "chain", "--resume", str(run_dir), "--json", "--no-progress")
     assert status == 2
     assert out == ""
     assert err.count("\n") == 1 and "corrupt" in err
@@ -335,7 +325,7 @@ def test_cli_refuses_a_corrupt_checkpoint(capsys, run_dir):
 def test_cli_refuses_resume_with_other_model_parameters(capsys, run_dir):
     """`--resume DIR --K 5` for a run made with K = 10 must not silently run with K = 10."""
     before = _digest_tree(run_dir)
-    status, out, err = _cli(capsys, "chain", "--resume", str(run_dir), "--K", "5", "--t-end", "200",
+    status, out, err = run_cli(capsys, "chain", "--resume", str(run_dir), "--K", "5", "--t-end", "200",
                             "--no-progress")  # fmt: skip
     assert status == 2, "model parameters given with --resume were ignored"
     assert err.count("\n") == 1 and "K" in err

@@ -41,6 +41,19 @@ from stickslip.kernels.layout import (
 )
 
 
+@njit(cache=True, inline="always")
+def _profile_row(n, x, ist, prof_x, prof_meta, N, profile_every):
+    """Write x_1..x_N at step n as the next profile row of the event in progress (Figs. 6-7's
+    snapshots); the next one is due ``profile_every`` steps on. The caller has checked the room."""
+    r = ist[P_COUNT]
+    for i in range(1, N + 1):
+        prof_x[r, i - 1] = x[i]
+    prof_meta[r, 0] = ist[N_EVENTS]
+    prof_meta[r, 1] = n
+    ist[P_COUNT] = r + 1
+    ist[NEXT_PROFILE] = n + profile_every
+
+
 @njit(cache=True)
 def _service(n, x, N, ist, samp_L, samp_step, prof_x, prof_meta, sample_every, profile_every):
     """Samples and profile rows due at step n (state at t_n). Returns a status code."""
@@ -53,15 +66,9 @@ def _service(n, x, N, ist, samp_L, samp_step, prof_x, prof_meta, sample_every, p
         ist[S_COUNT] = k + 1
         ist[NEXT_SAMPLE] = n + sample_every
     if profile_every > 0 and ist[EV_ACTIVE] == 1 and n == ist[NEXT_PROFILE]:
-        r = ist[P_COUNT]
-        if r >= prof_x.shape[0]:
+        if ist[P_COUNT] >= prof_x.shape[0]:
             return PROFILES_FULL
-        for i in range(1, N + 1):
-            prof_x[r, i - 1] = x[i]
-        prof_meta[r, 0] = ist[N_EVENTS]
-        prof_meta[r, 1] = n
-        ist[P_COUNT] = r + 1
-        ist[NEXT_PROFILE] = n + profile_every
+        _profile_row(n, x, ist, prof_x, prof_meta, N, profile_every)
     return DONE
 
 
@@ -85,14 +92,8 @@ def _open_event(n, first, x, ist, prof_x, prof_meta, N, profile_every):
     ist[EV_MAX_BLOCK] = 0
     ist[EV_N_MOVED] = 0
     if profile_every > 0:
-        r = ist[P_COUNT]
-        ist[EV_P_FIRST] = r
-        for i in range(1, N + 1):
-            prof_x[r, i - 1] = x[i]
-        prof_meta[r, 0] = ist[N_EVENTS]
-        prof_meta[r, 1] = n
-        ist[P_COUNT] = r + 1
-        ist[NEXT_PROFILE] = n + profile_every
+        ist[EV_P_FIRST] = ist[P_COUNT]
+        _profile_row(n, x, ist, prof_x, prof_meta, N, profile_every)
 
 
 @njit(cache=True)
