@@ -197,3 +197,51 @@ def test_blow_up_message_is_the_same_for_both_integrators():
                 run_chain(ChainParams(**kw), 200.0, integrator=integrator)
             msgs.append(str(info.value))
     assert msgs[:2] == msgs[2:]
+
+
+def _moving_in_pieces(p, state, times):
+    """The moving blocks at each of ``times``, from runs that stop there (the kernels' sampling
+    not involved: each count is taken from the returned state)."""
+    counts = []
+    for t in times:
+        if t > state.step * p.dt:
+            state = run_chain(p, t, start=state).state
+        counts.append(int(np.count_nonzero(state.mov[1:-1])))
+    return counts
+
+
+@pytest.mark.parametrize(
+    "model, integrator, t0",
+    [("sakaguchi", "exact", 3240.0), ("sakaguchi", "dense", 3240.0), ("carlson-langer", "exact", 3500.0)],
+)
+def test_moving_samples_count_the_moving_blocks_of_each_sampled_state(model, integrator, t0):
+    """n_moving (sample_moving) at each sample time is the number of moving blocks of the state
+    there: counted by the kernels along with L (the interval path, the reference and the plate
+    drive's sparse path), checked against runs stopped at each sample time. The window (t0,
+    t0 + 30) holds one slip of the loaded chain."""
+    from stickslip.models.presets import chain_params
+
+    p = chain_params(model, N=6)
+    warm = run_chain(p, t0, integrator=integrator)
+    run = run_chain(p, t0 + 30.0, integrator=integrator, start=warm.state, sample_interval=0.25, sample_moving=True)
+    t = run.samples["t_moving"].values
+    assert np.array_equal(t, run.samples["t"].values)
+    assert np.allclose(t, t0 + 0.25 * np.arange(121), rtol=0, atol=1e-9)
+    n = run.samples["n_moving"].values
+    assert n.max() >= 3 and n.min() == 0, "the window should hold a slip and rests"
+    assert list(n) == _moving_in_pieces(p, warm.state, t)
+
+
+def test_moving_samples_of_a_start_off_the_sampling_grid():
+    """A run that starts between two multiples of the sampling interval samples L from its start
+    and the moving blocks at the multiples (the driver counts them then)."""
+    from stickslip.models.presets import chain_params
+
+    p = chain_params("sakaguchi", N=6)
+    warm = run_chain(p, 3240.1)
+    run = run_chain(p, 3270.0, start=warm.state, sample_interval=0.25, sample_moving=True)
+    t = run.samples["t_moving"].values
+    assert np.allclose(t, 3240.25 + 0.25 * np.arange(120), rtol=0, atol=1e-9)
+    assert run.samples["t"].values[0] == pytest.approx(3240.1)
+    assert run.samples["n_moving"].values.max() >= 3
+    assert list(run.samples["n_moving"].values) == _moving_in_pieces(p, warm.state, t)

@@ -330,3 +330,16 @@ def test_cli_refuses_resume_with_other_model_parameters(capsys, run_dir):
     assert status == 2, "model parameters given with --resume were ignored"
     assert err.count("\n") == 1 and "K" in err
     assert _digest_tree(run_dir) == before
+
+
+@pytest.mark.parametrize("split", [1234.567, 1230.0])
+def test_moving_samples_resume_to_those_of_one_run(tmp_path, split):
+    """sample_moving across a checkpoint (off and on the sampling grid): the same samples as one run."""
+    opts = dict(OPTS, sample_moving=True)
+    ref = run_chain(P, T2, **opts)
+    run_chain(P, split, out_dir=tmp_path, **opts, keep_checkpoint=True)
+    run = resume_chain(tmp_path, t_end=T2)
+    assert_same_run(run, ref)
+    for key in ("t_moving", "n_moving"):
+        assert np.array_equal(run.samples[key].values, ref.samples[key].values)
+    assert len(ref.samples["n_moving"]) == T2 / 10.0 + 1 and ref.samples["n_moving"].values.max() > 0

@@ -55,14 +55,16 @@ def _profile_row(n, x, ist, prof_x, prof_meta, N, profile_every):
 
 
 @njit(cache=True)
-def _service(n, x, N, ist, samp_L, samp_step, prof_x, prof_meta, sample_every, profile_every):
-    """Samples and profile rows due at step n (state at t_n). Returns a status code."""
+def _service(n, x, N, ist, samp_L, samp_step, samp_moving, prof_x, prof_meta, sample_every, profile_every):
+    """Samples (L and the number of moving blocks) and profile rows due at step n (state at t_n).
+    Returns a status code."""
     if n == ist[NEXT_SAMPLE]:
         k = ist[S_COUNT]
         if k >= samp_L.shape[0]:
             return SAMPLES_FULL
         samp_L[k] = x[1] - x[N]
         samp_step[k] = n
+        samp_moving[k] = ist[N_MOVING]
         ist[S_COUNT] = k + 1
         ist[NEXT_SAMPLE] = n + sample_every
     if profile_every > 0 and ist[EV_ACTIVE] == 1 and n == ist[NEXT_PROFILE]:

@@ -119,8 +119,9 @@ class ChainArgs(NamedTuple):
     ev_int: np.ndarray  # event buffer (columns above) and each event's S
     ev_S: np.ndarray
     fm: np.ndarray  # first moves: (event, block, step)
-    samp_L: np.ndarray  # samples of L and their steps
+    samp_L: np.ndarray  # samples of L, their steps and the blocks moving then (int64)
     samp_step: np.ndarray
+    samp_moving: np.ndarray
     prof_x: np.ndarray  # profile rows and their (event, step)
     prof_meta: np.ndarray
     n_end: int  # the call ends at this step

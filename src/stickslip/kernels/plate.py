@@ -165,6 +165,7 @@ def run_sparse(args, drive, friction, threshold, ends):
         fm,
         samp_L,
         samp_step,
+        samp_moving,
         prof_x,
         prof_meta,
         n_end,
@@ -233,8 +234,11 @@ def run_sparse(args, drive, friction, threshold, ends):
             # Outputs due, the end, buffers that could overflow. These change only at the steps
             # named here or when an event starts or ends, after which n_chk is the next step.
             ist[STEP] = n
+            ist[N_MOVING] = nmov
             if n == ist[NEXT_SAMPLE] or (profile_every > 0 and active and n == ist[NEXT_PROFILE]):
-                st = _service(n, x, N, ist, samp_L, samp_step, prof_x, prof_meta, sample_every, profile_every)
+                st = _service(
+                    n, x, N, ist, samp_L, samp_step, samp_moving, prof_x, prof_meta, sample_every, profile_every
+                )
                 if st != DONE:
                     break
             if n >= n_end:

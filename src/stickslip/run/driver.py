@@ -422,8 +422,15 @@ def _drive(
     )
     stops = sorted({steps_for(t, params.dt) for t in options.snapshot_times} | {n_end})
     done_snaps = set(int(s) for a in outputs.parts["snap_step"] for s in a)
-    on_grid = options.until_steady is not None or options.sample_moving
     last_moving = max((int(a[-1, 0]) for a in outputs.parts["moving"] if len(a)), default=-1)
+    last_sample = max((int(a[-1]) for a in outputs.parts["samp_step"] if len(a)), default=-1)
+    # Moving blocks are sampled at the multiples of sample_every. Where those are L's sampling
+    # steps and none is missing, the kernel counts them with L; otherwise (a start off the grid,
+    # a checkpoint of an earlier version) the driver does, stopping the kernel at each one.
+    outputs.moving_from_kernel = (
+        options.sample_moving and state.ist[layout.NEXT_SAMPLE] % sample_every == 0 and last_moving == last_sample
+    )
+    on_grid = options.until_steady is not None or (options.sample_moving and not outputs.moving_from_kernel)
     steady_at: dict[str, float] = {}
     header = {
         "params": params.to_dict(),
@@ -448,7 +455,8 @@ def _drive(
                 if n in stops and n not in done_snaps and n != n_end:
                     outputs.add_snapshot(n, state.x)
                     done_snaps.add(n)
-                if options.sample_moving and n % sample_every == 0 and n > last_moving:
+                moving_due = options.sample_moving and not outputs.moving_from_kernel and n % sample_every == 0
+                if moving_due and n > last_moving:
                     outputs.add_moving(n, int(np.count_nonzero(state.mov[1:-1])))
                     last_moving = n
                 if options.until_steady is not None and n % sample_every == 0:

@@ -132,13 +132,26 @@ class _Outputs:
         self.fm = np.zeros((max(65536, 4 * (N + 1)), 3), dtype=np.int64)
         self.samp_L = np.zeros(65536)
         self.samp_step = np.zeros(65536, dtype=np.int64)
+        self.samp_moving = np.zeros(65536, dtype=np.int64)
+        # The kernels count the moving blocks at each sample of L; kept where the run samples
+        # them (set by the driver).
+        self.moving_from_kernel = False
         rows = 256 if profiling else 2
         self.prof_x = np.zeros((rows, N))
         self.prof_meta = np.zeros((rows, 2), dtype=np.int64)
         self.parts: dict[str, list[np.ndarray]] = {k: [] for k in PART_KEYS}
 
     def kernel_args(self):
-        return (self.ev_int, self.ev_S, self.fm, self.samp_L, self.samp_step, self.prof_x, self.prof_meta)
+        return (
+            self.ev_int,
+            self.ev_S,
+            self.fm,
+            self.samp_L,
+            self.samp_step,
+            self.samp_moving,
+            self.prof_x,
+            self.prof_meta,
+        )
 
     def flush(self, ist: np.ndarray) -> None:
         """Move filled buffer rows into Python-side lists and reset the counts."""
@@ -156,6 +169,8 @@ class _Outputs:
         if ns:
             self.parts["samp_L"].append(self.samp_L[:ns].copy())
             self.parts["samp_step"].append(self.samp_step[:ns].copy())
+            if self.moving_from_kernel:
+                self.parts["moving"].append(np.column_stack((self.samp_step[:ns], self.samp_moving[:ns])))
         if npr:
             self.parts["prof_x"].append(self.prof_x[:npr].copy())
             self.parts["prof_meta"].append(self.prof_meta[:npr].copy())
