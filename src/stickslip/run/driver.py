@@ -231,7 +231,8 @@ def run_chain(
     sliding, optionally perturbed by ``perturbation`` with ``seed``) or a :class:`ChainState`.
     With ``until_steady`` = TOL the run stops at the first sampling time at which every block
     slides within TOL of steady sliding; L is then taken from the steady solution up to t_end.
-    With ``sample_moving`` the number of moving blocks is sampled at the times of L.
+    With ``sample_moving`` the number of moving blocks is sampled at the multiples of the
+    sampling interval: the times of L where the run starts on one (the kernels count them with L).
     With ``out_dir``, checkpoints are written there every ``checkpoint_interval`` wall-clock
     seconds and on SIGINT/SIGTERM (``handle_signals``), and the results at the end; ``run_id``
     (that of the run directory, :func:`rundir.owned_run_dir`) goes into every checkpoint. A

@@ -32,8 +32,9 @@ class RunOptions:
     displacement over windows of Fig. 6, for events with >= profile_min_blocks moved blocks;
     until_steady: if set, the run stops at the first sampling time at which every block slides
     and the state is within this tolerance of steady sliding (:func:`steady_deviation`);
-    sample_moving: if set, the number of moving blocks is sampled at the times of L as well
-    (``samples["n_moving"]`` over ``t_moving``: the fraction of time with some block stuck).
+    sample_moving: if set, the number of moving blocks is sampled at the multiples of
+    sample_interval (``samples["n_moving"]`` over ``t_moving``: the fraction of time with some
+    block stuck); these are the times of L for a run that starts on one.
     """
 
     t_end: float
