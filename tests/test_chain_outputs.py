@@ -214,16 +214,18 @@ def _moving_in_pieces(p, state, times):
     "model, integrator, t0",
     [("sakaguchi", "exact", 3240.0), ("sakaguchi", "dense", 3240.0), ("carlson-langer", "exact", 3500.0)],
 )
-def test_moving_samples_count_the_moving_blocks_of_each_sampled_state(model, integrator, t0):
+def test_moving_samples_count_the_moving_blocks_of_each_sampled_state(monkeypatch, model, integrator, t0):
     """n_moving (sample_moving) at each sample time is the number of moving blocks of the state
     there: counted by the kernels along with L (the interval path, the reference and the plate
-    drive's sparse path), checked against runs stopped at each sample time. The window (t0,
-    t0 + 30) holds one slip of the loaded chain."""
+    drive's sparse path), checked against runs stopped at each sample time, in one kernel call.
+    The window (t0, t0 + 30) holds one slip of the loaded chain."""
     from stickslip.models.presets import chain_params
 
     p = chain_params(model, N=6)
     warm = run_chain(p, t0, integrator=integrator)
+    calls = _count_kernel_calls(monkeypatch)
     run = run_chain(p, t0 + 30.0, integrator=integrator, start=warm.state, sample_interval=0.25, sample_moving=True)
+    assert len(calls) <= 2, "the kernel is not stopped at each of the 121 samples"
     t = run.samples["t_moving"].values
     assert np.array_equal(t, run.samples["t"].values)
     assert np.allclose(t, t0 + 0.25 * np.arange(121), rtol=0, atol=1e-9)
@@ -245,3 +247,41 @@ def test_moving_samples_of_a_start_off_the_sampling_grid():
     assert run.samples["t"].values[0] == pytest.approx(3240.1)
     assert run.samples["n_moving"].values.max() >= 3
     assert list(run.samples["n_moving"].values) == _moving_in_pieces(p, warm.state, t)
+
+
+def _count_kernel_calls(monkeypatch):
+    from stickslip.run import driver
+
+    calls = []
+    call = driver._Kernel.__call__
+
+    def counted(self, state, target):
+        calls.append(target)
+        return call(self, state, target)
+
+    monkeypatch.setattr(driver._Kernel, "__call__", counted)
+    return calls
+
+
+@pytest.mark.parametrize("integrator", ["exact", "dense"])
+def test_until_steady_stops_at_the_first_sampled_steady_state(monkeypatch, integrator):
+    """until_steady stops at the first multiple of the sampling interval at which the state is
+    within the tolerance of steady sliding (found here by runs stopped at each multiple), and the
+    kernel is not stopped at the samples at which some block is stuck (only then can the chain
+    slide steadily): a chain knocked off steady sliding slips a few times before it settles."""
+    p = ChainParams(N=8, beta=5.0)
+    start = run_chain(p, 0.0, start="steady", perturbation=1e-3, seed=1).state
+    calls = _count_kernel_calls(monkeypatch)
+    run = run_chain(p, 5e3, integrator=integrator, start=start, until_steady=1e-6, sample_interval=10.0)
+    n_calls = len(calls)
+    assert run.summary["stopped_early"] and run.summary["n_events"] >= 2
+    t_steady = run.summary["t_steady"]
+    state, t = start, 0.0
+    while steady_deviation(state, p) > 1e-6:
+        t += 10.0
+        state = run_chain(p, t, integrator=integrator, start=state).state
+    assert t_steady == pytest.approx(t, abs=1e-9) and 1000.0 < t < 3000.0
+    assert len(run.samples["L"]) == int(t_steady / 10.0) + 1
+    # a kernel call per sample would be 184; the kernel returns only at the samples with every
+    # block moving (17 calls in all here)
+    assert n_calls < 0.3 * t_steady / 10.0

@@ -68,6 +68,7 @@ def run_dense(args, drive, friction, threshold, ends):
         sample_every,
         profile_every,
         profile_min_blocks,
+        stop_all_moving,
     ) = args
     N = x.shape[0] - 2
     mp, V, dt = _unpack(par)
@@ -79,7 +80,20 @@ def run_dense(args, drive, friction, threshold, ends):
         # Outputs due, the end, buffers that could overflow. Written out here rather than in a
         # helper: as a function this costs several times a short step (measured).
         if n == ist[NEXT_SAMPLE] or (profile_every > 0 and ist[EV_ACTIVE] == 1 and n == ist[NEXT_PROFILE]):
-            st = _service(n, x, N, ist, samp_L, samp_step, samp_moving, prof_x, prof_meta, sample_every, profile_every)
+            st = _service(
+                n,
+                x,
+                N,
+                ist,
+                samp_L,
+                samp_step,
+                samp_moving,
+                prof_x,
+                prof_meta,
+                sample_every,
+                profile_every,
+                stop_all_moving,
+            )
             if st != DONE:
                 return st
         if n >= n_end:

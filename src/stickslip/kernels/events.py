@@ -13,6 +13,7 @@ from __future__ import annotations
 from numba import njit
 
 from stickslip.kernels.layout import (
+    ALL_MOVING,
     DONE,
     E_END_STEP,
     E_ID,
@@ -55,10 +56,12 @@ def _profile_row(n, x, ist, prof_x, prof_meta, N, profile_every):
 
 
 @njit(cache=True)
-def _service(n, x, N, ist, samp_L, samp_step, samp_moving, prof_x, prof_meta, sample_every, profile_every):
+def _service(n, x, N, ist, samp_L, samp_step, samp_moving, prof_x, prof_meta, sample_every, profile_every, stop):
     """Samples (L and the number of moving blocks) and profile rows due at step n (state at t_n).
-    Returns a status code."""
-    if n == ist[NEXT_SAMPLE]:
+    Returns a status code: ALL_MOVING after a sample at which every block moves, if ``stop``
+    (the driver then looks for steady sliding, ``until_steady``)."""
+    sampled = n == ist[NEXT_SAMPLE]
+    if sampled:
         k = ist[S_COUNT]
         if k >= samp_L.shape[0]:
             return SAMPLES_FULL
@@ -71,6 +74,8 @@ def _service(n, x, N, ist, samp_L, samp_step, samp_moving, prof_x, prof_meta, sa
         if ist[P_COUNT] >= prof_x.shape[0]:
             return PROFILES_FULL
         _profile_row(n, x, ist, prof_x, prof_meta, N, profile_every)
+    if sampled and stop != 0 and ist[N_MOVING] == N:
+        return ALL_MOVING
     return DONE
 
 

@@ -122,6 +122,7 @@ def run_exact(args, drive, friction, threshold, ends):
         sample_every,
         profile_every,
         profile_min_blocks,
+        stop_all_moving,
     ) = args
     N = x.shape[0] - 2
     mp, V, dt = _unpack(par)
@@ -148,7 +149,18 @@ def run_exact(args, drive, friction, threshold, ends):
             # helper: as a function this costs several times a short step (measured).
             if n == ist[NEXT_SAMPLE] or (profile_every > 0 and ist[EV_ACTIVE] == 1 and n == ist[NEXT_PROFILE]):
                 st = _service(
-                    n, x, N, ist, samp_L, samp_step, samp_moving, prof_x, prof_meta, sample_every, profile_every
+                    n,
+                    x,
+                    N,
+                    ist,
+                    samp_L,
+                    samp_step,
+                    samp_moving,
+                    prof_x,
+                    prof_meta,
+                    sample_every,
+                    profile_every,
+                    stop_all_moving,
                 )
                 if st != DONE:
                     return st

@@ -95,6 +95,7 @@ FIRST_MOVES_FULL = 2
 SAMPLES_FULL = 3
 PROFILES_FULL = 4
 NONFINITE = 5
+ALL_MOVING = 6  # a sample taken with every block moving (``stop_all_moving``): the driver looks
 
 
 class ChainArgs(NamedTuple):
@@ -128,6 +129,7 @@ class ChainArgs(NamedTuple):
     sample_every: int
     profile_every: int  # 0: no profiles
     profile_min_blocks: int
+    stop_all_moving: int  # 1: return ALL_MOVING after a sample at which every block moves
 
 
 _BIG = np.float64(1.7976931348623157e308)

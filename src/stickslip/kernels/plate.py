@@ -172,6 +172,7 @@ def run_sparse(args, drive, friction, threshold, ends):
         sample_every,
         profile_every,
         profile_min_blocks,
+        stop_all_moving,
     ) = args
     N = x.shape[0] - 2
     mp, V, dt = _unpack(par)
@@ -237,7 +238,18 @@ def run_sparse(args, drive, friction, threshold, ends):
             ist[N_MOVING] = nmov
             if n == ist[NEXT_SAMPLE] or (profile_every > 0 and active and n == ist[NEXT_PROFILE]):
                 st = _service(
-                    n, x, N, ist, samp_L, samp_step, samp_moving, prof_x, prof_meta, sample_every, profile_every
+                    n,
+                    x,
+                    N,
+                    ist,
+                    samp_L,
+                    samp_step,
+                    samp_moving,
+                    prof_x,
+                    prof_meta,
+                    sample_every,
+                    profile_every,
+                    stop_all_moving,
                 )
                 if st != DONE:
                     break

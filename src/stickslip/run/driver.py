@@ -162,12 +162,13 @@ class _Kernel:
     so only the kernel a run uses is compiled.
     """
 
-    def __init__(self, name, params, state, scratch, par, outputs, sample_every, profile_every, min_blocks):
+    def __init__(self, name, params, state, scratch, par, outputs, ints):
         if name == "exact" and stopped_blocks_still(params.drive_piece, params.friction_piece):
             name = "sparse"
         self.scratch = tuple(scratch)
         self.rest = (par, *outputs.kernel_args())
-        self.tail = tuple(np.int64(t) for t in (sample_every, profile_every, min_blocks))
+        # sample_every, profile_every, profile_min_blocks, stop_all_moving (layout.ChainArgs)
+        self.tail = tuple(np.int64(t) for t in ints)
         self.pieces = params.codes
         self.entry = entry.specialise(_KERNELS[name], self._args(state, 0), self.pieces)
 
@@ -418,20 +419,22 @@ def _drive(
     n_end = steps_for(options.t_end, params.dt)
     sample_every = int(round(options.sample_interval / params.dt))
     profile_every = int(round(options.profile_window / params.dt)) if options.profile_window else 0
-    kernel = _Kernel(
-        integrator, params, state, scratch, par, outputs, sample_every, profile_every, options.profile_min_blocks
-    )
-    stops = sorted({steps_for(t, params.dt) for t in options.snapshot_times} | {n_end})
-    done_snaps = set(int(s) for a in outputs.parts["snap_step"] for s in a)
     last_moving = max((int(a[-1, 0]) for a in outputs.parts["moving"] if len(a)), default=-1)
     last_sample = max((int(a[-1]) for a in outputs.parts["samp_step"] if len(a)), default=-1)
-    # Moving blocks are sampled at the multiples of sample_every. Where those are L's sampling
-    # steps and none is missing, the kernel counts them with L; otherwise (a start off the grid,
-    # a checkpoint of an earlier version) the driver does, stopping the kernel at each one.
-    outputs.moving_from_kernel = (
-        options.sample_moving and state.ist[layout.NEXT_SAMPLE] % sample_every == 0 and last_moving == last_sample
+    # Moving blocks are counted, and steady sliding looked for, at the multiples of sample_every.
+    # Where those are L's sampling steps, the kernel counts them with L (unless a count is missing:
+    # a checkpoint of an earlier version) and stops only at a sample with every block moving
+    # (steady sliding needs it); otherwise (a start off the grid) the kernel stops at each one.
+    on_l_grid = state.ist[layout.NEXT_SAMPLE] % sample_every == 0
+    outputs.moving_from_kernel = options.sample_moving and on_l_grid and last_moving == last_sample
+    stop_all_moving = options.until_steady is not None and on_l_grid
+    on_grid = (options.until_steady is not None and not stop_all_moving) or (
+        options.sample_moving and not outputs.moving_from_kernel
     )
-    on_grid = options.until_steady is not None or (options.sample_moving and not outputs.moving_from_kernel)
+    ints = (sample_every, profile_every, options.profile_min_blocks, int(stop_all_moving))
+    kernel = _Kernel(integrator, params, state, scratch, par, outputs, ints)
+    stops = sorted({steps_for(t, params.dt) for t in options.snapshot_times} | {n_end})
+    done_snaps = set(int(s) for a in outputs.parts["snap_step"] for s in a)
     steady_at: dict[str, float] = {}
     header = {
         "params": params.to_dict(),
@@ -485,17 +488,7 @@ def _drive(
                     # The fast kernel does not look for non-finite values; replay this call
                     # with the reference, which follows the same arithmetic and checks each step.
                     state = before
-                    reference = _Kernel(
-                        "dense",
-                        params,
-                        state,
-                        scratch,
-                        par,
-                        outputs,
-                        sample_every,
-                        profile_every,
-                        options.profile_min_blocks,
-                    )
+                    reference = _Kernel("dense", params, state, scratch, par, outputs, ints)
                     status = reference(state, target)
                 if status == layout.NONFINITE:
                     bad = int(state.ist[layout.BAD_BLOCK])
@@ -560,7 +553,7 @@ class Stepper:
 
     def _kernel(self, name: str, state: ChainState) -> _Kernel:
         if name not in self._kernels:
-            self._kernels[name] = _Kernel(name, self.params, state, self.scratch, self.par, self.outputs, 1, 0, 0)
+            self._kernels[name] = _Kernel(name, self.params, state, self.scratch, self.par, self.outputs, (1, 0, 0, 0))
         return self._kernels[name]
 
     def advance(self, state: ChainState, step: int) -> tuple[ChainState, int]:
