@@ -14,7 +14,7 @@ from numba.core import ir, types
 from numba.core.compiler import CompilerBase, DefaultPassBuilder
 from numba.core.compiler_machinery import FunctionPass, register_pass
 from numba.core.ir_utils import build_definitions
-from numba.core.untyped_passes import IRProcessing
+from numba.core.untyped_passes import FixupArgs
 
 
 @register_pass(mutates_CFG=False, analysis_only=False)
@@ -36,16 +36,28 @@ class PiecesAsConstants(FunctionPass):
                         stmt.value = ir.Const(ty.literal_value, stmt.value.loc)
                         changed = True
         if changed:
-            # The table numba's passes read definitions from (as its own passes rebuild it).
-            state.func_ir._definitions = build_definitions(state.func_ir.blocks)
+            # A new IR from the edited blocks, with the table of definitions that numba's later
+            # passes read (built as numba's interpreter builds it); the post-processing that
+            # follows in IRProcessing works on this one.
+            fir = state.func_ir
+            state.func_ir = ir.FunctionIR(
+                fir.blocks,
+                fir.is_generator,
+                fir.func_id,
+                fir.loc,
+                build_definitions(fir.blocks),
+                fir.arg_count,
+                fir.arg_names,
+            )
         return changed
 
 
 class PiecesCompiler(CompilerBase):
-    """numba's nopython pipeline with :class:`PiecesAsConstants` before its branch pruning."""
+    """numba's nopython pipeline with :class:`PiecesAsConstants` after its bytecode translation,
+    before the IR's post-processing and branch pruning."""
 
     def define_pipelines(self):
         pm = DefaultPassBuilder.define_nopython_pipeline(self.state)
-        pm.add_pass_after(PiecesAsConstants, IRProcessing)
+        pm.add_pass_after(PiecesAsConstants, FixupArgs)
         pm.finalize()
         return [pm]
