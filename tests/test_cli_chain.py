@@ -144,6 +144,11 @@ def test_bench_partly_stuck_json(capsys):
     assert data["ratio"] == pytest.approx(data["ns_per_update_exact"] / data["ns_per_block_step_dense"])
     assert data["workload"]["steps"] == 40000 and data["workload"]["N"] == 20 and data["workload"]["beta"] == 1.3
     assert 0 < data["exact_block_updates"] <= 20 * 40000
+    assert data["repeat"] == 3  # the default of this workload: its exact run is short
+    status, out, _ = run_cli(
+        capsys, "bench", "--workload", "partly-stuck", "--N", "20", "--t-end", "200", "--repeat", "1", "--json"
+    )
+    assert status == 0 and json.loads(out)["repeat"] == 1
 
 
 def test_bench_partly_stuck_refuses_a_start(capsys):

@@ -270,6 +270,7 @@ def partly_stuck(params: ChainParams, *, t_prepare: float, t_timed: float, repea
         },
         "prepare_seconds": prepare_seconds,
         "timer": "process CPU time, best of repeat, the integrators alternated",
+        "repeat": repeat,
         "moving_fraction": float(e.samples["n_moving"].values.mean()) / params.N,
         "dense_seconds": best["dense"],
         "exact_seconds": best["exact"],
@@ -296,7 +297,7 @@ def format_partly_stuck(r: dict[str, Any]) -> str:
             f"{r['updates_per_step']:.1f} block updates per step",
             f"dense      {r['dense_seconds']:.3f} s CPU   {r['ns_per_block_step_dense']:.3g} ns/block-step",
             f"exact      {r['exact_seconds']:.3f} s CPU   {r['ns_per_update_exact']:.3g} ns/block update",
-            f"ratio      {r['ratio']:.3f} (exact per update / dense per block-step)",
+            f"ratio      {r['ratio']:.3f} (exact per update / dense per block-step; CPU time, best of {r['repeat']})",
             f"identical  {'yes' if r['identical'] else 'NO'}   sha256 {r['state_sha256'][:16]}...",
         ]
     )
