@@ -56,25 +56,29 @@ def _profile_row(n, x, ist, prof_x, prof_meta, N, profile_every):
 
 
 @njit(cache=True)
-def _service(n, x, N, ist, samp_L, samp_step, samp_moving, prof_x, prof_meta, sample_every, profile_every, stop):
-    """Samples (L and the number of moving blocks) and profile rows due at step n (state at t_n).
-    Returns a status code: ALL_MOVING after a sample at which every block moves, if ``stop``
-    (the driver then looks for steady sliding, ``until_steady``)."""
+def _service(n, args):
+    """Samples (L and the number of moving blocks) and profile rows due at step n (state at t_n;
+    ``args`` the kernel's :class:`~stickslip.kernels.layout.ChainArgs`). Returns a status code:
+    ALL_MOVING after a sample at which every block moves, if ``args.stop_all_moving`` (the driver
+    then looks for steady sliding, ``until_steady``)."""
+    x, ist, samp_L, prof_x = args.x, args.ist, args.samp_L, args.prof_x
+    N = x.shape[0] - 2
+    profile_every = args.profile_every
     sampled = n == ist[NEXT_SAMPLE]
     if sampled:
         k = ist[S_COUNT]
         if k >= samp_L.shape[0]:
             return SAMPLES_FULL
         samp_L[k] = x[1] - x[N]
-        samp_step[k] = n
-        samp_moving[k] = ist[N_MOVING]
+        args.samp_step[k] = n
+        args.samp_moving[k] = ist[N_MOVING]
         ist[S_COUNT] = k + 1
-        ist[NEXT_SAMPLE] = n + sample_every
+        ist[NEXT_SAMPLE] = n + args.sample_every
     if profile_every > 0 and ist[EV_ACTIVE] == 1 and n == ist[NEXT_PROFILE]:
         if ist[P_COUNT] >= prof_x.shape[0]:
             return PROFILES_FULL
-        _profile_row(n, x, ist, prof_x, prof_meta, N, profile_every)
-    if sampled and stop != 0 and ist[N_MOVING] == N:
+        _profile_row(n, x, ist, prof_x, args.prof_meta, N, profile_every)
+    if sampled and args.stop_all_moving != 0 and ist[N_MOVING] == N:
         return ALL_MOVING
     return DONE
 

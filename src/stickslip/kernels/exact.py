@@ -148,20 +148,7 @@ def run_exact(args, drive, friction, threshold, ends):
             # Outputs due, the end, buffers that could overflow. Written out here rather than in a
             # helper: as a function this costs several times a short step (measured).
             if n == ist[NEXT_SAMPLE] or (profile_every > 0 and ist[EV_ACTIVE] == 1 and n == ist[NEXT_PROFILE]):
-                st = _service(
-                    n,
-                    x,
-                    N,
-                    ist,
-                    samp_L,
-                    samp_step,
-                    samp_moving,
-                    prof_x,
-                    prof_meta,
-                    sample_every,
-                    profile_every,
-                    stop_all_moving,
-                )
+                st = _service(n, args)
                 if st != DONE:
                     return st
             if n >= n_end:

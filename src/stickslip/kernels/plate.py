@@ -237,20 +237,7 @@ def run_sparse(args, drive, friction, threshold, ends):
             ist[STEP] = n
             ist[N_MOVING] = nmov
             if n == ist[NEXT_SAMPLE] or (profile_every > 0 and active and n == ist[NEXT_PROFILE]):
-                st = _service(
-                    n,
-                    x,
-                    N,
-                    ist,
-                    samp_L,
-                    samp_step,
-                    samp_moving,
-                    prof_x,
-                    prof_meta,
-                    sample_every,
-                    profile_every,
-                    stop_all_moving,
-                )
+                st = _service(n, args)
                 if st != DONE:
                     break
             if n >= n_end:
