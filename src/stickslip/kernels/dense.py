@@ -40,36 +40,10 @@ def run_dense(args, drive, friction, threshold, ends):
     :mod:`stickslip.kernels.laws`, the events in :mod:`stickslip.kernels.events`. ``trig`` is
     scratch of :func:`stickslip.kernels.exact.run_exact`, unused here.
     """
-    (
-        x,
-        v,
-        th,
-        mov,
-        xs,
-        vs,
-        ths,
-        mm,
-        a1,
-        b1,
-        trig,
-        first_step,
-        x0ev,
-        ist,
-        par,
-        ev_int,
-        ev_S,
-        fm,
-        samp_L,
-        samp_step,
-        samp_moving,
-        prof_x,
-        prof_meta,
-        n_end,
-        sample_every,
-        profile_every,
-        profile_min_blocks,
-        stop_all_moving,
-    ) = args
+    x, v, th, mov, xs = args.x, args.v, args.th, args.mov, args.xs
+    vs, ths, mm, a1, b1 = args.vs, args.ths, args.mm, args.a1, args.b1
+    ist, par, ev_int, fm, prof_x = args.ist, args.par, args.ev_int, args.fm, args.prof_x
+    n_end, profile_every = args.n_end, args.profile_every
     N = x.shape[0] - 2
     mp, V, dt = _unpack(par)
     K, Kp, Fs = mp[0], mp[1], mp[5]
@@ -102,7 +76,7 @@ def run_dense(args, drive, friction, threshold, ends):
             ths[i] = th[i] + dt * b1[i]
         p2 = _pull(V, n + 1, dt)
         _set_ghosts(xs, ths, N, p2, drive, ends)
-        _start_and_first_moves(n, 1, N, x, mm, first_step, x0ev, ist, prof_x, prof_meta, N, profile_every)
+        _start_and_first_moves(n, 1, N, args)
         n_moving = 0
         bad = 0
         for i in range(1, N + 1):
@@ -133,6 +107,4 @@ def run_dense(args, drive, friction, threshold, ends):
             ist[BAD_BLOCK] = bad
             return NONFINITE
         if ist[EV_ACTIVE] == 1 and n_moving == 0:
-            _end_event(
-                n, x, first_step, x0ev, ist, ev_int, ev_S, fm, prof_x, prof_meta, N, profile_every, profile_min_blocks
-            )
+            _end_event(n, args)

@@ -94,22 +94,25 @@ def _overflow(ist, N, cap_ev, cap_fm):
 
 
 @njit(cache=True, inline="always")
-def _open_event(n, first, x, ist, prof_x, prof_meta, N, profile_every):
+def _open_event(n, first, args):
     """Open an event whose first block to move is ``first``, in step n (x holds t_n): its start
-    and, with profiles, its first profile row."""
+    and, with profiles, its first profile row (``args``: the kernel's ChainArgs)."""
+    ist = args.ist
     ist[EV_ACTIVE] = 1
     ist[EV_START_STEP] = n
     ist[EV_START_BLOCK] = first
     ist[EV_MAX_BLOCK] = 0
     ist[EV_N_MOVED] = 0
-    if profile_every > 0:
+    if args.profile_every > 0:
         ist[EV_P_FIRST] = ist[P_COUNT]
-        _profile_row(n, x, ist, prof_x, prof_meta, N, profile_every)
+        _profile_row(n, args.x, ist, args.prof_x, args.prof_meta, args.x.shape[0] - 2, args.profile_every)
 
 
 @njit(cache=True)
-def _start_and_first_moves(n, lo, hi, x, mm, first_step, x0ev, ist, prof_x, prof_meta, N, profile_every):
-    """Event bookkeeping before stage 2 (x still holds t_n): event start and first moves."""
+def _start_and_first_moves(n, lo, hi, args):
+    """Event bookkeeping before stage 2 (x still holds t_n): event start and first moves of the
+    blocks lo..hi of the step's mask ``args.mm``."""
+    x, mm, first_step, x0ev, ist = args.x, args.mm, args.first_step, args.x0ev, args.ist
     if ist[EV_ACTIVE] == 0:
         if ist[N_MOVING] != 0:
             return
@@ -120,7 +123,7 @@ def _start_and_first_moves(n, lo, hi, x, mm, first_step, x0ev, ist, prof_x, prof
                 break
         if first < 0:
             return
-        _open_event(n, first, x, ist, prof_x, prof_meta, N, profile_every)
+        _open_event(n, first, args)
     for i in range(lo, hi + 1):
         if mm[i] != 0.0 and first_step[i] < 0:
             first_step[i] = n
@@ -131,8 +134,11 @@ def _start_and_first_moves(n, lo, hi, x, mm, first_step, x0ev, ist, prof_x, prof
 
 
 @njit(cache=True)
-def _end_event(n, x, first_step, x0ev, ist, ev_int, ev_S, fm, prof_x, prof_meta, N, profile_every, profile_min_blocks):
+def _end_event(n, args):
     """Close the event that ended in step n (x holds t_{n+1}): S, its row, first-move rows."""
+    x, first_step, x0ev, ist, fm = args.x, args.first_step, args.x0ev, args.ist, args.fm
+    ev_int, ev_S, prof_x, prof_meta = args.ev_int, args.ev_S, args.prof_x, args.prof_meta
+    N = x.shape[0] - 2
     eid = ist[N_EVENTS]
     S = 0.0
     k = ist[FM_COUNT]
@@ -154,8 +160,8 @@ def _end_event(n, x, first_step, x0ev, ist, ev_int, ev_S, fm, prof_x, prof_meta,
     ev_int[r, E_N_BLOCKS] = ist[EV_N_MOVED]
     ev_S[r] = S
     ist[EV_COUNT] = r + 1
-    if profile_every > 0:
-        if ist[EV_N_MOVED] >= profile_min_blocks:
+    if args.profile_every > 0:
+        if ist[EV_N_MOVED] >= args.profile_min_blocks:
             p = ist[P_COUNT]
             for i in range(1, N + 1):
                 prof_x[p, i - 1] = x[i]

@@ -94,36 +94,10 @@ def run_exact(args, drive, friction, threshold, ends):
     (int64, N + 2) is scratch: the plate drive's first start step of each stopped block,
     rebuilt on entry.
     """
-    (
-        x,
-        v,
-        th,
-        mov,
-        xs,
-        vs,
-        ths,
-        mm,
-        a1,
-        b1,
-        trig,
-        first_step,
-        x0ev,
-        ist,
-        par,
-        ev_int,
-        ev_S,
-        fm,
-        samp_L,
-        samp_step,
-        samp_moving,
-        prof_x,
-        prof_meta,
-        n_end,
-        sample_every,
-        profile_every,
-        profile_min_blocks,
-        stop_all_moving,
-    ) = args
+    x, v, th, mov, xs = args.x, args.v, args.th, args.mov, args.xs
+    vs, ths, mm, a1, b1 = args.vs, args.ths, args.mm, args.a1, args.b1
+    trig, ist, par, ev_int, fm = args.trig, args.ist, args.par, args.ev_int, args.fm
+    prof_x, n_end, profile_every = args.prof_x, args.n_end, args.profile_every
     N = x.shape[0] - 2
     mp, V, dt = _unpack(par)
     K, Kp, Fs = mp[0], mp[1], mp[5]
@@ -237,21 +211,7 @@ def run_exact(args, drive, friction, threshold, ends):
                         if t < t_next:
                             t_next = t
                     if ist[EV_ACTIVE] == 1 and n_moving == 0:
-                        _end_event(
-                            n,
-                            x,
-                            first_step,
-                            x0ev,
-                            ist,
-                            ev_int,
-                            ev_S,
-                            fm,
-                            prof_x,
-                            prof_meta,
-                            N,
-                            profile_every,
-                            profile_min_blocks,
-                        )
+                        _end_event(n, args)
                 continue
 
             p1 = _pull(V, n, dt)
@@ -299,9 +259,7 @@ def run_exact(args, drive, friction, threshold, ends):
             _set_ghosts(xs, ths, N, p2, drive, ends)
             # Only a block that starts in this step can move for the first time in an event.
             if (ist[EV_ACTIVE] == 1 and starts) or (ist[N_MOVING] == 0 and first <= last):
-                _start_and_first_moves(
-                    n, max(first, lo), min(last, hi), x, mm, first_step, x0ev, ist, prof_x, prof_meta, N, profile_every
-                )
+                _start_and_first_moves(n, max(first, lo), min(last, hi), args)
             # Stage 2: full over the blocks that move, state variable alone elsewhere.
             sl = first if first > lo else lo
             sh = last if last < hi else hi
@@ -404,18 +362,4 @@ def run_exact(args, drive, friction, threshold, ends):
                     if t < t_next:
                         t_next = t
             if ist[EV_ACTIVE] == 1 and n_moving == 0:
-                _end_event(
-                    n,
-                    x,
-                    first_step,
-                    x0ev,
-                    ist,
-                    ev_int,
-                    ev_S,
-                    fm,
-                    prof_x,
-                    prof_meta,
-                    N,
-                    profile_every,
-                    profile_min_blocks,
-                )
+                _end_event(n, args)

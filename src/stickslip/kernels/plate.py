@@ -144,36 +144,9 @@ def run_sparse(args, drive, friction, threshold, ends):
     ``mm``, ``a1``, ``b1``, ``vs`` and ``ths`` are not used: the mask is 1 on the movers' list,
     and the stage-1 accelerations and predicted velocities are kept in the list's order.
     """
-    (
-        x,
-        v,
-        th,
-        mov,
-        xs,
-        vs,
-        ths,
-        mm,
-        a1,
-        b1,
-        trig,
-        first_step,
-        x0ev,
-        ist,
-        par,
-        ev_int,
-        ev_S,
-        fm,
-        samp_L,
-        samp_step,
-        samp_moving,
-        prof_x,
-        prof_meta,
-        n_end,
-        sample_every,
-        profile_every,
-        profile_min_blocks,
-        stop_all_moving,
-    ) = args
+    x, v, th, mov, xs = args.x, args.v, args.th, args.mov, args.xs
+    trig, first_step, x0ev, ist, par = args.trig, args.first_step, args.x0ev, args.ist, args.par
+    ev_int, fm, prof_x, n_end, profile_every = args.ev_int, args.fm, args.prof_x, args.n_end, args.profile_every
     N = x.shape[0] - 2
     mp, V, dt = _unpack(par)
     K, Kp, Fs = mp[0], mp[1], mp[5]
@@ -343,7 +316,7 @@ def run_sparse(args, drive, friction, threshold, ends):
                     first = min(first, np.int64(movers[k]))
                 active = True
                 n_chk = n + 1
-                _open_event(n, first, x, ist, prof_x, prof_meta, N, profile_every)
+                _open_event(n, first, args)
             for k in range(nmov, na):
                 i = movers[k]
                 if first_step[i] < 0:
@@ -459,9 +432,7 @@ def run_sparse(args, drive, friction, threshold, ends):
             qexact = ns == 0
         nmov = na - ns
         if active and nmov == 0:
-            _end_event(
-                n, x, first_step, x0ev, ist, ev_int, ev_S, fm, prof_x, prof_meta, N, profile_every, profile_min_blocks
-            )
+            _end_event(n, args)
             active = False
             n_chk = n + 1
         n += 1
