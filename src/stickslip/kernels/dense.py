@@ -43,6 +43,7 @@ def run_dense(args, drive, friction, threshold, ends):
     x, v, th, mov, xs = args.x, args.v, args.th, args.mov, args.xs
     vs, ths, mm, a1, b1 = args.vs, args.ths, args.mm, args.a1, args.b1
     ist, par, ev_int, fm, prof_x = args.ist, args.par, args.ev_int, args.fm, args.prof_x
+    first_step, x0ev, prof_meta = args.first_step, args.x0ev, args.prof_meta
     n_end, profile_every = args.n_end, args.profile_every
     N = x.shape[0] - 2
     mp, V, dt = _unpack(par)
@@ -76,7 +77,7 @@ def run_dense(args, drive, friction, threshold, ends):
             ths[i] = th[i] + dt * b1[i]
         p2 = _pull(V, n + 1, dt)
         _set_ghosts(xs, ths, N, p2, drive, ends)
-        _start_and_first_moves(n, 1, N, args)
+        _start_and_first_moves(n, 1, N, x, mm, first_step, x0ev, ist, prof_x, prof_meta, N, profile_every)
         n_moving = 0
         bad = 0
         for i in range(1, N + 1):

@@ -94,25 +94,25 @@ def _overflow(ist, N, cap_ev, cap_fm):
 
 
 @njit(cache=True, inline="always")
-def _open_event(n, first, args):
+def _open_event(n, first, x, ist, prof_x, prof_meta, N, profile_every):
     """Open an event whose first block to move is ``first``, in step n (x holds t_n): its start
-    and, with profiles, its first profile row (``args``: the kernel's ChainArgs)."""
-    ist = args.ist
+    and, with profiles, its first profile row."""
     ist[EV_ACTIVE] = 1
     ist[EV_START_STEP] = n
     ist[EV_START_BLOCK] = first
     ist[EV_MAX_BLOCK] = 0
     ist[EV_N_MOVED] = 0
-    if args.profile_every > 0:
+    if profile_every > 0:
         ist[EV_P_FIRST] = ist[P_COUNT]
-        _profile_row(n, args.x, ist, args.prof_x, args.prof_meta, args.x.shape[0] - 2, args.profile_every)
+        _profile_row(n, x, ist, prof_x, prof_meta, N, profile_every)
 
 
 @njit(cache=True)
-def _start_and_first_moves(n, lo, hi, args):
-    """Event bookkeeping before stage 2 (x still holds t_n): event start and first moves of the
-    blocks lo..hi of the step's mask ``args.mm``."""
-    x, mm, first_step, x0ev, ist = args.x, args.mm, args.first_step, args.x0ev, args.ist
+def _start_and_first_moves(n, lo, hi, x, mm, first_step, x0ev, ist, prof_x, prof_meta, N, profile_every):
+    """Event bookkeeping before stage 2 (x still holds t_n): event start and first moves.
+
+    Called in every step of the reference: its arrays are passed one by one, not as the kernel's
+    ChainArgs, which costs more per call (measured)."""
     if ist[EV_ACTIVE] == 0:
         if ist[N_MOVING] != 0:
             return
@@ -123,7 +123,7 @@ def _start_and_first_moves(n, lo, hi, args):
                 break
         if first < 0:
             return
-        _open_event(n, first, args)
+        _open_event(n, first, x, ist, prof_x, prof_meta, N, profile_every)
     for i in range(lo, hi + 1):
         if mm[i] != 0.0 and first_step[i] < 0:
             first_step[i] = n

@@ -98,6 +98,7 @@ def run_exact(args, drive, friction, threshold, ends):
     vs, ths, mm, a1, b1 = args.vs, args.ths, args.mm, args.a1, args.b1
     trig, ist, par, ev_int, fm = args.trig, args.ist, args.par, args.ev_int, args.fm
     prof_x, n_end, profile_every = args.prof_x, args.n_end, args.profile_every
+    first_step, x0ev, prof_meta = args.first_step, args.x0ev, args.prof_meta
     N = x.shape[0] - 2
     mp, V, dt = _unpack(par)
     K, Kp, Fs = mp[0], mp[1], mp[5]
@@ -259,7 +260,9 @@ def run_exact(args, drive, friction, threshold, ends):
             _set_ghosts(xs, ths, N, p2, drive, ends)
             # Only a block that starts in this step can move for the first time in an event.
             if (ist[EV_ACTIVE] == 1 and starts) or (ist[N_MOVING] == 0 and first <= last):
-                _start_and_first_moves(n, max(first, lo), min(last, hi), args)
+                _start_and_first_moves(
+                    n, max(first, lo), min(last, hi), x, mm, first_step, x0ev, ist, prof_x, prof_meta, N, profile_every
+                )
             # Stage 2: full over the blocks that move, state variable alone elsewhere.
             sl = first if first > lo else lo
             sh = last if last < hi else hi

@@ -147,6 +147,7 @@ def run_sparse(args, drive, friction, threshold, ends):
     x, v, th, mov, xs = args.x, args.v, args.th, args.mov, args.xs
     trig, first_step, x0ev, ist, par = args.trig, args.first_step, args.x0ev, args.ist, args.par
     ev_int, fm, prof_x, n_end, profile_every = args.ev_int, args.fm, args.prof_x, args.n_end, args.profile_every
+    prof_meta = args.prof_meta
     N = x.shape[0] - 2
     mp, V, dt = _unpack(par)
     K, Kp, Fs = mp[0], mp[1], mp[5]
@@ -316,7 +317,7 @@ def run_sparse(args, drive, friction, threshold, ends):
                     first = min(first, np.int64(movers[k]))
                 active = True
                 n_chk = n + 1
-                _open_event(n, first, args)
+                _open_event(n, first, x, ist, prof_x, prof_meta, N, profile_every)
             for k in range(nmov, na):
                 i = movers[k]
                 if first_step[i] < 0:
