@@ -8,8 +8,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from stickslip.kernels.block import heun_block
+from stickslip.kernels.entry import specialise_call
 from stickslip.models.params import BlockParams
-from stickslip.run.block import BlockState, n_samples, simulate_block
+from stickslip.run.block import LAW_ARG, BlockState, n_samples, simulate_block
 
 
 def _buffers(n_steps, every, capacity=64):
@@ -23,8 +24,10 @@ def _buffers(n_steps, every, capacity=64):
 
 def _call(fn, p: BlockParams, s: BlockState, n_steps: int, every: int):
     bufs = _buffers(n_steps, every)
-    ret = fn(s.x, s.v, s.theta, s.stopped, n_steps, every,
-             p.K, p.V, p.beta, p.alpha, p.Fs, p.M, p.sigma, p.dt, *bufs)  # fmt: skip
+    law = p.friction_piece
+    args = (s.x, s.v, s.theta, s.stopped, n_steps, every,
+            p.K, p.V, law.module, law.kernel_params(p), p.Fs, p.M, p.sigma, p.dt, *bufs, False)  # fmt: skip
+    ret = specialise_call(fn, args, LAW_ARG) if fn is heun_block else fn(*args)
     return ret, bufs
 
 

@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 from stickslip.kernels import dense, exact, layout, stages
+from stickslip.models.friction import state as state_law
 from stickslip.models.params import ChainParams
 from stickslip.run.driver import run_chain
 
@@ -33,9 +34,7 @@ def _fresh_ir(kernel, args=None) -> str:
     else:
         # The model's pieces (trailing arguments) are compile-time literals in the engine.
         n_pieces = 3 if kernel.py_func.__name__ == "_stage1" else 2 if kernel.py_func.__name__ == "_stage2" else 1
-        sig = tuple(numba.typeof(a) for a in args[:-n_pieces]) + tuple(
-            numba.types.literal(int(c)) for c in args[-n_pieces:]
-        )
+        sig = tuple(numba.typeof(a) for a in args[:-n_pieces]) + tuple(numba.types.literal(c) for c in args[-n_pieces:])
         fresh.compile(sig)
     return fresh.inspect_llvm(fresh.signatures[0])
 
@@ -44,10 +43,10 @@ def _example_args(name: str) -> tuple:
     a = [np.linspace(0.5, 1.5, 12) for _ in range(10)]
     lo, hi = 1, 10
     dt, p = 0.005, 0.0
-    # The paper's model: K, Kp, beta, alpha, D, Fs, 1 - sigma, 2 alpha, F0, then the rate-and-state
-    # a, b, D_c, v0, mu0, sigma_n (unused by its law); pieces as literals.
-    mp = (10.0, 1.0, 1.0, 1.0, 5.0, 3.0, 0.99, 2.0, 1.0, 0.01, 0.015, 0.001, 0.001, 0.6, 5.0)
-    end, state, constant = layout.DRIVE_END, layout.FRICTION_STATE, layout.THRESHOLD_CONSTANT
+    # The paper's model: K, Kp, Fs and eq. (4)'s law (beta, alpha, D); pieces as literals (the law
+    # by its module's path).
+    mp = (10.0, 1.0, 3.0, state_law.Params(1.0, 1.0, 5.0))
+    end, state, constant = layout.DRIVE_END, state_law.__name__, layout.THRESHOLD_CONSTANT
     return {
         "_stage1": (*a, lo, hi, p, mp, dt, end, state, constant),
         "_stage2": (*a, lo, hi, p, mp, 0.5 * dt, end, state),

@@ -17,9 +17,16 @@ from stickslip.models.presets import PRESETS, chain_params
 #: The kernels' integer codes as the kernels read them (kernels/ compare against these numbers).
 KERNEL_CODES = {
     "drive": {"end": 0, "plate": 1},
-    "friction": {"state": 0, "weakening": 1, "strengthening": 2, "rate-state": 3},
     "threshold": {"constant": 0, "state": 1},
     "ends": {"free": 0, "fixed": 1, "periodic": 2},
+}
+
+#: A friction law reaches the kernels as the import path of its own module.
+LAW_MODULES = {
+    "state": "stickslip.models.friction.state",
+    "weakening": "stickslip.models.friction.weakening",
+    "strengthening": "stickslip.models.friction.strengthening",
+    "rate-state": "stickslip.models.friction.rate_state",
 }
 
 
@@ -31,6 +38,16 @@ def test_kernel_codes_unchanged(kind):
         assert pieces.code(kind, name) == code
 
 
+@pytest.mark.parametrize("name", list(LAW_MODULES))
+def test_friction_laws_are_their_modules(name):
+    law = pieces.piece("friction", name)
+    assert pieces.code("friction", name) == LAW_MODULES[name] == law.module
+    p = ChainParams(friction=name, **({"sigma": 0.01} if name == "weakening" else {}))
+    lp = law.kernel_params(p)
+    # the named tuple the compiled functions read: the law's parameters, by name, in its order
+    assert lp._fields == law.reads and all(getattr(lp, k) == getattr(p, k) for k in law.reads)
+
+
 def test_params_hand_out_their_pieces():
     p = ChainParams(drive="plate", friction="weakening", ends="periodic", sigma=0.01)
     assert (p.drive_piece.name, p.friction_piece.name, p.threshold_piece.name, p.ends_piece.name) == (
@@ -39,7 +56,7 @@ def test_params_hand_out_their_pieces():
         "constant",
         "periodic",
     )
-    assert p.codes == (1, 1, 0, 2)
+    assert p.codes == (1, LAW_MODULES["weakening"], 0, 2)
     assert BlockParams(threshold="state").threshold_piece.has_state
     assert not BlockParams().threshold_piece.has_state
 

@@ -18,12 +18,12 @@ import pytest
 
 from chain_helpers import assert_same_run, run_cli
 from stickslip.analysis import stability as st
-from stickslip.kernels.laws import _rate_state_mu
-from stickslip.kernels.layout import _unpack
+from stickslip.models.friction.rate_state import mu_lp
 from stickslip.models.params import ChainParams, ParameterError
 from stickslip.models.pieces import CompositionError, check_composition
-from stickslip.run.driver import ChainState, _par, run_chain
-from stickslip.run.located import LocatedStepper
+from stickslip.run.driver import ChainState, run_chain
+from stickslip.run.located import LocatedState, run_located
+from stickslip.run.located import rates as located_rates
 
 
 def _params(**kw) -> ChainParams:
@@ -52,9 +52,9 @@ def test_law_and_its_regularisation():
         assert _mu(p, v, theta) == pytest.approx(_mu_log(p, v, theta), rel=1e-14)
     assert _mu(p, 0.0, 1.0) == 0.0
     # the kernel's expression, on both sides of its switch to ln(2 z) at z = e^20
-    mp = _unpack(_par(p))[0]
+    lp = law.kernel_params(p)
     for v, theta in [(1e-30, 1.0), (3e-35, 0.5), (-1e-30, 2.0), (1e-3, 1.0), (-0.02, 0.3), (0.0, 1.0)]:
-        assert _rate_state_mu(v, theta, mp) == pytest.approx(_mu(p, v, theta), rel=1e-14, abs=1e-300)
+        assert mu_lp(v, theta, lp) == pytest.approx(_mu(p, v, theta), rel=1e-14, abs=1e-300)
     assert 0.0 < _mu(p, 1e-30, 1.0) < 0.5 * p.mu0  # regularised: far below mu0 near v = 0
     # steady sliding: theta_0 = D_c / V, friction sigma_n (mu0 + (a - b) ln(V / v0))
     q = p.replace(V=0.004)
@@ -125,10 +125,15 @@ def test_velocity_strengthening_is_stable_at_every_K():
     assert math.isnan(st.critical_stiffness(p))
 
 
-def _plain_step(x, v, th, moving, n, p):
+def _aging(p, v, th):
+    """The aging law dtheta/dt = 1 - v theta / D_c."""
+    return 1.0 - v * th / p.Dc
+
+
+def _plain_step(x, v, th, moving, n, p, g=_aging):
     """One Heun step of the end-driven chain with free end, constant threshold Fs and rate-state
     friction, written from the equations (docs/model.md's step; friction sigma_n mu(|v|, theta);
-    dtheta/dt = 1 - v theta / D_c on every block)."""
+    dtheta/dt = g(v, theta) on every block, by default the aging law)."""
     N, dt = len(x), p.dt
 
     def forces(X, t):
@@ -138,14 +143,14 @@ def _plain_step(x, v, th, moving, n, p):
     f1 = forces(x, n * dt)
     mid = [moving[i] or f1[i] > p.Fs for i in range(N)]
     a1 = [f1[i] - p.sigma_n * _mu(p, v[i], th[i]) if mid[i] else 0.0 for i in range(N)]
-    b1 = [1.0 - v[i] * th[i] / p.Dc for i in range(N)]
+    b1 = [g(p, v[i], th[i]) for i in range(N)]
     xs = [x[i] + dt * v[i] for i in range(N)]
     vs = [v[i] + dt * a1[i] for i in range(N)]
     ths = [th[i] + dt * b1[i] for i in range(N)]
     f2 = forces(xs, (n + 1) * dt)
     out = []
     for i in range(N):
-        b2 = 1.0 - vs[i] * ths[i] / p.Dc
+        b2 = g(p, vs[i], ths[i])
         thn = th[i] + dt / 2 * (b1[i] + b2)
         if not mid[i]:
             out.append((x[i], 0.0, thn, False))
@@ -229,8 +234,26 @@ def test_parameters_and_composition():
     # eq. (4)'s explicit-step check on D is its own law's, not this one's
     assert _params(D=1000.0).D == 1000.0
     assert "rs_a" not in ChainParams().to_dict() and "rs_a" in _params().to_dict()
-    with pytest.raises(ValueError, match="located"):
-        LocatedStepper(_params())
+
+
+def test_located_switches_run_the_law():
+    """The located integrator's right-hand side is the law's, checked against the plain formulas
+    above (friction sigma_n mu(|v|, theta); the aging law on stuck blocks too)."""
+    p = _params(N=3, K=10.0, V=0.01)
+    st_ = LocatedState.from_blocks([0.3, -0.2, 0.1], [0.004, 0.0, 0.011], [0.05, 0.2, 0.1], [False, True, False])
+    du, dv, dth = located_rates(st_, p)
+    u = st_.u
+    for i in range(1, 4):
+        ur = u[i + 1] if i < 3 else u[i]
+        ul = u[i - 1] if i > 1 else 0.0
+        f = p.K * ((ul - u[i]) - (u[i] - ur))
+        moving = st_.mov[i] != 0.0
+        assert dv[i] == pytest.approx(f - p.sigma_n * _mu(p, st_.v[i], st_.th[i]) if moving else 0.0, rel=1e-12)
+        assert dth[i] == pytest.approx(1.0 - st_.v[i] * st_.th[i] / p.Dc, rel=1e-12)
+        assert du[i] == st_.v[i] - p.V
+    # and it runs: the spring-slider below k_c stick-slips with located switches
+    run = run_located(_params(V=0.01), 300.0, start="paper")
+    assert len(run.events) >= 2 and (run.events["size"] > 0).all()
 
 
 def test_command_line(capsys):
@@ -239,5 +262,20 @@ def test_command_line(capsys):
     d = json.loads(out)
     assert d["params"]["N"] == 1 and d["critical_K"] == pytest.approx(75.0, rel=1e-9)
     assert d["finite_chain"]["unstable"]  # K = 10 < k_c
-    status, _, err = run_cli(capsys, "lyapunov", "--friction", "rate-state", "--N", "3", "--switches", "located")
-    assert status != 0 and "--switches located has no friction rate-state" in err
+    status, out, err = run_cli(
+        capsys,
+        "lyapunov",
+        "--friction",
+        "rate-state",
+        "--N",
+        "1",
+        "--V",
+        "0.01",
+        "--switches",
+        "located",
+        "--t-end",
+        "200",
+        "--json",
+    )
+    assert status == 0, err
+    assert math.isfinite(json.loads(out)["lyapunov_dt0"])

@@ -40,9 +40,8 @@ from typing import Any
 import numpy as np
 
 from stickslip.analysis.lyapunov import _check_run, _estimate
-from stickslip.kernels import located as L
 from stickslip.models.params import ChainParams, ParameterError, check_number, steps_for
-from stickslip.run.located import LocatedState, LocatedStepper, parameter_vector, start_state
+from stickslip.run.located import LocatedState, LocatedStepper, rates, start_state
 from stickslip.run.state import ChainState
 
 NORM = "Euclidean norm of (sqrt(K) e_i, v_i, theta_i), e_i = u_{i-1} - u_i, u = x - V t, u_0 = 0"
@@ -124,11 +123,7 @@ def separation(ref: LocatedState, twin: LocatedState, params: ChainParams) -> np
 def flow_direction(state: LocatedState, params: ChainParams) -> np.ndarray:
     """F(y) = dy/dt at ``state`` in y coordinates: the direction of a shift in time."""
     N = state.N
-    du, dv, dth = np.zeros(N + 2), np.zeros(N + 2), np.zeros(N + 2)
-    drive, friction, _, ends = params.codes
-    t = state.step * params.dt
-    par = parameter_vector(params)
-    L.rates(state.u.copy(), state.v, state.th.copy(), state.mov, t, par, drive, friction, ends, du, dv, dth)
+    du, dv, dth = rates(state, params)
     fth = dth[1:-1] if params.friction_piece.has_state else np.zeros(N)
     if params.drive_piece.leaf_spring:
         return np.concatenate((math.sqrt(params.Kp) * du[1:-1], dv[1:-1], fth))

@@ -218,10 +218,6 @@ def run_lyapunov_command(args: argparse.Namespace) -> Result:
     if args.lifetimes is not None:
         return _lifetimes(params, args)
     if args.switches == "located":
-        if not params.friction_piece.located:
-            raise CommandError(
-                f"--switches located has no friction {params.friction} (kernels/located.py): use --switches grid"
-            )
         return _located(params, args, kw)
     for flag, given in (
         ("--finite-size", args.finite_size),

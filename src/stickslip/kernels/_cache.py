@@ -2,8 +2,9 @@
 
 numba stamps a cached function with its own source file only, so a kernel that inlines or
 calls functions of another module is loaded stale after that module changes (a documented
-numba limitation). The kernels of the chain span several modules, so every kernel is cached in
-a directory named after a digest of all of them, given to numba through its documented cache
+numba limitation). The kernels of the chain span several modules (and inline the friction laws
+of :mod:`stickslip.models.friction`), so every kernel is cached in a directory named after a
+digest of all of them and of the model modules, given to numba through its documented cache
 setting (``NUMBA_CACHE_DIR``, :data:`numba.config.CACHE_DIR`), set when this package is imported:
 an edit to any kernel module leads to a new directory, and every kernel is compiled afresh. A
 user's ``NUMBA_CACHE_DIR`` is kept as the place of these directories. (Other numba functions with
@@ -46,7 +47,9 @@ def modules_digest(paths) -> str:
     return h.hexdigest()
 
 
-DIGEST = modules_digest(_DIR.glob("*.py"))
+#: The kernels inline the friction laws' compiled functions from their own modules
+#: (:mod:`stickslip.models.friction`), so those modules are part of the digest too.
+DIGEST = modules_digest([*_DIR.glob("*.py"), *(_DIR.parent / "models").rglob("*.py")])
 
 
 def _writable(path: Path) -> bool:

@@ -1,14 +1,18 @@
 """Compiled time stepping of the single block and spring, eq. (1).
 
-One kernel, :func:`heun_block`, over plain floats and preallocated arrays: no globals, no I/O,
-no Python objects. Its ``py_func`` is the plain-Python reference the tests hold it to, bit for
-bit, so the step is written out in full here (a helper function would be compiled code even
-when called from ``py_func``).
+One kernel, :func:`heun_block`, over plain floats and preallocated arrays: no I/O, no Python
+objects. Its friction and state law are eq. (4)'s, the functions every integrator of the chain
+calls (:mod:`stickslip.models.friction.state` through :mod:`stickslip.kernels.laws`; the kernel
+is compiled for the law's module path, a literal): eq. (1)'s sigma theta + beta v is that law's
+theta + beta v read at the state term sigma theta, and its theta' is the law's rate with no
+neighbours (D = 0). The tests hold it to a plain-Python step of eq. (1) and to its ``py_func``.
 """
 
 from __future__ import annotations
 
 import numba
+
+from stickslip.kernels.laws import law_accel, law_rate
 
 
 @numba.njit(cache=True)
@@ -21,8 +25,8 @@ def heun_block(
     every,
     K,
     V,
-    beta,
-    alpha,
+    law,
+    lp,
     Fs,
     M,
     sigma,
@@ -41,7 +45,8 @@ def heun_block(
     """Advance eq. (1) by ``n_steps`` Heun steps with the start and stop rules of docs/model.md.
 
     State (x, v, theta, stopped); spring force f = K (V t - x) with t_n = n dt taken from the
-    integer step count.
+    integer step count. ``law`` is the friction law's module path and ``lp`` its parameters
+    (beta, alpha and D = 0 of eq. (4)'s law).
 
     - moving:  x' = v,  M v' = f - sigma theta - beta v,  theta' = theta (1 - theta) - alpha theta v
     - stopped: x fixed, v = 0, theta' = theta (1 - theta)
@@ -98,13 +103,13 @@ def heun_block(
                 current = n
                 x_start = x
         if moving:
-            a1 = (K * (V * t0 - x) - sigma * theta - beta * v) / M
-            g1 = theta * (1.0 - theta) - alpha * theta * v
+            a1 = law_accel(law, K * (V * t0 - x), v, sigma * theta, lp) / M
+            g1 = law_rate(law, theta, theta, theta, v, lp)
             xp = x + dt * v
             vp = v + dt * a1
             thp = theta + dt * g1
-            a2 = (K * (V * t1 - xp) - sigma * thp - beta * vp) / M
-            g2 = thp * (1.0 - thp) - alpha * thp * vp
+            a2 = law_accel(law, K * (V * t1 - xp), vp, sigma * thp, lp) / M
+            g2 = law_rate(law, thp, thp, thp, vp, lp)
             x = x + half * (v + vp)
             v = v + half * (a1 + a2)
             theta = theta + half * (g1 + g2)
@@ -121,9 +126,9 @@ def heun_block(
                     n_slips += 1
                     current = -1
         else:
-            g1 = theta * (1.0 - theta)
+            g1 = law_rate(law, theta, theta, theta, 0.0, lp)
             thp = theta + dt * g1
-            g2 = thp * (1.0 - thp)
+            g2 = law_rate(law, thp, thp, thp, 0.0, lp)
             theta = theta + half * (g1 + g2)
 
         if v < v_min:

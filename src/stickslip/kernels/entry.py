@@ -11,21 +11,37 @@ from __future__ import annotations
 def specialise(kernel, args, pieces):
     """The compiled entry point of a chain kernel for one model's pieces.
 
-    ``args`` is an example of the kernel's :class:`~stickslip.kernels.layout.ChainArgs` (arrays
-    and integers) and ``pieces`` the codes (drive, friction, threshold, ends). Each composition
-    is compiled once, with the pieces as literal constants (so branches on them vanish before
-    typing), and cached on disk; calling the returned entry point skips the dispatcher's
-    type matching.
+    ``args`` is an example of the kernel's :class:`~stickslip.kernels.layout.ChainArgs` (arrays,
+    integers and the law's parameters) and ``pieces`` what the kernel is compiled for (drive,
+    friction, threshold, ends: the friction law's module path, the other pieces' integer codes).
+    Each composition is compiled once, with the pieces as literal constants (the law's functions
+    are resolved from its module, branches on the other pieces vanish before typing), and cached
+    on disk; calling the returned entry point skips the dispatcher's type matching.
     """
     from numba import typeof, types
 
-    sig = (typeof(args),) + tuple(types.literal(int(c)) for c in pieces)
+    sig = (typeof(args),) + tuple(types.literal(c) for c in pieces)
     key = (kernel.py_func.__name__, sig)
     entry = _ENTRIES.get(key)
     if entry is None:
         entry = kernel.compile(sig)
         _ENTRIES[key] = entry
     return entry
+
+
+def specialise_call(kernel, args, literal):
+    """``kernel`` compiled for the types of ``args``, the positions in ``literal`` (the pieces) as
+    literal constants, and called with ``args``: the located integrator's entry
+    (:mod:`stickslip.kernels.located`), whose pieces sit among its arrays."""
+    from numba import typeof, types
+
+    sig = tuple(types.literal(a) if i in literal else typeof(a) for i, a in enumerate(args))
+    key = (kernel.py_func.__name__, sig)
+    entry = _ENTRIES.get(key)
+    if entry is None:
+        entry = kernel.compile(sig)
+        _ENTRIES[key] = entry
+    return entry(*args)
 
 
 _ENTRIES: dict = {}

@@ -37,7 +37,7 @@ from __future__ import annotations
 from numba import njit
 
 from stickslip.kernels.events import _end_event, _overflow, _service, _start_and_first_moves
-from stickslip.kernels.laws import _force, _pull, _right_of_first, _set_ghosts, _threshold
+from stickslip.kernels.laws import _force, _pull, _right_of_first, _set_ghosts, _threshold, law_has_state
 from stickslip.kernels.layout import (
     _NEVER,
     ACT_HI,
@@ -50,8 +50,6 @@ from stickslip.kernels.layout import (
     EV_ACTIVE,
     EV_COUNT,
     FM_COUNT,
-    FRICTION_STRENGTHENING,
-    FRICTION_WEAKENING,
     FULL_UPDATES,
     MECH_HI,
     MECH_LO,
@@ -100,8 +98,8 @@ def run_exact(args, drive, friction, threshold, ends):
     prof_x, n_end, profile_every = args.prof_x, args.n_end, args.profile_every
     first_step, x0ev, prof_meta = args.first_step, args.x0ev, args.prof_meta
     N = x.shape[0] - 2
-    mp, V, dt = _unpack(par)
-    K, Kp, Fs = mp[0], mp[1], mp[5]
+    mp, V, dt = _unpack(par, args.law)
+    K, Kp, Fs = mp[0], mp[1], mp[2]
     h2 = 0.5 * dt
     cap_ev, cap_fm, cap_p = ev_int.shape[0], fm.shape[0], prof_x.shape[0]
     # A run of blocks moving at t_n (empty if ra > rb): updated without the start rule and the
@@ -254,7 +252,7 @@ def run_exact(args, drive, friction, threshold, ends):
                     _stage1_theta(x, v, th, xs, vs, ths, mm, b1, l1, fl - 1, mp, dt, friction)
                 if fh < h1:
                     _stage1_theta(x, v, th, xs, vs, ths, mm, b1, fh + 1, h1, mp, dt, friction)
-            elif friction != FRICTION_WEAKENING and friction != FRICTION_STRENGTHENING:
+            elif law_has_state(friction):
                 _stage1_theta_only(v, th, ths, b1, l1, h1, mp, dt, friction)
             p2 = _pull(V, n + 1, dt)
             _set_ghosts(xs, ths, N, p2, drive, ends)
@@ -302,14 +300,14 @@ def run_exact(args, drive, friction, threshold, ends):
                         x, v, th, mov, xs, vs, ths, mm, a1, b1, sl, sh, p2, mp, h2, drive, friction
                     )
                 ist[FULL_UPDATES] += sh - sl + 1
-                if friction != FRICTION_WEAKENING and friction != FRICTION_STRENGTHENING:
+                if law_has_state(friction):
                     if lo < sl:
                         t_lo, t_hi = _stage2_theta(th, ths, v, b1, lo, sl - 1, mp, h2, friction)
                         c_lo, c_hi = _merge(c_lo, c_hi, t_lo, t_hi)
                     if sh < hi:
                         t_lo, t_hi = _stage2_theta(th, ths, v, b1, sh + 1, hi, mp, h2, friction)
                         c_lo, c_hi = _merge(c_lo, c_hi, t_lo, t_hi)
-            elif friction != FRICTION_WEAKENING and friction != FRICTION_STRENGTHENING:
+            elif law_has_state(friction):
                 c_lo, c_hi = _stage2_theta(th, ths, v, b1, lo, hi, mp, h2, friction)
             # Next step's movers: a stopped block starts only if its force or threshold changed;
             # through the springs that takes a neighbour's move, and only moving blocks change x.

@@ -14,28 +14,101 @@ One Heun step from t_n = n dt to t_{n+1} (docs/model.md):
 4. stop rule: a moving block whose new v <= 0 gets v = 0 and stops.
 
 Every integrator (:mod:`~stickslip.kernels.dense`, :mod:`~stickslip.kernels.exact`,
-:mod:`~stickslip.kernels.plate`) evaluates each quantity through these functions, inlined, so
-they agree bit for bit. Pieces and layout: :mod:`stickslip.kernels.layout`.
+:mod:`~stickslip.kernels.plate`, :mod:`~stickslip.kernels.located`) evaluates each quantity
+through these functions, inlined, so they agree bit for bit. Pieces and layout:
+:mod:`stickslip.kernels.layout`.
+
+A friction law is its own module (:mod:`stickslip.models.friction`), and a kernel is compiled for
+one law: it receives the import path of the law's module as a literal string (``friction``) and
+the law's parameters as the module's ``Params`` named tuple (``lp``). :func:`law_accel`,
+:func:`law_rate` and :func:`law_has_state` resolve, when the kernel is compiled, to the module's
+compiled functions (numba's :func:`~numba.extending.overload` on the literal), inlined there:
+
+* ``accel(f, v, th, lp)``: the force f on a moving block less the law's friction, in the law's
+  own order of operations (it fixes the bits);
+* ``rate(thl, th, thr, v, lp)``: dtheta/dt of the block between thl and thr, moving or stopped
+  (0.0 for a law without a state variable);
+* ``PIECE.has_state``: whether the law has a state variable (otherwise the kernels skip theta).
+
+So a new law needs no edit here or in any integrator.
 """
 
 from __future__ import annotations
 
-import math
+import importlib
 
 import numpy as np
-from numba import njit
+from numba import njit, types
+from numba.extending import overload
 
 from stickslip.kernels.layout import (
     DRIVE_END,
     DRIVE_PLATE,
     ENDS_FIXED,
     ENDS_PERIODIC,
-    FRICTION_RATE_STATE,
-    FRICTION_STATE,
-    FRICTION_STRENGTHENING,
-    FRICTION_WEAKENING,
     THRESHOLD_STATE,
 )
+
+
+def _law(friction):
+    """The module of a friction law, from the literal a kernel is compiled for (None otherwise)."""
+    if isinstance(friction, types.StringLiteral):
+        return importlib.import_module(friction.literal_value)
+    if isinstance(friction, str):
+        return importlib.import_module(friction)
+    return None
+
+
+def law_accel(friction, f, v, th, lp):
+    """The force f on a moving block less the friction of the law ``friction`` (its module's
+    ``accel``)."""
+    return _law(friction).accel(f, v, th, lp)
+
+
+def law_rate(friction, thl, th, thr, v, lp):
+    """dtheta/dt of the law ``friction`` (its module's ``rate``)."""
+    return _law(friction).rate(thl, th, thr, v, lp)
+
+
+def law_has_state(friction):
+    """Whether the law ``friction`` has a state variable (its ``PIECE.has_state``)."""
+    return _law(friction).PIECE.has_state
+
+
+@overload(law_accel, inline="always", prefer_literal=True)
+def _law_accel(friction, f, v, th, lp):
+    law = _law(friction)
+    if law is None:
+        return None
+    fn = law.accel
+
+    def impl(friction, f, v, th, lp):
+        return fn(f, v, th, lp)
+
+    return impl
+
+
+@overload(law_rate, inline="always", prefer_literal=True)
+def _law_rate(friction, thl, th, thr, v, lp):
+    law = _law(friction)
+    if law is None:
+        return None
+    fn = law.rate
+
+    def impl(friction, thl, th, thr, v, lp):
+        return fn(thl, th, thr, v, lp)
+
+    return impl
+
+
+@overload(law_has_state, inline="always", prefer_literal=True)
+def _law_has_state(friction):
+    law = _law(friction)
+    if law is None:
+        return None
+    if law.PIECE.has_state:
+        return lambda friction: True
+    return lambda friction: False
 
 
 @njit(cache=True, inline="always")
@@ -47,56 +120,18 @@ def _force(xl, xc, xr, K, Kp, p, drive):
     return K * ((xl - xc) - (xc - xr))
 
 
-_LN2 = math.log(2.0)
-
-
-@njit(cache=True, inline="always")
-def _rate_state_mu(v, th, mp):
-    """mu = a asinh(abs(v) / (2 v0) exp((mu0 + b ln(v0 theta / D_c)) / a)) of rate-and-state friction,
-    regularised at v = 0 (Rice & Ben-Zion 1996; models/friction/rate_state.py).
-
-    Read at abs(v): a moving block has v > 0, and where Heun's predictor dips below 0 within a step
-    the friction keeps braking, so the stop rule catches a block that stops in the step (the odd
-    extension would push it on into a spurious two-step cycle). Through log z: for z > e^20,
-    asinh(z) = ln(2 z) to round-off, and exp cannot overflow.
-    """
-    s = 0.5 * abs(v) / mp[12]
-    if s == 0.0:
-        return 0.0
-    lz = math.log(s) + (mp[13] + mp[10] * math.log(mp[12] * th / mp[11])) / mp[9]
-    if lz > 20.0:
-        return mp[9] * (lz + _LN2)
-    return mp[9] * math.asinh(math.exp(lz))
-
-
 @njit(cache=True, inline="always")
 def _accel(f, th, v, m, mp, friction):
-    """dv/dt of a block times the moving mask m (1.0 moving, 0.0 stopped).
-
-    state (eq. 4): f - theta - beta v; weakening (Carlson-Langer): f - phi(v) with
-    phi(v) = (1 - sigma) / (1 + 2 alpha max(v, 0) / (1 - sigma)); strengthening (train
-    model): f - F0 - beta v; rate-state: f - sigma_n mu(v, theta) (:func:`_rate_state_mu`).
-    ``mp`` = (K, Kp, beta, alpha, D, Fs, 1 - sigma, 2 alpha, F0, a, b, D_c, v0, mu0, sigma_n).
-    """
-    if friction == FRICTION_RATE_STATE:
-        return m * (f - mp[14] * _rate_state_mu(v, th, mp))
-    if friction == FRICTION_WEAKENING:
-        w = mp[6]
-        return m * (f - w / (1.0 + mp[7] * max(v, 0.0) / w))
-    if friction == FRICTION_STRENGTHENING:
-        return m * (f - mp[8] - mp[2] * v)
-    return m * (f - th - mp[2] * v)
+    """dv/dt of a block times the moving mask m (1.0 moving, 0.0 stopped): m (f - friction) with
+    the law's own ``accel``; ``mp`` = (K, Kp, Fs, the law's parameters)."""
+    return m * law_accel(friction, f, v, th, mp[3])
 
 
 @njit(cache=True, inline="always")
 def _dtheta(thl, th, thr, v, mp, friction):
-    """dtheta/dt of eq. (4) with diffusion D, for moving and stopped blocks alike; the aging law
-    1 - v theta / D_c of rate-state friction; 0 for frictions without a state variable."""
-    if friction == FRICTION_RATE_STATE:
-        return 1.0 - v * th / mp[11]
-    if friction == FRICTION_STATE:
-        return th * (1.0 - th) - mp[3] * th * v + mp[4] * ((thl - th) - (th - thr))
-    return 0.0
+    """dtheta/dt of the law (its ``rate``), for moving and stopped blocks alike; 0 for laws
+    without a state variable."""
+    return law_rate(friction, thl, th, thr, v, mp[3])
 
 
 @njit(cache=True, inline="always")

@@ -9,12 +9,10 @@ compiled into its own machine code with the branches on pieces removed:
 * drive ``DRIVE_END``: a pulling point x_0 = V t joined to block 1 (eq. 4);
   ``DRIVE_PLATE``: every block joined to a plate at V t by a leaf spring Kp (Burridge-Knopoff,
   Carlson-Langer): f_i gains Kp (V t - x_i);
-* friction of a moving block ``FRICTION_STATE``: theta_i + beta v_i with the theta equation
-  of eq. (4); ``FRICTION_WEAKENING``: phi(v) = (1 - sigma) / (1 + 2 alpha max(v, 0) / (1 - sigma))
-  (Carlson-Langer); ``FRICTION_STRENGTHENING``: F0 + beta v (train model), no state variable;
-  ``FRICTION_RATE_STATE``: sigma_n mu(v, theta), Dieterich-Ruina with the aging law, regularised
-  at v = 0 (:mod:`stickslip.models.friction.rate_state`); every law but weakening and
-  strengthening has a state variable that changes on stopped blocks too;
+* friction of a moving block: a law of :mod:`stickslip.models.friction`, one module each, whose
+  compiled functions the kernels call (:mod:`stickslip.kernels.laws`); the kernel gets the
+  module's import path as a literal string and the law's parameters as its ``Params`` named
+  tuple (``ChainArgs.law``);
 * static threshold ``THRESHOLD_CONSTANT``: Fs; ``THRESHOLD_STATE``: theta_i;
 * ends ``ENDS_FREE``: x_{N+1} = x_N (plate drive: also x_0 = x_1); ``ENDS_FIXED``: x_{N+1} = 0
   (plate drive: also x_0 = 0); ``ENDS_PERIODIC``: x_0 = x_N, x_{N+1} = x_1 (plate drive only).
@@ -26,7 +24,8 @@ th[N+1] = th[1]); models without a state variable leave theta untouched. ``mov``
 for a moving block and 0.0 for a stopped one, so a stopped block's acceleration is
 ``0 * (...)``.
 
-A kernel takes one :class:`ChainArgs` (the arrays and integers) and the four pieces' codes.
+A kernel takes one :class:`ChainArgs` (the arrays, integers and the law's parameters) and the
+four pieces (the law's module path, the other pieces' codes).
 Kernels return a status code; the driver empties the output buffers and calls again. All
 state lives in the arrays passed in, so a run can stop and resume at any step boundary.
 
@@ -72,15 +71,13 @@ MECH_HI = 21
 FULL_UPDATES = 22  # block updates of exact that were full (the rest updated the state variable alone)
 IST_SIZE = 23
 
-# Indices into the float64 parameter vector ``par``.
-P_K, P_D, P_V, P_BETA, P_ALPHA, P_FS, P_DT, P_KP, P_SIGMA, P_F0 = range(10)
-# Rate-and-state friction (models/friction/rate_state.py): a, b, D_c, v0, mu0, sigma_n.
-P_RS_A, P_RS_B, P_DC, P_V0, P_MU0, P_SIGMA_N = range(10, 16)
-PAR_SIZE = 16
+# Indices into the float64 parameter vector ``par``: the springs, drive and threshold (the friction
+# law's parameters travel as its own named tuple, ``ChainArgs.law``).
+P_K, P_V, P_DT, P_KP, P_FS = range(5)
+PAR_SIZE = 5
 
-# The pieces of a model (compile-time constants of every kernel).
+# The pieces of a model other than the friction law (compile-time constants of every kernel).
 DRIVE_END, DRIVE_PLATE = 0, 1
-FRICTION_STATE, FRICTION_WEAKENING, FRICTION_STRENGTHENING, FRICTION_RATE_STATE = 0, 1, 2, 3
 THRESHOLD_CONSTANT, THRESHOLD_STATE = 0, 1
 ENDS_FREE, ENDS_FIXED, ENDS_PERIODIC = 0, 1, 2
 
@@ -117,6 +114,7 @@ class ChainArgs(NamedTuple):
     x0ev: np.ndarray  # x of each block at its first move
     ist: np.ndarray  # int64 state vector (indices above)
     par: np.ndarray  # float64 parameter vector (indices above)
+    law: tuple  # the friction law's parameters (its module's Params named tuple)
     ev_int: np.ndarray  # event buffer (columns above) and each event's S
     ev_S: np.ndarray
     fm: np.ndarray  # first moves: (event, block, step)
@@ -147,24 +145,7 @@ def _merge(a_lo, a_hi, b_lo, b_hi):
 
 
 @njit(cache=True, inline="always")
-def _unpack(par):
-    """(K, Kp, beta, alpha, D, Fs, 1 - sigma, 2 alpha, F0, a, b, D_c, v0, mu0, sigma_n), V and dt
-    from the parameter vector (a .. sigma_n: rate-and-state friction)."""
-    mp = (
-        par[P_K],
-        par[P_KP],
-        par[P_BETA],
-        par[P_ALPHA],
-        par[P_D],
-        par[P_FS],
-        1.0 - par[P_SIGMA],
-        2.0 * par[P_ALPHA],
-        par[P_F0],
-        par[P_RS_A],
-        par[P_RS_B],
-        par[P_DC],
-        par[P_V0],
-        par[P_MU0],
-        par[P_SIGMA_N],
-    )
-    return mp, par[P_V], par[P_DT]
+def _unpack(par, law):
+    """mp = (K, Kp, Fs, the law's parameters), V and dt from the parameter vector and the law's
+    named tuple."""
+    return (par[P_K], par[P_KP], par[P_FS], law), par[P_V], par[P_DT]

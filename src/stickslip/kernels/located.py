@@ -22,10 +22,12 @@ t_n = n dt. Positions are held relative to the drive, u_i = x_i - V t: the frame
 equations are autonomous (except for fixed ends), and in which a stuck block's coordinate stays
 of order one however long the run, so no precision is lost as V t grows.
 
-Pieces (codes are the positions in ``stickslip.models.pieces.PIECES``): drive end (u_0 = 0) or
-plate (f_i gains -Kp u_i); friction state (theta_i + beta v_i with eq. (4)'s theta law),
-weakening (Carlson-Langer's phi(v)) or strengthening (F0 + beta v); threshold constant (Fs) or
-state (theta_i); ends free, fixed (x = 0, so u = -V t) or periodic.
+Pieces as the other integrators take them (:mod:`stickslip.kernels.layout`): drive end (u_0 = 0)
+or plate (f_i gains Kp (0 - u_i), the plate at u = 0); any friction law, through its module's
+compiled functions (:mod:`stickslip.kernels.laws`: the force less the friction, the state
+variable's rate, on stuck blocks too); threshold constant (Fs) or state (theta_i); ends free,
+fixed (x = 0, so u = -V t) or periodic. The spring force, the threshold and the law are the
+functions the engine evaluates; only the ghost cells are set here, in the frame of the drive.
 
 The integer vector ``ist``: [step, events recorded, blocks moving, event active, starts, stops,
 event's first block, blocks moved in the event]; the float vector ``evf``: [event start time,
@@ -39,14 +41,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-DRIVE_END, DRIVE_PLATE = 0, 1
-FRICTION_STATE, FRICTION_WEAKENING, FRICTION_STRENGTHENING = 0, 1, 2
-THRESHOLD_CONSTANT, THRESHOLD_STATE = 0, 1
-ENDS_FREE, ENDS_FIXED, ENDS_PERIODIC = 0, 1, 2
-
-# Parameter vector.
-P_K, P_D, P_V, P_BETA, P_ALPHA, P_FS, P_DT, P_KP, P_SIGMA, P_F0 = range(10)
-PAR_SIZE = 10
+from stickslip.kernels.laws import _force as _spring_force
+from stickslip.kernels.laws import _threshold, law_accel, law_rate
+from stickslip.kernels.layout import DRIVE_END, ENDS_FIXED, ENDS_PERIODIC, P_DT, P_FS, P_K, P_KP, P_V
 
 # Integer state vector.
 I_STEP, I_EVENTS, I_MOVING, I_ACTIVE, I_STARTS, I_STOPS, I_FIRST, I_NMOVED = range(8)
@@ -81,51 +78,34 @@ def _ghosts(u, th, N, t, V, drive, ends):
 
 @njit(cache=True, inline="always")
 def _force(u, i, par, drive):
-    """Spring force on block i (eq. 4), plus -Kp u_i from the plate with the plate drive."""
-    f = par[P_K] * ((u[i - 1] - u[i]) - (u[i] - u[i + 1]))
-    if drive == DRIVE_PLATE:
-        f -= par[P_KP] * u[i]
-    return f
-
-
-@njit(cache=True, inline="always")
-def _friction(v, th, par, friction):
-    """Friction of a moving block: theta + beta v, phi(v) (CL) or F0 + beta v."""
-    if friction == FRICTION_WEAKENING:
-        w = 1.0 - par[P_SIGMA]
-        return w / (1.0 + 2.0 * par[P_ALPHA] * max(v, 0.0) / w)
-    if friction == FRICTION_STRENGTHENING:
-        return par[P_F0] + par[P_BETA] * v
-    return th + par[P_BETA] * v
+    """Spring force on block i (eq. 4), plus Kp (0 - u_i) from the plate (at u = 0 in this frame)
+    with the plate drive: the engine's expression."""
+    return _spring_force(u[i - 1], u[i], u[i + 1], par[P_K], par[P_KP], 0.0, drive)
 
 
 @njit(cache=True, inline="always")
 def _gap(u, th, i, par, drive, threshold):
     """g_i = f_i - threshold_i: a stuck block starts where it turns positive."""
-    thr = th[i] if threshold == THRESHOLD_STATE else par[P_FS]
-    return _force(u, i, par, drive) - thr
+    return _force(u, i, par, drive) - _threshold(th[i], par[P_FS], threshold)
 
 
 @njit(cache=True, inline="always")
-def _rates(u, v, th, mov, N, t, par, drive, friction, ends, du, dv, dth):
-    """Right-hand side at time t: du = v - V, dv = (f - friction) while moving, dtheta of eq. (4)."""
+def _rates(u, v, th, mov, N, t, par, lp, drive, friction, ends, du, dv, dth):
+    """Right-hand side at time t: du = v - V, dv = the law's f - friction while moving, dtheta of
+    the law on every block."""
     V = par[P_V]
     _ghosts(u, th, N, t, V, drive, ends)
     for i in range(1, N + 1):
         du[i] = v[i] - V
         if mov[i] != 0.0:
-            dv[i] = _force(u, i, par, drive) - _friction(v[i], th[i], par, friction)
+            dv[i] = law_accel(friction, _force(u, i, par, drive), v[i], th[i], lp)
         else:
             dv[i] = 0.0
-        if friction == FRICTION_STATE:
-            diffusion = par[P_D] * ((th[i - 1] - th[i]) - (th[i] - th[i + 1]))
-            dth[i] = th[i] * (1.0 - th[i]) - par[P_ALPHA] * th[i] * v[i] + diffusion
-        else:
-            dth[i] = 0.0
+        dth[i] = law_rate(friction, th[i - 1], th[i], th[i + 1], v[i], lp)
 
 
 @njit(cache=True, inline="always")
-def _heun(h, t, u, v, th, mov, N, par, drive, friction, ends, sc):
+def _heun(h, t, u, v, th, mov, N, par, lp, drive, friction, ends, sc):
     """One Heun step of length h from (u, v, theta) at t; sc holds the rates k1 at t (given), the
     predictor p*, the rates k2 and the result o*."""
     k1u, k1v, k1th, pu, pv, pth, k2u, k2v, k2th, ou, ov, oth = sc
@@ -133,7 +113,7 @@ def _heun(h, t, u, v, th, mov, N, par, drive, friction, ends, sc):
         pu[i] = u[i] + h * k1u[i]
         pv[i] = v[i] + h * k1v[i]
         pth[i] = th[i] + h * k1th[i]
-    _rates(pu, pv, pth, mov, N, t + h, par, drive, friction, ends, k2u, k2v, k2th)
+    _rates(pu, pv, pth, mov, N, t + h, par, lp, drive, friction, ends, k2u, k2v, k2th)
     for i in range(1, N + 1):
         ou[i] = u[i] + 0.5 * h * (k1u[i] + k2u[i])
         ov[i] = v[i] + 0.5 * h * (k1v[i] + k2v[i])
@@ -196,7 +176,7 @@ def _switched(i, stop, ou, ov, oth, par, drive, threshold):
 
 
 @njit(cache=True)
-def _locate(i, stop, h, t, u, v, th, mov, N, par, drive, friction, threshold, ends, sc):
+def _locate(i, stop, h, t, u, v, th, mov, N, par, lp, drive, friction, threshold, ends, sc):
     """The switch time of block i in (0, h]: the smallest float b found with the switch done at b.
 
     Illinois (modified regula falsi) on the bracket [a, b], a bisection whenever a step fails to
@@ -210,7 +190,7 @@ def _locate(i, stop, h, t, u, v, th, mov, N, par, drive, friction, threshold, en
         fa = -_gap(u, th, i, par, drive, threshold)
     a = 0.0
     b = h
-    _heun(h, t, u, v, th, mov, N, par, drive, friction, ends, sc)
+    _heun(h, t, u, v, th, mov, N, par, lp, drive, friction, ends, sc)
     fb, _ = _switched(i, stop, ou, ov, oth, par, drive, threshold)
     side = 0
     width = b - a
@@ -226,7 +206,7 @@ def _locate(i, stop, h, t, u, v, th, mov, N, par, drive, friction, threshold, en
                 c = mid
         if it % 2 == 1:
             width = b - a
-        _heun(c, t, u, v, th, mov, N, par, drive, friction, ends, sc)
+        _heun(c, t, u, v, th, mov, N, par, lp, drive, friction, ends, sc)
         fc, sw = _switched(i, stop, ou, ov, oth, par, drive, threshold)
         if sw:
             b, fb = c, fc
@@ -242,7 +222,7 @@ def _locate(i, stop, h, t, u, v, th, mov, N, par, drive, friction, threshold, en
 
 
 @njit(cache=True)
-def advance(u, v, th, mov, n_end, par, drive, friction, threshold, ends, sc, cand, moved, ist, evf, ev_t, ev_i):
+def advance(u, v, th, mov, n_end, par, lp, drive, friction, threshold, ends, sc, cand, moved, ist, evf, ev_t, ev_i):
     """Advance the state (u, v, theta, moving mask) at step ist[I_STEP] to step n_end.
 
     Returns DONE, EVENTS_FULL (the event buffer has fewer than 4 free rows; the state is at the
@@ -267,8 +247,8 @@ def advance(u, v, th, mov, n_end, par, drive, friction, threshold, ends, sc, can
                 elif v[i] < 0.0:
                     _stop(i, u, v, mov, t, par, ist, evf, N, ev_t, ev_i)
             h = dt - s
-            _rates(u, v, th, mov, N, t, par, drive, friction, ends, k1u, k1v, k1th)
-            _heun(h, t, u, v, th, mov, N, par, drive, friction, ends, sc)
+            _rates(u, v, th, mov, N, t, par, lp, drive, friction, ends, k1u, k1v, k1th)
+            _heun(h, t, u, v, th, mov, N, par, lp, drive, friction, ends, sc)
             n_cand = 0
             for i in range(1, N + 1):
                 if mov[i] == 0.0:
@@ -295,10 +275,10 @@ def advance(u, v, th, mov, n_end, par, drive, friction, threshold, ends, sc, can
             for k in range(n_cand):
                 i = abs(cand[k])
                 is_stop = cand[k] < 0
-                b = _locate(i, is_stop, h, t, u, v, th, mov, N, par, drive, friction, threshold, ends, sc)
+                b = _locate(i, is_stop, h, t, u, v, th, mov, N, par, lp, drive, friction, threshold, ends, sc)
                 if blk == 0 or b < tau:
                     tau, blk, stop = b, i, is_stop
-            _heun(tau, t, u, v, th, mov, N, par, drive, friction, ends, sc)
+            _heun(tau, t, u, v, th, mov, N, par, lp, drive, friction, ends, sc)
             for i in range(1, N + 1):
                 u[i] = ou[i]
                 th[i] = oth[i]
@@ -320,6 +300,6 @@ def advance(u, v, th, mov, n_end, par, drive, friction, threshold, ends, sc, can
 
 
 @njit(cache=True)
-def rates(u, v, th, mov, t, par, drive, friction, ends, du, dv, dth):
+def rates(u, v, th, mov, t, par, lp, drive, friction, ends, du, dv, dth):
     """The right-hand side of the equations at time t (ghost cells of u and th are overwritten)."""
-    _rates(u, v, th, mov, u.shape[0] - 2, t, par, drive, friction, ends, du, dv, dth)
+    _rates(u, v, th, mov, u.shape[0] - 2, t, par, lp, drive, friction, ends, du, dv, dth)

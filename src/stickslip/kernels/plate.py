@@ -149,8 +149,8 @@ def run_sparse(args, drive, friction, threshold, ends):
     ev_int, fm, prof_x, n_end, profile_every = args.ev_int, args.fm, args.prof_x, args.n_end, args.profile_every
     prof_meta = args.prof_meta
     N = x.shape[0] - 2
-    mp, V, dt = _unpack(par)
-    K, Kp, Fs = mp[0], mp[1], mp[5]
+    mp, V, dt = _unpack(par, args.law)
+    K, Kp, Fs = mp[0], mp[1], mp[2]
     h2 = 0.5 * dt
     cap_ev, cap_fm, cap_p = ev_int.shape[0], fm.shape[0], prof_x.shape[0]
     one = np.uint64(1)

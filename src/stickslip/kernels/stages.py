@@ -33,7 +33,7 @@ def _stage1(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, p, mp, dt, drive, fr
     Returns the first and the last block that move in this step (lo > hi if none) and
     whether a stopped block starts.
     """
-    K, Kp, Fs = mp[0], mp[1], mp[5]
+    K, Kp, Fs = mp[0], mp[1], mp[2]
     one = np.uint64(1)
     u0 = np.uint64(lo)
     n = hi - lo + 1

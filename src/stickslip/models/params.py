@@ -168,6 +168,17 @@ class BlockParams(_Validated):
         """The static threshold as a :class:`~stickslip.models.pieces.Piece`."""
         return piece("threshold", self.threshold)
 
+    @property
+    def friction_piece(self) -> Piece:
+        """eq. (1)'s friction: eq. (4)'s law (:mod:`stickslip.models.friction.state`), its state
+        term scaled by sigma."""
+        return piece("friction", "state")
+
+    @property
+    def D(self) -> float:
+        """No diffusion of theta: a single block has no neighbours (the law's D reads 0)."""
+        return 0.0
+
 
 def scale_block(p: BlockParams) -> BlockParams:
     """Rescale eq. (1) to M = sigma = 1 (section 2 of the paper).
@@ -294,8 +305,9 @@ class ChainParams(_Validated):
         return piece("ends", self.ends)
 
     @property
-    def codes(self) -> tuple[int, int, int, int]:
-        """The kernels' integer codes of the pieces (drive, friction, threshold, ends)."""
+    def codes(self) -> tuple[int | str, ...]:
+        """What the kernels are compiled for, per piece (drive, friction, threshold, ends):
+        :func:`stickslip.models.pieces.code`."""
         from stickslip.models.pieces import code
 
         return tuple(code(k, v) for k, v in self.pieces.items())  # type: ignore[return-value]

@@ -3,13 +3,17 @@
 A :class:`Piece` is one choice for one of the four pieces (drive, friction, threshold, ends):
 its name and meaning, the parameters it reads (and those it declares itself, with their checks),
 and what the package asks of it: the state variable, steady sliding, the linearisation the
-stability analysis reads. The kernels read it through its integer code (its position in
-:data:`stickslip.models.pieces.PIECES`). The friction laws live one per module in
-:mod:`stickslip.models.friction`.
+stability analysis reads. A friction law is one module of :mod:`stickslip.models.friction` that
+also holds the compiled functions every integrator calls (:attr:`Piece.module`, the contract in
+:mod:`stickslip.kernels.laws`) and the named tuple of the parameters they read
+(:func:`kernel_params`); the other pieces reach the kernels through their integer codes (their
+positions in :data:`stickslip.models.pieces.PIECES`).
 """
 
 from __future__ import annotations
 
+import importlib
+from collections import namedtuple
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -17,6 +21,13 @@ from typing import Any
 
 class CompositionError(ValueError):
     """A choice of pieces that docs/model.md does not allow; the message is one line."""
+
+
+def kernel_params(module: str, reads: tuple[str, ...]) -> type:
+    """The named tuple of the parameters a piece's compiled functions read, in the order of
+    ``reads``: the one declaration the driver packs from and the compiled code reads by name
+    (``lp.beta``). Defined as ``Params`` in the piece's own module (numba's cache finds it there)."""
+    return namedtuple("Params", reads, module=module)
 
 
 @dataclass(frozen=True)
@@ -74,6 +85,8 @@ class Piece:
     kind: str
     name: str
     meaning: str
+    #: the parameters the piece reads (a friction law's compiled functions get them as its
+    #: ``Params``, in this order)
     reads: tuple[str, ...] = ()
     #: parameters the piece declares itself (ChainParams gains a field for each)
     params: tuple[Param, ...] = ()
@@ -95,8 +108,9 @@ class Piece:
     linear: Callable[[Any], Linearisation] | None = None
     #: friction with theta: the linearisation is eq. (5)'s, with Fig. 4's closed-form critical beta
     eq5: bool = False
-    #: friction: the located-switch integrator (kernels/located.py) has its expressions
-    located: bool = True
+    #: friction: the import path of the module holding the compiled functions the integrators
+    #: call (``accel``, ``rate``; :mod:`stickslip.kernels.laws`) and its ``Params``
+    module: str = ""
     #: friction: the law as a figure label (matplotlib mathtext)
     label: str = ""
     #: friction: extra numbers the stability report shows for this law (closed forms to compare)
@@ -108,6 +122,12 @@ class Piece:
     #: ends: a spring to a wall at x = 0, which moves at -V in the frame of the drive, so the
     #: equations read t there (the other ends leave them autonomous in that frame)
     wall: bool = False
+
+    def kernel_params(self, p: Any) -> tuple:
+        """The parameters of ``p`` the piece's compiled functions read, as the ``Params`` named
+        tuple of its module (floats, in the order of :attr:`reads`)."""
+        params = importlib.import_module(self.module).Params
+        return params(*(float(getattr(p, name)) for name in self.reads))
 
     def start_theta(self, p: Any) -> float:
         """theta_i at the start of a run of the parameters ``p`` (:attr:`theta0`)."""

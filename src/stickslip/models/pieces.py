@@ -9,7 +9,8 @@ drive      ``end``: a pulling point x_0 = V t joined to block 1 (eq. 4);
 friction   ``state``: theta_i + beta v_i, theta from eq. (4);
            ``weakening``: phi(v) = (1 - sigma) / (1 + 2 alpha max(v, 0) / (1 - sigma)) (CL);
            ``strengthening``: F0 + beta v, no state variable (train model);
-           one module each in :mod:`stickslip.models.friction`
+           ``rate-state``: Dieterich-Ruina with the aging law; ``slip``: with Ruina's slip law;
+           one module each in :mod:`stickslip.models.friction`, listed in :data:`FRICTIONS`
 threshold  ``constant``: Fs; ``state``: theta_i (the paper's reading of Batista-Carlson)
 ends       ``free``, ``fixed``, ``periodic`` (plate drive only)
 ========== ==========================================================================
@@ -22,11 +23,21 @@ line. Each piece lists the parameters it reads, so a run records exactly those.
 
 from __future__ import annotations
 
-from stickslip.models.friction import rate_state, state, strengthening, weakening
+import importlib
+
 from stickslip.models.friction.weakening import weakening_g
 from stickslip.models.piece import CompositionError, Linearisation, Param, Piece
 
-__all__ = ["PIECES", "KINDS", "CompositionError", "Linearisation", "Param", "Piece", "weakening_g"]
+__all__ = ["PIECES", "KINDS", "FRICTIONS", "CompositionError", "Linearisation", "Param", "Piece", "weakening_g"]
+
+#: The friction laws, one module each in :mod:`stickslip.models.friction` (a law is its module
+#: and its line here).
+FRICTIONS = (
+    "state",
+    "weakening",
+    "strengthening",
+    "rate_state",
+)
 
 
 PIECES: dict[str, tuple[Piece, ...]] = {
@@ -40,8 +51,7 @@ PIECES: dict[str, tuple[Piece, ...]] = {
             leaf_spring=True,
         ),
     ),
-    # In the order of the kernels' codes (FRICTION_* in kernels/layout.py).
-    "friction": (state.PIECE, weakening.PIECE, strengthening.PIECE, rate_state.PIECE),
+    "friction": tuple(importlib.import_module(f"stickslip.models.friction.{m}").PIECE for m in FRICTIONS),
     "threshold": (
         Piece("threshold", "constant", "a stuck block starts when f_i > Fs", ("Fs",)),
         Piece(
@@ -74,9 +84,11 @@ def piece(kind: str, name: str) -> Piece:
     raise CompositionError(f"{kind} must be one of {', '.join(names(kind))} (got {name!r})")
 
 
-def code(kind: str, name: str) -> int:
-    """The kernel's integer code of a piece (its position in :data:`PIECES`)."""
-    return names(kind).index(piece(kind, name).name)
+def code(kind: str, name: str) -> int | str:
+    """What a kernel is compiled for, for one piece: the import path of the module holding its
+    compiled functions (a friction law), else its integer code (its position in :data:`PIECES`)."""
+    pc = piece(kind, name)
+    return pc.module or names(kind).index(pc.name)
 
 
 def check_composition(drive: str, friction: str, threshold: str, ends: str) -> None:

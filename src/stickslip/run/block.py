@@ -18,9 +18,13 @@ import pandas as pd
 import xarray as xr
 
 from stickslip.kernels.block import heun_block
+from stickslip.kernels.entry import specialise_call
 from stickslip.models.params import BlockParams, ParameterError, check_number, steps_for
 
 INTEGRATOR = "heun (explicit trapezoid, fixed dt) with the start/stop rules of docs/model.md"
+
+#: The position of the law among heun_block's arguments (compiled as a literal).
+LAW_ARG = frozenset({8})
 
 SLIP_COLUMNS = ("t_c", "t_e", "duration", "slip", "force_at_stop", "period")
 
@@ -165,13 +169,15 @@ def simulate_block(
         slip_end = np.empty(capacity, dtype=np.int64)
         slip_x_start = np.empty(capacity)
         slip_x_end = np.empty(capacity)
-        (x, v, theta, stopped, n_slips, n_starts, n_stops, v_min, v_max) = heun_block(
+        law = params.friction_piece
+        args = (
             initial.x, initial.v, initial.theta, initial.stopped, steps, every,
-            params.K, params.V, params.beta, params.alpha, params.Fs, params.M, params.sigma,
+            params.K, params.V, law.module, law.kernel_params(params), params.Fs, params.M, params.sigma,
             params.dt,
             out_t, out_x, out_v, out_theta, out_stopped,
             slip_start, slip_end, slip_x_start, slip_x_end, params.threshold_piece.has_state,
         )  # fmt: skip
+        (x, v, theta, stopped, n_slips, n_starts, n_stops, v_min, v_max) = specialise_call(heun_block, args, LAW_ARG)
         if n_slips <= capacity:
             break
         capacity = n_slips

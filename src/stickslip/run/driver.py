@@ -145,12 +145,10 @@ def _finite(state: ChainState) -> bool:
 
 
 def _par(p: ChainParams) -> np.ndarray:
+    """The kernels' parameter vector: springs, drive and threshold (the friction law's own
+    parameters travel as its named tuple, :meth:`~stickslip.models.piece.Piece.kernel_params`)."""
     par = np.zeros(layout.PAR_SIZE)
-    par[layout.P_K], par[layout.P_D], par[layout.P_V] = p.K, p.D, p.V
-    par[layout.P_BETA], par[layout.P_ALPHA], par[layout.P_FS], par[layout.P_DT] = p.beta, p.alpha, p.Fs, p.dt
-    par[layout.P_KP], par[layout.P_SIGMA], par[layout.P_F0] = p.Kp, p.sigma, p.F0
-    par[layout.P_RS_A], par[layout.P_RS_B], par[layout.P_DC] = p.rs_a, p.rs_b, p.Dc
-    par[layout.P_V0], par[layout.P_MU0], par[layout.P_SIGMA_N] = p.v0, p.mu0, p.sigma_n
+    par[layout.P_K], par[layout.P_V], par[layout.P_DT], par[layout.P_KP], par[layout.P_FS] = p.K, p.V, p.dt, p.Kp, p.Fs
     return par
 
 
@@ -166,7 +164,7 @@ class _Kernel:
         if name == "exact" and stopped_blocks_still(params.drive_piece, params.friction_piece):
             name = "sparse"
         self.scratch = tuple(scratch)
-        self.rest = (par, *outputs.kernel_args())
+        self.rest = (par, params.friction_piece.kernel_params(params), *outputs.kernel_args())
         # sample_every, profile_every, profile_min_blocks, stop_all_moving (layout.ChainArgs)
         self.tail = tuple(np.int64(t) for t in ints)
         self.pieces = params.codes

@@ -16,7 +16,9 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from stickslip.kernels import layout
 from stickslip.kernels import located as L
+from stickslip.kernels.entry import specialise_call
 from stickslip.models.params import ChainParams, ParameterError, steps_for
 from stickslip.run.state import ChainState, initial_state
 
@@ -121,21 +123,37 @@ class LocatedState:
 
 
 def parameter_vector(p: ChainParams) -> np.ndarray:
-    """The kernel's parameter vector (indices P_* of :mod:`stickslip.kernels.located`)."""
-    par = np.zeros(L.PAR_SIZE)
-    par[L.P_K], par[L.P_D], par[L.P_V], par[L.P_BETA], par[L.P_ALPHA] = p.K, p.D, p.V, p.beta, p.alpha
-    par[L.P_FS], par[L.P_DT], par[L.P_KP], par[L.P_SIGMA], par[L.P_F0] = p.Fs, p.dt, p.Kp, p.sigma, p.F0
+    """The kernel's parameter vector, laid out as the engine's (:mod:`stickslip.kernels.layout`);
+    the friction law's parameters go separately (:meth:`~stickslip.models.piece.Piece.kernel_params`)."""
+    par = np.zeros(layout.PAR_SIZE)
+    par[layout.P_K], par[layout.P_V], par[layout.P_DT], par[layout.P_KP], par[layout.P_FS] = p.K, p.V, p.dt, p.Kp, p.Fs
     return par
+
+
+# Positions of the pieces among the arguments of L.advance and L.rates (compiled as literals).
+_ADVANCE_PIECES = frozenset(range(7, 11))
+_RATES_PIECES = frozenset(range(7, 10))
+
+
+def rates(state: LocatedState, params: ChainParams) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """du, dv, dtheta (arrays of N + 2) of the equations at ``state`` (:func:`stickslip.kernels.located.rates`)."""
+    N = state.N
+    du, dv, dth = np.zeros(N + 2), np.zeros(N + 2), np.zeros(N + 2)
+    drive, friction, _, ends = params.codes
+    t = state.step * params.dt
+    args = (state.u.copy(), state.v, state.th.copy(), state.mov, t, parameter_vector(params))
+    args += (params.friction_piece.kernel_params(params), drive, friction, ends, du, dv, dth)
+    specialise_call(L.rates, args, _RATES_PIECES)
+    return du, dv, dth
 
 
 class LocatedStepper:
     """Advances :class:`LocatedState` objects of one model with located switches (in place)."""
 
     def __init__(self, params: ChainParams, capacity: int = 4096):
-        if not params.friction_piece.located:
-            raise ValueError(f"friction {params.friction} has no located-switch integrator (kernels/located.py)")
         self.params = params
         self.par = parameter_vector(params)
+        self.lp = params.friction_piece.kernel_params(params)
         self.codes = params.codes
         N = params.N
         self.sc = tuple(np.zeros(N + 2) for _ in range(12))
@@ -152,25 +170,9 @@ class LocatedStepper:
         parts = []
         while True:
             state.ist[L.I_EVENTS] = 0
-            status = L.advance(
-                state.u,
-                state.v,
-                state.th,
-                state.mov,
-                np.int64(step),
-                self.par,
-                drive,
-                friction,
-                threshold,
-                ends,
-                self.sc,
-                self.cand,
-                state.moved,
-                state.ist,
-                state.evf,
-                self.ev_t,
-                self.ev_i,
-            )
+            args = (state.u, state.v, state.th, state.mov, np.int64(step), self.par, self.lp)
+            args += (drive, friction, threshold, ends, self.sc, self.cand, state.moved, state.ist, state.evf)
+            status = specialise_call(L.advance, args + (self.ev_t, self.ev_i), _ADVANCE_PIECES)
             r = int(state.ist[L.I_EVENTS])
             if r:
                 parts.append(np.column_stack((self.ev_t[:r], self.ev_i[:r])))

@@ -1,8 +1,15 @@
 """The friction laws of the model family, one module each (docs/models/rate-state.md, "Adding a law").
 
-A law's module defines ``PIECE``, a :class:`~stickslip.models.piece.Piece` carrying its name,
-meaning, parameters and their checks, steady sliding, start value of theta, linearisation and
-figure label. :data:`stickslip.models.pieces.PIECES` lists them in the order of their kernel
-codes (``FRICTION_*`` in :mod:`stickslip.kernels.layout`); the kernel expressions sit with the
-other kernels in :mod:`stickslip.kernels.laws`.
+A law's module defines
+
+* ``READS``, the parameters it reads, and ``Params``, their named tuple
+  (:func:`stickslip.models.piece.kernel_params`), from which the driver packs the kernels' copy;
+* ``accel(f, v, th, lp)``, the force f on a moving block less the law's friction, and
+  ``rate(thl, th, thr, v, lp)``, the state variable's rate (0 for a law without one): compiled
+  functions that every integrator calls (dense, exact, sparse, located switches; the contract is
+  in :mod:`stickslip.kernels.laws`);
+* ``PIECE``, a :class:`~stickslip.models.piece.Piece` carrying its name, meaning, parameters and
+  their checks, steady sliding, start value of theta, linearisation and figure label.
+
+:data:`stickslip.models.pieces.FRICTIONS` lists them: a new law is its module and one line there.
 """

@@ -18,8 +18,9 @@ threshold reads eq. (4)'s theta in [0, 1]); the stop rule is the family's (v <= 
 The spring-slider (N = 1, end drive, unit mass) is unstable below the critical stiffness
 k_c = sigma_n (b - a) / D_c (1 + V^2 / (sigma_n a D_c)) (Rice & Ruina 1983): docs/models/rate-state.md.
 
-Kernel expressions: ``FRICTION_RATE_STATE`` in :mod:`stickslip.kernels.laws` (with its
-parameters at ``P_RS_A``.. in :mod:`stickslip.kernels.layout`).
+Its compiled functions :func:`accel` and :func:`rate` are what every integrator evaluates
+(contract in :mod:`stickslip.kernels.laws`); :func:`mu_lp` is the friction coefficient they share
+with the slip law (:mod:`stickslip.models.friction.slip`).
 """
 
 from __future__ import annotations
@@ -27,7 +28,45 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from stickslip.models.piece import Linearisation, Param, Piece
+from numba import njit
+
+from stickslip.models.piece import Linearisation, Param, Piece, kernel_params
+
+READS = ("rs_a", "rs_b", "Dc", "v0", "mu0", "sigma_n")
+Params = kernel_params(__name__, READS)
+
+_LN2 = math.log(2.0)
+
+
+@njit(cache=True, inline="always")
+def mu_lp(v, th, lp):
+    """mu = a asinh(abs(v) / (2 v0) exp((mu0 + b ln(v0 theta / D_c)) / a)) (module docstring), from
+    the parameters ``lp`` (rs_a, rs_b, Dc, v0, mu0 by name).
+
+    Read at abs(v): a moving block has v > 0, and where Heun's predictor dips below 0 within a step
+    the friction keeps braking, so the stop rule catches a block that stops in the step (the odd
+    extension would push it on into a spurious two-step cycle). Through log z: for z > e^20,
+    asinh(z) = ln(2 z) to round-off, and exp cannot overflow.
+    """
+    s = 0.5 * abs(v) / lp.v0
+    if s == 0.0:
+        return 0.0
+    lz = math.log(s) + (lp.mu0 + lp.rs_b * math.log(lp.v0 * th / lp.Dc)) / lp.rs_a
+    if lz > 20.0:
+        return lp.rs_a * (lz + _LN2)
+    return lp.rs_a * math.asinh(math.exp(lz))
+
+
+@njit(cache=True, inline="always")
+def accel(f, v, th, lp):
+    """f - sigma_n mu(v, theta): the force on a moving block less its rate-and-state friction."""
+    return f - lp.sigma_n * mu_lp(v, th, lp)
+
+
+@njit(cache=True, inline="always")
+def rate(thl, th, thr, v, lp):
+    """The aging law dtheta/dt = 1 - v theta / D_c, on moving and stopped blocks alike."""
+    return 1.0 - v * th / lp.Dc
 
 
 def psi(p: Any, theta: float) -> float:
@@ -36,22 +75,19 @@ def psi(p: Any, theta: float) -> float:
 
 
 def mu(p: Any, v: float, theta: float) -> float:
-    """mu(abs(v), theta) = a asinh(abs(v) / (2 v0) exp(psi / a)) (module docstring), by its log for large
-    arguments. Read at abs(v) like the kernels (a moving block's Heun predictor may dip below v = 0)."""
-    if v == 0.0:
-        return 0.0
-    lz = math.log(0.5 * abs(v) / p.v0) + psi(p, theta)
-    return p.rs_a * (lz + math.log(2.0)) if lz > 20.0 else p.rs_a * math.asinh(math.exp(lz))
+    """mu(abs(v), theta) of the parameters ``p``: the kernels' :func:`mu_lp`."""
+    return float(mu_lp(float(v), float(theta), Params(*(float(getattr(p, n)) for n in READS))))
 
 
-def _steady(p: Any) -> tuple[float, float]:
+def steady_sliding(p: Any) -> tuple[float, float]:
     """theta_0 = D_c / V and c = sigma_n mu(V, theta_0)."""
     theta0 = p.Dc / p.V
     return p.sigma_n * mu(p, p.V, theta0), theta0
 
 
-def _linear(p: Any) -> Linearisation:
-    """The law linearised about steady sliding at v = V, theta_0 = D_c / V.
+def linearised(p: Any) -> Linearisation:
+    """The law linearised about steady sliding at v = V, theta_0 = D_c / V (the slip law's too:
+    its dg/dv and dg/dtheta at steady state are the aging law's).
 
     With z = V / (2 v0) exp(psi / a) and r = z / sqrt(1 + z^2) (1 to round-off away from v = 0):
     dphi/dv = sigma_n a r / V, dphi/dtheta = sigma_n b r / theta_0; the aging law
@@ -76,7 +112,7 @@ def critical_stiffness(p: Any) -> float:
     return p.sigma_n * (p.rs_b - p.rs_a) / p.Dc * (1.0 + p.V**2 / (p.sigma_n * p.rs_a * p.Dc))
 
 
-def _extras(p: Any) -> dict[str, float]:
+def extras(p: Any) -> dict[str, float]:
     """The spring-slider's critical stiffness in closed form, with and without inertia."""
     return {
         "k_c_spring_slider": critical_stiffness(p),
@@ -84,10 +120,10 @@ def _extras(p: Any) -> dict[str, float]:
     }
 
 
-def _check(p: Any) -> str | None:
+def check_v(p: Any) -> str | None:
     """Steady sliding and the start value theta_0 = D_c / V need V > 0."""
     if not p.V > 0.0:
-        return f"friction rate-state needs V > 0 (runs start at theta = D_c / V; got V={p.V:g})"
+        return f"friction {p.friction} needs V > 0 (runs start at theta = D_c / V; got V={p.V:g})"
     return None
 
 
@@ -96,7 +132,7 @@ PIECE = Piece(
     "rate-state",
     "sigma_n mu with mu = a asinh(v / (2 v0) exp((mu0 + b ln(v0 theta / D_c)) / a)); "
     "dtheta_i/dt = 1 - v_i theta_i / D_c (Dieterich-Ruina, aging law, regularised at v = 0)",
-    ("rs_a", "rs_b", "Dc", "v0", "mu0", "sigma_n"),
+    READS,
     params=(
         Param("rs_a", 0.01, "direct-effect coefficient a of rate-and-state friction", low=0.0, low_open=True),
         Param("rs_b", 0.015, "state-effect coefficient b of rate-and-state friction", low=0.0),
@@ -105,12 +141,12 @@ PIECE = Piece(
         Param("mu0", 0.6, "friction coefficient mu0 at v = v0 in steady state (rate-and-state)", low=0.0),
         Param("sigma_n", 5.0, "normal stress sigma_n times the rate-and-state coefficient mu", low=0.0, low_open=True),
     ),
-    check=_check,
+    check=check_v,
     has_state=True,
     theta0=lambda p: p.Dc / p.V,
-    steady=_steady,
-    linear=_linear,
-    located=False,
-    stability_extras=_extras,
+    steady=steady_sliding,
+    linear=linearised,
+    module=__name__,
+    stability_extras=extras,
     label=r"$\sigma_n\,[\mu_0 + a \ln(v/v_0) + b \ln(v_0\theta/D_c)]$",
 )

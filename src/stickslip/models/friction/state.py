@@ -1,14 +1,33 @@
 """eq. (4)'s friction: theta_i + beta v_i while moving, with the state law of eq. (4).
 
 dtheta_i/dt = theta_i (1 - theta_i) - alpha theta_i v_i + D (theta_{i+1} - 2 theta_i + theta_{i-1}).
-Kernel expressions: ``FRICTION_STATE`` in :mod:`stickslip.kernels.laws`.
+Its compiled functions :func:`accel` and :func:`rate` are what every integrator evaluates
+(contract in :mod:`stickslip.kernels.laws`).
 """
 
 from __future__ import annotations
 
 from typing import Any
 
-from stickslip.models.piece import Linearisation, Piece
+from numba import njit
+
+from stickslip.models.piece import Linearisation, Piece, kernel_params
+
+READS = ("beta", "alpha", "D")
+Params = kernel_params(__name__, READS)
+
+
+@njit(cache=True, inline="always")
+def accel(f, v, th, lp):
+    """f - theta - beta v: the force on a moving block less eq. (4)'s friction theta + beta v."""
+    return f - th - lp.beta * v
+
+
+@njit(cache=True, inline="always")
+def rate(thl, th, thr, v, lp):
+    """dtheta/dt of eq. (4): theta (1 - theta) - alpha theta v + D (theta_{i-1} - 2 theta + theta_{i+1}),
+    for moving and stopped blocks alike (a stopped block has v = 0)."""
+    return th * (1.0 - th) - lp.alpha * th * v + lp.D * ((thl - th) - (th - thr))
 
 
 def _steady(p: Any) -> tuple[float, float]:
@@ -43,12 +62,13 @@ PIECE = Piece(
     "state",
     "theta_i + beta v_i while moving; dtheta_i/dt = theta_i (1 - theta_i) "
     "- alpha theta_i v_i + D (theta_{i+1} - 2 theta_i + theta_{i-1}) (eq. 4)",
-    ("beta", "alpha", "D"),
+    READS,
     check=_check,
     has_state=True,
     theta0=0.1,
     steady=_steady,
     linear=_linear,
     eq5=True,
+    module=__name__,
     label=r"$\theta + \beta v$",
 )

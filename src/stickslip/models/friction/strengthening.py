@@ -1,13 +1,31 @@
 """The train model's friction: F0 + beta v, no state variable.
 
-Kernel expressions: ``FRICTION_STRENGTHENING`` in :mod:`stickslip.kernels.laws`.
+Its compiled functions :func:`accel` and :func:`rate` are what every integrator evaluates
+(contract in :mod:`stickslip.kernels.laws`).
 """
 
 from __future__ import annotations
 
 from typing import Any
 
-from stickslip.models.piece import Piece
+from numba import njit
+
+from stickslip.models.piece import Piece, kernel_params
+
+READS = ("beta", "F0")
+Params = kernel_params(__name__, READS)
+
+
+@njit(cache=True, inline="always")
+def accel(f, v, th, lp):
+    """f - F0 - beta v: the force on a moving block less the train model's friction."""
+    return f - lp.F0 - lp.beta * v
+
+
+@njit(cache=True, inline="always")
+def rate(thl, th, thr, v, lp):
+    """No state variable: 0."""
+    return 0.0
 
 
 def _slope(p: Any) -> float:
@@ -24,8 +42,9 @@ PIECE = Piece(
     "friction",
     "strengthening",
     "F0 + beta v, no state variable (train model)",
-    ("beta", "F0"),
+    READS,
     steady=_steady,
     slope=_slope,
+    module=__name__,
     label=r"$F_0 + \beta v$",
 )

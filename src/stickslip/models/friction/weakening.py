@@ -1,13 +1,35 @@
 """Carlson-Langer's velocity weakening: phi(v) = (1 - sigma) / (1 + 2 alpha max(v, 0) / (1 - sigma)).
 
-No state variable. Kernel expressions: ``FRICTION_WEAKENING`` in :mod:`stickslip.kernels.laws`.
+No state variable. Its compiled functions :func:`accel` and :func:`rate` are what every
+integrator evaluates (contract in :mod:`stickslip.kernels.laws`).
 """
 
 from __future__ import annotations
 
 from typing import Any
 
-from stickslip.models.piece import Piece
+from numba import njit
+
+from stickslip.models.piece import Piece, kernel_params
+
+READS = ("alpha", "sigma")
+Params = kernel_params(__name__, READS)
+
+
+@njit(cache=True, inline="always")
+def accel(f, v, th, lp):
+    """f - phi(v) with phi(v) = (1 - sigma) / (1 + 2 alpha max(v, 0) / (1 - sigma)) (Carlson-Langer).
+
+    The divisor 1 - sigma is positive (ChainParams holds sigma in [0, 1)), so a kernel may compile
+    this without a division-by-zero check (the plate kernel's numpy error model)."""
+    w = 1.0 - lp.sigma
+    return f - w / (1.0 + 2.0 * lp.alpha * max(v, 0.0) / w)
+
+
+@njit(cache=True, inline="always")
+def rate(thl, th, thr, v, lp):
+    """No state variable: 0."""
+    return 0.0
 
 
 def weakening_g(p: Any) -> float:
@@ -35,9 +57,10 @@ PIECE = Piece(
     "friction",
     "weakening",
     "phi(v) = (1 - sigma) / (1 + 2 alpha max(v, 0) / (1 - sigma)) (Carlson-Langer)",
-    ("alpha", "sigma"),
+    READS,
     steady=_steady,
     slope=_slope,
     stability_extras=_extras,
+    module=__name__,
     label=r"$\phi(v) = (1 - \sigma) / (1 + 2 \alpha v / (1 - \sigma))$",
 )
