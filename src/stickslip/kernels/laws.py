@@ -75,7 +75,7 @@ def law_has_state(friction):
     return _law(friction).PIECE.has_state
 
 
-@overload(law_accel, inline="always", prefer_literal=True)
+@overload(law_accel, prefer_literal=True)
 def _law_accel(friction, f, v, th, lp):
     law = _law(friction)
     if law is None:
@@ -88,7 +88,7 @@ def _law_accel(friction, f, v, th, lp):
     return impl
 
 
-@overload(law_rate, inline="always", prefer_literal=True)
+@overload(law_rate, prefer_literal=True)
 def _law_rate(friction, thl, th, thr, v, lp):
     law = _law(friction)
     if law is None:

@@ -49,12 +49,15 @@ def mu_lp(v, th, lp):
     asinh(z) = ln(2 z) to round-off, and exp cannot overflow.
     """
     s = 0.5 * abs(v) / lp.v0
-    if s == 0.0:
-        return 0.0
-    lz = math.log(s) + (lp.mu0 + lp.rs_b * math.log(lp.v0 * th / lp.Dc)) / lp.rs_a
-    if lz > 20.0:
-        return lp.rs_a * (lz + _LN2)
-    return lp.rs_a * math.asinh(math.exp(lz))
+    # One return statement: numba inlines the law into the kernels.
+    mu = 0.0
+    if s != 0.0:
+        lz = math.log(s) + (lp.mu0 + lp.rs_b * math.log(lp.v0 * th / lp.Dc)) / lp.rs_a
+        if lz > 20.0:
+            mu = lp.rs_a * (lz + _LN2)
+        else:
+            mu = lp.rs_a * math.asinh(math.exp(lz))
+    return mu
 
 
 @njit(cache=True, inline="always")
