@@ -37,6 +37,7 @@ FRICTIONS = (
     "weakening",
     "strengthening",
     "rate_state",
+    "rate_state_slip",
 )
 
 
