@@ -181,7 +181,7 @@ class Completeness:
 
 
 def _gft_residual(m: np.ndarray, mc: float, dm: float, b: float) -> float:
-    """Wiemer and Wyss's R: 100 - 100 sum |B_i - S_i| / sum B_i over the bins M_i >= mc, with B_i
+    """Wiemer and Wyss's R: 100 - 100 sum abs(B_i - S_i) / sum B_i over the bins M_i >= mc, with B_i
     the observed and S_i the Gutenberg-Richter cumulative counts N(>= M_i) of the fit."""
     top = float(m.max())
     centres = mc + dm * np.arange(int(round((top - mc) / dm)) + 1)
@@ -196,7 +196,7 @@ def completeness(M: Any, *, dm: float = DM, min_events: int = MIN_EVENTS_B) -> C
     Candidates: every bin centre from the most populated bin (the maximum curvature of the
     frequency-magnitude distribution, Wiemer and Wyss 2000) upwards while at least
     ``min_events`` events remain at or above it. At each, the Aki-Utsu b-value is fitted and
-    R = 100 - 100 sum |B_i - S_i| / sum B_i compares the observed cumulative counts B_i with
+    R = 100 - 100 sum abs(B_i - S_i) / sum B_i compares the observed cumulative counts B_i with
     the Gutenberg-Richter ones S_i. mc is the first candidate with R >= 95, else the first with
     R >= 90 (Woessner and Wiemer 2005), else the maximum curvature. In a simulated catalogue
     nothing goes undetected: mc marks where the slips start to follow Gutenberg-Richter.

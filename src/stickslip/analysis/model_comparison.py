@@ -15,7 +15,7 @@ end of the range kept: every candidate is a density normalised on the fit range 
 
 Two candidates are compared by the log-likelihood ratio R = sum_i (log p1(S_i) - log p2(S_i)),
 normalised by its standard deviation, R / (sqrt(n) sigma), with Vuong's (1989) two-sided p-value
-erfc(|R| / sqrt(2 n sigma^2)); for nested candidates (the power law is the exponential cut-off's
+erfc(abs(R) / sqrt(2 n sigma^2)); for nested candidates (the power law is the exponential cut-off's
 lambda = 0) Wilks' chi^2 with one degree of freedom instead. The goodness of fit of the power law
 is the semi-parametric KS bootstrap of Clauset et al. (section 4.1): synthetic catalogues from the
 fit above s_min and the data below it, each refitted with its own s_min.
@@ -29,6 +29,7 @@ the tests, which check these functions against it on the same data.
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -230,10 +231,14 @@ def fit_candidates(S: Any, s_min: float, s_max: float = math.inf) -> dict[str, C
     """Every candidate of :data:`CANDIDATES` fitted on [s_min, s_max]; a fit that fails is a string saying why."""
     out: dict[str, CandidateFit | str] = {}
     for name in CANDIDATES:
-        try:
-            out[name] = fit_candidate(name, S, s_min, s_max)
-        except (ValueError, ArithmeticError, RuntimeError) as exc:
-            out[name] = f"no fit: {exc}"
+        # the search passes through parameters where scipy's densities overflow; those are
+        # rejected by their likelihood, not worth a warning
+        with warnings.catch_warnings(), np.errstate(all="ignore"):
+            warnings.simplefilter("ignore", RuntimeWarning)
+            try:
+                out[name] = fit_candidate(name, S, s_min, s_max)
+            except (ValueError, ArithmeticError, RuntimeError) as exc:
+                out[name] = f"no fit: {exc}"
     return out
 
 
@@ -241,9 +246,9 @@ def vuong(logpdf1: Any, logpdf2: Any, *, nested: bool = False) -> dict[str, floa
     """Log-likelihood ratio test of two fitted densities on the same events (Vuong 1989).
 
     ``R`` = sum(l1 - l2) (> 0: the first is favoured), ``normalized_ratio`` = R / (sqrt(n) sigma)
-    with sigma the standard deviation of l1 - l2, ``p`` = erfc(|R| / sqrt(2 n sigma^2)): the
+    with sigma the standard deviation of l1 - l2, ``p`` = erfc(abs(R) / sqrt(2 n sigma^2)): the
     probability of a ratio this far from 0 if both were equally good. ``nested``: the first is
-    the second with one parameter fixed; then p = chi2(1).sf(2 |R|) (Wilks).
+    the second with one parameter fixed; then p = chi2(1).sf(2 abs(R)) (Wilks).
     """
     d = np.asarray(logpdf1, dtype=np.float64) - np.asarray(logpdf2, dtype=np.float64)
     n = d.size
