@@ -281,3 +281,26 @@ def test_help_lists_the_modes(capsys):
     assert exc.value.code == 0
     text = capsys.readouterr().out
     assert "--quick" in text and "--full" in text and "--scheduler" in text and "--smoke" not in text
+
+
+def test_plot_reproduce_and_catalog_give_the_same_tau_on_the_same_run(smoke, tmp_path, capsys):
+    """One stationary window (analysis.chain_runs.stationary_from) and one fit for all three."""
+    from stickslip.analysis.chain_runs import chain_analysis
+
+    out, _ = smoke
+    exp = ex.experiment("smoke", "chain-runs")
+    a = chain_analysis(rp.run_experiment(exp, out / "runs"))
+    points = out / "runs" / exp.dirname / "points"
+    for beta, key, reading in ((1.0, "sizes1", "whole_range"), (0.2, "sizes02", "below_spanning")):
+        run_dir = points / f"beta={beta:g}_N={a['figure_N']}"
+        tau = a[key]["fit"].tau
+        capsys.readouterr()
+        assert main(["plot", str(run_dir), "--out", str(tmp_path / f"plot{beta:g}"), "--json"]) == 0
+        plotted = next(r for r in json.loads(capsys.readouterr().out)["figures"] if r["figure"] == "sizes")
+        assert (
+            main(["catalog", str(run_dir), "--out", str(tmp_path / f"cat{beta:g}"), "--gof-sims", "0", "--json"]) == 0
+        )
+        catalog = json.loads(capsys.readouterr().out)
+        assert catalog["window"]["t_from"] == plotted["numbers"]["t_from"] == a["t_from"]
+        assert catalog["sizes"][reading]["tau"] == tau
+        assert plotted["numbers"]["tau" if reading == "whole_range" else "tau_below_span"] == tau

@@ -27,6 +27,10 @@ from stickslip.run.state import steady_deviation
 
 # choose_s_min lives in stickslip.analysis.statistics; the name is kept importable from here.
 __all__ = [
+    "stationary_from",
+    "stationary_events",
+    "spanning_column",
+    "run_size_statistics",
     "final_state",
     "choose_s_min",
     "size_statistics",
@@ -36,6 +40,55 @@ __all__ = [
     "fig6_start_note",
     "sweep_table",
 ]
+
+
+def stationary_from(run) -> float:
+    """Start of the stationary window of a chain run (eq. 4 and its relatives): the one rule for
+    every slip statistic (``stickslip plot``, ``reproduce`` and ``catalog``; docs/statistics.md).
+
+    The window is the run's own averaging window of <L> (Fig. 5b): events that start at
+    t >= ``average_from`` of the run, which is the second half of the run unless the run was
+    given another (``stickslip chain --average-from``). A chain loaded from x_i = 0 needs about
+    L_ss / V to load (:func:`stickslip.run.state.loading_warnings` says so when the window starts
+    earlier); its events before then are the loading, not the stationary state.
+    """
+    summary = getattr(run, "summary", {}) or {}
+    if summary.get("L_mean_from") is not None:
+        return float(summary["L_mean_from"])
+    options = run.options
+    return float(options.average_from) if options.average_from is not None else float(options.t_end) / 2.0
+
+
+def stationary_events(run) -> pd.DataFrame:
+    """The events of ``run`` in its stationary window (:func:`stationary_from`), in order."""
+    return run.events[run.events["t_start"] >= stationary_from(run)]
+
+
+def spanning_column(params: ChainParams) -> str:
+    """Which column of the event table says that a slip spans the system, as the drive piece has it.
+
+    A chain pulled at one end (eq. 4) is spanned by an event that reaches its far end: column
+    ``max_block`` = N. A plate-driven chain (Burridge-Knopoff, Carlson-Langer) has no far end
+    (periodic or not, every block is loaded alike): an event spans it when all N blocks moved,
+    column ``n_blocks`` = N.
+    """
+    return "n_blocks" if params.drive_piece.leaf_spring else "max_block"
+
+
+def run_size_statistics(run, *, small_only: bool, seed: int = 0, bootstrap: int = 200) -> dict[str, Any]:
+    """:func:`size_statistics` of a run's stationary events (Figs. 7, 8), as ``plot``, ``reproduce``
+    and ``catalog`` all compute it: the window of :func:`stationary_from`, spanning events by
+    :func:`spanning_column`. Adds ``t_from`` (start of the window) and ``spanning``; raises
+    ValueError when the window holds no event with S > 0."""
+    events = stationary_events(run)
+    S = events["S"].to_numpy(dtype=float)
+    if not np.any(np.isfinite(S) & (S > 0)):
+        raise ValueError(f"no slip with S > 0 at t >= {stationary_from(run):g} (the stationary window)")
+    spanning = spanning_column(run.params)
+    out = size_statistics(
+        events, run.params.N, small_only=small_only, seed=seed, spanning=spanning, bootstrap=bootstrap
+    )
+    return {**out, "t_from": stationary_from(run), "spanning": spanning}
 
 
 def final_state(summary: dict[str, Any], state, params: ChainParams, tolerance: float) -> tuple[str, float]:
@@ -215,16 +268,16 @@ def chain_analysis(outcome) -> dict[str, Any]:
     table = outcome.data["table"]
     sweep_N, fig_N = int(opts["sweep_N"]), int(opts["figure_N"])
     t_fig = float(opts["t_end_by_N"][str(fig_N)])
-    t_from = float(opts["average_fraction"]) * t_fig
-    out: dict[str, Any] = {"table": table, "sweep_N": sweep_N, "figure_N": fig_N, "t_fig": t_fig, "t_from": t_from}
     run1 = outcome.data["run"](fig_N, 1.0)
     run02 = outcome.data["run"](fig_N, 0.2)
+    # The stationary window of every slip statistic (stationary_from): the run's <L> window.
+    t_from = stationary_from(run1)
+    out: dict[str, Any] = {"table": table, "sweep_N": sweep_N, "figure_N": fig_N, "t_fig": t_fig, "t_from": t_from}
     out["run1"], out["run02"] = run1, run02
-    ev1 = run1.events[run1.events["t_start"] >= t_from]
-    ev02 = run02.events[run02.events["t_start"] >= t_from]
+    ev1, ev02 = stationary_events(run1), stationary_events(run02)
     out["events1"], out["events02"] = ev1, ev02
-    out["sizes1"] = size_statistics(ev1, fig_N, small_only=False) if len(ev1) >= 10 else None
-    out["sizes02"] = size_statistics(ev02, fig_N, small_only=True) if len(ev02) >= 10 else None
+    out["sizes1"] = run_size_statistics(run1, small_only=False) if len(ev1) >= 10 else None
+    out["sizes02"] = run_size_statistics(run02, small_only=True) if len(ev02) >= 10 else None
     out["fronts"] = front_statistics(run1, fig_N, t_from)
     return out
 

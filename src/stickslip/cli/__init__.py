@@ -51,6 +51,7 @@ def build_parser() -> argparse.ArgumentParser:
     """The full parser with every subcommand registered."""
     from stickslip.cli import (
         block,
+        catalog,
         chain,
         compile,
         lyapunov,
@@ -71,7 +72,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"stickslip {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
-    for module in (block, stability, chain, models, sweep, reproduce, study, lyapunov, plot, compile):
+    for module in (block, stability, chain, models, sweep, reproduce, study, lyapunov, plot, catalog, compile):
         module.register(sub)
     parser.commands = sub.choices
     return parser

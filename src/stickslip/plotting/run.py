@@ -16,12 +16,12 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
-from stickslip.analysis.chain_runs import front_statistics, size_statistics
+from stickslip.analysis.chain_runs import front_statistics, run_size_statistics, stationary_events, stationary_from
 from stickslip.models.physics import chain_steady_length, has_steady_state, loading_time
 from stickslip.plotting.chain import fig5a_snapshot, fig6_fronts, fig7_8_sizes
 from stickslip.plotting.style import FIGURE_FORMATS, PAPER, SIM, THEORY, new_figure, save_figure
 
-__all__ = ["RunFigure", "length_series", "run_figures", "draw_run_figures", "MIN_EVENTS_FOR_SIZES"]
+__all__ = ["RunFigure", "length_series", "run_figures", "draw_run_figures", "size_numbers", "MIN_EVENTS_FOR_SIZES"]
 
 #: Fewest events with S > 0 for a size distribution and its fit.
 MIN_EVENTS_FOR_SIZES = 50
@@ -35,6 +35,7 @@ class RunFigure:
     title: str
     figure: Figure | None
     skipped: str = ""
+    numbers: dict | None = None
 
 
 def length_series(samples, params) -> Figure:
@@ -83,17 +84,27 @@ def run_figures(run, *, max_snapshots: int = 4) -> list[RunFigure]:
     else:
         out.append(RunFigure("snapshot_final", "final state", None, "no steady sliding profile for this model"))
     events = run.events
-    n_pos = int(np.count_nonzero(events["S"].to_numpy(dtype=float) > 0)) if len(events) else 0
+    # The stationary window shared with `reproduce` and `catalog` (analysis.chain_runs.stationary_from).
+    window = stationary_events(run)
+    n_pos = int(np.count_nonzero(window["S"].to_numpy(dtype=float) > 0)) if len(window) else 0
     if n_pos >= MIN_EVENTS_FOR_SIZES:
-        stats = size_statistics(events, p.N, small_only=False, bootstrap=100)
-        out.append(RunFigure("sizes", "slip-size distribution", fig7_8_sizes(events, stats["fit"], p.beta)))
+        stats = run_size_statistics(run, small_only=False)
+        out.append(
+            RunFigure(
+                "sizes",
+                f"slip-size distribution (events at t >= {stats['t_from']:g})",
+                fig7_8_sizes(window, stats["fit"], p.beta),
+                numbers=size_numbers(run, stats),
+            )
+        )
     else:
         out.append(
             RunFigure(
                 "sizes",
                 "slip-size distribution",
                 None,
-                f"{n_pos} events with S > 0 (a distribution needs {MIN_EVENTS_FOR_SIZES})",
+                f"{n_pos} events with S > 0 at t >= {stationary_from(run):g}, the stationary window "
+                f"(a distribution needs {MIN_EVENTS_FOR_SIZES})",
             )
         )
     if run.profiles.sizes.get("row", 0) and len(events):
@@ -119,11 +130,35 @@ def run_figures(run, *, max_snapshots: int = 4) -> list[RunFigure]:
     return out
 
 
+def size_numbers(run, stats: dict) -> dict:
+    """The exponent of the sizes figure and, where the run has system-spanning events, the one
+    below the smallest of them (Fig. 8's reading), as ``plot --json`` reports them."""
+    fit = stats["fit"]
+    numbers = {
+        "t_from": stats["t_from"],
+        "tau": fit.tau,
+        "tau_err": fit.tau_err,
+        "s_min": fit.s_min,
+        "s_max": fit.s_max,
+        "n": fit.n,
+        "n_spanning": stats["n_spanning"],
+    }
+    if stats["n_spanning"]:
+        try:
+            small = run_size_statistics(run, small_only=True)["fit"]
+        except ValueError:
+            small = None
+        numbers["tau_below_span"] = small.tau if small is not None else None
+    return numbers
+
+
 def draw_run_figures(run, out_dir: str | Path, *, formats: tuple[str, ...] = FIGURE_FORMATS) -> list[dict]:
     """Save every figure of :func:`run_figures` as OUT_DIR/<stem>.<fmt>; one record per figure."""
     records = []
     for item in run_figures(run):
         record = {"figure": item.stem, "title": item.title}
+        if item.numbers is not None:
+            record["numbers"] = item.numbers
         if item.figure is None:
             record["skipped"] = item.skipped
         else:

@@ -1,0 +1,290 @@
+"""Slip catalogues of chain runs as seismologists read them (``stickslip catalog``).
+
+:func:`slip_catalog` turns the events of a chain run (eq. 4, or any model of its family) into a
+catalogue: per slip its start time, duration, size S, magnitude M = (2/3) log10 S
+(:mod:`stickslip.analysis.magnitudes`), epicentre (the block that moved first), extent (the
+blocks that moved), reach (the farthest block) and whether it spans the system
+(:func:`stickslip.analysis.chain_runs.spanning_column`), over the stationary window of
+:func:`stickslip.analysis.chain_runs.stationary_from` that ``plot`` and ``reproduce`` use too.
+
+:func:`catalog_analysis` adds what is read from such a catalogue: the frequency-magnitude
+statistics (b-value, completeness, doubly truncated Gutenberg-Richter, the size exponent tau of
+Figs. 7, 8 and the relation b = (3/2)(tau - 1)), which distribution the sizes follow
+(:mod:`stickslip.analysis.model_comparison`), the recurrence of all and of system-spanning slips
+(:mod:`stickslip.analysis.recurrence`) and the moment rate of the largest events whose
+displacement profiles the run kept. Every part that cannot be computed says why instead.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from stickslip.analysis import magnitudes as mg
+from stickslip.analysis.chain_runs import run_size_statistics, spanning_column, stationary_events, stationary_from
+from stickslip.analysis.model_comparison import compare_distributions, power_law_gof
+from stickslip.analysis.recurrence import recurrence
+from stickslip.models.params import ParameterError
+
+__all__ = [
+    "CATALOG_COLUMNS",
+    "CATALOG_DOCS",
+    "MIN_EVENTS",
+    "Catalog",
+    "slip_catalog",
+    "moment_rate",
+    "catalog_analysis",
+    "load_catalog_run",
+]
+
+#: Fewest slips with S > 0 in the stationary window for a catalogue's fits.
+MIN_EVENTS = 50
+
+CATALOG_COLUMNS = ["event", "t_start", "duration", "S", "magnitude", "epicentre", "extent", "reach", "spans"]
+CATALOG_DOCS = {
+    "event": "event number of the run (events.parquet column event)",
+    "t_start": "start time of the slip, model units",
+    "duration": "duration of the slip, model units",
+    "S": "slip size S = sum_i (x_i(end) - x_i(start)), model units (Figs. 7, 8)",
+    "magnitude": "magnitude M = (2/3) log10 S, the moment-magnitude analogue (docs/statistics.md)",
+    "epicentre": "block that moved first (1..N)",
+    "extent": "number of blocks that moved",
+    "reach": "farthest block that moved (1..N)",
+    "spans": "the slip spans the system (end-driven chain: reaches block N; plate-driven: all N blocks moved)",
+}
+
+
+def load_catalog_run(run_dir: str | Path):
+    """The :class:`~stickslip.run.outputs.ChainRun` of a run directory, or a ParameterError in one line."""
+    from stickslip.run.rundir import RunDirDamaged, load_run
+
+    run_dir = Path(run_dir)
+    if not run_dir.is_dir():
+        raise ParameterError(f"{run_dir} is not a directory (a catalogue is read from a chain run directory)")
+    if not (run_dir / "run.json").is_file() or not (run_dir / "events.parquet").is_file():
+        raise ParameterError(
+            f"{run_dir} is not a chain run directory (no run.json or events.parquet; "
+            "write one with stickslip chain --out)"
+        )
+    try:
+        return load_run(run_dir)
+    except RunDirDamaged as exc:
+        raise ParameterError(str(exc)) from None
+
+
+def slip_catalog(run) -> pd.DataFrame:
+    """The catalogue of a run's slips in its stationary window: one row per slip, :data:`CATALOG_COLUMNS`."""
+    events = stationary_events(run)
+    column = spanning_column(run.params)
+    S = events["S"].to_numpy(dtype=np.float64)
+    return pd.DataFrame(
+        {
+            "event": events["event"].to_numpy(dtype=np.int64),
+            "t_start": events["t_start"].to_numpy(dtype=np.float64),
+            "duration": events["duration"].to_numpy(dtype=np.float64),
+            "S": S,
+            "magnitude": mg.magnitude(S),
+            "epicentre": events["start_block"].to_numpy(dtype=np.int64),
+            "extent": events["n_blocks"].to_numpy(dtype=np.int64),
+            "reach": events["max_block"].to_numpy(dtype=np.int64),
+            "spans": (events[column].to_numpy() >= run.params.N),
+        },
+        columns=CATALOG_COLUMNS,
+    )
+
+
+def moment_rate(run, catalog: pd.DataFrame, *, largest: int = 5) -> tuple[pd.DataFrame, list[dict[str, Any]], str]:
+    """Moment rate of the largest slips with stored displacement profiles (``--profile-window``).
+
+    For each window [t, t + W] of an event's profiles the moment rate is sum_i Delta x_i / W,
+    the slip rate summed over the blocks (S is the moment up to a constant, so this is the
+    moment-rate function up to the same constant); its time integral is the slip the windows
+    cover, at most S. Returns the table (event, t: window centre from the slip's start, rate),
+    one summary per event (S, covered fraction, peak rate and its time, duration) and, when
+    there is nothing to show, why.
+    """
+    profiles = run.profiles
+    if not profiles.sizes.get("row", 0):
+        return (
+            pd.DataFrame(columns=["event", "t", "rate"]),
+            [],
+            "no displacement profiles stored (run with --profile-window W)",
+        )
+    stored = set(np.unique(profiles["event"].values).tolist())
+    picks = catalog[catalog["event"].isin(stored)].nlargest(largest, "S")
+    if picks.empty:
+        return pd.DataFrame(columns=["event", "t", "rate"]), [], "no slip of the stationary window has stored profiles"
+    event_of_row = profiles["event"].values
+    rows, summaries = [], []
+    for r in picks.itertuples():
+        sel = np.flatnonzero(event_of_row == r.event)
+        t0 = profiles["t"].values[sel]
+        t1 = profiles["t_next"].values[sel]
+        slip = profiles["dx"].values[sel].sum(axis=1)
+        rate = slip / (t1 - t0)
+        centre = 0.5 * (t0 + t1) - r.t_start
+        rows.append(pd.DataFrame({"event": int(r.event), "t": centre, "rate": rate}))
+        k = int(np.argmax(rate))
+        summaries.append(
+            {
+                "event": int(r.event),
+                "S": float(r.S),
+                "magnitude": float(r.magnitude),
+                "duration": float(r.duration),
+                "windows": int(sel.size),
+                "covered_fraction": float(slip.sum() / r.S) if r.S > 0 else math.nan,
+                "peak_rate": float(rate[k]),
+                "t_peak": float(centre[k]),
+            }
+        )
+    return pd.concat(rows, ignore_index=True), summaries, ""
+
+
+def _frequency_magnitude(M: np.ndarray, S: np.ndarray, size_fit, *, dm: float, bootstrap: int, seed: int) -> dict:
+    """b-value, completeness, doubly truncated Gutenberg-Richter and their relation to tau."""
+    out: dict[str, Any] = {"dm": dm, "definition": "M = (2/3) log10 S", "relation": "b = (3/2)(tau - 1)"}
+    try:
+        c = mg.completeness(M, dm=dm)
+        out["completeness"] = {"mc": c.mc, "method": c.method, "R": c.R}
+        out["b_value"] = mg.b_value(M, c.mc, dm=dm, bootstrap=bootstrap, seed=seed).to_dict()
+    except ValueError as exc:
+        out["completeness"] = None
+        out["b_value"] = None
+        out["reason"] = f"no b-value: {exc}"
+    if size_fit is not None:
+        m_lo, m_hi = (float(v) for v in mg.magnitude([size_fit.s_min, size_fit.s_max]))
+        try:
+            out["truncated_gr"] = mg.truncated_gr_fit(M, m_lo, m_hi).to_dict()
+        except ValueError as exc:
+            out["truncated_gr"] = None
+            out["truncated_gr_reason"] = f"no fit: {exc}"
+        out["b_from_tau"] = mg.b_from_tau(size_fit.tau)
+        out["b_from_tau_err"] = 1.5 * size_fit.tau_err
+    return out
+
+
+@dataclass
+class Catalog:
+    """A run's catalogue and what is read from it (:func:`catalog_analysis`).
+
+    ``table``: :func:`slip_catalog`; ``summary``: every number, JSON-able; ``size_fits``: the
+    Figs. 7/8 statistics (:func:`~stickslip.analysis.chain_runs.run_size_statistics`) by reading
+    ("whole range", "below spanning"); ``candidates``: the fitted candidate densities;
+    ``moment_rate``: the moment-rate table; ``intervals``: inter-event times, all and spanning.
+    """
+
+    table: pd.DataFrame
+    summary: dict[str, Any]
+    size_fits: dict[str, Any] = field(default_factory=dict)
+    candidates: dict[str, Any] = field(default_factory=dict)
+    moment_rate: pd.DataFrame | None = None
+    intervals: dict[str, np.ndarray] = field(default_factory=dict)
+
+
+def catalog_analysis(
+    run,
+    *,
+    dm: float = mg.DM,
+    bootstrap: int = 200,
+    gof_sims: int = 100,
+    seed: int = 0,
+    min_events: int = MIN_EVENTS,
+) -> Catalog:
+    """Catalogue of a chain run and everything read from it (``stickslip catalog``; module docstring).
+
+    ``run``: a :class:`~stickslip.run.outputs.ChainRun` or a run directory. ``dm``: magnitude bin
+    of the b-value; ``bootstrap``: resamples of the tau and b errors; ``gof_sims``: synthetic
+    catalogues of the KS goodness of fit (0: none); ``seed`` of all of them. A run with fewer than
+    ``min_events`` slips with S > 0 in its stationary window is refused (ParameterError, one line).
+    """
+    if isinstance(run, (str, Path)):
+        run = load_catalog_run(run)
+    from stickslip.run.state import loading_warnings
+
+    table = slip_catalog(run)
+    t_from = stationary_from(run)
+    positive = table[np.isfinite(table["S"]) & (table["S"] > 0)]
+    if len(positive) < min_events:
+        raise ParameterError(
+            f"{len(positive)} slips with S > 0 at t >= {t_from:g} (the run's stationary window, "
+            f"{len(run.events)} in all); a catalogue's fits need at least {min_events}: run longer"
+        )
+    p = run.params
+    start = (run.start or {}).get("kind", "paper") if isinstance(run.start, dict) else "paper"
+    summary: dict[str, Any] = {
+        "model": p.model,
+        "pieces": p.pieces,
+        "N": p.N,
+        "t_end": float(run.summary.get("t_end", run.options.t_end)),
+        "window": {
+            "t_from": t_from,
+            "rule": "slips starting at t >= the run's averaging window of <L> (default t_end / 2)",
+            "warnings": loading_warnings(p, float(run.options.t_end), run.options.average_from, start)
+            if not p.drive_piece.leaf_spring
+            else [],
+        },
+        "n_events_run": int(len(run.events)),
+        "n_events": int(len(table)),
+        "n_positive": int(len(positive)),
+        "spanning": spanning_column(p),
+        "n_spanning": int(table["spans"].sum()),
+        "magnitude": {
+            "definition": "M = (2/3) log10 S",
+            "min": float(positive["magnitude"].min()),
+            "max": float(positive["magnitude"].max()),
+        },
+    }
+    cat = Catalog(table=table, summary=summary)
+    S = positive["S"].to_numpy(dtype=np.float64)
+    M = positive["magnitude"].to_numpy(dtype=np.float64)
+
+    # Sizes: the exponent tau of Figs. 7, 8, read as `plot` and `reproduce` read it
+    sizes: dict[str, Any] = {}
+    for key, small in (("whole_range", False), ("below_spanning", True)):
+        if small and not summary["n_spanning"]:
+            sizes[key] = {"reason": "no system-spanning slip: no cut-off below them"}
+            continue
+        try:
+            st = run_size_statistics(run, small_only=small, seed=seed, bootstrap=bootstrap)
+        except ValueError as exc:
+            sizes[key] = {"reason": f"no fit: {exc}"}
+            continue
+        cat.size_fits[key] = st
+        sizes[key] = {**st["fit"].to_dict(), "s_span": st["s_span"], "excess": st["excess"]}
+    summary["sizes"] = sizes
+    whole = cat.size_fits.get("whole_range")
+    summary["frequency_magnitude"] = _frequency_magnitude(
+        M, S, whole["fit"] if whole else None, dm=dm, bootstrap=bootstrap, seed=seed
+    )
+
+    # Which distribution: every candidate on the range of the whole-range fit
+    if whole is not None:
+        fit = whole["fit"]
+        comparison = compare_distributions(S, fit.s_min, fit.s_max)
+        cat.candidates = comparison.pop("objects")
+        summary["distributions"] = comparison
+        if gof_sims > 0:
+            summary["goodness_of_fit"] = power_law_gof(S, fit.s_max, sims=gof_sims, seed=seed)
+        else:
+            summary["goodness_of_fit"] = {"reason": "not computed (gof_sims = 0)"}
+    else:
+        summary["distributions"] = {"reason": "no power-law fit of the sizes"}
+        summary["goodness_of_fit"] = {"reason": "no power-law fit of the sizes"}
+
+    # Recurrence of all and of system-spanning slips
+    rec = {}
+    for key, rows in (("all", table), ("spanning", table[table["spans"]])):
+        t = rows["t_start"].to_numpy(dtype=np.float64)
+        cat.intervals[key] = np.diff(np.sort(t))
+        rec[key] = recurrence(t)
+    summary["recurrence"] = rec
+
+    rate, per_event, why = moment_rate(run, table)
+    cat.moment_rate = rate
+    summary["moment_rate"] = {"events": per_event, **({"reason": why} if why else {})}
+    return cat
