@@ -20,7 +20,7 @@ from stickslip.cli._common import (
     chain_params_from_args,
     float_arg,
 )
-from stickslip.models.params import ParameterError, check_number
+from stickslip.models.params import MAX_PERTURBATION, ParameterError, check_number
 
 
 def register(sub) -> None:
@@ -193,7 +193,7 @@ def run_lyapunov_command(args: argparse.Namespace) -> Result:
         raise CommandError("--seed goes with --start steady or --start rest (the paper's start draws no numbers)")
     if args.seed is None:
         args.seed = preset.start_options.get("seed", 0)
-    check_number("perturbation", args.perturbation, low=0.0)
+    check_number("perturbation", args.perturbation, low=0.0, high=MAX_PERTURBATION)
     check_number("seed", args.seed, low=0, integer=True)
     check_number("direction-seed", args.direction_seed, low=0, integer=True)
     if args.betas is not None:
@@ -324,7 +324,8 @@ def _finite_size(params, args) -> Result:
 
     deltas = thresholds(args.delta_min, args.delta_max)
     check_number("cycles", args.cycles, low=1, integer=True)
-    check = max(1, int(round(check_number("check", args.check, low=params.dt) / params.dt)))
+    # A check further apart than the longest cycle (--t-end) would never look at the distance.
+    check = max(1, int(round(check_number("check", args.check, low=params.dt, high=args.t_end) / params.dt)))
     ref = start_state(params, args.start, perturbation=args.perturbation, seed=args.seed)
     ref, _ = LocatedStepper(params).advance(ref, steps_for(args.transient, params.dt))
     pair = LocatedPair(params, ref, neutral=args.neutral, direction_seed=args.direction_seed)

@@ -66,7 +66,9 @@ def perturbed(state, amplitude: float, seed: int):
 
 
 def _save_state(path: Path, state) -> None:
-    _save_npz(path, {k: getattr(state, k) for k in state.ARRAYS})
+    from stickslip.run.rundir import write_state_file
+
+    write_state_file(path, state)
 
 
 def _save_npz(path: Path, arrays: dict) -> None:
@@ -77,10 +79,10 @@ def _save_npz(path: Path, arrays: dict) -> None:
 
 
 def _load_state(path: Path):
-    from stickslip.run.state import ChainState
+    """The state of a rung's ``state.npz``; ValueError (one line) if it is missing or damaged."""
+    from stickslip.run.rundir import read_state_file
 
-    with np.load(path) as z:
-        return ChainState(**{k: z[k].copy() for k in ChainState.ARRAYS})
+    return read_state_file(path)
 
 
 def run_rung(params, state, cfg: dict[str, Any], *, leave_stops: bool = False, stop_requested=None) -> dict[str, Any]:

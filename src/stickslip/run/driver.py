@@ -47,7 +47,7 @@ from stickslip.run.errors import ChainRunError, Interrupted, NonFiniteState, Sho
 from stickslip.run.outputs import EVENT_COLUMNS, ChainRun, RunOptions, _assemble, _Outputs
 from stickslip.run.rundir import load_run, read_run_id, write_run
 from stickslip.run.state import STARTS, ChainState, initial_state, line_aligned, loading_warnings, steady_deviation
-from stickslip.run.validate import check_checkpoint_state
+from stickslip.run.validate import check_checkpoint_state, check_start_state
 
 __all__ = [
     "run_chain",
@@ -197,11 +197,6 @@ def _scratch(N: int) -> list[np.ndarray]:
     return [line_aligned(np.zeros(N + 2)) for _ in range(6)] + [np.zeros(N + 2, dtype=np.int64)]
 
 
-def _check_state(state: ChainState, p: ChainParams) -> None:
-    if state.N != p.N:
-        raise ParameterError(f"initial state has {state.N} blocks but N = {p.N}")
-
-
 def run_chain(
     params: ChainParams,
     t_end: float,
@@ -258,8 +253,8 @@ def run_chain(
         check_number("checkpoint_interval", checkpoint_interval, low=0.0, low_open=True)
     check_number("perturbation", perturbation, low=0.0)
     if isinstance(start, ChainState):
+        check_start_state(start, params)
         state = start.copy()
-        _check_state(state, params)
         start_info: dict[str, Any] = {"kind": "state", "sha256": start.sha256()}
     else:
         state = initial_state(params, start, amplitude=perturbation, seed=seed)

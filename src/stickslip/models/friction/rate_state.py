@@ -108,6 +108,7 @@ PIECE = Piece(
     check=_check,
     has_state=True,
     theta0=lambda p: p.Dc / p.V,
+    theta_range=(0.0, float("inf"), True),  # ln(v0 theta / D_c) needs theta > 0
     steady=_steady,
     linear=_linear,
     located=False,
