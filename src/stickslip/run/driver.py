@@ -45,9 +45,9 @@ from stickslip.models.pieces import stopped_blocks_still
 from stickslip.run.checkpoint import CHECKPOINT_FORMAT, Checkpointer, _read_npz, _write_npz  # noqa: F401
 from stickslip.run.errors import ChainRunError, Interrupted, NonFiniteState, ShortRunWarning
 from stickslip.run.outputs import EVENT_COLUMNS, ChainRun, RunOptions, _assemble, _Outputs
-from stickslip.run.rundir import load_run, read_run_id, write_run
+from stickslip.run.rundir import load_run, owned_by_caller, read_run_id, run_dir_for_run, write_run
 from stickslip.run.state import STARTS, ChainState, initial_state, line_aligned, loading_warnings, steady_deviation
-from stickslip.run.validate import check_checkpoint_state, check_start_state
+from stickslip.run.validate import check_chain_params, check_checkpoint_state, check_start_state
 
 __all__ = [
     "run_chain",
@@ -230,17 +230,20 @@ def run_chain(
     With ``sample_moving`` the number of moving blocks is sampled at the multiples of the
     sampling interval: the times of L where the run starts on one (the kernels count them with L).
     With ``out_dir``, checkpoints are written there every ``checkpoint_interval`` wall-clock
-    seconds and on SIGINT/SIGTERM (``handle_signals``), and the results at the end; ``run_id``
-    (that of the run directory, :func:`rundir.owned_run_dir`) goes into every checkpoint. A
+    seconds and on SIGINT/SIGTERM (``handle_signals``), and the results at the end; the folder is
+    owned as ``stickslip chain --out`` owns it (:func:`rundir.run_dir_for_run`: locked, foreign
+    files and an earlier run refused); ``run_id`` (that of the run directory,
+    :func:`rundir.owned_run_dir`) goes into every checkpoint. A
     finished run removes its checkpoint unless ``keep_checkpoint`` (needed only to continue it to
     a later t_end with :func:`resume_chain`). ``stop_requested``, called between chunks of about
     a quarter second, stops the run as a signal does: checkpoint, then :class:`Interrupted`
     (how a sweep's worker learns that the sweep was interrupted).
     """
+    check_chain_params(params)
     if integrator not in INTEGRATORS:
         raise ParameterError(f"integrator must be one of {', '.join(INTEGRATORS)} (got {integrator!r})")
     options = RunOptions(
-        t_end=float(check_number("t_end", t_end, low=0.0)),
+        t_end=float(check_number("t_end", t_end, low=0.0, low_open=True)),
         sample_interval=sample_interval,
         average_from=average_from,
         snapshot_times=tuple(float(t) for t in snapshot_times),
@@ -253,7 +256,7 @@ def run_chain(
         check_number("checkpoint_interval", checkpoint_interval, low=0.0, low_open=True)
     check_number("perturbation", perturbation, low=0.0)
     if isinstance(start, ChainState):
-        check_start_state(start, params)
+        check_start_state(start, params, t_end=options.t_end)
         state = start.copy()
         start_info: dict[str, Any] = {"kind": "state", "sha256": start.sha256()}
     else:
@@ -263,23 +266,24 @@ def run_chain(
             warnings.warn(message, ShortRunWarning, stacklevel=2)
     state.ist[layout.NEXT_SAMPLE] = state.step
     outputs = _Outputs(params.N, options.profile_window is not None)
-    return _drive(
-        params,
-        options,
-        integrator,
-        start_info,
-        state,
-        outputs,
-        run_id=run_id,
-        out_dir=out_dir,
-        checkpointer=Checkpointer(Path(out_dir)) if out_dir else None,
-        checkpoint_interval=checkpoint_interval,
-        progress=progress,
-        handle_signals=handle_signals,
-        wall_before=0.0,
-        keep_checkpoint=keep_checkpoint,
-        stop_requested=stop_requested,
-    )
+    with run_dir_for_run(out_dir, run_id) as run_id:  # owned as the command owns its --out
+        return _drive(
+            params,
+            options,
+            integrator,
+            start_info,
+            state,
+            outputs,
+            run_id=run_id,
+            out_dir=out_dir,
+            checkpointer=Checkpointer(Path(out_dir)) if out_dir else None,
+            checkpoint_interval=checkpoint_interval,
+            progress=progress,
+            handle_signals=handle_signals,
+            wall_before=0.0,
+            keep_checkpoint=keep_checkpoint,
+            stop_requested=stop_requested,
+        )
 
 
 def resume_chain(
@@ -380,14 +384,15 @@ def continue_or_run(
             )
         except ChainRunError:
             shutil.rmtree(ckpt.dir, ignore_errors=True)
-    return run_chain(
-        params,
-        t_end,
-        out_dir=run_dir,
-        checkpoint_interval=checkpoint_interval,
-        stop_requested=stop_requested,
-        **options,
-    )
+    with owned_by_caller(run_dir):  # a point's folder: the study or sweep owns it
+        return run_chain(
+            params,
+            t_end,
+            out_dir=run_dir,
+            checkpoint_interval=checkpoint_interval,
+            stop_requested=stop_requested,
+            **options,
+        )
 
 
 def _drive(

@@ -320,6 +320,58 @@ class RunDirBusy(RuntimeError):
     """Another run holds the run directory's lock; the message names the holder."""
 
 
+#: Run directories held in this process (:func:`owned_run_dir`), or owned by the caller of a run
+#: (:func:`owned_by_caller`): a run writing into one of them neither locks nor checks it again.
+_HELD: set[str] = set()
+
+
+@contextlib.contextmanager
+def owned_by_caller(run_dir: str | Path) -> Iterator[None]:
+    """Mark ``run_dir`` as owned by the caller for the block (a sweep's point folder, which the
+    sweep owns), so that :func:`run_dir_for_run` takes it as it is."""
+    key = os.path.realpath(run_dir)
+    new = key not in _HELD
+    _HELD.add(key)
+    try:
+        yield
+    finally:
+        if new:
+            _HELD.discard(key)
+
+
+@contextlib.contextmanager
+def run_dir_for_run(out_dir: str | Path | None, run_id: str | None = None) -> Iterator[str | None]:
+    """The run directory of ``run_chain(out_dir=...)``, owned as ``stickslip chain --out`` owns it:
+    a folder holding files a chain run does not write, or a run already (finished, or with a
+    checkpoint to resume), is refused with ParameterError before anything is written; the folder
+    is locked for the run (a second writer gets :class:`RunDirBusy`, naming the holder) and gets
+    a run id, which is yielded. A folder this process already holds (the command's) or that its
+    caller owns (:func:`owned_by_caller`) is taken as it is, with ``run_id``."""
+    if out_dir is None or os.path.realpath(out_dir) in _HELD:
+        yield run_id
+        return
+    from stickslip.models.params import ParameterError
+
+    out = Path(out_dir)
+    if out.exists() and not out.is_dir():
+        raise ParameterError(f"out_dir {out} is not a directory")
+    if out.is_dir():
+        foreign = sorted(n for n in os.listdir(out) if n not in OWN_FILES and not is_temporary(n))
+        if foreign:
+            shown = ", ".join(foreign[:3]) + (", ..." if len(foreign) > 3 else "")
+            raise ParameterError(
+                f"out_dir {out} holds files that a chain run does not write ({shown}); choose an empty directory"
+            )
+        if (out / "checkpoint" / "state.npz").exists():
+            raise ParameterError(
+                f"{out} already holds a run; continue it with resume_chain({str(out)!r}) or choose another out_dir"
+            )
+        if (out / "run.json").exists():
+            raise ParameterError(f"{out} already holds a finished run; choose another out_dir")
+    with owned_run_dir(out) as rid:
+        yield rid
+
+
 def read_run_id(run_dir: str | Path) -> str | None:
     """The run id of a run directory (None for one written before run ids)."""
     path = Path(run_dir) / RUN_ID_FILE
@@ -367,6 +419,8 @@ def owned_run_dir(
     except OSError:
         _remove_if_empty(run_dir, created)
         raise
+    key = os.path.realpath(run_dir)
+    _HELD.add(key)
     try:
         from stickslip.io import write_bytes
 
@@ -390,6 +444,7 @@ def owned_run_dir(
             _undo_on_full_disk(run_dir, before | set(keep))
         raise
     finally:
+        _HELD.discard(key)
         # Unlinked while held, so a directory left behind is as it was (the check above
         # keeps a waiter from holding the unlinked file).
         for path in (info, run_dir / ".lock"):

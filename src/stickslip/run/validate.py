@@ -19,7 +19,7 @@ from stickslip.kernels import layout
 from stickslip.models.params import MAX_STEPS, ChainParams, ParameterError
 from stickslip.run.errors import ChainRunError
 
-__all__ = ["check_start_state", "check_checkpoint_state", "state_problem", "array_problem"]
+__all__ = ["check_chain_params", "check_start_state", "check_checkpoint_state", "state_problem", "array_problem"]
 
 #: The arrays of a state: their type and length (N + 2 with the ghost cells, or the integer vector's).
 _FLOAT = ("x", "v", "th", "mov", "x0ev")
@@ -131,12 +131,21 @@ def _model_text(model: dict) -> str:
     return f"{model.get('model')} ({pieces})"
 
 
-def check_start_state(state, params: ChainParams, where: str = "the start state") -> None:
+def check_chain_params(params, name: str = "params") -> None:
+    """Raise TypeError unless ``params`` are :class:`ChainParams` (eq. 4 or a relative)."""
+    if not isinstance(params, ChainParams):
+        raise TypeError(
+            f"{name} must be ChainParams (stickslip.models.presets.chain_params(MODEL, ...)), "
+            f"not {type(params).__name__} {params!r:.40}"
+        )
+
+
+def check_start_state(state, params: ChainParams, where: str = "the start state", t_end: float | None = None) -> None:
     """Raise :class:`ParameterError` (one line) unless ``state`` is a state of the chain of
     ``params`` (eq. 4 or the relative they name) that a run may start from: a
     :class:`~stickslip.run.state.ChainState` of N blocks with arrays of the kernels' types, of
-    the model of ``params`` where the state knows its model, and :func:`state_problem` finds
-    nothing wrong with it."""
+    the model of ``params`` where the state knows its model, :func:`state_problem` finds
+    nothing wrong with it, and a run to ``t_end`` (if given) has a step to make."""
     from stickslip.run.state import ChainState, model_of
 
     if not isinstance(state, ChainState):
@@ -153,6 +162,9 @@ def check_start_state(state, params: ChainParams, where: str = "the start state"
         problem = state_problem(state, params)
     if problem is not None:
         raise ParameterError(f"{where} cannot be run: {problem}")
+    t0 = int(state.ist[layout.STEP]) * params.dt
+    if t_end is not None and not t_end > t0:
+        raise ParameterError(f"t_end must be after the start state's time {t0:g} (got {t_end:g})")
 
 
 def check_checkpoint_state(state, params: ChainParams, options, parts: dict, where: str | Path) -> None:
