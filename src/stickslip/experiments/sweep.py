@@ -42,7 +42,7 @@ import numpy as np
 import pandas as pd
 
 from stickslip import __version__, heartbeat
-from stickslip.experiments.cache import file_digests
+from stickslip.experiments.cache import file_digests, sealed
 from stickslip.experiments.cache import read_done as _read_done
 from stickslip.experiments.cache import spec_before as _spec_before
 from stickslip.io import disk_full, run_metadata, write_dataset, write_json, write_table_files
@@ -197,6 +197,7 @@ def _run_point(
         "summary": _jsonable(summary),
         "files": file_digests(directory),  # a later sweep reuses the point only if these match
     }
+    record = sealed(record)  # and only if the record itself is as written
     write_json(directory / DONE_FILE, record)
     return record
 
