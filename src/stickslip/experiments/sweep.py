@@ -436,18 +436,20 @@ def _compute(
             _stop_points(stop_file, list(futures), stop_wait)
         raise
     finally:
-        if bar is not None:
-            bar.close()
-        client.close()
-        if cluster is not None:
-            cluster.close()
-        stop_file.unlink(missing_ok=True)
+        from stickslip.experiments.worker_signals import deferred_interrupts
+
+        with deferred_interrupts():  # a second Ctrl-C does not cut the closing short
+            if bar is not None:
+                bar.close()
+            client.close()
+            if cluster is not None:
+                cluster.close()
+            stop_file.unlink(missing_ok=True)
 
 
 def _stop_points(stop_file: Path, futures: list, timeout: float) -> None:
-    """Ask the running points to stop (they checkpoint first) and wait for them, at most
-    ``timeout`` seconds; points not yet started then return at once. A second interrupt ends
-    the wait."""
+    """Ask the running points to stop (they checkpoint first) and wait for them, at most ``timeout``
+    seconds; points not yet started then return at once. A second interrupt ends the wait."""
     from dask.distributed import wait
 
     stop_file.touch()
