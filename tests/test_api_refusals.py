@@ -126,10 +126,8 @@ def test_run_chain_owns_its_folder(case, prepare, words, tmp_path):
     assert {p: p.read_bytes() for p in tmp_path.rglob("*") if p.is_file()} == before
 
 
-def test_run_chain_locks_its_folder(tmp_path):
-    """A folder another process holds is refused at once, naming the holder; a free one gets a run
-    id and no lock is left behind."""
-    d = tmp_path / "held"
+def _hold(d):
+    """A process holding the lock of folder ``d`` (as a running command does), once it says so."""
     holder = subprocess.Popen(
         [
             sys.executable,
@@ -144,8 +142,16 @@ def test_run_chain_locks_its_folder(tmp_path):
         text=True,
         env=cli_env(),
     )
+    assert holder.stdout.readline().strip() == "held"
+    return holder
+
+
+def test_run_chain_locks_its_folder(tmp_path):
+    """A folder another process holds is refused at once, naming the holder; a free one gets a run
+    id and no lock is left behind."""
+    d = tmp_path / "held"
+    holder = _hold(d)
     try:
-        assert holder.stdout.readline().strip() == "held"
         t0 = time.perf_counter()
         with pytest.raises(RunDirBusy, match=f"pid {holder.pid}"):
             run_chain(_p(), 30.0, out_dir=d)
@@ -158,3 +164,21 @@ def test_run_chain_locks_its_folder(tmp_path):
     names = {p.name for p in free.iterdir()}
     assert {"run.json", "state.nc", ".run_id"} <= names and not names & {".lock", ".lock.json"}
     assert json.loads((free / "run.json").read_text())["summary"]["state_sha256"] == run.summary["state_sha256"]
+
+
+def test_resume_chain_locks_its_folder(tmp_path):
+    """resume_chain(DIR) holds DIR's lock as chain --resume does: refused while another process
+    holds it (before: two writers in one folder), and it finishes the run once free."""
+    from stickslip.run.driver import resume_chain
+
+    d = tmp_path / "run"
+    run_chain(_p(), 20.0, out_dir=d, keep_checkpoint=True)
+    holder = _hold(d)
+    try:
+        with pytest.raises(RunDirBusy, match=f"pid {holder.pid}"):
+            resume_chain(d, t_end=40.0)
+    finally:
+        holder.kill()
+        holder.wait()
+    assert resume_chain(d, t_end=40.0).state.step == 8000
+    assert not {p.name for p in d.iterdir()} & {".lock", ".lock.json"}

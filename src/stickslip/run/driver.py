@@ -40,12 +40,13 @@ from stickslip import heartbeat
 from stickslip.kernels import dense, entry, exact, layout, plate
 from stickslip.models.params import ChainParams, ParameterError, check_number, steps_for
 from stickslip.models.pieces import stopped_blocks_still
+from stickslip.run import rundir
 
 # The checkpoint file helpers (_read_npz, _write_npz) are named here too, for checks of the files.
 from stickslip.run.checkpoint import CHECKPOINT_FORMAT, Checkpointer, _read_npz, _write_npz  # noqa: F401
 from stickslip.run.errors import ChainRunError, Interrupted, NonFiniteState, ShortRunWarning
 from stickslip.run.outputs import EVENT_COLUMNS, ChainRun, RunOptions, _assemble, _Outputs
-from stickslip.run.rundir import load_run, owned_by_caller, read_run_id, run_dir_for_run, write_run
+from stickslip.run.rundir import load_run, read_run_id, write_run
 from stickslip.run.state import STARTS, ChainState, initial_state, line_aligned, loading_warnings, steady_deviation
 from stickslip.run.validate import check_chain_params, check_checkpoint_state, check_start_state
 
@@ -266,7 +267,7 @@ def run_chain(
             warnings.warn(message, ShortRunWarning, stacklevel=2)
     state.ist[layout.NEXT_SAMPLE] = state.step
     outputs = _Outputs(params.N, options.profile_window is not None)
-    with run_dir_for_run(out_dir, run_id) as run_id:  # owned as the command owns its --out
+    with rundir.run_dir_for_run(out_dir, run_id) as run_id:  # owned as the command owns its --out
         return _drive(
             params,
             options,
@@ -341,23 +342,24 @@ def resume_chain(
     ckpt.since = {k: len(v) for k, v in parts.items()}
     if keep_checkpoint is None:
         keep_checkpoint = header.get("keep_checkpoint") is True
-    return _drive(
-        params,
-        options,
-        integrator,
-        header["start"],
-        state,
-        outputs,
-        run_id=run_id,
-        out_dir=run_dir,
-        checkpointer=ckpt,
-        checkpoint_interval=checkpoint_interval,
-        progress=progress,
-        handle_signals=handle_signals,
-        wall_before=float(header.get("wall_seconds", 0.0)),
-        keep_checkpoint=keep_checkpoint,
-        stop_requested=stop_requested,
-    )
+    with rundir.run_dir_for_resume(run_dir):  # locked as chain --resume locks it
+        return _drive(
+            params,
+            options,
+            integrator,
+            header["start"],
+            state,
+            outputs,
+            run_id=run_id,
+            out_dir=run_dir,
+            checkpointer=ckpt,
+            checkpoint_interval=checkpoint_interval,
+            progress=progress,
+            handle_signals=handle_signals,
+            wall_before=float(header.get("wall_seconds", 0.0)),
+            keep_checkpoint=keep_checkpoint,
+            stop_requested=stop_requested,
+        )
 
 
 def continue_or_run(
@@ -377,14 +379,17 @@ def continue_or_run(
     import shutil
 
     ckpt = Checkpointer(Path(run_dir))
-    if ckpt.state_path.is_file():
-        try:
-            return resume_chain(
-                run_dir, checkpoint_interval=checkpoint_interval, expect_params=params, stop_requested=stop_requested
-            )
-        except ChainRunError:
-            shutil.rmtree(ckpt.dir, ignore_errors=True)
-    with owned_by_caller(run_dir):  # a point's folder: the study or sweep owns it
+    with rundir.owned_by_caller(run_dir):  # a point's folder: the study or sweep owns it
+        if ckpt.state_path.is_file():
+            try:
+                return resume_chain(
+                    run_dir,
+                    checkpoint_interval=checkpoint_interval,
+                    expect_params=params,
+                    stop_requested=stop_requested,
+                )
+            except ChainRunError:
+                shutil.rmtree(ckpt.dir, ignore_errors=True)
         return run_chain(
             params,
             t_end,

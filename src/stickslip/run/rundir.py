@@ -340,6 +340,18 @@ def owned_by_caller(run_dir: str | Path) -> Iterator[None]:
 
 
 @contextlib.contextmanager
+def run_dir_for_resume(run_dir: str | Path) -> Iterator[None]:
+    """The run directory of ``resume_chain(run_dir)``, locked for the run as ``chain --resume``
+    locks it (a second writer gets :class:`RunDirBusy`); one this process already holds or its
+    caller owns (:func:`owned_by_caller`) is taken as it is."""
+    if os.path.realpath(run_dir) in _HELD:
+        yield
+        return
+    with owned_run_dir(run_dir, new_id=False):
+        yield
+
+
+@contextlib.contextmanager
 def run_dir_for_run(out_dir: str | Path | None, run_id: str | None = None) -> Iterator[str | None]:
     """The run directory of ``run_chain(out_dir=...)``, owned as ``stickslip chain --out`` owns it:
     a folder holding files a chain run does not write, or a run already (finished, or with a
