@@ -14,7 +14,7 @@ import stickslip
 from chain_helpers import assert_bits_equal, assert_same_run
 from stickslip.models import physics
 from stickslip.models.params import ChainParams
-from stickslip.run.driver import ChainRunError, load_run, run_chain, steady_deviation, write_run
+from stickslip.run.driver import ChainRunError, initial_state, load_run, run_chain, steady_deviation, write_run
 
 P = ChainParams(N=6, V=0.01)
 SNAPS = (123.45, 400.0, 0.0)
@@ -102,9 +102,10 @@ def test_snapshots_equal_runs_stopped_at_those_times(run_and_dir):
     assert times.tolist() == sorted(times.tolist())
     assert len(times) == len(SNAPS) + 1  # the requested times and the final state
     for i, t in enumerate(sorted(SNAPS)):
-        stopped_there = run_chain(P, t)
+        # at t = 0 the start itself (run_chain refuses a run of no steps)
+        stopped_there = run_chain(P, t).state if t > 0 else initial_state(P)
         assert times[i] == pytest.approx(t, abs=0.5 * P.dt)
-        assert_bits_equal(run.snapshots.values[i], stopped_there.state.x[1:-1], f"snapshot at t = {t}")
+        assert_bits_equal(run.snapshots.values[i], stopped_there.x[1:-1], f"snapshot at t = {t}")
     assert_bits_equal(run.snapshots.values[-1], run.state.x[1:-1], "final snapshot")
 
 
@@ -270,7 +271,7 @@ def test_until_steady_stops_at_the_first_sampled_steady_state(monkeypatch, integ
     kernel is not stopped at the samples at which some block is stuck (only then can the chain
     slide steadily): a chain knocked off steady sliding slips a few times before it settles."""
     p = ChainParams(N=8, beta=5.0)
-    start = run_chain(p, 0.0, start="steady", perturbation=1e-3, seed=1).state
+    start = initial_state(p, "steady", amplitude=1e-3, seed=1)
     calls = _count_kernel_calls(monkeypatch)
     run = run_chain(p, 5e3, integrator=integrator, start=start, until_steady=1e-6, sample_interval=10.0)
     n_calls = len(calls)

@@ -139,19 +139,20 @@ def test_chain_task_continues_from_a_checkpoint(tmp_path, monkeypatch):
     assert not (tmp_path / "done" / "checkpoint").exists(), "a finished point keeps no checkpoint"
     # A run killed while writing its results: the checkpoint is there, the results are not.
     params, t_end, options = rp._point_settings(point)
-    chain.run_chain(params, t_end, out_dir=tmp_path, keep_checkpoint=True, **options)
-    assert (tmp_path / "checkpoint" / "state.npz").is_file()
+    killed = tmp_path / "killed"  # a folder of its own: run_chain refuses one holding other files
+    chain.run_chain(params, t_end, out_dir=killed, keep_checkpoint=True, **options)
+    assert (killed / "checkpoint" / "state.npz").is_file()
     for name in ("run.json", "state.nc", "events.parquet"):
-        (tmp_path / name).unlink()
+        (killed / name).unlink()
 
     def no_fresh_run(*a, **k):
         raise AssertionError("a run with a checkpoint must continue from it")
 
     monkeypatch.setattr(chain, "run_chain", no_fresh_run)
-    again = rp.chain_point_task(point, tmp_path)
+    again = rp.chain_point_task(point, killed)
     assert again["state_sha256"] == first["state_sha256"]
     assert again["n_events"] == first["n_events"]
-    assert (tmp_path / "run.json").is_file()
+    assert (killed / "run.json").is_file()
 
 
 # ---------------------------------------------------------------------------------------------

@@ -198,6 +198,9 @@ DAMAGES = [
     ("run.json changed", lambda p: (p / "run.json").write_text("{}"), "run.json does not match"),
     ("done.json unreadable", lambda p: (p / "done.json").write_text("{half"), "done.json is unreadable"),
     ("no checksums recorded", _edit_done(lambda r: r.pop("files")), "no checksums"),
+    # before: an edited summary (tau = 42) was reused and went into the table
+    ("summary edited", _edit_done(lambda r: r["summary"].update(tau_int=42)), "changed after it was written"),
+    ("record without its own checksum", _edit_done(lambda r: r.pop("sha256")), "no checksum of itself"),
 ]
 
 

@@ -75,12 +75,23 @@ class FSLEResult:
         }
 
 
+#: Most thresholds of one finite-size measurement (delta_min to delta_max by factors of ratio).
+MAX_THRESHOLDS = 200
+
+
 def thresholds(delta_min: float, delta_max: float, ratio: float = 2.0) -> np.ndarray:
     """delta_min r^k up to the last one not above delta_max (at least two)."""
     delta_min = float(check_number("delta_min", delta_min, low=0.0, low_open=True))
     delta_max = float(check_number("delta_max", delta_max, low=delta_min, low_open=True))
     ratio = float(check_number("ratio", ratio, low=1.0, low_open=True))
-    n = int(math.floor(math.log(delta_max / delta_min) / math.log(ratio) + 1e-9)) + 1
+    # Logarithms apart: delta_max / delta_min may overflow (1e300 / 1e-300).
+    k = (math.log(delta_max) - math.log(delta_min)) / math.log(ratio)
+    if k > MAX_THRESHOLDS - 1:
+        raise ParameterError(
+            f"delta_max / delta_min must be <= ratio^{MAX_THRESHOLDS - 1} = {ratio:g}^{MAX_THRESHOLDS - 1} "
+            f"(at most {MAX_THRESHOLDS} thresholds; got {delta_max:g} / {delta_min:g})"
+        )
+    n = int(math.floor(k + 1e-9)) + 1
     if n < 2:
         raise ParameterError(f"delta_max must be >= ratio * delta_min = {ratio * delta_min:g} (got {delta_max:g})")
     return delta_min * ratio ** np.arange(n)

@@ -45,6 +45,8 @@ import pandas as pd
 from stickslip.models.params import ChainParams, ParameterError, check_number, steps_for
 from stickslip.run.driver import ChainState, Stepper, run_chain
 from stickslip.run.errors import short_runs_expected
+from stickslip.run.state import initial_state
+from stickslip.run.validate import check_start_state
 
 #: Largest allowed initial separation: beyond it the twin is not a small perturbation.
 D0_MAX = 1e-3
@@ -322,11 +324,17 @@ def largest_lyapunov(
     n_count = steps_for(transient + align, dt)
     wall0 = time.perf_counter()
 
-    with short_runs_expected():  # only the state at the transient's end is used, not <L>
-        run = run_chain(
-            params, n0 * dt, start=start, perturbation=perturbation, seed=seed, sample_interval=max(transient, dt)
-        )
-    ref = run.state
+    if n0 > (start.step if isinstance(start, ChainState) else 0):
+        with short_runs_expected():  # only the state at the transient's end is used, not <L>
+            run = run_chain(
+                params, n0 * dt, start=start, perturbation=perturbation, seed=seed, sample_interval=max(transient, dt)
+            )
+        ref = run.state
+    elif isinstance(start, ChainState):  # no transient to run (run_chain refuses a run of no steps)
+        check_start_state(start, params)
+        ref = start.copy()
+    else:
+        ref = initial_state(params, start, amplitude=perturbation, seed=seed)
     start_name = start if isinstance(start, str) else "state"
     rng = np.random.default_rng(direction_seed)
     twin = twin_state(ref, rng.standard_normal(3 * params.N), d0, params)

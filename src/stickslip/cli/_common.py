@@ -358,8 +358,8 @@ def chain_params_from_args(args: argparse.Namespace, **overrides: Any):
     An option the composition does not read (``--D`` with weakening friction, say) is refused
     rather than silently ignored.
     """
-    from stickslip.models.params import ChainParams, ParameterError
-    from stickslip.models.presets import chain_params
+    from stickslip.models.params import ChainParams
+    from stickslip.models.presets import build_chain_params, refuse_unread
 
     values: dict[str, Any] = {}
     for kind in ("drive", "friction", "threshold", "ends"):
@@ -373,16 +373,8 @@ def chain_params_from_args(args: argparse.Namespace, **overrides: Any):
         if getattr(args, f"param_{name}", None) is not None:
             values[name] = getattr(args, f"param_{name}")
     values.update(overrides)
-    params = chain_params(args.model or "sakaguchi", **values)
-    used = set(params.used()) | {"l", "nu"}
-    unused = [k for k in values if k not in used and k not in params.pieces]
-    if unused:
-        raise ParameterError(
-            f"--{unused[0]} is not a parameter of this model ({params.model}: "
-            f"{', '.join(f'{k} {v}' for k, v in params.pieces.items())}); it reads {', '.join(params.used())}"
-        )
-    if ("l" in values or "nu" in values) and not params.drive_piece.leaf_spring:
-        raise ParameterError("--l and --nu are Carlson-Langer's symbols: they need drive plate")
+    params = build_chain_params(args.model or "sakaguchi", **values)
+    refuse_unread(params, values, prefix="--")
     return params
 
 

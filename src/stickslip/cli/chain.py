@@ -17,7 +17,7 @@ from stickslip.cli._common import (
     int_arg,
     owned_out_dir,
 )
-from stickslip.models.params import check_number, steps_for
+from stickslip.models.params import MAX_PERTURBATION, check_number, steps_for
 from stickslip.run.rundir import OWN_FILES, RunDirBusy, owned_run_dir, read_run_id
 
 
@@ -346,7 +346,7 @@ def run_chain_command(args: argparse.Namespace) -> Result:
         profile_min_blocks=args.profile_min_blocks,
         until_steady=args.until_steady,
     ).validated(params.dt)
-    check_number("perturbation", args.perturbation, low=0.0)
+    check_number("perturbation", args.perturbation, low=0.0, high=MAX_PERTURBATION)
     out = check_out_owned(args.out, OWN_FILES, "stickslip chain", overwrite=args.overwrite)
     if out is not None and out.is_dir():
         if (out / "checkpoint" / "state.npz").exists() and not args.overwrite:
@@ -415,12 +415,16 @@ def _from_state(params, args):
     ):
         if value is not None:
             raise CommandError(f"{flag} cannot be combined with --from (the state of the run named there is the start)")
+    from stickslip.run.validate import check_start_state
+
     try:
         state = final_state(args.from_dir)
     except (OSError, ValueError, KeyError) as exc:
         raise CommandError(f"--from: {exc}") from None
-    if state.N != params.N:
-        raise CommandError(f"--from: the state there has {state.N} blocks, the run N = {params.N} (give --N {state.N})")
+    n_state = state.x.shape[0] - 2 if getattr(state.x, "ndim", 0) == 1 else None
+    if n_state is not None and n_state != params.N:
+        raise CommandError(f"--from: the state there has {n_state} blocks, the run N = {params.N} (give --N {n_state})")
+    check_start_state(state, params, where=f"--from: the state in {args.from_dir}")
     t0 = state.step * params.dt
     if args.t_end is not None and args.t_end <= t0:
         raise CommandError(f"--t-end must be after the start state's time {t0:g} (got {args.t_end:g})")
@@ -441,7 +445,7 @@ def _start_of(params, args) -> tuple[str, float, int]:
         raise CommandError("--seed goes with --start steady or --start rest (the paper's start draws no numbers)")
     if start == "rest":
         amplitude = args.perturbation if args.perturbation is not None else preset.start_options.get("amplitude", 0.0)
-        check_number("perturbation", amplitude, low=0.0)
+        check_number("perturbation", amplitude, low=0.0, high=MAX_PERTURBATION)
     else:
         amplitude = args.perturbation if args.perturbation is not None else 0.0
     seed = args.seed if args.seed is not None else preset.start_options.get("seed", 0)

@@ -20,7 +20,7 @@ from stickslip.cli._common import (
     chain_params_from_args,
     float_arg,
 )
-from stickslip.models.params import ParameterError, check_number
+from stickslip.models.params import MAX_PERTURBATION, MAX_STEPS, ParameterError, check_number
 
 
 def register(sub) -> None:
@@ -131,7 +131,9 @@ def register(sub) -> None:
         "by delta = 1e-10, 1e-6, 1e-3, 1e-2 spread (blocks differing by more than 1e-2 delta) over "
         "--t-end minus --transient, from the engine's state at --transient (JSON key fronts)",
     )
-    p.add_argument("--front-block", type=int, default=0, metavar="B", help="--fronts: the block moved (0-based)")
+    p.add_argument(
+        "--front-block", type=int, default=None, metavar="B", help="--fronts: the block moved (0-based, default 0)"
+    )
     p.add_argument(
         "--lifetimes",
         default=None,
@@ -139,12 +141,20 @@ def register(sub) -> None:
         help="the time from the paper's start until every block slides steadily, for each N, at most "
         "--loads loading times (JSON key lifetimes)",
     )
-    p.add_argument("--loads", type=float_arg("loads"), default=8.0, metavar="L", help="--lifetimes: cap (default 8)")
-    p.add_argument("--delta-min", type=float_arg("delta-min"), default=1e-10, metavar="D", help="(default 1e-10)")
-    p.add_argument("--delta-max", type=float_arg("delta-max"), default=0.1, metavar="D", help="(default 0.1)")
-    p.add_argument("--cycles", type=int, default=20, metavar="C", help="finite-size cycles counted (default 20)")
+    p.add_argument("--loads", type=float_arg("loads"), default=None, metavar="L", help="--lifetimes: cap (default 8)")
     p.add_argument(
-        "--check", type=float_arg("check"), default=0.1, metavar="TAU", help="finite-size: time between distance checks"
+        "--delta-min", type=float_arg("delta-min"), default=None, metavar="D", help="--finite-size (default 1e-10)"
+    )
+    p.add_argument(
+        "--delta-max", type=float_arg("delta-max"), default=None, metavar="D", help="--finite-size (default 0.1)"
+    )
+    p.add_argument("--cycles", type=int, default=None, metavar="C", help="finite-size cycles counted (default 20)")
+    p.add_argument(
+        "--check",
+        type=float_arg("check"),
+        default=None,
+        metavar="TAU",
+        help="finite-size: time between distance checks (default 0.1)",
     )
     p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     add_json_option(p)
@@ -193,7 +203,7 @@ def run_lyapunov_command(args: argparse.Namespace) -> Result:
         raise CommandError("--seed goes with --start steady or --start rest (the paper's start draws no numbers)")
     if args.seed is None:
         args.seed = preset.start_options.get("seed", 0)
-    check_number("perturbation", args.perturbation, low=0.0)
+    check_number("perturbation", args.perturbation, low=0.0, high=MAX_PERTURBATION)
     check_number("seed", args.seed, low=0, integer=True)
     check_number("direction-seed", args.direction_seed, low=0, integer=True)
     if args.betas is not None:
@@ -215,6 +225,7 @@ def run_lyapunov_command(args: argparse.Namespace) -> Result:
     )
     # Validate every option before the first (possibly long) run.
     ly._check_run(params, args.t_end, args.interval, args.d0, args.transient, args.align, args.segments)
+    _refuse_ignored(args)
     if args.lifetimes is not None:
         return _lifetimes(params, args)
     if args.switches == "located":
@@ -318,9 +329,13 @@ def _finite_size(params, args) -> Result:
     from stickslip.models.params import steps_for
     from stickslip.run.located import LocatedStepper, start_state
 
+    for name, default in (("delta_min", 1e-10), ("delta_max", 0.1), ("cycles", 20), ("check", 0.1)):
+        if getattr(args, name) is None:
+            setattr(args, name, default)
     deltas = thresholds(args.delta_min, args.delta_max)
     check_number("cycles", args.cycles, low=1, integer=True)
-    check = max(1, int(round(check_number("check", args.check, low=params.dt) / params.dt)))
+    # A check further apart than the longest cycle (--t-end) would never look at the distance.
+    check = max(1, int(round(check_number("check", args.check, low=params.dt, high=args.t_end) / params.dt)))
     ref = start_state(params, args.start, perturbation=args.perturbation, seed=args.seed)
     ref, _ = LocatedStepper(params).advance(ref, steps_for(args.transient, params.dt))
     pair = LocatedPair(params, ref, neutral=args.neutral, direction_seed=args.direction_seed)
@@ -369,6 +384,8 @@ def _fronts(params, args) -> Result:
 
     if not args.t_end > args.transient:
         raise CommandError(f"--t-end must exceed --transient (got {args.t_end:g} and {args.transient:g})")
+    if args.front_block is None:
+        args.front_block = 0
     check_number("front-block", args.front_block, low=0, high=params.N - 1, integer=True)
     if params.ends_piece.wall and args.transient > 0:
         raise CommandError("--fronts restarts the clock after --transient: fixed ends (which read t) are refused")
@@ -388,6 +405,36 @@ def _fronts(params, args) -> Result:
     return Result(data, "\n".join(lines))
 
 
+#: Options that only one mode reads: (option, its attribute, the mode's flag, whether the mode is on).
+_MODE_OPTIONS = (
+    ("--front-block", "front_block", "--fronts", lambda a: a.fronts),
+    ("--delta-min", "delta_min", "--finite-size", lambda a: a.finite_size),
+    ("--delta-max", "delta_max", "--finite-size", lambda a: a.finite_size),
+    ("--cycles", "cycles", "--finite-size", lambda a: a.finite_size),
+    ("--check", "check", "--finite-size", lambda a: a.finite_size),
+    ("--loads", "loads", "--lifetimes", lambda a: a.lifetimes is not None),
+)
+
+
+def _refuse_ignored(args) -> None:
+    """Refuse an option the chosen mode would ignore: one of another mode's (``--front-block``
+    without ``--fronts``), or beside ``--lifetimes`` one of the exponents' (``--betas``,
+    ``--switches located``)."""
+    for option, name, mode, on in _MODE_OPTIONS:
+        if getattr(args, name) is not None and not on(args):
+            raise CommandError(f"{option} goes with {mode}")
+    if args.lifetimes is None:
+        return
+    for option, given in (
+        ("--betas", args.betas is not None),
+        ("--convergence", args.convergence),
+        ("--switches located", args.switches == "located"),
+        ("--plot", bool(args.plot)),
+    ):
+        if given:
+            raise CommandError(f"{option} does not go with --lifetimes (it measures no exponent)")
+
+
 def _lifetimes(params, args) -> Result:
     """`--lifetimes`: :func:`stickslip.analysis.stable_chaos.steady_lifetime` at each N."""
     from stickslip.analysis.stable_chaos import steady_lifetime
@@ -403,7 +450,16 @@ def _lifetimes(params, args) -> Result:
         raise CommandError("--lifetimes needs at least one N")
     for n in Ns:
         check_number("N", n, low=1, integer=True)
+    if args.loads is None:
+        args.loads = 8.0
     check_number("loads", args.loads, low=0.0, low_open=True)
+    for n in Ns:  # every run's length, before the first runs
+        cap = max(loading_time(n, params.K, params.V), 1.0)
+        if args.loads * cap / params.dt > MAX_STEPS:
+            raise CommandError(
+                f"--loads must be <= {MAX_STEPS * params.dt / cap:.3g} at N = {n} (a run of at most "
+                f"{MAX_STEPS:.0e} steps of dt = {params.dt:g}, its loading time {cap:.3g}; got {args.loads:g})"
+            )
     rows = []
     for n in Ns:
         p = params.replace(N=n)

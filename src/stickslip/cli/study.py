@@ -87,6 +87,10 @@ def run(args: argparse.Namespace) -> Result:
     _, workers = dask_options(args)
     if args.extra_n and (args.name != "transition" or min(args.extra_n) < 3):
         raise CommandError("--extra-n takes chains of at least 3 blocks, for the transition study only")
+    from stickslip.models.params import MAX_BLOCKS, check_number
+
+    for n in args.extra_n or ():  # before any ladder runs
+        check_number("extra-n", n, low=3, high=MAX_BLOCKS, integer=True)
     spec = _spec(args)
     with _claim(args.out, spec, overwrite=args.overwrite) as out:
         if args.name == "transition":

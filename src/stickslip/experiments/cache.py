@@ -13,7 +13,8 @@ document of everything its result depends on, the package version included.
 - a finished point of a sweep records the checksum of every file it wrote
   (:func:`file_digests`); it is reused only if its summary is there and every file matches
   (:func:`damage`, :func:`read_done`), otherwise it runs again and the table and the study's page
-  say why; :func:`spec_before` tells whether an interrupted point's checkpoint was made from the
+  say why; the record itself carries its SHA-256 (:func:`sealed`), so an edited summary is
+  not reused either; :func:`spec_before` tells whether an interrupted point's checkpoint was made from the
   same spec and may be continued.
 """
 
@@ -27,7 +28,19 @@ from typing import Any
 from stickslip.io import read_json
 from stickslip.jsonable import to_jsonable
 
-__all__ = ["canonical", "spec_key", "read_record", "read_done", "spec_before", "file_digests", "damage"]
+__all__ = [
+    "canonical",
+    "spec_key",
+    "read_record",
+    "read_done",
+    "spec_before",
+    "file_digests",
+    "damage",
+    "files_damage",
+    "sealed",
+    "record_digest",
+    "file_sha256",
+]
 
 #: The separators of :func:`spec_key`'s JSON text: compact, as ``reproduce`` and the studies use.
 COMPACT = (",", ":")
@@ -100,7 +113,8 @@ def spec_before(point_dir: Path) -> dict[str, Any] | None:
     return record.get("spec") if isinstance(record, dict) else None
 
 
-def _sha256(path: Path) -> str:
+def file_sha256(path: Path) -> str:
+    """SHA-256 of the file at ``path``, read in blocks."""
     h = hashlib.sha256()
     with open(path, "rb") as fh:
         for block in iter(lambda: fh.read(1 << 20), b""):
@@ -119,25 +133,47 @@ def file_digests(point_dir: str | Path) -> dict[str, str]:
         rel = path.relative_to(root).as_posix()
         if not path.is_file() or rel in BOOKKEEPING or path.name in LOCK_FILES or is_temporary(path.name):
             continue
-        digests[rel] = _sha256(path)
+        digests[rel] = file_sha256(path)
     return digests
+
+
+def record_digest(record: dict[str, Any]) -> str:
+    """SHA-256 of a record's :func:`canonical` JSON text, its own ``sha256`` field left out: what
+    :func:`sealed` stores and :func:`damage` compares, so an edited record is not reused."""
+    body = {k: v for k, v in record.items() if k != "sha256"}
+    return hashlib.sha256(json.dumps(canonical(body), sort_keys=True, separators=COMPACT).encode()).hexdigest()
+
+
+def sealed(record: dict[str, Any]) -> dict[str, Any]:
+    """``record`` with its :func:`record_digest` under ``sha256`` (done.json, rung.json)."""
+    return {**record, "sha256": record_digest(record)}
 
 
 def damage(point_dir: str | Path, record: dict[str, Any]) -> str | None:
     """Why the finished point in ``point_dir`` (its done.json ``record``) cannot be reused, or None
-    when its summary is there and every file it recorded is present with its checksum."""
+    when its summary is there, the record is as written (:func:`sealed`) and every file it
+    recorded is present with its checksum."""
     summary, files = record.get("summary"), record.get("files")
     if not isinstance(summary, dict):
         return "its summary is missing"
     if not isinstance(files, dict):
         return "it records no checksums of its files"
-    root = Path(point_dir)
+    if not isinstance(record.get("sha256"), str):
+        return "it records no checksum of itself"
+    if record["sha256"] != record_digest(record):
+        return "its record was changed after it was written (checksum)"
+    return files_damage(point_dir, files)
+
+
+def files_damage(root: str | Path, files: dict[str, Any]) -> str | None:
+    """Why the files ``files`` (relative path -> SHA-256) under ``root`` are not as recorded, or None."""
+    root = Path(root)
     for rel, digest in sorted(files.items()):
         path = root / rel
         if not path.is_file():
             return f"{rel} is missing"
         try:
-            if _sha256(path) != digest:
+            if file_sha256(path) != digest:
                 return f"{rel} does not match its checksum"
         except OSError as exc:
             return f"{rel} cannot be read ({exc.strerror})"

@@ -32,7 +32,7 @@ from typing import Any
 import numpy as np
 
 from stickslip import io
-from stickslip.experiments.cache import canonical, read_record
+from stickslip.experiments.cache import canonical
 from stickslip.jsonable import to_jsonable
 
 __all__ = ["ladder_task", "run_rung", "perturbed", "ladder_rows", "UNTIL_STEADY", "DIRECTIONS"]
@@ -66,7 +66,9 @@ def perturbed(state, amplitude: float, seed: int):
 
 
 def _save_state(path: Path, state) -> None:
-    _save_npz(path, {k: getattr(state, k) for k in state.ARRAYS})
+    from stickslip.run.rundir import write_state_file
+
+    write_state_file(path, state)
 
 
 def _save_npz(path: Path, arrays: dict) -> None:
@@ -77,10 +79,10 @@ def _save_npz(path: Path, arrays: dict) -> None:
 
 
 def _load_state(path: Path):
-    from stickslip.run.state import ChainState
+    """The state of a rung's ``state.npz``; ValueError (one line) if it is missing or damaged."""
+    from stickslip.run.rundir import read_state_file
 
-    with np.load(path) as z:
-        return ChainState(**{k: z[k].copy() for k in ChainState.ARRAYS})
+    return read_state_file(path)
 
 
 def run_rung(params, state, cfg: dict[str, Any], *, leave_stops: bool = False, stop_requested=None) -> dict[str, Any]:
@@ -210,32 +212,76 @@ def _rung_settings(cfg: dict[str, Any]) -> dict[str, Any]:
     )
 
 
+#: The files of a rung's folder, each recorded with its SHA-256 in rung.json.
+RUNG_FILES = ("state.npz", "samples.npz")
+
+
+def _replay(rdir: Path, spec: dict[str, Any], params) -> tuple[dict[str, Any] | None, str | None]:
+    """The row and final state of the rung stored in ``rdir`` if it was run from ``spec`` and is
+    whole: its record as written (its SHA-256), every file present with the checksum recorded
+    when it was written, the state the one its row names and one a run can go on from. Else
+    None, and why a stored rung of this spec is not reused (None when there is none)."""
+    from stickslip.experiments.cache import files_damage, record_digest
+    from stickslip.models.params import ParameterError
+    from stickslip.run.validate import check_start_state
+
+    path = rdir / "rung.json"
+    if not path.is_file():
+        return None, None
+    try:
+        rec = io.read_json(path)
+    except (OSError, ValueError):
+        return None, "rung.json is unreadable"
+    if not isinstance(rec, dict) or rec.get("spec") != spec:
+        return None, None  # another rung's record (another start or settings): not this rung
+    files, row = rec.get("files"), rec.get("row")
+    if not isinstance(files, dict) or set(files) != set(RUNG_FILES) or not isinstance(row, dict):
+        return None, "rung.json records no checksums of its files"
+    if rec.get("sha256") != record_digest(rec):
+        return None, "rung.json was changed after it was written (checksum)"
+    why = files_damage(rdir, files)
+    if why is not None:
+        return None, why
+    try:
+        state = _load_state(rdir / "state.npz")
+        if state.sha256() != row.get("final_sha256"):
+            return None, "state.npz is not the final state its row records"
+        check_start_state(state, params, where="state.npz")
+    except (ValueError, ParameterError) as exc:
+        return None, str(exc)
+    return {"row": row, "state": state}, None
+
+
 def _rung(
     ladder_dir: Path, index: int, beta: float, state, start: str, cfg: dict[str, Any], role: str = "grid", **kw
 ) -> dict[str, Any]:
     """Rung ``index`` at ``beta`` from ``state``: reused from its directory when it was run from the
-    same state with the same settings, else run and written."""
+    same state with the same settings and its files are whole (:func:`_replay`), else run and
+    written; a rung run again because its stored files were damaged says so in its row's ``note``."""
+    from stickslip.experiments.cache import file_sha256, sealed
+
     rdir = ladder_dir / "rungs" / f"{index:02d}-beta{beta:.6g}"
     sha = state.sha256()
     settings = _rung_settings(cfg)
-    path = rdir / "rung.json"
     # The rung's spec: the state it starts from and its settings (the study cache's record format).
     spec = canonical({"start_sha256": sha, "settings": settings})
-    rec = read_record(path, spec)
-    if rec is not None and (rdir / "state.npz").is_file():
-        try:
-            return {"row": rec["row"], "state": _load_state(rdir / "state.npz")}
-        except (OSError, ValueError, KeyError):
-            pass
-    res = run_rung(params_at(cfg, beta), state, cfg, **kw)
+    params = params_at(cfg, beta)
+    stored, why = _replay(rdir, spec, params)
+    if stored is not None:
+        return stored
+    res = run_rung(params, state, cfg, **kw)
     row = {**res["row"], "branch": cfg["direction"], "replica": int(cfg.get("replica", 0)), "seed": int(cfg["seed"])}
     row.update(rung=index, role=role, start=start, start_sha256=sha)
     row["final_sha256"] = res["state"].sha256()
     row = to_jsonable(row)  # as a replay reads it back (NaN and inf become None)
     rdir.mkdir(parents=True, exist_ok=True)
+    (rdir / "rung.json").unlink(missing_ok=True)  # no record while its files are rewritten
     _save_state(rdir / "state.npz", res["state"])
     _save_npz(rdir / "samples.npz", res["samples"])
-    io.write_json(path, {"spec": spec, "row": row})
+    files = {name: file_sha256(rdir / name) for name in RUNG_FILES}
+    io.write_json(rdir / "rung.json", sealed({"spec": spec, "row": row, "files": files}))
+    if why is not None:  # this run's row says why the stored rung was not reused
+        row = {**row, "note": f"cached rung damaged ({why}): run again"}
     return {"row": row, "state": res["state"]}
 
 

@@ -14,6 +14,7 @@ figures (:mod:`stickslip.plotting.studies`) and writes its page. Layout::
 
 from __future__ import annotations
 
+import re
 import sys
 import time
 from pathlib import Path
@@ -305,8 +306,11 @@ def foreign_files(out: str | Path, spec: Study) -> list[str]:
     paths): at its top anything but the runs folder, the study pages and the manifest; in a page
     folder anything not in the manifest; in the runs folder anything but the folders of studies
     (``<name>-<key>``) holding their spec, their points (each with its point.json) and the sweep's
-    summary. ``spec`` is the study about to run (its page names are checked even before the page
-    folder exists)."""
+    summary; in a transition study's ladder anything but its bookkeeping and its rungs' files.
+    ``spec`` is the study about to run (its page names are checked even before the page folder
+    exists)."""
+    from stickslip.experiments.cache import BOOKKEEPING
+    from stickslip.experiments.ladders import RUNG_FILES
     from stickslip.experiments.studies import STUDIES
     from stickslip.experiments.sweep import POINT_FILE, STOP_FILE, SUMMARY_NAME
     from stickslip.run.rundir import LOCK_FILES, is_temporary
@@ -335,8 +339,24 @@ def foreign_files(out: str | Path, spec: Study) -> list[str]:
         summary = {f"{SUMMARY_NAME}.parquet", f"{SUMMARY_NAME}.csv", STOP_FILE}
         return (path.is_file() and path.name in summary) or (path / POINT_FILE).is_file()
 
+    def rung(path: Path, rel: str):
+        return path.is_file() and path.name in ("rung.json", *RUNG_FILES)
+
+    def rungs(path: Path, rel: str):
+        return rung if path.is_dir() and re.fullmatch(r"\d{2,}-beta[^/]+", path.name) else False
+
+    def ladder(path: Path, rel: str):  # a ladder's folder: the sweep's bookkeeping and its rungs
+        if path.name == "rungs" and path.is_dir():
+            return rungs
+        return path.is_file() and path.name in BOOKKEEPING
+
+    def ladders(path: Path, rel: str):
+        return ladder if path.is_dir() and (path / POINT_FILE).is_file() else points(path, rel)
+
     def study_runs(path: Path, rel: str):
-        if path.name in ("points", "ladders") and path.is_dir():  # a transition study's are ladders
+        if path.name == "ladders" and path.is_dir():  # a transition study's points are ladders
+            return ladders
+        if path.name == "points" and path.is_dir():
             return points
         return path.name == "study-spec.json" and path.is_file()
 

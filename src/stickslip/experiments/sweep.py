@@ -42,7 +42,7 @@ import numpy as np
 import pandas as pd
 
 from stickslip import __version__, heartbeat
-from stickslip.experiments.cache import file_digests
+from stickslip.experiments.cache import file_digests, sealed
 from stickslip.experiments.cache import read_done as _read_done
 from stickslip.experiments.cache import spec_before as _spec_before
 from stickslip.io import disk_full, run_metadata, write_dataset, write_json, write_table_files
@@ -197,6 +197,7 @@ def _run_point(
         "summary": _jsonable(summary),
         "files": file_digests(directory),  # a later sweep reuses the point only if these match
     }
+    record = sealed(record)  # and only if the record itself is as written
     write_json(directory / DONE_FILE, record)
     return record
 
@@ -435,18 +436,20 @@ def _compute(
             _stop_points(stop_file, list(futures), stop_wait)
         raise
     finally:
-        if bar is not None:
-            bar.close()
-        client.close()
-        if cluster is not None:
-            cluster.close()
-        stop_file.unlink(missing_ok=True)
+        from stickslip.experiments.worker_signals import deferred_interrupts
+
+        with deferred_interrupts():  # a second Ctrl-C does not cut the closing short
+            if bar is not None:
+                bar.close()
+            client.close()
+            if cluster is not None:
+                cluster.close()
+            stop_file.unlink(missing_ok=True)
 
 
 def _stop_points(stop_file: Path, futures: list, timeout: float) -> None:
-    """Ask the running points to stop (they checkpoint first) and wait for them, at most
-    ``timeout`` seconds; points not yet started then return at once. A second interrupt ends
-    the wait."""
+    """Ask the running points to stop (they checkpoint first) and wait for them, at most ``timeout``
+    seconds; points not yet started then return at once. A second interrupt ends the wait."""
     from dask.distributed import wait
 
     stop_file.touch()

@@ -60,4 +60,5 @@ def write_page(path: Path, data: dict[str, Any]) -> None:
         per_n_cols=PER_N_COLUMNS + ["undecided", "rungs"],
         rows=[{**r, "_class": "undecided" if r.get("final_state") == "undecided" else ""} for r in data["rows"]],
         row_cols=ROW_COLUMNS,
+        damaged=data.get("damaged", []),
     )

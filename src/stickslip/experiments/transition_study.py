@@ -32,6 +32,7 @@ import pandas as pd
 from stickslip import __version__, io
 from stickslip.analysis.adaptive import STOP_BATCHES
 from stickslip.experiments.cache import spec_key
+from stickslip.experiments.ladders import params_at
 from stickslip.experiments.study_run import PAGE_FILES, record_outputs
 from stickslip.experiments.transition_page import PER_N_COLUMNS, ROW_COLUMNS, write_page
 
@@ -99,6 +100,8 @@ def ladder_points(mode: str, extra_Ns: tuple[int, ...] = ()) -> tuple[dict[str, 
         for r in range(REPLICAS[mode]):
             points.append({"N": N, "direction": "up", "betas": up, "cap_loads": cap, "seed": r, "replica": r})
         points.append({"N": N, "direction": "down", "betas": down, "cap_loads": cap, "seed": 0, "replica": 0})
+        for beta in (*up, *down):  # every rung's parameters, refused before any ladder runs
+            params_at({**common, "N": N}, beta)
     return common, points
 
 
@@ -264,6 +267,9 @@ def run_transition(
         except (OSError, ValueError, KeyError):
             err = d / "error.json"
             failed.append({"ladder": point_name(p), "error": io.read_json(err).get("error") if err.is_file() else None})
+    # why cached ladders and rungs ran again (their files damaged), for the page
+    rerun = [f"{r.point_dir}: {r.note}" for r in result.table.itertuples() if isinstance(getattr(r, "note", None), str)]
+    rerun += [f"N = {r['N']} {r['branch']} rung {r['rung']}: {r['note']}" for r in rows if r.get("note")]
     table = pd.DataFrame(rows)
     if len(table):
         table = table[[c for c in ROW_COLUMNS if c in table] + [c for c in table if c not in ROW_COLUMNS]]
@@ -285,6 +291,7 @@ def run_transition(
         "ladders_run": result.n_run,
         "ladders_reused": result.n_reused,
         "ladders_damaged": result.n_damaged,  # cached ladders run again: their files were damaged
+        "rungs_damaged": sum(1 for r in rows if r.get("note")),  # cached rungs run again: their files were damaged
         "failed": len(failed),
         "rungs": len(table),
         "undecided": int((table["final_state"] == "undecided").sum()) if len(table) else 0,
@@ -299,6 +306,7 @@ def run_transition(
         "rows": _records(table),
         "figures": figures,
         "failed_ladders": failed,
+        "damaged": rerun,
     }
     record_outputs(out, [page / n for n in PAGE_FILES])
     io.write_table_files(page / "table", table)

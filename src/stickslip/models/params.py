@@ -76,6 +76,8 @@ def _shown(value: Any) -> str:
 MAX_STEPS = 10**12
 #: Largest chain (blocks).
 MAX_BLOCKS = 1_000_000
+#: Largest perturbation of a start: the uniform draw in [-A, A] spans 2 A, which must stay a finite float.
+MAX_PERTURBATION = 1e300
 
 
 def _positive(default: float, doc: str) -> Any:

@@ -97,6 +97,9 @@ class Piece:
     #: friction: theta_i at the start of a run, a number or a function of the parameters
     #: (eq. 4 starts at 0.1; laws without theta at 0)
     theta0: float | Callable[[Any], float] = 0.0
+    #: friction with theta: the values theta_i may take, (low, high, low excluded); a start state
+    #: outside is refused before a run (:func:`stickslip.run.validate.check_start_state`)
+    theta_range: tuple[float, float, bool] | None = None
     #: friction: (friction c, theta_0) of steady sliding at v = V
     steady: Callable[[Any], tuple[float, float]] | None = None
     #: drive: every block is joined to the plate by the leaf spring Kp

@@ -170,22 +170,51 @@ def chain_params(model: str = "sakaguchi", **overrides: Any):
     """Validated parameters of preset ``model`` with ``overrides`` (pieces or parameters).
 
     For the Carlson-Langer family ``l`` and ``nu`` are accepted in the model's own symbols
-    (K = l^2, V = nu).
+    (K = l^2, V = nu). A parameter the composition does not read (``beta`` of Carlson-Langer,
+    say) is refused with :class:`~stickslip.models.params.ParameterError`, as the commands refuse
+    its option, rather than silently ignored (:func:`refuse_unread`).
     """
+    params = build_chain_params(model, **overrides)
+    refuse_unread(params, overrides)
+    return params
+
+
+def build_chain_params(model: str = "sakaguchi", **overrides: Any):
+    """:func:`chain_params` without the refusal of parameters the composition does not read."""
     from stickslip.models.params import ChainParams, ParameterError, check_number
 
     _check_names()
+    if not isinstance(model, str):
+        raise ParameterError(f"model must be a preset's name, one of {', '.join(PRESETS)} (got {model!r})")
     try:
         pr = preset(model)
     except ValueError as exc:
         raise ParameterError(str(exc)) from None
     values: dict[str, Any] = {**pr.pieces, **pr.params}
+    overrides = dict(overrides)
     if "l" in overrides:
         values["K"] = check_number("l", overrides.pop("l"), low=0.0, low_open=True) ** 2
     if "nu" in overrides:
         values["V"] = overrides.pop("nu")
     values.update(overrides)
     return ChainParams(model=model, **values)
+
+
+def refuse_unread(params, given, prefix: str = "") -> None:
+    """Raise ParameterError for the first of the names ``given`` that the composition of ``params``
+    does not read (docs/model.md's family table), naming it as ``prefix`` + name (``--`` for an
+    option), and for Carlson-Langer's symbols ``l`` and ``nu`` without the plate drive."""
+    from stickslip.models.params import ParameterError
+
+    used = set(params.used()) | {"l", "nu", "model"}
+    unused = [k for k in given if k not in used and k not in params.pieces]
+    if unused:
+        raise ParameterError(
+            f"{prefix}{unused[0]} is not a parameter of this model ({params.model}: "
+            f"{', '.join(f'{k} {v}' for k, v in params.pieces.items())}); it reads {', '.join(params.used())}"
+        )
+    if ("l" in given or "nu" in given) and not params.drive_piece.leaf_spring:
+        raise ParameterError(f"{prefix}l and {prefix}nu are Carlson-Langer's symbols: they need drive plate")
 
 
 # Presets that are a single block of eq. (1): their chain form has N = 1, the end drive, state

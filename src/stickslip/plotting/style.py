@@ -39,7 +39,8 @@ FIGURE_FORMATS = ("png", "pdf")
 
 
 def save_figure(fig: Figure, path: str | Path, *, formats: tuple[str, ...] = FIGURE_FORMATS) -> list[Path]:
-    """Save ``fig`` as PATH.png and PATH.pdf (or ``formats``); returns the written paths. Each file
+    """Save ``fig`` as PATH.png and PATH.pdf (or ``formats``), the format added to the whole name
+    (``lam_beta0.9`` gives ``lam_beta0.9.png``); returns the written paths. Each file
     is rendered in memory and written atomically (:func:`stickslip.io.write_bytes`), so a full
     disk leaves no half-written image."""
     import io as _io
@@ -51,7 +52,7 @@ def save_figure(fig: Figure, path: str | Path, *, formats: tuple[str, ...] = FIG
     written = []
     with matplotlib.rc_context(RC):
         for fmt in formats:
-            out = path.with_suffix(f".{fmt}")
+            out = path.parent / f"{path.name}.{fmt}"  # the whole name: 'lam_beta0.9' has no suffix to drop
             buf = _io.BytesIO()
             fig.savefig(buf, format=fmt)
             write_bytes(out, buf.getvalue())

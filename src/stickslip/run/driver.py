@@ -40,6 +40,7 @@ from stickslip import heartbeat
 from stickslip.kernels import dense, entry, exact, layout, plate
 from stickslip.models.params import ChainParams, ParameterError, check_number, steps_for
 from stickslip.models.pieces import stopped_blocks_still
+from stickslip.run import rundir
 
 # The checkpoint file helpers (_read_npz, _write_npz) are named here too, for checks of the files.
 from stickslip.run.checkpoint import CHECKPOINT_FORMAT, Checkpointer, _read_npz, _write_npz  # noqa: F401
@@ -47,7 +48,7 @@ from stickslip.run.errors import ChainRunError, Interrupted, NonFiniteState, Sho
 from stickslip.run.outputs import EVENT_COLUMNS, ChainRun, RunOptions, _assemble, _Outputs
 from stickslip.run.rundir import load_run, read_run_id, write_run
 from stickslip.run.state import STARTS, ChainState, initial_state, line_aligned, loading_warnings, steady_deviation
-from stickslip.run.validate import check_checkpoint_state
+from stickslip.run.validate import check_chain_params, check_checkpoint_state, check_start_state
 
 __all__ = [
     "run_chain",
@@ -195,11 +196,6 @@ def _scratch(N: int) -> list[np.ndarray]:
     return [line_aligned(np.zeros(N + 2)) for _ in range(6)] + [np.zeros(N + 2, dtype=np.int64)]
 
 
-def _check_state(state: ChainState, p: ChainParams) -> None:
-    if state.N != p.N:
-        raise ParameterError(f"initial state has {state.N} blocks but N = {p.N}")
-
-
 def run_chain(
     params: ChainParams,
     t_end: float,
@@ -233,17 +229,20 @@ def run_chain(
     With ``sample_moving`` the number of moving blocks is sampled at the multiples of the
     sampling interval: the times of L where the run starts on one (the kernels count them with L).
     With ``out_dir``, checkpoints are written there every ``checkpoint_interval`` wall-clock
-    seconds and on SIGINT/SIGTERM (``handle_signals``), and the results at the end; ``run_id``
-    (that of the run directory, :func:`rundir.owned_run_dir`) goes into every checkpoint. A
+    seconds and on SIGINT/SIGTERM (``handle_signals``), and the results at the end; the folder is
+    owned as ``stickslip chain --out`` owns it (:func:`rundir.run_dir_for_run`: locked, foreign
+    files and an earlier run refused); ``run_id`` (that of the run directory,
+    :func:`rundir.owned_run_dir`) goes into every checkpoint. A
     finished run removes its checkpoint unless ``keep_checkpoint`` (needed only to continue it to
     a later t_end with :func:`resume_chain`). ``stop_requested``, called between chunks of about
     a quarter second, stops the run as a signal does: checkpoint, then :class:`Interrupted`
     (how a sweep's worker learns that the sweep was interrupted).
     """
+    check_chain_params(params)
     if integrator not in INTEGRATORS:
         raise ParameterError(f"integrator must be one of {', '.join(INTEGRATORS)} (got {integrator!r})")
     options = RunOptions(
-        t_end=float(check_number("t_end", t_end, low=0.0)),
+        t_end=float(check_number("t_end", t_end, low=0.0, low_open=True)),
         sample_interval=sample_interval,
         average_from=average_from,
         snapshot_times=tuple(float(t) for t in snapshot_times),
@@ -256,8 +255,8 @@ def run_chain(
         check_number("checkpoint_interval", checkpoint_interval, low=0.0, low_open=True)
     check_number("perturbation", perturbation, low=0.0)
     if isinstance(start, ChainState):
+        check_start_state(start, params, t_end=options.t_end)
         state = start.copy()
-        _check_state(state, params)
         start_info: dict[str, Any] = {"kind": "state", "sha256": start.sha256()}
     else:
         state = initial_state(params, start, amplitude=perturbation, seed=seed)
@@ -266,23 +265,24 @@ def run_chain(
             warnings.warn(message, ShortRunWarning, stacklevel=2)
     state.ist[layout.NEXT_SAMPLE] = state.step
     outputs = _Outputs(params.N, options.profile_window is not None)
-    return _drive(
-        params,
-        options,
-        integrator,
-        start_info,
-        state,
-        outputs,
-        run_id=run_id,
-        out_dir=out_dir,
-        checkpointer=Checkpointer(Path(out_dir)) if out_dir else None,
-        checkpoint_interval=checkpoint_interval,
-        progress=progress,
-        handle_signals=handle_signals,
-        wall_before=0.0,
-        keep_checkpoint=keep_checkpoint,
-        stop_requested=stop_requested,
-    )
+    with rundir.run_dir_for_run(out_dir, run_id) as run_id:  # owned as the command owns its --out
+        return _drive(
+            params,
+            options,
+            integrator,
+            start_info,
+            state,
+            outputs,
+            run_id=run_id,
+            out_dir=out_dir,
+            checkpointer=Checkpointer(Path(out_dir)) if out_dir else None,
+            checkpoint_interval=checkpoint_interval,
+            progress=progress,
+            handle_signals=handle_signals,
+            wall_before=0.0,
+            keep_checkpoint=keep_checkpoint,
+            stop_requested=stop_requested,
+        )
 
 
 def resume_chain(
@@ -340,23 +340,24 @@ def resume_chain(
     ckpt.since = {k: len(v) for k, v in parts.items()}
     if keep_checkpoint is None:
         keep_checkpoint = header.get("keep_checkpoint") is True
-    return _drive(
-        params,
-        options,
-        integrator,
-        header["start"],
-        state,
-        outputs,
-        run_id=run_id,
-        out_dir=run_dir,
-        checkpointer=ckpt,
-        checkpoint_interval=checkpoint_interval,
-        progress=progress,
-        handle_signals=handle_signals,
-        wall_before=float(header.get("wall_seconds", 0.0)),
-        keep_checkpoint=keep_checkpoint,
-        stop_requested=stop_requested,
-    )
+    with rundir.run_dir_for_resume(run_dir):  # locked as chain --resume locks it
+        return _drive(
+            params,
+            options,
+            integrator,
+            header["start"],
+            state,
+            outputs,
+            run_id=run_id,
+            out_dir=run_dir,
+            checkpointer=ckpt,
+            checkpoint_interval=checkpoint_interval,
+            progress=progress,
+            handle_signals=handle_signals,
+            wall_before=float(header.get("wall_seconds", 0.0)),
+            keep_checkpoint=keep_checkpoint,
+            stop_requested=stop_requested,
+        )
 
 
 def continue_or_run(
@@ -376,21 +377,25 @@ def continue_or_run(
     import shutil
 
     ckpt = Checkpointer(Path(run_dir))
-    if ckpt.state_path.is_file():
-        try:
-            return resume_chain(
-                run_dir, checkpoint_interval=checkpoint_interval, expect_params=params, stop_requested=stop_requested
-            )
-        except ChainRunError:
-            shutil.rmtree(ckpt.dir, ignore_errors=True)
-    return run_chain(
-        params,
-        t_end,
-        out_dir=run_dir,
-        checkpoint_interval=checkpoint_interval,
-        stop_requested=stop_requested,
-        **options,
-    )
+    with rundir.owned_by_caller(run_dir):  # a point's folder: the study or sweep owns it
+        if ckpt.state_path.is_file():
+            try:
+                return resume_chain(
+                    run_dir,
+                    checkpoint_interval=checkpoint_interval,
+                    expect_params=params,
+                    stop_requested=stop_requested,
+                )
+            except ChainRunError:
+                shutil.rmtree(ckpt.dir, ignore_errors=True)
+        return run_chain(
+            params,
+            t_end,
+            out_dir=run_dir,
+            checkpoint_interval=checkpoint_interval,
+            stop_requested=stop_requested,
+            **options,
+        )
 
 
 def _drive(

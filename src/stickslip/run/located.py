@@ -21,6 +21,7 @@ from stickslip.kernels import located as L
 from stickslip.kernels.entry import specialise_call
 from stickslip.models.params import ChainParams, ParameterError, steps_for
 from stickslip.run.state import ChainState, initial_state
+from stickslip.run.validate import check_start_state
 
 INTEGRATOR = "heun with located switches (start at f_i = threshold, stop at v_i = 0, to round-off)"
 
@@ -214,6 +215,8 @@ def start_state(
         return start.copy()
     if isinstance(start, str):
         start = initial_state(params, start, amplitude=perturbation, seed=seed)
+    else:
+        check_start_state(start, params)
     return LocatedState.from_chain_state(start, params)
 
 

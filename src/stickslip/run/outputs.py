@@ -230,6 +230,7 @@ def _concat(key: str, arrays: list[np.ndarray]) -> np.ndarray:
 
 def _assemble(params, options, integrator, start_info, state, outputs, wall, steady_at=None) -> ChainRun:
     dt = params.dt
+    state.of(params)  # the final state belongs to the run's model
     parts = outputs.all()
     ev = parts["ev_int"]
     events = pd.DataFrame(

@@ -171,7 +171,7 @@ def load_run(run_dir: str | Path) -> ChainRun:
         return _load_run(run_dir)
     except RunDirDamaged:
         raise
-    except (KeyError, TypeError, ValueError, IndexError, AttributeError) as exc:
+    except (KeyError, TypeError, ValueError, IndexError, AttributeError, OverflowError) as exc:
         raise RunDirDamaged(
             f"{run_dir} does not hold a whole chain run ({type(exc).__name__}: {str(exc)[:80]})"
         ) from None
@@ -187,6 +187,9 @@ def _load_run(run_dir: Path) -> ChainRun:
         ds["x"].values, ds["v"].values, ds["theta"].values, ds["stopped"].values.astype(bool)
     )
     state.ist[layout.STEP] = int(meta["summary"]["steps"])
+    if state.N != params.N:
+        raise RunDirDamaged(f"{run_dir / 'state.nc'} holds {state.N} blocks, its run.json N = {params.N}")
+    state.of(params)
     samples = xr.Dataset({"L": ("t", ds["L"].values)}, coords={"t": ds["t_sample"].values})
     if "n_moving" in ds:
         samples["n_moving"] = xr.DataArray(ds["n_moving"].values, dims="t_moving")
@@ -225,17 +228,87 @@ RUN_FILES = ("run.json", "state.nc", "events.parquet", "events.csv", "first_move
 OWN_FILES = frozenset({*RUN_FILES, "checkpoint", RUN_ID_FILE, *LOCK_FILES})
 
 
+#: The file of a state handed on (a rung of the transition study): every array of the state and its model.
+STATE_FILE = "state.npz"
+
+
+def write_state_file(path: str | Path, state: ChainState) -> Path:
+    """Write ``state`` (every array, and its model as JSON under ``__model__``) to ``path`` as
+    an npz file, built in memory and written atomically (a full disk leaves no half file)."""
+    from io import BytesIO
+
+    from stickslip import io
+
+    arrays = {k: getattr(state, k) for k in ChainState.ARRAYS}
+    if state.model is not None:
+        arrays["__model__"] = np.frombuffer(json.dumps(state.model, sort_keys=True).encode(), dtype=np.uint8)
+    buf = BytesIO()
+    np.savez(buf, **arrays)
+    return io.write_bytes(path, buf.getvalue())
+
+
+def read_state_file(path: str | Path) -> ChainState:
+    """The state in an npz file of :func:`write_state_file`; raises ValueError (one line naming the
+    file) if it is missing, damaged or lacks an array. A file without ``__model__`` (written before
+    states recorded it: a rung of the transition study) holds a state of eq. (4)."""
+    from stickslip.run.state import model_of
+
+    path = Path(path)
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            arrays = {k: z[k] for k in z.files}
+    except FileNotFoundError:
+        raise ValueError(f"{path} is missing") from None
+    except Exception as exc:  # truncated, empty, not npz, pickled objects: all refused alike
+        raise ValueError(f"{path} is damaged or not a state file ({type(exc).__name__})") from None
+    missing = [k for k in ChainState.ARRAYS if k not in arrays]
+    if missing:
+        raise ValueError(f"{path} is not a state file: it lacks {', '.join(missing)}")
+    model = model_of(ChainParams())
+    if "__model__" in arrays:
+        try:
+            model = json.loads(arrays["__model__"].tobytes().decode())
+        except (ValueError, UnicodeDecodeError):
+            model = None
+        if not isinstance(model, dict) or not all(isinstance(v, str) for v in model.values()):
+            raise ValueError(f"{path} is damaged: its model record is unreadable")
+    return ChainState(**{k: arrays[k].copy() for k in ChainState.ARRAYS}, model=model)
+
+
 def final_state(path: str | Path) -> ChainState:
     """The final state of another run, as a start: a run directory (its ``state.nc``: x, v, theta,
     stopped and the step count, so the time goes on) or a rung of the transition study (its
-    ``state.npz``, every array of the state). Raises ValueError (one line) if there is neither."""
+    ``state.npz``, every array of the state, checked against the SHA-256 its ``rung.json``
+    recorded). Raises ValueError (one line) if there is neither, or it is damaged; the state
+    itself is checked by :func:`stickslip.run.validate.check_start_state` before a run."""
     path = Path(path)
-    if (path / "state.npz").is_file():
-        with np.load(path / "state.npz") as z:
-            return ChainState(**{k: z[k].copy() for k in ChainState.ARRAYS})
+    if (path / STATE_FILE).is_file():
+        state = read_state_file(path / STATE_FILE)
+        recorded = _recorded_sha256(path / "rung.json")
+        if recorded is not None and (_safe_sha256(state) != recorded):
+            raise ValueError(f"{path / STATE_FILE} does not match the final state its rung.json records")
+        return state
     if (path / "run.json").is_file() and (path / "state.nc").is_file():
         return load_run(path).state
     raise ValueError(f"{path} holds no finished run (run.json and state.nc) and no study rung (state.npz)")
+
+
+def _recorded_sha256(path: Path) -> str | None:
+    """The final state's SHA-256 a rung's record names, or None where there is no readable one."""
+    try:
+        row = json.loads(path.read_text()).get("row", {})
+    except (OSError, ValueError, AttributeError):
+        return None
+    digest = row.get("final_sha256") if isinstance(row, dict) else None
+    return digest if isinstance(digest, str) else None
+
+
+def _safe_sha256(state: ChainState) -> str | None:
+    """:meth:`ChainState.sha256`, or None for arrays it cannot hash (the start check names them)."""
+    try:
+        return state.sha256()
+    except (TypeError, ValueError, IndexError):
+        return None
 
 
 def is_temporary(name: str) -> bool:
@@ -245,6 +318,70 @@ def is_temporary(name: str) -> bool:
 
 class RunDirBusy(RuntimeError):
     """Another run holds the run directory's lock; the message names the holder."""
+
+
+#: Run directories held in this process (:func:`owned_run_dir`), or owned by the caller of a run
+#: (:func:`owned_by_caller`): a run writing into one of them neither locks nor checks it again.
+_HELD: set[str] = set()
+
+
+@contextlib.contextmanager
+def owned_by_caller(run_dir: str | Path) -> Iterator[None]:
+    """Mark ``run_dir`` as owned by the caller for the block (a sweep's point folder, which the
+    sweep owns), so that :func:`run_dir_for_run` takes it as it is."""
+    key = os.path.realpath(run_dir)
+    new = key not in _HELD
+    _HELD.add(key)
+    try:
+        yield
+    finally:
+        if new:
+            _HELD.discard(key)
+
+
+@contextlib.contextmanager
+def run_dir_for_resume(run_dir: str | Path) -> Iterator[None]:
+    """The run directory of ``resume_chain(run_dir)``, locked for the run as ``chain --resume``
+    locks it (a second writer gets :class:`RunDirBusy`); one this process already holds or its
+    caller owns (:func:`owned_by_caller`) is taken as it is."""
+    if os.path.realpath(run_dir) in _HELD:
+        yield
+        return
+    with owned_run_dir(run_dir, new_id=False):
+        yield
+
+
+@contextlib.contextmanager
+def run_dir_for_run(out_dir: str | Path | None, run_id: str | None = None) -> Iterator[str | None]:
+    """The run directory of ``run_chain(out_dir=...)``, owned as ``stickslip chain --out`` owns it:
+    a folder holding files a chain run does not write, or a run already (finished, or with a
+    checkpoint to resume), is refused with ParameterError before anything is written; the folder
+    is locked for the run (a second writer gets :class:`RunDirBusy`, naming the holder) and gets
+    a run id, which is yielded. A folder this process already holds (the command's) or that its
+    caller owns (:func:`owned_by_caller`) is taken as it is, with ``run_id``."""
+    if out_dir is None or os.path.realpath(out_dir) in _HELD:
+        yield run_id
+        return
+    from stickslip.models.params import ParameterError
+
+    out = Path(out_dir)
+    if out.exists() and not out.is_dir():
+        raise ParameterError(f"out_dir {out} is not a directory")
+    if out.is_dir():
+        foreign = sorted(n for n in os.listdir(out) if n not in OWN_FILES and not is_temporary(n))
+        if foreign:
+            shown = ", ".join(foreign[:3]) + (", ..." if len(foreign) > 3 else "")
+            raise ParameterError(
+                f"out_dir {out} holds files that a chain run does not write ({shown}); choose an empty directory"
+            )
+        if (out / "checkpoint" / "state.npz").exists():
+            raise ParameterError(
+                f"{out} already holds a run; continue it with resume_chain({str(out)!r}) or choose another out_dir"
+            )
+        if (out / "run.json").exists():
+            raise ParameterError(f"{out} already holds a finished run; choose another out_dir")
+    with owned_run_dir(out) as rid:
+        yield rid
 
 
 def read_run_id(run_dir: str | Path) -> str | None:
@@ -294,6 +431,8 @@ def owned_run_dir(
     except OSError:
         _remove_if_empty(run_dir, created)
         raise
+    key = os.path.realpath(run_dir)
+    _HELD.add(key)
     try:
         from stickslip.io import write_bytes
 
@@ -317,6 +456,7 @@ def owned_run_dir(
             _undo_on_full_disk(run_dir, before | set(keep))
         raise
     finally:
+        _HELD.discard(key)
         # Unlinked while held, so a directory left behind is as it was (the check above
         # keeps a waiter from holding the unlinked file).
         for path in (info, run_dir / ".lock"):

@@ -13,7 +13,7 @@ import numpy as np
 
 from stickslip.kernels import layout
 from stickslip.models import physics
-from stickslip.models.params import ChainParams, ParameterError
+from stickslip.models.params import MAX_PERTURBATION, ChainParams, ParameterError, check_number
 
 STARTS = ("paper", "steady", "rest")
 
@@ -42,7 +42,9 @@ class ChainState:
 
     x, v, th, mov: positions, velocities, state variables and moving mask (1.0/0.0) of
     blocks 1..N at index 1..N; first_step, x0ev: per-block bookkeeping of the event in
-    progress; ist: the integer state vector (step count, event bookkeeping, active range).
+    progress; ist: the integer state vector (step count, event bookkeeping, active range);
+    model: the model the state belongs to (:func:`model_of` its parameters), None when unknown
+    (a state built from blocks).
     """
 
     x: np.ndarray
@@ -52,6 +54,7 @@ class ChainState:
     first_step: np.ndarray
     x0ev: np.ndarray
     ist: np.ndarray
+    model: dict[str, str] | None = None
 
     ARRAYS = ("x", "v", "th", "mov", "first_step", "x0ev", "ist")
 
@@ -76,6 +79,9 @@ class ChainState:
         """Build a state from per-block arrays (length N) of x, v, theta and stopped flags."""
         x = np.asarray(x, dtype=np.float64)
         N = x.shape[0]
+        shapes = {name: np.shape(a) for name, a in (("x", x), ("v", v), ("theta", theta), ("stopped", stopped))}
+        if x.ndim != 1 or any(shape != (N,) for shape in shapes.values()):
+            raise ValueError(f"the per-block arrays differ in shape: {shapes}")
         arrays = {}
         for name, values in (("x", x), ("v", v), ("th", theta)):
             a = np.zeros(N + 2)
@@ -103,7 +109,7 @@ class ChainState:
         """The paper's initial state (section 3): x_i = 0, v_i = 0.1, theta_i = 0.1, all moving."""
         N = p.N
         theta = np.full(N, p.friction_piece.start_theta(p))
-        return cls.from_blocks(np.zeros(N), np.full(N, 0.1), theta, np.zeros(N, bool))
+        return cls.from_blocks(np.zeros(N), np.full(N, 0.1), theta, np.zeros(N, bool)).of(p)
 
     @classmethod
     def steady(cls, p: ChainParams, amplitude: float = 0.0, seed: int = 0) -> ChainState:
@@ -118,7 +124,7 @@ class ChainState:
             rng = np.random.default_rng(seed)
             x += rng.uniform(-amplitude, amplitude, p.N)
             v += rng.uniform(-amplitude, amplitude, p.N)
-        return cls.from_blocks(x, v, s["theta"], np.zeros(p.N, bool))
+        return cls.from_blocks(x, v, s["theta"], np.zeros(p.N, bool)).of(p)
 
     @classmethod
     def rest(cls, p: ChainParams, amplitude: float = 0.01, seed: int = 0) -> ChainState:
@@ -126,7 +132,12 @@ class ChainState:
         (Carlson-Langer's start, docs/model.md), theta_i = 0.1 (the paper's) for state friction."""
         x = -amplitude * np.random.default_rng(seed).random(p.N) if amplitude > 0 else np.zeros(p.N)
         theta = np.full(p.N, p.friction_piece.start_theta(p))
-        return cls.from_blocks(x, np.zeros(p.N), theta, np.ones(p.N, bool))
+        return cls.from_blocks(x, np.zeros(p.N), theta, np.ones(p.N, bool)).of(p)
+
+    def of(self, p: ChainParams) -> ChainState:
+        """This state, marked as one of the model of the parameters ``p`` (:func:`model_of`)."""
+        self.model = model_of(p)
+        return self
 
     def blocks(self) -> dict[str, np.ndarray]:
         """Per-block copies: x, v, theta (float64) and stopped (bool), block i at index i - 1."""
@@ -146,12 +157,19 @@ class ChainState:
         return h.hexdigest()
 
     def copy(self) -> ChainState:
-        return ChainState(**{k: getattr(self, k).copy() for k in self.ARRAYS})
+        return ChainState(**{k: getattr(self, k).copy() for k in self.ARRAYS}, model=self.model)
+
+
+def model_of(p: ChainParams) -> dict[str, str]:
+    """The model a state of the parameters ``p`` belongs to: the preset's name and the four pieces
+    (docs/model.md), which decide what x, v and theta mean."""
+    return {"model": p.model, **p.pieces}
 
 
 def initial_state(p: ChainParams, start: str = "paper", *, amplitude: float = 0.0, seed: int = 0) -> ChainState:
     """The initial state named by ``start``: 'paper' (section 3), 'steady' (docs/model.md) or 'rest'
     (every block stuck, x_i = -A u_i: Carlson-Langer's start, docs/model.md)."""
+    amplitude = check_number("perturbation", amplitude, low=0.0, high=MAX_PERTURBATION)
     if start == "paper":
         return ChainState.paper(p)
     if start == "steady":

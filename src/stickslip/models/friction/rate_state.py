@@ -147,6 +147,7 @@ PIECE = Piece(
     check=check_v,
     has_state=True,
     theta0=lambda p: p.Dc / p.V,
+    theta_range=(0.0, float("inf"), True),  # ln(v0 theta / D_c) needs theta > 0
     steady=steady_sliding,
     linear=linearised,
     module=__name__,

@@ -59,6 +59,7 @@ PIECE = Piece(
     check=aging.check_v,
     has_state=True,
     theta0=lambda p: p.Dc / p.V,
+    theta_range=aging.PIECE.theta_range,
     steady=aging.steady_sliding,
     linear=aging.linearised,
     module=__name__,

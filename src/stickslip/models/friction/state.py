@@ -66,6 +66,7 @@ PIECE = Piece(
     check=_check,
     has_state=True,
     theta0=0.1,
+    theta_range=(0.0, 1.0, False),  # Heun keeps theta_i in [0, 1] (docs/limits.md)
     steady=_steady,
     linear=_linear,
     eq5=True,
