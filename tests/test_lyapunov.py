@@ -290,3 +290,60 @@ def test_plate_drive_steady_sliding_decays_at_minus_beta_over_two():
     )
     res = largest_lyapunov(p, 200.0, interval=2.0, d0=1e-8, transient=0.0, start="steady", perturbation=1e-3, seed=0)
     assert res.lyapunov == pytest.approx(-0.2, rel=0.02)
+
+
+# ------------------------------------------------------------------------------------------
+# The method over any engine
+
+
+class _LinearEngine:
+    """dy/dt = A y, advanced exactly (a matrix exponential per step): the largest exponent is
+    the largest real part of A's eigenvalues, with no switching and no round-off floor."""
+
+    method = norm = "linear"
+    max_wait = 0
+
+    def __init__(self, params, a):
+        from scipy.linalg import expm
+
+        self.params = params
+        self.step_map = expm(a * params.dt)
+
+    def advance(self, ref, twin, step):
+        k = step - ref[0]
+        P = np.linalg.matrix_power(self.step_map, k)
+        return (step, P @ ref[1]), (step, P @ twin[1]), 0
+
+    def step(self, ref):
+        return ref[0]
+
+    def separation(self, ref, twin):
+        return twin[1] - ref[1]
+
+    def twin(self, ref, direction, d0):
+        return ref[0], ref[1] + d0 * direction / np.linalg.norm(direction)
+
+    def on_branch(self, dy, ref):
+        return dy
+
+    def same_branch(self, ref, twin):
+        return True
+
+    def neutral(self, ref):
+        return None
+
+    def fingerprint(self, ref):
+        return ""
+
+
+def test_one_loop_serves_any_engine_linear_flow():
+    from stickslip.analysis.benettin import two_trajectory_exponent
+
+    p = ChainParams(N=1, dt=0.01)
+    # a damped oscillator (-0.2 +- 2 i) and a faster decay (-0.7)
+    a = np.array([[-0.2, 2.0, 0.0], [-2.0, -0.2, 0.0], [0.0, 0.0, -0.7]])
+    res = two_trajectory_exponent(
+        _LinearEngine(p, a), (0, np.zeros(3)), 200.0, interval=5.0, d0=1e-6, transient=0.0, align=20.0, segments=5
+    )
+    assert res.lyapunov == pytest.approx(-0.2, rel=1e-9)
+    assert res.renormalisations == 36 and res.waits == 0 and res.merges == 0

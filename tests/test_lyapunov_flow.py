@@ -20,11 +20,11 @@ import numpy as np
 import pytest
 
 from chain_helpers import run_cli
+from stickslip.analysis.benettin import remove_flow
 from stickslip.analysis.lyapunov_flow import (
     extrapolate,
     flow_direction,
     flow_lyapunov,
-    remove_flow,
     separation,
     twin_state,
 )

@@ -191,6 +191,7 @@ def _result_text(d: dict) -> str:
 def run_lyapunov_command(args: argparse.Namespace) -> Result:
     """Handler of `stickslip lyapunov`."""
     from stickslip.analysis import lyapunov as ly
+    from stickslip.analysis.benettin import check_run
     from stickslip.models.presets import PRESETS
 
     params = chain_params_from_args(args)
@@ -224,7 +225,7 @@ def run_lyapunov_command(args: argparse.Namespace) -> Result:
         segments=args.segments,
     )
     # Validate every option before the first (possibly long) run.
-    ly._check_run(params, args.t_end, args.interval, args.d0, args.transient, args.align, args.segments)
+    check_run(params, args.t_end, args.interval, args.d0, args.transient, args.align, args.segments)
     _refuse_ignored(args)
     if args.lifetimes is not None:
         return _lifetimes(params, args)
