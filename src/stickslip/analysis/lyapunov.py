@@ -36,6 +36,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -117,6 +118,13 @@ def _with_step(state: ChainState, step: int) -> ChainState:
     return state
 
 
+def _moved_back(state: ChainState, k: int, params: ChainParams) -> ChainState:
+    """``state`` moved back along the drive by k steps: x -> x - V k dt at step - k (a new state)."""
+    b = state.blocks()
+    moved = ChainState.from_blocks(b["x"] - params.V * (np.float64(k) * params.dt), b["v"], b["theta"], b["stopped"])
+    return _with_step(moved, state.step - k)
+
+
 def twin_state(ref: ChainState, direction: np.ndarray, d0: float, params: ChainParams) -> ChainState:
     """The twin ref + d0 * direction (direction in y coordinates, see :func:`separation`).
 
@@ -142,49 +150,118 @@ def twin_state(ref: ChainState, direction: np.ndarray, d0: float, params: ChainP
     return _with_step(ChainState.from_blocks(x, v, th, b["stopped"]), ref.step)
 
 
+#: Frames the grid's twin runs in (:class:`GridEngine`).
+FRAMES = ("centred", "absolute")
+
+
+@dataclass
+class FramedTwin:
+    """The grid's twin, and the frame it runs in.
+
+    ``state``: the twin; ``base``: the reference moved back by ``shift`` grid steps, x -> x - V
+    shift dt (the same motion, the drive shifted in time by the symmetry of the equations), or
+    None when the twin runs in the reference's own frame (``shift`` 0). Both run ``shift`` steps
+    behind the reference's clock, and are moved back together every ``hop`` steps.
+    """
+
+    state: ChainState
+    base: ChainState | None
+    shift: int
+    hop: int = 0
+
+
 class GridEngine:
     """The engine's map (starts and stops on the time grid) for :func:`two_trajectory_exponent`.
 
     Separations in y = (sqrt(K) e, v, theta) (:func:`separation`), twins by :func:`twin_state`,
     advanced with ``engine`` 'lean' (:class:`stickslip.run.driver.Stepper`) or 'run_chain'.
     No neutral direction (the grid locks the phase of a slip to a step) and no waiting.
+
+    ``frame`` 'centred' (default): at every renormalisation the twin is built from a copy of the
+    reference moved back by the whole number of steps k that brings the pulling point and the
+    positions closest to zero (x -> x - V k dt, t -> t - k dt; eq. (4) reads positions only
+    relative to V t, so this copy continues the reference's motion), and the separation is
+    measured against that copy, both run with the engine. Their rounding is that of positions
+    of the size of the chain's own extent, not of V t: a decaying separation does not sink into
+    the round-off of absolute positions (ulp(V t), 1.8e-12 at V t = 1e4) in a long run.
+    'absolute': the twin runs beside the reference itself (the method before the frame). Ends
+    that read t (a wall, fixed ends) always run in the reference's frame.
     """
 
     method = METHOD
     norm = NORM
     max_wait = 0
 
-    def __init__(self, params: ChainParams, engine: str = "lean"):
+    def __init__(self, params: ChainParams, engine: str = "lean", frame: str = "centred"):
         if engine not in ENGINES:
             raise ParameterError(f"engine must be one of {', '.join(ENGINES)} (got {engine!r})")
+        if frame not in FRAMES:
+            raise ParameterError(f"frame must be one of {', '.join(FRAMES)} (got {frame!r})")
         self.params = params
+        self.frame = frame
         self.stepper = _LeanEngine(params) if engine == "lean" else _RunChainEngine(params)
+        self.shifts = frame == "centred" and not params.ends_piece.wall and params.V * params.dt > 0.0
 
-    def advance(self, ref: ChainState, twin: ChainState, step: int) -> tuple[ChainState, ChainState, int]:
-        """Both to ``step``; the reference's slip events on the way."""
+    def advance(self, ref: ChainState, twin: FramedTwin, step: int) -> tuple[ChainState, FramedTwin, int]:
+        """All to ``step`` of the reference's clock; the reference's slip events on the way.
+
+        In the centred frame the twin and the reference's copy go in hops over which the drive
+        moves by no more than the chain's extent (at least 1), and are moved back together after
+        each (:meth:`centring_shift`), so that their positions stay of that size.
+        """
         ref, n_events = self.stepper.advance(ref, step)
-        twin, _ = self.stepper.advance(twin, step)
-        return ref, twin, n_events
+        if twin.base is None:
+            twin.state, _ = self.stepper.advance(twin.state, step - twin.shift)
+            return ref, twin, n_events
+        while True:
+            target = step - twin.shift
+            reach = min(target, twin.base.step + twin.hop)
+            twin.base, _ = self.stepper.advance(twin.base, reach)
+            twin.state, _ = self.stepper.advance(twin.state, reach)
+            if reach == target:
+                return ref, twin, n_events
+            k, twin.hop = self.centring_shift(twin.base)
+            if k:
+                twin.base, twin.state = _moved_back(twin.base, k, self.params), _moved_back(twin.state, k, self.params)
+                twin.shift += k
 
     def step(self, ref: ChainState) -> int:
         """The reference's step."""
         return ref.step
 
-    def separation(self, ref: ChainState, twin: ChainState) -> np.ndarray:
-        """:func:`separation`."""
-        return separation(ref, twin, self.params)
+    def separation(self, ref: ChainState, twin: FramedTwin) -> np.ndarray:
+        """:func:`separation` of the twin from the reference (its copy in the twin's frame)."""
+        return separation(ref if twin.base is None else twin.base, twin.state, self.params)
 
-    def twin(self, ref: ChainState, direction: np.ndarray, d0: float) -> ChainState:
-        """:func:`twin_state`."""
-        return twin_state(ref, direction, d0, self.params)
+    def twin(self, ref: ChainState, direction: np.ndarray, d0: float) -> FramedTwin:
+        """:func:`twin_state` of the reference's copy moved back by :meth:`centring_shift`
+        (of the reference itself in the absolute frame)."""
+        k, hop = self.centring_shift(ref) if self.shifts else (0, 0)
+        base = _moved_back(ref, k, self.params) if k else None
+        return FramedTwin(twin_state(ref if base is None else base, direction, d0, self.params), base, k, hop)
+
+    def centring_shift(self, state: ChainState) -> tuple[int, int]:
+        """(k, hop): k steps in [0, state.step] to move ``state`` back by so that the pulling
+        point and the blocks lie about zero (within +-R/2, R the extent of those positions, at
+        least 1: below, positions round no worse than velocities of order one), and the hop,
+        the steps over which the drive moves by R (after it, within -R/2 .. 3R/2)."""
+        p = self.params
+        n = state.step
+        x = state.x[1:-1]
+        drive = p.V * (np.float64(n) * p.dt)
+        lo, hi = min(float(x.min()), drive), max(float(x.max()), drive)
+        rate = p.V * p.dt  # drive per step
+        hop = max(1, int(max(hi - lo, 1.0) / rate))
+        k = int(round(0.5 * (lo + hi) / rate))
+        return min(max(k, 0), n), hop
 
     def on_branch(self, dy: np.ndarray, ref: ChainState) -> np.ndarray:
         """No velocity on the reference's stuck blocks."""
         return _project(dy, ref.mov[1:-1] == 0.0)
 
-    def same_branch(self, ref: ChainState, twin: ChainState) -> bool:
+    def same_branch(self, ref: ChainState, twin: FramedTwin) -> bool:
         """Whether both have the same blocks stuck."""
-        return bool(np.array_equal(ref.mov, twin.mov))
+        return bool(np.array_equal(ref.mov, twin.state.mov))
 
     def neutral(self, ref: ChainState) -> None:
         """None: nothing is removed."""
@@ -209,6 +286,7 @@ def largest_lyapunov(
     direction_seed: int = 0,
     segments: int = 10,
     engine: str = "lean",
+    frame: str = "centred",
     progress: bool = False,
 ) -> LyapunovResult:
     """Largest Lyapunov exponent of eq. (4) (eq. (1) for N = 1), Benettin et al. (1980).
@@ -228,11 +306,14 @@ def largest_lyapunov(
     (:func:`stickslip.analysis.benettin.two_trajectory_exponent` with :class:`GridEngine`).
 
     The reference is continued exactly as one uninterrupted run: its final state is bit for bit
-    ``run_chain(params, t_end, start=start, ...).state``. d0 is the realised distance after
-    rounding, so ln(d / d0) is not biased by the rounding of the twin's positions.
+    ``run_chain(params, t_end, start=start, ...).state``. With ``frame`` 'centred' (default) the
+    twin and a copy of the reference run in a frame moved back along the drive by whole steps
+    (:class:`GridEngine`), so that the separation is not limited by the rounding of positions of
+    the size of V t; 'absolute' runs the twin beside the reference itself. d0 is the realised
+    distance after rounding, so ln(d / d0) is not biased by the rounding of the twin's positions.
     """
     t_end, interval, d0, transient, align, segments = check_run(params, t_end, interval, d0, transient, align, segments)
-    grid = GridEngine(params, engine)
+    grid = GridEngine(params, engine, frame)
     dt = params.dt
     n0 = steps_for(transient, dt)
     wall0 = time.perf_counter()
@@ -259,6 +340,7 @@ def largest_lyapunov(
         segments=segments,
         direction_seed=direction_seed,
         start=start if isinstance(start, str) else "state",
+        extra={"frame": frame},
         progress=progress,
         wall0=wall0,
     )
