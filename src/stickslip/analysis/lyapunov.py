@@ -118,10 +118,15 @@ def _with_step(state: ChainState, step: int) -> ChainState:
     return state
 
 
-def _moved_back(state: ChainState, k: int, params: ChainParams) -> ChainState:
-    """``state`` moved back along the drive by k steps: x -> x - V k dt at step - k (a new state)."""
+def moved_back(state: ChainState, k: int, params: ChainParams) -> ChainState:
+    """``state`` moved back along the drive by k steps: x -> x - V k dt at step - k (a new state).
+
+    Eq. (4) and its relatives read positions only relative to the drive (V t), so the motion
+    from it is the same (fixed ends, which read t, excepted); k = step restarts the clock.
+    """
     b = state.blocks()
     moved = ChainState.from_blocks(b["x"] - params.V * (np.float64(k) * params.dt), b["v"], b["theta"], b["stopped"])
+    moved.model = state.model
     return _with_step(moved, state.step - k)
 
 
@@ -222,7 +227,7 @@ class GridEngine:
                 return ref, twin, n_events
             k, twin.hop = self.centring_shift(twin.base)
             if k:
-                twin.base, twin.state = _moved_back(twin.base, k, self.params), _moved_back(twin.state, k, self.params)
+                twin.base, twin.state = moved_back(twin.base, k, self.params), moved_back(twin.state, k, self.params)
                 twin.shift += k
 
     def step(self, ref: ChainState) -> int:
@@ -237,7 +242,7 @@ class GridEngine:
         """:func:`twin_state` of the reference's copy moved back by :meth:`centring_shift`
         (of the reference itself in the absolute frame)."""
         k, hop = self.centring_shift(ref) if self.shifts else (0, 0)
-        base = _moved_back(ref, k, self.params) if k else None
+        base = moved_back(ref, k, self.params) if k else None
         return FramedTwin(twin_state(ref if base is None else base, direction, d0, self.params), base, k, hop)
 
     def centring_shift(self, state: ChainState) -> tuple[int, int]:
