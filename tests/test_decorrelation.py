@@ -279,3 +279,15 @@ def test_a_thousand_slips_of_the_chain_in_minutes():
     res = sequence_decorrelation(GridSequences(p), st, DELTAS, events=1000)
     assert time.process_time() - t0 < 600
     assert res.reference_events == 1000 and len(res.rows) == 4
+
+
+def test_a_reference_that_stops_slipping_ends_its_window():
+    """Steady sliding (eq. 1 above the inverse transition, V = 0.5) has no slips: the window of
+    slips ends once the reference has been quiet for long, and nothing is compared."""
+    from stickslip.analysis.decorrelation import QUIET_STEPS
+    from stickslip.run.state import initial_state
+
+    p = ChainParams(N=1, V=0.5)
+    res = sequence_decorrelation(GridSequences(p), initial_state(p, "steady"), (1e-6,), events=10)
+    assert res.reference_events == 0 and res.windows[0]["t_window"] > QUIET_STEPS * p.dt
+    assert res.rows[0]["decorrelated"] is False and res.rows[0]["events"] == 0

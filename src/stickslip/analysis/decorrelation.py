@@ -275,8 +275,15 @@ def _check_parameter_perturbation(params: ChainParams, name: str, deltas) -> Non
         params.replace(**{name: getattr(params, name) * (1.0 + d)})  # in range, one line if not
 
 
+#: A window of slips also ends when the reference has had no slip for this many steps and for
+#: QUIET_INTERVALS times the mean time between its slips so far (steady sliding, say).
+QUIET_STEPS = 2_000_000
+QUIET_INTERVALS = 100
+
+
 def _reference_window(source, ref, events, t_max, chunk):
-    """The reference from its state to the end of its ``events``-th slip (or ``t_max`` later)."""
+    """The reference from its state to the end of its ``events``-th slip (or ``t_max`` later, or
+    once it has gone quiet: :data:`QUIET_STEPS`)."""
     dt = source.params.dt
     n0 = ref.step
     n_cap = n0 + int(round(t_max / dt)) if t_max is not None else None
@@ -284,6 +291,7 @@ def _reference_window(source, ref, events, t_max, chunk):
     parts = []
     have = 0
     n = n0
+    last = n0  # step of the latest slip's start
     while (events is None or have < events) and (n_cap is None or n < n_cap):
         target = n + m if n_cap is None else min(n + m, n_cap)
         ref, rows = source.run(source.params, ref, target)
@@ -291,6 +299,10 @@ def _reference_window(source, ref, events, t_max, chunk):
         if len(rows):
             parts.append(rows)
             have += len(rows)
+            last = int(round(rows[-1, 0] / dt))
+        mean = (last - n0) / have if have > 1 else 0.0
+        if n_cap is None and n - last > max(QUIET_STEPS, QUIET_INTERVALS * mean):
+            break
         if chunk is None and t_max is None and len(rows) < 50:
             m *= 2  # about 50 slips a chunk
     rows = np.concatenate(parts) if parts else _NO_ROWS
