@@ -14,9 +14,11 @@ import numpy as np
 import pytest
 
 from stickslip.analysis.decorrelation import (
+    GridSequences,
     event_decorrelation,
     first_disagreement,
     growth_power,
+    sequence_decorrelation,
     verdict,
 )
 from stickslip.models.params import ChainParams
@@ -41,6 +43,11 @@ def test_first_disagreement_by_hand():
     assert first_disagreement(a, [1.5, 2.0, 3.0, 4.0]) == 0
     assert first_disagreement(a, [1.0, 2.0, 3.0, 4.0 * (1 + 2e-3)], rtol=1e-3) == 3
     assert first_disagreement([], a) is None
+    # the same sizes, but another start block or another number of blocks: another slip
+    blocks = [[1, 1], [2, 1], [1, 3], [4, 1]]
+    assert first_disagreement(a, a, 1e-3, blocks, blocks) is None
+    assert first_disagreement(a, a, 1e-3, blocks, [[1, 1], [2, 1], [2, 3], [4, 1]]) == 2
+    assert first_disagreement(a, a, 1e-3, blocks, [[1, 1], [2, 2], [1, 3], [4, 1]]) == 1
 
 
 def test_periodic_block_never_decorrelates():
@@ -111,4 +118,176 @@ def test_cli_decorrelation_json(capsys):
     rows = out["decorrelation"]
     assert [r["delta"] for r in rows] == list(DELTAS)
     assert all(r["decorrelated"] for r in rows) and rows[0]["events"] > rows[-1]["events"]
-    assert main(["lyapunov", "--model", "two-blocks", "--decorrelation"]) == 2
+    assert main(["lyapunov", "--model", "two-blocks", "--decorrelation", "--betas", "1"]) == 2
+
+
+# ------------------------------------------------------------------------------------------
+# Slip sequences: the comparison's logic on scripted sequences, then the engine's map
+
+
+class _Scripted:
+    """Slips every 10 steps: t_start = k dt, size 1 + k / 100, start block k % 3, one block. A
+    twin's slips change from slip ``flip`` on (another start block) or stop after slip ``stop``
+    (a twin that stops slipping); a change of Fs acts as a twin with flip = 7."""
+
+    switches = "scripted"
+
+    class State:
+        def __init__(self, step=0, flip=None, stop=None):
+            self.step, self.flip, self.stop = step, flip, stop
+
+        def copy(self):
+            return _Scripted.State(self.step, self.flip, self.stop)
+
+    def __init__(self, params, flips):
+        self.params = params
+        self.flips = flips  # delta -> (flip, stop)
+
+    def prepare(self, state):
+        return state.copy()
+
+    def twin(self, params, state, direction, delta):
+        flip, stop = self.flips[delta]
+        return _Scripted.State(state.step, flip, stop)
+
+    def run(self, params, state, step):
+        flip = 7 if params.Fs != self.params.Fs else state.flip
+        ks = np.arange(state.step // 10 + 1, step // 10 + 1)
+        if state.stop is not None:
+            ks = ks[ks <= state.stop]
+        blocks = (ks % 3) + (0 if flip is None else (ks >= flip))
+        rows = np.column_stack((ks * 10 * params.dt, 1 + ks / 100, blocks, np.ones(len(ks))))
+        out = state.copy()
+        out.step = step
+        return out, rows.reshape(-1, 4)
+
+
+def test_sequence_comparison_counts_agreeing_slips_and_missing_ones():
+    p = ChainParams(N=1)
+    flips = {1e-9: (None, None), 1e-6: (25, None), 1e-3: (None, 40)}
+    src = _Scripted(p, flips)
+    res = sequence_decorrelation(src, _Scripted.State(), (1e-9, 1e-6, 1e-3), events=100, chunk=0.3)
+    by = {r["delta"]: r for r in res.rows}
+    assert res.reference_events == 100 and res.windows[0]["reference_events"] == 100
+    assert by[1e-9]["decorrelated"] is False and by[1e-9]["events"] == 100
+    # slip k (1-based) is row k - 1: the 25th slip is the first other one, 24 agree before it
+    assert by[1e-6]["events"] == 24 and by[1e-6]["t_decorrelated"] == pytest.approx(250 * p.dt)
+    # a twin that stops slipping after 40 slips: it has run twice the window, the 41st is missing
+    assert by[1e-3]["decorrelated"] is True and by[1e-3]["events"] == 40
+    # a window of time: both run as long, and a slip the twin lacks at the end is not counted
+    res = sequence_decorrelation(src, _Scripted.State(), (1e-3,), events=None, t_max=0.5 * 300 * p.dt * 10 / 10)
+    (row,) = res.rows
+    assert row["decorrelated"] is False and row["events"] == res.reference_events == 15
+    # a change of Fs; and seeds: windows one after the other
+    res = sequence_decorrelation(src, _Scripted.State(), (1e-4,), perturbation="Fs", events=30, seeds=3, chunk=0.3)
+    assert [r["events"] for r in res.rows] == [6, 0, 0]
+    assert [w["reference_events"] for w in res.windows] == [30, 30, 30]
+
+
+def test_parameter_perturbations_are_checked_against_the_model():
+    from stickslip.models.params import ParameterError
+
+    src = _Scripted(chain_params("batista-carlson"), {})
+    with pytest.raises(ParameterError, match="perturbation Fs needs a model that reads Fs"):
+        sequence_decorrelation(src, _Scripted.State(), (1e-3,), perturbation="Fs")
+    with pytest.raises(ParameterError, match="perturbation V needs ends that do not read t"):
+        sequence_decorrelation(
+            _Scripted(ChainParams(N=3, ends="fixed"), {}), _Scripted.State(), (1e-3,), perturbation="V"
+        )
+    with pytest.raises(ParameterError, match="perturbation must be one of state, Fs, V"):
+        sequence_decorrelation(src, _Scripted.State(), (1e-3,), perturbation="K")
+
+
+def _grid_state(params, t):
+    from stickslip.run.driver import run_chain
+    from stickslip.run.errors import short_runs_expected
+
+    with short_runs_expected():
+        return run_chain(params, t).state
+
+
+def test_grid_chunks_and_restarted_clock_give_the_slips_of_one_run():
+    """Chunks continue the run exactly; a state moved back to t = 0 with its positions relative
+    to the drive kept has the same slips (eq. 4 reads positions only relative to V t)."""
+    from stickslip.run.driver import run_chain
+
+    p = ChainParams(N=9, beta=0.5)
+    st = _grid_state(p, 3000.0)
+    one = run_chain(p, 6000.0, start=st).events
+    src = GridSequences(p)
+    s, a = src.run(p, st.copy(), round(4500.0 / p.dt))
+    s, b = src.run(p, s, round(6000.0 / p.dt))
+    rows = np.concatenate((a, b))
+    assert len(rows) == len(one) > 5
+    assert np.array_equal(rows[:, 1], one["S"].to_numpy()) and np.array_equal(rows[:, 2], one["start_block"])
+    moved = src.prepare(st)
+    assert moved.step == 0
+    _, c = src.run(p, moved, round(3000.0 / p.dt))
+    assert len(c) == len(one)
+    assert np.array_equal(c[:, 2:], rows[:, 2:])
+    assert np.allclose(c[:, 1], rows[:, 1], rtol=1e-9)
+    assert np.allclose(c[:, 0] + 3000.0, rows[:, 0], atol=p.dt / 2)
+
+
+@pytest.mark.parametrize("perturbation", ["state", "Fs", "V"])
+def test_grid_periodic_block_keeps_its_slips_under_every_perturbation(perturbation):
+    """One block's stick-slip cycle (eq. 1): every slip is block 1 alone, so no perturbation that
+    keeps the cycle can change the sequence's slips; sizes move by about delta."""
+    st = _grid_state(CYCLE, 200.0)
+    res = sequence_decorrelation(GridSequences(CYCLE), st, (1e-12, 1e-6, 1e-3), perturbation=perturbation, events=300)
+    assert res.reference_events == 300
+    for row in res.rows:
+        assert row["decorrelated"] is False and row["events"] == 300, row
+
+
+def test_grid_two_blocks_decorrelate_later_for_smaller_delta():
+    params = chain_params("two-blocks")
+    from stickslip.run.driver import run_chain
+
+    st = run_chain(params, 500.0, start="rest", perturbation=0.01).state
+    res = sequence_decorrelation(GridSequences(params), st, (1e-12, 1e-8, 1e-4), events=1000)
+    n = [r["events"] for r in res.rows]
+    assert all(r["decorrelated"] for r in res.rows), res.rows
+    assert n[0] > n[-1] and n[0] < 200
+
+
+def test_cli_decorrelation_grid_rows_and_seeds(capsys):
+    import json
+
+    from stickslip.cli import main
+
+    argv = ["lyapunov", "--N", "1", "--K", "10", "--V", "0.05", "--decorrelation", "--transient", "200"]
+    status = main(argv + ["--perturb", "V", "--deltas", "1e-6,1e-3", "--events", "100", "--seeds", "2", "--json"])
+    out = json.loads(capsys.readouterr().out)
+    assert status in (0, None)
+    assert [(r["seed"], r["delta"]) for r in out["decorrelation"]] == [(0, 1e-6), (0, 1e-3), (1, 1e-6), (1, 1e-3)]
+    assert all(not r["decorrelated"] and r["events"] == 100 for r in out["decorrelation"])
+    assert out["decorrelation_switches"] == "grid" and out["decorrelation_perturbation"] == "V"
+    assert [w["reference_events"] for w in out["decorrelation_windows"]] == [100, 100]
+    assert main(argv + ["--deltas", "2"]) == 2
+    assert main(["lyapunov", "--N", "1", "--events", "10"]) == 2
+
+
+def test_a_thousand_slips_of_the_chain_in_minutes():
+    """The chain of eq. (4), N = 99, beta = 0.5: 1000 slips of the reference and four twins on
+    the engine's map, well under ten minutes on one core."""
+    import time
+
+    p = ChainParams(N=99, beta=0.5)
+    st = _grid_state(p, 5e5)
+    t0 = time.process_time()
+    res = sequence_decorrelation(GridSequences(p), st, DELTAS, events=1000)
+    assert time.process_time() - t0 < 600
+    assert res.reference_events == 1000 and len(res.rows) == 4
+
+
+def test_a_reference_that_stops_slipping_ends_its_window():
+    """Steady sliding (eq. 1 above the inverse transition, V = 0.5) has no slips: the window of
+    slips ends once the reference has been quiet for long, and nothing is compared."""
+    from stickslip.analysis.decorrelation import QUIET_STEPS
+    from stickslip.run.state import initial_state
+
+    p = ChainParams(N=1, V=0.5)
+    res = sequence_decorrelation(GridSequences(p), initial_state(p, "steady"), (1e-6,), events=10)
+    assert res.reference_events == 0 and res.windows[0]["t_window"] > QUIET_STEPS * p.dt
+    assert res.rows[0]["decorrelated"] is False and res.rows[0]["events"] == 0

@@ -102,6 +102,66 @@ def test_steady_sliding_chain_exponent_is_the_least_stable_eigenvalue_of_eq5():
     assert abs(res.lyapunov - expected) <= 0.03 * abs(expected)
 
 
+def _heun_map_exponent(params: ChainParams) -> tuple[float, float]:
+    """Eq. (2)'s least stable eigenvalue's real part, and that of one Heun step of it: Heun
+    multiplies an eigenvector of a linear system by g = 1 + z + z^2 / 2, z = lambda dt (closed
+    form), so the map the engine integrates decays at ln|g| / dt."""
+    lam = complex(block_eigenvalues(BlockParams(K=params.K, beta=params.beta, V=params.V, Fs=params.Fs))[0])
+    z = lam * params.dt
+    return lam.real, math.log(abs(1 + z + z * z / 2)) / params.dt
+
+
+def test_sliding_block_at_the_commands_defaults(capsys):
+    """`stickslip lyapunov --N 1 --V 0.5 --json`: start paper, t_end 2e4, d0 1e-10, interval 10.
+    Over an interval the separation decays by exp(-4.87), to 8e-13: below the rounding of
+    positions x ~ V t = 1e4 (ulp 1.8e-12), above that of the twin's frame."""
+    status, out, _ = run_cli(capsys, "lyapunov", "--N", "1", "--V", "0.5", "--json", "--no-progress")
+    assert status == 0
+    d = json.loads(out)
+    exact, heun = _heun_map_exponent(ChainParams(N=1, V=0.5))
+    assert exact == pytest.approx(-0.4865, abs=1e-4) and heun - exact == pytest.approx(-5.5e-5, abs=5e-6)
+    assert d["frame"] == "centred" and d["t_end"] == 2e4 and d["merges"] == 0
+    assert abs(d["lyapunov"] - heun) <= 3 * d["lyapunov_err"] + 1e-6
+    assert abs(d["lyapunov"] - exact) <= abs(heun - exact) + 3 * d["lyapunov_err"]
+    assert d["lyapunov_err"] < 1e-4
+
+
+def test_sliding_block_in_the_absolute_frame_sinks_into_round_off():
+    """The method before the frame: the same run with the twin beside the reference itself."""
+    exact, _ = _heun_map_exponent(ChainParams(N=1, V=0.5))
+    res = largest_lyapunov(ChainParams(N=1, V=0.5), 2e4, frame="absolute")
+    assert res.lyapunov > exact + 0.1
+
+
+@pytest.mark.slow
+def test_sliding_block_ten_times_the_defaults():
+    p = ChainParams(N=1, V=0.5)
+    exact, heun = _heun_map_exponent(p)
+    res = largest_lyapunov(p, 2e5)
+    assert res.merges == 0 and res.lyapunov_err < 1e-5
+    assert abs(res.lyapunov - heun) <= 3 * res.lyapunov_err + 1e-6
+    assert abs(res.lyapunov - exact) <= abs(heun - exact) + 3 * res.lyapunov_err
+
+
+def test_twin_runs_in_a_frame_moved_back_along_the_drive():
+    from stickslip.analysis.lyapunov import GridEngine
+
+    p = ChainParams(N=1, V=0.5)
+    ref = run_chain(p, 1000.0).state
+    eng = GridEngine(p)
+    twin = eng.twin(ref, np.ones(3), 1e-10)
+    assert twin.shift > 0 and abs(twin.base.x[1]) < 1.0 and ref.x[1] > 400
+    # the copy is the reference's motion: same velocity, theta and spring force
+    assert twin.base.v[1] == ref.v[1] and twin.base.th[1] == ref.th[1]
+    f_ref = p.V * ref.step * p.dt - ref.x[1]
+    assert p.V * twin.base.step * p.dt - twin.base.x[1] == pytest.approx(f_ref, abs=1e-12)
+    ref, twin, _ = eng.advance(ref, twin, ref.step + round(10.0 / p.dt))
+    assert abs(twin.base.x[1]) < 2.0 and twin.base.step + twin.shift == ref.step
+    # fixed ends read t: the twin stays beside the reference
+    wall = GridEngine(ChainParams(N=3, ends="fixed"))
+    assert wall.twin(run_chain(ChainParams(N=3, ends="fixed"), 100.0).state, np.ones(9), 1e-10).base is None
+
+
 @pytest.fixture(scope="module")
 def grid_multiplier():
     """Per-cycle multiplier m = d f_end / d Fs of the slip of eq. (3), and the period T(V)."""
@@ -290,3 +350,60 @@ def test_plate_drive_steady_sliding_decays_at_minus_beta_over_two():
     )
     res = largest_lyapunov(p, 200.0, interval=2.0, d0=1e-8, transient=0.0, start="steady", perturbation=1e-3, seed=0)
     assert res.lyapunov == pytest.approx(-0.2, rel=0.02)
+
+
+# ------------------------------------------------------------------------------------------
+# The method over any engine
+
+
+class _LinearEngine:
+    """dy/dt = A y, advanced exactly (a matrix exponential per step): the largest exponent is
+    the largest real part of A's eigenvalues, with no switching and no round-off floor."""
+
+    method = norm = "linear"
+    max_wait = 0
+
+    def __init__(self, params, a):
+        from scipy.linalg import expm
+
+        self.params = params
+        self.step_map = expm(a * params.dt)
+
+    def advance(self, ref, twin, step):
+        k = step - ref[0]
+        P = np.linalg.matrix_power(self.step_map, k)
+        return (step, P @ ref[1]), (step, P @ twin[1]), 0
+
+    def step(self, ref):
+        return ref[0]
+
+    def separation(self, ref, twin):
+        return twin[1] - ref[1]
+
+    def twin(self, ref, direction, d0):
+        return ref[0], ref[1] + d0 * direction / np.linalg.norm(direction)
+
+    def on_branch(self, dy, ref):
+        return dy
+
+    def same_branch(self, ref, twin):
+        return True
+
+    def neutral(self, ref):
+        return None
+
+    def fingerprint(self, ref):
+        return ""
+
+
+def test_one_loop_serves_any_engine_linear_flow():
+    from stickslip.analysis.benettin import two_trajectory_exponent
+
+    p = ChainParams(N=1, dt=0.01)
+    # a damped oscillator (-0.2 +- 2 i) and a faster decay (-0.7)
+    a = np.array([[-0.2, 2.0, 0.0], [-2.0, -0.2, 0.0], [0.0, 0.0, -0.7]])
+    res = two_trajectory_exponent(
+        _LinearEngine(p, a), (0, np.zeros(3)), 200.0, interval=5.0, d0=1e-6, transient=0.0, align=20.0, segments=5
+    )
+    assert res.lyapunov == pytest.approx(-0.2, rel=1e-9)
+    assert res.renormalisations == 36 and res.waits == 0 and res.merges == 0

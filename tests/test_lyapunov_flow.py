@@ -20,11 +20,11 @@ import numpy as np
 import pytest
 
 from chain_helpers import run_cli
+from stickslip.analysis.benettin import remove_flow
 from stickslip.analysis.lyapunov_flow import (
     extrapolate,
     flow_direction,
     flow_lyapunov,
-    remove_flow,
     separation,
     twin_state,
 )
@@ -132,3 +132,17 @@ def test_block_steady_sliding_at_the_commands_defaults_and_ten_times_longer(t_en
     res = flow_lyapunov(STEADY, t_end, d0=1e-10)
     assert abs(res.lyapunov - expected) < max(4 * res.lyapunov_err, 1e-4)
     assert max(res.segment_means) - min(res.segment_means) < 2e-3
+
+
+@pytest.mark.slow
+def test_cli_located_at_the_commands_defaults(capsys):
+    """`stickslip lyapunov --switches located --N 1 --V 0.5 --json` (start paper, t_end 2e4, the
+    ladder dt .. dt/4): extrapolated to dt -> 0, eq. (2)'s -0.4865 itself."""
+    status, out, _ = run_cli(
+        capsys, "lyapunov", "--switches", "located", "--N", "1", "--V", "0.5", "--json", "--no-progress"
+    )
+    assert status == 0
+    d = json.loads(out)
+    expected = float(block_eigenvalues(BlockParams(K=10.0, V=0.5, beta=1.0, Fs=3.0))[0].real)
+    assert d["t_end"] == 2e4 and d["lyapunov_dt0_err"] < 1e-4
+    assert abs(d["lyapunov_dt0"] - expected) <= 3 * d["lyapunov_dt0_err"]

@@ -28,6 +28,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
+from stickslip.analysis.benettin import remove_flow
 from stickslip.models.params import ChainParams, ParameterError, check_number
 
 
@@ -192,29 +193,22 @@ class LocatedPair:
     """
 
     def __init__(self, params: ChainParams, ref, *, neutral: str = "remove", direction_seed: int = 0):
-        from stickslip.analysis import lyapunov_flow as lf
-        from stickslip.run.located import LocatedStepper
+        from stickslip.analysis.lyapunov_flow import LocatedEngine
 
         self.params = params
         self.dt = params.dt
-        self.lf = lf
-        self.stepper = LocatedStepper(params)
+        self.engine = LocatedEngine(params, neutral=neutral)
         self.ref = ref.copy()
         self.twin = None
         self.neutral = neutral
         self.rng = np.random.default_rng(direction_seed)
 
     def _dy(self) -> np.ndarray:
-        dy = self.lf.separation(self.ref, self.twin, self.params)
-        if self.neutral == "remove":
-            dy = self.lf.remove_flow(dy, self.lf.flow_direction(self.ref, self.params), 1e-9)
-        return dy
+        return remove_flow(self.engine.separation(self.ref, self.twin), self.engine.neutral(self.ref))
 
     def advance(self, steps: int) -> None:
         """Both by ``steps`` grid steps."""
-        n = self.ref.step + steps
-        self.ref, _ = self.stepper.advance(self.ref, n)
-        self.twin, _ = self.stepper.advance(self.twin, n)
+        self.ref, self.twin, _ = self.engine.advance(self.ref, self.twin, self.ref.step + steps)
 
     def distance(self) -> float:
         """The norm of y_twin - y_ref (less the part along the flow with neutral 'remove')."""
@@ -225,13 +219,12 @@ class LocatedPair:
         direction = None
         if self.twin is not None:
             dy = self._dy()
-            if np.any(self.lf._on_branch(dy, self.ref.stopped, self.params) != 0.0):
+            if np.any(self.engine.on_branch(dy, self.ref) != 0.0):
                 direction = dy
         if direction is None:
             direction = self.rng.standard_normal(3 * self.params.N)
         # delta is the measured distance: rescale once for the removed part
-        twin = self.lf.twin_state(self.ref, direction, delta, self.params)
-        self.twin = twin
+        self.twin = self.engine.twin(self.ref, direction, delta)
         d = self.distance()
         if d > 0:
-            self.twin = self.lf.twin_state(self.ref, direction, delta * delta / d, self.params)
+            self.twin = self.engine.twin(self.ref, direction, delta * delta / d)

@@ -1,11 +1,12 @@
 """The largest Lyapunov exponent of the chain of eq. (4) (and of eq. (1) as the chain with N = 1).
 
-Two-trajectory method of Benettin, Galgani, Giorgilli and Strelcyn (Meccanica 15, 9, 1980):
-a reference trajectory and a twin a distance d0 away are advanced side by side with the chain
-engine (:func:`stickslip.run.driver.run_chain`); every ``interval`` the distance d is measured and
-the twin is put back at distance d0 along the current separation. The exponent is the mean of
-ln(d / d0) per unit time over the renormalisations after a transient, and its error bar the
-standard error of the means of M independent segments of them.
+Two-trajectory method of Benettin, Galgani, Giorgilli and Strelcyn (Meccanica 15, 9, 1980),
+:mod:`stickslip.analysis.benettin`, over the chain engine (:class:`GridEngine`, the map of
+:func:`stickslip.run.driver.run_chain`): a reference trajectory and a twin a distance d0 away
+are advanced side by side; every ``interval`` the distance d is measured and the twin is put
+back at distance d0 along the current separation. The exponent is the mean of ln(d / d0) per
+unit time over the renormalisations after a transient, and its error bar the standard error of
+the means of M independent segments of them.
 
 Separation. The state of block i is (x_i, v_i, theta_i, stopped_i). Forces depend on positions
 only through the spring extensions e_i = x_{i-1} - x_i (x_0 = V t_n, the pulling point), so the
@@ -33,120 +34,22 @@ perturbation's energy that every block has whatever its neighbours do).
 from __future__ import annotations
 
 import math
-import sys
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 import pandas as pd
 
-from stickslip.models.params import ChainParams, ParameterError, check_number, steps_for
+from stickslip.analysis.benettin import METHOD, LyapunovResult, check_run, two_trajectory_exponent
+from stickslip.models.params import ChainParams, ParameterError, steps_for
 from stickslip.run.driver import ChainState, Stepper, run_chain
 from stickslip.run.errors import short_runs_expected
 from stickslip.run.state import initial_state
 from stickslip.run.validate import check_start_state
 
-#: Largest allowed initial separation: beyond it the twin is not a small perturbation.
-D0_MAX = 1e-3
-
 NORM = "Euclidean norm of (sqrt(K) e_i, v_i, theta_i), e_i = x_{i-1} - x_i, x_0 = V t"
-
-
-@dataclass(frozen=True)
-class LyapunovResult:
-    """The largest Lyapunov exponent of one run (Benettin et al. 1980, two trajectories).
-
-    lyapunov: sum of ln(d_k / d0_k) over the counted renormalisations divided by their total
-    time; lyapunov_err: standard error of the means of ``segments`` consecutive groups of them;
-    times, log_growth, durations: end time, ln(d / d0) and length of every renormalisation
-    interval (counted or not); counted: which enter the exponent (those ending after
-    transient + align).
-    """
-
-    lyapunov: float
-    lyapunov_err: float
-    t_end: float
-    transient: float
-    align: float
-    interval: float
-    d0: float
-    renormalisations: int
-    segments: int
-    segment_means: tuple[float, ...]
-    events: int
-    max_log_growth: float
-    reference_sha256: str
-    wall_seconds: float
-    params: ChainParams
-    start: str
-    times: np.ndarray = field(repr=False)
-    log_growth: np.ndarray = field(repr=False)
-    durations: np.ndarray = field(repr=False)
-    counted: np.ndarray = field(repr=False)
-
-    @property
-    def merges(self) -> int:
-        """Counted renormalisations after which the twin had fallen onto the reference (d = 0):
-        d0 at the rounding floor of the state, or a sticking phase that contracts to one point.
-        Any makes the exponent -inf; a larger d0 tells the two apart."""
-        return int(np.count_nonzero(np.isneginf(self.log_growth[self.counted])))
-
-    def to_dict(self) -> dict[str, Any]:
-        """The scalars of the result, its parameters and the method, as a plain dict for JSON."""
-        return {
-            "lyapunov": self.lyapunov,
-            "lyapunov_err": self.lyapunov_err,
-            "t_end": self.t_end,
-            "transient": self.transient,
-            "align": self.align,
-            "interval": self.interval,
-            "d0": self.d0,
-            "renormalisations": self.renormalisations,
-            "merges": self.merges,
-            "segments": self.segments,
-            "segment_means": list(self.segment_means),
-            "events": self.events,
-            "max_log_growth": self.max_log_growth,
-            "reference_sha256": self.reference_sha256,
-            "wall_seconds": self.wall_seconds,
-            "params": self.params.to_dict(),
-            "start": self.start,
-            "method": "Benettin et al. (1980) two-trajectory method with renormalisation",
-            "norm": NORM,
-        }
-
-    def truncated(self, t_end: float) -> LyapunovResult:
-        """The estimate a run to ``t_end`` (a renormalisation time of this run) would have given.
-
-        The twin's history does not depend on the run's end, so this equals the shorter run
-        apart from the reference's final state (its hash is left empty).
-        """
-        keep = self.times <= t_end + 0.5 * self.params.dt
-        lam, err, means = _estimate(self.log_growth[keep], self.durations[keep], self.counted[keep], self.segments)
-        return LyapunovResult(
-            lam,
-            err,
-            float(t_end),
-            self.transient,
-            self.align,
-            self.interval,
-            self.d0,
-            int(np.count_nonzero(self.counted[keep])),
-            self.segments,
-            means,
-            -1,
-            float(np.max(self.log_growth[keep], initial=-np.inf)),
-            "",
-            float("nan"),
-            self.params,
-            self.start,
-            self.times[keep],
-            self.log_growth[keep],
-            self.durations[keep],
-            self.counted[keep],
-        )
 
 
 def separation(ref: ChainState, twin: ChainState, params: ChainParams) -> np.ndarray:
@@ -215,6 +118,18 @@ def _with_step(state: ChainState, step: int) -> ChainState:
     return state
 
 
+def moved_back(state: ChainState, k: int, params: ChainParams) -> ChainState:
+    """``state`` moved back along the drive by k steps: x -> x - V k dt at step - k (a new state).
+
+    Eq. (4) and its relatives read positions only relative to the drive (V t), so the motion
+    from it is the same (fixed ends, which read t, excepted); k = step restarts the clock.
+    """
+    b = state.blocks()
+    moved = ChainState.from_blocks(b["x"] - params.V * (np.float64(k) * params.dt), b["v"], b["theta"], b["stopped"])
+    moved.model = state.model
+    return _with_step(moved, state.step - k)
+
+
 def twin_state(ref: ChainState, direction: np.ndarray, d0: float, params: ChainParams) -> ChainState:
     """The twin ref + d0 * direction (direction in y coordinates, see :func:`separation`).
 
@@ -240,40 +155,126 @@ def twin_state(ref: ChainState, direction: np.ndarray, d0: float, params: ChainP
     return _with_step(ChainState.from_blocks(x, v, th, b["stopped"]), ref.step)
 
 
-def _estimate(log_growth, durations, counted, segments):
-    """Exponent, standard error of the segment means, and the segment means."""
-    g = log_growth[counted]
-    tau = durations[counted]
-    if len(g) < segments:
-        return float("nan"), float("nan"), ()
-    lam = float(np.sum(g) / np.sum(tau))
-    parts = np.array_split(np.arange(len(g)), segments)
-    means = tuple(float(np.sum(g[p]) / np.sum(tau[p])) for p in parts)
-    err = float(np.std(means, ddof=1) / math.sqrt(segments))
-    return lam, err, means
+#: Frames the grid's twin runs in (:class:`GridEngine`).
+FRAMES = ("centred", "absolute")
 
 
-def _check_run(params: ChainParams, t_end, interval, d0, transient, align, segments):
-    """Validate the options; returns (t_end, interval, d0, transient, align, segments) as numbers."""
-    t_end = float(check_number("t_end", t_end, low=0.0, low_open=True))
-    interval = float(check_number("interval", interval, low=params.dt))
-    d0 = float(check_number("d0", d0, low=0.0, high=D0_MAX, low_open=True))
-    transient = float(check_number("transient", transient, low=0.0, high=t_end, high_open=True))
-    if align is None:
-        align = 0.1 * (t_end - transient)
-    align = float(check_number("align", align, low=0.0, high=t_end - transient, high_open=True))
-    segments = int(check_number("segments", segments, low=2, integer=True))
-    m = int(round(interval / params.dt))
-    n_lo = steps_for(transient + align, params.dt)
-    n_end = steps_for(t_end, params.dt)
-    counted = -(-(n_end - n_lo) // m) if n_end > n_lo else 0
-    if counted < segments:
-        need = transient + align + segments * m * params.dt
-        raise ParameterError(
-            f"t_end must be >= {need:g} for {segments} segments of one renormalisation each "
-            f"after transient + align (got {t_end:g})"
-        )
-    return t_end, interval, d0, transient, align, segments
+@dataclass
+class FramedTwin:
+    """The grid's twin, and the frame it runs in.
+
+    ``state``: the twin; ``base``: the reference moved back by ``shift`` grid steps, x -> x - V
+    shift dt (the same motion, the drive shifted in time by the symmetry of the equations), or
+    None when the twin runs in the reference's own frame (``shift`` 0). Both run ``shift`` steps
+    behind the reference's clock, and are moved back together every ``hop`` steps.
+    """
+
+    state: ChainState
+    base: ChainState | None
+    shift: int
+    hop: int = 0
+
+
+class GridEngine:
+    """The engine's map (starts and stops on the time grid) for :func:`two_trajectory_exponent`.
+
+    Separations in y = (sqrt(K) e, v, theta) (:func:`separation`), twins by :func:`twin_state`,
+    advanced with ``engine`` 'lean' (:class:`stickslip.run.driver.Stepper`) or 'run_chain'.
+    No neutral direction (the grid locks the phase of a slip to a step) and no waiting.
+
+    ``frame`` 'centred' (default): at every renormalisation the twin is built from a copy of the
+    reference moved back by the whole number of steps k that brings the pulling point and the
+    positions closest to zero (x -> x - V k dt, t -> t - k dt; eq. (4) reads positions only
+    relative to V t, so this copy continues the reference's motion), and the separation is
+    measured against that copy, both run with the engine. Their rounding is that of positions
+    of the size of the chain's own extent, not of V t: a decaying separation does not sink into
+    the round-off of absolute positions (ulp(V t), 1.8e-12 at V t = 1e4) in a long run.
+    'absolute': the twin runs beside the reference itself (the method before the frame). Ends
+    that read t (a wall, fixed ends) always run in the reference's frame.
+    """
+
+    method = METHOD
+    norm = NORM
+    max_wait = 0
+
+    def __init__(self, params: ChainParams, engine: str = "lean", frame: str = "centred"):
+        if engine not in ENGINES:
+            raise ParameterError(f"engine must be one of {', '.join(ENGINES)} (got {engine!r})")
+        if frame not in FRAMES:
+            raise ParameterError(f"frame must be one of {', '.join(FRAMES)} (got {frame!r})")
+        self.params = params
+        self.frame = frame
+        self.stepper = _LeanEngine(params) if engine == "lean" else _RunChainEngine(params)
+        self.shifts = frame == "centred" and not params.ends_piece.wall and params.V * params.dt > 0.0
+
+    def advance(self, ref: ChainState, twin: FramedTwin, step: int) -> tuple[ChainState, FramedTwin, int]:
+        """All to ``step`` of the reference's clock; the reference's slip events on the way.
+
+        In the centred frame the twin and the reference's copy go in hops over which the drive
+        moves by no more than the chain's extent (at least 1), and are moved back together after
+        each (:meth:`centring_shift`), so that their positions stay of that size.
+        """
+        ref, n_events = self.stepper.advance(ref, step)
+        if twin.base is None:
+            twin.state, _ = self.stepper.advance(twin.state, step - twin.shift)
+            return ref, twin, n_events
+        while True:
+            target = step - twin.shift
+            reach = min(target, twin.base.step + twin.hop)
+            twin.base, _ = self.stepper.advance(twin.base, reach)
+            twin.state, _ = self.stepper.advance(twin.state, reach)
+            if reach == target:
+                return ref, twin, n_events
+            k, twin.hop = self.centring_shift(twin.base)
+            if k:
+                twin.base, twin.state = moved_back(twin.base, k, self.params), moved_back(twin.state, k, self.params)
+                twin.shift += k
+
+    def step(self, ref: ChainState) -> int:
+        """The reference's step."""
+        return ref.step
+
+    def separation(self, ref: ChainState, twin: FramedTwin) -> np.ndarray:
+        """:func:`separation` of the twin from the reference (its copy in the twin's frame)."""
+        return separation(ref if twin.base is None else twin.base, twin.state, self.params)
+
+    def twin(self, ref: ChainState, direction: np.ndarray, d0: float) -> FramedTwin:
+        """:func:`twin_state` of the reference's copy moved back by :meth:`centring_shift`
+        (of the reference itself in the absolute frame)."""
+        k, hop = self.centring_shift(ref) if self.shifts else (0, 0)
+        base = moved_back(ref, k, self.params) if k else None
+        return FramedTwin(twin_state(ref if base is None else base, direction, d0, self.params), base, k, hop)
+
+    def centring_shift(self, state: ChainState) -> tuple[int, int]:
+        """(k, hop): k steps in [0, state.step] to move ``state`` back by so that the pulling
+        point and the blocks lie about zero (within +-R/2, R the extent of those positions, at
+        least 1: below, positions round no worse than velocities of order one), and the hop,
+        the steps over which the drive moves by R (after it, within -R/2 .. 3R/2)."""
+        p = self.params
+        n = state.step
+        x = state.x[1:-1]
+        drive = p.V * (np.float64(n) * p.dt)
+        lo, hi = min(float(x.min()), drive), max(float(x.max()), drive)
+        rate = p.V * p.dt  # drive per step
+        hop = max(1, int(max(hi - lo, 1.0) / rate))
+        k = int(round(0.5 * (lo + hi) / rate))
+        return min(max(k, 0), n), hop
+
+    def on_branch(self, dy: np.ndarray, ref: ChainState) -> np.ndarray:
+        """No velocity on the reference's stuck blocks."""
+        return _project(dy, ref.mov[1:-1] == 0.0)
+
+    def same_branch(self, ref: ChainState, twin: FramedTwin) -> bool:
+        """Whether both have the same blocks stuck."""
+        return bool(np.array_equal(ref.mov, twin.state.mov))
+
+    def neutral(self, ref: ChainState) -> None:
+        """None: nothing is removed."""
+        return None
+
+    def fingerprint(self, ref: ChainState) -> str:
+        """:meth:`stickslip.run.state.ChainState.sha256`."""
+        return ref.sha256()
 
 
 def largest_lyapunov(
@@ -290,6 +291,7 @@ def largest_lyapunov(
     direction_seed: int = 0,
     segments: int = 10,
     engine: str = "lean",
+    frame: str = "centred",
     progress: bool = False,
 ) -> LyapunovResult:
     """Largest Lyapunov exponent of eq. (4) (eq. (1) for N = 1), Benettin et al. (1980).
@@ -305,23 +307,20 @@ def largest_lyapunov(
     (:func:`twin_state`). The renormalisations ending after transient + ``align`` (default a
     tenth of t_end - transient, for the separation to turn into the most unstable direction)
     give the exponent: sum of ln(d / d0) over their total time. The error bar is the standard
-    error of the exponents of ``segments`` consecutive groups of them.
+    error of the exponents of ``segments`` consecutive groups of them
+    (:func:`stickslip.analysis.benettin.two_trajectory_exponent` with :class:`GridEngine`).
 
     The reference is continued exactly as one uninterrupted run: its final state is bit for bit
-    ``run_chain(params, t_end, start=start, ...).state``. d0 is the realised distance after
-    rounding, so ln(d / d0) is not biased by the rounding of the twin's positions.
+    ``run_chain(params, t_end, start=start, ...).state``. With ``frame`` 'centred' (default) the
+    twin and a copy of the reference run in a frame moved back along the drive by whole steps
+    (:class:`GridEngine`), so that the separation is not limited by the rounding of positions of
+    the size of V t; 'absolute' runs the twin beside the reference itself. d0 is the realised
+    distance after rounding, so ln(d / d0) is not biased by the rounding of the twin's positions.
     """
-    t_end, interval, d0, transient, align, segments = _check_run(
-        params, t_end, interval, d0, transient, align, segments
-    )
-    if engine not in ENGINES:
-        raise ParameterError(f"engine must be one of {', '.join(ENGINES)} (got {engine!r})")
-    stepper = _LeanEngine(params) if engine == "lean" else _RunChainEngine(params)
+    t_end, interval, d0, transient, align, segments = check_run(params, t_end, interval, d0, transient, align, segments)
+    grid = GridEngine(params, engine, frame)
     dt = params.dt
-    m = int(round(interval / dt))
     n0 = steps_for(transient, dt)
-    n_end = steps_for(t_end, dt)
-    n_count = steps_for(transient + align, dt)
     wall0 = time.perf_counter()
 
     if n0 > (start.step if isinstance(start, ChainState) else 0):
@@ -335,82 +334,20 @@ def largest_lyapunov(
         ref = start.copy()
     else:
         ref = initial_state(params, start, amplitude=perturbation, seed=seed)
-    start_name = start if isinstance(start, str) else "state"
-    rng = np.random.default_rng(direction_seed)
-    twin = twin_state(ref, rng.standard_normal(3 * params.N), d0, params)
-    d_start = float(np.linalg.norm(separation(ref, twin, params)))
-
-    n_k = (n_end - n0 + m - 1) // m
-    times = np.zeros(n_k)
-    logs = np.zeros(n_k)
-    taus = np.zeros(n_k)
-    events = 0
-    bar = _bar(progress, t_end - transient)
-    try:
-        n = n0
-        for k in range(n_k):
-            n_next = min(n + m, n_end)
-            ref, n_events = stepper.advance(ref, n_next)
-            twin, _ = stepper.advance(twin, n_next)
-            if n_next > n_count:
-                events += n_events
-            dy = separation(ref, twin, params)
-            d = float(np.linalg.norm(dy))
-            times[k], taus[k] = n_next * dt, (n_next - n) * dt
-            logs[k] = math.log(d / d_start) if d > 0.0 else -math.inf
-            if d > 0.0 and np.any(_project(dy, ref.blocks()["stopped"]) != 0.0):
-                twin = twin_state(ref, dy, d0, params)
-            else:
-                # The twin fell onto the reference (sticking can merge them): start a fresh one.
-                twin = twin_state(ref, rng.standard_normal(3 * params.N), d0, params)
-            d_start = float(np.linalg.norm(separation(ref, twin, params)))
-            n = n_next
-            if bar is not None:
-                bar.update(taus[k])
-    finally:
-        if bar is not None:
-            bar.close()
-    counted = times > n_count * dt + 0.5 * dt
-    lam, err, means = _estimate(logs, taus, counted, segments)
-    return LyapunovResult(
-        lyapunov=lam,
-        lyapunov_err=err,
-        t_end=t_end,
-        transient=transient,
-        align=align,
+    return two_trajectory_exponent(
+        grid,
+        ref,
+        t_end,
         interval=interval,
         d0=d0,
-        renormalisations=int(np.count_nonzero(counted)),
+        transient=transient,
+        align=align,
         segments=segments,
-        segment_means=means,
-        events=events,
-        max_log_growth=float(np.max(logs[counted], initial=-np.inf)),
-        reference_sha256=ref.sha256(),
-        wall_seconds=time.perf_counter() - wall0,
-        params=params,
-        start=start_name,
-        times=times,
-        log_growth=logs,
-        durations=taus,
-        counted=counted,
-    )
-
-
-def _bar(progress: bool, total: float):
-    """A tqdm bar on stderr, only when asked and stderr is a terminal."""
-    if not (progress and sys.stderr.isatty()):
-        return None
-    from tqdm import tqdm
-
-    # rate in model time units per wall-clock second
-    return tqdm(
-        total=total,
-        unit=" time units",
-        unit_scale=False,
-        dynamic_ncols=True,
-        desc="lyapunov",
-        file=sys.stderr,
-        bar_format="{l_bar}{bar}| t = {n:.4g}/{total:.4g} [{elapsed}<{remaining}, {rate_fmt}]",
+        direction_seed=direction_seed,
+        start=start if isinstance(start, str) else "state",
+        extra={"frame": frame},
+        progress=progress,
+        wall0=wall0,
     )
 
 

@@ -32,6 +32,7 @@ branch: its stuck blocks have v = 0 and the separation no velocity on them.
 
 from __future__ import annotations
 
+import hashlib
 import math
 import time
 from dataclasses import dataclass, field
@@ -39,7 +40,7 @@ from typing import Any
 
 import numpy as np
 
-from stickslip.analysis.lyapunov import _check_run, _estimate
+from stickslip.analysis.benettin import LyapunovResult, check_run, two_trajectory_exponent
 from stickslip.models.params import ChainParams, ParameterError, check_number, steps_for
 from stickslip.run.located import LocatedState, LocatedStepper, rates, start_state
 from stickslip.run.state import ChainState
@@ -52,59 +53,8 @@ METHOD = (
 )
 
 
-@dataclass(frozen=True)
-class FlowLyapunovResult:
-    """The largest exponent of the flow at one dt (two trajectories, located switches).
-
-    As :class:`stickslip.analysis.lyapunov.LyapunovResult`; ``neutral`` says whether the time
-    shift was removed, ``waits`` counts renormalisations delayed until the stuck blocks agreed.
-    """
-
-    lyapunov: float
-    lyapunov_err: float
-    dt: float
-    t_end: float
-    transient: float
-    align: float
-    interval: float
-    d0: float
-    renormalisations: int
-    segments: int
-    segment_means: tuple[float, ...]
-    events: int
-    neutral: str
-    waits: int
-    wall_seconds: float
-    params: ChainParams
-    start: str
-    times: np.ndarray = field(repr=False)
-    log_growth: np.ndarray = field(repr=False)
-    durations: np.ndarray = field(repr=False)
-    counted: np.ndarray = field(repr=False)
-
-    def to_dict(self) -> dict[str, Any]:
-        """Scalars, parameters and method as a plain dict for JSON."""
-        return {
-            "lyapunov": self.lyapunov,
-            "lyapunov_err": self.lyapunov_err,
-            "dt": self.dt,
-            "t_end": self.t_end,
-            "transient": self.transient,
-            "align": self.align,
-            "interval": self.interval,
-            "d0": self.d0,
-            "renormalisations": self.renormalisations,
-            "segments": self.segments,
-            "segment_means": list(self.segment_means),
-            "events": self.events,
-            "neutral": self.neutral,
-            "waits": self.waits,
-            "wall_seconds": self.wall_seconds,
-            "params": self.params.to_dict(),
-            "start": self.start,
-            "method": METHOD,
-            "norm": NORM,
-        }
+#: The flow's result is the method's one result class (``extra`` holds ``neutral``).
+FlowLyapunovResult = LyapunovResult
 
 
 def separation(ref: LocatedState, twin: LocatedState, params: ChainParams) -> np.ndarray:
@@ -129,15 +79,6 @@ def flow_direction(state: LocatedState, params: ChainParams) -> np.ndarray:
         return np.concatenate((math.sqrt(params.Kp) * du[1:-1], dv[1:-1], fth))
     fe = np.concatenate(([0.0], du[1:-2])) - du[1:-1]
     return np.concatenate((math.sqrt(params.K) * fe, dv[1:-1], fth))
-
-
-def remove_flow(dy: np.ndarray, flow: np.ndarray, floor: float) -> np.ndarray:
-    """dy less its component along ``flow`` (left as it is where the norm of ``flow`` is below ``floor``)."""
-    norm = float(np.linalg.norm(flow))
-    if not norm > floor:
-        return dy
-    f = flow / norm
-    return dy - float(np.dot(dy, f)) * f
 
 
 def _on_branch(dy: np.ndarray, stopped: np.ndarray, params: ChainParams) -> np.ndarray:
@@ -173,6 +114,70 @@ def twin_state(ref: LocatedState, direction: np.ndarray, d0: float, params: Chai
     return twin
 
 
+class LocatedEngine:
+    """The equations with located switches (:class:`stickslip.run.located.LocatedStepper`) for
+    :func:`stickslip.analysis.benettin.two_trajectory_exponent`.
+
+    Separations in y (:func:`separation`), twins by :func:`twin_state`; the neutral direction is
+    the flow F(y_ref) with ``neutral='remove'`` (none where its norm is not above ``flow_floor``,
+    or with 'keep'); a renormalisation waits up to ``max_wait`` steps for both to have the same
+    blocks stuck.
+    """
+
+    method = METHOD
+    norm = NORM
+
+    def __init__(self, params: ChainParams, *, neutral: str = "remove", flow_floor: float = 1e-9, max_wait: int = 0):
+        if neutral not in NEUTRAL:
+            raise ParameterError(f"neutral must be one of {', '.join(NEUTRAL)} (got {neutral!r})")
+        self.params = params
+        self.stepper = LocatedStepper(params)
+        self.remove = neutral == "remove"
+        self.flow_floor = flow_floor
+        self.max_wait = max_wait
+
+    def advance(self, ref: LocatedState, twin: LocatedState, step: int) -> tuple[LocatedState, LocatedState, int]:
+        """Both to grid ``step``; the reference's slip events on the way."""
+        ref, ev = self.stepper.advance(ref, step)
+        twin, _ = self.stepper.advance(twin, step)
+        return ref, twin, len(ev)
+
+    def step(self, ref: LocatedState) -> int:
+        """The reference's grid step."""
+        return ref.step
+
+    def separation(self, ref: LocatedState, twin: LocatedState) -> np.ndarray:
+        """:func:`separation`."""
+        return separation(ref, twin, self.params)
+
+    def twin(self, ref: LocatedState, direction: np.ndarray, d0: float) -> LocatedState:
+        """:func:`twin_state`."""
+        return twin_state(ref, direction, d0, self.params)
+
+    def on_branch(self, dy: np.ndarray, ref: LocatedState) -> np.ndarray:
+        """No velocity on the reference's stuck blocks, no theta without a state variable."""
+        return _on_branch(dy, ref.stopped, self.params)
+
+    def same_branch(self, ref: LocatedState, twin: LocatedState) -> bool:
+        """Whether both have the same blocks stuck."""
+        return bool(np.array_equal(ref.mov, twin.mov))
+
+    def neutral(self, ref: LocatedState) -> np.ndarray | None:
+        """F(y_ref) (:func:`flow_direction`) with neutral 'remove' where its norm is above the floor."""
+        if not self.remove:
+            return None
+        flow = flow_direction(ref, self.params)
+        return flow if float(np.linalg.norm(flow)) > self.flow_floor else None
+
+    def fingerprint(self, ref: LocatedState) -> str:
+        """SHA-256 of u, v, theta (float64 little-endian, block order) then the stuck flags (1 byte each)."""
+        h = hashlib.sha256()
+        for a in (ref.u, ref.v, ref.th):
+            h.update(np.ascontiguousarray(a[1:-1], dtype="<f8").tobytes())
+        h.update(ref.stopped.astype(np.uint8).tobytes())
+        return h.hexdigest()
+
+
 def flow_lyapunov(
     params: ChainParams,
     t_end: float,
@@ -189,7 +194,8 @@ def flow_lyapunov(
     neutral: str = "remove",
     flow_floor: float = 1e-9,
     max_wait: int | None = None,
-) -> FlowLyapunovResult:
+    progress: bool = False,
+) -> LyapunovResult:
     """Largest Lyapunov exponent of the equations with switches at the step ``params.dt``.
 
     The reference runs with located switches (:func:`stickslip.run.located.run_located`) from
@@ -198,89 +204,30 @@ def flow_lyapunov(
     have the same stuck blocks, at most ``max_wait`` steps, default one interval); the separation
     (less its component along the flow with ``neutral='remove'``, module docstring) gives
     ln(d / d0) and the twin is put back d0 away along it. Counted and averaged as in
-    :func:`stickslip.analysis.lyapunov.largest_lyapunov`.
+    :func:`stickslip.analysis.lyapunov.largest_lyapunov`: one loop,
+    :func:`stickslip.analysis.benettin.two_trajectory_exponent` with :class:`LocatedEngine`.
     """
-    t_end, interval, d0, transient, align, segments = _check_run(
-        params, t_end, interval, d0, transient, align, segments
-    )
-    if neutral not in NEUTRAL:
-        raise ParameterError(f"neutral must be one of {', '.join(NEUTRAL)} (got {neutral!r})")
+    t_end, interval, d0, transient, align, segments = check_run(params, t_end, interval, d0, transient, align, segments)
     dt = params.dt
     m = int(round(interval / dt))
-    if max_wait is None:
-        max_wait = m
-    n0 = steps_for(transient, dt)
-    n_end = steps_for(t_end, dt)
-    n_count = steps_for(transient + align, dt)
+    engine = LocatedEngine(params, neutral=neutral, flow_floor=flow_floor, max_wait=m if max_wait is None else max_wait)
     wall0 = time.perf_counter()
-    stepper = LocatedStepper(params)
     ref = start_state(params, start, perturbation=perturbation, seed=seed)
-    ref, _ = stepper.advance(ref, n0)
-    start_name = start if isinstance(start, str) else "state"
-    rng = np.random.default_rng(direction_seed)
-
-    def measured(ref, twin):
-        dy = separation(ref, twin, params)
-        if neutral == "remove":
-            dy = remove_flow(dy, flow_direction(ref, params), flow_floor)
-        return dy
-
-    twin = twin_state(ref, rng.standard_normal(3 * params.N), d0, params)
-    d_start = float(np.linalg.norm(measured(ref, twin)))
-    times, logs, taus = [], [], []
-    events = waits = 0
-    n = ref.step
-    while n < n_end:
-        n_next = min(n + m, n_end)
-        ref, ev = stepper.advance(ref, n_next)
-        twin, _ = stepper.advance(twin, n_next)
-        n_ev = len(ev)
-        extra = 0
-        while extra < max_wait and not np.array_equal(ref.mov, twin.mov):
-            ref, ev = stepper.advance(ref, ref.step + 1)
-            twin, _ = stepper.advance(twin, twin.step + 1)
-            n_ev += len(ev)
-            extra += 1
-        waits += extra > 0
-        n_next = ref.step
-        if n_next > n_count:
-            events += n_ev
-        dy = measured(ref, twin)
-        d = float(np.linalg.norm(dy))
-        times.append(n_next * dt)
-        taus.append((n_next - n) * dt)
-        logs.append(math.log(d / d_start) if d > 0.0 and d_start > 0.0 else -math.inf)
-        if d > 0.0 and np.any(_on_branch(dy, ref.stopped, params) != 0.0):
-            twin = twin_state(ref, dy, d0, params)
-        else:
-            twin = twin_state(ref, rng.standard_normal(3 * params.N), d0, params)
-        d_start = float(np.linalg.norm(measured(ref, twin)))
-        n = n_next
-    times_a, logs_a, taus_a = np.array(times), np.array(logs), np.array(taus)
-    counted = times_a > n_count * dt + 0.5 * dt
-    lam, err, means = _estimate(logs_a, taus_a, counted, segments)
-    return FlowLyapunovResult(
-        lyapunov=lam,
-        lyapunov_err=err,
-        dt=dt,
-        t_end=t_end,
-        transient=transient,
-        align=align,
+    ref, _ = engine.stepper.advance(ref, steps_for(transient, dt))
+    return two_trajectory_exponent(
+        engine,
+        ref,
+        t_end,
         interval=interval,
         d0=d0,
-        renormalisations=int(np.count_nonzero(counted)),
+        transient=transient,
+        align=align,
         segments=segments,
-        segment_means=means,
-        events=events,
-        neutral=neutral,
-        waits=waits,
-        wall_seconds=time.perf_counter() - wall0,
-        params=params,
-        start=start_name,
-        times=times_a,
-        log_growth=logs_a,
-        durations=taus_a,
-        counted=counted,
+        direction_seed=direction_seed,
+        start=start if isinstance(start, str) else "state",
+        extra={"neutral": neutral},
+        progress=progress,
+        wall0=wall0,
     )
 
 
@@ -308,6 +255,20 @@ def extrapolate(dts, values, errors, order: int = 2) -> tuple[float, float, floa
     return float(coef[0]), float(math.sqrt(cov[0, 0]) * scale), float(coef[1])
 
 
+#: What each rung of a ladder has for itself (its rows), not the ladder's settings.
+_PER_RUNG = (
+    "lyapunov",
+    "lyapunov_err",
+    "dt",
+    "renormalisations",
+    "merges",
+    "segment_means",
+    "events",
+    "waits",
+    "max_log_growth",
+    "reference_sha256",
+)
+
 LADDER_COLUMNS = ["dt", "lyapunov", "lyapunov_err", "renormalisations", "events", "waits", "wall_seconds"]
 
 
@@ -319,13 +280,13 @@ class FlowLadder:
     lyapunov_dt0: float
     lyapunov_dt0_err: float
     slope: float
-    results: list[FlowLyapunovResult] = field(repr=False)
+    results: list[LyapunovResult] = field(repr=False)
 
     def to_dict(self) -> dict[str, Any]:
         """``lyapunov_dt0``, ``lyapunov_dt0_err``, ``ladder`` rows and the run's settings."""
         first = self.results[0]
         d = first.to_dict()
-        for k in ("lyapunov", "lyapunov_err", "dt", "renormalisations", "segment_means", "events", "waits"):
+        for k in _PER_RUNG:
             d.pop(k)
         d["wall_seconds"] = float(sum(r.wall_seconds for r in self.results))
         d.update(

@@ -5,6 +5,7 @@ tabulates the exponent against d0, the renormalisation interval and the run leng
 ``--betas`` tabulates it against beta, and ``--plot FILE`` draws that table. ``--switches located``
 measures the exponent of the flow instead (:mod:`stickslip.analysis.lyapunov_flow`): located
 switches, the time-shift direction removed, at dt, dt/2, dt/4 and extrapolated to dt -> 0.
+``--decorrelation`` compares slip sequences of perturbed twins (:mod:`stickslip.cli.decorrelation`).
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from stickslip.cli import decorrelation
 from stickslip.cli._common import (
     CommandError,
     Result,
@@ -51,7 +53,13 @@ def register(sub) -> None:
         "--start rest: x_i = -A u_i (default the model's, 0.01 for Carlson-Langer)",
     )
     p.add_argument("--seed", type=int, default=None, help="seed of the perturbation (default the model's, 0)")
-    p.add_argument("--t-end", type=float_arg("t-end"), default=2e4, metavar="T", help="end time (default 2e4)")
+    p.add_argument(
+        "--t-end",
+        type=float_arg("t-end"),
+        default=None,
+        metavar="T",
+        help="end time (default 2e4; with --decorrelation the latest end of a window, none by default)",
+    )
     p.add_argument(
         "--interval",
         type=float_arg("interval"),
@@ -121,8 +129,9 @@ def register(sub) -> None:
     p.add_argument(
         "--decorrelation",
         action="store_true",
-        help="with --switches located: the number of slip events after which runs started delta = 1e-12, "
-        "1e-10, 1e-8, 1e-6 apart stop agreeing, over --t-end minus --transient (JSON key decorrelation)",
+        help="the number of slips after which a reference and twins perturbed by each delta (--perturb, "
+        "--deltas) stop agreeing, over --events slips from the state at --transient, with either "
+        "--switches (JSON key decorrelation)",
     )
     p.add_argument(
         "--fronts",
@@ -156,6 +165,7 @@ def register(sub) -> None:
         metavar="TAU",
         help="finite-size: time between distance checks (default 0.1)",
     )
+    decorrelation.add_options(p)
     p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     add_json_option(p)
     p.set_defaults(handler=run_lyapunov_command)
@@ -191,6 +201,7 @@ def _result_text(d: dict) -> str:
 def run_lyapunov_command(args: argparse.Namespace) -> Result:
     """Handler of `stickslip lyapunov`."""
     from stickslip.analysis import lyapunov as ly
+    from stickslip.analysis.benettin import check_run
     from stickslip.models.presets import PRESETS
 
     params = chain_params_from_args(args)
@@ -223,18 +234,18 @@ def run_lyapunov_command(args: argparse.Namespace) -> Result:
         direction_seed=args.direction_seed,
         segments=args.segments,
     )
-    # Validate every option before the first (possibly long) run.
-    ly._check_run(params, args.t_end, args.interval, args.d0, args.transient, args.align, args.segments)
     _refuse_ignored(args)
+    if args.decorrelation:
+        return _decorrelation(params, args)
+    if args.t_end is None:
+        args.t_end = 2e4
+    # Validate every option before the first (possibly long) run.
+    check_run(params, args.t_end, args.interval, args.d0, args.transient, args.align, args.segments)
     if args.lifetimes is not None:
         return _lifetimes(params, args)
     if args.switches == "located":
         return _located(params, args, kw)
-    for flag, given in (
-        ("--finite-size", args.finite_size),
-        ("--decorrelation", args.decorrelation),
-        ("--fronts", args.fronts),
-    ):
+    for flag, given in (("--finite-size", args.finite_size), ("--fronts", args.fronts)):
         if given:
             raise CommandError(f"{flag} goes with --switches located")
     if args.convergence:
@@ -309,14 +320,12 @@ def _located(params, args, kw) -> Result:
 
     if args.convergence or args.betas is not None:
         raise CommandError("--switches located runs one ladder; --convergence and --betas go with --switches grid")
-    if sum(map(bool, (args.finite_size, args.decorrelation, args.fronts))) > 1:
+    if args.finite_size and args.fronts:
         raise CommandError("give one of --finite-size, --decorrelation and --fronts")
     if args.fronts:
         return _fronts(params, args)
     if args.finite_size:
         return _finite_size(params, args)
-    if args.decorrelation:
-        return _decorrelation(params, args)
     check_number("levels", args.levels, low=2, high=6, integer=True)
     ladder = flow_ladder(params, args.t_end, levels=args.levels, neutral=args.neutral, **kw)
     data = ladder.to_dict()
@@ -356,25 +365,17 @@ def _finite_size(params, args) -> Result:
 
 
 def _decorrelation(params, args) -> Result:
-    """`--switches located --decorrelation`: :func:`stickslip.analysis.decorrelation.event_decorrelation`."""
-    from stickslip.analysis.decorrelation import DELTAS, event_decorrelation
-    from stickslip.models.params import steps_for
-    from stickslip.run.located import LocatedStepper, start_state
-
-    if not args.t_end > args.transient:
-        raise CommandError(f"--t-end must exceed --transient (got {args.t_end:g} and {args.transient:g})")
-    ref = start_state(params, args.start, perturbation=args.perturbation, seed=args.seed)
-    ref, _ = LocatedStepper(params).advance(ref, steps_for(args.transient, params.dt))
-    res = event_decorrelation(
-        params, ref, DELTAS, t_max=args.t_end - args.transient, direction_seed=args.direction_seed
-    )
-    data = {"params": params.to_dict(), "switches": "located", "transient": args.transient, **res.to_dict()}
-    lines = [f"{'delta':>8} {'events agreeing':>16}"]
-    for r in res.rows:
-        n = f"{r['events']}" if r["decorrelated"] else f"all {r['events']}"
-        lines.append(f"{r['delta']:>8.0e} {n:>16}")
-    lines.append(f"{res.reference_events} events of the reference; sizes agree to rtol {res.rtol:g}")
-    return Result(data, "\n".join(lines))
+    """`--decorrelation` (either switch rule): :func:`stickslip.cli.decorrelation.run`."""
+    for option, given in (
+        ("--convergence", args.convergence),
+        ("--betas", args.betas is not None),
+        ("--finite-size", args.finite_size),
+        ("--fronts", args.fronts),
+    ):
+        if given:
+            raise CommandError(f"{option} does not go with --decorrelation")
+    check_number("transient", args.transient, low=0.0)
+    return decorrelation.run(params, args)
 
 
 def _fronts(params, args) -> Result:
@@ -413,6 +414,7 @@ _MODE_OPTIONS = (
     ("--cycles", "cycles", "--finite-size", lambda a: a.finite_size),
     ("--check", "check", "--finite-size", lambda a: a.finite_size),
     ("--loads", "loads", "--lifetimes", lambda a: a.lifetimes is not None),
+    *((option, name, "--decorrelation", lambda a: a.decorrelation) for option, name in decorrelation.OPTIONS),
 )
 
 

@@ -55,7 +55,7 @@ def delta_column(delta: float) -> str:
 
 def check_verdict(cfg: dict[str, Any], params, options: dict[str, Any]) -> None:
     """Raise ParameterError (one line) unless the verdict's run lengths of a point are valid."""
-    from stickslip.analysis.lyapunov import _check_run
+    from stickslip.analysis.benettin import check_run
     from stickslip.models.params import ParameterError, check_number
 
     if not any(k in cfg for k in FLOW_KEYS):
@@ -69,7 +69,7 @@ def check_verdict(cfg: dict[str, Any], params, options: dict[str, Any]) -> None:
     if params.ends_piece.wall and float(options.get("transient", 0.0)) > 0.0:
         raise ParameterError("the verdict's located runs restart the clock: fixed ends (which read t) are refused")
     interval = float(options.get("interval", 10.0))
-    _check_run(params, float(cfg["flow_t"]), interval, float(options.get("d0", 1e-10)), 0.0, None, 10)
+    check_run(params, float(cfg["flow_t"]), interval, float(options.get("d0", 1e-10)), 0.0, None, 10)
 
 
 def located_start(params, options: dict[str, Any]):

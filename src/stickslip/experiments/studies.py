@@ -313,7 +313,7 @@ def lyapunov_options(cfg: dict[str, Any], params) -> tuple[float, dict[str, Any]
     """Run length and :func:`~stickslip.analysis.lyapunov.largest_lyapunov` options of a chaos
     point (start, perturbation and seed default to the model's preset), checked as that
     function checks them."""
-    from stickslip.analysis.lyapunov import _check_run
+    from stickslip.analysis.benettin import check_run
     from stickslip.models.presets import PRESETS
 
     preset = PRESETS[params.model]
@@ -324,7 +324,7 @@ def lyapunov_options(cfg: dict[str, Any], params) -> tuple[float, dict[str, Any]
     options["seed"] = int(cfg.get("seed", preset.start_options.get("seed", 0)))
     if options["start"] == "paper":
         options["perturbation"] = 0.0
-    _check_run(
+    check_run(
         params,
         t_end,
         options.get("interval", 10.0),
