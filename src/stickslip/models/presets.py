@@ -229,17 +229,19 @@ def build_chain_params(model: str = "sakaguchi", **overrides: Any):
     return ChainParams(model=model, **values)
 
 
-def refuse_unread(params, given, prefix: str = "") -> None:
+def refuse_unread(params, given, prefix: str = "", spell=None) -> None:
     """Raise ParameterError for the first of the names ``given`` that the composition of ``params``
     does not read (docs/model.md's family table), naming it as ``prefix`` + name (``--`` for an
-    option), and for Carlson-Langer's symbols ``l`` and ``nu`` without the plate drive."""
+    option) or as ``spell(name)`` spells it, and for Carlson-Langer's symbols ``l`` and ``nu``
+    without the plate drive."""
     from stickslip.models.params import ParameterError
 
     used = set(params.used()) | {"l", "nu", "model"}
     unused = [k for k in given if k not in used and k not in params.pieces]
     if unused:
+        shown = spell(unused[0]) if spell is not None else f"{prefix}{unused[0]}"
         raise ParameterError(
-            f"{prefix}{unused[0]} is not a parameter of this model ({params.model}: "
+            f"{shown} is not a parameter of this model ({params.model}: "
             f"{', '.join(f'{k} {v}' for k, v in params.pieces.items())}); it reads {', '.join(params.used())}"
         )
     if ("l" in given or "nu" in given) and not params.drive_piece.leaf_spring:
@@ -247,9 +249,8 @@ def refuse_unread(params, given, prefix: str = "") -> None:
 
 
 def model_name(params) -> str:
-    """The model of ``params`` in a figure title: its preset's short name (``eq. (4)``,
-    ``Carlson-Langer``) when the pieces are the preset's, else the preset's name and the pieces
-    that differ (``eq. (4), friction rate-state``).
+    """The model of ``params`` as a figure title names it: its preset's short name when the pieces
+    are the preset's (eq. (4), Carlson-Langer), else that name and the pieces that differ.
 
     >>> model_name(chain_params("carlson-langer"))
     'Carlson-Langer'

@@ -23,8 +23,9 @@ Examples
 >>> import stickslip, stickslip.plotting as ssp
 >>> run = stickslip.run_chain(stickslip.chain_params(N=10), 2e4)
 >>> fig = ssp.length(run)
->>> fig.axes[0].get_title(loc="left")
-'$L(t)$, eq. (4): $N=10$, $K=10$, $V=0.001$, $\\\\beta=1$, $\\\\alpha=1$, $D=5$, $F_s=3$'
+>>> print(fig.axes[0].get_title(loc="left"))
+$L(t)$
+eq. (4): $N=10$, $K=10$, $V=0.001$, $\\beta=1$, $\\alpha=1$, $D=5$, $F_s=3$
 """
 
 from importlib import import_module

@@ -44,13 +44,16 @@ __all__ = [
 PAPER_FRONT_SPEED = 1.43
 
 
-def _title(what: str, params: ChainParams | None, paper_figure: str | None, number: str, **kw: Any) -> str:
-    """``what`` and the model (when ``params`` are known), headed by the paper's figure number
-    where the run is the paper's (``number``) or the caller names one (``paper_figure``)."""
+def _title(
+    what: str, params: ChainParams | None, paper_figure: str | None, number: str, *, wrap: bool = False, **kw: Any
+) -> str:
+    """``what`` and the model (when ``params`` are known; on a line of its own with ``wrap``, for
+    one panel among others), headed by the paper's figure number where the run is the paper's
+    (``number``) or the caller names one (``paper_figure``)."""
     if paper_figure is None and params is not None and is_paper_run(params):
         paper_figure = number
     head = f"{paper_figure}: " if paper_figure else ""
-    return head + what + (f", {model_title(params, **kw)}" if params is not None else "")
+    return head + what + (("\n" if wrap else ", ") + model_title(params, **kw) if params is not None else "")
 
 
 def _snapshot_array(x: Any, N: int) -> np.ndarray:
@@ -88,7 +91,9 @@ def snapshot_figure(x: Any, params: ChainParams, t: float, *, ax=None, paper_fig
     ax.plot(i, paper - shift, **PAPER, label="steady sliding, paper's continuum form")
     ax.set_ylabel(r"$x_i - Vt$")
     ax.legend(loc="upper right", fontsize=8)
-    title = _title(f"snapshot at $t = {t:.4g}$ and steady sliding", params, paper_figure, "Fig. 5(a)")
+    title = _title(
+        f"snapshot at $t = {t:.4g}$ and steady sliding", params, paper_figure, "Fig. 5(a)", wrap=ax_r is None
+    )
     if ax_r is None:
         ax.set_xlabel("block $i$")
         ax.set_title(title, loc="left", fontsize=8)
@@ -475,7 +480,7 @@ def sizes_figure(
     what = r"slip sizes $S = \sum_i \Delta x_i$"
     if params is None and beta is not None:
         what += f" at $\\beta = {beta:g}$"
-    title = _title(what, params, paper_figure, number)
+    title = _title(what, params, paper_figure, number, wrap=ax_b is None)
     if ax_b is None:
         ax_a.set_title(title, loc="left", fontsize=8)
         return fig

@@ -66,7 +66,7 @@ def length_series(samples, params, *, ax=None) -> Figure:
     ax.set_xlabel("$t$")
     ax.set_ylabel("$L$")
     ax.legend(loc="lower right", fontsize=8)
-    ax.set_title(f"$L(t)$, {model_title(params)}", loc="left", fontsize=8)
+    ax.set_title(f"$L(t)$\n{model_title(params)}", loc="left", fontsize=8)
     return fig
 
 
