@@ -175,3 +175,30 @@ def test_old_plotting_names_still_work():
 
     assert chain.fig5a_snapshot is ssp.snapshot_figure and chain.fig7_8_sizes is ssp.sizes_figure
     assert chain.fig5b_length is ssp.length_against_beta and chain.fig6_fronts is ssp.fronts_figure
+
+
+def test_fig4_has_its_title_and_panel_letters():
+    from stickslip.analysis.stability import fig4_data
+    from stickslip.plotting.stability import plot_fig4
+
+    fig = plot_fig4(fig4_data(ChainParams(), k=np.linspace(0.0, np.pi, 40)))
+    assert fig._suptitle.get_text().startswith("Fig. 4: growth rates")
+    letters = [ax.get_title(loc="left")[:3] for ax in fig.axes]
+    assert letters == ["(a)", "(b)"]
+
+
+def test_state_nc_names_quantities_as_python_does_and_old_files_still_load(run, tmp_path):
+    folder = run.save(tmp_path / "run")
+    ds = xr.load_dataset(folder / "state.nc")
+    # L over t, as run.samples has it; no other t; the final state's time is t_end
+    assert ds["L"].dims == ("t",) and "t_sample" not in ds.variables and "t" not in ds.attrs
+    assert ds.attrs["t_end"] == run.summary["t_end"] and ds["profile_t"].dims == ("profile_row",)
+    # a run directory of the former layout: L over t_sample, the window starts also as coordinate t
+    old = ds.rename({"t": "t_sample"}).assign_coords(t=("profile_row", ds["profile_t"].values))
+    old.attrs["t"] = old.attrs.pop("t_end")
+    (folder / "state.nc").unlink()
+    old.to_netcdf(folder / "state.nc")
+    back = load_run(folder)
+    np.testing.assert_array_equal(back.samples["t"].values, run.samples["t"].values)
+    np.testing.assert_array_equal(back.samples["L"].values, run.samples["L"].values)
+    np.testing.assert_array_equal(back.profiles["t"].values, run.profiles["t"].values)

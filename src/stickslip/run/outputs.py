@@ -141,8 +141,8 @@ class ChainRun:
         ``block`` (1..N), ``step`` and ``t_first`` = step dt (model time units).
     samples : xarray.Dataset
         ``L`` = x_1 - x_N (model length units) over ``t``, sampled every ``sample_interval``
-        (Fig. 5b); with ``sample_moving``, ``n_moving`` over ``t_moving``. state.nc calls this
-        time axis ``t_sample``.
+        (Fig. 5b); with ``sample_moving``, ``n_moving`` over ``t_moving`` (the same names in
+        state.nc).
     snapshots : xarray.DataArray
         x_i (model length units) over (``time``, ``block``): the ``snapshot_times`` and the end.
     profiles : xarray.Dataset

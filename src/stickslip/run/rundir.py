@@ -110,7 +110,9 @@ def _load_run(run_dir: Path) -> ChainRun:
     if state.N != params.N:
         raise RunDirDamaged(f"{run_dir / 'state.nc'} holds {state.N} blocks, its run.json N = {params.N}")
     state.of(params)
-    samples = xr.Dataset({"L": ("t", ds["L"].values)}, coords={"t": ds["t_sample"].values})
+    # L's time axis was called t_sample before it took the name it has in ChainRun.samples
+    t_sample = ds["t_sample"] if "t_sample" in ds.variables else ds["t"]
+    samples = xr.Dataset({"L": ("t", ds["L"].values)}, coords={"t": t_sample.values})
     if "n_moving" in ds:
         samples["n_moving"] = xr.DataArray(ds["n_moving"].values, dims="t_moving")
         samples = samples.assign_coords(t_moving=("t_moving", ds["t_moving"].values))

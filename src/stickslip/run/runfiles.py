@@ -1,9 +1,11 @@
 """The files of a chain run directory (eq. 4): what :func:`write_run` writes, with their labels.
 
 state.nc (final state, L(t), snapshots and profiles as labelled arrays, CF attributes from
-:data:`VARIABLE_ATTRS`), events and first_move (each as .parquet and .csv, the columns described
-by :data:`EVENT_DOCS` and :data:`FIRST_MOVE_DOCS`) and run.json. Reading them back is
-:func:`stickslip.run.rundir.load_run`; owning and locking the directory is
+:data:`VARIABLE_ATTRS`; L over ``t`` as in ``ChainRun.samples``, the time of the final state in
+the attribute ``t_end``; files written before these names had ``t_sample`` and ``t``, and
+:func:`~stickslip.run.rundir.load_run` reads both), events and first_move (each as .parquet and
+.csv, the columns described by :data:`EVENT_DOCS` and :data:`FIRST_MOVE_DOCS`) and run.json.
+Reading them back is :func:`stickslip.run.rundir.load_run`; owning and locking the directory is
 :mod:`stickslip.run.ownership`.
 """
 
@@ -45,7 +47,7 @@ VARIABLE_ATTRS = {
         "flag_values": np.array([0, 1], dtype=np.int8),
         "flag_meanings": "moving stopped",
     },
-    "t_sample": _model("sampling time of L"),
+    "t": _model("sampling time t of L (ChainRun.samples' t)"),
     "L": _model("chain length L = x_1 - x_N (Fig. 5b)"),
     "snapshot_time": _model("time of the snapshot"),
     "snapshot_x": _model("block positions x_i at the snapshot time (Fig. 5a)"),
@@ -53,7 +55,6 @@ VARIABLE_ATTRS = {
     "profile_event": {"long_name": "slip event of the profile row (events.parquet column event)", "units": "1"},
     "profile_t": _model("start of the profile window"),
     "profile_t_next": _model("end of the profile window"),
-    "t": _model("start of the profile window"),
 }
 
 #: Descriptions of the columns of events.parquet and first_move.parquet (Parquet field metadata).
@@ -101,9 +102,9 @@ def write_run(run: Any, out_dir: str | Path) -> Path:
             "v": ("block", b["v"]),
             "theta": ("block", b["theta"]),
             "stopped": ("block", b["stopped"].astype(np.int8)),
-            "L": run.samples["L"].rename({"t": "t_sample"}),
+            "L": run.samples["L"],
             "snapshot_x": run.snapshots.rename({"time": "snapshot_time"}),
-            "profile_dx": run.profiles["dx"].rename({"row": "profile_row"}),
+            "profile_dx": run.profiles["dx"].reset_coords(drop=True).rename({"row": "profile_row"}),
             "profile_event": ("profile_row", run.profiles["event"].values),
             "profile_t": ("profile_row", run.profiles["t"].values),
             "profile_t_next": ("profile_row", run.profiles["t_next"].values),
@@ -118,13 +119,12 @@ def write_run(run: Any, out_dir: str | Path) -> Path:
             **_param_attrs(run.params),
             "integrator": run.integrator,
             "version": __version__,
-            "t": run.summary["t_end"],
+            "t_end": run.summary["t_end"],
         },
     )
     if "n_moving" in run.samples:
         ds["n_moving"] = ("t_moving", run.samples["n_moving"].values)
         ds = ds.assign_coords(t_moving=run.samples["t_moving"].values)
-    ds = ds.drop_vars([c for c in ("event", "t_next") if c in ds.coords], errors="ignore")
     for name, attrs in VARIABLE_ATTRS.items():
         if name in ds.variables:
             ds[name].attrs.update(attrs)
