@@ -88,3 +88,28 @@ def test_progress_shows_only_where_someone_watches(monkeypatch):
     bar.update(50.0, 3)
     bar.close()
     assert "t = 50/100" in err.getvalue() and "events=3" in err.getvalue()
+
+
+def test_a_notebook_shows_the_figures_and_the_progress_of_a_run(monkeypatch):
+    """In a Jupyter kernel (the docs extra installs one): a Figure that ends a cell is shown as an
+    image though no pyplot figure came before it, and a run's bar goes to the cell's output."""
+    nbformat = pytest.importorskip("nbformat")
+    nbclient = pytest.importorskip("nbclient")
+    pytest.importorskip("ipykernel")
+    from pathlib import Path
+
+    import stickslip
+
+    cells = [
+        "import stickslip\nrun = stickslip.run_chain(stickslip.chain_params(N=10), 2e4, progress=True)",
+        "run.plot_length()",
+    ]
+    nb = nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell(c) for c in cells])
+    src = str(Path(stickslip.__file__).resolve().parent.parent)
+    code = f"import sys; sys.path.insert(0, {src!r})\n"
+    nb.cells.insert(0, nbformat.v4.new_code_cell(code))
+    monkeypatch.delenv("MPLBACKEND", raising=False)  # the tests' Agg; a notebook has its own
+    nbclient.NotebookClient(nb, timeout=120, kernel_name="python3").execute()
+    ran, drew = nb.cells[1], nb.cells[2]
+    assert any(o.get("name") == "stderr" and "chain:" in o.get("text", "") for o in ran.outputs)
+    assert any("image/png" in o.get("data", {}) for o in drew.outputs)
