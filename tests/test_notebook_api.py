@@ -202,3 +202,10 @@ def test_state_nc_names_quantities_as_python_does_and_old_files_still_load(run, 
     np.testing.assert_array_equal(back.samples["t"].values, run.samples["t"].values)
     np.testing.assert_array_equal(back.samples["L"].values, run.samples["L"].values)
     np.testing.assert_array_equal(back.profiles["t"].values, run.profiles["t"].values)
+
+
+def test_a_snapshot_of_a_model_without_a_steady_profile_is_refused_in_one_line():
+    from types import SimpleNamespace
+
+    with pytest.raises(ValueError, match=r"no steady sliding profile .* \(Carlson-Langer\)$"):
+        ssp.snapshot(SimpleNamespace(params=chain_params("carlson-langer")))

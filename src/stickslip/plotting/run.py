@@ -21,7 +21,7 @@ from matplotlib.figure import Figure
 
 from stickslip.analysis.chain_runs import front_statistics, run_size_statistics, stationary_events, stationary_from
 from stickslip.models.physics import chain_steady_length, has_steady_state, loading_time
-from stickslip.models.presets import model_title
+from stickslip.models.presets import model_name, model_title
 from stickslip.plotting.chain import fronts_figure, sizes_figure, snapshot_figure
 from stickslip.plotting.style import FIGURE_FORMATS, PAPER, SIM, THEORY, new_figure, save_figure
 
@@ -107,7 +107,7 @@ def snapshot(run, t: float | None = None, *, ax=None) -> Figure:
     """
     p = run.params
     if not has_steady_state(p) or p.drive_piece.leaf_spring:
-        raise ValueError(f"no steady sliding profile for this model ({model_title(p)})")
+        raise ValueError(f"no steady sliding profile pulled from one end for this model ({model_name(p)})")
     if t is None:
         return snapshot_figure(run.state.blocks()["x"], p, float(run.summary["t_end"]), ax=ax)
     times = run.snapshots["time"].values
