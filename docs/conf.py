@@ -44,3 +44,36 @@ autodoc_default_options = {"members": True, "undoc-members": False, "show-inheri
 autodoc_typehints = "none"
 autodoc_member_order = "bysource"
 nitpicky = False
+
+# The public names carry numpydoc sections (Parameters, Returns, Examples); those docstrings, and
+# only those, are turned into reST fields by napoleon's numpy parser. The others are reST already.
+NUMPYDOC_SECTIONS = {"Parameters", "Returns", "Attributes", "Raises", "Examples"}
+TYPE_ALIASES = {
+    "ChainRun": "~stickslip.run.outputs.ChainRun",
+    "ChainState": "~stickslip.run.state.ChainState",
+    "ChainParams": "~stickslip.models.params.ChainParams",
+    "BlockParams": "~stickslip.models.params.BlockParams",
+    "BlockRun": "~stickslip.run.block.BlockRun",
+    "BlockState": "~stickslip.run.block.BlockState",
+    "RunOptions": "~stickslip.run.outputs.RunOptions",
+}
+
+
+def _numpydoc(app, what, name, obj, options, lines):
+    from sphinx.ext.napoleon import Config
+    from sphinx.ext.napoleon.docstring import NumpyDocstring
+
+    sections = {a.strip() for a, b in zip(lines, lines[1:], strict=False) if b.strip() and set(b.strip()) == {"-"}}
+    if not sections & NUMPYDOC_SECTIONS:
+        return
+    config = Config(
+        napoleon_use_ivar=True,
+        napoleon_use_rtype=False,
+        napoleon_preprocess_types=True,
+        napoleon_type_aliases=TYPE_ALIASES,
+    )
+    lines[:] = NumpyDocstring(lines, config, app, what, name, obj, options).lines()
+
+
+def setup(app):
+    app.connect("autodoc-process-docstring", _numpydoc)

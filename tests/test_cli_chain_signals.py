@@ -68,7 +68,7 @@ def _assert_outputs_match(out_dir, reference, sha):
     assert io.read_table(out_dir / "first_move.parquet").equals(reference.first_move)
     ds = io.read_dataset(out_dir / "state.nc")
     assert_bits_equal(ds["L"].values, reference.samples["L"].values, "L samples")
-    assert_bits_equal(ds["t_sample"].values, reference.samples["t"].values, "sample times")
+    assert_bits_equal(ds["t"].values, reference.samples["t"].values, "sample times")
 
 
 @pytest.mark.parametrize("delay", [0.37, pytest.param(0.0, marks=pytest.mark.slow),

@@ -20,7 +20,7 @@ def run_dir(tmp_path_factory):
 
 def test_state_variables_carry_long_name_and_units(run_dir):
     with xr.open_dataset(run_dir / "state.nc") as ds:
-        for name in ("x", "v", "theta", "stopped", "L", "snapshot_x", "profile_dx", "t_sample"):
+        for name in ("x", "v", "theta", "stopped", "L", "snapshot_x", "profile_dx", "t"):
             assert ds[name].attrs.get("long_name"), name
             assert "units" in ds[name].attrs, name
         assert ds["x"].attrs["units"] == "1" and "M = sigma = 1" in ds["x"].attrs["comment"]

@@ -115,9 +115,9 @@ def test_fig7_8_draws_the_density_and_the_fitted_law(tmp_path):
     S = (0.5**e + rng.random(4000) * ((0.5e3) ** e - 0.5**e)) ** (1 / e)
     events = pd.DataFrame({"event": np.arange(S.size), "t_start": np.sort(rng.uniform(0, 1e6, S.size)), "S": S})
     fit = fit_power_law(S, 0.5, 500.0, bootstrap=50)
-    fig = fig7_8_sizes(events, fit, 1.0, bins=20, paper_tau=1.5)
+    fig = fig7_8_sizes(events, fit, params=ChainParams(), bins=20, paper_tau=1.5)
     ax_a, ax_b = fig.axes
-    assert fig._suptitle.get_text().startswith("Fig. 7")
+    assert fig._suptitle.get_text().startswith("Fig. 7: slip sizes")
     points = line(ax_a, "simulation")
     # the binned density: share of events per bin over bin width, computed here from the edges
     edges = np.geomspace(S.min(), S.max(), 21)
@@ -130,5 +130,14 @@ def test_fig7_8_draws_the_density_and_the_fitted_law(tmp_path):
     np.testing.assert_allclose(slope, -fit.tau, rtol=1e-9)
     assert "1.50" in law.get_label() or "1.49" in law.get_label() or "1.51" in law.get_label()
     np.testing.assert_allclose(ax_b.get_lines()[0].get_ydata(), S)
-    assert fig7_8_sizes(events, fit, 0.2)._suptitle.get_text().startswith("Fig. 8")
+    # the paper's slope is drawn a factor 3 under the fit at the middle of the range, not on it
+    guide = line(ax_a, "paper: slope")
+    mid = len(s) // 2
+    assert guide.get_ydata()[mid] == pytest.approx(
+        law.get_ydata()[mid] / 3.0 * (s[mid] / np.sqrt(0.5 * 500.0)) ** (fit.tau - 1.5), rel=1e-6
+    )
+    assert fig7_8_sizes(events, fit, params=ChainParams(beta=0.2))._suptitle.get_text().startswith("Fig. 8")
+    # only the paper's runs carry its figure numbers; others their model and parameters
+    assert "Fig." not in fig7_8_sizes(events, fit, params=ChainParams(N=99, beta=0.5))._suptitle.get_text()
+    assert "Fig." not in fig7_8_sizes(events, fit, 1.0)._suptitle.get_text()
     save_figure(fig, tmp_path / "fig7")

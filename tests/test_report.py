@@ -249,3 +249,13 @@ def test_fig6_row_judges_the_paper_value_against_the_per_event_distribution():
     assert row.agrees is None and "no event" in row.na_reason
     full = front_speed_row(centred, K=10.0, mode="full", command="x")
     assert full.agrees is True and "central 90%" in full.tolerance
+
+
+def test_the_header_shows_lists_as_lines_not_json(tmp_path, figures):
+    meta = {"mode": "quick", "experiments": ["fig1: runs/fig1, computed in 1.0 s", "fig4: runs/fig4, reused"]}
+    meta["notes"] = ["a note <b>"]
+    page = write_report(tmp_path, ROWS, figures, meta)["html"].read_text()
+    header = re.search(r'<dl class="meta">(.*?)</dl>', page, re.S).group(1)
+    assert "fig1: runs/fig1, computed in 1.0 s<br>fig4: runs/fig4, reused" in header
+    assert "a note &lt;b&gt;" in header
+    assert '["' not in header and "&#34;" not in header and "&quot;" not in header

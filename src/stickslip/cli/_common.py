@@ -136,11 +136,51 @@ def interrupted(command: str, out: Path | None, kept: str) -> Result:
     return Result({"interrupted": True, "out": str(out)}, "", status=130)
 
 
+def option_name(name: str) -> str:
+    """The command-line spelling of a parameter: ``--`` and the name, words joined by hyphens
+    as in every other option (``rs_a`` is ``--rs-a``, ``t_end`` ``--t-end``)."""
+    return "--" + name.replace("_", "-")
+
+
+class _OldSpelling(argparse.Action):
+    """An option's former spelling (``--rs_a``): still accepted, with one line on stderr."""
+
+    def __init__(self, option_strings, dest, new: str = "", **kw):
+        self.new = new
+        super().__init__(option_strings, dest, **kw)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        sys.stderr.write(f"{parser.prog}: {option_string} is the old spelling of {self.new}; write {self.new}\n")
+        setattr(namespace, self.dest, values)
+
+
+def model_defaults(name: str, default: Any) -> str:
+    """The default of parameter ``name`` in each preset (:mod:`stickslip.models.presets`) that
+    reads it, e.g. ``10 (sakaguchi, train, batista-carlson), 100 (carlson-langer, two-blocks)``;
+    a parameter no preset reads: its default and the pieces that read it."""
+    from stickslip.models.pieces import PIECES
+    from stickslip.models.presets import PRESETS
+
+    by_value: dict[str, list[str]] = {}
+    for pr in PRESETS.values():
+        if name in ("N", "K", "V", "dt") or name in pr.reads():
+            by_value.setdefault(f"{pr.params.get(name, default):g}", []).append(pr.name)
+    if not by_value:
+        readers = [f"{p.kind} {p.name}" for kind in PIECES.values() for p in kind if name in p.reads]
+        return f"{default:g}" + (f"; read by {', '.join(readers)}" if readers else "")
+    if len(by_value) == 1 and len(next(iter(by_value.values()))) == len(PRESETS):
+        return next(iter(by_value))
+    return ", ".join(f"{value} ({', '.join(names)})" for value, names in by_value.items())
+
+
 def add_param_options(
     parser: argparse.ArgumentParser, params_cls: type, skip: tuple[str, ...] = (), helps: dict[str, str] | None = None
 ) -> None:
-    """One ``--NAME`` option per field of a parameter dataclass (default: the dataclass's); ``helps``
-    replaces the help text of some."""
+    """One option per field of a parameter dataclass (:func:`option_name`; the former spelling
+    with underscores still accepted), its help giving the default of each model that reads it
+    (ChainParams) or the dataclass's; ``helps`` replaces the help text of some."""
+    from stickslip.models.params import ChainParams
+
     docs = params_cls.field_docs()
     group = parser.add_argument_group("model parameters")
     for f in dataclasses.fields(params_cls):
@@ -151,14 +191,26 @@ def add_param_options(
         allowed = _range_text(
             meta.get("low"), meta.get("high"), meta.get("low_open", False), meta.get("high_open", False)
         )
+        default = model_defaults(f.name, f.default) if params_cls is ChainParams else f"{f.default}"
+        flag = option_name(f.name)
+        convert = _number(kind, f.name, allowed)
         group.add_argument(
-            f"--{f.name}",
+            flag,
             dest=f"param_{f.name}",
-            type=_number(kind, f.name, allowed),
+            type=convert,
             default=None,
             metavar=f.name,
-            help=(helps or {}).get(f.name, f"{docs[f.name]} (default {f.default})"),
+            help=(helps or {}).get(f.name, f"{docs[f.name]} (default {default})"),
         )
+        if flag != f"--{f.name}":
+            group.add_argument(
+                f"--{f.name}",
+                dest=f"param_{f.name}",
+                type=convert,
+                action=_OldSpelling,
+                new=flag,
+                help=argparse.SUPPRESS,
+            )
 
 
 def params_from_args(params_cls: type, args: argparse.Namespace, **overrides: Any):
@@ -340,14 +392,16 @@ def add_model_options(parser: argparse.ArgumentParser, helps: dict[str, str] | N
         dest="param_l",
         type=_number(float, "l"),
         default=None,
-        help="Carlson-Langer's spring ratio l (sets K = l^2)",
+        metavar="l",
+        help="Carlson-Langer's spring ratio l (sets K = l^2; default 10 for carlson-langer, two-blocks)",
     )
     group.add_argument(
         "--nu",
         dest="param_nu",
         type=_number(float, "nu"),
         default=None,
-        help="Carlson-Langer's plate velocity nu (sets V)",
+        metavar="nu",
+        help="Carlson-Langer's plate velocity nu (sets V; default 0.01 for carlson-langer, two-blocks)",
     )
     add_param_options(parser, ChainParams, helps=helps)
 
@@ -374,7 +428,7 @@ def chain_params_from_args(args: argparse.Namespace, **overrides: Any):
             values[name] = getattr(args, f"param_{name}")
     values.update(overrides)
     params = build_chain_params(args.model or "sakaguchi", **values)
-    refuse_unread(params, values, prefix="--")
+    refuse_unread(params, values, prefix="--", spell=option_name)
     return params
 
 

@@ -18,6 +18,7 @@ from stickslip.cli._common import (
     owned_out_dir,
 )
 from stickslip.models.params import MAX_PERTURBATION, check_number, steps_for
+from stickslip.run.ownership import PLOT_FOLDER, only_plot_files
 from stickslip.run.rundir import OWN_FILES, RunDirBusy, owned_run_dir, read_run_id
 
 
@@ -227,6 +228,8 @@ def _summary_text(summary: dict, out: Path | None, N: int | None = None) -> str:
         lines.append(f"stopped early  {summary['reason']}")
     if out is not None:
         lines.append(f"written to     {out}")
+    else:
+        lines.append("not written    nothing was saved; give --out DIR to keep the run (events, L(t), state)")
     return "\n".join(lines)
 
 
@@ -347,7 +350,8 @@ def run_chain_command(args: argparse.Namespace) -> Result:
         until_steady=args.until_steady,
     ).validated(params.dt)
     check_number("perturbation", args.perturbation, low=0.0, high=MAX_PERTURBATION)
-    out = check_out_owned(args.out, OWN_FILES, "stickslip chain", overwrite=args.overwrite)
+    own = _own_files(args.out)
+    out = check_out_owned(args.out, own, "stickslip chain", overwrite=args.overwrite)
     if out is not None and out.is_dir():
         if (out / "checkpoint" / "state.npz").exists() and not args.overwrite:
             raise CommandError(
@@ -356,7 +360,7 @@ def run_chain_command(args: argparse.Namespace) -> Result:
         if (out / "run.json").exists() and not args.overwrite:
             raise CommandError(f"{out} already holds a finished run; choose another --out or give --overwrite")
     try:
-        with owned_out_dir(out, OWN_FILES, "stickslip chain", overwrite=args.overwrite, run_id=True) as out:
+        with owned_out_dir(out, own, "stickslip chain", overwrite=args.overwrite, run_id=True) as out:
             run = chain.run_chain(
                 params,
                 t_end,
@@ -386,6 +390,15 @@ def run_chain_command(args: argparse.Namespace) -> Result:
     if args.t_end is None:
         text = f"N              {params.N}  (without --t-end a first look; the paper's run is --t-end 2e7)\n" + text
     return Result(_json_summary(run.summary, out), text)
+
+
+def _own_files(out: str | None):
+    """What `chain` treats as its own in ``--out``: a run's files, and the figures `stickslip plot`
+    drew from that run into RUN_DIR/figures (``--overwrite`` replaces them with the run)."""
+    if out is None:
+        return OWN_FILES
+    folder = Path(out) / PLOT_FOLDER
+    return lambda name: name in OWN_FILES or (name == PLOT_FOLDER and only_plot_files(folder))
 
 
 def _first_look(params, args, start: str):

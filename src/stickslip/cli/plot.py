@@ -3,13 +3,13 @@
 from __future__ import annotations
 
 import argparse
-import re
 from pathlib import Path
 
 from stickslip.cli._common import CommandError, Result, add_json_option, add_overwrite_option, owned_out_dir
 
-#: The figures `plot` draws (stickslip.plotting.run.run_figures); its --out may hold only these.
-_FIGURE = re.compile(r"(length|snapshot_final|snapshot_t[^/]*|sizes|fronts)\.(png|pdf|svg)")
+# The figures `plot` draws (stickslip.plotting.run.run_figures); its --out may hold only these.
+from stickslip.run.ownership import PLOT_FILE as _FIGURE
+from stickslip.run.ownership import PLOT_FOLDER
 
 
 def register(sub) -> None:
@@ -43,7 +43,7 @@ def run_plot_command(args: argparse.Namespace) -> Result:
     run_dir = Path(args.run_dir)
     if not (run_dir / "run.json").is_file() or not (run_dir / "state.nc").is_file():
         raise CommandError(f"{run_dir} is not a finished chain run directory (no run.json or state.nc)")
-    out = Path(args.out) if args.out else run_dir / "figures"
+    out = Path(args.out) if args.out else run_dir / PLOT_FOLDER
     if out.resolve() == run_dir.resolve():
         raise CommandError(
             f"--out {out} is the run directory itself; the figures go into a folder of "

@@ -138,6 +138,19 @@ class BlockParams(_Validated):
     theta' = theta (1 - theta) - alpha theta v, with static friction Fs.
     Defaults are the paper's (section 2, Fig. 1): M = sigma = alpha = beta = 1, K = 10,
     V = 0.001, Fs = 3, Heun step dt = 0.005.
+
+    Parameters
+    ----------
+    K, V, beta, alpha, Fs, M, sigma, dt : float
+        Spring constant, pulling velocity, viscous friction, weakening of theta, static
+        threshold, mass, state-friction scale, Heun time step.
+    threshold : {'constant', 'state'}
+        Static threshold: Fs, or sigma theta (the paper's reading of Batista-Carlson).
+
+    Examples
+    --------
+    >>> BlockParams(V=0.01)
+    BlockParams(K=10.0, V=0.01, beta=1.0, alpha=1.0, Fs=3.0, M=1.0, sigma=1.0, dt=0.005, threshold='constant')
     """
 
     K: float = _positive(10.0, "spring constant K")
@@ -247,6 +260,32 @@ class ChainParams(_Validated):
     (:mod:`stickslip.models.presets`). Parameters a composition does not read are kept at
     their defaults and left out of :meth:`to_dict`. A piece may declare further parameters
     (a friction law's own, :mod:`stickslip.models.friction`): they become fields after these.
+
+    Parameters
+    ----------
+    N, K, D, V, beta, alpha, Fs, dt : int, float
+        Blocks, spring constant, diffusion of theta, pulling velocity, viscous friction,
+        weakening of theta, static threshold, Heun time step (the paper's values by default).
+    model : str
+        The preset the parameters came from (:func:`stickslip.chain_params` sets it).
+    drive, friction, threshold, ends : str
+        The pieces (``stickslip models`` lists the choices).
+    Kp, sigma, F0 : float
+        Leaf spring of the plate drive, friction drop of velocity weakening, constant friction
+        of the train model; the rate-and-state laws add ``rs_a``, ``rs_b``, ``Dc``, ``v0``,
+        ``mu0``, ``sigma_n``. Each is read only by the pieces that name it (:meth:`used`).
+
+    Examples
+    --------
+    >>> p = ChainParams(N=49, beta=0.5)
+    >>> p
+    ChainParams(model='sakaguchi', N=49, K=10.0, D=5.0, V=0.001, beta=0.5, alpha=1.0, Fs=3.0, dt=0.005)
+    >>> p.used()
+    ('N', 'K', 'V', 'dt', 'beta', 'alpha', 'D', 'Fs')
+    >>> ChainParams(K=-1)
+    Traceback (most recent call last):
+    ...
+    stickslip.models.params.ParameterError: K must be > 0 (got -1)
     """
 
     N: int = field(default=399, metadata={"low": 1, "high": MAX_BLOCKS, "integer": True, "doc": "number of blocks N"})
@@ -333,6 +372,42 @@ class ChainParams(_Validated):
             for k, v in super().field_docs().items()
             if k not in ("model", "drive", "friction", "threshold", "ends")
         }
+
+    @classmethod
+    def symbol(cls, name: str) -> str:
+        """The parameter ``name`` as a figure label writes it (matplotlib mathtext, no dollars):
+        the paper's symbol, or the one a piece declares (:attr:`~stickslip.models.piece.Param.symbol`).
+
+        >>> print(ChainParams.symbol("beta"), ChainParams.symbol("Fs"), ChainParams.symbol("sigma_n"))
+        \\beta F_s \\sigma_n
+        """
+        meta = {f.name: f.metadata for f in dataclasses.fields(cls)}.get(name, {})
+        return meta.get("symbol") or SYMBOLS.get(name, name)
+
+    def __repr__(self) -> str:
+        """The model and the parameters it reads (those it ignores stay at their defaults), so
+        that ``eval(repr(p)) == p``."""
+        d = self.to_dict()
+        shown = {"model": d.pop("model")}
+        shown.update({k: d.pop(k) for k in PIECE_DEFAULTS if d[k] != PIECE_DEFAULTS[k]})
+        for k in PIECE_DEFAULTS:
+            d.pop(k, None)
+        return "ChainParams(" + ", ".join(f"{k}={v!r}" for k, v in {**shown, **d}.items()) + ")"
+
+
+#: The pieces a ChainParams has unless told otherwise: the paper's chain of eq. (4).
+PIECE_DEFAULTS = {"drive": "end", "friction": "state", "threshold": "constant", "ends": "free"}
+
+#: The paper's symbols of the fields of BlockParams and ChainParams in figure labels (mathtext).
+SYMBOLS = {
+    "beta": r"\beta",
+    "alpha": r"\alpha",
+    "sigma": r"\sigma",
+    "Fs": "F_s",
+    "Kp": "K_p",
+    "F0": "F_0",
+    "dt": r"\Delta t",
+}
 
 
 def steps_for(t_end: float, dt: float, name: str = "t_end") -> int:

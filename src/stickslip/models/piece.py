@@ -45,10 +45,14 @@ class Param:
     high: float | None = None
     low_open: bool = False
     high_open: bool = False
+    #: the parameter in figure labels (matplotlib mathtext without the dollars); the name if empty
+    symbol: str = ""
 
     def metadata(self) -> dict[str, Any]:
-        """The field metadata ChainParams validates with."""
+        """The field metadata ChainParams validates with (and labels figures with)."""
         meta: dict[str, Any] = {"doc": self.doc, "low_open": self.low_open, "high_open": self.high_open}
+        if self.symbol:
+            meta["symbol"] = self.symbol
         if self.low is not None:
             meta["low"] = self.low
         if self.high is not None:

@@ -90,6 +90,7 @@ PRESETS: dict[str, Preset] = {
             "2 theta_i + theta_{i-1}); a stuck block starts when its force exceeds Fs"
         ),
         source="H. Sakaguchi, Stick-Slip Motion and Phase Transition in a Block-Spring System, eq. (4)",
+        label="eq. (4)",
     ),
     "carlson-langer": Preset(
         "carlson-langer",
@@ -121,6 +122,7 @@ PRESETS: dict[str, Preset] = {
         source="F.-J. Elmer; here the paper's chain with alpha = 0 and theta = F0 = 1",
         note="Elmer's own parametrisation was not available; this is one member of the model",
         note_in_runs=True,
+        label="train model",
     ),
     "batista-carlson": Preset(
         "batista-carlson",
@@ -137,6 +139,7 @@ PRESETS: dict[str, Preset] = {
         source="after A. A. Batista and J. M. Carlson, Phys. Rev. E 57, 4986 (1998)",
         note=_BC_NOTE,
         note_in_runs=True,
+        label="Batista-Carlson (the paper's reading)",
     ),
     "two-blocks": Preset(
         "two-blocks",
@@ -173,6 +176,32 @@ def chain_params(model: str = "sakaguchi", **overrides: Any):
     (K = l^2, V = nu). A parameter the composition does not read (``beta`` of Carlson-Langer,
     say) is refused with :class:`~stickslip.models.params.ParameterError`, as the commands refuse
     its option, rather than silently ignored (:func:`refuse_unread`).
+
+    Parameters
+    ----------
+    model : str
+        A preset (``stickslip models`` lists them): ``sakaguchi`` (the paper's chain of eq. 4,
+        the default), ``carlson-langer``, ``train``, ``batista-carlson``, ``two-blocks``.
+    **overrides
+        Pieces (``drive``, ``friction``, ``threshold``, ``ends``) or parameters (``N``,
+        ``beta``, ...) that replace the preset's.
+
+    Returns
+    -------
+    ChainParams
+        Every parameter checked; a bad one raises ParameterError naming it and its range.
+
+    Examples
+    --------
+    >>> from stickslip import chain_params
+    >>> chain_params(N=49, beta=0.5)
+    ChainParams(model='sakaguchi', N=49, K=10.0, D=5.0, V=0.001, beta=0.5, alpha=1.0, Fs=3.0, dt=0.005)
+    >>> chain_params("carlson-langer", l=10, nu=0.01).K
+    100.0
+    >>> chain_params("carlson-langer", beta=2.0)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    stickslip.models.params.ParameterError: beta is not a parameter of this model (carlson-langer: ...
     """
     params = build_chain_params(model, **overrides)
     refuse_unread(params, overrides)
@@ -200,21 +229,71 @@ def build_chain_params(model: str = "sakaguchi", **overrides: Any):
     return ChainParams(model=model, **values)
 
 
-def refuse_unread(params, given, prefix: str = "") -> None:
+def refuse_unread(params, given, prefix: str = "", spell=None) -> None:
     """Raise ParameterError for the first of the names ``given`` that the composition of ``params``
     does not read (docs/model.md's family table), naming it as ``prefix`` + name (``--`` for an
-    option), and for Carlson-Langer's symbols ``l`` and ``nu`` without the plate drive."""
+    option) or as ``spell(name)`` spells it, and for Carlson-Langer's symbols ``l`` and ``nu``
+    without the plate drive."""
     from stickslip.models.params import ParameterError
 
     used = set(params.used()) | {"l", "nu", "model"}
     unused = [k for k in given if k not in used and k not in params.pieces]
     if unused:
+        shown = spell(unused[0]) if spell is not None else f"{prefix}{unused[0]}"
         raise ParameterError(
-            f"{prefix}{unused[0]} is not a parameter of this model ({params.model}: "
+            f"{shown} is not a parameter of this model ({params.model}: "
             f"{', '.join(f'{k} {v}' for k, v in params.pieces.items())}); it reads {', '.join(params.used())}"
         )
     if ("l" in given or "nu" in given) and not params.drive_piece.leaf_spring:
         raise ParameterError(f"{prefix}l and {prefix}nu are Carlson-Langer's symbols: they need drive plate")
+
+
+def model_name(params) -> str:
+    """The model of ``params`` as a figure title names it: its preset's short name when the pieces
+    are the preset's (eq. (4), Carlson-Langer), else that name and the pieces that differ.
+
+    >>> model_name(chain_params("carlson-langer"))
+    'Carlson-Langer'
+    >>> model_name(chain_params(friction="weakening", ends="fixed"))
+    'eq. (4), friction weakening, ends fixed'
+    """
+    pr = PRESETS[params.model]
+    changed = [f"{k} {v}" for k, v in params.pieces.items() if pr.pieces[k] != v]
+    return ", ".join([pr.label or pr.name, *changed])
+
+
+def model_title(params, *, skip: tuple[str, ...] = ("dt",)) -> str:
+    """The model and the values of every parameter it reads (but ``skip``), as matplotlib
+    mathtext for a figure title: what tells two runs apart, and nothing the model ignores.
+
+    >>> print(model_title(chain_params("carlson-langer")))
+    Carlson-Langer: $N=100$, $K=100$, $V=0.01$, $K_p=1$, $\\alpha=2.5$, $\\sigma=0.01$, $F_s=1$
+    """
+    values = ", ".join(f"${params.symbol(k)}={getattr(params, k):g}$" for k in params.used() if k not in skip)
+    return f"{model_name(params)}: {values}"
+
+
+def is_paper_model(params) -> bool:
+    """Whether ``params`` are of the paper's chain, eq. (4) (its preset and pieces, any values):
+    the runs the paper's own numbers (its front speed, its exponents) are drawn beside.
+
+    >>> is_paper_model(chain_params(N=49)), is_paper_model(chain_params(ends="fixed"))
+    (True, False)
+    """
+    return params.model == PAPER and params.pieces == PRESETS[PAPER].pieces
+
+
+def is_paper_run(params) -> bool:
+    """Whether ``params`` are the paper's chain with the paper's parameters (section 3), beta
+    aside: the runs whose figures are the paper's Figs. 5-8.
+
+    >>> is_paper_run(chain_params(beta=0.2)), is_paper_run(chain_params(N=49))
+    (True, False)
+    """
+    from stickslip.models.params import ChainParams
+
+    pr = PRESETS[PAPER]
+    return params.model == PAPER and params.replace(beta=1.0) == ChainParams(**pr.pieces, **pr.params)
 
 
 # Presets that are a single block of eq. (1): their chain form has N = 1, the end drive, state

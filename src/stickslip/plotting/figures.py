@@ -211,7 +211,7 @@ def _fig5(o: dict[str, Outcome], a: dict[str, Any], d: Path, mode: str) -> list[
             "of the pulling point, against the exact discrete steady sliding profile (dashed) and the "
             "paper's continuum form (dotted).",
             d,
-            fig5a_snapshot(snap, p, t),
+            fig5a_snapshot(snap, p, t, paper_figure="Fig. 5(a)"),
             fa,
             chain_command(o["chain-runs"], p.N, 1.0, plot="snapshot_final"),
         )
@@ -231,7 +231,7 @@ def _fig5(o: dict[str, Outcome], a: dict[str, Any], d: Path, mode: str) -> list[
             f"{steady_note or 'none'}) were stopped there and count L_ss from then on; open symbols: "
             "runs above beta_c that had not settled into steady sliding by their end.",
             d,
-            fig5b_length(sweep, q),
+            fig5b_length(sweep, q, paper_figure="Fig. 5(b)"),
             fb,
             sweep_command(o["chain-runs"], mode),
         )
@@ -282,7 +282,15 @@ def _fig6(o: dict[str, Outcome], a: dict[str, Any], d: Path) -> list[ReportFigur
         + f" (sound speed 3.16). {fig6_start_note(a)}"
     )
     fig = fig6_fronts(
-        prof, fm, fr["fronts"], run.params, labels=fr["labels"], window=20.0, edges=fr["edges"], speeds=per_event
+        prof,
+        fm,
+        fr["fronts"],
+        run.params,
+        labels=fr["labels"],
+        window=20.0,
+        edges=fr["edges"],
+        speeds=per_event,
+        paper_figure="Fig. 6",
     )
     return [
         _figure(
@@ -327,7 +335,7 @@ def _fig7_8(o: dict[str, Outcome], a: dict[str, Any], d: Path, which: str) -> li
             label,
             caption,
             d,
-            fig7_8_sizes(events, fit, beta, paper_tau=paper_tau),
+            fig7_8_sizes(events, fit, beta, paper_tau=paper_tau, paper_figure=label),
             [*f1, f2],
             chain_command(o["chain-runs"], N, beta, plot="sizes"),
         )

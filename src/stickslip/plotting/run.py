@@ -1,10 +1,13 @@
-"""Every figure one chain run (eq. 4) supports, drawn from its run directory (``stickslip plot``).
+"""The figures of one chain run (eq. 4 or a relative), from Python or its run directory (``stickslip plot``).
 
-:func:`run_figures` looks at what the run recorded and draws: L(t) against the steady length and
-the loading time (Fig. 5b's quantity over time); the final state, and each stored snapshot,
-against the steady sliding profile (Fig. 5a); the slip-size distribution with its truncated
-power-law fit (Figs. 7, 8); the rupture fronts of the largest events with stored displacement
-profiles (Fig. 6). Figures a run cannot support (no events, no profiles) are listed with the reason.
+One function per figure, each taking a :class:`~stickslip.run.outputs.ChainRun` (a run just made
+or one read back with :func:`~stickslip.run.rundir.load_run`), drawing into ``ax`` when given and
+returning the Figure: :func:`length` (L(t) against the steady length and the loading time),
+:func:`snapshot` (the final state or a stored snapshot against steady sliding, Fig. 5a),
+:func:`sizes` (the slip-size distribution of the stationary window with its truncated power-law
+fit, Figs. 7, 8) and :func:`fronts` (the rupture fronts of the largest events with stored
+displacement profiles, Fig. 6). :func:`run_figures` looks at what the run recorded and draws
+every figure it supports; those it cannot (no events, no profiles) are listed with the reason.
 """
 
 from __future__ import annotations
@@ -18,10 +21,22 @@ from matplotlib.figure import Figure
 
 from stickslip.analysis.chain_runs import front_statistics, run_size_statistics, stationary_events, stationary_from
 from stickslip.models.physics import chain_steady_length, has_steady_state, loading_time
-from stickslip.plotting.chain import fig5a_snapshot, fig6_fronts, fig7_8_sizes
+from stickslip.models.presets import model_name, model_title
+from stickslip.plotting.chain import fronts_figure, sizes_figure, snapshot_figure
 from stickslip.plotting.style import FIGURE_FORMATS, PAPER, SIM, THEORY, new_figure, save_figure
 
-__all__ = ["RunFigure", "length_series", "run_figures", "draw_run_figures", "size_numbers", "MIN_EVENTS_FOR_SIZES"]
+__all__ = [
+    "length",
+    "snapshot",
+    "sizes",
+    "fronts",
+    "RunFigure",
+    "length_series",
+    "run_figures",
+    "draw_run_figures",
+    "size_numbers",
+    "MIN_EVENTS_FOR_SIZES",
+]
 
 #: Fewest events with S > 0 for a size distribution and its fit.
 MIN_EVENTS_FOR_SIZES = 50
@@ -38,9 +53,10 @@ class RunFigure:
     numbers: dict | None = None
 
 
-def length_series(samples, params) -> Figure:
-    """L(t) = x_1 - x_N of a run against the exact steady length L_ss and the loading time L_ss / V."""
-    fig, ax = new_figure(1, 1, width=6.0, height=3.2)
+def length_series(samples, params, *, ax=None) -> Figure:
+    """L(t) = x_1 - x_N of a run against the exact steady length L_ss and the loading time L_ss / V
+    (Fig. 5b's quantity over time); ``samples`` as :attr:`ChainRun.samples <stickslip.run.outputs.ChainRun>`."""
+    fig, ax = new_figure(1, 1, width=6.0, height=3.2) if ax is None else (ax.figure, ax)
     ax.plot(samples["t"].values, samples["L"].values, color=SIM["color"], lw=0.7, label="$L(t) = x_1 - x_N$")
     if has_steady_state(params) and not params.drive_piece.leaf_spring:
         ax.axhline(chain_steady_length(params), **THEORY, label="steady sliding $L_{ss}$")
@@ -50,8 +66,105 @@ def length_series(samples, params) -> Figure:
     ax.set_xlabel("$t$")
     ax.set_ylabel("$L$")
     ax.legend(loc="lower right", fontsize=8)
-    ax.set_title(f"$L(t)$, $\\beta$ = {params.beta:g}, N = {params.N}", loc="left", fontsize=9)
+    ax.set_title(f"$L(t)$\n{model_title(params)}", loc="left", fontsize=8)
     return fig
+
+
+def length(run, *, ax=None) -> Figure:
+    """L(t) = x_1 - x_N of ``run`` against the steady length L_ss and the loading time L_ss / V.
+
+    Parameters
+    ----------
+    run : ChainRun
+        A run of :func:`~stickslip.run.driver.run_chain` or one read by :func:`~stickslip.run.rundir.load_run`.
+    ax : matplotlib.axes.Axes, optional
+        Where to draw; a new Figure if not given.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The Figure drawn in (that of ``ax`` when given).
+    """
+    return length_series(run.samples, run.params, ax=ax)
+
+
+def snapshot(run, t: float | None = None, *, ax=None) -> Figure:
+    """x_i - V t of ``run`` at its end (or at a stored snapshot time ``t``) against the exact
+    discrete steady sliding profile and the paper's continuum form (Fig. 5a).
+
+    Parameters
+    ----------
+    run : ChainRun
+        A run whose model has steady sliding pulled from one end (eq. 4 and the train model).
+    t : float, optional
+        A time in ``run.snapshots["time"]`` (``snapshot_times`` of the run); the end if not given.
+    ax : matplotlib.axes.Axes, optional
+        Draw the snapshot panel alone into this Axes; else a Figure with the residual beneath.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    p = run.params
+    if not has_steady_state(p) or p.drive_piece.leaf_spring:
+        raise ValueError(f"no steady sliding profile pulled from one end for this model ({model_name(p)})")
+    if t is None:
+        return snapshot_figure(run.state.blocks()["x"], p, float(run.summary["t_end"]), ax=ax)
+    times = run.snapshots["time"].values
+    near = [float(s) for s in times if math.isclose(float(s), float(t), rel_tol=1e-9, abs_tol=0.5 * p.dt)]
+    if not near:
+        raise ValueError(f"no snapshot stored at t = {t:g} (stored: {', '.join(f'{s:g}' for s in times)})")
+    return snapshot_figure(run.snapshots.sel(time=near[0]), p, near[0], ax=ax)
+
+
+def sizes(run, *, ax=None, bins: int = 30) -> Figure:
+    """The slip-size distribution of ``run``'s stationary window with its truncated power-law
+    fit (:func:`~stickslip.analysis.chain_runs.run_size_statistics`), and S against time (Figs. 7, 8).
+
+    Parameters
+    ----------
+    run : ChainRun
+    ax : matplotlib.axes.Axes, optional
+        Draw the distribution alone into this Axes; else a Figure with S against time beside it.
+    bins : int
+        Logarithmic bins of the density.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    stats = run_size_statistics(run, small_only=False)
+    return sizes_figure(stationary_events(run), stats["fit"], params=run.params, bins=bins, ax=ax)
+
+
+def fronts(run, *, ax=None) -> Figure:
+    """The rupture fronts of ``run``'s largest events with stored displacement profiles (Fig. 6):
+    a run made with ``profile_window`` (20 in the paper).
+
+    Parameters
+    ----------
+    run : ChainRun
+    ax : matplotlib.axes.Axes or a pair of them, optional
+        Draw the largest event's windows (and, given two Axes, its first moves) there.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    if not run.profiles.sizes.get("row", 0):
+        raise ValueError("no displacement profiles stored (run with profile_window=20)")
+    found = front_statistics(run, run.params.N, 0.0)
+    if not found["fronts"]:
+        raise ValueError("no event with stored profiles could be fitted")
+    return fronts_figure(
+        run.profiles,
+        run.first_move,
+        found["fronts"],
+        run.params,
+        labels=found["labels"],
+        window=run.options.profile_window,
+        ax=ax,
+    )
 
 
 def run_figures(run, *, max_snapshots: int = 4) -> list[RunFigure]:
@@ -69,7 +182,7 @@ def run_figures(run, *, max_snapshots: int = 4) -> list[RunFigure]:
             RunFigure(
                 "snapshot_final",
                 f"final state at t = {t_end:g} against steady sliding",
-                fig5a_snapshot(run.state.blocks()["x"], p, t_end),
+                snapshot_figure(run.state.blocks()["x"], p, t_end),
             )
         )
         times = run.snapshots["time"].values if "time" in run.snapshots.dims else []
@@ -78,7 +191,7 @@ def run_figures(run, *, max_snapshots: int = 4) -> list[RunFigure]:
                 RunFigure(
                     f"snapshot_t{float(t):.6g}",
                     f"snapshot at t = {float(t):g}",
-                    fig5a_snapshot(run.snapshots.sel(time=t), p, float(t)),
+                    snapshot_figure(run.snapshots.sel(time=t), p, float(t)),
                 )
             )
     else:
@@ -93,7 +206,7 @@ def run_figures(run, *, max_snapshots: int = 4) -> list[RunFigure]:
             RunFigure(
                 "sizes",
                 f"slip-size distribution (events at t >= {stats['t_from']:g})",
-                fig7_8_sizes(window, stats["fit"], p.beta),
+                sizes_figure(window, stats["fit"], params=p),
                 numbers=size_numbers(run, stats),
             )
         )
@@ -110,7 +223,7 @@ def run_figures(run, *, max_snapshots: int = 4) -> list[RunFigure]:
     if run.profiles.sizes.get("row", 0) and len(events):
         fronts = front_statistics(run, p.N, 0.0)
         if fronts["fronts"]:
-            fig = fig6_fronts(
+            fig = fronts_figure(
                 run.profiles,
                 run.first_move,
                 fronts["fronts"],

@@ -90,13 +90,15 @@ def plot_fig4(ds: xr.Dataset, *, k_zoom: float = 0.3) -> Figure:
     pad = 0.08 * (hi - lo)
     axes[1].set_ylim(lo - pad, hi + pad)
     attrs = ds.attrs
-    axes[0].set_title(
+    axes[0].set_title("(a) every wavenumber", loc="left", fontsize=9)
+    axes[1].set_title("(b) long waves (solid: largest, dashed: second)", loc="left", fontsize=9)
+    axes[0].legend(fontsize=8)
+    fig.suptitle(
+        "Fig. 4: growth rates of the Fourier modes of steady sliding, eq. (5), "
         f"$K = {attrs.get('K', float('nan')):g}$, $D = {attrs.get('D', float('nan')):g}$, "
         f"$V = {attrs.get('V', float('nan')):g}$",
         fontsize=9,
     )
-    axes[1].set_title("long waves (solid: largest, dashed: second)", fontsize=9)
-    axes[0].legend(fontsize=8)
     return fig
 
 

@@ -2,13 +2,22 @@
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 import matplotlib
 
-matplotlib.use("Agg", force=False)
+# Figures are drawn off screen; in a Jupyter kernel the notebook's own backend stays, so that
+# its figures go on showing inline.
+if "ipykernel" not in sys.modules:
+    matplotlib.use("Agg", force=False)
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
+
+if "ipykernel" in sys.modules:
+    # Settle the backend now: the notebook's inline backend, once loaded, shows a Figure that
+    # ends a cell (the figures here are made without pyplot, which would load it only later).
+    plt.switch_backend(matplotlib.get_backend())
 
 RC = {
     "figure.dpi": 110,

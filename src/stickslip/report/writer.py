@@ -189,6 +189,18 @@ def _agreement_class(agrees: bool | None) -> str:
     return "na" if agrees is None else ("yes" if agrees else "no")
 
 
+def _meta_text(value: Any) -> str | list[str]:
+    """A header entry as the page shows it: text as it is, a list (the experiments, the notes)
+    as one line per item, a mapping as ``key: value`` lines, other values as JSON."""
+    if isinstance(value, str):
+        return value
+    if isinstance(value, Mapping):
+        return [f"{k}: {v if isinstance(v, str) else _json_text(v)}" for k, v in value.items()]
+    if isinstance(value, (list, tuple)):
+        return [v if isinstance(v, str) else _json_text(v) for v in value]
+    return _json_text(value)
+
+
 def _json_text(value: Any) -> str:
     import json
 
@@ -204,7 +216,7 @@ def _page_context(report: Report, out: Path, *, embed: bool, title: str) -> dict
         f"{len(report.rows)} stated numbers: {counts['yes']} agree, {counts['no']} disagree, "
         f"{counts['na']} not settled at this run length."
     )
-    meta = [(str(k), v if isinstance(v, str) else _json_text(v)) for k, v in report.meta.items()]
+    meta = [(str(k), _meta_text(v)) for k, v in report.meta.items()]
     rows = [
         {
             "where": r.where,

@@ -147,6 +147,30 @@ def simulate_block(
     the nearest integer; ``every`` > 1 keeps every ``every``-th state in ``series`` (the
     statistics and the slip table still see every step). To go on from a run with another V,
     pass ``initial=run.restart_state()``.
+
+    Parameters
+    ----------
+    params : BlockParams
+        The block's parameters (the paper's by default).
+    t_end : float
+        End time, in the model's time units.
+    initial : BlockState, optional
+        The start (default x = v = 0, theta = 0.1, stuck).
+    every : int
+        Keep every ``every``-th state in ``series``.
+
+    Returns
+    -------
+    BlockRun
+        ``series`` (x, v, theta, f over t), ``slips`` (one row per slip: t_c, t_e, duration,
+        slip, force_at_stop, period), ``final`` and counts.
+
+    Examples
+    --------
+    >>> from stickslip import BlockParams, simulate_block
+    >>> run = simulate_block(BlockParams(), 5000.0, every=100)
+    >>> len(run.slips), round(float(run.slips["period"].iloc[-1]), 3)
+    (14, 344.14)
     """
     if not isinstance(params, BlockParams):
         raise TypeError("params must be a BlockParams")

@@ -25,18 +25,14 @@ errors (:mod:`stickslip.run.errors`).
 
 from __future__ import annotations
 
-import signal
-import sys
 import time
 import warnings
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from stickslip import heartbeat
 from stickslip.kernels import dense, entry, exact, layout, plate
 from stickslip.models.params import ChainParams, ParameterError, check_number, steps_for
 from stickslip.models.pieces import stopped_blocks_still
@@ -46,6 +42,7 @@ from stickslip.run import rundir
 from stickslip.run.checkpoint import CHECKPOINT_FORMAT, Checkpointer, _read_npz, _write_npz  # noqa: F401
 from stickslip.run.errors import ChainRunError, Interrupted, NonFiniteState, ShortRunWarning
 from stickslip.run.outputs import EVENT_COLUMNS, ChainRun, RunOptions, _assemble, _Outputs
+from stickslip.run.progress import Progress, SignalFlag, show_progress
 from stickslip.run.rundir import load_run, read_run_id, write_run
 from stickslip.run.state import STARTS, ChainState, initial_state, line_aligned, loading_warnings, steady_deviation
 from stickslip.run.validate import check_chain_params, check_checkpoint_state, check_start_state
@@ -74,71 +71,6 @@ __all__ = [
 INTEGRATORS = ("exact", "dense")
 
 _KERNELS = {"dense": dense.run_dense, "exact": exact.run_exact, "sparse": plate.run_sparse}
-
-
-@dataclass
-class _Progress:
-    """Progress on a terminal: time reached, events so far, speed, time left."""
-
-    t_end: float
-    enabled: bool
-    bar: Any = None
-    t_last: float = 0.0
-
-    def __post_init__(self):
-        if self.enabled:
-            from tqdm import tqdm
-
-            self.bar = tqdm(
-                total=self.t_end,
-                unit=" time units",
-                unit_scale=False,
-                dynamic_ncols=True,
-                desc="chain",
-                file=sys.stderr,
-                smoothing=0.1,
-                bar_format="{l_bar}{bar}| t = {n:.4g}/{total:.4g} [{elapsed}<{remaining}, {rate_fmt}{postfix}]",
-            )
-
-    def update(self, t: float, n_events: int) -> None:
-        heartbeat.note(f"chain t = {t:.4g} of {self.t_end:.4g}, {n_events} events")
-        if self.bar is not None:
-            self.bar.update(t - self.t_last)
-            self.bar.set_postfix(events=n_events, refresh=False)
-            self.t_last = t
-
-    def close(self) -> None:
-        if self.bar is not None:
-            self.bar.close()
-
-
-class _SignalFlag:
-    """Turns SIGINT/SIGTERM into a flag checked between chunks (main thread only)."""
-
-    def __init__(self, enabled: bool):
-        self.set = False
-        self.enabled = enabled and _in_main_thread()
-        self.previous: dict[int, Any] = {}
-
-    def __enter__(self):
-        if self.enabled:
-            for sig in (signal.SIGINT, signal.SIGTERM):
-                self.previous[sig] = signal.signal(sig, self._handler)
-        return self
-
-    def _handler(self, signum, frame):
-        self.set = True
-
-    def __exit__(self, *exc):
-        for sig, handler in self.previous.items():
-            signal.signal(sig, handler)
-        return False
-
-
-def _in_main_thread() -> bool:
-    import threading
-
-    return threading.current_thread() is threading.main_thread()
 
 
 def _finite(state: ChainState) -> bool:
@@ -213,30 +145,72 @@ def run_chain(
     sample_moving: bool = False,
     out_dir: str | Path | None = None,
     checkpoint_interval: float | None = None,
-    progress: bool = False,
+    progress: bool | None = None,
     handle_signals: bool = False,
     run_id: str | None = None,
     keep_checkpoint: bool = False,
     stop_requested: Callable[[], bool] | None = None,
 ) -> ChainRun:
-    """Integrate the chain of eq. (4) from ``start`` to ``t_end`` (docs/model.md, "Chain").
+    """Integrate the chain of eq. (4), or a relative, from ``start`` to ``t_end`` (docs/model.md, "Chain").
 
-    ``integrator`` is 'exact' (default) or 'dense'; both give the same result bit for bit.
-    ``start`` is 'paper' (x = 0, v = 0.1, theta = 0.1, all moving), 'steady' (exact steady
-    sliding, optionally perturbed by ``perturbation`` with ``seed``) or a :class:`ChainState`.
-    With ``until_steady`` = TOL the run stops at the first sampling time at which every block
-    slides within TOL of steady sliding; L is then taken from the steady solution up to t_end.
-    With ``sample_moving`` the number of moving blocks is sampled at the multiples of the
-    sampling interval: the times of L where the run starts on one (the kernels count them with L).
-    With ``out_dir``, checkpoints are written there every ``checkpoint_interval`` wall-clock
-    seconds and on SIGINT/SIGTERM (``handle_signals``), and the results at the end; the folder is
-    owned as ``stickslip chain --out`` owns it (:func:`rundir.run_dir_for_run`: locked, foreign
-    files and an earlier run refused); ``run_id`` (that of the run directory,
-    :func:`rundir.owned_run_dir`) goes into every checkpoint. A
-    finished run removes its checkpoint unless ``keep_checkpoint`` (needed only to continue it to
-    a later t_end with :func:`resume_chain`). ``stop_requested``, called between chunks of about
-    a quarter second, stops the run as a signal does: checkpoint, then :class:`Interrupted`
-    (how a sweep's worker learns that the sweep was interrupted).
+    Parameters
+    ----------
+    params : ChainParams
+        The model and its parameters: :func:`stickslip.chain_params` (``'sakaguchi'``, the
+        paper's chain, or another preset, with overrides).
+    t_end : float
+        End time, in the model's time units (the paper's runs: 2e7 at N = 399).
+    integrator : {'exact', 'dense'}
+        ``exact`` (fast) or ``dense`` (the reference); the same result bit for bit.
+    start : {'paper', 'steady', 'rest'} or ChainState
+        ``paper``: x = 0, v = 0.1, theta = 0.1, all moving; ``steady``: exact steady sliding
+        (perturbed uniformly in [-A, A] with ``perturbation`` A and ``seed``); ``rest``: every
+        block stuck at x_i = -A u_i (Carlson-Langer's); or the state of another run.
+    perturbation, seed : float, int
+        The draw of ``steady`` and ``rest``.
+    sample_interval : float
+        L = x_1 - x_N is sampled every this long (Fig. 5b).
+    average_from : float, optional
+        <L> (``summary['L_mean']``) averages the samples from this time (default t_end / 2).
+    snapshot_times : sequence of float
+        Times at which every x_i is kept (Fig. 5a); the end is always kept.
+    profile_window, profile_min_blocks : float, int, optional
+        Keep x_i every ``profile_window`` during events of at least ``profile_min_blocks``
+        blocks: the rupture fronts of Fig. 6 (the paper's window is 20).
+    until_steady : float, optional
+        Stop at the first sampling time at which every block slides within this tolerance of
+        steady sliding; L is then taken from the steady solution up to t_end.
+    sample_moving : bool
+        Also sample the number of moving blocks (``samples['n_moving']``).
+    out_dir : str or Path, optional
+        A run directory, owned as ``stickslip chain --out`` owns it (locked; foreign files and an
+        earlier run refused): checkpoints every ``checkpoint_interval`` wall-clock seconds and on
+        SIGINT/SIGTERM (``handle_signals``), the results at the end. Without it nothing is
+        written; :meth:`ChainRun.save` writes the same folder afterwards.
+    progress : bool, optional
+        Show a progress bar: ``None`` (default) where the session is interactive (a Jupyter
+        notebook, the interpreter on a terminal), ``True`` on any terminal, ``False`` never.
+    run_id, keep_checkpoint, stop_requested
+        The run directory's id in every checkpoint; keep the checkpoint at the end (to continue
+        to a later t_end with :func:`resume_chain`); a callable asked between chunks of about
+        a quarter second whether to stop as a signal does (checkpoint, then :class:`Interrupted`).
+
+    Returns
+    -------
+    ChainRun
+        Events, first moves, L(t), snapshots, profiles, final state and summary.
+
+    Raises
+    ------
+    ParameterError
+        A bad value (one line naming it); :class:`NonFiniteState` if the state blows up.
+
+    Examples
+    --------
+    >>> import stickslip
+    >>> run = stickslip.run_chain(stickslip.chain_params(N=10, beta=0.5), 2e4)
+    >>> run.summary["n_events"], len(run.events), run.summary["steps"]
+    (65, 65, 4000000)
     """
     check_chain_params(params)
     if integrator not in INTEGRATORS:
@@ -290,18 +264,33 @@ def resume_chain(
     *,
     t_end: float | None = None,
     checkpoint_interval: float | None = None,
-    progress: bool = False,
+    progress: bool | None = None,
     handle_signals: bool = False,
     expect_params: ChainParams | None = None,
     keep_checkpoint: bool | None = None,
     stop_requested: Callable[[], bool] | None = None,
 ) -> ChainRun:
-    """Continue the run in ``run_dir`` from its checkpoint to its t_end (or a later ``t_end``).
+    """Continue the run in ``run_dir`` from its checkpoint to its t_end (or a later ``t_end``),
+    ending bit for bit where an uninterrupted :func:`run_chain` ends.
 
-    A corrupt checkpoint, one of another format, or one whose parameters differ from
-    ``expect_params`` is refused with :class:`ChainRunError`. The checkpoint is kept at the end
-    if ``keep_checkpoint``, or (None) if the run was started keeping it. ``stop_requested`` as
-    for :func:`run_chain`.
+    Parameters
+    ----------
+    run_dir : str or Path
+        The run directory of an interrupted run (or one kept with ``keep_checkpoint``).
+    t_end : float, optional
+        A later end time than the run's own.
+    checkpoint_interval, progress, handle_signals, stop_requested
+        As for :func:`run_chain`.
+    expect_params : ChainParams, optional
+        Refuse a checkpoint made with other parameters.
+    keep_checkpoint : bool, optional
+        Keep the checkpoint at the end; ``None``: if the run was started keeping it.
+
+    Returns
+    -------
+    ChainRun
+        The whole run, written into ``run_dir``. A corrupt checkpoint, one of another format or
+        of other parameters raises :class:`ChainRunError`.
     """
     run_dir = Path(run_dir)
     ckpt = Checkpointer(run_dir)
@@ -449,13 +438,14 @@ def _drive(
         header["run_id"] = run_id
     if keep_checkpoint:
         header["keep_checkpoint"] = True
-    bar = _Progress(options.t_end, progress and sys.stderr.isatty())
+    # From Python (progress None) the bar waits a second, so that a short run shows none.
+    bar = Progress(options.t_end, show_progress(progress), delay=1.0 if progress is None else 0.0)
     t0 = time.perf_counter()
     last_ckpt = t0
     chunk = 200_000
     if out_dir is not None:
         Path(out_dir).mkdir(parents=True, exist_ok=True)
-    with _SignalFlag(handle_signals) as flag:
+    with SignalFlag(handle_signals) as flag:
         try:
             while True:
                 n = state.step

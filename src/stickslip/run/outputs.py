@@ -9,6 +9,7 @@ The kernels fill fixed-size buffers (:class:`_Outputs`) that are flushed into Py
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -99,9 +100,69 @@ EVENT_COLUMNS = [
 ]
 
 
-@dataclass
+@dataclass(repr=False)
 class ChainRun:
-    """The result of a chain run (eq. 4): events, first moves, L(t), snapshots, profiles, state."""
+    """The result of a chain run (eq. 4 or a relative): its slip events, L(t), snapshots,
+    displacement profiles and final state, with methods to plot and to save them.
+
+    Made by :func:`~stickslip.run.driver.run_chain` (or read back from a run directory by
+    :func:`~stickslip.run.rundir.load_run`). Times are in the model's units (eq. 4 scaled to
+    M = sigma = 1, docs/model.md); blocks are numbered 1 (pulled end) to N.
+
+    Attributes
+    ----------
+    params : ChainParams
+        The model and its parameters.
+    options : RunOptions
+        What the run recorded (t_end, sampling interval, snapshot times, profile window).
+    integrator : str
+        ``'exact'`` or ``'dense'`` (the same result bit for bit).
+    start : dict
+        The start state: its kind (``'paper'``, ``'steady'``, ``'rest'`` or ``'state'``) and draw.
+    state : ChainState
+        The final state: x_i, v_i, theta_i, which blocks are stuck, the step count.
+    events : pandas.DataFrame
+        One row per slip event (docs/model.md, "Slip events"), columns:
+
+        ============  =================================================================
+        event         event number, 0-based, in order of start
+        step_start    first step n in which a block moved (t = n dt)
+        step_end      first step that ended with every block stopped again
+        t_start       start time, step_start dt (model time units)
+        t_end         end time, (step_end + 1) dt (model time units)
+        duration      t_end - t_start (model time units)
+        S             slip size S = sum_i (x_i(end) - x_i(start)) (model length units; Figs. 7, 8)
+        start_block   block that moved first (1..N)
+        max_block     farthest block that moved (1..N)
+        n_blocks      number of blocks that moved
+        ============  =================================================================
+    first_move : pandas.DataFrame
+        When each block first moved in each event (rupture fronts, Fig. 6): columns ``event``,
+        ``block`` (1..N), ``step`` and ``t_first`` = step dt (model time units).
+    samples : xarray.Dataset
+        ``L`` = x_1 - x_N (model length units) over ``t``, sampled every ``sample_interval``
+        (Fig. 5b); with ``sample_moving``, ``n_moving`` over ``t_moving`` (the same names in
+        state.nc).
+    snapshots : xarray.DataArray
+        x_i (model length units) over (``time``, ``block``): the ``snapshot_times`` and the end.
+    profiles : xarray.Dataset
+        ``dx`` over (``row``, ``block``): x_i(t_next) - x_i(t) over each stored window of an
+        event (Fig. 6), with ``event``, ``t`` and ``t_next`` per row.
+    summary : dict
+        Numbers of the run: ``n_events``, ``L_mean``, ``L_steady``, ``t_end``, ``steps``,
+        ``wall_seconds``, ``state_sha256`` (the final state's SHA-256), ...
+
+    Examples
+    --------
+    >>> import stickslip
+    >>> run = stickslip.run_chain(stickslip.chain_params(N=10), 2e4)
+    >>> run  # doctest: +ELLIPSIS
+    ChainRun(eq. (4): N=10, K=10, V=0.001, dt=0.005, beta=1, alpha=1, D=5, Fs=3
+             t_end=20000 (4000000 steps, exact), 69 events, L_mean=4.69194
+             state sha256 ef0a3122809af663...)
+    >>> list(run.events.columns[:4])
+    ['event', 'step_start', 'step_end', 't_start']
+    """
 
     params: ChainParams
     options: RunOptions
@@ -117,11 +178,83 @@ class ChainRun:
 
     @property
     def t_end(self) -> float:
+        """The end time the run was asked for (model time units)."""
         return self.options.t_end
 
     @property
     def steps(self) -> int:
+        """Time steps taken (t = steps dt)."""
         return self.state.step
+
+    def __repr__(self) -> str:
+        from stickslip.models.presets import model_name
+
+        p = self.params
+        values = ", ".join(f"{k}={getattr(p, k):g}" for k in p.used())
+        s = self.summary
+        return (
+            f"ChainRun({model_name(p)}: {values}\n"
+            f"         t_end={s['t_end']:g} ({s['steps']} steps, {self.integrator}), {s['n_events']} events, "
+            f"L_mean={s['L_mean']:.6g}\n"
+            f"         state sha256 {s['state_sha256'][:16]}...)"
+        )
+
+    def save(self, out_dir: str | Path) -> Path:
+        """Write the run directory ``stickslip chain --out DIR`` writes (run.json, state.nc,
+        events and first_move as Parquet and CSV), for :func:`~stickslip.run.rundir.load_run`
+        and ``stickslip plot`` to read.
+
+        The folder is owned as the command owns it: a folder holding files a chain run does not
+        write, or a run already, is refused with ParameterError; it is locked while written.
+
+        Parameters
+        ----------
+        out_dir : str or Path
+            The run directory; created if missing.
+
+        Returns
+        -------
+        Path
+            ``out_dir``.
+
+        Examples
+        --------
+        >>> import stickslip, tempfile, pathlib
+        >>> run = stickslip.run_chain(stickslip.chain_params(N=10), 2e4)
+        >>> folder = run.save(pathlib.Path(tempfile.mkdtemp()) / "run1")
+        >>> stickslip.load_run(folder).summary["state_sha256"] == run.summary["state_sha256"]
+        True
+        """
+        from stickslip.run.ownership import run_dir_for_run
+        from stickslip.run.runfiles import write_run
+
+        with run_dir_for_run(out_dir):
+            return write_run(self, out_dir)
+
+    def plot_length(self, *, ax=None):
+        """L(t) against steady sliding: :func:`stickslip.plotting.length`; returns the Figure."""
+        from stickslip.plotting.run import length
+
+        return length(self, ax=ax)
+
+    def plot_snapshot(self, t: float | None = None, *, ax=None):
+        """The final state (or the snapshot at ``t``) against steady sliding:
+        :func:`stickslip.plotting.snapshot`; returns the Figure."""
+        from stickslip.plotting.run import snapshot
+
+        return snapshot(self, t, ax=ax)
+
+    def plot_sizes(self, *, ax=None, bins: int = 30):
+        """The slip-size distribution with its fit: :func:`stickslip.plotting.sizes`; returns the Figure."""
+        from stickslip.plotting.run import sizes
+
+        return sizes(self, ax=ax, bins=bins)
+
+    def plot_fronts(self, *, ax=None):
+        """The rupture fronts of the largest events: :func:`stickslip.plotting.fronts`; returns the Figure."""
+        from stickslip.plotting.run import fronts
+
+        return fronts(self, ax=ax)
 
 
 class _Outputs:

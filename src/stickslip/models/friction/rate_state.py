@@ -137,12 +137,30 @@ PIECE = Piece(
     "dtheta_i/dt = 1 - v_i theta_i / D_c (Dieterich-Ruina, aging law, regularised at v = 0)",
     READS,
     params=(
-        Param("rs_a", 0.01, "direct-effect coefficient a of rate-and-state friction", low=0.0, low_open=True),
-        Param("rs_b", 0.015, "state-effect coefficient b of rate-and-state friction", low=0.0),
-        Param("Dc", 0.001, "characteristic slip distance D_c of rate-and-state friction", low=0.0, low_open=True),
-        Param("v0", 0.001, "reference velocity v0 of rate-and-state friction", low=0.0, low_open=True),
-        Param("mu0", 0.6, "friction coefficient mu0 at v = v0 in steady state (rate-and-state)", low=0.0),
-        Param("sigma_n", 5.0, "normal stress sigma_n times the rate-and-state coefficient mu", low=0.0, low_open=True),
+        Param(
+            "rs_a", 0.01, "direct-effect coefficient a of rate-and-state friction", low=0.0, low_open=True, symbol=r"a"
+        ),
+        Param("rs_b", 0.015, "state-effect coefficient b of rate-and-state friction", low=0.0, symbol=r"b"),
+        Param(
+            "Dc",
+            0.001,
+            "characteristic slip distance D_c of rate-and-state friction",
+            low=0.0,
+            low_open=True,
+            symbol=r"D_c",
+        ),
+        Param("v0", 0.001, "reference velocity v0 of rate-and-state friction", low=0.0, low_open=True, symbol=r"v_0"),
+        Param(
+            "mu0", 0.6, "friction coefficient mu0 at v = v0 in steady state (rate-and-state)", low=0.0, symbol=r"\mu_0"
+        ),
+        Param(
+            "sigma_n",
+            5.0,
+            "normal stress sigma_n times the rate-and-state coefficient mu",
+            low=0.0,
+            low_open=True,
+            symbol=r"\sigma_n",
+        ),
     ),
     check=check_v,
     has_state=True,

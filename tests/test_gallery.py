@@ -1,0 +1,58 @@
+"""The gallery (docs/gallery): every page's code cells run in order, draw their figures, and take
+under a minute (the documentation build executes them too)."""
+
+from __future__ import annotations
+
+import os
+import re
+import time
+from pathlib import Path
+
+import pytest
+
+GALLERY = Path(__file__).resolve().parent.parent / "docs" / "gallery"
+CELL = re.compile(r"^```\{code-cell\}[^\n]*\n(.*?)^```", re.S | re.M)
+#: Pages whose runs take longer than the default test run allows (run with -m slow).
+SLOW = {"sizes_two_models"}
+
+
+def pages() -> list:
+    return [
+        pytest.param(p, marks=pytest.mark.slow, id=p.stem) if p.stem in SLOW else pytest.param(p, id=p.stem)
+        for p in sorted(GALLERY.glob("*.md"))
+        if p.stem != "index"
+    ]
+
+
+def test_every_page_is_in_the_gallery_toctree():
+    index = (GALLERY / "index.md").read_text()
+    for page in GALLERY.glob("*.md"):
+        if page.stem != "index":
+            assert f"\n{page.stem}\n" in index, page.stem
+
+
+@pytest.mark.parametrize("page", pages())
+def test_gallery_page_runs_and_draws(page, tmp_path, monkeypatch):
+    import matplotlib
+    import matplotlib.pyplot as plt
+
+    matplotlib.use("Agg")
+    monkeypatch.chdir(tmp_path)
+    cells = CELL.findall(page.read_text())
+    assert cells, f"{page.name} has no code cells"
+    from numba.core import event
+
+    namespace: dict = {"__name__": "__main__"}
+    plt.close("all")
+    compiling: list[float] = []
+    start = time.perf_counter()
+    with event.install_timer("numba:compile", compiling.append):
+        for cell in cells:
+            exec(compile(cell, f"{page.name}", "exec"), namespace)
+    wall = time.perf_counter() - start - sum(compiling)  # a model's first run compiles its kernels
+    drawn = plt.get_fignums() or [v for v in namespace.values() if isinstance(v, matplotlib.figure.Figure)]
+    assert drawn, f"{page.name} draws no figure"
+    plt.close("all")
+    # under a minute once compiled (a busy shared machine may set more)
+    limit = float(os.environ.get("STICKSLIP_GALLERY_LIMIT", "60"))
+    assert wall < limit, f"{page.name} took {wall:.0f} s"
