@@ -91,12 +91,12 @@ def test_progress_shows_only_where_someone_watches(monkeypatch):
 
 
 def test_a_notebook_shows_the_figures_and_the_progress_of_a_run(monkeypatch):
-    """In a Jupyter kernel (the docs extra installs one): a Figure that ends a cell is shown as an
+    """In a Jupyter kernel (the test extra installs one): a Figure that ends a cell is shown as an
     image though no pyplot figure came before it, and a run's bar goes to the cell's output."""
-    nbformat = pytest.importorskip("nbformat")
-    nbclient = pytest.importorskip("nbclient")
-    pytest.importorskip("ipykernel")
     from pathlib import Path
+
+    import nbclient  # declared in the test extra, with ipykernel
+    import nbformat
 
     import stickslip
 
