@@ -18,6 +18,7 @@ import pandas as pd
 
 from stickslip.kernels import layout
 from stickslip.kernels import located as L
+from stickslip.kernels import located_fast as LF
 from stickslip.kernels.entry import specialise_call
 from stickslip.models.params import ChainParams, ParameterError, steps_for
 from stickslip.run.state import ChainState, initial_state
@@ -148,10 +149,20 @@ def rates(state: LocatedState, params: ChainParams) -> tuple[np.ndarray, np.ndar
     return du, dv, dth
 
 
-class LocatedStepper:
-    """Advances :class:`LocatedState` objects of one model with located switches (in place)."""
+#: The forms of the located integrator: "fast" (:mod:`stickslip.kernels.located_fast`, the
+#: default) skips work whose result is known and equals "dense" (every block at every step,
+#: :func:`stickslip.kernels.located.advance`) bit for bit.
+FORMS = ("fast", "dense")
 
-    def __init__(self, params: ChainParams, capacity: int = 4096):
+
+class LocatedStepper:
+    """Advances :class:`LocatedState` objects of one model with located switches (in place), in
+    the form ``form`` (:data:`FORMS`; the results are the same bits)."""
+
+    def __init__(self, params: ChainParams, capacity: int = 4096, form: str = "fast"):
+        if form not in FORMS:
+            raise ParameterError(f"form must be one of {', '.join(FORMS)} (got {form!r})")
+        self.form = form
         self.params = params
         self.par = parameter_vector(params)
         self.lp = params.friction_piece.kernel_params(params)
@@ -159,6 +170,12 @@ class LocatedStepper:
         N = params.N
         self.sc = tuple(np.zeros(N + 2) for _ in range(12))
         self.cand = np.zeros(N + 2, dtype=np.int64)
+        self.lazy = (
+            np.zeros(N + 2, dtype=np.int64),
+            np.zeros(N + 2, dtype=np.int64),
+            np.zeros(N + 2),
+            np.zeros(N + 2, dtype=np.int64),
+        )  # fast form's scratch
         self.ev_t = np.zeros((capacity, 3))
         self.ev_i = np.zeros((capacity, 2), dtype=np.int64)
 
@@ -173,7 +190,11 @@ class LocatedStepper:
             state.ist[L.I_EVENTS] = 0
             args = (state.u, state.v, state.th, state.mov, np.int64(step), self.par, self.lp)
             args += (drive, friction, threshold, ends, self.sc, self.cand, state.moved, state.ist, state.evf)
-            status = specialise_call(L.advance, args + (self.ev_t, self.ev_i), _ADVANCE_PIECES)
+            args += (self.ev_t, self.ev_i)
+            if self.form == "fast":
+                status = specialise_call(LF.advance_fast, args + self.lazy, _ADVANCE_PIECES)
+            else:
+                status = specialise_call(L.advance, args, _ADVANCE_PIECES)
             r = int(state.ist[L.I_EVENTS])
             if r:
                 parts.append(np.column_stack((self.ev_t[:r], self.ev_i[:r])))
@@ -227,13 +248,15 @@ def run_located(
     start: str | ChainState | LocatedState = "paper",
     perturbation: float = 0.0,
     seed: int = 0,
+    form: str = "fast",
 ) -> LocatedRun:
     """Integrate the model of ``params`` (eq. (4) or a relative, docs/model.md) to ``t_end`` with
     Heun and located switches (:mod:`stickslip.kernels.located`), from ``start``.
 
     Second order in dt up to and across switches; the events carry located start and end times.
+    ``form``: "fast" or "dense" (:data:`FORMS`), the same bits.
     """
     state = start_state(params, start, perturbation=perturbation, seed=seed)
     n_end = steps_for(t_end, params.dt)
-    state, events = LocatedStepper(params).advance(state, n_end)
+    state, events = LocatedStepper(params, form=form).advance(state, n_end)
     return LocatedRun(params, state, events_frame(events))
