@@ -19,7 +19,7 @@ import pandas as pd
 from stickslip.kernels import layout
 from stickslip.kernels import located as L
 from stickslip.kernels import located_fast as LF
-from stickslip.kernels.entry import specialise_call
+from stickslip.kernels.entry import specialise_call, specialised
 from stickslip.models.params import ChainParams, ParameterError, steps_for
 from stickslip.run.state import ChainState, initial_state
 from stickslip.run.validate import check_start_state
@@ -178,6 +178,11 @@ class LocatedStepper:
         )  # fast form's scratch
         self.ev_t = np.zeros((capacity, 3))
         self.ev_i = np.zeros((capacity, 2), dtype=np.int64)
+        self._entries: dict = {}
+        #: Work of the fast form, summed over calls (:mod:`stickslip.kernels.located_fast`): grid
+        #: steps through the dense form's step, steps stepped on the moving blocks' neighbourhood
+        #: or on theta alone, jumps over steps in which only the drive moves, start tests redone.
+        self.work = {"switch_steps": 0, "stepped": 0, "jumps": 0, "start_tests": 0}
 
     def advance(self, state: LocatedState, step: int) -> tuple[LocatedState, np.ndarray]:
         """The state at grid ``step`` and the slip events completed on the way (docs/model.md),
@@ -192,9 +197,18 @@ class LocatedStepper:
             args += (drive, friction, threshold, ends, self.sc, self.cand, state.moved, state.ist, state.evf)
             args += (self.ev_t, self.ev_i)
             if self.form == "fast":
-                status = specialise_call(LF.advance_fast, args + self.lazy, _ADVANCE_PIECES)
-            else:
-                status = specialise_call(L.advance, args, _ADVANCE_PIECES)
+                args += self.lazy
+            # Typed once per layout of the state's arrays (the stepper's own never change).
+            key = tuple((a.dtype, a.flags.c_contiguous, a.flags.writeable) for a in args[:4] + args[13:16])
+            entry = self._entries.get(key)
+            if entry is None:
+                kernel = LF.advance_fast if self.form == "fast" else L.advance
+                entry = self._entries[key] = specialised(kernel, args, _ADVANCE_PIECES)
+            status = entry(*args)
+            if self.form == "fast":
+                us, safe = self.lazy[0], self.lazy[1]
+                for k, x in zip(self.work, (us[0], us[-1], safe[0], safe[-1]), strict=True):
+                    self.work[k] += int(x)
             r = int(state.ist[L.I_EVENTS])
             if r:
                 parts.append(np.column_stack((self.ev_t[:r], self.ev_i[:r])))
