@@ -29,6 +29,11 @@ variable's rate, on stuck blocks too); threshold constant (Fs) or state (theta_i
 fixed (x = 0, so u = -V t) or periodic. The spring force, the threshold and the law are the
 functions the engine evaluates; only the ghost cells are set here, in the frame of the drive.
 
+:func:`advance` is the dense form: every block at every step. :mod:`stickslip.kernels.located_fast`
+is its fast form, the same bits with the work whose result is known left out; it runs
+:func:`_steps` for the steps in which a switch happens. In both, the trial steps of a switch's
+location compute only what the switching block's test reads (:func:`_heun_near`).
+
 The integer vector ``ist``: [step, events recorded, blocks moving, event active, starts, stops,
 event's first block, blocks moved in the event]; the float vector ``evf``: [event start time,
 sum of u at its start]. Events are recorded as in docs/model.md ("Slip events of the chain")

@@ -3,7 +3,7 @@ their u along exact binade segments, and how long their start tests provably sta
 
 * **u.** In the frame of the drive a stuck block has v = 0, so both Heun stages give du = 0 - V
   and a full step maps u to fl(u + c), c = fl(dt/2 (-V - V)), whatever the other blocks do.
-  Inside one binade of u (|u| in [2^(e-1), 2^e), floats spaced q apart) and away from its
+  Inside one binade of u (abs(u) in [2^(e-1), 2^e), floats spaced q apart) and away from its
   edges, fl(w + c) = w + d for every w on the way, d the multiple of q nearest to c: w is a
   multiple of q, and a c exactly halfway between two multiples is refused. So k steps give
   u + k d exactly, in one addition (k d is a multiple of q below the binade's width, hence a
