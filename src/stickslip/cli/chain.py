@@ -1,4 +1,5 @@
-"""`stickslip chain` (run the chain of eq. 4) and `stickslip bench` (dense against exact)."""
+"""`stickslip chain` (run the chain of eq. 4) and `stickslip bench` (dense against exact, and the
+located integrator's dense against its fast form)."""
 
 from __future__ import annotations
 
@@ -144,6 +145,14 @@ def register(sub) -> None:
     )
     b.add_argument(
         "--profile", action="store_true", help="instead: where the exact integrator spends its time on this workload"
+    )
+    b.add_argument(
+        "--switches",
+        choices=("grid", "located"),
+        default="grid",
+        help="located: the located integrator's dense against its fast form, from the engine's "
+        "state at t = 5e5 (N = 99; scaled with N^2) from the paper's start, timed over --t-end "
+        "(default 5000); N and beta as given, else 99 and 0.5",
     )
     add_json_option(b)
     b.set_defaults(handler=run_bench_command)
@@ -484,6 +493,8 @@ def run_bench_command(args: argparse.Namespace) -> Result:
         # A short timing is the noisier one: the partly stuck workload's exact run takes about 0.25 s.
         args.repeat = 3 if args.workload == "partly-stuck" else 1
     check_number("repeat", args.repeat, low=1, integer=True)
+    if args.switches == "located":
+        return _located(args)
     if args.workload == "partly-stuck":
         return _partly_stuck(args)
     params = chain_params_from_args(args)
@@ -514,3 +525,19 @@ def _partly_stuck(args: argparse.Namespace) -> Result:
     t_prepare = w["t_prepare"] * (params.N / w["N"]) ** 2  # loading time grows as L_ss ~ N^2
     result = bench.partly_stuck(params, t_prepare=t_prepare, t_timed=t_timed, repeat=args.repeat)
     return Result(result, bench.format_partly_stuck(result))
+
+
+def _located(args: argparse.Namespace) -> Result:
+    """`stickslip bench --switches located`: the located integrator's dense form against its fast form."""
+    from stickslip.run import bench
+
+    if args.profile or args.start is not None or args.workload != "default":
+        raise CommandError("--switches located prepares its own start and has no --profile or --workload")
+    w = bench.LOCATED
+    overrides = {k: w[k] for k in ("N", "beta") if getattr(args, f"param_{k}", None) is None}
+    params = chain_params_from_args(args, **overrides)
+    t_timed = args.t_end if args.t_end is not None else w["t_timed"]
+    check_number("t-end", t_timed, low=0.0, low_open=True)
+    t_prepare = w["t_prepare"] * (params.N / w["N"]) ** 2  # loading time grows as L_ss ~ N^2
+    result = bench.located(params, t_prepare=t_prepare, t_timed=t_timed, repeat=args.repeat)
+    return Result(result, bench.format_located(result))

@@ -29,6 +29,11 @@ variable's rate, on stuck blocks too); threshold constant (Fs) or state (theta_i
 fixed (x = 0, so u = -V t) or periodic. The spring force, the threshold and the law are the
 functions the engine evaluates; only the ghost cells are set here, in the frame of the drive.
 
+:func:`advance` is the dense form: every block at every step. :mod:`stickslip.kernels.located_fast`
+is its fast form, the same bits with the work whose result is known left out; it runs
+:func:`_steps` for the steps in which a switch happens. In both, the trial steps of a switch's
+location compute only what the switching block's test reads (:func:`_heun_near`).
+
 The integer vector ``ist``: [step, events recorded, blocks moving, event active, starts, stops,
 event's first block, blocks moved in the event]; the float vector ``evf``: [event start time,
 sum of u at its start]. Events are recorded as in docs/model.md ("Slip events of the chain")
@@ -121,7 +126,7 @@ def _heun(h, t, u, v, th, mov, N, par, lp, drive, friction, ends, sc):
     _ghosts(ou, oth, N, t + h, par[P_V], drive, ends)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _start(i, u, v, th, mov, t, par, ist, evf, moved, N):
     """Block i starts at time t (v_i stays 0); opens an event if every block was stuck."""
     mov[i] = 1.0
@@ -143,7 +148,7 @@ def _start(i, u, v, th, mov, t, par, ist, evf, moved, N):
         ist[I_NMOVED] += 1
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _stop(i, u, v, mov, t, par, ist, evf, N, ev_t, ev_i):
     """Block i stops at time t (v_i = 0); closes the event if it was the last one moving."""
     mov[i] = 0.0
@@ -166,7 +171,7 @@ def _stop(i, u, v, mov, t, par, ist, evf, N, ev_t, ev_i):
             ist[I_EVENTS] = r + 1
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _switched(i, stop, ou, ov, oth, par, drive, threshold):
     """(value, switched) of block i's switching function on the state o*: v (stop) or -g (start)."""
     if stop:
@@ -175,12 +180,54 @@ def _switched(i, stop, ou, ov, oth, par, drive, threshold):
     return -g, g > 0.0
 
 
-@njit(cache=True)
-def _locate(i, stop, h, t, u, v, th, mov, N, par, lp, drive, friction, threshold, ends, sc):
+@njit(cache=True, inline="always")
+def _predict_u(j, h, u, v, th, V, sc):
+    """Block j's predictors and o* of u in a Heun step (the expressions of :func:`_heun`)."""
+    k1u, k1v, k1th, pu, pv, pth, k2u, k2v, k2th, ou, ov, oth = sc
+    pu[j] = u[j] + h * k1u[j]
+    pv[j] = v[j] + h * k1v[j]
+    pth[j] = th[j] + h * k1th[j]
+    k2u[j] = pv[j] - V
+    ou[j] = u[j] + 0.5 * h * (k1u[j] + k2u[j])
+
+
+@njit(cache=True, _nrt=False)
+def _heun_near(i, h, t, u, v, th, mov, N, par, lp, drive, friction, ends, sc):
+    """Of one Heun step (:func:`_heun`), the values block i's switching functions read: the
+    predictors of blocks i-1..i+1, o* of u on them, o* of v and theta on block i, and the ghost
+    cells (periodic ends: blocks 1 and N too, which the ghosts copy).
+
+    Each value is computed by the expression :func:`_heun` evaluates for it, from the same
+    inputs, so it has the same bits; the other blocks' values are left as they were.
+    """
+    k1u, k1v, k1th, pu, pv, pth, k2u, k2v, k2th, ou, ov, oth = sc
+    V = par[P_V]
+    a = i - 1 if i > 1 else 1
+    b = i + 1 if i < N else N
+    for j in range(a, b + 1):
+        _predict_u(j, h, u, v, th, V, sc)
+    if ends == ENDS_PERIODIC:
+        _predict_u(1, h, u, v, th, V, sc)
+        _predict_u(N, h, u, v, th, V, sc)
+    _ghosts(pu, pth, N, t + h, V, drive, ends)
+    if mov[i] != 0.0:
+        k2v[i] = law_accel(friction, _force(pu, i, par, drive), pv[i], pth[i], lp)
+    else:
+        k2v[i] = 0.0
+    k2th[i] = law_rate(friction, pth[i - 1], pth[i], pth[i + 1], pv[i], lp)
+    ov[i] = v[i] + 0.5 * h * (k1v[i] + k2v[i])
+    oth[i] = th[i] + 0.5 * h * (k1th[i] + k2th[i])
+    _ghosts(ou, oth, N, t + h, V, drive, ends)
+
+
+@njit(cache=True, _nrt=False)
+def _locate(i, stop, h, t, u, v, th, mov, N, par, lp, drive, friction, threshold, ends, sc, near):
     """The switch time of block i in (0, h]: the smallest float b found with the switch done at b.
 
     Illinois (modified regula falsi) on the bracket [a, b], a bisection whenever a step fails to
-    halve the bracket, until no float lies strictly between a and b.
+    halve the bracket, until no float lies strictly between a and b. With ``near`` each trial
+    step computes only what block i's switching function reads (:func:`_heun_near`: the same
+    bits), otherwise the whole chain's step.
     """
     k1u, k1v, k1th, pu, pv, pth, k2u, k2v, k2th, ou, ov, oth = sc
     if stop:
@@ -190,7 +237,10 @@ def _locate(i, stop, h, t, u, v, th, mov, N, par, lp, drive, friction, threshold
         fa = -_gap(u, th, i, par, drive, threshold)
     a = 0.0
     b = h
-    _heun(h, t, u, v, th, mov, N, par, lp, drive, friction, ends, sc)
+    if near:
+        _heun_near(i, h, t, u, v, th, mov, N, par, lp, drive, friction, ends, sc)
+    else:
+        _heun(h, t, u, v, th, mov, N, par, lp, drive, friction, ends, sc)
     fb, _ = _switched(i, stop, ou, ov, oth, par, drive, threshold)
     side = 0
     width = b - a
@@ -206,7 +256,10 @@ def _locate(i, stop, h, t, u, v, th, mov, N, par, lp, drive, friction, threshold
                 c = mid
         if it % 2 == 1:
             width = b - a
-        _heun(c, t, u, v, th, mov, N, par, lp, drive, friction, ends, sc)
+        if near:
+            _heun_near(i, c, t, u, v, th, mov, N, par, lp, drive, friction, ends, sc)
+        else:
+            _heun(c, t, u, v, th, mov, N, par, lp, drive, friction, ends, sc)
         fc, sw = _switched(i, stop, ou, ov, oth, par, drive, threshold)
         if sw:
             b, fb = c, fc
@@ -221,13 +274,11 @@ def _locate(i, stop, h, t, u, v, th, mov, N, par, lp, drive, friction, threshold
     return b
 
 
-@njit(cache=True)
-def advance(u, v, th, mov, n_end, par, lp, drive, friction, threshold, ends, sc, cand, moved, ist, evf, ev_t, ev_i):
-    """Advance the state (u, v, theta, moving mask) at step ist[I_STEP] to step n_end.
-
-    Returns DONE, EVENTS_FULL (the event buffer has fewer than 4 free rows; the state is at the
-    grid step ist[I_STEP], continue after emptying it) or NONFINITE. See the module docstring.
-    """
+@njit(cache=True, _nrt=False)
+def _steps(
+    u, v, th, mov, n_end, par, lp, drive, friction, threshold, ends, sc, cand, moved, ist, evf, ev_t, ev_i, near
+):
+    """:func:`advance`; ``near``: :func:`_locate`'s trial steps on the neighbourhood alone."""
     N = u.shape[0] - 2
     dt = par[P_DT]
     k1u, k1v, k1th, pu, pv, pth, k2u, k2v, k2th, ou, ov, oth = sc
@@ -275,7 +326,7 @@ def advance(u, v, th, mov, n_end, par, lp, drive, friction, threshold, ends, sc,
             for k in range(n_cand):
                 i = abs(cand[k])
                 is_stop = cand[k] < 0
-                b = _locate(i, is_stop, h, t, u, v, th, mov, N, par, lp, drive, friction, threshold, ends, sc)
+                b = _locate(i, is_stop, h, t, u, v, th, mov, N, par, lp, drive, friction, threshold, ends, sc, near)
                 if blk == 0 or b < tau:
                     tau, blk, stop = b, i, is_stop
             _heun(tau, t, u, v, th, mov, N, par, lp, drive, friction, ends, sc)
@@ -299,7 +350,21 @@ def advance(u, v, th, mov, n_end, par, lp, drive, friction, threshold, ends, sc,
     return DONE
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
+def advance(u, v, th, mov, n_end, par, lp, drive, friction, threshold, ends, sc, cand, moved, ist, evf, ev_t, ev_i):
+    """Advance the state (u, v, theta, moving mask) at step ist[I_STEP] to step n_end.
+
+    Returns DONE, EVENTS_FULL (the event buffer has fewer than 4 free rows; the state is at the
+    grid step ist[I_STEP], continue after emptying it) or NONFINITE. See the module docstring.
+    This is the dense form: every block at every step, and each trial step of a switch's
+    location over the whole chain (the reference of :mod:`stickslip.kernels.located_fast`).
+    """
+    return _steps(
+        u, v, th, mov, n_end, par, lp, drive, friction, threshold, ends, sc, cand, moved, ist, evf, ev_t, ev_i, False
+    )
+
+
+@njit(cache=True, _nrt=False)
 def rates(u, v, th, mov, t, par, lp, drive, friction, ends, du, dv, dth):
     """The right-hand side of the equations at time t (ghost cells of u and th are overwritten)."""
     _rates(u, v, th, mov, u.shape[0] - 2, t, par, lp, drive, friction, ends, du, dv, dth)

@@ -6,7 +6,9 @@ threshold and stops at the time its velocity reaches zero, both located inside t
 round-off (:mod:`stickslip.kernels.located`). Its trajectories converge to the solution of the
 equations with switches at second order in dt. It is a reference for studies (the exponent of
 the flow, :mod:`stickslip.analysis.lyapunov_flow`), not the engine: :func:`stickslip.run_chain`
-keeps the gridded rules of docs/model.md and its bit-exact results.
+keeps the gridded rules of docs/model.md and its bit-exact results. It runs in a fast form by
+default (:mod:`stickslip.kernels.located_fast`, docs/performance.md), bit for bit the dense one
+(``form="dense"``).
 """
 
 from __future__ import annotations
@@ -18,7 +20,8 @@ import pandas as pd
 
 from stickslip.kernels import layout
 from stickslip.kernels import located as L
-from stickslip.kernels.entry import specialise_call
+from stickslip.kernels import located_fast as LF
+from stickslip.kernels.entry import specialise_call, specialised
 from stickslip.models.params import ChainParams, ParameterError, steps_for
 from stickslip.run.state import ChainState, initial_state
 from stickslip.run.validate import check_start_state
@@ -148,10 +151,20 @@ def rates(state: LocatedState, params: ChainParams) -> tuple[np.ndarray, np.ndar
     return du, dv, dth
 
 
-class LocatedStepper:
-    """Advances :class:`LocatedState` objects of one model with located switches (in place)."""
+#: The forms of the located integrator: "fast" (:mod:`stickslip.kernels.located_fast`, the
+#: default) skips work whose result is known and equals "dense" (every block at every step,
+#: :func:`stickslip.kernels.located.advance`) bit for bit.
+FORMS = ("fast", "dense")
 
-    def __init__(self, params: ChainParams, capacity: int = 4096):
+
+class LocatedStepper:
+    """Advances :class:`LocatedState` objects of one model with located switches (in place), in
+    the form ``form`` (:data:`FORMS`; the results are the same bits)."""
+
+    def __init__(self, params: ChainParams, capacity: int = 4096, form: str = "fast"):
+        if form not in FORMS:
+            raise ParameterError(f"form must be one of {', '.join(FORMS)} (got {form!r})")
+        self.form = form
         self.params = params
         self.par = parameter_vector(params)
         self.lp = params.friction_piece.kernel_params(params)
@@ -159,8 +172,19 @@ class LocatedStepper:
         N = params.N
         self.sc = tuple(np.zeros(N + 2) for _ in range(12))
         self.cand = np.zeros(N + 2, dtype=np.int64)
+        self.lazy = (
+            np.zeros(N + 2, dtype=np.int64),
+            np.zeros(N + 2, dtype=np.int64),
+            np.zeros(N + 2),
+            np.zeros(N + 2, dtype=np.int64),
+        )  # fast form's scratch
         self.ev_t = np.zeros((capacity, 3))
         self.ev_i = np.zeros((capacity, 2), dtype=np.int64)
+        self._entries: dict = {}
+        #: Work of the fast form, summed over calls (:mod:`stickslip.kernels.located_fast`): grid
+        #: steps through the dense form's step, steps stepped on the moving blocks' neighbourhood
+        #: or on theta alone, jumps over steps in which only the drive moves, start tests redone.
+        self.work = {"switch_steps": 0, "stepped": 0, "jumps": 0, "start_tests": 0}
 
     def advance(self, state: LocatedState, step: int) -> tuple[LocatedState, np.ndarray]:
         """The state at grid ``step`` and the slip events completed on the way (docs/model.md),
@@ -173,7 +197,20 @@ class LocatedStepper:
             state.ist[L.I_EVENTS] = 0
             args = (state.u, state.v, state.th, state.mov, np.int64(step), self.par, self.lp)
             args += (drive, friction, threshold, ends, self.sc, self.cand, state.moved, state.ist, state.evf)
-            status = specialise_call(L.advance, args + (self.ev_t, self.ev_i), _ADVANCE_PIECES)
+            args += (self.ev_t, self.ev_i)
+            if self.form == "fast":
+                args += self.lazy
+            # Typed once per layout of the state's arrays (the stepper's own never change).
+            key = tuple((a.dtype, a.flags.c_contiguous, a.flags.writeable) for a in args[:4] + args[13:16])
+            entry = self._entries.get(key)
+            if entry is None:
+                kernel = LF.advance_fast if self.form == "fast" else L.advance
+                entry = self._entries[key] = specialised(kernel, args, _ADVANCE_PIECES)
+            status = entry(*args)
+            if self.form == "fast":
+                us, safe = self.lazy[0], self.lazy[1]
+                for k, x in zip(self.work, (us[0], us[-1], safe[0], safe[-1]), strict=True):
+                    self.work[k] += int(x)
             r = int(state.ist[L.I_EVENTS])
             if r:
                 parts.append(np.column_stack((self.ev_t[:r], self.ev_i[:r])))
@@ -227,13 +264,15 @@ def run_located(
     start: str | ChainState | LocatedState = "paper",
     perturbation: float = 0.0,
     seed: int = 0,
+    form: str = "fast",
 ) -> LocatedRun:
     """Integrate the model of ``params`` (eq. (4) or a relative, docs/model.md) to ``t_end`` with
     Heun and located switches (:mod:`stickslip.kernels.located`), from ``start``.
 
     Second order in dt up to and across switches; the events carry located start and end times.
+    ``form``: "fast" or "dense" (:data:`FORMS`), the same bits.
     """
     state = start_state(params, start, perturbation=perturbation, seed=seed)
     n_end = steps_for(t_end, params.dt)
-    state, events = LocatedStepper(params).advance(state, n_end)
+    state, events = LocatedStepper(params, form=form).advance(state, n_end)
     return LocatedRun(params, state, events_frame(events))
