@@ -120,6 +120,33 @@ def test_run_experiment_computes_once_and_reuses(tmp_path, monkeypatch):
     assert len(calls) == 2 and not third.reused and third.run_dir != first.run_dir
 
 
+@pytest.mark.parametrize("damage", ["summary edited", "file changed", "file deleted", "no checksums"])
+def test_a_damaged_result_is_run_again(tmp_path, damage):
+    exp = ex.experiment("smoke", "slip-limit")
+    first = rp.run_experiment(exp, tmp_path)
+    path = tmp_path / exp.dirname / rp.RESULT_FILE
+    record = read_json(path)
+    assert record["files"], "the record lists the files it stands for"
+    rel = sorted(record["files"])[0]
+    if damage == "summary edited":
+        key = sorted(record["summary"])[0]
+        record["summary"][key] = 42
+        path.write_text(json.dumps(record))
+    elif damage == "file changed":
+        with open(tmp_path / exp.dirname / rel, "ab") as fh:
+            fh.write(b" ")
+    elif damage == "file deleted":
+        (tmp_path / exp.dirname / rel).unlink()
+    else:
+        del record["files"], record["sha256"]
+        path.write_text(json.dumps(record))
+    lines = []
+    again = rp.run_experiment(exp, tmp_path, log=lines.append)
+    assert not again.reused and again.summary == first.summary
+    assert any("not reused" in line for line in lines)
+    assert rp.run_experiment(exp, tmp_path).reused
+
+
 def test_a_result_of_another_spec_in_the_same_directory_is_not_reused(tmp_path):
     exp = ex.experiment("smoke", "slip-limit")
     rp.run_experiment(exp, tmp_path)

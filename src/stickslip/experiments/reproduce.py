@@ -40,7 +40,7 @@ import pandas as pd
 
 from stickslip import heartbeat, io
 from stickslip.analysis.chain_runs import chain_analysis, final_state
-from stickslip.experiments.cache import read_record
+from stickslip.experiments.cache import damage, file_digests, read_record, sealed
 from stickslip.experiments.specs import (
     UNTIL_STEADY,
     Experiment,
@@ -96,9 +96,19 @@ class _Log:
 # Running experiments (with reuse)
 
 
-def _stored(run_dir: Path, exp: Experiment) -> dict[str, Any] | None:
-    """The stored ``result.json`` of ``exp`` if it is there and made from the same spec."""
-    return read_record(run_dir / RESULT_FILE, exp.spec())
+def _stored(run_dir: Path, exp: Experiment, log: Callable[[str], None] | None = None) -> dict[str, Any] | None:
+    """The stored ``result.json`` of ``exp`` if it is there, made from the same spec, as written
+    (sealed) and with every file it recorded present with its checksum; else None, and a line on
+    ``log`` saying why a record of this spec is not reused."""
+    record = read_record(run_dir / RESULT_FILE, exp.spec())
+    if record is None:
+        return None
+    reason = damage(run_dir, record)
+    if reason:
+        if log is not None:
+            log(f"{exp.name}: not reused, {reason}: running it again")
+        return None
+    return record
 
 
 def run_experiment(
@@ -112,13 +122,14 @@ def run_experiment(
     """Compute one experiment into ``runs_dir/<name>-<key>/``, or load it if already there.
 
     The stored result is reused only if its ``result.json`` holds the same spec (kind,
-    parameters, run length, options, package version). Chain runs go to Dask
+    parameters, run length, options, package version), is as written and every file it recorded
+    matches its checksum (:func:`stickslip.experiments.cache.damage`). Chain runs go to Dask
     (``scheduler`` address, or a local cluster of ``n_workers`` processes).
     """
     log = log or (lambda text: None)
     runner = _RUNNERS[exp.kind]
     run_dir = Path(runs_dir) / exp.dirname
-    record = _stored(run_dir, exp)
+    record = _stored(run_dir, exp, log)
     reused = record is not None
     if record is None:
         run_dir.mkdir(parents=True, exist_ok=True)
@@ -126,6 +137,7 @@ def run_experiment(
         start = time.perf_counter()
         summary = runner.compute(exp, run_dir, scheduler=scheduler, n_workers=n_workers, log=log)
         record = {"spec": exp.spec(), "name": exp.name, "summary": summary, "wall_seconds": time.perf_counter() - start}
+        record = sealed({**record, "files": file_digests(run_dir)})
         io.write_json(run_dir / RESULT_FILE, record)
     data = runner.load(exp, run_dir, record["summary"])
     return Outcome(exp, run_dir, data, record["summary"], reused, float(record.get("wall_seconds", math.nan)))
