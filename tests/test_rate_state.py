@@ -161,9 +161,9 @@ def _plain_step(x, v, th, moving, n, p, g=_aging):
     return [list(c) for c in zip(*out, strict=True)]
 
 
-@pytest.mark.parametrize("integrator", ["dense", "exact"])
-def test_one_kernel_step_against_the_plain_step(integrator):
-    p = _params(N=4, K=12.0, Fs=2.9)
+def steps_against_the_plain_step(p, integrator, g=_aging):
+    """One and three kernel steps from a partly stuck state of four blocks against
+    :func:`_plain_step` with the state law ``g``; returns the blocks after three steps."""
     x = [-0.30, -0.46, -0.70, -0.93]
     v = [0.002, 0.0, 0.03, 1e-9]
     th = [0.8, 3.0, 0.05, 40.0]
@@ -174,12 +174,19 @@ def test_one_kernel_step_against_the_plain_step(integrator):
     for steps in (1, 3):
         ref = (x, v, th, moving)
         for k in range(steps):
-            ref = _plain_step(*ref, n + k, p)
+            ref = _plain_step(*ref, n + k, p, g=g)
         b = run_chain(p, (n + steps) * p.dt, integrator=integrator, start=start.copy()).state.blocks()
         np.testing.assert_allclose(b["x"], ref[0], rtol=1e-14, atol=0)
         np.testing.assert_allclose(b["v"], ref[1], rtol=1e-11, atol=1e-17)
         np.testing.assert_allclose(b["theta"], ref[2], rtol=1e-13, atol=0)
         assert (~b["stopped"]).tolist() == ref[3]
+    return b
+
+
+@pytest.mark.parametrize("integrator", ["dense", "exact"])
+def test_one_kernel_step_against_the_plain_step(integrator):
+    p = _params(N=4, K=12.0, Fs=2.9)
+    b = steps_against_the_plain_step(p, integrator)
     # the stuck block ages: dtheta/dt = 1
     assert b["theta"][1] == pytest.approx(3.0 + 3 * p.dt, rel=1e-15)
 

@@ -16,9 +16,9 @@ import pytest
 from stickslip.analysis import stability as st
 from stickslip.models.friction import rate_state, rate_state_slip
 from stickslip.models.params import ChainParams
-from stickslip.run.driver import ChainState, run_chain
+from stickslip.run.driver import run_chain
 from stickslip.run.located import run_located
-from test_rate_state import _k_c, _mu, _plain_step
+from test_rate_state import _k_c, _mu, steps_against_the_plain_step
 
 LAW = "rate-state-slip"
 
@@ -115,23 +115,7 @@ def test_a_stuck_block_does_not_heal():
 
 @pytest.mark.parametrize("integrator", ["dense", "exact"])
 def test_one_kernel_step_against_the_plain_step(integrator):
-    p = _params(N=4, K=12.0, Fs=2.9)
-    x = [-0.30, -0.46, -0.70, -0.93]
-    v = [0.002, 0.0, 0.03, 1e-9]
-    th = [0.8, 3.0, 0.05, 40.0]
-    moving = [True, False, True, True]
-    n = 20_000
-    start = ChainState.from_blocks(np.array(x), np.array(v), np.array(th), ~np.array(moving))
-    start.ist[0] = n
-    for steps in (1, 3):
-        ref = (x, v, th, moving)
-        for k in range(steps):
-            ref = _plain_step(*ref, n + k, p, g=_slip)
-        b = run_chain(p, (n + steps) * p.dt, integrator=integrator, start=start.copy()).state.blocks()
-        np.testing.assert_allclose(b["x"], ref[0], rtol=1e-14, atol=0)
-        np.testing.assert_allclose(b["v"], ref[1], rtol=1e-11, atol=1e-17)
-        np.testing.assert_allclose(b["theta"], ref[2], rtol=1e-13, atol=0)
-        assert (~b["stopped"]).tolist() == ref[3]
+    b = steps_against_the_plain_step(_params(N=4, K=12.0, Fs=2.9), integrator, g=_slip)
     assert b["theta"][1] == 3.0  # the stuck block keeps its state
 
 
