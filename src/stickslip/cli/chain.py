@@ -517,14 +517,19 @@ def _partly_stuck(args: argparse.Namespace) -> Result:
 
     if args.profile or args.start is not None:
         raise CommandError("--workload partly-stuck prepares its own start and has no --profile")
-    w = bench.PARTLY_STUCK
+    params, t_prepare, t_timed = _workload(args, bench.PARTLY_STUCK)
+    result = bench.partly_stuck(params, t_prepare=t_prepare, t_timed=t_timed, repeat=args.repeat)
+    return Result(result, bench.format_partly_stuck(result))
+
+
+def _workload(args: argparse.Namespace, w: dict):
+    """The parameters, preparation time and timed span of a bench workload ``w`` (its N and beta
+    unless given), the preparation scaled with the loading time L_ss / V ~ N^2."""
     overrides = {k: w[k] for k in ("N", "beta") if getattr(args, f"param_{k}", None) is None}
     params = chain_params_from_args(args, **overrides)
     t_timed = args.t_end if args.t_end is not None else w["t_timed"]
     check_number("t-end", t_timed, low=0.0, low_open=True)
-    t_prepare = w["t_prepare"] * (params.N / w["N"]) ** 2  # loading time grows as L_ss ~ N^2
-    result = bench.partly_stuck(params, t_prepare=t_prepare, t_timed=t_timed, repeat=args.repeat)
-    return Result(result, bench.format_partly_stuck(result))
+    return params, w["t_prepare"] * (params.N / w["N"]) ** 2, t_timed
 
 
 def _located(args: argparse.Namespace) -> Result:
@@ -533,11 +538,6 @@ def _located(args: argparse.Namespace) -> Result:
 
     if args.profile or args.start is not None or args.workload != "default":
         raise CommandError("--switches located prepares its own start and has no --profile or --workload")
-    w = bench.LOCATED
-    overrides = {k: w[k] for k in ("N", "beta") if getattr(args, f"param_{k}", None) is None}
-    params = chain_params_from_args(args, **overrides)
-    t_timed = args.t_end if args.t_end is not None else w["t_timed"]
-    check_number("t-end", t_timed, low=0.0, low_open=True)
-    t_prepare = w["t_prepare"] * (params.N / w["N"]) ** 2  # loading time grows as L_ss ~ N^2
+    params, t_prepare, t_timed = _workload(args, bench.LOCATED)
     result = bench.located(params, t_prepare=t_prepare, t_timed=t_timed, repeat=args.repeat)
     return Result(result, bench.format_located(result))

@@ -79,7 +79,7 @@ def psi(p: Any, theta: float) -> float:
 
 def mu(p: Any, v: float, theta: float) -> float:
     """mu(abs(v), theta) of the parameters ``p``: the kernels' :func:`mu_lp`."""
-    return float(mu_lp(float(v), float(theta), Params(*(float(getattr(p, n)) for n in READS))))
+    return float(mu_lp(float(v), float(theta), PIECE.kernel_params(p)))
 
 
 def steady_sliding(p: Any) -> tuple[float, float]:
