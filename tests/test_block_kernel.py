@@ -24,9 +24,9 @@ def _buffers(n_steps, every, capacity=64):
 
 def _call(fn, p: BlockParams, s: BlockState, n_steps: int, every: int):
     bufs = _buffers(n_steps, every)
-    law = p.friction_piece
-    args = (s.x, s.v, s.theta, s.stopped, n_steps, every,
-            p.K, p.V, law.module, law.kernel_params(p), p.Fs, p.M, p.sigma, p.dt, *bufs, False)  # fmt: skip
+    law, thr = p.friction_piece, p.threshold_piece
+    args = (s.x, s.v, s.theta, s.stopped, n_steps, every, p.K, p.V, law.module, law.kernel_params(p),
+            thr.module, thr.kernel_params(p), p.M, p.sigma, p.dt, *bufs)  # fmt: skip
     ret = specialise_call(fn, args, LAW_ARG) if fn is heun_block else fn(*args)
     return ret, bufs
 

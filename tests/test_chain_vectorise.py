@@ -15,6 +15,7 @@ import pytest
 
 from stickslip.kernels import dense, exact, layout, stages
 from stickslip.models.friction import state as state_law
+from stickslip.models.threshold import constant as constant_threshold
 from stickslip.models.params import ChainParams
 from stickslip.run.driver import run_chain
 
@@ -43,10 +44,10 @@ def _example_args(name: str) -> tuple:
     a = [np.linspace(0.5, 1.5, 12) for _ in range(10)]
     lo, hi = 1, 10
     dt, p = 0.005, 0.0
-    # The paper's model: K, Kp, Fs and eq. (4)'s law (beta, alpha, D); pieces as literals (the law
-    # by its module's path).
-    mp = (10.0, 1.0, 3.0, state_law.Params(1.0, 1.0, 5.0))
-    end, state, constant = layout.DRIVE_END, state_law.__name__, layout.THRESHOLD_CONSTANT
+    # The paper's model: K, Kp, the threshold's Fs and eq. (4)'s law (beta, alpha, D); pieces as
+    # literals (the law and the threshold by their modules' paths).
+    mp = (10.0, 1.0, constant_threshold.Params(3.0), state_law.Params(1.0, 1.0, 5.0))
+    end, state, constant = layout.DRIVE_END, state_law.__name__, constant_threshold.__name__
     return {
         "_stage1": (*a, lo, hi, p, mp, dt, end, state, constant),
         "_stage2": (*a, lo, hi, p, mp, 0.5 * dt, end, state),

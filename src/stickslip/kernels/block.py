@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numba
 
-from stickslip.kernels.laws import law_accel, law_rate
+from stickslip.kernels.laws import _threshold, law_accel, law_rate
 
 
 @numba.njit(cache=True)
@@ -27,7 +27,8 @@ def heun_block(
     V,
     law,
     lp,
-    Fs,
+    threshold,
+    tp,
     M,
     sigma,
     dt,
@@ -40,7 +41,6 @@ def heun_block(
     slip_end,
     slip_x_start,
     slip_x_end,
-    state_threshold=False,
 ):
     """Advance eq. (1) by ``n_steps`` Heun steps with the start and stop rules of docs/model.md.
 
@@ -53,8 +53,9 @@ def heun_block(
 
     Step n (t_n -> t_{n+1}):
 
-    1. start rule: a stopped block with f(t_n) > Fs becomes moving, still with v = 0 (with
-       ``state_threshold``: f(t_n) > sigma theta, the paper's reading of Batista-Carlson);
+    1. start rule: a stopped block with f(t_n) > the threshold piece's value (``threshold``, its
+       module path, and ``tp``, its parameters: Fs, or sigma theta for the state threshold, the
+       paper's reading of Batista-Carlson) becomes moving, still with v = 0;
     2. Heun (explicit trapezoid) with the status fixed for the whole step: stage 1 derivatives
        k1 at (y_n, t_n), predictor y* = y_n + dt k1, stage 2 derivatives k2 at (y*, t_{n+1}),
        y_{n+1} = y_n + (dt/2) (k1 + k2);
@@ -97,7 +98,7 @@ def heun_block(
         t0 = n * dt
         t1 = (n + 1) * dt
         if not moving:
-            if K * (V * t0 - x) > (sigma * theta if state_threshold else Fs):
+            if K * (V * t0 - x) > _threshold(sigma * theta, tp, threshold):
                 moving = True
                 n_starts += 1
                 current = n

@@ -46,8 +46,8 @@ def run_dense(args, drive, friction, threshold, ends):
     first_step, x0ev, prof_meta = args.first_step, args.x0ev, args.prof_meta
     n_end, profile_every = args.n_end, args.profile_every
     N = x.shape[0] - 2
-    mp, V, dt = _unpack(par, args.law)
-    K, Kp, Fs = mp[0], mp[1], mp[2]
+    mp, V, dt = _unpack(par, args.tp, args.law)
+    K, Kp, tp = mp[0], mp[1], mp[2]
     h2 = 0.5 * dt
     cap_ev, cap_fm, cap_p = ev_int.shape[0], fm.shape[0], prof_x.shape[0]
     while True:
@@ -66,7 +66,7 @@ def run_dense(args, drive, friction, threshold, ends):
         _set_ghosts(x, th, N, p1, drive, ends)
         for i in range(1, N + 1):
             f = _force(x[i - 1], x[i], x[i + 1], K, Kp, p1, drive)
-            if mov[i] != 0.0 or f > _threshold(th[i], Fs, threshold):
+            if mov[i] != 0.0 or f > _threshold(th[i], tp, threshold):
                 mm[i] = 1.0
             else:
                 mm[i] = 0.0

@@ -37,7 +37,7 @@ from __future__ import annotations
 from numba import njit
 
 from stickslip.kernels.events import _end_event, _overflow, _service, _start_and_first_moves
-from stickslip.kernels.laws import _force, _pull, _right_of_first, _set_ghosts, _threshold, law_has_state
+from stickslip.kernels.laws import _force, _pull, _right_of_first, _set_ghosts, _threshold, has, law_has_state
 from stickslip.kernels.layout import (
     _NEVER,
     ACT_HI,
@@ -59,7 +59,6 @@ from stickslip.kernels.layout import (
     P_COUNT,
     STEP,
     STEPS_COMPUTED,
-    THRESHOLD_STATE,
     _merge,
     _unpack,
 )
@@ -98,8 +97,8 @@ def run_exact(args, drive, friction, threshold, ends):
     prof_x, n_end, profile_every = args.prof_x, args.n_end, args.profile_every
     first_step, x0ev, prof_meta = args.first_step, args.x0ev, args.prof_meta
     N = x.shape[0] - 2
-    mp, V, dt = _unpack(par, args.law)
-    K, Kp, Fs = mp[0], mp[1], mp[2]
+    mp, V, dt = _unpack(par, args.tp, args.law)
+    K, Kp, tp = mp[0], mp[1], mp[2]
     h2 = 0.5 * dt
     cap_ev, cap_fm, cap_p = ev_int.shape[0], fm.shape[0], prof_x.shape[0]
     # A run of blocks moving at t_n (empty if ra > rb): updated without the start rule and the
@@ -141,7 +140,7 @@ def run_exact(args, drive, friction, threshold, ends):
             if drive == DRIVE_END:
                 x2 = _right_of_first(x, N, ends)
                 if mov[1] != 0.0 or _force(_pull(V, n, dt), x[1], x2, K, Kp, 0.0, drive) > _threshold(
-                    th[1], Fs, threshold
+                    th[1], tp, threshold
                 ):
                     lo = 1
                     if hi < 1:
@@ -158,7 +157,7 @@ def run_exact(args, drive, friction, threshold, ends):
                         elif trig[i] < t_next:
                             t_next = trig[i]
                 lo, hi = _merge(lo, hi, ml, mh)
-            if threshold == THRESHOLD_STATE:
+            if has(threshold, "has_state"):
                 # A changing state variable moves the threshold itself.
                 ml, mh = _merge(ml, mh, lo, hi)
             if ends == ENDS_PERIODIC and lo <= hi and (lo == 1 or hi == N):
@@ -173,7 +172,7 @@ def run_exact(args, drive, friction, threshold, ends):
                 if profile_every > 0 and ist[EV_ACTIVE] == 1 and ist[NEXT_PROFILE] < target:
                     target = ist[NEXT_PROFILE]
                 if drive == DRIVE_END:
-                    ist[STEP] = _first_trigger(x, N, V, dt, K, _threshold(th[1], Fs, threshold), n + 1, target, ends)
+                    ist[STEP] = _first_trigger(x, N, V, dt, K, _threshold(th[1], tp, threshold), n + 1, target, ends)
                 else:
                     ist[STEP] = t_next if t_next < target else target
                 continue
@@ -351,7 +350,7 @@ def run_exact(args, drive, friction, threshold, ends):
             ist[ACT_LO], ist[ACT_HI] = _merge(c_lo, c_hi, ist[MECH_LO], ist[MECH_HI])
             if drive == DRIVE_PLATE:
                 # Stopped blocks whose force or threshold changed: their first start step anew.
-                if threshold == THRESHOLD_STATE:
+                if has(threshold, "has_state"):
                     w_lo, w_hi = _merge(ist[MECH_LO], ist[MECH_HI], lo, hi)
                     every = True
                 else:

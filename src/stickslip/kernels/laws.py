@@ -46,11 +46,10 @@ from stickslip.kernels.layout import (
     DRIVE_PLATE,
     ENDS_FIXED,
     ENDS_PERIODIC,
-    THRESHOLD_STATE,
 )
 
 
-def _law(friction):
+def _module(friction):
     """The module of a friction law, from the literal a kernel is compiled for (None otherwise)."""
     if isinstance(friction, types.StringLiteral):
         return importlib.import_module(friction.literal_value)
@@ -62,22 +61,22 @@ def _law(friction):
 def law_accel(friction, f, v, th, lp):
     """The force f on a moving block less the friction of the law ``friction`` (its module's
     ``accel``)."""
-    return _law(friction).accel(f, v, th, lp)
+    return _module(friction).accel(f, v, th, lp)
 
 
 def law_rate(friction, thl, th, thr, v, lp):
     """dtheta/dt of the law ``friction`` (its module's ``rate``)."""
-    return _law(friction).rate(thl, th, thr, v, lp)
+    return _module(friction).rate(thl, th, thr, v, lp)
 
 
 def law_has_state(friction):
     """Whether the law ``friction`` has a state variable (its ``PIECE.has_state``)."""
-    return _law(friction).PIECE.has_state
+    return _module(friction).PIECE.has_state
 
 
 @overload(law_accel, prefer_literal=True)
 def _law_accel(friction, f, v, th, lp):
-    law = _law(friction)
+    law = _module(friction)
     if law is None:
         return None
     fn = law.accel
@@ -90,7 +89,7 @@ def _law_accel(friction, f, v, th, lp):
 
 @overload(law_rate, prefer_literal=True)
 def _law_rate(friction, thl, th, thr, v, lp):
-    law = _law(friction)
+    law = _module(friction)
     if law is None:
         return None
     fn = law.rate
@@ -103,12 +102,57 @@ def _law_rate(friction, thl, th, thr, v, lp):
 
 @overload(law_has_state, inline="always", prefer_literal=True)
 def _law_has_state(friction):
-    law = _law(friction)
+    law = _module(friction)
     if law is None:
         return None
     if law.PIECE.has_state:
         return lambda friction: True
     return lambda friction: False
+
+
+def call(piece, name, *args):
+    """The compiled function ``name`` of the piece whose module is ``piece`` (a literal import
+    path), called with ``args``: resolved when the kernel is compiled, so no other piece's code
+    is typed."""
+    return getattr(importlib.import_module(piece), name)(*args)
+
+
+def has(piece, name):
+    """The attribute ``name`` of the piece whose module is ``piece`` (``PIECE.has_state``, ...), a
+    compile-time constant in a kernel."""
+    return bool(getattr(importlib.import_module(piece).PIECE, name))
+
+
+# ``call``'s compiled form per number of arguments (numba inlines the pieces' functions, which
+# it cannot do for a call with ``*args``).
+_CALLS = {
+    1: lambda fn: lambda piece, name, *args: fn(args[0]),
+    2: lambda fn: lambda piece, name, *args: fn(args[0], args[1]),
+    3: lambda fn: lambda piece, name, *args: fn(args[0], args[1], args[2]),
+    4: lambda fn: lambda piece, name, *args: fn(args[0], args[1], args[2], args[3]),
+    5: lambda fn: lambda piece, name, *args: fn(args[0], args[1], args[2], args[3], args[4]),
+    6: lambda fn: lambda piece, name, *args: fn(args[0], args[1], args[2], args[3], args[4], args[5]),
+    7: lambda fn: lambda piece, name, *args: fn(args[0], args[1], args[2], args[3], args[4], args[5], args[6]),
+    8: lambda fn: lambda piece, name, *args: fn(args[0], args[1], args[2], args[3], args[4], args[5], args[6], args[7]),
+}
+
+
+@overload(call, prefer_literal=True)
+def _call(piece, name, *args):
+    mod = _module(piece)
+    if mod is None or not isinstance(name, types.StringLiteral):
+        return None
+    return _CALLS[len(args)](getattr(mod, name.literal_value))
+
+
+@overload(has, inline="always", prefer_literal=True)
+def _has(piece, name):
+    mod = _module(piece)
+    if mod is None or not isinstance(name, types.StringLiteral):
+        return None
+    if getattr(mod.PIECE, name.literal_value):
+        return lambda piece, name: True
+    return lambda piece, name: False
 
 
 @njit(cache=True, inline="always")
@@ -123,7 +167,7 @@ def _force(xl, xc, xr, K, Kp, p, drive):
 @njit(cache=True, inline="always")
 def _accel(f, th, v, m, mp, friction):
     """dv/dt of a block times the moving mask m (1.0 moving, 0.0 stopped): m (f - friction) with
-    the law's own ``accel``; ``mp`` = (K, Kp, Fs, the law's parameters)."""
+    the law's own ``accel``; ``mp`` = (K, Kp, the threshold's parameters, the law's parameters)."""
     return m * law_accel(friction, f, v, th, mp[3])
 
 
@@ -135,11 +179,10 @@ def _dtheta(thl, th, thr, v, mp, friction):
 
 
 @njit(cache=True, inline="always")
-def _threshold(th, Fs, threshold):
-    """Static threshold of the start rule: Fs, or theta_i for the state threshold."""
-    if threshold == THRESHOLD_STATE:
-        return th
-    return Fs
+def _threshold(th, tp, threshold):
+    """Static threshold of the start rule: the threshold piece's ``value`` (Fs, or theta_i), its
+    parameters ``tp``."""
+    return call(threshold, "value", th, tp)
 
 
 @njit(cache=True, inline="always")

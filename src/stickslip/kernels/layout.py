@@ -13,7 +13,8 @@ compiled into its own machine code with the branches on pieces removed:
   compiled functions the kernels call (:mod:`stickslip.kernels.laws`); the kernel gets the
   module's import path as a literal string and the law's parameters as its ``Params`` named
   tuple (``ChainArgs.law``);
-* static threshold ``THRESHOLD_CONSTANT``: Fs; ``THRESHOLD_STATE``: theta_i;
+* static threshold: a module of :mod:`stickslip.models.threshold` (Fs, or theta_i), passed like the
+  friction law, its parameters as ``ChainArgs.tp``;
 * ends ``ENDS_FREE``: x_{N+1} = x_N (plate drive: also x_0 = x_1); ``ENDS_FIXED``: x_{N+1} = 0
   (plate drive: also x_0 = 0); ``ENDS_PERIODIC``: x_0 = x_N, x_{N+1} = x_1 (plate drive only).
 
@@ -71,14 +72,14 @@ MECH_HI = 21
 FULL_UPDATES = 22  # block updates of exact that were full (the rest updated the state variable alone)
 IST_SIZE = 23
 
-# Indices into the float64 parameter vector ``par``: the springs, drive and threshold (the friction
-# law's parameters travel as its own named tuple, ``ChainArgs.law``).
-P_K, P_V, P_DT, P_KP, P_FS = range(5)
-PAR_SIZE = 5
+# Indices into the float64 parameter vector ``par``: the springs and the drive (the threshold's and
+# the friction law's parameters travel as their modules' named tuples, ``ChainArgs.tp`` and
+# ``ChainArgs.law``).
+P_K, P_V, P_DT, P_KP = range(4)
+PAR_SIZE = 4
 
-# The pieces of a model other than the friction law (compile-time constants of every kernel).
+# The drive and the ends (compile-time constants of every kernel).
 DRIVE_END, DRIVE_PLATE = 0, 1
-THRESHOLD_CONSTANT, THRESHOLD_STATE = 0, 1
 ENDS_FREE, ENDS_FIXED, ENDS_PERIODIC = 0, 1, 2
 
 # Columns of the int64 event buffer ``ev_int``.
@@ -114,6 +115,7 @@ class ChainArgs(NamedTuple):
     x0ev: np.ndarray  # x of each block at its first move
     ist: np.ndarray  # int64 state vector (indices above)
     par: np.ndarray  # float64 parameter vector (indices above)
+    tp: tuple  # the threshold's parameters (its module's Params named tuple)
     law: tuple  # the friction law's parameters (its module's Params named tuple)
     ev_int: np.ndarray  # event buffer (columns above) and each event's S
     ev_S: np.ndarray
@@ -145,7 +147,7 @@ def _merge(a_lo, a_hi, b_lo, b_hi):
 
 
 @njit(cache=True, inline="always")
-def _unpack(par, law):
-    """mp = (K, Kp, Fs, the law's parameters), V and dt from the parameter vector and the law's
-    named tuple."""
-    return (par[P_K], par[P_KP], par[P_FS], law), par[P_V], par[P_DT]
+def _unpack(par, tp, law):
+    """mp = (K, Kp, the threshold's parameters, the law's parameters), V and dt from the parameter
+    vector and the pieces' named tuples."""
+    return (par[P_K], par[P_KP], tp, law), par[P_V], par[P_DT]

@@ -48,7 +48,7 @@ from numba import njit
 
 from stickslip.kernels.laws import _force as _spring_force
 from stickslip.kernels.laws import _threshold, law_accel, law_rate
-from stickslip.kernels.layout import DRIVE_END, ENDS_FIXED, ENDS_PERIODIC, P_DT, P_FS, P_K, P_KP, P_V
+from stickslip.kernels.layout import DRIVE_END, ENDS_FIXED, ENDS_PERIODIC, P_DT, P_K, P_KP, P_V
 
 # Integer state vector.
 I_STEP, I_EVENTS, I_MOVING, I_ACTIVE, I_STARTS, I_STOPS, I_FIRST, I_NMOVED = range(8)
@@ -89,9 +89,9 @@ def _force(u, i, par, drive):
 
 
 @njit(cache=True, inline="always")
-def _gap(u, th, i, par, drive, threshold):
+def _gap(u, th, i, par, tp, drive, threshold):
     """g_i = f_i - threshold_i: a stuck block starts where it turns positive."""
-    return _force(u, i, par, drive) - _threshold(th[i], par[P_FS], threshold)
+    return _force(u, i, par, drive) - _threshold(th[i], tp, threshold)
 
 
 @njit(cache=True, inline="always")
@@ -172,11 +172,11 @@ def _stop(i, u, v, mov, t, par, ist, evf, N, ev_t, ev_i):
 
 
 @njit(cache=True, _nrt=False)
-def _switched(i, stop, ou, ov, oth, par, drive, threshold):
+def _switched(i, stop, ou, ov, oth, par, tp, drive, threshold):
     """(value, switched) of block i's switching function on the state o*: v (stop) or -g (start)."""
     if stop:
         return ov[i], ov[i] <= 0.0
-    g = _gap(ou, oth, i, par, drive, threshold)
+    g = _gap(ou, oth, i, par, tp, drive, threshold)
     return -g, g > 0.0
 
 
@@ -221,7 +221,7 @@ def _heun_near(i, h, t, u, v, th, mov, N, par, lp, drive, friction, ends, sc):
 
 
 @njit(cache=True, _nrt=False)
-def _locate(i, stop, h, t, u, v, th, mov, N, par, lp, drive, friction, threshold, ends, sc, near):
+def _locate(i, stop, h, t, u, v, th, mov, N, par, lp, tp, drive, friction, threshold, ends, sc, near):
     """The switch time of block i in (0, h]: the smallest float b found with the switch done at b.
 
     Illinois (modified regula falsi) on the bracket [a, b], a bisection whenever a step fails to
@@ -234,14 +234,14 @@ def _locate(i, stop, h, t, u, v, th, mov, N, par, lp, drive, friction, threshold
         fa = v[i]
     else:
         _ghosts(u, th, N, t, par[P_V], drive, ends)
-        fa = -_gap(u, th, i, par, drive, threshold)
+        fa = -_gap(u, th, i, par, tp, drive, threshold)
     a = 0.0
     b = h
     if near:
         _heun_near(i, h, t, u, v, th, mov, N, par, lp, drive, friction, ends, sc)
     else:
         _heun(h, t, u, v, th, mov, N, par, lp, drive, friction, ends, sc)
-    fb, _ = _switched(i, stop, ou, ov, oth, par, drive, threshold)
+    fb, _ = _switched(i, stop, ou, ov, oth, par, tp, drive, threshold)
     side = 0
     width = b - a
     for it in range(400):
@@ -260,7 +260,7 @@ def _locate(i, stop, h, t, u, v, th, mov, N, par, lp, drive, friction, threshold
             _heun_near(i, c, t, u, v, th, mov, N, par, lp, drive, friction, ends, sc)
         else:
             _heun(c, t, u, v, th, mov, N, par, lp, drive, friction, ends, sc)
-        fc, sw = _switched(i, stop, ou, ov, oth, par, drive, threshold)
+        fc, sw = _switched(i, stop, ou, ov, oth, par, tp, drive, threshold)
         if sw:
             b, fb = c, fc
             if side == -1:
@@ -276,7 +276,7 @@ def _locate(i, stop, h, t, u, v, th, mov, N, par, lp, drive, friction, threshold
 
 @njit(cache=True, _nrt=False)
 def _steps(
-    u, v, th, mov, n_end, par, lp, drive, friction, threshold, ends, sc, cand, moved, ist, evf, ev_t, ev_i, near
+    u, v, th, mov, n_end, par, lp, tp, drive, friction, threshold, ends, sc, cand, moved, ist, evf, ev_t, ev_i, near
 ):
     """:func:`advance`; ``near``: :func:`_locate`'s trial steps on the neighbourhood alone."""
     N = u.shape[0] - 2
@@ -293,7 +293,7 @@ def _steps(
             _ghosts(u, th, N, t, par[P_V], drive, ends)
             for i in range(1, N + 1):
                 if mov[i] == 0.0:
-                    if _gap(u, th, i, par, drive, threshold) > 0.0:
+                    if _gap(u, th, i, par, tp, drive, threshold) > 0.0:
                         _start(i, u, v, th, mov, t, par, ist, evf, moved, N)
                 elif v[i] < 0.0:
                     _stop(i, u, v, mov, t, par, ist, evf, N, ev_t, ev_i)
@@ -303,7 +303,7 @@ def _steps(
             n_cand = 0
             for i in range(1, N + 1):
                 if mov[i] == 0.0:
-                    if _gap(ou, oth, i, par, drive, threshold) > 0.0:
+                    if _gap(ou, oth, i, par, tp, drive, threshold) > 0.0:
                         cand[n_cand] = i
                         n_cand += 1
                 elif v[i] > 0.0 and ov[i] <= 0.0:
@@ -326,7 +326,7 @@ def _steps(
             for k in range(n_cand):
                 i = abs(cand[k])
                 is_stop = cand[k] < 0
-                b = _locate(i, is_stop, h, t, u, v, th, mov, N, par, lp, drive, friction, threshold, ends, sc, near)
+                b = _locate(i, is_stop, h, t, u, v, th, mov, N, par, lp, tp, drive, friction, threshold, ends, sc, near)
                 if blk == 0 or b < tau:
                     tau, blk, stop = b, i, is_stop
             _heun(tau, t, u, v, th, mov, N, par, lp, drive, friction, ends, sc)
@@ -351,7 +351,7 @@ def _steps(
 
 
 @njit(cache=True, _nrt=False)
-def advance(u, v, th, mov, n_end, par, lp, drive, friction, threshold, ends, sc, cand, moved, ist, evf, ev_t, ev_i):
+def advance(u, v, th, mov, n_end, par, lp, tp, drive, friction, threshold, ends, sc, cand, moved, ist, evf, ev_t, ev_i):
     """Advance the state (u, v, theta, moving mask) at step ist[I_STEP] to step n_end.
 
     Returns DONE, EVENTS_FULL (the event buffer has fewer than 4 free rows; the state is at the
@@ -360,7 +360,7 @@ def advance(u, v, th, mov, n_end, par, lp, drive, friction, threshold, ends, sc,
     location over the whole chain (the reference of :mod:`stickslip.kernels.located_fast`).
     """
     return _steps(
-        u, v, th, mov, n_end, par, lp, drive, friction, threshold, ends, sc, cand, moved, ist, evf, ev_t, ev_i, False
+        u, v, th, mov, n_end, par, lp, tp, drive, friction, threshold, ends, sc, cand, moved, ist, evf, ev_t, ev_i, False
     )
 
 

@@ -30,16 +30,14 @@ import numpy as np
 from numba import njit
 
 from stickslip.kernels.laws import _force as _spring_force
-from stickslip.kernels.laws import _threshold, law_accel, law_rate
+from stickslip.kernels.laws import _threshold, has, law_accel, law_rate
 from stickslip.kernels.layout import (
     ENDS_FIXED,
     ENDS_PERIODIC,
     P_DT,
-    P_FS,
     P_K,
     P_KP,
     P_V,
-    THRESHOLD_STATE,
 )
 from stickslip.kernels.located import (
     DONE,
@@ -132,14 +130,14 @@ def _stage2_near(a, b, u, v, th, mov, sc, h, V, K, Kp, lp, drive, friction):
 
 
 @njit(cache=True, _nrt=False, inline="always")
-def _fires(a, b, x, th, v0, v1, mov, K, Kp, Fs, drive, threshold, end):
+def _fires(a, b, x, th, v0, v1, mov, K, Kp, tp, drive, threshold, end):
     """Whether a switch test of blocks a..b fires, on the state x, th (end = False: a stuck block
     above its threshold, a moving one with v0 < 0, due at the step's start) or on o* (end = True:
     a moving one with v0 > 0 and v1 <= 0); located's expressions, branch-free."""
     one = np.uint64(1)
     f = False
     for i in range(np.uint64(a), np.uint64(b) + one):
-        g = _spring_force(x[i - one], x[i], x[i + one], K, Kp, 0.0, drive) - _threshold(th[i], Fs, threshold)
+        g = _spring_force(x[i - one], x[i], x[i + one], K, Kp, 0.0, drive) - _threshold(th[i], tp, threshold)
         stops = (v0[i] > 0.0) & (v1[i] <= 0.0) if end else v0[i] < 0.0
         f |= (g > 0.0) if mov[i] == 0.0 else stops
     return f
@@ -154,6 +152,7 @@ def advance_fast(
     n_end,
     par,
     lp,
+    tp,
     drive,
     friction,
     threshold,
@@ -175,13 +174,13 @@ def advance_fast(
     (int64, N + 2), ``sd`` (float64) and ``se`` (int64) are scratch. Returns with every block at the step reached."""
     if ends == ENDS_FIXED:
         return advance(
-            u, v, th, mov, n_end, par, lp, drive, friction, threshold, ends, sc, cand, moved, ist, evf, ev_t, ev_i
+            u, v, th, mov, n_end, par, lp, tp, drive, friction, threshold, ends, sc, cand, moved, ist, evf, ev_t, ev_i
         )
     N = u.shape[0] - 2
     dt = par[P_DT]
     V = par[P_V]
-    K, Kp, Fs = par[P_K], par[P_KP], par[P_FS]
-    mp = (K, Kp, Fs, lp)
+    K, Kp = par[P_K], par[P_KP]
+    mp = (K, Kp, tp, lp)
     k1u, k1v, k1th, pu, pv, pth, k2u, k2v, k2th, ou, ov, oth = sc
     h = dt - 0.0
     h2 = 0.5 * h
@@ -208,7 +207,7 @@ def advance_fast(
             status = EVENTS_FULL
             break
         if not dense and low <= n:
-            dense, low = _expire(n, el, eh, u, us, sd, se, th, mov, safe, N, c, par, drive, threshold, ends)
+            dense, low = _expire(n, el, eh, u, us, sd, se, th, mov, safe, N, c, par, tp, drive, threshold, ends)
         if not dense and el > eh and tl > tr:
             # Only the drive moves: jump to the first step at which a start test must be redone
             # (after _expire, low > n).
@@ -226,7 +225,7 @@ def advance_fast(
                     _catch(j, n, u, us, sd, se, c)
             _ghosts(u, th, N, t, V, drive, ends)
             if fresh and el <= eh:
-                dense = _fires(el, eh, u, th, v, v, mov, K, Kp, Fs, drive, threshold, False)
+                dense = _fires(el, eh, u, th, v, v, mov, K, Kp, tp, drive, threshold, False)
         if not dense:
             # Stage 1 on E's neighbourhood, theta alone on T's outside it.
             if el <= eh:
@@ -250,7 +249,7 @@ def advance_fast(
                         k2u[i] = pv[i] - V
                         ou[i] = u[i] + 0.5 * h * (k1u[i] + k2u[i])
                 _ghosts(ou, oth, N, t + h, V, drive, ends)
-                dense = _fires(el, eh, ou, oth, v, ov, mov, K, Kp, Fs, drive, threshold, True)
+                dense = _fires(el, eh, ou, oth, v, ov, mov, K, Kp, tp, drive, threshold, True)
         if dense:
             # A switch step: the dense form's own step, every block.
             _catch_all(n, u, us, sd, se, c, N)
@@ -285,9 +284,9 @@ def advance_fast(
                 break
             el, eh = _near_movers(mov, 1, N, N, ends)
             tl, tr = 1, N
-            if threshold == THRESHOLD_STATE:
+            if has(threshold, "has_state"):
                 el, eh = 1, N
-            dense, low = _horizons(n, el, eh, u, us, sd, se, th, mov, safe, N, c, par, drive, threshold, ends)
+            dense, low = _horizons(n, el, eh, u, us, sd, se, th, mov, safe, N, c, par, tp, drive, threshold, ends)
             fresh = True
             continue
         # Commit E; theta alone on T outside E (in place); stops at the step's end.
@@ -334,13 +333,13 @@ def advance_fast(
         tl, tr = _dilate(cl, ch, N, ends)
         ol, oh = el, eh
         el, eh = _near_movers(mov, ol, oh, N, ends)
-        if threshold == THRESHOLD_STATE and tl <= tr:
+        if has(threshold, "has_state") and tl <= tr:
             # The threshold is theta: a block whose theta changes is tested step by step.
             el, eh = (tl, tr) if el > eh else (min(el, tl), max(eh, tr))
             fresh |= el < ol or eh > oh
         for j in range(ol, oh + 1):
             if (j < el or j > eh) and mov[j] == 0.0:
-                f, last = _horizon(j, n, 0, u, us, sd, se, th, N, c, par, drive, threshold, ends)
+                f, last = _horizon(j, n, 0, u, us, sd, se, th, N, c, par, tp, drive, threshold, ends)
                 dense |= f
                 safe[j] = last
                 low = min(low, last)

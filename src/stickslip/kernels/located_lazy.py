@@ -28,7 +28,7 @@ from numba import njit
 
 from stickslip.kernels.laws import _force as _spring_force
 from stickslip.kernels.laws import _threshold
-from stickslip.kernels.layout import DRIVE_END, DRIVE_PLATE, ENDS_PERIODIC, P_FS, P_K, P_KP
+from stickslip.kernels.layout import DRIVE_END, DRIVE_PLATE, ENDS_PERIODIC, P_K, P_KP
 
 _BIG = np.int64(1) << np.int64(62)
 # Powers of two, as constants of the compiled code.
@@ -161,7 +161,7 @@ def _right(j, N, ends):
 
 
 @njit(cache=True, _nrt=False)
-def _horizon(j, m, ahead, u, us, sd, se, th, N, c, par, drive, threshold, ends):
+def _horizon(j, m, ahead, u, us, sd, se, th, N, c, par, tp, drive, threshold, ends):
     """(fires, last) for stuck block j on the state at step m: whether its start test fires
     there, else the last step up to which it provably does not (module docstring, 2), its
     neighbours staying stuck and the steps full. The u are brought to m - ahead and taken
@@ -193,7 +193,7 @@ def _horizon(j, m, ahead, u, us, sd, se, th, N, c, par, drive, threshold, ends):
             if jl >= 0:
                 ul = ul + c
     F = _spring_force(ul, uc, ur, K, Kp, 0.0, drive)
-    thr = _threshold(th[j], par[P_FS], threshold)
+    thr = _threshold(th[j], tp, threshold)
     if F - thr > 0.0:
         return True, m
     if L == 0:
@@ -222,7 +222,7 @@ def _horizon(j, m, ahead, u, us, sd, se, th, N, c, par, drive, threshold, ends):
 
 
 @njit(cache=True, _nrt=False)
-def _horizons(n, el, eh, u, us, sd, se, th, mov, safe, N, c, par, drive, threshold, ends):
+def _horizons(n, el, eh, u, us, sd, se, th, mov, safe, N, c, par, tp, drive, threshold, ends):
     """``safe`` of every stuck block outside el..eh from the state at step n; returns (fires,
     the smallest)."""
     fires = False
@@ -231,7 +231,7 @@ def _horizons(n, el, eh, u, us, sd, se, th, mov, safe, N, c, par, drive, thresho
         if mov[j] != 0.0 or (el <= j and j <= eh):
             safe[j] = _BIG
             continue
-        f, last = _horizon(j, n, 0, u, us, sd, se, th, N, c, par, drive, threshold, ends)
+        f, last = _horizon(j, n, 0, u, us, sd, se, th, N, c, par, tp, drive, threshold, ends)
         fires |= f
         safe[j] = last
         low = min(low, last)
@@ -240,7 +240,7 @@ def _horizons(n, el, eh, u, us, sd, se, th, mov, safe, N, c, par, drive, thresho
 
 
 @njit(cache=True, _nrt=False)
-def _expire(n, el, eh, u, us, sd, se, th, mov, safe, N, c, par, drive, threshold, ends):
+def _expire(n, el, eh, u, us, sd, se, th, mov, safe, N, c, par, tp, drive, threshold, ends):
     """Test again, on the state at step n + 1, the stuck blocks whose ``safe`` step is n or
     earlier; returns (some start test fires, the new smallest ``safe``)."""
     fires = False
@@ -250,7 +250,7 @@ def _expire(n, el, eh, u, us, sd, se, th, mov, safe, N, c, par, drive, threshold
             if mov[j] != 0.0 or (el <= j and j <= eh):
                 safe[j] = _BIG
             else:
-                f, last = _horizon(j, n + 1, 1, u, us, sd, se, th, N, c, par, drive, threshold, ends)
+                f, last = _horizon(j, n + 1, 1, u, us, sd, se, th, N, c, par, tp, drive, threshold, ends)
                 fires |= f
                 safe[j] = last
                 safe[N + 1] += 1

@@ -149,8 +149,8 @@ def run_sparse(args, drive, friction, threshold, ends):
     ev_int, fm, prof_x, n_end, profile_every = args.ev_int, args.fm, args.prof_x, args.n_end, args.profile_every
     prof_meta = args.prof_meta
     N = x.shape[0] - 2
-    mp, V, dt = _unpack(par, args.law)
-    K, Kp, Fs = mp[0], mp[1], mp[2]
+    mp, V, dt = _unpack(par, args.tp, args.law)
+    K, Kp, tp = mp[0], mp[1], mp[2]
     h2 = 0.5 * dt
     cap_ev, cap_fm, cap_p = ev_int.shape[0], fm.shape[0], prof_x.shape[0]
     one = np.uint64(1)
@@ -186,7 +186,7 @@ def run_sparse(args, drive, friction, threshold, ends):
             xs[i] = x[i] + dt * v[i]
     for i in range(1, N + 1):
         if mov[i] == 0.0:
-            m = _plate_trigger(x[i - 1], x[i], x[i + 1], _threshold(th[i], Fs, threshold), K, Kp, V, dt, n0, n_end)
+            m = _plate_trigger(x[i - 1], x[i], x[i + 1], _threshold(th[i], tp, threshold), K, Kp, V, dt, n0, n_end)
             nq, t_next = _settle(i, m, n0, trig, queue, nq, t_next)
     if n0 < n_end:
         # run_dense adds dt/2 (0 + 0) to every theta in each step (no state variable); nothing
@@ -237,12 +237,12 @@ def run_sparse(args, drive, friction, threshold, ends):
         for k in range(nq):
             i = queue[k]
             f = _force(x[i - one], x[i], x[i + one], K, Kp, p1, drive)
-            fired |= f > _threshold(th[i], Fs, threshold)
+            fired |= f > _threshold(th[i], tp, threshold)
         if fired:
             for k in range(nq):
                 i = queue[k]
                 f = _force(x[i - one], x[i], x[i + one], K, Kp, p1, drive)
-                fire = f > _threshold(th[i], Fs, threshold)
+                fire = f > _threshold(th[i], tp, threshold)
                 movers[nmov + nst] = i
                 still[nsl] = i
                 nst += 1 if fire else 0
@@ -263,7 +263,7 @@ def run_sparse(args, drive, friction, threshold, ends):
                         i = np.uint64(j)
                         trig[i] = _NEVER
                         f = _force(x[i - one], x[i], x[i + one], K, Kp, p1, drive)
-                        if f > _threshold(th[i], Fs, threshold):
+                        if f > _threshold(th[i], tp, threshold):
                             movers[nmov + nst] = i
                             nst += 1
                         else:
@@ -425,7 +425,7 @@ def run_sparse(args, drive, friction, threshold, ends):
                 i = still[k] if k < nsl else stopped[k - nsl]
                 if trig[i] != _QUEUED:
                     m = _plate_trigger(
-                        x[i - one], x[i], x[i + one], _threshold(th[i], Fs, threshold), K, Kp, V, dt, n + 1, n_end
+                        x[i - one], x[i], x[i + one], _threshold(th[i], tp, threshold), K, Kp, V, dt, n + 1, n_end
                     )
                     nq, t_next = _settle(i, m, n + 1, trig, queue, nq, t_next)
             if ns > 0:

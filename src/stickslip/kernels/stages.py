@@ -33,7 +33,7 @@ def _stage1(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, p, mp, dt, drive, fr
     Returns the first and the last block that move in this step (lo > hi if none) and
     whether a stopped block starts.
     """
-    K, Kp, Fs = mp[0], mp[1], mp[2]
+    K, Kp, tp = mp[0], mp[1], mp[2]
     one = np.uint64(1)
     u0 = np.uint64(lo)
     n = hi - lo + 1
@@ -44,7 +44,7 @@ def _stage1(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, p, mp, dt, drive, fr
         i = u0 + np.uint64(k)
         f = _force(x[i - one], x[i], x[i + one], K, Kp, p, drive)
         mo = mov[i]
-        m = 1.0 if f > _threshold(th[i], Fs, threshold) else mo
+        m = 1.0 if f > _threshold(th[i], tp, threshold) else mo
         mm[i] = m
         first = min(first, k if m != 0.0 else n)
         last = max(last, k if m != 0.0 else -1)

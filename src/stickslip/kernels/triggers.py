@@ -103,7 +103,7 @@ def _plate_triggers(x, th, mov, mm, trig, lo, hi, every, n0, n_cap, mp, V, dt, t
     it the blocks next to or at a block of the mid-step mask ``mm``, which holds this step's
     movers on the interval (only they change x).
     """
-    K, Kp, Fs = mp[0], mp[1], mp[2]
+    K, Kp, tp = mp[0], mp[1], mp[2]
     N = x.shape[0] - 2
     t_min = _NEVER
     for i in range(lo, hi + 1):
@@ -115,7 +115,7 @@ def _plate_triggers(x, th, mov, mm, trig, lo, hi, every, n0, n_cap, mp, V, dt, t
                 t_min = trig[i]
             continue
         if mov[i] == 0.0:
-            m = _plate_trigger(x[i - 1], x[i], x[i + 1], _threshold(th[i], Fs, threshold), K, Kp, V, dt, n0, n_cap)
+            m = _plate_trigger(x[i - 1], x[i], x[i + 1], _threshold(th[i], tp, threshold), K, Kp, V, dt, n0, n_cap)
             trig[i] = m
             if m < t_min:
                 t_min = m

@@ -28,7 +28,7 @@ import importlib
 from stickslip.models.friction.weakening import weakening_g
 from stickslip.models.piece import CompositionError, Linearisation, Param, Piece
 
-__all__ = ["PIECES", "KINDS", "FRICTIONS", "CompositionError", "Linearisation", "Param", "Piece", "weakening_g"]
+__all__ = ["PIECES", "KINDS", "FRICTIONS", "THRESHOLDS", "CompositionError", "Linearisation", "Param", "Piece", "weakening_g"]
 
 #: The friction laws, one module each in :mod:`stickslip.models.friction` (a law is its module
 #: and its line here).
@@ -39,6 +39,9 @@ FRICTIONS = (
     "rate_state",
     "rate_state_slip",
 )
+
+#: The static thresholds, one module each in :mod:`stickslip.models.threshold`.
+THRESHOLDS = ("constant", "state")
 
 
 PIECES: dict[str, tuple[Piece, ...]] = {
@@ -53,15 +56,7 @@ PIECES: dict[str, tuple[Piece, ...]] = {
         ),
     ),
     "friction": tuple(importlib.import_module(f"stickslip.models.friction.{m}").PIECE for m in FRICTIONS),
-    "threshold": (
-        Piece("threshold", "constant", "a stuck block starts when f_i > Fs", ("Fs",)),
-        Piece(
-            "threshold",
-            "state",
-            "a stuck block starts when f_i > theta_i (the paper's reading of Batista-Carlson)",
-            has_state=True,
-        ),
-    ),
+    "threshold": tuple(importlib.import_module(f"stickslip.models.threshold.{m}").PIECE for m in THRESHOLDS),
     "ends": (
         Piece("ends", "free", "x_{N+1} = x_N (plate drive: also x_0 = x_1)"),
         Piece("ends", "fixed", "x_{N+1} = 0 (plate drive: also x_0 = 0)", steady_sliding=False, wall=True),
@@ -87,7 +82,8 @@ def piece(kind: str, name: str) -> Piece:
 
 def code(kind: str, name: str) -> int | str:
     """What a kernel is compiled for, for one piece: the import path of the module holding its
-    compiled functions (a friction law), else its integer code (its position in :data:`PIECES`)."""
+    compiled functions (a friction law, a threshold), else its integer code (its position in
+    :data:`PIECES`)."""
     pc = piece(kind, name)
     return pc.module or names(kind).index(pc.name)
 

@@ -23,8 +23,9 @@ from stickslip.models.params import BlockParams, ParameterError, check_number, s
 
 INTEGRATOR = "heun (explicit trapezoid, fixed dt) with the start/stop rules of docs/model.md"
 
-#: The position of the law among heun_block's arguments (compiled as a literal).
-LAW_ARG = frozenset({8})
+#: The positions of the friction law and the threshold among heun_block's arguments (compiled
+#: as literals).
+LAW_ARG = frozenset({8, 10})
 
 SLIP_COLUMNS = ("t_c", "t_e", "duration", "slip", "force_at_stop", "period")
 
@@ -193,13 +194,13 @@ def simulate_block(
         slip_end = np.empty(capacity, dtype=np.int64)
         slip_x_start = np.empty(capacity)
         slip_x_end = np.empty(capacity)
-        law = params.friction_piece
+        law, thr = params.friction_piece, params.threshold_piece
         args = (
             initial.x, initial.v, initial.theta, initial.stopped, steps, every,
-            params.K, params.V, law.module, law.kernel_params(params), params.Fs, params.M, params.sigma,
-            params.dt,
+            params.K, params.V, law.module, law.kernel_params(params), thr.module, thr.kernel_params(params),
+            params.M, params.sigma, params.dt,
             out_t, out_x, out_v, out_theta, out_stopped,
-            slip_start, slip_end, slip_x_start, slip_x_end, params.threshold_piece.has_state,
+            slip_start, slip_end, slip_x_start, slip_x_end,
         )  # fmt: skip
         (x, v, theta, stopped, n_slips, n_starts, n_stops, v_min, v_max) = specialise_call(heun_block, args, LAW_ARG)
         if n_slips <= capacity:

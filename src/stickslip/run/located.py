@@ -128,14 +128,15 @@ class LocatedState:
 
 def parameter_vector(p: ChainParams) -> np.ndarray:
     """The kernel's parameter vector, laid out as the engine's (:mod:`stickslip.kernels.layout`);
-    the friction law's parameters go separately (:meth:`~stickslip.models.piece.Piece.kernel_params`)."""
+    the threshold's and the friction law's parameters go separately
+    (:meth:`~stickslip.models.piece.Piece.kernel_params`)."""
     par = np.zeros(layout.PAR_SIZE)
-    par[layout.P_K], par[layout.P_V], par[layout.P_DT], par[layout.P_KP], par[layout.P_FS] = p.K, p.V, p.dt, p.Kp, p.Fs
+    par[layout.P_K], par[layout.P_V], par[layout.P_DT], par[layout.P_KP] = p.K, p.V, p.dt, p.Kp
     return par
 
 
 # Positions of the pieces among the arguments of L.advance and L.rates (compiled as literals).
-_ADVANCE_PIECES = frozenset(range(7, 11))
+_ADVANCE_PIECES = frozenset(range(8, 12))
 _RATES_PIECES = frozenset(range(7, 10))
 
 
@@ -168,6 +169,7 @@ class LocatedStepper:
         self.params = params
         self.par = parameter_vector(params)
         self.lp = params.friction_piece.kernel_params(params)
+        self.tp = params.threshold_piece.kernel_params(params)
         self.codes = params.codes
         N = params.N
         self.sc = tuple(np.zeros(N + 2) for _ in range(12))
@@ -195,13 +197,13 @@ class LocatedStepper:
         parts = []
         while True:
             state.ist[L.I_EVENTS] = 0
-            args = (state.u, state.v, state.th, state.mov, np.int64(step), self.par, self.lp)
+            args = (state.u, state.v, state.th, state.mov, np.int64(step), self.par, self.lp, self.tp)
             args += (drive, friction, threshold, ends, self.sc, self.cand, state.moved, state.ist, state.evf)
             args += (self.ev_t, self.ev_i)
             if self.form == "fast":
                 args += self.lazy
             # Typed once per layout of the state's arrays (the stepper's own never change).
-            key = tuple((a.dtype, a.flags.c_contiguous, a.flags.writeable) for a in args[:4] + args[13:16])
+            key = tuple((a.dtype, a.flags.c_contiguous, a.flags.writeable) for a in args[:4] + args[14:17])
             entry = self._entries.get(key)
             if entry is None:
                 kernel = LF.advance_fast if self.form == "fast" else L.advance
