@@ -15,8 +15,8 @@ import pytest
 
 from stickslip.kernels import dense, exact, layout, stages
 from stickslip.models.friction import state as state_law
-from stickslip.models.threshold import constant as constant_threshold
 from stickslip.models.params import ChainParams
+from stickslip.models.threshold import constant as constant_threshold
 from stickslip.run.driver import run_chain
 
 # The block loops: separate compiled functions, and the all-moving ones inlined in run_exact.

@@ -17,8 +17,16 @@ from stickslip.models.presets import PRESETS, chain_params
 #: The kernels' integer codes as the kernels read them (kernels/ compare against these numbers).
 KERNEL_CODES = {
     "drive": {"end": 0, "plate": 1},
-    "threshold": {"constant": 0, "state": 1},
-    "ends": {"free": 0, "fixed": 1, "periodic": 2},
+}
+
+#: A threshold and an end condition reach the kernels as the import paths of their modules.
+PIECE_MODULES = {
+    "threshold": {"constant": "stickslip.models.threshold.constant", "state": "stickslip.models.threshold.state"},
+    "ends": {
+        "free": "stickslip.models.ends.free",
+        "fixed": "stickslip.models.ends.fixed",
+        "periodic": "stickslip.models.ends.periodic",
+    },
 }
 
 #: A friction law reaches the kernels as the import path of its own module.
@@ -36,6 +44,29 @@ def test_kernel_codes_unchanged(kind):
     for name, code in KERNEL_CODES[kind].items():
         assert pieces.PIECES[kind][code] is pieces.piece(kind, name)
         assert pieces.code(kind, name) == code
+
+
+@pytest.mark.parametrize("kind", list(PIECE_MODULES))
+def test_thresholds_and_ends_are_their_modules(kind):
+    assert pieces.names(kind) == tuple(PIECE_MODULES[kind])
+    for name, module in PIECE_MODULES[kind].items():
+        pc = pieces.piece(kind, name)
+        assert pieces.code(kind, name) == module == pc.module
+
+
+def test_threshold_values_and_ghost_cells():
+    # The compiled functions the integrators call, run as Python: Fs; theta_i; the ghost beyond
+    # an end (free: the end block; fixed: the wall; periodic: the other end).
+    from stickslip.models.ends import fixed, free, periodic
+    from stickslip.models.threshold import constant, state
+
+    assert constant.value.py_func(0.7, constant.Params(3.0)) == 3.0
+    assert state.value.py_func(0.7, state.Params()) == 0.7
+    assert free.ghost.py_func(1.5, -2.0, 0.0) == 1.5
+    assert fixed.ghost.py_func(1.5, -2.0, -0.25) == -0.25
+    assert periodic.ghost.py_func(1.5, -2.0, 0.0) == -2.0
+    assert pieces.piece("ends", "periodic").ring and pieces.piece("ends", "fixed").wall
+    assert not pieces.piece("ends", "free").ring and not pieces.piece("ends", "free").wall
 
 
 @pytest.mark.parametrize("name", list(LAW_MODULES))
@@ -56,7 +87,12 @@ def test_params_hand_out_their_pieces():
         "constant",
         "periodic",
     )
-    assert p.codes == (1, LAW_MODULES["weakening"], 0, 2)
+    assert p.codes == (
+        1,
+        LAW_MODULES["weakening"],
+        PIECE_MODULES["threshold"]["constant"],
+        PIECE_MODULES["ends"]["periodic"],
+    )
     assert BlockParams(threshold="state").threshold_piece.has_state
     assert not BlockParams().threshold_piece.has_state
 

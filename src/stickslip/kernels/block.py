@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numba
 
-from stickslip.kernels.laws import _threshold, law_accel, law_rate
+from stickslip.kernels.laws import call, law_accel, law_rate
 
 
 @numba.njit(cache=True)
@@ -98,7 +98,7 @@ def heun_block(
         t0 = n * dt
         t1 = (n + 1) * dt
         if not moving:
-            if K * (V * t0 - x) > _threshold(sigma * theta, tp, threshold):
+            if K * (V * t0 - x) > call(threshold, "value", sigma * theta, tp):
                 moving = True
                 n_starts += 1
                 current = n

@@ -46,7 +46,6 @@ from stickslip.kernels.layout import (
     DONE,
     DRIVE_END,
     DRIVE_PLATE,
-    ENDS_PERIODIC,
     EV_ACTIVE,
     EV_COUNT,
     FM_COUNT,
@@ -160,7 +159,7 @@ def run_exact(args, drive, friction, threshold, ends):
             if has(threshold, "has_state"):
                 # A changing state variable moves the threshold itself.
                 ml, mh = _merge(ml, mh, lo, hi)
-            if ends == ENDS_PERIODIC and lo <= hi and (lo == 1 or hi == N):
+            if has(ends, "ring") and lo <= hi and (lo == 1 or hi == N):
                 # Blocks 1 and N read each other's predictors: update the whole ring.
                 lo = 1
                 hi = N
@@ -312,7 +311,7 @@ def run_exact(args, drive, friction, threshold, ends):
             # through the springs that takes a neighbour's move, and only moving blocks change x.
             # So: this step's movers +- 1 (and, as above, the drive's starts and changing thetas).
             if first <= last:
-                if ends == ENDS_PERIODIC and (first == 1 or last == N):
+                if has(ends, "ring") and (first == 1 or last == N):
                     ist[MECH_LO] = 1
                     ist[MECH_HI] = N
                 else:
@@ -341,7 +340,7 @@ def run_exact(args, drive, friction, threshold, ends):
             # Next step's candidates: changes dilated by two, and every block that may move (a
             # start rule that fires is an event's move even when it changes no bit).
             if c_lo <= c_hi:
-                if ends == ENDS_PERIODIC and (c_lo <= 2 or c_hi >= N - 1):
+                if has(ends, "ring") and (c_lo <= 2 or c_hi >= N - 1):
                     c_lo = 1
                     c_hi = N
                 else:

@@ -41,12 +41,7 @@ import numpy as np
 from numba import njit, types
 from numba.extending import overload
 
-from stickslip.kernels.layout import (
-    DRIVE_END,
-    DRIVE_PLATE,
-    ENDS_FIXED,
-    ENDS_PERIODIC,
-)
+from stickslip.kernels.layout import DRIVE_END, DRIVE_PLATE
 
 
 def _module(friction):
@@ -145,7 +140,7 @@ def _call(piece, name, *args):
     return _CALLS[len(args)](getattr(mod, name.literal_value))
 
 
-@overload(has, inline="always", prefer_literal=True)
+@overload(has, prefer_literal=True)
 def _has(piece, name):
     mod = _module(piece)
     if mod is None or not isinstance(name, types.StringLiteral):
@@ -193,26 +188,15 @@ def _pull(V, n, dt):
 
 @njit(cache=True, inline="always")
 def _set_ghosts(x, th, N, p, drive, ends):
-    """Ghost cells 0 and N + 1 from the drive and the ends (module docstring)."""
+    """Ghost cells 0 and N + 1 from the drive and the ends' ``ghost`` (a wall at x = 0; theta
+    without flux)."""
     if drive == DRIVE_END:
         x[0] = p
-    elif ends == ENDS_PERIODIC:
-        x[0] = x[N]
-    elif ends == ENDS_FIXED:
-        x[0] = 0.0
     else:
-        x[0] = x[1]
-    if ends == ENDS_PERIODIC:
-        x[N + 1] = x[1]
-        th[0] = th[N]
-        th[N + 1] = th[1]
-    else:
-        if ends == ENDS_FIXED:
-            x[N + 1] = 0.0
-        else:
-            x[N + 1] = x[N]
-        th[0] = th[1]
-        th[N + 1] = th[N]
+        x[0] = call(ends, "ghost", x[1], x[N], 0.0)
+    x[N + 1] = call(ends, "ghost", x[N], x[1], 0.0)
+    th[0] = call(ends, "ghost", th[1], th[N], th[1])
+    th[N + 1] = call(ends, "ghost", th[N], th[1], th[N])
 
 
 @njit(cache=True, inline="always")
@@ -220,6 +204,4 @@ def _right_of_first(x, N, ends):
     """x_2 as block 1's force reads it (the ghost cell when N = 1; end drive)."""
     if N > 1:
         return x[2]
-    if ends == ENDS_FIXED:
-        return 0.0
-    return x[1]
+    return call(ends, "ghost", x[1], x[1], 0.0)

@@ -47,8 +47,8 @@ import numpy as np
 from numba import njit
 
 from stickslip.kernels.laws import _force as _spring_force
-from stickslip.kernels.laws import _threshold, law_accel, law_rate
-from stickslip.kernels.layout import DRIVE_END, ENDS_FIXED, ENDS_PERIODIC, P_DT, P_K, P_KP, P_V
+from stickslip.kernels.laws import _threshold, call, has, law_accel, law_rate
+from stickslip.kernels.layout import DRIVE_END, P_DT, P_K, P_KP, P_V
 
 # Integer state vector.
 I_STEP, I_EVENTS, I_MOVING, I_ACTIVE, I_STARTS, I_STOPS, I_FIRST, I_NMOVED = range(8)
@@ -65,20 +65,11 @@ def _ghosts(u, th, N, t, V, drive, ends):
     """Ghost cells 0 and N + 1 of u = x - V t and theta (docs/model.md, the ends)."""
     if drive == DRIVE_END:
         u[0] = 0.0
-    elif ends == ENDS_PERIODIC:
-        u[0] = u[N]
-    elif ends == ENDS_FIXED:
-        u[0] = -V * t
     else:
-        u[0] = u[1]
-    if ends == ENDS_PERIODIC:
-        u[N + 1] = u[1]
-        th[0] = th[N]
-        th[N + 1] = th[1]
-    else:
-        u[N + 1] = -V * t if ends == ENDS_FIXED else u[N]
-        th[0] = th[1]
-        th[N + 1] = th[N]
+        u[0] = call(ends, "ghost", u[1], u[N], -V * t)
+    u[N + 1] = call(ends, "ghost", u[N], u[1], -V * t)
+    th[0] = call(ends, "ghost", th[1], th[N], th[1])
+    th[N + 1] = call(ends, "ghost", th[N], th[1], th[N])
 
 
 @njit(cache=True, inline="always")
@@ -206,7 +197,7 @@ def _heun_near(i, h, t, u, v, th, mov, N, par, lp, drive, friction, ends, sc):
     b = i + 1 if i < N else N
     for j in range(a, b + 1):
         _predict_u(j, h, u, v, th, V, sc)
-    if ends == ENDS_PERIODIC:
+    if has(ends, "ring"):
         _predict_u(1, h, u, v, th, V, sc)
         _predict_u(N, h, u, v, th, V, sc)
     _ghosts(pu, pth, N, t + h, V, drive, ends)
@@ -360,7 +351,26 @@ def advance(u, v, th, mov, n_end, par, lp, tp, drive, friction, threshold, ends,
     location over the whole chain (the reference of :mod:`stickslip.kernels.located_fast`).
     """
     return _steps(
-        u, v, th, mov, n_end, par, lp, tp, drive, friction, threshold, ends, sc, cand, moved, ist, evf, ev_t, ev_i, False
+        u,
+        v,
+        th,
+        mov,
+        n_end,
+        par,
+        lp,
+        tp,
+        drive,
+        friction,
+        threshold,
+        ends,
+        sc,
+        cand,
+        moved,
+        ist,
+        evf,
+        ev_t,
+        ev_i,
+        False,
     )
 
 

@@ -32,8 +32,6 @@ from numba import njit
 from stickslip.kernels.laws import _force as _spring_force
 from stickslip.kernels.laws import _threshold, has, law_accel, law_rate
 from stickslip.kernels.layout import (
-    ENDS_FIXED,
-    ENDS_PERIODIC,
     P_DT,
     P_K,
     P_KP,
@@ -49,7 +47,6 @@ from stickslip.kernels.located import (
     _ghosts,
     _steps,
     _stop,
-    advance,
 )
 from stickslip.kernels.located_lazy import _BIG, _catch, _catch_all, _expire, _horizon, _horizons
 from stickslip.kernels.stages import _stage1_theta_only, _stage2_theta
@@ -81,7 +78,7 @@ def _near_movers(mov, lo, hi, N, ends):
         return 1, 0
     a -= 1
     b += 1
-    if ends == ENDS_PERIODIC and (a < 1 or b > N):
+    if has(ends, "ring") and (a < 1 or b > N):
         return 1, N
     return max(a, 1), min(b, N)
 
@@ -93,7 +90,7 @@ def _dilate(lo, hi, N, ends):
         return 1, 0
     lo -= 2
     hi += 2
-    if ends == ENDS_PERIODIC and (lo < 1 or hi > N):
+    if has(ends, "ring") and (lo < 1 or hi > N):
         return 1, N
     return max(lo, 1), min(hi, N)
 
@@ -171,11 +168,9 @@ def advance_fast(
 ):
     """:func:`stickslip.kernels.located.advance` (same arguments, results and status codes, bit
     for bit), skipping the work whose result is known (module docstring); ``us`` and ``safe``
-    (int64, N + 2), ``sd`` (float64) and ``se`` (int64) are scratch. Returns with every block at the step reached."""
-    if ends == ENDS_FIXED:
-        return advance(
-            u, v, th, mov, n_end, par, lp, tp, drive, friction, threshold, ends, sc, cand, moved, ist, evf, ev_t, ev_i
-        )
+    (int64, N + 2), ``sd`` (float64) and ``se`` (int64) are scratch. Returns with every block at the step reached.
+    Not for ends with a wall (``PIECE.wall``): their ghost cells move with t in the drive's frame,
+    and :class:`~stickslip.run.located.LocatedStepper` runs the dense form there."""
     N = u.shape[0] - 2
     dt = par[P_DT]
     V = par[P_V]
@@ -262,6 +257,7 @@ def advance_fast(
                 n + 1,
                 par,
                 lp,
+                tp,
                 drive,
                 friction,
                 threshold,

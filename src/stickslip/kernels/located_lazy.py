@@ -27,8 +27,8 @@ import numpy as np
 from numba import njit
 
 from stickslip.kernels.laws import _force as _spring_force
-from stickslip.kernels.laws import _threshold
-from stickslip.kernels.layout import DRIVE_END, DRIVE_PLATE, ENDS_PERIODIC, P_K, P_KP
+from stickslip.kernels.laws import _threshold, has
+from stickslip.kernels.layout import DRIVE_END, DRIVE_PLATE, P_K, P_KP
 
 _BIG = np.int64(1) << np.int64(62)
 # Powers of two, as constants of the compiled code.
@@ -146,7 +146,7 @@ def _left(j, N, drive, ends):
         return j - 1
     if drive == DRIVE_END:
         return -1
-    if ends == ENDS_PERIODIC:
+    if has(ends, "ring"):
         return N
     return 1
 
@@ -155,7 +155,7 @@ def _left(j, N, drive, ends):
 def _right(j, N, ends):
     if j < N:
         return j + 1
-    if ends == ENDS_PERIODIC:
+    if has(ends, "ring"):
         return 1
     return N
 

@@ -55,15 +55,13 @@ import numpy as np
 from numba import njit
 
 from stickslip.kernels.events import _end_event, _open_event, _overflow, _service
-from stickslip.kernels.laws import _accel, _force, _pull, _set_ghosts, _threshold
+from stickslip.kernels.laws import _accel, _force, _pull, _set_ghosts, _threshold, call, has
 from stickslip.kernels.layout import (
     _NEVER,
     ACT_HI,
     ACT_LO,
     BLOCK_UPDATES,
     DONE,
-    ENDS_FIXED,
-    ENDS_PERIODIC,
     EV_ACTIVE,
     EV_COUNT,
     EV_MAX_BLOCK,
@@ -91,15 +89,8 @@ _FEW = 8  # up to this many movers, each stage is one scalar loop (faster than t
 def _x_ghosts(x, N, ends):
     """Ghost cells of x under the plate drive, as laws._set_ghosts sets them (theta's do not
     change here)."""
-    if ends == ENDS_PERIODIC:
-        x[0] = x[N]
-        x[N + 1] = x[1]
-    elif ends == ENDS_FIXED:
-        x[0] = 0.0
-        x[N + 1] = 0.0
-    else:
-        x[0] = x[1]
-        x[N + 1] = x[N]
+    x[0] = call(ends, "ghost", x[1], x[N], 0.0)
+    x[N + 1] = call(ends, "ghost", x[N], x[1], 0.0)
 
 
 @njit(cache=True, inline="always")
@@ -155,7 +146,7 @@ def run_sparse(args, drive, friction, threshold, ends):
     cap_ev, cap_fm, cap_p = ev_int.shape[0], fm.shape[0], prof_x.shape[0]
     one = np.uint64(1)
     uN = np.uint64(N)
-    periodic = ends == ENDS_PERIODIC
+    periodic = has(ends, "ring")
     movers = np.empty(N, np.uint64)  # moving blocks, then this step's starters
     nxt = np.empty(N, np.uint64)  # the movers of the next step
     queue = np.empty(N + 1, np.uint64)  # stopped candidates of the next step (a spare slot: _enqueue)

@@ -28,7 +28,18 @@ import importlib
 from stickslip.models.friction.weakening import weakening_g
 from stickslip.models.piece import CompositionError, Linearisation, Param, Piece
 
-__all__ = ["PIECES", "KINDS", "FRICTIONS", "THRESHOLDS", "CompositionError", "Linearisation", "Param", "Piece", "weakening_g"]
+__all__ = [
+    "PIECES",
+    "KINDS",
+    "FRICTIONS",
+    "THRESHOLDS",
+    "ENDS",
+    "CompositionError",
+    "Linearisation",
+    "Param",
+    "Piece",
+    "weakening_g",
+]
 
 #: The friction laws, one module each in :mod:`stickslip.models.friction` (a law is its module
 #: and its line here).
@@ -42,6 +53,9 @@ FRICTIONS = (
 
 #: The static thresholds, one module each in :mod:`stickslip.models.threshold`.
 THRESHOLDS = ("constant", "state")
+
+#: The end conditions, one module each in :mod:`stickslip.models.ends`.
+ENDS = ("free", "fixed", "periodic")
 
 
 PIECES: dict[str, tuple[Piece, ...]] = {
@@ -57,11 +71,7 @@ PIECES: dict[str, tuple[Piece, ...]] = {
     ),
     "friction": tuple(importlib.import_module(f"stickslip.models.friction.{m}").PIECE for m in FRICTIONS),
     "threshold": tuple(importlib.import_module(f"stickslip.models.threshold.{m}").PIECE for m in THRESHOLDS),
-    "ends": (
-        Piece("ends", "free", "x_{N+1} = x_N (plate drive: also x_0 = x_1)"),
-        Piece("ends", "fixed", "x_{N+1} = 0 (plate drive: also x_0 = 0)", steady_sliding=False, wall=True),
-        Piece("ends", "periodic", "x_0 = x_N, x_{N+1} = x_1 (plate drive only)", ring=True),
-    ),
+    "ends": tuple(importlib.import_module(f"stickslip.models.ends.{m}").PIECE for m in ENDS),
 }
 
 KINDS = tuple(PIECES)

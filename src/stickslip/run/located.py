@@ -166,6 +166,9 @@ class LocatedStepper:
         if form not in FORMS:
             raise ParameterError(f"form must be one of {', '.join(FORMS)} (got {form!r})")
         self.form = form
+        # A wall's ghost cells move with t in the drive's frame: the dense form, which the fast
+        # form skips no work of there.
+        self.fast = form == "fast" and not params.ends_piece.wall
         self.params = params
         self.par = parameter_vector(params)
         self.lp = params.friction_piece.kernel_params(params)
@@ -200,16 +203,16 @@ class LocatedStepper:
             args = (state.u, state.v, state.th, state.mov, np.int64(step), self.par, self.lp, self.tp)
             args += (drive, friction, threshold, ends, self.sc, self.cand, state.moved, state.ist, state.evf)
             args += (self.ev_t, self.ev_i)
-            if self.form == "fast":
+            if self.fast:
                 args += self.lazy
             # Typed once per layout of the state's arrays (the stepper's own never change).
             key = tuple((a.dtype, a.flags.c_contiguous, a.flags.writeable) for a in args[:4] + args[14:17])
             entry = self._entries.get(key)
             if entry is None:
-                kernel = LF.advance_fast if self.form == "fast" else L.advance
+                kernel = LF.advance_fast if self.fast else L.advance
                 entry = self._entries[key] = specialised(kernel, args, _ADVANCE_PIECES)
             status = entry(*args)
-            if self.form == "fast":
+            if self.fast:
                 us, safe = self.lazy[0], self.lazy[1]
                 for k, x in zip(self.work, (us[0], us[-1], safe[0], safe[-1]), strict=True):
                     self.work[k] += int(x)
