@@ -13,7 +13,8 @@ import numba
 import numpy as np
 import pytest
 
-from stickslip.kernels import dense, exact, layout, stages
+from stickslip.kernels import dense, exact, stages
+from stickslip.models.drive import end as end_drive
 from stickslip.models.friction import state as state_law
 from stickslip.models.params import ChainParams
 from stickslip.models.threshold import constant as constant_threshold
@@ -33,9 +34,8 @@ def _fresh_ir(kernel, args=None) -> str:
         assert kernel.signatures, "kernel was not compiled by the workloads"
         fresh.compile(kernel.signatures[0])
     else:
-        # The model's pieces (trailing arguments) are compile-time literals in the engine.
-        n_pieces = 3 if kernel.py_func.__name__ == "_stage1" else 2 if kernel.py_func.__name__ == "_stage2" else 1
-        sig = tuple(numba.typeof(a) for a in args[:-n_pieces]) + tuple(numba.types.literal(c) for c in args[-n_pieces:])
+        # The model's pieces (their modules' paths) are compile-time literals in the engine.
+        sig = tuple(numba.types.literal(a) if isinstance(a, str) else numba.typeof(a) for a in args)
         fresh.compile(sig)
     return fresh.inspect_llvm(fresh.signatures[0])
 
@@ -44,10 +44,10 @@ def _example_args(name: str) -> tuple:
     a = [np.linspace(0.5, 1.5, 12) for _ in range(10)]
     lo, hi = 1, 10
     dt, p = 0.005, 0.0
-    # The paper's model: K, Kp, the threshold's Fs and eq. (4)'s law (beta, alpha, D); pieces as
-    # literals (the law and the threshold by their modules' paths).
-    mp = (10.0, 1.0, constant_threshold.Params(3.0), state_law.Params(1.0, 1.0, 5.0))
-    end, state, constant = layout.DRIVE_END, state_law.__name__, constant_threshold.__name__
+    # The paper's model: K, the end drive, the threshold's Fs and eq. (4)'s law (beta, alpha, D);
+    # pieces as literals (their modules' paths).
+    mp = (10.0, end_drive.Params(), constant_threshold.Params(3.0), state_law.Params(1.0, 1.0, 5.0))
+    end, state, constant = end_drive.__name__, state_law.__name__, constant_threshold.__name__
     return {
         "_stage1": (*a, lo, hi, p, mp, dt, end, state, constant),
         "_stage2": (*a, lo, hi, p, mp, 0.5 * dt, end, state),

@@ -14,7 +14,10 @@ _SCRIPT = """
 import numpy as np
 from stickslip.kernels import triggers
 # End drive, blocks 1 and 2 at rest: f_1 = K V n dt exceeds 0.5 first at n = 51.
-print(triggers._first_trigger(np.zeros(5), 3, 1.0, 0.01, 1.0, 0.5, 0, 1000, 0))
+from stickslip.kernels.entry import specialise_call
+from stickslip.models.drive import end
+args = (np.zeros(5), 3, 1.0, 0.01, 1.0, 0.5, 0, 1000, end.Params(), end.__name__, "stickslip.models.ends.free")
+print(specialise_call(triggers._first_trigger, args, {9, 10}))
 """
 
 

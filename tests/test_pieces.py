@@ -14,13 +14,9 @@ from stickslip.models import pieces
 from stickslip.models.params import BlockParams, ChainParams
 from stickslip.models.presets import PRESETS, chain_params
 
-#: The kernels' integer codes as the kernels read them (kernels/ compare against these numbers).
-KERNEL_CODES = {
-    "drive": {"end": 0, "plate": 1},
-}
-
-#: A threshold and an end condition reach the kernels as the import paths of their modules.
+#: A drive, a threshold and an end condition reach the kernels as the import paths of their modules.
 PIECE_MODULES = {
+    "drive": {"end": "stickslip.models.drive.end", "plate": "stickslip.models.drive.plate"},
     "threshold": {"constant": "stickslip.models.threshold.constant", "state": "stickslip.models.threshold.state"},
     "ends": {
         "free": "stickslip.models.ends.free",
@@ -36,14 +32,6 @@ LAW_MODULES = {
     "strengthening": "stickslip.models.friction.strengthening",
     "rate-state": "stickslip.models.friction.rate_state",
 }
-
-
-@pytest.mark.parametrize("kind", list(KERNEL_CODES))
-def test_kernel_codes_unchanged(kind):
-    assert pieces.names(kind) == tuple(KERNEL_CODES[kind])
-    for name, code in KERNEL_CODES[kind].items():
-        assert pieces.PIECES[kind][code] is pieces.piece(kind, name)
-        assert pieces.code(kind, name) == code
 
 
 @pytest.mark.parametrize("kind", list(PIECE_MODULES))
@@ -88,7 +76,7 @@ def test_params_hand_out_their_pieces():
         "periodic",
     )
     assert p.codes == (
-        1,
+        PIECE_MODULES["drive"]["plate"],
         LAW_MODULES["weakening"],
         PIECE_MODULES["threshold"]["constant"],
         PIECE_MODULES["ends"]["periodic"],

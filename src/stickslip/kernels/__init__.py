@@ -7,9 +7,7 @@ show their parts: :mod:`~stickslip.kernels.layout` (arrays, pieces' codes, statu
 fast sparse path of the plate drive), :mod:`~stickslip.kernels.located` (Heun with switches
 located inside the step, the flow's reference) with its fast form
 :mod:`~stickslip.kernels.located_fast` and :mod:`~stickslip.kernels.located_lazy` (the same
-bits), :mod:`~stickslip.kernels.entry` (a compiled entry point per model) and
-:mod:`~stickslip.kernels.pipeline` (the compiler pipeline that removes the other pieces' code
-before typing).
+bits), and :mod:`~stickslip.kernels.entry` (a compiled entry point per model).
 
 numba's on-disk cache (``cache=True``) stamps a kernel with its own module only, and would load
 a kernel compiled from an older version of a module it calls. :mod:`~stickslip.kernels._cache`

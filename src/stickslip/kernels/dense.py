@@ -26,10 +26,9 @@ from stickslip.kernels.layout import (
     STEPS_COMPUTED,
     _unpack,
 )
-from stickslip.kernels.pipeline import PiecesCompiler
 
 
-@njit(cache=True, pipeline_class=PiecesCompiler)
+@njit(cache=True)
 def run_dense(args, drive, friction, threshold, ends):
     """Reference integrator of the chain (eq. 4 and its relatives): Heun over every block at
     every step, written plainly.
@@ -46,8 +45,8 @@ def run_dense(args, drive, friction, threshold, ends):
     first_step, x0ev, prof_meta = args.first_step, args.x0ev, args.prof_meta
     n_end, profile_every = args.n_end, args.profile_every
     N = x.shape[0] - 2
-    mp, V, dt = _unpack(par, args.tp, args.law)
-    K, Kp, tp = mp[0], mp[1], mp[2]
+    mp, V, dt = _unpack(par, args.dp, args.tp, args.law)
+    K, dp, tp = mp[0], mp[1], mp[2]
     h2 = 0.5 * dt
     cap_ev, cap_fm, cap_p = ev_int.shape[0], fm.shape[0], prof_x.shape[0]
     while True:
@@ -65,7 +64,7 @@ def run_dense(args, drive, friction, threshold, ends):
         p1 = _pull(V, n, dt)
         _set_ghosts(x, th, N, p1, drive, ends)
         for i in range(1, N + 1):
-            f = _force(x[i - 1], x[i], x[i + 1], K, Kp, p1, drive)
+            f = _force(x[i - 1], x[i], x[i + 1], K, dp, p1, drive)
             if mov[i] != 0.0 or f > _threshold(th[i], tp, threshold):
                 mm[i] = 1.0
             else:
@@ -81,7 +80,7 @@ def run_dense(args, drive, friction, threshold, ends):
         n_moving = 0
         bad = 0
         for i in range(1, N + 1):
-            f2 = _force(xs[i - 1], xs[i], xs[i + 1], K, Kp, p2, drive)
+            f2 = _force(xs[i - 1], xs[i], xs[i + 1], K, dp, p2, drive)
             a2 = _accel(f2, ths[i], vs[i], mm[i], mp, friction)
             b2 = _dtheta(ths[i - 1], ths[i], ths[i + 1], vs[i], mp, friction)
             th[i] = th[i] + h2 * (b1[i] + b2)

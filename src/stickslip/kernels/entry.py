@@ -1,8 +1,8 @@
 """One compiled entry point of a chain kernel (:func:`stickslip.kernels.dense.run_dense`,
 :func:`stickslip.kernels.exact.run_exact` or :func:`stickslip.kernels.plate.run_sparse`) per
-model: the model's pieces (docs/model.md, "The family the paper stands in"; codes in
-:mod:`stickslip.kernels.layout`) are handed on as literal constants, so each composition is its
-own machine code, compiled without the other pieces' code (:mod:`stickslip.kernels.pipeline`).
+model: the model's pieces (docs/model.md, "The family the paper stands in"; the modules of
+:mod:`stickslip.models`) are handed on as literal import paths, so each composition is its own
+machine code, typed with its pieces' functions only (:mod:`stickslip.kernels.laws`).
 """
 
 from __future__ import annotations
@@ -12,11 +12,10 @@ def specialise(kernel, args, pieces):
     """The compiled entry point of a chain kernel for one model's pieces.
 
     ``args`` is an example of the kernel's :class:`~stickslip.kernels.layout.ChainArgs` (arrays,
-    integers and the law's parameters) and ``pieces`` what the kernel is compiled for (drive,
-    friction, threshold, ends: the friction law's module path, the other pieces' integer codes).
-    Each composition is compiled once, with the pieces as literal constants (the law's functions
-    are resolved from its module, branches on the other pieces vanish before typing), and cached
-    on disk; calling the returned entry point skips the dispatcher's type matching.
+    integers and the pieces' parameters) and ``pieces`` what the kernel is compiled for (drive,
+    friction, threshold, ends: their modules' import paths). Each composition is compiled once,
+    with the pieces as literal constants (their functions are resolved from their modules), and
+    cached on disk; calling the returned entry point skips the dispatcher's type matching.
     """
     from numba import typeof, types
 

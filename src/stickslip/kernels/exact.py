@@ -44,8 +44,6 @@ from stickslip.kernels.layout import (
     ACT_LO,
     BLOCK_UPDATES,
     DONE,
-    DRIVE_END,
-    DRIVE_PLATE,
     EV_ACTIVE,
     EV_COUNT,
     FM_COUNT,
@@ -61,7 +59,6 @@ from stickslip.kernels.layout import (
     _merge,
     _unpack,
 )
-from stickslip.kernels.pipeline import PiecesCompiler
 from stickslip.kernels.stages import (
     _longest_run,
     _stage1,
@@ -74,10 +71,10 @@ from stickslip.kernels.stages import (
     _stage2_run,
     _stage2_theta,
 )
-from stickslip.kernels.triggers import _first_trigger, _plate_triggers
+from stickslip.kernels.triggers import leaf_triggers, pull_trigger
 
 
-@njit(cache=True, pipeline_class=PiecesCompiler)
+@njit(cache=True)
 def run_exact(args, drive, friction, threshold, ends):
     """Fast integrator of the chain, bit for bit equal to :func:`~stickslip.kernels.dense.run_dense`.
 
@@ -96,17 +93,17 @@ def run_exact(args, drive, friction, threshold, ends):
     prof_x, n_end, profile_every = args.prof_x, args.n_end, args.profile_every
     first_step, x0ev, prof_meta = args.first_step, args.x0ev, args.prof_meta
     N = x.shape[0] - 2
-    mp, V, dt = _unpack(par, args.tp, args.law)
-    K, Kp, tp = mp[0], mp[1], mp[2]
+    mp, V, dt = _unpack(par, args.dp, args.tp, args.law)
+    K, dp, tp = mp[0], mp[1], mp[2]
     h2 = 0.5 * dt
     cap_ev, cap_fm, cap_p = ev_int.shape[0], fm.shape[0], prof_x.shape[0]
     # A run of blocks moving at t_n (empty if ra > rb): updated without the start rule and the
     # bookkeeping of changes (stages._stage1_run, _stage2_run).
     ra, rb = _longest_run(mov, 1, N)
     t_next = _NEVER  # plate drive: no stopped block starts before this step unless listed in trig
-    if drive == DRIVE_PLATE:
+    if has(drive, "leaf_spring"):
         _set_ghosts(x, th, N, 0.0, drive, ends)
-        t_next = _plate_triggers(x, th, mov, mm, trig, 1, N, True, ist[STEP], n_end, mp, V, dt, threshold)
+        t_next = leaf_triggers(x, th, mov, mm, trig, 1, N, True, ist[STEP], n_end, mp, V, dt, drive, threshold)
     while True:
         # The run's bounds, fixed over the inner loop of steps: the compiler then checks the
         # run stages' arrays for overlap once per run rather than once per step (measured).
@@ -136,9 +133,9 @@ def run_exact(args, drive, friction, threshold, ends):
             # brings to their threshold.
             ml = ist[MECH_LO]
             mh = ist[MECH_HI]
-            if drive == DRIVE_END:
+            if not has(drive, "leaf_spring"):
                 x2 = _right_of_first(x, N, ends)
-                if mov[1] != 0.0 or _force(_pull(V, n, dt), x[1], x2, K, Kp, 0.0, drive) > _threshold(
+                if mov[1] != 0.0 or _force(_pull(V, n, dt), x[1], x2, K, dp, 0.0, drive) > _threshold(
                     th[1], tp, threshold
                 ):
                     lo = 1
@@ -170,8 +167,10 @@ def run_exact(args, drive, friction, threshold, ends):
                     target = ist[NEXT_SAMPLE]
                 if profile_every > 0 and ist[EV_ACTIVE] == 1 and ist[NEXT_PROFILE] < target:
                     target = ist[NEXT_PROFILE]
-                if drive == DRIVE_END:
-                    ist[STEP] = _first_trigger(x, N, V, dt, K, _threshold(th[1], tp, threshold), n + 1, target, ends)
+                if not has(drive, "leaf_spring"):
+                    ist[STEP] = pull_trigger(
+                        x, N, V, dt, K, _threshold(th[1], tp, threshold), n + 1, target, dp, drive, ends
+                    )
                 else:
                     ist[STEP] = t_next if t_next < target else target
                 continue
@@ -201,10 +200,10 @@ def run_exact(args, drive, friction, threshold, ends):
                         n_moving += 1 if v[i] > 0.0 else 0
                     ist[N_MOVING] = n_moving
                     ra, rb = _longest_run(mov, 1, N)
-                    if drive == DRIVE_PLATE:
+                    if has(drive, "leaf_spring"):
                         # The blocks that stopped need their first start step under the plate.
                         _set_ghosts(x, th, N, 0.0, drive, ends)
-                        t = _plate_triggers(x, th, mov, mm, trig, 1, N, True, n + 1, n_end, mp, V, dt, threshold)
+                        t = leaf_triggers(x, th, mov, mm, trig, 1, N, True, n + 1, n_end, mp, V, dt, drive, threshold)
                         if t < t_next:
                             t_next = t
                     if ist[EV_ACTIVE] == 1 and n_moving == 0:
@@ -347,7 +346,7 @@ def run_exact(args, drive, friction, threshold, ends):
                     c_lo = c_lo - 2 if c_lo > 2 else 1
                     c_hi = c_hi + 2 if c_hi < N - 2 else N
             ist[ACT_LO], ist[ACT_HI] = _merge(c_lo, c_hi, ist[MECH_LO], ist[MECH_HI])
-            if drive == DRIVE_PLATE:
+            if has(drive, "leaf_spring"):
                 # Stopped blocks whose force or threshold changed: their first start step anew.
                 if has(threshold, "has_state"):
                     w_lo, w_hi = _merge(ist[MECH_LO], ist[MECH_HI], lo, hi)
@@ -357,7 +356,9 @@ def run_exact(args, drive, friction, threshold, ends):
                     every = False
                 if w_lo <= w_hi:
                     _set_ghosts(x, th, N, 0.0, drive, ends)
-                    t = _plate_triggers(x, th, mov, mm, trig, w_lo, w_hi, every, n + 1, n_end, mp, V, dt, threshold)
+                    t = leaf_triggers(
+                        x, th, mov, mm, trig, w_lo, w_hi, every, n + 1, n_end, mp, V, dt, drive, threshold
+                    )
                     if t < t_next:
                         t_next = t
             if ist[EV_ACTIVE] == 1 and n_moving == 0:

@@ -39,17 +39,15 @@ import importlib
 
 import numpy as np
 from numba import njit, types
-from numba.extending import overload
-
-from stickslip.kernels.layout import DRIVE_END, DRIVE_PLATE
+from numba.extending import intrinsic, overload
 
 
-def _module(friction):
-    """The module of a friction law, from the literal a kernel is compiled for (None otherwise)."""
-    if isinstance(friction, types.StringLiteral):
-        return importlib.import_module(friction.literal_value)
-    if isinstance(friction, str):
-        return importlib.import_module(friction)
+def _module(piece):
+    """The module of a piece, from the literal a kernel is compiled for (None otherwise)."""
+    if isinstance(piece, types.StringLiteral):
+        return importlib.import_module(piece.literal_value)
+    if isinstance(piece, str):
+        return importlib.import_module(piece)
     return None
 
 
@@ -112,12 +110,6 @@ def call(piece, name, *args):
     return getattr(importlib.import_module(piece), name)(*args)
 
 
-def has(piece, name):
-    """The attribute ``name`` of the piece whose module is ``piece`` (``PIECE.has_state``, ...), a
-    compile-time constant in a kernel."""
-    return bool(getattr(importlib.import_module(piece).PIECE, name))
-
-
 # ``call``'s compiled form per number of arguments (numba inlines the pieces' functions, which
 # it cannot do for a call with ``*args``).
 _CALLS = {
@@ -140,29 +132,39 @@ def _call(piece, name, *args):
     return _CALLS[len(args)](getattr(mod, name.literal_value))
 
 
-@overload(has, prefer_literal=True)
-def _has(piece, name):
+def piece_attr(piece, name):
+    """The attribute ``name`` of the piece whose module is the literal ``piece``, when a kernel is
+    typed (None for a piece that is not a literal): what an ``overload`` dispatches on."""
     mod = _module(piece)
-    if mod is None or not isinstance(name, types.StringLiteral):
+    return None if mod is None else bool(getattr(mod.PIECE, name))
+
+
+@intrinsic(prefer_literal=True)
+def has(typingctx, piece, name):
+    """The attribute ``name`` of the piece whose module is ``piece`` (``PIECE.has_state``,
+    ``PIECE.ring``, ...), a constant in the compiled kernel (no function of its own to compile)."""
+    value = piece_attr(piece, name.literal_value) if isinstance(name, types.StringLiteral) else None
+    if value is None:
         return None
-    if getattr(mod.PIECE, name.literal_value):
-        return lambda piece, name: True
-    return lambda piece, name: False
+
+    def codegen(context, builder, signature, args):
+        return context.get_constant(types.boolean, value)
+
+    return types.boolean(piece, name), codegen
 
 
 @njit(cache=True, inline="always")
-def _force(xl, xc, xr, K, Kp, p, drive):
-    """Spring force on a block: K (x_{i+1} - 2 x_i + x_{i-1}) (eq. 4), plus Kp (V t - x_i)
-    from the plate at p = V t with the plate drive (Burridge-Knopoff, Carlson-Langer)."""
-    if drive == DRIVE_PLATE:
-        return K * ((xl - xc) - (xc - xr)) + Kp * (p - xc)
-    return K * ((xl - xc) - (xc - xr))
+def _force(xl, xc, xr, K, dp, p, drive):
+    """Spring force on a block: the drive's ``force``, K (x_{i+1} - 2 x_i + x_{i-1}) (eq. 4), plus
+    Kp (V t - x_i) from the plate at p = V t with the plate drive (Burridge-Knopoff,
+    Carlson-Langer); ``dp`` the drive's parameters."""
+    return call(drive, "force", xl, xc, xr, K, p, dp)
 
 
 @njit(cache=True, inline="always")
 def _accel(f, th, v, m, mp, friction):
     """dv/dt of a block times the moving mask m (1.0 moving, 0.0 stopped): m (f - friction) with
-    the law's own ``accel``; ``mp`` = (K, Kp, the threshold's parameters, the law's parameters)."""
+    the law's own ``accel``; ``mp`` = (K, the drive's, the threshold's and the law's parameters)."""
     return m * law_accel(friction, f, v, th, mp[3])
 
 
@@ -190,10 +192,7 @@ def _pull(V, n, dt):
 def _set_ghosts(x, th, N, p, drive, ends):
     """Ghost cells 0 and N + 1 from the drive and the ends' ``ghost`` (a wall at x = 0; theta
     without flux)."""
-    if drive == DRIVE_END:
-        x[0] = p
-    else:
-        x[0] = call(ends, "ghost", x[1], x[N], 0.0)
+    x[0] = call(drive, "left", p, call(ends, "ghost", x[1], x[N], 0.0))
     x[N + 1] = call(ends, "ghost", x[N], x[1], 0.0)
     th[0] = call(ends, "ghost", th[1], th[N], th[1])
     th[N + 1] = call(ends, "ghost", th[N], th[1], th[N])

@@ -1,22 +1,20 @@
-"""Layout of the chain kernels' arrays and codes: the indices of the int64 state vector
-``ist`` and the float64 parameter vector ``par``, the pieces' codes, the event buffer's
-columns and the status codes (eq. 4 and its relatives, docs/model.md).
+"""Layout of the chain kernels' arrays: the indices of the int64 state vector ``ist`` and the
+float64 parameter vector ``par``, the event buffer's columns and the status codes (eq. 4 and its
+relatives, docs/model.md).
 
-A model is a choice of four pieces (docs/model.md, "The family the paper stands in"), passed to
-every kernel as compile-time constants (numba integer literals), so that each composition is
-compiled into its own machine code with the branches on pieces removed:
+A model is a choice of four pieces (docs/model.md, "The family the paper stands in"), each a
+module of :mod:`stickslip.models` that holds the compiled functions the kernels call
+(:mod:`stickslip.kernels.laws`). A kernel is compiled for one composition: it gets the four
+modules' import paths as literal strings, so each composition is its own machine code, and each
+piece's parameters as its module's ``Params`` named tuple:
 
-* drive ``DRIVE_END``: a pulling point x_0 = V t joined to block 1 (eq. 4);
-  ``DRIVE_PLATE``: every block joined to a plate at V t by a leaf spring Kp (Burridge-Knopoff,
-  Carlson-Langer): f_i gains Kp (V t - x_i);
-* friction of a moving block: a law of :mod:`stickslip.models.friction`, one module each, whose
-  compiled functions the kernels call (:mod:`stickslip.kernels.laws`); the kernel gets the
-  module's import path as a literal string and the law's parameters as its ``Params`` named
-  tuple (``ChainArgs.law``);
-* static threshold: a module of :mod:`stickslip.models.threshold` (Fs, or theta_i), passed like the
-  friction law, its parameters as ``ChainArgs.tp``;
-* ends ``ENDS_FREE``: x_{N+1} = x_N (plate drive: also x_0 = x_1); ``ENDS_FIXED``: x_{N+1} = 0
-  (plate drive: also x_0 = 0); ``ENDS_PERIODIC``: x_0 = x_N, x_{N+1} = x_1 (plate drive only).
+* drive, :mod:`stickslip.models.drive` (``end``: a pulling point x_0 = V t joined to block 1,
+  eq. 4; ``plate``: every block joined to a plate at V t by a leaf spring Kp, Burridge-Knopoff,
+  Carlson-Langer), its parameters ``ChainArgs.dp``;
+* friction of a moving block, :mod:`stickslip.models.friction`, ``ChainArgs.law``;
+* static threshold, :mod:`stickslip.models.threshold` (Fs, or theta_i), ``ChainArgs.tp``;
+* ends, :mod:`stickslip.models.ends` (free: x_{N+1} = x_N; fixed: x_{N+1} = 0; periodic:
+  x_0 = x_N, x_{N+1} = x_1), no parameters.
 
 Blocks i = 1..N live at index i of arrays of length N + 2; index 0 and N + 1 are ghost cells
 set from the drive and the ends (:func:`stickslip.kernels.laws._set_ghosts`). The state
@@ -25,8 +23,8 @@ th[N+1] = th[1]); models without a state variable leave theta untouched. ``mov``
 for a moving block and 0.0 for a stopped one, so a stopped block's acceleration is
 ``0 * (...)``.
 
-A kernel takes one :class:`ChainArgs` (the arrays, integers and the law's parameters) and the
-four pieces (the law's module path, the other pieces' codes).
+A kernel takes one :class:`ChainArgs` (the arrays, integers and the pieces' parameters) and the
+four pieces' module paths.
 Kernels return a status code; the driver empties the output buffers and calls again. All
 state lives in the arrays passed in, so a run can stop and resume at any step boundary.
 
@@ -75,12 +73,8 @@ IST_SIZE = 23
 # Indices into the float64 parameter vector ``par``: the springs and the drive (the threshold's and
 # the friction law's parameters travel as their modules' named tuples, ``ChainArgs.tp`` and
 # ``ChainArgs.law``).
-P_K, P_V, P_DT, P_KP = range(4)
-PAR_SIZE = 4
-
-# The drive and the ends (compile-time constants of every kernel).
-DRIVE_END, DRIVE_PLATE = 0, 1
-ENDS_FREE, ENDS_FIXED, ENDS_PERIODIC = 0, 1, 2
+P_K, P_V, P_DT = range(3)
+PAR_SIZE = 3
 
 # Columns of the int64 event buffer ``ev_int``.
 E_ID, E_START_STEP, E_END_STEP, E_START_BLOCK, E_MAX_BLOCK, E_N_BLOCKS = range(6)
@@ -115,6 +109,7 @@ class ChainArgs(NamedTuple):
     x0ev: np.ndarray  # x of each block at its first move
     ist: np.ndarray  # int64 state vector (indices above)
     par: np.ndarray  # float64 parameter vector (indices above)
+    dp: tuple  # the drive's parameters (its module's Params named tuple)
     tp: tuple  # the threshold's parameters (its module's Params named tuple)
     law: tuple  # the friction law's parameters (its module's Params named tuple)
     ev_int: np.ndarray  # event buffer (columns above) and each event's S
@@ -147,7 +142,7 @@ def _merge(a_lo, a_hi, b_lo, b_hi):
 
 
 @njit(cache=True, inline="always")
-def _unpack(par, tp, law):
-    """mp = (K, Kp, the threshold's parameters, the law's parameters), V and dt from the parameter
-    vector and the pieces' named tuples."""
-    return (par[P_K], par[P_KP], tp, law), par[P_V], par[P_DT]
+def _unpack(par, dp, tp, law):
+    """mp = (K, the drive's, the threshold's and the law's parameters), V and dt from the
+    parameter vector and the pieces' named tuples."""
+    return (par[P_K], dp, tp, law), par[P_V], par[P_DT]

@@ -48,7 +48,7 @@ from numba import njit
 
 from stickslip.kernels.laws import _force as _spring_force
 from stickslip.kernels.laws import _threshold, call, has, law_accel, law_rate
-from stickslip.kernels.layout import DRIVE_END, P_DT, P_K, P_KP, P_V
+from stickslip.kernels.layout import P_DT, P_K, P_V
 
 # Integer state vector.
 I_STEP, I_EVENTS, I_MOVING, I_ACTIVE, I_STARTS, I_STOPS, I_FIRST, I_NMOVED = range(8)
@@ -63,30 +63,27 @@ DONE, EVENTS_FULL, NONFINITE = 0, 1, 2
 @njit(cache=True, inline="always")
 def _ghosts(u, th, N, t, V, drive, ends):
     """Ghost cells 0 and N + 1 of u = x - V t and theta (docs/model.md, the ends)."""
-    if drive == DRIVE_END:
-        u[0] = 0.0
-    else:
-        u[0] = call(ends, "ghost", u[1], u[N], -V * t)
+    u[0] = call(drive, "left", 0.0, call(ends, "ghost", u[1], u[N], -V * t))
     u[N + 1] = call(ends, "ghost", u[N], u[1], -V * t)
     th[0] = call(ends, "ghost", th[1], th[N], th[1])
     th[N + 1] = call(ends, "ghost", th[N], th[1], th[N])
 
 
 @njit(cache=True, inline="always")
-def _force(u, i, par, drive):
+def _force(u, i, par, dp, drive):
     """Spring force on block i (eq. 4), plus Kp (0 - u_i) from the plate (at u = 0 in this frame)
     with the plate drive: the engine's expression."""
-    return _spring_force(u[i - 1], u[i], u[i + 1], par[P_K], par[P_KP], 0.0, drive)
+    return _spring_force(u[i - 1], u[i], u[i + 1], par[P_K], dp, 0.0, drive)
 
 
 @njit(cache=True, inline="always")
-def _gap(u, th, i, par, tp, drive, threshold):
+def _gap(u, th, i, par, tp, dp, drive, threshold):
     """g_i = f_i - threshold_i: a stuck block starts where it turns positive."""
-    return _force(u, i, par, drive) - _threshold(th[i], tp, threshold)
+    return _force(u, i, par, dp, drive) - _threshold(th[i], tp, threshold)
 
 
 @njit(cache=True, inline="always")
-def _rates(u, v, th, mov, N, t, par, lp, drive, friction, ends, du, dv, dth):
+def _rates(u, v, th, mov, N, t, par, lp, dp, drive, friction, ends, du, dv, dth):
     """Right-hand side at time t: du = v - V, dv = the law's f - friction while moving, dtheta of
     the law on every block."""
     V = par[P_V]
@@ -94,14 +91,14 @@ def _rates(u, v, th, mov, N, t, par, lp, drive, friction, ends, du, dv, dth):
     for i in range(1, N + 1):
         du[i] = v[i] - V
         if mov[i] != 0.0:
-            dv[i] = law_accel(friction, _force(u, i, par, drive), v[i], th[i], lp)
+            dv[i] = law_accel(friction, _force(u, i, par, dp, drive), v[i], th[i], lp)
         else:
             dv[i] = 0.0
         dth[i] = law_rate(friction, th[i - 1], th[i], th[i + 1], v[i], lp)
 
 
 @njit(cache=True, inline="always")
-def _heun(h, t, u, v, th, mov, N, par, lp, drive, friction, ends, sc):
+def _heun(h, t, u, v, th, mov, N, par, lp, dp, drive, friction, ends, sc):
     """One Heun step of length h from (u, v, theta) at t; sc holds the rates k1 at t (given), the
     predictor p*, the rates k2 and the result o*."""
     k1u, k1v, k1th, pu, pv, pth, k2u, k2v, k2th, ou, ov, oth = sc
@@ -109,7 +106,7 @@ def _heun(h, t, u, v, th, mov, N, par, lp, drive, friction, ends, sc):
         pu[i] = u[i] + h * k1u[i]
         pv[i] = v[i] + h * k1v[i]
         pth[i] = th[i] + h * k1th[i]
-    _rates(pu, pv, pth, mov, N, t + h, par, lp, drive, friction, ends, k2u, k2v, k2th)
+    _rates(pu, pv, pth, mov, N, t + h, par, lp, dp, drive, friction, ends, k2u, k2v, k2th)
     for i in range(1, N + 1):
         ou[i] = u[i] + 0.5 * h * (k1u[i] + k2u[i])
         ov[i] = v[i] + 0.5 * h * (k1v[i] + k2v[i])
@@ -163,11 +160,11 @@ def _stop(i, u, v, mov, t, par, ist, evf, N, ev_t, ev_i):
 
 
 @njit(cache=True, _nrt=False)
-def _switched(i, stop, ou, ov, oth, par, tp, drive, threshold):
+def _switched(i, stop, ou, ov, oth, par, tp, dp, drive, threshold):
     """(value, switched) of block i's switching function on the state o*: v (stop) or -g (start)."""
     if stop:
         return ov[i], ov[i] <= 0.0
-    g = _gap(ou, oth, i, par, tp, drive, threshold)
+    g = _gap(ou, oth, i, par, tp, dp, drive, threshold)
     return -g, g > 0.0
 
 
@@ -183,7 +180,7 @@ def _predict_u(j, h, u, v, th, V, sc):
 
 
 @njit(cache=True, _nrt=False)
-def _heun_near(i, h, t, u, v, th, mov, N, par, lp, drive, friction, ends, sc):
+def _heun_near(i, h, t, u, v, th, mov, N, par, lp, dp, drive, friction, ends, sc):
     """Of one Heun step (:func:`_heun`), the values block i's switching functions read: the
     predictors of blocks i-1..i+1, o* of u on them, o* of v and theta on block i, and the ghost
     cells (periodic ends: blocks 1 and N too, which the ghosts copy).
@@ -202,7 +199,7 @@ def _heun_near(i, h, t, u, v, th, mov, N, par, lp, drive, friction, ends, sc):
         _predict_u(N, h, u, v, th, V, sc)
     _ghosts(pu, pth, N, t + h, V, drive, ends)
     if mov[i] != 0.0:
-        k2v[i] = law_accel(friction, _force(pu, i, par, drive), pv[i], pth[i], lp)
+        k2v[i] = law_accel(friction, _force(pu, i, par, dp, drive), pv[i], pth[i], lp)
     else:
         k2v[i] = 0.0
     k2th[i] = law_rate(friction, pth[i - 1], pth[i], pth[i + 1], pv[i], lp)
@@ -212,7 +209,7 @@ def _heun_near(i, h, t, u, v, th, mov, N, par, lp, drive, friction, ends, sc):
 
 
 @njit(cache=True, _nrt=False)
-def _locate(i, stop, h, t, u, v, th, mov, N, par, lp, tp, drive, friction, threshold, ends, sc, near):
+def _locate(i, stop, h, t, u, v, th, mov, N, par, lp, tp, dp, drive, friction, threshold, ends, sc, near):
     """The switch time of block i in (0, h]: the smallest float b found with the switch done at b.
 
     Illinois (modified regula falsi) on the bracket [a, b], a bisection whenever a step fails to
@@ -225,14 +222,14 @@ def _locate(i, stop, h, t, u, v, th, mov, N, par, lp, tp, drive, friction, thres
         fa = v[i]
     else:
         _ghosts(u, th, N, t, par[P_V], drive, ends)
-        fa = -_gap(u, th, i, par, tp, drive, threshold)
+        fa = -_gap(u, th, i, par, tp, dp, drive, threshold)
     a = 0.0
     b = h
     if near:
-        _heun_near(i, h, t, u, v, th, mov, N, par, lp, drive, friction, ends, sc)
+        _heun_near(i, h, t, u, v, th, mov, N, par, lp, dp, drive, friction, ends, sc)
     else:
-        _heun(h, t, u, v, th, mov, N, par, lp, drive, friction, ends, sc)
-    fb, _ = _switched(i, stop, ou, ov, oth, par, tp, drive, threshold)
+        _heun(h, t, u, v, th, mov, N, par, lp, dp, drive, friction, ends, sc)
+    fb, _ = _switched(i, stop, ou, ov, oth, par, tp, dp, drive, threshold)
     side = 0
     width = b - a
     for it in range(400):
@@ -248,10 +245,10 @@ def _locate(i, stop, h, t, u, v, th, mov, N, par, lp, tp, drive, friction, thres
         if it % 2 == 1:
             width = b - a
         if near:
-            _heun_near(i, c, t, u, v, th, mov, N, par, lp, drive, friction, ends, sc)
+            _heun_near(i, c, t, u, v, th, mov, N, par, lp, dp, drive, friction, ends, sc)
         else:
-            _heun(c, t, u, v, th, mov, N, par, lp, drive, friction, ends, sc)
-        fc, sw = _switched(i, stop, ou, ov, oth, par, tp, drive, threshold)
+            _heun(c, t, u, v, th, mov, N, par, lp, dp, drive, friction, ends, sc)
+        fc, sw = _switched(i, stop, ou, ov, oth, par, tp, dp, drive, threshold)
         if sw:
             b, fb = c, fc
             if side == -1:
@@ -267,7 +264,7 @@ def _locate(i, stop, h, t, u, v, th, mov, N, par, lp, tp, drive, friction, thres
 
 @njit(cache=True, _nrt=False)
 def _steps(
-    u, v, th, mov, n_end, par, lp, tp, drive, friction, threshold, ends, sc, cand, moved, ist, evf, ev_t, ev_i, near
+    u, v, th, mov, n_end, par, lp, tp, dp, drive, friction, threshold, ends, sc, cand, moved, ist, evf, ev_t, ev_i, near
 ):
     """:func:`advance`; ``near``: :func:`_locate`'s trial steps on the neighbourhood alone."""
     N = u.shape[0] - 2
@@ -284,17 +281,17 @@ def _steps(
             _ghosts(u, th, N, t, par[P_V], drive, ends)
             for i in range(1, N + 1):
                 if mov[i] == 0.0:
-                    if _gap(u, th, i, par, tp, drive, threshold) > 0.0:
+                    if _gap(u, th, i, par, tp, dp, drive, threshold) > 0.0:
                         _start(i, u, v, th, mov, t, par, ist, evf, moved, N)
                 elif v[i] < 0.0:
                     _stop(i, u, v, mov, t, par, ist, evf, N, ev_t, ev_i)
             h = dt - s
-            _rates(u, v, th, mov, N, t, par, lp, drive, friction, ends, k1u, k1v, k1th)
-            _heun(h, t, u, v, th, mov, N, par, lp, drive, friction, ends, sc)
+            _rates(u, v, th, mov, N, t, par, lp, dp, drive, friction, ends, k1u, k1v, k1th)
+            _heun(h, t, u, v, th, mov, N, par, lp, dp, drive, friction, ends, sc)
             n_cand = 0
             for i in range(1, N + 1):
                 if mov[i] == 0.0:
-                    if _gap(ou, oth, i, par, tp, drive, threshold) > 0.0:
+                    if _gap(ou, oth, i, par, tp, dp, drive, threshold) > 0.0:
                         cand[n_cand] = i
                         n_cand += 1
                 elif v[i] > 0.0 and ov[i] <= 0.0:
@@ -317,10 +314,12 @@ def _steps(
             for k in range(n_cand):
                 i = abs(cand[k])
                 is_stop = cand[k] < 0
-                b = _locate(i, is_stop, h, t, u, v, th, mov, N, par, lp, tp, drive, friction, threshold, ends, sc, near)
+                b = _locate(
+                    i, is_stop, h, t, u, v, th, mov, N, par, lp, tp, dp, drive, friction, threshold, ends, sc, near
+                )
                 if blk == 0 or b < tau:
                     tau, blk, stop = b, i, is_stop
-            _heun(tau, t, u, v, th, mov, N, par, lp, drive, friction, ends, sc)
+            _heun(tau, t, u, v, th, mov, N, par, lp, dp, drive, friction, ends, sc)
             for i in range(1, N + 1):
                 u[i] = ou[i]
                 th[i] = oth[i]
@@ -342,7 +341,9 @@ def _steps(
 
 
 @njit(cache=True, _nrt=False)
-def advance(u, v, th, mov, n_end, par, lp, tp, drive, friction, threshold, ends, sc, cand, moved, ist, evf, ev_t, ev_i):
+def advance(
+    u, v, th, mov, n_end, par, lp, tp, dp, drive, friction, threshold, ends, sc, cand, moved, ist, evf, ev_t, ev_i
+):
     """Advance the state (u, v, theta, moving mask) at step ist[I_STEP] to step n_end.
 
     Returns DONE, EVENTS_FULL (the event buffer has fewer than 4 free rows; the state is at the
@@ -359,6 +360,7 @@ def advance(u, v, th, mov, n_end, par, lp, tp, drive, friction, threshold, ends,
         par,
         lp,
         tp,
+        dp,
         drive,
         friction,
         threshold,
@@ -375,6 +377,6 @@ def advance(u, v, th, mov, n_end, par, lp, tp, drive, friction, threshold, ends,
 
 
 @njit(cache=True, _nrt=False)
-def rates(u, v, th, mov, t, par, lp, drive, friction, ends, du, dv, dth):
+def rates(u, v, th, mov, t, par, lp, dp, drive, friction, ends, du, dv, dth):
     """The right-hand side of the equations at time t (ghost cells of u and th are overwritten)."""
-    _rates(u, v, th, mov, u.shape[0] - 2, t, par, lp, drive, friction, ends, du, dv, dth)
+    _rates(u, v, th, mov, u.shape[0] - 2, t, par, lp, dp, drive, friction, ends, du, dv, dth)

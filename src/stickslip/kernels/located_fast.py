@@ -34,7 +34,6 @@ from stickslip.kernels.laws import _threshold, has, law_accel, law_rate
 from stickslip.kernels.layout import (
     P_DT,
     P_K,
-    P_KP,
     P_V,
 )
 from stickslip.kernels.located import (
@@ -96,14 +95,14 @@ def _dilate(lo, hi, N, ends):
 
 
 @njit(cache=True, _nrt=False, inline="always")
-def _stage1_near(a, b, u, v, th, mov, sc, h, V, K, Kp, lp, drive, friction):
+def _stage1_near(a, b, u, v, th, mov, sc, h, V, K, dp, lp, drive, friction):
     """located._rates' k1 and _heun's predictor for blocks a..b: the same expressions, in a loop
     with unsigned indices and a select for the moving mask, so that it is vectorised."""
     k1u, k1v, k1th, pu, pv, pth = sc[0], sc[1], sc[2], sc[3], sc[4], sc[5]
     one = np.uint64(1)
     for i in range(np.uint64(a), np.uint64(b) + one):
         k1u[i] = v[i] - V
-        acc = law_accel(friction, _spring_force(u[i - one], u[i], u[i + one], K, Kp, 0.0, drive), v[i], th[i], lp)
+        acc = law_accel(friction, _spring_force(u[i - one], u[i], u[i + one], K, dp, 0.0, drive), v[i], th[i], lp)
         k1v[i] = acc if mov[i] != 0.0 else 0.0
         k1th[i] = law_rate(friction, th[i - one], th[i], th[i + one], v[i], lp)
         pu[i] = u[i] + h * k1u[i]
@@ -112,13 +111,13 @@ def _stage1_near(a, b, u, v, th, mov, sc, h, V, K, Kp, lp, drive, friction):
 
 
 @njit(cache=True, _nrt=False, inline="always")
-def _stage2_near(a, b, u, v, th, mov, sc, h, V, K, Kp, lp, drive, friction):
+def _stage2_near(a, b, u, v, th, mov, sc, h, V, K, dp, lp, drive, friction):
     """located._rates' k2 and _heun's o* for blocks a..b (as :func:`_stage1_near`)."""
     k1u, k1v, k1th, pu, pv, pth, k2u, k2v, k2th, ou, ov, oth = sc
     one = np.uint64(1)
     for i in range(np.uint64(a), np.uint64(b) + one):
         k2u[i] = pv[i] - V
-        acc = law_accel(friction, _spring_force(pu[i - one], pu[i], pu[i + one], K, Kp, 0.0, drive), pv[i], pth[i], lp)
+        acc = law_accel(friction, _spring_force(pu[i - one], pu[i], pu[i + one], K, dp, 0.0, drive), pv[i], pth[i], lp)
         k2v[i] = acc if mov[i] != 0.0 else 0.0
         k2th[i] = law_rate(friction, pth[i - one], pth[i], pth[i + one], pv[i], lp)
         ou[i] = u[i] + 0.5 * h * (k1u[i] + k2u[i])
@@ -127,14 +126,14 @@ def _stage2_near(a, b, u, v, th, mov, sc, h, V, K, Kp, lp, drive, friction):
 
 
 @njit(cache=True, _nrt=False, inline="always")
-def _fires(a, b, x, th, v0, v1, mov, K, Kp, tp, drive, threshold, end):
+def _fires(a, b, x, th, v0, v1, mov, K, dp, tp, drive, threshold, end):
     """Whether a switch test of blocks a..b fires, on the state x, th (end = False: a stuck block
     above its threshold, a moving one with v0 < 0, due at the step's start) or on o* (end = True:
     a moving one with v0 > 0 and v1 <= 0); located's expressions, branch-free."""
     one = np.uint64(1)
     f = False
     for i in range(np.uint64(a), np.uint64(b) + one):
-        g = _spring_force(x[i - one], x[i], x[i + one], K, Kp, 0.0, drive) - _threshold(th[i], tp, threshold)
+        g = _spring_force(x[i - one], x[i], x[i + one], K, dp, 0.0, drive) - _threshold(th[i], tp, threshold)
         stops = (v0[i] > 0.0) & (v1[i] <= 0.0) if end else v0[i] < 0.0
         f |= (g > 0.0) if mov[i] == 0.0 else stops
     return f
@@ -150,6 +149,7 @@ def advance_fast(
     par,
     lp,
     tp,
+    dp,
     drive,
     friction,
     threshold,
@@ -174,8 +174,8 @@ def advance_fast(
     N = u.shape[0] - 2
     dt = par[P_DT]
     V = par[P_V]
-    K, Kp = par[P_K], par[P_KP]
-    mp = (K, Kp, tp, lp)
+    K = par[P_K]
+    mp = (K, dp, tp, lp)
     k1u, k1v, k1th, pu, pv, pth, k2u, k2v, k2th, ou, ov, oth = sc
     h = dt - 0.0
     h2 = 0.5 * h
@@ -202,7 +202,7 @@ def advance_fast(
             status = EVENTS_FULL
             break
         if not dense and low <= n:
-            dense, low = _expire(n, el, eh, u, us, sd, se, th, mov, safe, N, c, par, tp, drive, threshold, ends)
+            dense, low = _expire(n, el, eh, u, us, sd, se, th, mov, safe, N, c, par, tp, dp, drive, threshold, ends)
         if not dense and el > eh and tl > tr:
             # Only the drive moves: jump to the first step at which a start test must be redone
             # (after _expire, low > n).
@@ -220,11 +220,11 @@ def advance_fast(
                     _catch(j, n, u, us, sd, se, c)
             _ghosts(u, th, N, t, V, drive, ends)
             if fresh and el <= eh:
-                dense = _fires(el, eh, u, th, v, v, mov, K, Kp, tp, drive, threshold, False)
+                dense = _fires(el, eh, u, th, v, v, mov, K, dp, tp, drive, threshold, False)
         if not dense:
             # Stage 1 on E's neighbourhood, theta alone on T's outside it.
             if el <= eh:
-                _stage1_near(a1, b1, u, v, th, mov, sc, h, V, K, Kp, lp, drive, friction)
+                _stage1_near(a1, b1, u, v, th, mov, sc, h, V, K, dp, lp, drive, friction)
             if tl <= tr:
                 sl = tl - 1 if tl > 1 else 1
                 sr = tr + 1 if tr < N else N
@@ -238,13 +238,13 @@ def advance_fast(
             _ghosts(pu, pth, N, t + h, V, drive, ends)
             # Stage 2 on E, o* of u on its two neighbours, the tests of the step's end.
             if el <= eh:
-                _stage2_near(el, eh, u, v, th, mov, sc, h, V, K, Kp, lp, drive, friction)
+                _stage2_near(el, eh, u, v, th, mov, sc, h, V, K, dp, lp, drive, friction)
                 for i in (a1, b1):
                     if i < el or i > eh:
                         k2u[i] = pv[i] - V
                         ou[i] = u[i] + 0.5 * h * (k1u[i] + k2u[i])
                 _ghosts(ou, oth, N, t + h, V, drive, ends)
-                dense = _fires(el, eh, ou, oth, v, ov, mov, K, Kp, tp, drive, threshold, True)
+                dense = _fires(el, eh, ou, oth, v, ov, mov, K, dp, tp, drive, threshold, True)
         if dense:
             # A switch step: the dense form's own step, every block.
             _catch_all(n, u, us, sd, se, c, N)
@@ -258,6 +258,7 @@ def advance_fast(
                 par,
                 lp,
                 tp,
+                dp,
                 drive,
                 friction,
                 threshold,
@@ -282,7 +283,7 @@ def advance_fast(
             tl, tr = 1, N
             if has(threshold, "has_state"):
                 el, eh = 1, N
-            dense, low = _horizons(n, el, eh, u, us, sd, se, th, mov, safe, N, c, par, tp, drive, threshold, ends)
+            dense, low = _horizons(n, el, eh, u, us, sd, se, th, mov, safe, N, c, par, tp, dp, drive, threshold, ends)
             fresh = True
             continue
         # Commit E; theta alone on T outside E (in place); stops at the step's end.
@@ -335,7 +336,7 @@ def advance_fast(
             fresh |= el < ol or eh > oh
         for j in range(ol, oh + 1):
             if (j < el or j > eh) and mov[j] == 0.0:
-                f, last = _horizon(j, n, 0, u, us, sd, se, th, N, c, par, tp, drive, threshold, ends)
+                f, last = _horizon(j, n, 0, u, us, sd, se, th, N, c, par, tp, dp, drive, threshold, ends)
                 dense |= f
                 safe[j] = last
                 low = min(low, last)

@@ -27,8 +27,8 @@ import numpy as np
 from numba import njit
 
 from stickslip.kernels.laws import _force as _spring_force
-from stickslip.kernels.laws import _threshold, has
-from stickslip.kernels.layout import DRIVE_END, DRIVE_PLATE, P_K, P_KP
+from stickslip.kernels.laws import _threshold, call, has
+from stickslip.kernels.layout import P_K
 
 _BIG = np.int64(1) << np.int64(62)
 # Powers of two, as constants of the compiled code.
@@ -144,7 +144,7 @@ def _left(j, N, drive, ends):
     :func:`stickslip.kernels.located._ghosts` without fixed ends."""
     if j > 1:
         return j - 1
-    if drive == DRIVE_END:
+    if not has(drive, "leaf_spring"):
         return -1
     if has(ends, "ring"):
         return N
@@ -161,12 +161,12 @@ def _right(j, N, ends):
 
 
 @njit(cache=True, _nrt=False)
-def _horizon(j, m, ahead, u, us, sd, se, th, N, c, par, tp, drive, threshold, ends):
+def _horizon(j, m, ahead, u, us, sd, se, th, N, c, par, tp, dp, drive, threshold, ends):
     """(fires, last) for stuck block j on the state at step m: whether its start test fires
     there, else the last step up to which it provably does not (module docstring, 2), its
     neighbours staying stuck and the steps full. The u are brought to m - ahead and taken
     ``ahead`` (0 or 1) steps further without storing."""
-    K, Kp = par[P_K], par[P_KP]
+    K, Kp = par[P_K], call(drive, "leaf", dp)
     jl = _left(j, N, drive, ends)
     jr = _right(j, N, ends)
     m0 = m - ahead
@@ -192,18 +192,18 @@ def _horizon(j, m, ahead, u, us, sd, se, th, N, c, par, tp, drive, threshold, en
             uc, ur = uc + c, ur + c
             if jl >= 0:
                 ul = ul + c
-    F = _spring_force(ul, uc, ur, K, Kp, 0.0, drive)
+    F = _spring_force(ul, uc, ur, K, dp, 0.0, drive)
     thr = _threshold(th[j], tp, threshold)
     if F - thr > 0.0:
         return True, m
     if L == 0:
         return False, m
-    if drive == DRIVE_END and dl == dc and dc == dr:
+    if not has(drive, "leaf_spring") and dl == dc and dc == dr:
         return False, m + L  # the differences, hence the force, keep their bits
     # The exact force moves by r per step; the computed one lies within E of it (each |u|
     # stays below twice its value within its binade).
     r = K * ((dl - dc) - (dc - dr))
-    if drive == DRIVE_PLATE:
+    if has(drive, "leaf_spring"):
         r = r + Kp * (0.0 - dc)
     al, ac, ar = abs(ul), abs(uc), abs(ur)
     E = _2M45 * (K * (al + 2.0 * ac + ar) + Kp * ac + abs(thr)) + 1e-300
@@ -222,7 +222,7 @@ def _horizon(j, m, ahead, u, us, sd, se, th, N, c, par, tp, drive, threshold, en
 
 
 @njit(cache=True, _nrt=False)
-def _horizons(n, el, eh, u, us, sd, se, th, mov, safe, N, c, par, tp, drive, threshold, ends):
+def _horizons(n, el, eh, u, us, sd, se, th, mov, safe, N, c, par, tp, dp, drive, threshold, ends):
     """``safe`` of every stuck block outside el..eh from the state at step n; returns (fires,
     the smallest)."""
     fires = False
@@ -231,7 +231,7 @@ def _horizons(n, el, eh, u, us, sd, se, th, mov, safe, N, c, par, tp, drive, thr
         if mov[j] != 0.0 or (el <= j and j <= eh):
             safe[j] = _BIG
             continue
-        f, last = _horizon(j, n, 0, u, us, sd, se, th, N, c, par, tp, drive, threshold, ends)
+        f, last = _horizon(j, n, 0, u, us, sd, se, th, N, c, par, tp, dp, drive, threshold, ends)
         fires |= f
         safe[j] = last
         low = min(low, last)
@@ -240,7 +240,7 @@ def _horizons(n, el, eh, u, us, sd, se, th, mov, safe, N, c, par, tp, drive, thr
 
 
 @njit(cache=True, _nrt=False)
-def _expire(n, el, eh, u, us, sd, se, th, mov, safe, N, c, par, tp, drive, threshold, ends):
+def _expire(n, el, eh, u, us, sd, se, th, mov, safe, N, c, par, tp, dp, drive, threshold, ends):
     """Test again, on the state at step n + 1, the stuck blocks whose ``safe`` step is n or
     earlier; returns (some start test fires, the new smallest ``safe``)."""
     fires = False
@@ -250,7 +250,7 @@ def _expire(n, el, eh, u, us, sd, se, th, mov, safe, N, c, par, tp, drive, thres
             if mov[j] != 0.0 or (el <= j and j <= eh):
                 safe[j] = _BIG
             else:
-                f, last = _horizon(j, n + 1, 1, u, us, sd, se, th, N, c, par, tp, drive, threshold, ends)
+                f, last = _horizon(j, n + 1, 1, u, us, sd, se, th, N, c, par, tp, dp, drive, threshold, ends)
                 fires |= f
                 safe[j] = last
                 safe[N + 1] += 1

@@ -78,7 +78,6 @@ from stickslip.kernels.layout import (
     STEPS_COMPUTED,
     _unpack,
 )
-from stickslip.kernels.pipeline import PiecesCompiler
 from stickslip.kernels.triggers import _plate_trigger
 
 _QUEUED = np.int64(-1)  # trig of a stopped block queued as a candidate of the next step
@@ -127,7 +126,7 @@ def _settle(i, m, n, trig, queue, nq, t_next):
     return nq, min(t_next, m)
 
 
-@njit(cache=True, error_model="numpy", pipeline_class=PiecesCompiler)
+@njit(cache=True, error_model="numpy")
 def run_sparse(args, drive, friction, threshold, ends):
     """:func:`stickslip.kernels.exact.run_exact` for the plate drive with weakening or
     strengthening friction: same arguments, state and status codes (module docstring).
@@ -140,8 +139,8 @@ def run_sparse(args, drive, friction, threshold, ends):
     ev_int, fm, prof_x, n_end, profile_every = args.ev_int, args.fm, args.prof_x, args.n_end, args.profile_every
     prof_meta = args.prof_meta
     N = x.shape[0] - 2
-    mp, V, dt = _unpack(par, args.tp, args.law)
-    K, Kp, tp = mp[0], mp[1], mp[2]
+    mp, V, dt = _unpack(par, args.dp, args.tp, args.law)
+    K, dp, tp = mp[0], mp[1], mp[2]
     h2 = 0.5 * dt
     cap_ev, cap_fm, cap_p = ev_int.shape[0], fm.shape[0], prof_x.shape[0]
     one = np.uint64(1)
@@ -177,7 +176,9 @@ def run_sparse(args, drive, friction, threshold, ends):
             xs[i] = x[i] + dt * v[i]
     for i in range(1, N + 1):
         if mov[i] == 0.0:
-            m = _plate_trigger(x[i - 1], x[i], x[i + 1], _threshold(th[i], tp, threshold), K, Kp, V, dt, n0, n_end)
+            m = _plate_trigger(
+                x[i - 1], x[i], x[i + 1], _threshold(th[i], tp, threshold), K, dp, V, dt, n0, n_end, drive
+            )
             nq, t_next = _settle(i, m, n0, trig, queue, nq, t_next)
     if n0 < n_end:
         # run_dense adds dt/2 (0 + 0) to every theta in each step (no state variable); nothing
@@ -227,12 +228,12 @@ def run_sparse(args, drive, friction, threshold, ends):
         fired = False
         for k in range(nq):
             i = queue[k]
-            f = _force(x[i - one], x[i], x[i + one], K, Kp, p1, drive)
+            f = _force(x[i - one], x[i], x[i + one], K, dp, p1, drive)
             fired |= f > _threshold(th[i], tp, threshold)
         if fired:
             for k in range(nq):
                 i = queue[k]
-                f = _force(x[i - one], x[i], x[i + one], K, Kp, p1, drive)
+                f = _force(x[i - one], x[i], x[i + one], K, dp, p1, drive)
                 fire = f > _threshold(th[i], tp, threshold)
                 movers[nmov + nst] = i
                 still[nsl] = i
@@ -253,7 +254,7 @@ def run_sparse(args, drive, friction, threshold, ends):
                     if 0 <= t and t <= n:
                         i = np.uint64(j)
                         trig[i] = _NEVER
-                        f = _force(x[i - one], x[i], x[i + one], K, Kp, p1, drive)
+                        f = _force(x[i - one], x[i], x[i + one], K, dp, p1, drive)
                         if f > _threshold(th[i], tp, threshold):
                             movers[nmov + nst] = i
                             nst += 1
@@ -279,7 +280,7 @@ def run_sparse(args, drive, friction, threshold, ends):
         if packed:
             for k in range(na):
                 i = movers[k]
-                fb[k] = _force(x[i - one], x[i], x[i + one], K, Kp, p1, drive)
+                fb[k] = _force(x[i - one], x[i], x[i + one], K, dp, p1, drive)
                 vi = v[i]
                 vb[k] = vi
                 xs[i] = x[i] + dt * vi
@@ -290,7 +291,7 @@ def run_sparse(args, drive, friction, threshold, ends):
         else:
             for k in range(na):
                 i = movers[k]
-                f = _force(x[i - one], x[i], x[i + one], K, Kp, p1, drive)
+                f = _force(x[i - one], x[i], x[i + one], K, dp, p1, drive)
                 vi = v[i]
                 a = _accel(f, 0.0, vi, 1.0, mp, friction)
                 vb[k] = vi
@@ -323,7 +324,7 @@ def run_sparse(args, drive, friction, threshold, ends):
         if packed:
             for k in range(na):
                 i = movers[k]
-                fb[k] = _force(xs[i - one], xs[i], xs[i + one], K, Kp, p2, drive)
+                fb[k] = _force(xs[i - one], xs[i], xs[i + one], K, dp, p2, drive)
             for k in range(na):
                 a2 = _accel(fb[k], 0.0, vsb[k], 1.0, mp, friction)
                 vn = vb[k] + h2 * (acc[k] + a2)
@@ -340,7 +341,7 @@ def run_sparse(args, drive, friction, threshold, ends):
         else:
             for k in range(na):
                 i = movers[k]
-                f2 = _force(xs[i - one], xs[i], xs[i + one], K, Kp, p2, drive)
+                f2 = _force(xs[i - one], xs[i], xs[i + one], K, dp, p2, drive)
                 sv = vsb[k]
                 vo = vb[k]
                 vn = vo + h2 * (acc[k] + _accel(f2, 0.0, sv, 1.0, mp, friction))
@@ -416,7 +417,17 @@ def run_sparse(args, drive, friction, threshold, ends):
                 i = still[k] if k < nsl else stopped[k - nsl]
                 if trig[i] != _QUEUED:
                     m = _plate_trigger(
-                        x[i - one], x[i], x[i + one], _threshold(th[i], tp, threshold), K, Kp, V, dt, n + 1, n_end
+                        x[i - one],
+                        x[i],
+                        x[i + one],
+                        _threshold(th[i], tp, threshold),
+                        K,
+                        dp,
+                        V,
+                        dt,
+                        n + 1,
+                        n_end,
+                        drive,
                     )
                     nq, t_next = _settle(i, m, n + 1, trig, queue, nq, t_next)
             if ns > 0:

@@ -33,7 +33,7 @@ def _stage1(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, p, mp, dt, drive, fr
     Returns the first and the last block that move in this step (lo > hi if none) and
     whether a stopped block starts.
     """
-    K, Kp, tp = mp[0], mp[1], mp[2]
+    K, dp, tp = mp[0], mp[1], mp[2]
     one = np.uint64(1)
     u0 = np.uint64(lo)
     n = hi - lo + 1
@@ -42,7 +42,7 @@ def _stage1(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, p, mp, dt, drive, fr
     starts = False
     for k in range(n):
         i = u0 + np.uint64(k)
-        f = _force(x[i - one], x[i], x[i + one], K, Kp, p, drive)
+        f = _force(x[i - one], x[i], x[i + one], K, dp, p, drive)
         mo = mov[i]
         m = 1.0 if f > _threshold(th[i], tp, threshold) else mo
         mm[i] = m
@@ -65,9 +65,9 @@ def _stage1_all(x, v, th, xs, vs, ths, a1, b1, N, p, mp, dt, drive, friction):
 
     The mid-step mask is 1 everywhere and is not stored: no later use reads it.
     """
-    K, Kp = mp[0], mp[1]
+    K, dp = mp[0], mp[1]
     for i in range(1, N + 1):
-        f = _force(x[i - 1], x[i], x[i + 1], K, Kp, p, drive)
+        f = _force(x[i - 1], x[i], x[i + 1], K, dp, p, drive)
         a = _accel(f, th[i], v[i], 1.0, mp, friction)
         b = _dtheta(th[i - 1], th[i], th[i + 1], v[i], mp, friction)
         a1[i] = a
@@ -85,10 +85,10 @@ def _stage2_all(x, v, th, xs, vs, ths, a1, b1, N, p, mp, h2, drive, friction):
     some block stopped. The moving flags are not written: after the step a block moves
     exactly when its v > 0, and the caller rebuilds them from v when a block stopped.
     """
-    K, Kp = mp[0], mp[1]
+    K, dp = mp[0], mp[1]
     stops = False
     for i in range(1, N + 1):
-        f2 = _force(xs[i - 1], xs[i], xs[i + 1], K, Kp, p, drive)
+        f2 = _force(xs[i - 1], xs[i], xs[i + 1], K, dp, p, drive)
         a2 = _accel(f2, ths[i], vs[i], 1.0, mp, friction)
         b2 = _dtheta(ths[i - 1], ths[i], ths[i + 1], vs[i], mp, friction)
         x[i] = x[i] + h2 * (v[i] + vs[i])
@@ -163,7 +163,7 @@ def _stage2(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, p, mp, h2, drive, fr
     Returns the first and last block that changed (lo > hi if none) and the number of
     moving blocks among lo..hi before and after.
     """
-    K, Kp = mp[0], mp[1]
+    K, dp = mp[0], mp[1]
     one = np.uint64(1)
     u0 = np.uint64(lo)
     n = hi - lo + 1
@@ -174,7 +174,7 @@ def _stage2(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, p, mp, h2, drive, fr
     for k in range(n):
         i = u0 + np.uint64(k)
         m = mm[i]
-        f2 = _force(xs[i - one], xs[i], xs[i + one], K, Kp, p, drive)
+        f2 = _force(xs[i - one], xs[i], xs[i + one], K, dp, p, drive)
         a2 = _accel(f2, ths[i], vs[i], m, mp, friction)
         b2 = _dtheta(ths[i - one], ths[i], ths[i + one], vs[i], mp, friction)
         xo = x[i]
@@ -206,10 +206,10 @@ def _stage1_run(x, v, th, xs, vs, ths, mm, a1, b1, lo, hi, p, mp, dt, drive, fri
     A moving block moves in this step whatever its force (start rule), so the mask is 1 and
     no start is looked for; the expressions are those of :func:`_stage1` with m = 1.
     """
-    K, Kp = mp[0], mp[1]
+    K, dp = mp[0], mp[1]
     one = np.uint64(1)
     for i in range(np.uint64(lo), np.uint64(hi) + one):
-        f = _force(x[i - one], x[i], x[i + one], K, Kp, p, drive)
+        f = _force(x[i - one], x[i], x[i + one], K, dp, p, drive)
         a = _accel(f, th[i], v[i], 1.0, mp, friction)
         b = _dtheta(th[i - one], th[i], th[i + one], v[i], mp, friction)
         mm[i] = 1.0
@@ -227,11 +227,11 @@ def _stage2_run(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, h2, drive, frictio
     As :func:`_stage2_all` on the run: the moving flags are not written and the changes not
     tracked (the caller counts the run as changed); returns whether some block stopped.
     """
-    K, Kp = mp[0], mp[1]
+    K, dp = mp[0], mp[1]
     one = np.uint64(1)
     stops = False
     for i in range(np.uint64(lo), np.uint64(hi) + one):
-        f2 = _force(xs[i - one], xs[i], xs[i + one], K, Kp, p, drive)
+        f2 = _force(xs[i - one], xs[i], xs[i + one], K, dp, p, drive)
         a2 = _accel(f2, ths[i], vs[i], 1.0, mp, friction)
         b2 = _dtheta(ths[i - one], ths[i], ths[i + one], vs[i], mp, friction)
         x[i] = x[i] + h2 * (v[i] + vs[i])

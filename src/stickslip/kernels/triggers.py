@@ -19,13 +19,14 @@ from __future__ import annotations
 
 import numpy as np
 from numba import njit
+from numba.extending import overload
 
-from stickslip.kernels.laws import _force, _pull, _right_of_first, _threshold
-from stickslip.kernels.layout import _NEVER, DRIVE_END, DRIVE_PLATE
+from stickslip.kernels.laws import _force, _pull, _right_of_first, _threshold, call, piece_attr
+from stickslip.kernels.layout import _NEVER
 
 
 @njit(cache=True)
-def _first_trigger(x, N, V, dt, K, thr, n_lo, n_hi, ends):
+def _first_trigger(x, N, V, dt, K, thr, n_lo, n_hi, dp, drive, ends):
     """End drive: first step m in [n_lo, n_hi) at which stopped block 1 starts (f_1 > thr),
     else n_hi.
 
@@ -33,13 +34,13 @@ def _first_trigger(x, N, V, dt, K, thr, n_lo, n_hi, ends):
     """
     x1 = x[1]
     x2 = _right_of_first(x, N, ends)
-    if n_lo >= n_hi or not (_force(_pull(V, n_hi - 1, dt), x1, x2, K, 0.0, 0.0, DRIVE_END) > thr):
+    if n_lo >= n_hi or not (_force(_pull(V, n_hi - 1, dt), x1, x2, K, dp, 0.0, drive) > thr):
         return n_hi
     lo = n_lo
     hi = n_hi - 1  # invariant: fires at hi
     while lo < hi:
         mid = lo + (hi - lo) // 2
-        if _force(_pull(V, mid, dt), x1, x2, K, 0.0, 0.0, DRIVE_END) > thr:
+        if _force(_pull(V, mid, dt), x1, x2, K, dp, 0.0, drive) > thr:
             hi = mid
         else:
             lo = mid + 1
@@ -47,12 +48,12 @@ def _first_trigger(x, N, V, dt, K, thr, n_lo, n_hi, ends):
 
 
 @njit(cache=True, inline="always")
-def _plate_fires(xl, xc, xr, thr, K, Kp, V, dt, m):
-    return _force(xl, xc, xr, K, Kp, _pull(V, m, dt), DRIVE_PLATE) > thr
+def _plate_fires(xl, xc, xr, thr, K, dp, V, dt, m, drive):
+    return _force(xl, xc, xr, K, dp, _pull(V, m, dt), drive) > thr
 
 
 @njit(cache=True)
-def _plate_trigger(xl, xc, xr, thr, K, Kp, V, dt, n0, n_cap):
+def _plate_trigger(xl, xc, xr, thr, K, dp, V, dt, n0, n_cap, drive):
     """Plate drive: first step m in [n0, n_cap) at which a stopped block with neighbours xl, xr
     starts (f > thr), else n_cap.
 
@@ -61,32 +62,32 @@ def _plate_trigger(xl, xc, xr, thr, K, Kp, V, dt, n0, n_cap):
     """
     if n0 >= n_cap:
         return n_cap
-    if _plate_fires(xl, xc, xr, thr, K, Kp, V, dt, n0):
+    if _plate_fires(xl, xc, xr, thr, K, dp, V, dt, n0, drive):
         return n0
-    if not _plate_fires(xl, xc, xr, thr, K, Kp, V, dt, n_cap - 1):
+    if not _plate_fires(xl, xc, xr, thr, K, dp, V, dt, n_cap - 1, drive):
         return n_cap
     lo = n0  # does not fire
     hi = n_cap - 1  # fires
-    f0 = _force(xl, xc, xr, K, Kp, _pull(V, n0, dt), DRIVE_PLATE)
-    rate = Kp * V * dt
+    f0 = _force(xl, xc, xr, K, dp, _pull(V, n0, dt), drive)
+    rate = call(drive, "leaf", dp) * V * dt
     if rate > 0.0:
         guess = (thr - f0) / rate
         if guess < np.float64(hi - lo):
             g = lo + 1 + np.int64(guess)
             if g < hi:
-                if _plate_fires(xl, xc, xr, thr, K, Kp, V, dt, g):
+                if _plate_fires(xl, xc, xr, thr, K, dp, V, dt, g, drive):
                     hi = g
-                    if not _plate_fires(xl, xc, xr, thr, K, Kp, V, dt, g - 1):
+                    if not _plate_fires(xl, xc, xr, thr, K, dp, V, dt, g - 1, drive):
                         return g
                     hi = g - 1
                 else:
                     lo = g
-                    if _plate_fires(xl, xc, xr, thr, K, Kp, V, dt, g + 1):
+                    if _plate_fires(xl, xc, xr, thr, K, dp, V, dt, g + 1, drive):
                         return g + 1
                     lo = g + 1
     while hi - lo > 1:
         mid = lo + (hi - lo) // 2
-        if _plate_fires(xl, xc, xr, thr, K, Kp, V, dt, mid):
+        if _plate_fires(xl, xc, xr, thr, K, dp, V, dt, mid, drive):
             hi = mid
         else:
             lo = mid
@@ -94,7 +95,7 @@ def _plate_trigger(xl, xc, xr, thr, K, Kp, V, dt, n0, n_cap):
 
 
 @njit(cache=True)
-def _plate_triggers(x, th, mov, mm, trig, lo, hi, every, n0, n_cap, mp, V, dt, threshold):
+def _plate_triggers(x, th, mov, mm, trig, lo, hi, every, n0, n_cap, mp, V, dt, drive, threshold):
     """Recompute ``trig`` for the stopped blocks lo..hi (ghost cells of x set); returns their
     smallest value (``_NEVER`` if none).
 
@@ -103,7 +104,7 @@ def _plate_triggers(x, th, mov, mm, trig, lo, hi, every, n0, n_cap, mp, V, dt, t
     it the blocks next to or at a block of the mid-step mask ``mm``, which holds this step's
     movers on the interval (only they change x).
     """
-    K, Kp, tp = mp[0], mp[1], mp[2]
+    K, dp, tp = mp[0], mp[1], mp[2]
     N = x.shape[0] - 2
     t_min = _NEVER
     for i in range(lo, hi + 1):
@@ -115,10 +116,53 @@ def _plate_triggers(x, th, mov, mm, trig, lo, hi, every, n0, n_cap, mp, V, dt, t
                 t_min = trig[i]
             continue
         if mov[i] == 0.0:
-            m = _plate_trigger(x[i - 1], x[i], x[i + 1], _threshold(th[i], tp, threshold), K, Kp, V, dt, n0, n_cap)
+            m = _plate_trigger(
+                x[i - 1], x[i], x[i + 1], _threshold(th[i], tp, threshold), K, dp, V, dt, n0, n_cap, drive
+            )
             trig[i] = m
             if m < t_min:
                 t_min = m
         else:
             trig[i] = _NEVER
     return t_min
+
+
+def leaf_triggers(x, th, mov, mm, trig, lo, hi, every, n0, n_cap, mp, V, dt, drive, threshold):
+    """:func:`_plate_triggers` for a drive with a leaf spring to every block; ``_NEVER`` for one
+    that pulls block 1 only (resolved when the kernel is compiled, so that drive's kernels do not
+    compile the search)."""
+    if piece_attr(drive, "leaf_spring"):
+        return _plate_triggers(x, th, mov, mm, trig, lo, hi, every, n0, n_cap, mp, V, dt, drive, threshold)
+    return _NEVER
+
+
+def pull_trigger(x, N, V, dt, K, thr, n_lo, n_hi, dp, drive, ends):
+    """:func:`_first_trigger` for a drive that pulls block 1 only; ``n_hi`` for a drive with a
+    leaf spring (resolved when the kernel is compiled, as :func:`leaf_triggers`)."""
+    if piece_attr(drive, "leaf_spring"):
+        return n_hi
+    return _first_trigger(x, N, V, dt, K, thr, n_lo, n_hi, dp, drive, ends)
+
+
+@overload(leaf_triggers, prefer_literal=True)
+def _leaf_triggers(x, th, mov, mm, trig, lo, hi, every, n0, n_cap, mp, V, dt, drive, threshold):
+    leaf = piece_attr(drive, "leaf_spring")
+    if leaf is None:
+        return None
+    if leaf:
+        return lambda x, th, mov, mm, trig, lo, hi, every, n0, n_cap, mp, V, dt, drive, threshold: _plate_triggers(
+            x, th, mov, mm, trig, lo, hi, every, n0, n_cap, mp, V, dt, drive, threshold
+        )
+    return lambda x, th, mov, mm, trig, lo, hi, every, n0, n_cap, mp, V, dt, drive, threshold: _NEVER
+
+
+@overload(pull_trigger, prefer_literal=True)
+def _pull_trigger(x, N, V, dt, K, thr, n_lo, n_hi, dp, drive, ends):
+    leaf = piece_attr(drive, "leaf_spring")
+    if leaf is None:
+        return None
+    if leaf:
+        return lambda x, N, V, dt, K, thr, n_lo, n_hi, dp, drive, ends: n_hi
+    return lambda x, N, V, dt, K, thr, n_lo, n_hi, dp, drive, ends: _first_trigger(
+        x, N, V, dt, K, thr, n_lo, n_hi, dp, drive, ends
+    )

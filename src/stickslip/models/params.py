@@ -346,12 +346,12 @@ class ChainParams(_Validated):
         return piece("ends", self.ends)
 
     @property
-    def codes(self) -> tuple[int | str, ...]:
+    def codes(self) -> tuple[str, ...]:
         """What the kernels are compiled for, per piece (drive, friction, threshold, ends):
         :func:`stickslip.models.pieces.code`."""
         from stickslip.models.pieces import code
 
-        return tuple(code(k, v) for k, v in self.pieces.items())  # type: ignore[return-value]
+        return tuple(code(k, v) for k, v in self.pieces.items())
 
     def used(self) -> tuple[str, ...]:
         """The numerical parameters this composition reads."""

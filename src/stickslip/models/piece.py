@@ -3,11 +3,10 @@
 A :class:`Piece` is one choice for one of the four pieces (drive, friction, threshold, ends):
 its name and meaning, the parameters it reads (and those it declares itself, with their checks),
 and what the package asks of it: the state variable, steady sliding, the linearisation the
-stability analysis reads. A friction law is one module of :mod:`stickslip.models.friction` that
-also holds the compiled functions every integrator calls (:attr:`Piece.module`, the contract in
-:mod:`stickslip.kernels.laws`) and the named tuple of the parameters they read
-(:func:`kernel_params`); the other pieces reach the kernels through their integer codes (their
-positions in :data:`stickslip.models.pieces.PIECES`).
+stability analysis reads. Every piece is one module of :mod:`stickslip.models` (``friction``,
+``drive``, ``threshold``, ``ends``) that also holds the compiled functions every integrator calls
+(:attr:`Piece.module`, the contract in :mod:`stickslip.kernels.laws`) and the named tuple of the
+parameters they read (:func:`kernel_params`).
 """
 
 from __future__ import annotations
@@ -82,8 +81,7 @@ class Linearisation:
 class Piece:
     """One choice for one piece: its name, what it means, and the parameters it reads.
 
-    Its kernel code is its position in :data:`~stickslip.models.pieces.PIECES`
-    (:func:`stickslip.models.pieces.code`).
+    A kernel is compiled for its module (:attr:`module`, :func:`stickslip.models.pieces.code`).
     """
 
     kind: str
@@ -115,8 +113,10 @@ class Piece:
     linear: Callable[[Any], Linearisation] | None = None
     #: friction with theta: the linearisation is eq. (5)'s, with Fig. 4's closed-form critical beta
     eq5: bool = False
-    #: friction: the import path of the module holding the compiled functions the integrators
-    #: call (``accel``, ``rate``; :mod:`stickslip.kernels.laws`) and its ``Params``
+    #: the import path of the module holding the compiled functions the integrators call (a
+    #: friction law's ``accel`` and ``rate``, a drive's ``force``, ``leaf`` and ``left``, a
+    #: threshold's ``value``, an end condition's ``ghost``; :mod:`stickslip.kernels.laws`) and its
+    #: ``Params``
     module: str = ""
     #: friction: the law as a figure label (matplotlib mathtext)
     label: str = ""

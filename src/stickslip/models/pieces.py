@@ -31,6 +31,7 @@ from stickslip.models.piece import CompositionError, Linearisation, Param, Piece
 __all__ = [
     "PIECES",
     "KINDS",
+    "DRIVES",
     "FRICTIONS",
     "THRESHOLDS",
     "ENDS",
@@ -51,6 +52,9 @@ FRICTIONS = (
     "rate_state_slip",
 )
 
+#: The drives, one module each in :mod:`stickslip.models.drive`.
+DRIVES = ("end", "plate")
+
 #: The static thresholds, one module each in :mod:`stickslip.models.threshold`.
 THRESHOLDS = ("constant", "state")
 
@@ -59,16 +63,7 @@ ENDS = ("free", "fixed", "periodic")
 
 
 PIECES: dict[str, tuple[Piece, ...]] = {
-    "drive": (
-        Piece("drive", "end", "pulling point x_0 = V t joined to block 1 by the spring K (eq. 4)"),
-        Piece(
-            "drive",
-            "plate",
-            "every block joined to a plate at V t by a leaf spring Kp: f_i gains Kp (V t - x_i)",
-            ("Kp",),
-            leaf_spring=True,
-        ),
-    ),
+    "drive": tuple(importlib.import_module(f"stickslip.models.drive.{m}").PIECE for m in DRIVES),
     "friction": tuple(importlib.import_module(f"stickslip.models.friction.{m}").PIECE for m in FRICTIONS),
     "threshold": tuple(importlib.import_module(f"stickslip.models.threshold.{m}").PIECE for m in THRESHOLDS),
     "ends": tuple(importlib.import_module(f"stickslip.models.ends.{m}").PIECE for m in ENDS),
@@ -78,7 +73,7 @@ KINDS = tuple(PIECES)
 
 
 def names(kind: str) -> tuple[str, ...]:
-    """The allowed choices of one piece, in the order of their kernel codes."""
+    """The allowed choices of one piece, in the order of :data:`PIECES`."""
     return tuple(p.name for p in PIECES[kind])
 
 
@@ -90,12 +85,10 @@ def piece(kind: str, name: str) -> Piece:
     raise CompositionError(f"{kind} must be one of {', '.join(names(kind))} (got {name!r})")
 
 
-def code(kind: str, name: str) -> int | str:
+def code(kind: str, name: str) -> str:
     """What a kernel is compiled for, for one piece: the import path of the module holding its
-    compiled functions (a friction law, a threshold), else its integer code (its position in
-    :data:`PIECES`)."""
-    pc = piece(kind, name)
-    return pc.module or names(kind).index(pc.name)
+    compiled functions."""
+    return piece(kind, name).module
 
 
 def check_composition(drive: str, friction: str, threshold: str, ends: str) -> None:

@@ -78,10 +78,10 @@ def _finite(state: ChainState) -> bool:
 
 
 def _par(p: ChainParams) -> np.ndarray:
-    """The kernels' parameter vector: springs and drive (the threshold's and the friction law's
-    parameters travel as their named tuples, :meth:`~stickslip.models.piece.Piece.kernel_params`)."""
+    """The kernels' parameter vector: K, V and dt (the pieces' parameters travel as their named
+    tuples, :meth:`~stickslip.models.piece.Piece.kernel_params`)."""
     par = np.zeros(layout.PAR_SIZE)
-    par[layout.P_K], par[layout.P_V], par[layout.P_DT], par[layout.P_KP] = p.K, p.V, p.dt, p.Kp
+    par[layout.P_K], par[layout.P_V], par[layout.P_DT] = p.K, p.V, p.dt
     return par
 
 
@@ -97,7 +97,9 @@ class _Kernel:
         if name == "exact" and stopped_blocks_still(params.drive_piece, params.friction_piece):
             name = "sparse"
         self.scratch = tuple(scratch)
-        pieces_p = (params.threshold_piece.kernel_params(params), params.friction_piece.kernel_params(params))
+        pieces_p = tuple(
+            pc.kernel_params(params) for pc in (params.drive_piece, params.threshold_piece, params.friction_piece)
+        )
         self.rest = (par, *pieces_p, *outputs.kernel_args())
         # sample_every, profile_every, profile_min_blocks, stop_all_moving (layout.ChainArgs)
         self.tail = tuple(np.int64(t) for t in ints)

@@ -131,13 +131,13 @@ def parameter_vector(p: ChainParams) -> np.ndarray:
     the threshold's and the friction law's parameters go separately
     (:meth:`~stickslip.models.piece.Piece.kernel_params`)."""
     par = np.zeros(layout.PAR_SIZE)
-    par[layout.P_K], par[layout.P_V], par[layout.P_DT], par[layout.P_KP] = p.K, p.V, p.dt, p.Kp
+    par[layout.P_K], par[layout.P_V], par[layout.P_DT] = p.K, p.V, p.dt
     return par
 
 
 # Positions of the pieces among the arguments of L.advance and L.rates (compiled as literals).
-_ADVANCE_PIECES = frozenset(range(8, 12))
-_RATES_PIECES = frozenset(range(7, 10))
+_ADVANCE_PIECES = frozenset(range(9, 13))
+_RATES_PIECES = frozenset(range(8, 11))
 
 
 def rates(state: LocatedState, params: ChainParams) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -147,7 +147,8 @@ def rates(state: LocatedState, params: ChainParams) -> tuple[np.ndarray, np.ndar
     drive, friction, _, ends = params.codes
     t = state.step * params.dt
     args = (state.u.copy(), state.v, state.th.copy(), state.mov, t, parameter_vector(params))
-    args += (params.friction_piece.kernel_params(params), drive, friction, ends, du, dv, dth)
+    args += (params.friction_piece.kernel_params(params), params.drive_piece.kernel_params(params))
+    args += (drive, friction, ends, du, dv, dth)
     specialise_call(L.rates, args, _RATES_PIECES)
     return du, dv, dth
 
@@ -173,6 +174,7 @@ class LocatedStepper:
         self.par = parameter_vector(params)
         self.lp = params.friction_piece.kernel_params(params)
         self.tp = params.threshold_piece.kernel_params(params)
+        self.dp = params.drive_piece.kernel_params(params)
         self.codes = params.codes
         N = params.N
         self.sc = tuple(np.zeros(N + 2) for _ in range(12))
@@ -200,13 +202,13 @@ class LocatedStepper:
         parts = []
         while True:
             state.ist[L.I_EVENTS] = 0
-            args = (state.u, state.v, state.th, state.mov, np.int64(step), self.par, self.lp, self.tp)
+            args = (state.u, state.v, state.th, state.mov, np.int64(step), self.par, self.lp, self.tp, self.dp)
             args += (drive, friction, threshold, ends, self.sc, self.cand, state.moved, state.ist, state.evf)
             args += (self.ev_t, self.ev_i)
             if self.fast:
                 args += self.lazy
             # Typed once per layout of the state's arrays (the stepper's own never change).
-            key = tuple((a.dtype, a.flags.c_contiguous, a.flags.writeable) for a in args[:4] + args[14:17])
+            key = tuple((a.dtype, a.flags.c_contiguous, a.flags.writeable) for a in args[:4] + args[15:18])
             entry = self._entries.get(key)
             if entry is None:
                 kernel = LF.advance_fast if self.fast else L.advance

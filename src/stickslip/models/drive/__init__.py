@@ -1,0 +1,16 @@
+"""The drives of the chain, one module each (docs/model.md, "The family the paper stands in").
+
+A drive's module defines ``READS`` and ``Params`` (the parameters its compiled functions read,
+:func:`stickslip.models.piece.kernel_params`) and the compiled functions every integrator calls
+through :func:`stickslip.kernels.laws.call`:
+
+* ``force(xl, xc, xr, K, p, dp)``: the spring force on a block between xl and xr with the drive
+  at p = V t (in the drive's own frame, p = 0), in the drive's own order of operations;
+* ``leaf(dp)``: the stiffness of the spring joining every block to the drive (0 when it pulls
+  block 1 only), which the start-step searches and rounding bounds read;
+* ``left(p, ghost)``: x_0, the ghost cell left of block 1: the pulling point p, or the ends'
+  ``ghost`` where the drive does not pull there;
+
+and ``PIECE`` (``leaf_spring``: the drive reaches every block, so stopped blocks start at steps
+known in advance). :data:`stickslip.models.pieces.DRIVES` lists them.
+"""

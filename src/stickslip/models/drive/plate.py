@@ -1,0 +1,39 @@
+"""The plate drive of Burridge-Knopoff and Carlson-Langer: every block joined to a plate at V t
+by a leaf spring Kp."""
+
+from __future__ import annotations
+
+from numba import njit
+
+from stickslip.models.piece import Piece, kernel_params
+
+READS = ("Kp",)
+Params = kernel_params(__name__, READS)
+
+
+@njit(cache=True, inline="always")
+def force(xl, xc, xr, K, p, dp):
+    """K (x_{i+1} - 2 x_i + x_{i-1}) + Kp (V t - x_i), the plate at p = V t."""
+    return K * ((xl - xc) - (xc - xr)) + dp.Kp * (p - xc)
+
+
+@njit(cache=True, inline="always")
+def leaf(dp):
+    """Kp."""
+    return dp.Kp
+
+
+@njit(cache=True, inline="always")
+def left(p, ghost):
+    """x_0 is the ends' ghost cell (the plate pulls every block, not block 1)."""
+    return ghost
+
+
+PIECE = Piece(
+    "drive",
+    "plate",
+    "every block joined to a plate at V t by a leaf spring Kp: f_i gains Kp (V t - x_i)",
+    READS,
+    leaf_spring=True,
+    module=__name__,
+)
