@@ -103,7 +103,7 @@ def test_save_writes_the_run_directory_the_command_writes(run, tmp_path):
     pd.testing.assert_frame_equal(back.first_move.reset_index(drop=True), run.first_move, check_dtype=False)
     np.testing.assert_array_equal(back.samples["L"].values, run.samples["L"].values)
     np.testing.assert_array_equal(back.snapshots.values, run.snapshots.values)
-    np.testing.assert_array_equal(back.profiles["dx"].values, run.profiles["dx"].values)
+    np.testing.assert_array_equal(back.profiles["profile_dx"].values, run.profiles["profile_dx"].values)
     assert back.params == run.params and back.options == run.options
     meta = json.loads((folder / "run.json").read_text())
     assert meta["summary"]["n_events"] == len(run.events)
@@ -159,8 +159,12 @@ def test_figures_of_carlson_langer_carry_its_name_and_no_paper_figure():
     first_move = pd.DataFrame({"event": 0, "block": i, "t_first": 100.0 + i / 2.0})
     dx = np.tile(np.linspace(0.0, 1.0, 30), (4, 1))
     profiles = xr.Dataset(
-        {"dx": (("row", "block"), dx)},
-        coords={"event": ("row", np.zeros(4, dtype=int)), "t": ("row", 100.0 + 20.0 * np.arange(4)), "block": i},
+        {"profile_dx": (("profile_row", "block"), dx)},
+        coords={
+            "profile_event": ("profile_row", np.zeros(4, dtype=int)),
+            "profile_t": ("profile_row", 100.0 + 20.0 * np.arange(4)),
+            "block": i,
+        },
     )
     fig = fronts_figure(profiles, first_move, [front_speed(first_move, 0)], cl)
     assert not fig._suptitle.get_text().startswith("Fig.") and "Carlson-Langer" in fig._suptitle.get_text()
@@ -201,7 +205,31 @@ def test_state_nc_names_quantities_as_python_does_and_old_files_still_load(run, 
     back = load_run(folder)
     np.testing.assert_array_equal(back.samples["t"].values, run.samples["t"].values)
     np.testing.assert_array_equal(back.samples["L"].values, run.samples["L"].values)
-    np.testing.assert_array_equal(back.profiles["t"].values, run.profiles["t"].values)
+    np.testing.assert_array_equal(back.profiles["profile_t"].values, run.profiles["profile_t"].values)
+
+
+#: The quantities of the stored windows of events (Fig. 6), in ChainRun.profiles and state.nc.
+PROFILE_NAMES = ("profile_dx", "profile_event", "profile_t", "profile_t_next")
+
+
+def test_every_quantity_has_one_name_in_memory_and_on_disk(run, tmp_path):
+    """Each array of run.samples, .snapshots and .profiles is in state.nc under its own name,
+    over the same dimensions and with the same values; a loaded run has the same names again; the
+    tables' columns are the Parquet files' columns."""
+    folder = run.save(tmp_path / "named")
+    ds = xr.load_dataset(folder / "state.nc")
+    back = load_run(folder)
+    assert run.profiles.sizes["profile_row"] > 0 and run.snapshots.sizes["snapshot_time"] == 2
+    for held in (run, back):
+        arrays = {**held.samples.variables, **held.profiles.variables, **held.snapshots.coords}
+        arrays[held.snapshots.name] = held.snapshots.variable
+        assert set(arrays) == {"t", "L", "block", "snapshot_time", "snapshot_x", *PROFILE_NAMES}
+        for name, array in arrays.items():
+            assert ds[name].dims == array.dims, name
+            np.testing.assert_array_equal(ds[name].values, array.values, err_msg=name)
+    for table in ("events", "first_move"):
+        on_disk = pd.read_parquet(folder / f"{table}.parquet")
+        assert list(on_disk.columns) == list(getattr(run, table).columns) == list(getattr(back, table).columns)
 
 
 def test_a_snapshot_of_a_model_without_a_steady_profile_is_refused_in_one_line():

@@ -109,23 +109,23 @@ def moment_rate(run, catalog: pd.DataFrame, *, largest: int = 5) -> tuple[pd.Dat
     there is nothing to show, why.
     """
     profiles = run.profiles
-    if not profiles.sizes.get("row", 0):
+    if not profiles.sizes.get("profile_row", 0):
         return (
             pd.DataFrame(columns=["event", "t", "rate"]),
             [],
             "no displacement profiles stored (run with --profile-window W)",
         )
-    stored = set(np.unique(profiles["event"].values).tolist())
+    stored = set(np.unique(profiles["profile_event"].values).tolist())
     picks = catalog[catalog["event"].isin(stored)].nlargest(largest, "S")
     if picks.empty:
         return pd.DataFrame(columns=["event", "t", "rate"]), [], "no slip of the stationary window has stored profiles"
-    event_of_row = profiles["event"].values
+    event_of_row = profiles["profile_event"].values
     rows, summaries = [], []
     for r in picks.itertuples():
         sel = np.flatnonzero(event_of_row == r.event)
-        t0 = profiles["t"].values[sel]
-        t1 = profiles["t_next"].values[sel]
-        slip = profiles["dx"].values[sel].sum(axis=1)
+        t0 = profiles["profile_t"].values[sel]
+        t1 = profiles["profile_t_next"].values[sel]
+        slip = profiles["profile_dx"].values[sel].sum(axis=1)
         rate = slip / (t1 - t0)
         centre = 0.5 * (t0 + t1) - r.t_start
         rows.append(pd.DataFrame({"event": int(r.event), "t": centre, "rate": rate}))

@@ -166,8 +166,8 @@ def front_speeds(run, N: int, t_from: float) -> pd.DataFrame:
     """
     events = run.events[(run.events["t_start"] >= t_from) & (run.events["max_block"] >= N)]
     groups = {int(e): g for e, g in run.first_move.groupby("event")}
-    profiles = run.profiles if run.profiles.sizes.get("row") else None
-    stored = set(np.unique(profiles["event"].values).tolist()) if profiles is not None else set()
+    profiles = run.profiles if run.profiles.sizes.get("profile_row") else None
+    stored = set(np.unique(profiles["profile_event"].values).tolist()) if profiles is not None else set()
     rows = []
     for r in events.itertuples():
         e = int(r.event)
@@ -200,7 +200,8 @@ def front_statistics(run, N: int, t_from: float) -> dict[str, Any]:
     ``t_first_span``: start of the run's first event that reached block N (NaN if none).
     """
     events = run.events[run.events["t_start"] >= t_from]
-    with_profiles = set(np.unique(run.profiles["event"].values).tolist()) if run.profiles.sizes.get("row") else set()
+    prof = run.profiles
+    with_profiles = set(np.unique(prof["profile_event"].values).tolist()) if prof.sizes.get("profile_row") else set()
     candidates = events[events["event"].isin(with_profiles)]
     picks = pick_front_events(candidates, N) if len(candidates) else candidates.assign(kind=pd.Series(dtype=str))
     groups = {int(e): g for e, g in run.first_move.groupby("event")}

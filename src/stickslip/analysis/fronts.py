@@ -133,21 +133,23 @@ def leading_edge_speed(
 ) -> EdgeSpeed:
     """Rupture-front speed of one event from the leading edge of its Delta x_i windows (Fig. 6).
 
-    ``profiles``: the run's stored windows (dim ``row`` with ``event``, ``t`` (window start),
-    optionally ``t_next`` (window end), ``dx(row, block)``). Default range: the far half of the
+    ``profiles``: the run's stored windows (``ChainRun.profiles``: dim ``profile_row`` with
+    ``profile_event``, ``profile_t`` (window start), optionally ``profile_t_next`` (window end),
+    ``profile_dx(profile_row, block)``). Default range: the far half of the
     blocks the event reached, i_min = ceil(i_far / 2), i_max = i_far (i_far: the farthest edge).
     """
-    rows = np.flatnonzero(profiles["event"].values == event)
+    rows = np.flatnonzero(profiles["profile_event"].values == event)
     if rows.size == 0:
         raise ValueError(f"no displacement profiles stored for event {event}")
-    sub = profiles.isel(row=rows)
-    order = np.argsort(sub["t"].values, kind="stable")
-    dx = sub["dx"].transpose("row", "block").values[order]
+    sub = profiles.isel(profile_row=rows)
+    order = np.argsort(sub["profile_t"].values, kind="stable")
+    dx = sub["profile_dx"].transpose("profile_row", "block").values[order]
     blocks = sub["block"].values if "block" in sub.coords else np.arange(1, dx.shape[1] + 1)
-    t_end = (sub["t_next"] if "t_next" in sub.coords else sub["t"]).values[order]
-    if "t_next" not in sub.coords or np.all(t_end == sub["t"].values[order]):
+    has_end = "profile_t_next" in sub.coords
+    t_end = (sub["profile_t_next"] if has_end else sub["profile_t"]).values[order]
+    if not has_end or np.all(t_end == sub["profile_t"].values[order]):
         # window ends: the next window's start, the last one as long as the one before it
-        starts = sub["t"].values[order]
+        starts = sub["profile_t"].values[order]
         width = float(np.median(np.diff(starts))) if starts.size > 1 else 0.0
         t_end = np.append(starts[1:], starts[-1] + width)
     edges = np.zeros(dx.shape[0], dtype=np.int64)

@@ -176,11 +176,11 @@ def length_against_beta(
 
 
 def _event_profiles(profiles: xr.Dataset, event: int) -> xr.Dataset:
-    rows = np.flatnonzero(profiles["event"].values == event)
+    rows = np.flatnonzero(profiles["profile_event"].values == event)
     if rows.size == 0:
         raise ValueError(f"no displacement profiles stored for event {event}")
-    sub = profiles.isel(row=rows)
-    return sub.isel(row=np.argsort(sub["t"].values, kind="stable"))
+    sub = profiles.isel(profile_row=rows)
+    return sub.isel(profile_row=np.argsort(sub["profile_t"].values, kind="stable"))
 
 
 def _nice(x: float) -> float:
@@ -209,9 +209,9 @@ def _waterfall(ax, sub: xr.Dataset, window: float | None, edge: EdgeSpeed | None
     bar at the right gives the Delta x_i scale. At most :data:`MAX_WINDOWS` windows are drawn,
     evenly spaced from the first. ``edge``: the leading edge of each window (marks).
     """
-    dx = sub["dx"].transpose("row", "block").values
+    dx = sub["profile_dx"].transpose("profile_row", "block").values
     blocks = sub["block"].values if "block" in sub.coords else np.arange(1, dx.shape[1] + 1)
-    t = sub["t"].values
+    t = sub["profile_t"].values
     every = max(1, int(math.ceil(dx.shape[0] / MAX_WINDOWS)))
     shown = np.arange(0, dx.shape[0], every)
     n = shown.size
@@ -364,16 +364,41 @@ def fronts_figure(
 
     Left: the displacement Delta x_i = x_i(t + Delta t) - x_i(t) over successive windows of
     Delta t = ``window`` (20 in the paper) from the event's start, stacked upwards in time like
-    the paper's plot, with a scale bar for Delta x_i (``profiles``: dim ``row`` with ``event``,
-    ``t`` and ``dx(row, block)``). Right: the time each block first moved against i, the front
-    speed fitted over the far part of the chain (:func:`~stickslip.analysis.statistics.front_speed`),
-    the sound speed sqrt(K) (3.16 for K = 10) and, for the paper's chain, its c = 1.43 as slopes
-    from the same point. ``edges`` (one :class:`~stickslip.analysis.statistics.EdgeSpeed` or None per
-    front) marks the leading edge of each window in both panels. ``speeds`` (columns
-    ``c_first_move``, ``c_leading_edge``, one row per event that reached block N) adds a last
-    row: the per-event distribution of c by both definitions, with the paper's value and its
-    percentile. Given ``ax`` (one Axes, or two), the first front's windows (and first moves)
-    are drawn there.
+    the paper's plot, with a scale bar for Delta x_i. Right: the time each block first moved
+    against i, the front speed fitted over the far part of the chain
+    (:func:`~stickslip.analysis.statistics.front_speed`), the sound speed sqrt(K) (3.16 for
+    K = 10) and, for the paper's chain, its c = 1.43 as slopes from the same point.
+
+    Parameters
+    ----------
+    profiles : xarray.Dataset
+        The stored windows, ``ChainRun.profiles``: ``profile_dx`` over (``profile_row``,
+        ``block``) with ``profile_event`` and ``profile_t`` per row.
+    first_move : pandas.DataFrame
+        ``ChainRun.first_move``: columns ``event``, ``block``, ``t_first``.
+    fronts : sequence of FrontSpeed
+        The fitted fronts, one per event drawn (:func:`~stickslip.analysis.statistics.front_speed`).
+    params : ChainParams
+        The run's model (titles, sqrt(K), the paper's c only for eq. 4).
+    labels : sequence of str, optional
+        One label per front (default ``event <number>``).
+    window : float or None
+        Delta t of the windows, for the axis label.
+    edges : sequence of EdgeSpeed or None, optional
+        The leading edge of each front's windows, marked in both panels.
+    speeds : pandas.DataFrame, optional
+        Columns ``c_first_move`` and ``c_leading_edge``, one row per event that reached block N:
+        adds a last row, the per-event distribution of c by both definitions with the paper's
+        value and its percentile.
+    ax : matplotlib.axes.Axes or a pair of them, optional
+        Draw the first front's windows (and, given two Axes, its first moves) there.
+    paper_figure : str, optional
+        The paper's figure this drawing is (``"Fig. 6"``); by default named only for the
+        paper's own runs.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
     """
     fronts = list(fronts)
     if not fronts:
@@ -386,7 +411,8 @@ def fronts_figure(
         pair = list(np.ravel(ax))
         sub = _event_profiles(profiles, fronts[0].event)
         _waterfall(pair[0], sub, window, edges[0])
-        pair[0].set_title(f"{labels[0]}, $t_s \\approx {float(sub['t'].values[0]):.6g}$", loc="left", fontsize=8)
+        t0 = float(sub["profile_t"].values[0])
+        pair[0].set_title(f"{labels[0]}, $t_s \\approx {t0:.6g}$", loc="left", fontsize=8)
         if len(pair) > 1:
             _arrivals(pair[1], first_move, fronts[0], params.K, edges[0], paper)
             pair[1].set_title(f"front: blocks {fronts[0].i_min}-{fronts[0].i_max}", loc="left", fontsize=8)
@@ -400,7 +426,7 @@ def fronts_figure(
         sub = _event_profiles(profiles, front.event)
         _waterfall(ax_w, sub, window, edge)
         letter = letters[row] if row < 8 else str(row)
-        t0 = float(sub["t"].values[0])
+        t0 = float(sub["profile_t"].values[0])
         ax_w.set_title(f"({letter}) {label}, $t_s \\approx {t0:.6g}$", loc="left", fontsize=9)
         _arrivals(ax_t, first_move, front, params.K, edge, paper)
         ax_t.set_title(f"front: blocks {front.i_min}-{front.i_max}", loc="left", fontsize=9)
