@@ -69,11 +69,26 @@ def snapshot_figure(x: Any, params: ChainParams, t: float, *, ax=None, paper_fig
 
     Top: x_i - V t of the run (solid), of the exact discrete steady sliding solution
     (:func:`~stickslip.models.physics.chain_steady_state`, dashed) and of the paper's continuum form
-    x_i = V t - c/K {N^2 - (i - N)^2}/2 (dotted), all in the frame moving with the pulling point
-    x_0 = V t. Bottom: the run's departure from the exact steady profile, and the continuum
-    form's, which lies c i / (2K) above it (c N / (2K), about 20, at the free end of the paper's chain).
-    ``x`` is x_1..x_N (an array or a DataArray over ``block``). Given ``ax``, only the top panel
-    is drawn, into it.
+    x_i = V t - c/K {N^2 - (i - N)^2}/2 (dotted), in the frame of the pulling point x_0 = V t.
+    Bottom: the run's departure from the exact steady profile, and the continuum form's, which lies
+    c i / (2K) above it (about 20 at the free end of the paper's chain).
+
+    Parameters
+    ----------
+    x : array_like or xarray.DataArray
+        x_1..x_N (``run.state.blocks()["x"]``, or one time of ``run.snapshots``).
+    params : ChainParams
+        The chain (end drive).
+    t : float
+        The snapshot's time.
+    ax : matplotlib.axes.Axes, optional
+        Draw only the top panel, into this Axes.
+    paper_figure : str, optional
+        The paper's figure this is (by default named only for the paper's own runs).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
     """
     xs = _snapshot_array(x, params.N)
     i = np.arange(1, params.N + 1)
@@ -114,14 +129,28 @@ def length_against_beta(
 ) -> Figure:
     """Average total length <L> = <x_1 - x_N> against beta, with steady sliding (the paper's Fig. 5b).
 
-    ``table`` has columns ``beta`` and ``L_mean`` (and optionally ``L_err``, drawn as error
-    bars, and ``final_state``), e.g. a sweep's summary. The dashed line is the exact discrete
-    steady sliding length L_ss = (c/K) N (N - 1) / 2 with the steady friction
-    c = 1 - (1 - beta) V (:func:`~stickslip.models.physics.chain_steady_length`) for the other
-    parameters of ``params``; the paper's printed L = c N^2 / 2 lacks the factor 1/K (docs/model.md)
-    and is not drawn. The dotted vertical line marks beta_c = 1, where the long-wave
-    instability sets in (Fig. 4). With ``final_state``, runs above beta_c that had not settled
-    into steady sliding by their end are drawn with open symbols. Given ``ax``, it is drawn there.
+    The dashed line is the exact discrete steady length L_ss = (c/K) N (N - 1) / 2 with
+    c = 1 - (1 - beta) V (:func:`~stickslip.models.physics.chain_steady_length`); the paper's
+    printed L = c N^2 / 2 lacks the factor 1/K (docs/model.md) and is not drawn. The dotted line
+    marks beta_c, where the long-wave instability sets in (Fig. 4).
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        Columns ``beta`` and ``L_mean``, optionally ``L_err`` (error bars) and ``final_state``
+        (runs above beta_c not settled into steady sliding are drawn open), e.g. a sweep's summary.
+    params : ChainParams
+        The chain's other parameters.
+    beta_c : float
+        The linear threshold marked.
+    ax : matplotlib.axes.Axes, optional
+        Draw into this Axes.
+    paper_figure : str, optional
+        The paper's figure this is.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
     """
     data = table.sort_values("beta")
     beta = data["beta"].to_numpy(dtype=np.float64)
@@ -455,15 +484,37 @@ def sizes_figure(
     ax=None,
     paper_figure: str | None = None,
 ) -> Figure:
-    """Slip sizes: (a) their distribution with the fitted power law, (b) S against event time
-    (the paper's Figs. 7 at beta = 1 and 8 at beta = 0.2).
+    """Slip sizes: (a) their distribution with the fitted power law, (b) S against event time (the
+    paper's Figs. 7 at beta = 1 and 8 at beta = 0.2).
 
-    (a): the density of S on logarithmic bins (:func:`~stickslip.analysis.statistics.size_distribution`,
-    normalised for bin width) with the fitted power law p ~ S^-tau over [s_min, s_max]
-    (scaled by the share of events in that range); ``paper_tau`` adds the paper's exponent
-    (1.5 at beta = 1, about 1.6 at beta = 0.2) as a dotted guide, set below the fit so that
-    both show. (b): S of every event against its start time ``t_start``. The title names the
-    model of ``params`` (else the ``beta`` given); given ``ax``, only (a) is drawn, into it.
+    (a): the density of S on logarithmic bins
+    (:func:`~stickslip.analysis.statistics.size_distribution`) with the fitted power law
+    p ~ S^-tau over [s_min, s_max], scaled by the share of events in that range. (b): S of every
+    event against its start time.
+
+    Parameters
+    ----------
+    events : pandas.DataFrame
+        The events (``S``, ``t_start``), usually the stationary window's.
+    fit : PowerLawFit
+        The fit drawn (:func:`~stickslip.analysis.statistics.fit_power_law`).
+    beta : float, optional
+        For the title, without ``params``.
+    params : ChainParams, optional
+        The model the title names.
+    bins : int or array_like
+        Bins of the density.
+    paper_tau : float, optional
+        The paper's exponent (1.5 at beta = 1, about 1.6 at beta = 0.2) as a dotted guide below
+        the fit.
+    ax : matplotlib.axes.Axes, optional
+        Draw only (a), into this Axes.
+    paper_figure : str, optional
+        The paper's figure this is.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
     """
     S = events["S"].to_numpy(dtype=np.float64)
     dist = size_distribution(S, bins)

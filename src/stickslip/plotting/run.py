@@ -169,7 +169,21 @@ def fronts(run, *, ax=None) -> Figure:
 
 
 def run_figures(run, *, max_snapshots: int = 4) -> list[RunFigure]:
-    """The figures ``run`` (a :class:`~stickslip.run.outputs.ChainRun`) supports, in a fixed order."""
+    """The figures a chain run supports, in a fixed order: what ``stickslip plot`` draws.
+
+    Parameters
+    ----------
+    run : ChainRun
+        A run (``run_chain`` or ``load_run``).
+    max_snapshots : int
+        Most stored snapshots drawn (besides the final state).
+
+    Returns
+    -------
+    list of RunFigure
+        Each with its file stem, title and Figure, or None and why it was not drawn (``skipped``:
+        no steady profile for this model, too few events, no stored profiles).
+    """
     p = run.params
     out = []
     if run.samples.sizes.get("t", 0) > 1:
@@ -267,7 +281,23 @@ def size_numbers(run, stats: dict) -> dict:
 
 
 def draw_run_figures(run, out_dir: str | Path, *, formats: tuple[str, ...] = FIGURE_FORMATS) -> list[dict]:
-    """Save every figure of :func:`run_figures` as OUT_DIR/<stem>.<fmt>; one record per figure."""
+    """Save every figure of :func:`run_figures` as OUT_DIR/<stem>.<fmt>.
+
+    Parameters
+    ----------
+    run : ChainRun
+        A run.
+    out_dir : str or Path
+        The folder (``RUN_DIR/figures`` for ``stickslip plot``).
+    formats : tuple of str
+        File formats.
+
+    Returns
+    -------
+    list of dict
+        One record per figure: ``figure`` (stem), ``title``, and ``files`` written or ``skipped``
+        with why; ``numbers`` where the figure has some (the size fit).
+    """
     records = []
     for item in run_figures(run):
         record = {"figure": item.stem, "title": item.title}
