@@ -99,6 +99,11 @@ def test_public_names_have_numpydoc_sections(module, name):
     sections = _sections(inspect.getdoc(obj) or "")
     if inspect.isclass(obj):
         assert sections & {"Parameters", "Attributes"}, (module, name, sections)
+        # the reference's variable lists take one field to an entry ("a, b : float" reads as one)
+        doc = inspect.getdoc(obj)
+        if "Attributes" in sections:
+            fields = doc.split("\nAttributes\n----------\n", 1)[1]
+            assert not re.search(r"^\w+, \w+.* : ", fields, re.M), (module, name)
     else:
         assert {"Parameters", "Returns"} <= sections, (module, name, sections)
 

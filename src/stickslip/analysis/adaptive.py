@@ -85,9 +85,11 @@ class Assessment:
 
     Attributes
     ----------
-    m, phi : MeanEstimate
-        The order parameter m and the stuck fraction phi over the kept window, each with its
-        batch-means error (:func:`stickslip.analysis.order.mean_with_error`).
+    m : MeanEstimate
+        The order parameter m over the kept window with its batch-means error
+        (:func:`stickslip.analysis.order.mean_with_error`).
+    phi : MeanEstimate
+        The stuck fraction phi over the kept window, likewise.
     t_cut : float
         Start of the kept window (model time).
     decided : bool

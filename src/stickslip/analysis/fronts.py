@@ -40,8 +40,10 @@ class FrontSpeed:
         i_0.
     t_start : float
         The event's first first-move time.
-    i_min, i_max : int
-        The blocks fitted.
+    i_min : int
+        The first block fitted.
+    i_max : int
+        The last block fitted.
     n_blocks : int
         How many blocks were fitted.
     rms : float
@@ -154,16 +156,22 @@ class EdgeSpeed:
     ----------
     event : int
         The event's number.
-    speed, speed_err : float
-        The slope in blocks per time unit and its standard error (NaN with 2 windows).
-    i_min, i_max : int
-        The range of edges fitted.
+    speed : float
+        The slope, blocks per time unit.
+    speed_err : float
+        Its standard error (NaN with 2 windows).
+    i_min : int
+        The lowest edge fitted.
+    i_max : int
+        The edge at which the fit stops (left out).
     n_windows : int
         Windows fitted.
     edge_fraction : float
         The share of a window's largest Delta x_i that marks its edge.
-    edges, times : tuple
-        The edge and the end time of every window.
+    edges : tuple
+        The edge of every window.
+    times : tuple
+        The end time of every window.
     """
 
     event: int
@@ -264,10 +272,14 @@ class CentralInterval:
 
     Attributes
     ----------
-    value, level : float
-        The value and the share of the sample the interval holds.
-    lo, hi : float
-        The bounds of the central ``level`` of the sample (5th and 95th percentiles for 0.9).
+    value : float
+        The stated value.
+    level : float
+        The share of the sample the interval holds.
+    lo : float
+        Lower bound of the central ``level`` of the sample (the 5th percentile for 0.9).
+    hi : float
+        Upper bound (the 95th percentile for 0.9).
     inside : bool
         lo <= value <= hi.
     percentile : float

@@ -169,14 +169,18 @@ class BValue:
         b / sqrt(n) (Aki 1965).
     b_err_bootstrap : float
         Standard deviation of b over ``bootstrap`` resamples of the magnitudes (NaN without).
-    mc, dm : float
-        Completeness magnitude and bin.
+    mc : float
+        Completeness magnitude.
+    dm : float
+        Magnitude bin.
     n : int
         Events with M >= mc.
     a : float
         log10 of the number of events at or above mc, the a-value at M = mc.
-    bootstrap, seed : int
-        Resamples and their seed.
+    bootstrap : int
+        Resamples of the bootstrap error.
+    seed : int
+        Their seed.
     method : str
         The estimator in words.
     """
@@ -362,10 +366,14 @@ class TruncatedGR:
 
     Attributes
     ----------
-    b, b_err : float
-        The b-value and its error from the Fisher information of the truncated exponential.
-    m_min, m_max : float
-        The range.
+    b : float
+        The b-value.
+    b_err : float
+        Its error from the Fisher information of the truncated exponential.
+    m_min : float
+        Lower end of the range.
+    m_max : float
+        Upper end of the range.
     n : int
         Events in it.
     loglikelihood : float

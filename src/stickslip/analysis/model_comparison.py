@@ -72,8 +72,10 @@ class CandidateFit:
         Parameters fitted (k).
     aic : float
         2 k - 2 log L.
-    s_min, s_max : float
-        The range.
+    s_min : float
+        Lower end of the range.
+    s_max : float
+        Upper end of the range.
     n : int
         Events in it.
     logpdf : numpy.ndarray

@@ -139,8 +139,10 @@ class MeanEstimate:
         Integrated autocorrelation time, samples.
     batch : int
         Samples per batch.
-    n_batches, n : int
-        Batches and samples.
+    n_batches : int
+        Batches.
+    n : int
+        Samples.
     reliable : bool
         At least :data:`MIN_BATCHES` batches of :data:`BATCH_TAUS` tau_int each.
     """
@@ -409,10 +411,14 @@ class TimeAverage:
         The standard deviation of the means of ``n_batches`` consecutive equal batches over
         sqrt(n_batches) (stick-slip samples are correlated, so the naive error would be too
         small); NaN with fewer samples than batches.
-    t_from, t_to : float
-        The first and last sampling time averaged over.
-    n_samples, n_batches : int
-        Samples used and batches.
+    t_from : float
+        The first sampling time averaged over.
+    t_to : float
+        The last.
+    n_samples : int
+        Samples used.
+    n_batches : int
+        Batches of the error.
     """
 
     mean: float

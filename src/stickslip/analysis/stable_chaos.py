@@ -98,8 +98,10 @@ class FrontResult:
         delta -> the front against ``times``.
     block : int
         The block perturbed (0-based).
-    rel, t_max : float
-        The threshold's factor and the run length.
+    rel : float
+        The threshold's factor.
+    t_max : float
+        The run length.
     wall_seconds : float
         Time taken.
     """

@@ -1,8 +1,6 @@
-"""Analysis of chain runs: slip-size statistics (Figs. 7, 8), rupture fronts (Fig. 6), time averages (Fig. 5b).
-
-Conventions (docs/model.md): a slip event's size is S = sum_i (x_i(end) - x_i(start)); blocks are
-numbered 1..N. The functions here take the labelled tables of a chain run (``events``,
-``first_move``, ``samples``) and return labelled results: xarray Datasets and frozen dataclasses.
+"""Analysis of chain runs: slip-size statistics (Figs. 7, 8); rupture fronts (Fig. 6) and time
+averages (Fig. 5b) are importable here from :mod:`~stickslip.analysis.fronts` and
+:mod:`~stickslip.analysis.order`. A slip's size is S = sum_i (x_i(end) - x_i(start)) (docs/model.md).
 
 Power-law fit. The paper quotes p(S) ~ S^-tau with tau about 1.5 at beta = 1 (Fig. 7) and
 about 1.6 for small S at beta = 0.2 (Fig. 8). A finite chain cuts the distribution off near
@@ -14,19 +12,15 @@ the largest possible event, so the fit is the maximum-likelihood estimate for a 
 computed here in closed form (the score equation is solved by bracketing). For tau > 1
 ``scipy.stats.truncpareto.fit`` with c and scale fixed solves the same equation (the tests check
 that they agree); it is not called because for tau <= 1, which a fit range of junk can give, it
-falls back to a generic numerical search. The Kolmogorov-Smirnov distance is
-``scipy.stats.ks_1samp``'s and the bootstrap resampling ``scipy.stats.bootstrap``'s. The ``powerlaw``
-package (2.0) was checked and is not used for the estimate: ``powerlaw.Fit(..., xmax=...)``
-keeps the untruncated closed-form estimate 1 + n / sum log(S / s_min) whenever that estimate
-lies in (1.5, 3], i.e. it ignores ``xmax`` exactly in the range of exponents the paper reports
-(for tau = 1.5, s_max / s_min = 1e3 it returns about 1.57). Its truncated likelihood is only
-maximised with ``Power_Law(..., force_numerical_fit=True)``, a Nelder-Mead search with
-tolerance 1e-4; the tests use that as an independent check of this module.
+falls back to a generic numerical search. The KS distance is ``scipy.stats.ks_1samp``'s, the
+bootstrap ``scipy.stats.bootstrap``'s. ``powerlaw.Fit(..., xmax=...)`` (powerlaw 2.0) is not used:
+it keeps the untruncated estimate 1 + n / sum log(S / s_min) whenever it lies in (1.5, 3], the
+range the paper reports (for tau = 1.5, s_max / s_min = 1e3 it returns about 1.57); its
+``Power_Law(..., force_numerical_fit=True)`` is the tests' independent check of this module.
 
-Fit range. Without an explicit s_min the lower end is chosen by :func:`choose_s_min` (least
-Kolmogorov-Smirnov distance over a fixed candidate range; docs/statistics.md), because the
-smallest slips of a chain do not follow the power law: on the beta = 1 run of Fig. 7 the fit
-from the smallest S is rejected outright (KS distance about 0.5).
+Fit range. Without an explicit s_min the lower end is chosen by :func:`choose_s_min`
+(docs/statistics.md): the smallest slips of a chain do not follow the power law (on the
+beta = 1 run of Fig. 7 the fit from the smallest S has KS distance about 0.5).
 """
 
 from __future__ import annotations
@@ -276,12 +270,18 @@ class PowerLawFit:
         Its bootstrap standard error (NaN without bootstrap).
     tau_err_fisher : float
         The asymptotic error 1 / sqrt(n I(tau)) from the Fisher information.
-    s_min, s_max : float
-        The fitted range.
-    n, n_total : int
-        Events in [s_min, s_max] used for the fit; all finite positive events.
-    bootstrap, seed : int
-        Resamples of the error and their seed.
+    s_min : float
+        Lower end of the fitted range.
+    s_max : float
+        Upper end.
+    n : int
+        Events in [s_min, s_max] used for the fit.
+    n_total : int
+        All finite positive events.
+    bootstrap : int
+        Resamples of the error.
+    seed : int
+        Their seed.
     truncated : bool
         Whether the upper cut-off enters the likelihood (False: s_max = inf, the classic
         estimator).
