@@ -68,10 +68,10 @@ def assert_same_run(a, b, *, state: bool = True) -> None:
     assert a.first_move.equals(b.first_move), "first-move tables differ"
     assert_bits_equal(a.samples["t"].values, b.samples["t"].values, "sample times")
     assert_bits_equal(a.samples["L"].values, b.samples["L"].values, "L samples")
-    assert_bits_equal(a.snapshots["time"].values, b.snapshots["time"].values, "snapshot times")
+    assert_bits_equal(a.snapshots["snapshot_time"].values, b.snapshots["snapshot_time"].values, "snapshot times")
     assert_bits_equal(a.snapshots.values, b.snapshots.values, "snapshots")
-    assert_bits_equal(a.profiles["dx"].values, b.profiles["dx"].values, "profiles dx")
-    for c in ("event", "t", "t_next"):
+    assert_bits_equal(a.profiles["profile_dx"].values, b.profiles["profile_dx"].values, "profiles dx")
+    for c in ("profile_event", "profile_t", "profile_t_next"):
         assert_bits_equal(a.profiles[c].values, b.profiles[c].values, f"profiles {c}")
     for key in set(a.summary) | set(b.summary):
         if _is_work(key):

@@ -52,7 +52,7 @@ def test_dense_equals_exact_from_the_paper_start(beta, N, t_end, extra, expect_e
     assert_same_run(dense, exact)
     if expect_events:
         assert dense.summary["n_events"] > 0
-        assert len(dense.profiles["dx"]) > 0
+        assert len(dense.profiles["profile_dx"]) > 0
     # between slips the exact integrator skips work (otherwise this would not test its shortcuts)
     if expect_events:
         assert exact.summary["block_updates"] < dense.summary["block_updates"]

@@ -98,7 +98,7 @@ def test_state_nc_holds_labelled_arrays(run_and_dir):
 
 def test_snapshots_equal_runs_stopped_at_those_times(run_and_dir):
     run, _ = run_and_dir
-    times = run.snapshots["time"].values
+    times = run.snapshots["snapshot_time"].values
     assert times.tolist() == sorted(times.tolist())
     assert len(times) == len(SNAPS) + 1  # the requested times and the final state
     for i, t in enumerate(sorted(SNAPS)):

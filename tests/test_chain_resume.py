@@ -31,7 +31,7 @@ def full():
     """One uninterrupted run to T2 (about ten slips of up to five blocks)."""
     run = run_chain(P, T2, **OPTS)
     assert run.summary["n_events"] >= 5 and run.events["n_blocks"].max() >= 3
-    assert len(run.profiles["dx"]) > 0
+    assert len(run.profiles["profile_dx"]) > 0
     return run
 
 

@@ -12,7 +12,14 @@ from scipy.signal import lfilter
 from chain_helpers import run_cli_subprocess
 from stickslip.analysis.adaptive import assess, mser_cut
 from stickslip.experiments.ladders import ladder_task, perturbed
-from stickslip.experiments.transition_study import PER_N_COLUMNS, ladder_points, per_n_summary, run_transition
+from stickslip.experiments.transition_study import (
+    PER_N_COLUMNS,
+    ladder_points,
+    per_n_summary,
+    run_transition,
+    transition_loop,
+)
+from stickslip.models.params import ParameterError
 from stickslip.models.presets import chain_params
 from stickslip.run.state import ChainState
 
@@ -215,6 +222,31 @@ def test_run_transition_resumes_a_ladder_from_its_finished_rungs(tmp_path):
     second = run_transition(tmp_path, "tiny", n_workers=1, progress=False)
     assert second["meta"]["ladders_run"] == 3 and second["rows"] == first["rows"]
     assert {p: p.stat().st_mtime_ns for p in stamps} == stamps
+
+
+def test_transition_loop_runs_the_studys_ladders_in_this_process(tmp_path):
+    """transition_loop's rungs are the study's ladders with the study's settings (ladder_task with
+    the quick mode's, bit for bit); the up ladder stick-slips below the loop and slides above it;
+    a second call reuses every rung; a bad beta is refused before anything runs."""
+    kw = {"bisections": 1, "cap_loads": 1.0, "up": [0.8, 2.0, 4.0], "down": [2.0, 1.2, 0.8]}
+    rows = transition_loop(9, out_dir=tmp_path / "loop", **kw)
+    common, _ = ladder_points("quick")
+    for branch in ("up", "down"):
+        point = {**common, "N": 9, "direction": branch, "betas": kw[branch], "cap_loads": 1.0, "bisections": 1}
+        direct = ladder_task({**point, "seed": 0, "replica": 0}, tmp_path / branch)["rows"]
+        mine = rows[rows["branch"] == branch].sort_values("rung")
+        assert mine["beta"].tolist() == [r["beta"] for r in direct]
+        assert mine["order_parameter"].tolist() == [r["order_parameter"] for r in direct]
+        assert mine["final_sha256"].tolist() == [r["final_sha256"] for r in direct]
+    up = rows[rows["branch"] == "up"].set_index("beta")["branch_state"]
+    assert up[0.8] == "stick-slip" and up[4.0] == "sliding"
+    stamps = {q: q.stat().st_mtime_ns for q in (tmp_path / "loop").rglob("rung.json")}
+    assert len(stamps) == len(rows)
+    again = transition_loop(9, out_dir=tmp_path / "loop", **kw)
+    assert again.equals(rows) and {q: q.stat().st_mtime_ns for q in stamps} == stamps
+    with pytest.raises(ParameterError, match="beta"):
+        transition_loop(9, out_dir=tmp_path / "refused", up=[0.8, -1.0])
+    assert not (tmp_path / "refused").exists()
 
 
 # --- the faster method measures the same thing --------------------------------------------------

@@ -75,6 +75,55 @@ def test_help_gives_each_models_default():
     assert model_defaults("rs_a", 0.01).startswith("0.01; read by friction rate-state")
 
 
+def _commands(parser, prefix=()):
+    """Every command of the command line with its parser (sub-commands walked)."""
+    import argparse
+
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for name, sub in action.choices.items():
+                yield from _commands(sub, (*prefix, name))
+    if prefix:
+        yield prefix, parser
+
+
+#: Each model's default, written out from the presets' tables (docs/model.md, "Preset defaults";
+#: the single block's from its table there too): the chain's relatives, and the block's two models.
+CHAIN_DEFAULTS = {
+    "--K": "10 (sakaguchi, train, batista-carlson), 100 (carlson-langer, two-blocks)",
+    "--beta": "1 (sakaguchi, train), 0.08 (batista-carlson)",
+    "--sigma": "0.01 (carlson-langer, two-blocks)",
+    "--V": "0.001 (sakaguchi, train), 0.01 (carlson-langer, two-blocks), 0.05 (batista-carlson)",
+}
+BLOCK_DEFAULTS = {
+    "--V": "0.001 (sakaguchi), 0.05 (batista-carlson)",
+    "--beta": "1 (sakaguchi), 0.08 (batista-carlson)",
+    "--Fs": "3 (sakaguchi); not read by batista-carlson",
+    "--sigma": "(default 1)",
+}
+
+
+def test_every_command_with_models_gives_each_models_defaults(monkeypatch):
+    """A command that takes ``--model`` shows, for a parameter the models differ in, each model's
+    default; one that runs only the paper's block shows its own."""
+    from stickslip.cli import build_parser
+
+    monkeypatch.setenv("COLUMNS", "1000")  # one line per option: no hyphen broken across lines
+    checked = set()
+    for command, parser in _commands(build_parser()):
+        helps = {opt: a.help for a in parser._actions for opt in a.option_strings}
+        if "--model" not in helps or "--beta" not in helps:
+            continue
+        chain = "--nu" in helps  # the chain's relatives (Carlson-Langer's symbols)
+        for option, text in (CHAIN_DEFAULTS if chain else BLOCK_DEFAULTS).items():
+            if option in helps:
+                assert text in parser.format_help(), (command, option, helps[option])
+        checked.add(" ".join(command))
+    assert {"chain", "lyapunov", "stability chain", "block", "hysteresis"} <= checked
+    slip = dict(_commands(build_parser()))[("slip-limit",)].format_help()
+    assert "spring constant K (default 10)" in slip and "(sakaguchi)" not in slip
+
+
 def test_progress_shows_only_where_someone_watches(monkeypatch):
     # under the tests stderr is no terminal and no notebook runs: the default shows nothing
     assert progress.show_progress(None) is False and progress.show_progress(False) is False

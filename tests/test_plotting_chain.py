@@ -77,8 +77,12 @@ def synthetic_event(event: int, reach: int, t0: float, speed: float, window: flo
         overlap = np.clip(np.minimum(s + window, t_first + 30.0) - np.maximum(s, t_first), 0.0, None)
         dx[k, :reach] = 0.05 * overlap
     profiles = xr.Dataset(
-        {"dx": (("row", "block"), dx)},
-        coords={"event": ("row", np.full(starts.size, event)), "t": ("row", starts), "block": np.arange(1, P.N + 1)},
+        {"profile_dx": (("profile_row", "block"), dx)},
+        coords={
+            "profile_event": ("profile_row", np.full(starts.size, event)),
+            "profile_t": ("profile_row", starts),
+            "block": np.arange(1, P.N + 1),
+        },
     )
     return first_move, profiles
 
@@ -87,15 +91,15 @@ def test_fig6_draws_stacked_windows_and_the_fitted_front(tmp_path):
     fm_a, pr_a = synthetic_event(3, P.N, 19_100.0, 1.43)
     fm_b, pr_b = synthetic_event(8, 50, 40_400.0, 1.43)
     first_move = pd.concat([fm_a, fm_b], ignore_index=True)
-    profiles = xr.concat([pr_a, pr_b], dim="row")
+    profiles = xr.concat([pr_a, pr_b], dim="profile_row")
     fronts = [front_speed(first_move, 3), front_speed(first_move, 8)]
     assert fronts[0].speed == pytest.approx(1.43, rel=1e-9)
     fig = fig6_fronts(profiles, first_move, fronts, P, labels=["large event", "intermediate event"])
     assert len(fig.axes) == 4
     waterfall, arrivals = fig.axes[0], fig.axes[1]
-    assert len(waterfall.get_lines()) == pr_a.sizes["row"]
+    assert len(waterfall.get_lines()) == pr_a.sizes["profile_row"]
     # each window's curve is its displacement lifted by a constant
-    lifted = [ln.get_ydata() - pr_a["dx"].values[k] for k, ln in enumerate(waterfall.get_lines())]
+    lifted = [ln.get_ydata() - pr_a["profile_dx"].values[k] for k, ln in enumerate(waterfall.get_lines())]
     assert all(np.ptp(v) < 1e-12 for v in lifted)
     assert np.all(np.diff([v[0] for v in lifted]) > 0)
     fit = line(arrivals, "fit:")

@@ -409,8 +409,12 @@ def test_leading_edge_speed_of_a_known_front():
     for k, s in enumerate(starts):
         dx[k] = 0.05 * np.clip(np.minimum(s + window, t_first + 60.0) - np.maximum(s, t_first), 0.0, None)
     profiles = xr.Dataset(
-        {"dx": (("row", "block"), dx)},
-        coords={"event": ("row", np.full(starts.size, 4)), "t": ("row", starts), "block": np.arange(1, N + 1)},
+        {"profile_dx": (("profile_row", "block"), dx)},
+        coords={
+            "profile_event": ("profile_row", np.full(starts.size, 4)),
+            "profile_t": ("profile_row", starts),
+            "block": np.arange(1, N + 1),
+        },
     )
     edge = leading_edge_speed(profiles, 4)
     # each edge sits within one block-step of the front at the window's end

@@ -43,8 +43,26 @@ def mser_cut(x: np.ndarray, block: int = MSER_BLOCK) -> int:
     """Number of leading samples of ``x`` to drop as transient (MSER-``block``, White 1997).
 
     The series is cut into means of ``block`` samples y_j; the cut d (in blocks) minimises
-    sum_{j>=d} (y_j - mean(y[d:]))^2 / (n - d)^2 over d <= n / 2. Returns d * block samples.
-    A constant series gives 0.
+    sum_{j>=d} (y_j - mean(y[d:]))^2 / (n - d)^2 over d <= n / 2.
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        The series, in time order (the order parameter m of a rung, say).
+    block : int
+        Samples per batch mean (MSER-5 by default).
+
+    Returns
+    -------
+    int
+        d * block, the samples to drop; 0 for a constant series.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from stickslip.analysis.adaptive import mser_cut
+    >>> mser_cut(np.concatenate([np.linspace(10.0, 0.0, 50), np.zeros(450)]))
+    50
     """
     x = np.asarray(x, dtype=float)
     n = x.size // block
@@ -63,9 +81,24 @@ def mser_cut(x: np.ndarray, block: int = MSER_BLOCK) -> int:
 
 @dataclass(frozen=True)
 class Assessment:
-    """What the samples of one point say: ``m`` and ``phi`` (estimates over the kept window),
-    ``t_cut`` (start of the kept window), ``decided`` (the stop rule holds), ``sliding`` (no block
-    stuck in the kept window), ``reason`` (one line)."""
+    """What the samples of one point say after the transient is dropped (:func:`assess`).
+
+    Attributes
+    ----------
+    m : MeanEstimate
+        The order parameter m over the kept window with its batch-means error
+        (:func:`stickslip.analysis.order.mean_with_error`).
+    phi : MeanEstimate
+        The stuck fraction phi over the kept window, likewise.
+    t_cut : float
+        Start of the kept window (model time).
+    decided : bool
+        Whether the stop rule holds (error of m below the target from enough batches).
+    sliding : bool
+        Whether no block was stuck in the kept window.
+    reason : str
+        One line saying why the point is decided or not.
+    """
 
     m: MeanEstimate
     phi: MeanEstimate
@@ -82,9 +115,31 @@ class Assessment:
 
 
 def assess(t: np.ndarray, m: np.ndarray, phi: np.ndarray, target: float, min_batches: int = STOP_BATCHES) -> Assessment:
-    """Drop the transient of the order parameter ``m`` sampled at times ``t`` (MSER on m and on
-    the stuck fraction ``phi``, the later cut wins) and test the stop rule: batch-means error of m
-    below ``target`` from at least ``min_batches`` (:data:`STOP_BATCHES`) batches of 10 tau_int."""
+    """Drop the transient of the order parameter ``m`` sampled at times ``t`` and test the stop rule
+    of the transition study (docs/studies/transition.md).
+
+    The transient is cut by MSER (:func:`mser_cut`) on m and on the stuck fraction ``phi``, the
+    later cut winning; the rule holds when the batch-means error of m is below ``target`` from at
+    least ``min_batches`` (:data:`STOP_BATCHES`) batches of 10 tau_int.
+
+    Parameters
+    ----------
+    t : numpy.ndarray
+        Sampling times (model time), increasing.
+    m : numpy.ndarray
+        m = 1 - L / L_ss at those times.
+    phi : numpy.ndarray
+        Stuck fraction 1 - n_moving / N at those times.
+    target : float
+        Largest error of m at which the point is decided.
+    min_batches : int
+        Fewest batches of 10 tau_int the error must come from.
+
+    Returns
+    -------
+    Assessment
+        m and phi over the kept window, where it starts, and whether the rule holds, with why.
+    """
     t, m, phi = (np.asarray(a, dtype=float) for a in (t, m, phi))
     if t.size < 4 * MSER_BLOCK:
         empty = mean_with_error(m)

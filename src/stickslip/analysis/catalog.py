@@ -60,7 +60,23 @@ CATALOG_DOCS = {
 
 
 def load_catalog_run(run_dir: str | Path):
-    """The :class:`~stickslip.run.outputs.ChainRun` of a run directory, or a ParameterError in one line."""
+    """The chain run of a run directory, for ``stickslip catalog``.
+
+    Parameters
+    ----------
+    run_dir : str or Path
+        A directory written by ``stickslip chain --out`` or ``run.save``.
+
+    Returns
+    -------
+    ChainRun
+        The run (:func:`~stickslip.run.rundir.load_run`).
+
+    Raises
+    ------
+    ParameterError
+        In one line, where the folder holds no whole run.
+    """
     from stickslip.run.rundir import RunDirDamaged, load_run
 
     run_dir = Path(run_dir)
@@ -78,7 +94,20 @@ def load_catalog_run(run_dir: str | Path):
 
 
 def slip_catalog(run) -> pd.DataFrame:
-    """The catalogue of a run's slips in its stationary window: one row per slip, :data:`CATALOG_COLUMNS`."""
+    """The catalogue of a run's slips in its stationary window.
+
+    Parameters
+    ----------
+    run : ChainRun
+        A chain run (eq. 4 or a relative).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per slip, the columns :data:`CATALOG_COLUMNS` (described in :data:`CATALOG_DOCS`):
+        ``event``, ``t_start``, ``duration``, ``S``, ``magnitude`` = (2/3) log10 S, ``epicentre``,
+        ``extent``, ``reach``, ``spans``.
+    """
     events = stationary_events(run)
     column = spanning_column(run.params)
     S = events["S"].to_numpy(dtype=np.float64)
@@ -99,33 +128,47 @@ def slip_catalog(run) -> pd.DataFrame:
 
 
 def moment_rate(run, catalog: pd.DataFrame, *, largest: int = 5) -> tuple[pd.DataFrame, list[dict[str, Any]], str]:
-    """Moment rate of the largest slips with stored displacement profiles (``--profile-window``).
+    """Moment rate of the largest slips with stored displacement profiles (``profile_window``).
 
-    For each window [t, t + W] of an event's profiles the moment rate is sum_i Delta x_i / W,
-    the slip rate summed over the blocks (S is the moment up to a constant, so this is the
+    For each window [t, t + W] of an event's profiles the moment rate is sum_i Delta x_i / W, the
+    slip rate summed over the blocks (S is the moment up to a constant, so this is the
     moment-rate function up to the same constant); its time integral is the slip the windows
-    cover, at most S. Returns the table (event, t: window centre from the slip's start, rate),
-    one summary per event (S, covered fraction, peak rate and its time, duration) and, when
-    there is nothing to show, why.
+    cover, at most S.
+
+    Parameters
+    ----------
+    run : ChainRun
+        A run with ``profiles``.
+    catalog : pandas.DataFrame
+        Its catalogue (:func:`slip_catalog`), from which the largest slips are picked.
+    largest : int
+        How many slips.
+
+    Returns
+    -------
+    tuple of (pandas.DataFrame, list of dict, str)
+        The table (``event``, ``t``: window centre from the slip's start, ``rate``), one summary
+        per event (S, covered fraction, peak rate and its time, duration) and, when there is
+        nothing to show, why (else an empty string).
     """
     profiles = run.profiles
-    if not profiles.sizes.get("row", 0):
+    if not profiles.sizes.get("profile_row", 0):
         return (
             pd.DataFrame(columns=["event", "t", "rate"]),
             [],
             "no displacement profiles stored (run with --profile-window W)",
         )
-    stored = set(np.unique(profiles["event"].values).tolist())
+    stored = set(np.unique(profiles["profile_event"].values).tolist())
     picks = catalog[catalog["event"].isin(stored)].nlargest(largest, "S")
     if picks.empty:
         return pd.DataFrame(columns=["event", "t", "rate"]), [], "no slip of the stationary window has stored profiles"
-    event_of_row = profiles["event"].values
+    event_of_row = profiles["profile_event"].values
     rows, summaries = [], []
     for r in picks.itertuples():
         sel = np.flatnonzero(event_of_row == r.event)
-        t0 = profiles["t"].values[sel]
-        t1 = profiles["t_next"].values[sel]
-        slip = profiles["dx"].values[sel].sum(axis=1)
+        t0 = profiles["profile_t"].values[sel]
+        t1 = profiles["profile_t_next"].values[sel]
+        slip = profiles["profile_dx"].values[sel].sum(axis=1)
         rate = slip / (t1 - t0)
         centre = 0.5 * (t0 + t1) - r.t_start
         rows.append(pd.DataFrame({"event": int(r.event), "t": centre, "rate": rate}))
@@ -172,10 +215,21 @@ def _frequency_magnitude(M: np.ndarray, S: np.ndarray, size_fit, *, dm: float, b
 class Catalog:
     """A run's catalogue and what is read from it (:func:`catalog_analysis`).
 
-    ``table``: :func:`slip_catalog`; ``summary``: every number, JSON-able; ``size_fits``: the
-    Figs. 7/8 statistics (:func:`~stickslip.analysis.chain_runs.run_size_statistics`) by reading
-    ("whole range", "below spanning"); ``candidates``: the fitted candidate densities;
-    ``moment_rate``: the moment-rate table; ``intervals``: inter-event times, all and spanning.
+    Attributes
+    ----------
+    table : pandas.DataFrame
+        One row per slip of the stationary window (:func:`slip_catalog`).
+    summary : dict
+        Every number read from it, JSON-able.
+    size_fits : dict
+        The Figs. 7/8 statistics (:func:`~stickslip.analysis.chain_runs.run_size_statistics`) by
+        reading ("whole range", "below spanning").
+    candidates : dict
+        The fitted candidate densities of the sizes.
+    moment_rate : pandas.DataFrame or None
+        The moment-rate table (:func:`moment_rate`).
+    intervals : dict
+        Inter-event times, all and of the spanning slips.
     """
 
     table: pd.DataFrame
@@ -197,10 +251,31 @@ def catalog_analysis(
 ) -> Catalog:
     """Catalogue of a chain run and everything read from it (``stickslip catalog``; module docstring).
 
-    ``run``: a :class:`~stickslip.run.outputs.ChainRun` or a run directory. ``dm``: magnitude bin
-    of the b-value; ``bootstrap``: resamples of the tau and b errors; ``gof_sims``: synthetic
-    catalogues of the KS goodness of fit (0: none); ``seed`` of all of them. A run with fewer than
-    ``min_events`` slips with S > 0 in its stationary window is refused (ParameterError, one line).
+    Parameters
+    ----------
+    run : ChainRun or str or Path
+        A run, or a run directory.
+    dm : float
+        Magnitude bin of the b-value.
+    bootstrap : int
+        Resamples of the tau and b errors.
+    gof_sims : int
+        Synthetic catalogues of the KS goodness of fit (0: none).
+    seed : int
+        Seed of all of them.
+    min_events : int
+        Fewest slips with S > 0 in the stationary window.
+
+    Returns
+    -------
+    Catalog
+        The table, the summary, the size fits, the candidate distributions, the moment rate and
+        the inter-event times.
+
+    Raises
+    ------
+    ParameterError
+        For a run with fewer than ``min_events`` slips (one line).
     """
     if isinstance(run, (str, Path)):
         run = load_catalog_run(run)

@@ -51,6 +51,16 @@ def stationary_from(run) -> float:
     given another (``stickslip chain --average-from``). A chain loaded from x_i = 0 needs about
     L_ss / V to load (:func:`stickslip.run.state.loading_warnings` says so when the window starts
     earlier); its events before then are the loading, not the stationary state.
+
+    Parameters
+    ----------
+    run : ChainRun
+        A chain run (from ``run_chain`` or ``load_run``).
+
+    Returns
+    -------
+    float
+        The window's start time (model units).
     """
     summary = getattr(run, "summary", {}) or {}
     if summary.get("L_mean_from") is not None:
@@ -60,7 +70,18 @@ def stationary_from(run) -> float:
 
 
 def stationary_events(run) -> pd.DataFrame:
-    """The events of ``run`` in its stationary window (:func:`stationary_from`), in order."""
+    """The events of ``run`` in its stationary window (:func:`stationary_from`), in order.
+
+    Parameters
+    ----------
+    run : ChainRun
+        A chain run.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The rows of ``run.events`` with ``t_start`` in the window.
+    """
     return run.events[run.events["t_start"] >= stationary_from(run)]
 
 
@@ -71,6 +92,16 @@ def spanning_column(params: ChainParams) -> str:
     ``max_block`` = N. A plate-driven chain (Burridge-Knopoff, Carlson-Langer) has no far end
     (periodic or not, every block is loaded alike): an event spans it when all N blocks moved,
     column ``n_blocks`` = N.
+
+    Parameters
+    ----------
+    params : ChainParams
+        The model (its drive piece).
+
+    Returns
+    -------
+    str
+        ``"max_block"`` or ``"n_blocks"``.
     """
     return "n_blocks" if params.drive_piece.leaf_spring else "max_block"
 
@@ -78,8 +109,40 @@ def spanning_column(params: ChainParams) -> str:
 def run_size_statistics(run, *, small_only: bool, seed: int = 0, bootstrap: int = 200) -> dict[str, Any]:
     """:func:`size_statistics` of a run's stationary events (Figs. 7, 8), as ``plot``, ``reproduce``
     and ``catalog`` all compute it: the window of :func:`stationary_from`, spanning events by
-    :func:`spanning_column`. Adds ``t_from`` (start of the window) and ``spanning``; raises
-    ValueError when the window holds no event with S > 0."""
+    :func:`spanning_column`.
+
+    Parameters
+    ----------
+    run : ChainRun
+        A chain run.
+    small_only : bool
+        Fit below the smallest spanning event (Fig. 8) rather than over the whole range (Fig. 7).
+    seed : int
+        Seed of the bootstrap.
+    bootstrap : int
+        Bootstrap resamples of the error of tau.
+
+    Returns
+    -------
+    dict
+        :func:`size_statistics`'s (``fit``, a
+        :class:`~stickslip.analysis.statistics.PowerLawFit`, the spanning events and the excess of
+        large events) with ``t_from`` (start of the window) and ``spanning``.
+
+    Raises
+    ------
+    ValueError
+        When the window holds no event with S > 0.
+
+    Examples
+    --------
+    >>> import stickslip
+    >>> from stickslip.analysis.chain_runs import run_size_statistics
+    >>> run = stickslip.run_chain(stickslip.chain_params(N=12), 6e4)
+    >>> fit = run_size_statistics(run, small_only=False, bootstrap=0)["fit"]
+    >>> 1.0 < fit.tau < 3.0 and fit.n <= fit.n_total
+    True
+    """
     events = stationary_events(run)
     S = events["S"].to_numpy(dtype=float)
     if not np.any(np.isfinite(S) & (S > 0)):
@@ -97,8 +160,24 @@ def final_state(summary: dict[str, Any], state, params: ChainParams, tolerance: 
     Steady sliding: the run stopped there (``until_steady``), or its final state is within
     ``tolerance`` of it (:func:`stickslip.run.state.steady_deviation`; ``stickslip reproduce``
     uses :data:`stickslip.experiments.specs.UNTIL_STEADY`), which for beta > 1 it never leaves.
-    Otherwise stick-slip if events happened in the averaged
-    second half or some block is stopped at the end. Returns the state and the final deviation.
+    Otherwise stick-slip if events happened in the averaged second half or some block is stopped
+    at the end.
+
+    Parameters
+    ----------
+    summary : dict
+        The run's summary (``stopped_early``, ``n_events_late``, ``n_moving``).
+    state : ChainState
+        Its final state.
+    params : ChainParams
+        Its model.
+    tolerance : float
+        Largest deviation from steady sliding taken as steady.
+
+    Returns
+    -------
+    tuple of (str, float)
+        The state and the final deviation from steady sliding.
     """
     deviation = steady_deviation(state, params)
     if summary.get("stopped_early") or deviation <= tolerance:
@@ -113,17 +192,37 @@ def size_statistics(
 ) -> dict[str, Any]:
     """Slip-size statistics of one chain run for Fig. 7 (beta = 1) or Fig. 8 (beta = 0.2).
 
-    The events that reach block N ("system-spanning") set the largest sizes. With
-    ``small_only`` (Fig. 8, "about 1.6 for small S") the power law is fitted below the smallest
-    system-spanning event, s_span; otherwise (Fig. 7) up to the largest S, with the cut-off in
-    the likelihood. s_min is the default of :func:`~stickslip.analysis.statistics.fit_power_law`
-    (:func:`~stickslip.analysis.statistics.choose_s_min`, least KS distance). ``excess`` is the number of events
-    with S >= s_span over the number the fitted power law, continued without cut-off beyond
-    s_span, predicts for them (the paper's "excess of large events" at beta = 0.2 is > 1).
+    The events that span the system set the largest sizes. With ``small_only`` (Fig. 8, "about
+    1.6 for small S") the power law is fitted below the smallest spanning event, s_span; otherwise
+    (Fig. 7) up to the largest S, with the cut-off in the likelihood. s_min is the default of
+    :func:`~stickslip.analysis.statistics.fit_power_law`
+    (:func:`~stickslip.analysis.statistics.choose_s_min`, least KS distance).
 
-    ``spanning`` says which events span the system: "max_block" (they reach block N: the
-    end-driven chain of eq. 4) or "n_blocks" (all N blocks moved: the periodic Carlson-Langer
-    chain, which has no far end). ``observed`` and ``expected`` are the two counts of the excess.
+    Parameters
+    ----------
+    events : pandas.DataFrame
+        The event table (``S`` and the ``spanning`` column), usually the stationary window's.
+    N : int
+        Blocks of the chain.
+    small_only : bool
+        Fit below s_span (Fig. 8) or over the whole range (Fig. 7).
+    seed : int
+        Seed of the bootstrap.
+    spanning : str
+        Which events span the system: ``"max_block"`` (they reach block N: the end-driven chain
+        of eq. 4) or ``"n_blocks"`` (all N blocks moved: the periodic Carlson-Langer chain, which
+        has no far end).
+    bootstrap : int
+        Bootstrap resamples of the error of tau.
+
+    Returns
+    -------
+    dict
+        ``fit`` (:class:`~stickslip.analysis.statistics.PowerLawFit`), ``n_events``,
+        ``n_spanning``, ``s_span``, ``S_max``, ``largest_reaches_N``, and ``excess``: the number of
+        events with S >= s_span (``observed``) over the number the fitted power law, continued
+        without cut-off beyond s_span, predicts for them (``expected``); the paper's "excess of
+        large events" at beta = 0.2 is > 1.
     """
     if spanning not in ("max_block", "n_blocks"):
         raise ValueError(f"spanning must be 'max_block' or 'n_blocks' (got {spanning!r})")
@@ -161,13 +260,28 @@ def front_speeds(run, N: int, t_from: float) -> pd.DataFrame:
     Two definitions side by side: ``c_first_move``, the least-squares slope of block against
     first-move time over the far half (:func:`~stickslip.analysis.statistics.front_speed`), and
     ``c_leading_edge``, the slope of the leading edge of the Delta x_i windows against window
-    end (:func:`~stickslip.analysis.statistics.leading_edge_speed`; NaN where the event has no
-    stored profiles or fewer than two windows in the far half). One row per event.
+    end (:func:`~stickslip.analysis.statistics.leading_edge_speed`).
+
+    Parameters
+    ----------
+    run : ChainRun
+        A chain run (its ``first_move`` and ``profiles``).
+    N : int
+        The block an event must reach.
+    t_from : float
+        Earliest start time of the events.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per event: ``event``, ``t_start``, ``S``, ``c_first_move`` and ``c_leading_edge``
+        (blocks per time unit; NaN where the event has no stored profiles or fewer than two
+        windows in the far half).
     """
     events = run.events[(run.events["t_start"] >= t_from) & (run.events["max_block"] >= N)]
     groups = {int(e): g for e, g in run.first_move.groupby("event")}
-    profiles = run.profiles if run.profiles.sizes.get("row") else None
-    stored = set(np.unique(profiles["event"].values).tolist()) if profiles is not None else set()
+    profiles = run.profiles if run.profiles.sizes.get("profile_row") else None
+    stored = set(np.unique(profiles["profile_event"].values).tolist()) if profiles is not None else set()
     rows = []
     for r in events.itertuples():
         e = int(r.event)
@@ -192,15 +306,30 @@ def front_speeds(run, N: int, t_from: float) -> pd.DataFrame:
 def front_statistics(run, N: int, t_from: float) -> dict[str, Any]:
     """Rupture fronts for Fig. 6: the picked large and intermediate events and all spanning ones.
 
-    The picks (:func:`stickslip.analysis.statistics.pick_front_events`) are made among the events after
-    ``t_from`` whose displacement profiles were stored. ``per_event`` is :func:`front_speeds`
-    (both definitions for every event after ``t_from`` that reached block N); ``speeds`` its
-    first-move column without NaN, whose median and quartiles are kept for the summary;
-    ``edges`` the leading-edge fits of the picked events (None where there is none);
-    ``t_first_span``: start of the run's first event that reached block N (NaN if none).
+    The picks (:func:`stickslip.analysis.statistics.pick_front_events`) are made among the events
+    after ``t_from`` whose displacement profiles were stored.
+
+    Parameters
+    ----------
+    run : ChainRun
+        A chain run with ``profiles``.
+    N : int
+        The block a spanning event reaches.
+    t_from : float
+        Earliest start time of the events.
+
+    Returns
+    -------
+    dict
+        ``fronts`` (the picks' :class:`~stickslip.analysis.statistics.FrontSpeed`), their
+        ``labels`` and ``edges`` (leading-edge fits, None where there is none), ``picks``,
+        ``per_event`` (:func:`front_speeds`), ``speeds`` (its first-move column without NaN),
+        ``median_speed`` and ``quartiles`` of them, and ``t_first_span`` (start of the run's
+        first event that reached block N; NaN if none).
     """
     events = run.events[run.events["t_start"] >= t_from]
-    with_profiles = set(np.unique(run.profiles["event"].values).tolist()) if run.profiles.sizes.get("row") else set()
+    prof = run.profiles
+    with_profiles = set(np.unique(prof["profile_event"].values).tolist()) if prof.sizes.get("profile_row") else set()
     candidates = events[events["event"].isin(with_profiles)]
     picks = pick_front_events(candidates, N) if len(candidates) else candidates.assign(kind=pd.Series(dtype=str))
     groups = {int(e): g for e, g in run.first_move.groupby("event")}
@@ -240,7 +369,17 @@ def fig6_start_note(a: dict[str, Any]) -> str:
 
     From x_i(0) = 0 the pulled end must first stretch the chain by about its steady length
     L_ss = (c/K) N (N - 1) / 2 before an event can reach block N, which at pulling speed V takes
-    t ~ L_ss / V (8.0e6 for N = 399); ``a`` is :func:`stickslip.analysis.chain_runs.chain_analysis`.
+    t ~ L_ss / V (8.0e6 for N = 399).
+
+    Parameters
+    ----------
+    a : dict
+        :func:`chain_analysis` of the experiment.
+
+    Returns
+    -------
+    str
+        The note, with the numbers of the paper's N = 399 and of this run.
     """
     p = a["run1"].params
     p399 = p.replace(N=399)
@@ -259,10 +398,21 @@ def fig6_start_note(a: dict[str, Any]) -> str:
 
 
 def chain_analysis(outcome) -> dict[str, Any]:
-    """Everything Figs. 5-8 and their rows need from the chain runs of one experiment.
+    """Everything Figs. 5-8 and their rows need from the chain runs of one experiment of
+    ``stickslip reproduce``.
 
-    ``outcome`` is the :class:`~stickslip.experiments.specs.Outcome` of a ``chain_runs``
-    experiment: its options name the sweep's N, the figures' N and their run length.
+    Parameters
+    ----------
+    outcome : Outcome
+        The :class:`~stickslip.experiments.specs.Outcome` of a ``chain_runs`` experiment: its
+        options name the sweep's N, the figures' N and their run length.
+
+    Returns
+    -------
+    dict
+        The sweep's ``table``, the runs at beta = 1 and 0.2 (``run1``, ``run02``), their
+        stationary events and size statistics (``sizes1``, ``sizes02``; None with fewer than 10
+        events), the rupture fronts (``fronts``), ``t_from``, ``sweep_N``, ``figure_N``, ``t_fig``.
     """
     opts = outcome.experiment.options
     table = outcome.data["table"]
@@ -283,7 +433,20 @@ def chain_analysis(outcome) -> dict[str, Any]:
 
 
 def sweep_table(a: dict[str, Any]) -> pd.DataFrame:
-    """The runs at the sweep's N (Fig. 5b), by beta, with the columns the figure and its row show."""
+    """The runs at the sweep's N (Fig. 5b), by beta, with the columns the figure and its row show.
+
+    Parameters
+    ----------
+    a : dict
+        :func:`chain_analysis` of the experiment.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per beta: ``beta``, ``N``, ``L_mean``, ``L_err``, ``L_steady``, ``final_state``,
+        ``n_events``, ``n_events_late``, ``t_steady``, ``stopped_early``, ``t_end``,
+        ``wall_seconds``.
+    """
     t = a["table"]
     t = t[t["N"] == a["sweep_N"]].sort_values("beta")
     cols = [

@@ -22,13 +22,32 @@ from scipy import stats
 
 @dataclass(frozen=True)
 class FrontSpeed:
-    """Speed of a rupture front fitted from first-motion times (Fig. 6).
+    """Speed of a rupture front fitted from first-motion times (Fig. 6; :func:`front_speed`).
 
     Least squares of block index i against first-move time t over blocks i_min..i_max:
-    i = i_0 + speed (t - t_start). ``speed`` is in blocks per time unit (the paper: c = 1.43 in
-    large events at beta = 1, below the sound speed sqrt(K) = 3.16); ``speed_err`` is the
-    standard error of the slope; ``t_start`` the event's first first-move time; ``intercept``
-    is i_0; ``rms`` the residual root mean square in blocks; ``n_blocks`` the blocks fitted.
+    i = i_0 + speed (t - t_start).
+
+    Attributes
+    ----------
+    event : int
+        The event's number.
+    speed : float
+        Blocks per time unit (the paper: c = 1.43 in large events at beta = 1, below the sound
+        speed sqrt(K) = 3.16).
+    speed_err : float
+        Standard error of the slope.
+    intercept : float
+        i_0.
+    t_start : float
+        The event's first first-move time.
+    i_min : int
+        The first block fitted.
+    i_max : int
+        The last block fitted.
+    n_blocks : int
+        How many blocks were fitted.
+    rms : float
+        Root mean square of the residuals, in blocks.
     """
 
     event: int
@@ -58,11 +77,37 @@ def front_speed(
 ) -> FrontSpeed:
     """Rupture-front speed of one event from the time each block first moved (Fig. 6).
 
-    ``first_move`` is the run's long table (event, block, t_first), blocks numbered 1..N;
-    blocks that did not move are absent or have NaN ``t_first``. The paper measures the leading
-    edge "for large i", away from the pulled end where the rupture starts, so by default the
-    fit uses the far half of the blocks the event reached: i_min = ceil(i_far / 2),
-    i_max = i_far, with i_far the farthest block that moved.
+    The paper measures the leading edge "for large i", away from the pulled end where the rupture
+    starts, so by default the fit uses the far half of the blocks the event reached:
+    i_min = ceil(i_far / 2), i_max = i_far, with i_far the farthest block that moved.
+
+    Parameters
+    ----------
+    first_move : pandas.DataFrame
+        The run's long table (``event``, ``block``, ``t_first``; ``ChainRun.first_move``), blocks
+        numbered 1..N; blocks that did not move are absent or have NaN ``t_first``.
+    event : int
+        The event's number.
+    i_min, i_max : int, optional
+        The blocks fitted (default the far half).
+
+    Returns
+    -------
+    FrontSpeed
+        The fitted speed, its error and the fitted range.
+
+    Raises
+    ------
+    ValueError
+        Where the event has fewer than 3 moved blocks in the range, or they first moved at one time.
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> from stickslip.analysis.statistics import front_speed
+    >>> fm = pd.DataFrame({"event": 0, "block": range(1, 21), "t_first": [i / 1.43 for i in range(1, 21)]})
+    >>> round(front_speed(fm, 0).speed, 9), front_speed(fm, 0).i_min
+    (1.43, 10)
     """
     rows = first_move[(first_move["event"] == event) & np.isfinite(first_move["t_first"])]
     if rows.empty:
@@ -98,15 +143,35 @@ def front_speed(
 
 @dataclass(frozen=True)
 class EdgeSpeed:
-    """Speed of the leading edge of the Delta x_i windows of one event, as the paper reads Fig. 6.
+    """Speed of the leading edge of the Delta x_i windows of one event, as the paper reads Fig. 6
+    (:func:`leading_edge_speed`).
 
     For each stored window (Delta x_i = x_i(t + Delta t) - x_i(t)) the edge is the farthest block
-    whose Delta x_i is at least ``edge_fraction`` of that window's largest Delta x_i; ``edges``
-    and ``times`` (window ends) are those of every window. The speed is the least-squares slope
-    of edge against time over the windows whose edge lies in [i_min, i_max) (the far half, as
-    :func:`front_speed`; a window whose edge has reached i_max is left out: it only says the
-    front got there within the window, and so are the windows after it). ``n_windows``: windows
-    fitted; ``speed_err`` NaN with 2.
+    whose Delta x_i is at least ``edge_fraction`` of that window's largest Delta x_i. The speed is
+    the least-squares slope of edge against time over the windows whose edge lies in
+    [i_min, i_max) (the far half, as :func:`front_speed`; a window whose edge has reached i_max is
+    left out: it only says the front got there within the window, and so are the windows after it).
+
+    Attributes
+    ----------
+    event : int
+        The event's number.
+    speed : float
+        The slope, blocks per time unit.
+    speed_err : float
+        Its standard error (NaN with 2 windows).
+    i_min : int
+        The lowest edge fitted.
+    i_max : int
+        The edge at which the fit stops (left out).
+    n_windows : int
+        Windows fitted.
+    edge_fraction : float
+        The share of a window's largest Delta x_i that marks its edge.
+    edges : tuple
+        The edge of every window.
+    times : tuple
+        The end time of every window.
     """
 
     event: int
@@ -133,21 +198,42 @@ def leading_edge_speed(
 ) -> EdgeSpeed:
     """Rupture-front speed of one event from the leading edge of its Delta x_i windows (Fig. 6).
 
-    ``profiles``: the run's stored windows (dim ``row`` with ``event``, ``t`` (window start),
-    optionally ``t_next`` (window end), ``dx(row, block)``). Default range: the far half of the
-    blocks the event reached, i_min = ceil(i_far / 2), i_max = i_far (i_far: the farthest edge).
+    Parameters
+    ----------
+    profiles : xarray.Dataset
+        The run's stored windows (``ChainRun.profiles``: dim ``profile_row`` with
+        ``profile_event``, ``profile_t`` (window start), optionally ``profile_t_next`` (window
+        end), ``profile_dx(profile_row, block)``).
+    event : int
+        The event's number.
+    edge_fraction : float
+        The share of a window's largest Delta x_i that marks its edge.
+    i_min, i_max : int, optional
+        The range of edges fitted (default the far half of the blocks the event reached,
+        i_min = ceil(i_far / 2), i_max = i_far, i_far the farthest edge).
+
+    Returns
+    -------
+    EdgeSpeed
+        The speed, its error and every window's edge.
+
+    Raises
+    ------
+    ValueError
+        Where the event has no stored windows, or fewer than two with the edge in range.
     """
-    rows = np.flatnonzero(profiles["event"].values == event)
+    rows = np.flatnonzero(profiles["profile_event"].values == event)
     if rows.size == 0:
         raise ValueError(f"no displacement profiles stored for event {event}")
-    sub = profiles.isel(row=rows)
-    order = np.argsort(sub["t"].values, kind="stable")
-    dx = sub["dx"].transpose("row", "block").values[order]
+    sub = profiles.isel(profile_row=rows)
+    order = np.argsort(sub["profile_t"].values, kind="stable")
+    dx = sub["profile_dx"].transpose("profile_row", "block").values[order]
     blocks = sub["block"].values if "block" in sub.coords else np.arange(1, dx.shape[1] + 1)
-    t_end = (sub["t_next"] if "t_next" in sub.coords else sub["t"]).values[order]
-    if "t_next" not in sub.coords or np.all(t_end == sub["t"].values[order]):
+    has_end = "profile_t_next" in sub.coords
+    t_end = (sub["profile_t_next"] if has_end else sub["profile_t"]).values[order]
+    if not has_end or np.all(t_end == sub["profile_t"].values[order]):
         # window ends: the next window's start, the last one as long as the one before it
-        starts = sub["t"].values[order]
+        starts = sub["profile_t"].values[order]
         width = float(np.median(np.diff(starts))) if starts.size > 1 else 0.0
         t_end = np.append(starts[1:], starts[-1] + width)
     edges = np.zeros(dx.shape[0], dtype=np.int64)
@@ -181,11 +267,29 @@ def leading_edge_speed(
 
 @dataclass(frozen=True)
 class CentralInterval:
-    """Where a stated value lies in a per-event distribution (Fig. 6: the paper's c = 1.43).
+    """Where a stated value lies in a per-event distribution (Fig. 6: the paper's c = 1.43;
+    :func:`central_interval`).
 
-    ``percentile``: the share of the sample below ``value`` (ties count half), in percent;
-    ``lo``, ``hi``: the bounds of the central ``level`` of the sample (5th and 95th percentiles
-    for level 0.9); ``inside``: lo <= value <= hi; ``median``, ``quartiles``, ``n``.
+    Attributes
+    ----------
+    value : float
+        The stated value.
+    level : float
+        The share of the sample the interval holds.
+    lo : float
+        Lower bound of the central ``level`` of the sample (the 5th percentile for 0.9).
+    hi : float
+        Upper bound (the 95th percentile for 0.9).
+    inside : bool
+        lo <= value <= hi.
+    percentile : float
+        The share of the sample below ``value`` (ties count half), in percent.
+    median : float
+        The sample's median.
+    quartiles : tuple of float
+        Its first and third quartiles.
+    n : int
+        Its finite values.
     """
 
     value: float
@@ -203,7 +307,29 @@ class CentralInterval:
 
 
 def central_interval(sample: Any, value: float, *, level: float = 0.9) -> CentralInterval:
-    """Is ``value`` inside the central ``level`` of ``sample`` (Fig. 6's row), and at which percentile."""
+    """Is ``value`` inside the central ``level`` of ``sample`` (Fig. 6's row), and at which percentile.
+
+    Parameters
+    ----------
+    sample : array_like
+        Per-event values (front speeds); NaN are left out.
+    value : float
+        The stated value (the paper's c = 1.43).
+    level : float
+        The share of the sample the interval holds, in (0, 1).
+
+    Returns
+    -------
+    CentralInterval
+        The interval, whether ``value`` lies in it, and its percentile.
+
+    Examples
+    --------
+    >>> from stickslip.analysis.statistics import central_interval
+    >>> c = central_interval(range(1, 101), 50.5)
+    >>> c.inside, c.percentile
+    (True, 50.0)
+    """
     x = np.asarray(sample, dtype=np.float64)
     x = x[np.isfinite(x)]
     if x.size == 0:
@@ -232,8 +358,22 @@ def pick_front_events(events: pd.DataFrame, N: int, *, intermediate: tuple[float
 
     Large: the largest-S event whose rupture reached block N (the paper's event near t = 19100).
     Intermediate: among events whose farthest moved block lies in ``intermediate`` * N, the one
-    closest to N/2 (the paper's event near t = 40400). Returns the chosen rows of ``events``
-    with a ``kind`` column ("large", "intermediate"); a kind with no candidate is left out.
+    closest to N/2 (the paper's event near t = 40400).
+
+    Parameters
+    ----------
+    events : pandas.DataFrame
+        The event table (``S``, ``max_block``).
+    N : int
+        Blocks of the chain.
+    intermediate : tuple of float
+        The range of an intermediate event's farthest block, as fractions of N.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The chosen rows of ``events`` with a ``kind`` column ("large", "intermediate"); a kind
+        with no candidate is left out.
     """
     chosen = []
     reached = events[events["max_block"] >= N]

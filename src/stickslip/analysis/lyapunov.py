@@ -294,28 +294,72 @@ def largest_lyapunov(
     frame: str = "centred",
     progress: bool = False,
 ) -> LyapunovResult:
-    """Largest Lyapunov exponent of eq. (4) (eq. (1) for N = 1), Benettin et al. (1980).
+    """Largest Lyapunov exponent of eq. (4) (eq. (1) for N = 1) by the two-trajectory method of
+    Benettin et al. (1980).
 
-    The reference runs alone from ``start`` ('paper', 'steady' with ``perturbation`` and
-    ``seed``, or a ChainState) to ``transient``; there a twin is placed d0 away in a random
-    direction (numpy ``default_rng(direction_seed)``). Both advance with
-    the exact integrator of :func:`stickslip.run.driver.run_chain` in steps of ``interval`` up to
-    ``t_end`` (``engine`` 'lean': its kernel loop without the run record, a hundred times faster
-    for short intervals; 'run_chain': one public call per interval; both give the same numbers
-    bit for bit); after each
-    the distance d (:data:`NORM`) is recorded and the twin put back at d0 along the separation
-    (:func:`twin_state`). The renormalisations ending after transient + ``align`` (default a
-    tenth of t_end - transient, for the separation to turn into the most unstable direction)
-    give the exponent: sum of ln(d / d0) over their total time. The error bar is the standard
-    error of the exponents of ``segments`` consecutive groups of them
-    (:func:`stickslip.analysis.benettin.two_trajectory_exponent` with :class:`GridEngine`).
+    The reference runs alone from ``start`` to ``transient``; there a twin is placed d0 away in a
+    random direction. Both advance with the exact integrator of
+    :func:`stickslip.run.driver.run_chain` in steps of ``interval`` up to ``t_end``; after each the
+    distance d (:data:`NORM`) is recorded and the twin put back at d0 along the separation
+    (:func:`twin_state`). The renormalisations ending after transient + ``align`` give the
+    exponent: the sum of ln(d / d0) over their total time; its error is the standard error of the
+    exponents of ``segments`` consecutive groups of them
+    (:func:`stickslip.analysis.benettin.two_trajectory_exponent` with :class:`GridEngine`). The
+    reference is continued exactly as one uninterrupted run: its final state is bit for bit
+    ``run_chain(params, t_end, start=start, ...).state``. d0 is the realised distance after
+    rounding, so ln(d / d0) is not biased by the rounding of the twin's positions (docs/lyapunov.md).
 
-    The reference is continued exactly as one uninterrupted run: its final state is bit for bit
-    ``run_chain(params, t_end, start=start, ...).state``. With ``frame`` 'centred' (default) the
-    twin and a copy of the reference run in a frame moved back along the drive by whole steps
-    (:class:`GridEngine`), so that the separation is not limited by the rounding of positions of
-    the size of V t; 'absolute' runs the twin beside the reference itself. d0 is the realised
-    distance after rounding, so ln(d / d0) is not biased by the rounding of the twin's positions.
+    Parameters
+    ----------
+    params : ChainParams
+        The chain (any model of the family).
+    t_end : float
+        End of the run.
+    interval : float
+        Time between renormalisations.
+    d0 : float
+        Initial separation of the twin.
+    transient : float
+        The reference runs alone up to here before the twin is placed.
+    align : float, optional
+        Renormalisations ending before transient + align are not counted (default a tenth of
+        t_end - transient, for the separation to turn into the most unstable direction).
+    start : str or ChainState
+        ``'paper'``, ``'steady'`` (with ``perturbation`` and ``seed``) or a state.
+    perturbation : float
+        With ``start='steady'``: uniform perturbation of x and v in [-A, A].
+    seed : int
+        Seed of that perturbation.
+    direction_seed : int
+        Seed of the twin's first direction (numpy ``default_rng``).
+    segments : int
+        Groups of renormalisations for the error bar.
+    engine : str
+        ``'lean'``: the kernel loop without the run record, a hundred times faster for short
+        intervals; ``'run_chain'``: one public call per interval. Both give the same numbers bit
+        for bit.
+    frame : str
+        ``'centred'``: the twin and a copy of the reference run in a frame moved back along the
+        drive by whole steps (:class:`GridEngine`), so that the separation is not limited by the
+        rounding of positions of the size of V t; ``'absolute'``: the twin beside the reference.
+    progress : bool
+        A progress bar on stderr.
+
+    Returns
+    -------
+    LyapunovResult
+        ``lyapunov`` and ``lyapunov_err`` (per unit time), the renormalisations counted, the
+        events of the reference, the reference's final state hash, and every interval's
+        ln(d / d0).
+
+    Examples
+    --------
+    >>> import stickslip
+    >>> res = stickslip.largest_lyapunov(stickslip.chain_params(N=9), 2e4)
+    >>> res.renormalisations  # (t_end - align) / interval
+    1800
+    >>> abs(res.lyapunov) < 1e-3  # per unit time, within 1e-3 of zero at N = 9
+    True
     """
     t_end, interval, d0, transient, align, segments = check_run(params, t_end, interval, d0, transient, align, segments)
     grid = GridEngine(params, engine, frame)

@@ -56,29 +56,98 @@ LN10 = math.log(10.0)
 
 
 def magnitude(S: Any) -> np.ndarray:
-    """Magnitude M = (2/3) log10 S of slips of size S (module docstring; NaN for S <= 0)."""
+    """Magnitude M = (2/3) log10 S of slips of size S (the moment-magnitude analogue; module docstring).
+
+    Parameters
+    ----------
+    S : array_like
+        Slip sizes.
+
+    Returns
+    -------
+    numpy.ndarray
+        M; NaN for S <= 0.
+
+    Examples
+    --------
+    >>> from stickslip.analysis.magnitudes import magnitude
+    >>> magnitude([1.0, 1000.0]).tolist()
+    [0.0, 2.0]
+    """
     S = np.asarray(S, dtype=np.float64)
     with np.errstate(divide="ignore", invalid="ignore"):
         return np.where(S > 0, (2.0 / 3.0) * np.log10(np.where(S > 0, S, 1.0)), np.nan)
 
 
 def size_from_magnitude(M: Any) -> np.ndarray:
-    """The size S = 10^(3 M / 2) of magnitude M (inverse of :func:`magnitude`)."""
+    """The size S = 10^(3 M / 2) of magnitude M (inverse of :func:`magnitude`).
+
+    Parameters
+    ----------
+    M : array_like
+        Magnitudes.
+
+    Returns
+    -------
+    numpy.ndarray
+        The sizes.
+    """
     return 10.0 ** (1.5 * np.asarray(M, dtype=np.float64))
 
 
 def b_from_tau(tau: float) -> float:
-    """b-value of p(S) ~ S^-tau in the magnitude M = (2/3) log10 S: b = (3/2)(tau - 1)."""
+    """b-value of p(S) ~ S^-tau in the magnitude M = (2/3) log10 S: b = (3/2)(tau - 1).
+
+    Parameters
+    ----------
+    tau : float
+        The size exponent.
+
+    Returns
+    -------
+    float
+        The b-value (b = 0.75 for the paper's tau = 1.5).
+
+    Examples
+    --------
+    >>> from stickslip.analysis.magnitudes import b_from_tau, tau_from_b
+    >>> b_from_tau(1.5), tau_from_b(0.75)
+    (0.75, 1.5)
+    """
     return 1.5 * (tau - 1.0)
 
 
 def tau_from_b(b: float) -> float:
-    """Size exponent tau = 1 + (2/3) b of a b-value (inverse of :func:`b_from_tau`)."""
+    """Size exponent tau = 1 + (2/3) b of a b-value (inverse of :func:`b_from_tau`).
+
+    Parameters
+    ----------
+    b : float
+        The b-value.
+
+    Returns
+    -------
+    float
+        tau.
+    """
     return 1.0 + b / 1.5
 
 
 def bin_magnitudes(M: Any, dm: float = DM) -> np.ndarray:
-    """Magnitudes rounded to the nearest multiple of ``dm`` (a catalogue's reporting), ``dm = 0``: as they are."""
+    """Magnitudes rounded to the nearest multiple of ``dm``, as a catalogue reports them.
+
+    Parameters
+    ----------
+    M : array_like
+        Magnitudes.
+    dm : float
+        The bin; 0 leaves them as they are.
+
+    Returns
+    -------
+    numpy.ndarray
+        The binned magnitudes.
+    """
     M = np.asarray(M, dtype=np.float64)
     if dm <= 0:
         return M.copy()
@@ -87,13 +156,33 @@ def bin_magnitudes(M: Any, dm: float = DM) -> np.ndarray:
 
 @dataclass(frozen=True)
 class BValue:
-    """Maximum-likelihood b-value of N(>= M) ~ 10^(-b M) above the completeness magnitude mc.
+    """Maximum-likelihood b-value of N(>= M) ~ 10^(-b M) above the completeness magnitude mc
+    (:func:`b_value`).
 
-    ``b``: Aki-Utsu, log10(e) / (mean(M) - (mc - dm/2)) on magnitudes binned to ``dm``;
-    ``b_err_shi_bolt``: 2.30 b^2 sqrt(sum (M - mean)^2 / (n (n - 1))) (Shi and Bolt 1982);
-    ``b_err_aki``: b / sqrt(n) (Aki 1965); ``b_err_bootstrap``: standard deviation of b over
-    ``bootstrap`` resamples of the magnitudes (NaN without); ``n``: events with M >= mc;
-    ``a``: log10 of the number of events at or above mc, the a-value at M = mc.
+    Attributes
+    ----------
+    b : float
+        Aki-Utsu, log10(e) / (mean(M) - (mc - dm/2)) on magnitudes binned to ``dm``.
+    b_err_shi_bolt : float
+        2.30 b^2 sqrt(sum (M - mean)^2 / (n (n - 1))) (Shi and Bolt 1982).
+    b_err_aki : float
+        b / sqrt(n) (Aki 1965).
+    b_err_bootstrap : float
+        Standard deviation of b over ``bootstrap`` resamples of the magnitudes (NaN without).
+    mc : float
+        Completeness magnitude.
+    dm : float
+        Magnitude bin.
+    n : int
+        Events with M >= mc.
+    a : float
+        log10 of the number of events at or above mc, the a-value at M = mc.
+    bootstrap : int
+        Resamples of the bootstrap error.
+    seed : int
+        Their seed.
+    method : str
+        The estimator in words.
     """
 
     b: float
@@ -120,13 +209,36 @@ def _aki_utsu(m: np.ndarray, mc: float, dm: float, axis: int = -1) -> np.ndarray
 
 
 def b_value(M: Any, mc: float, *, dm: float = DM, bootstrap: int = 200, seed: int = 0) -> BValue:
-    """b-value of the events with binned magnitude >= ``mc`` by the Aki-Utsu estimator (Gutenberg-Richter law).
+    """b-value of the events with binned magnitude >= ``mc`` by the Aki-Utsu estimator
+    (Gutenberg-Richter law).
 
-    ``M`` are magnitudes (:func:`magnitude`); they are binned to ``dm`` (:func:`bin_magnitudes`)
-    and the events with M >= mc kept (``mc`` a bin centre, :func:`completeness`). The estimator
-    is Aki's maximum likelihood log10(e) / (mean(M) - M0) with M0 = mc - dm/2, the lower edge of
-    the lowest bin (Utsu's correction for binned magnitudes; dm = 0 gives Aki's for continuous
-    ones). Raises ValueError with fewer than 2 events above mc.
+    The magnitudes are binned to ``dm`` (:func:`bin_magnitudes`) and those with M >= mc kept. The
+    estimator is Aki's maximum likelihood log10(e) / (mean(M) - M0) with M0 = mc - dm/2, the lower
+    edge of the lowest bin (Utsu's correction for binned magnitudes; dm = 0 gives Aki's for
+    continuous ones).
+
+    Parameters
+    ----------
+    M : array_like
+        Magnitudes (:func:`magnitude`).
+    mc : float
+        Completeness magnitude, a bin centre (:func:`completeness`).
+    dm : float
+        The bin.
+    bootstrap : int
+        Resamples of the bootstrap error (0: none).
+    seed : int
+        Their seed.
+
+    Returns
+    -------
+    BValue
+        b with three errors, n and the a-value.
+
+    Raises
+    ------
+    ValueError
+        With fewer than 2 events above mc.
     """
     m = bin_magnitudes(M, dm)
     m = m[np.isfinite(m) & (m >= mc - 1e-9 * max(dm, 1.0))]
@@ -166,9 +278,16 @@ def b_value(M: Any, mc: float, *, dm: float = DM, bootstrap: int = 200, seed: in
 class Completeness:
     """Completeness magnitude mc and how it was found (:func:`completeness`).
 
-    ``method``: "goodness of fit 95%", "goodness of fit 90%" or "maximum curvature";
-    ``R``: the goodness of fit (percent) at mc, NaN for maximum curvature; ``scan``: the
-    candidates tried, each (mc, n, b, R).
+    Attributes
+    ----------
+    mc : float
+        The completeness magnitude.
+    method : str
+        "goodness of fit 95%", "goodness of fit 90%" or "maximum curvature".
+    R : float
+        The goodness of fit (percent) at mc; NaN for maximum curvature.
+    scan : list of tuple
+        The candidates tried, each (mc, n, b, R).
     """
 
     mc: float
@@ -194,12 +313,26 @@ def completeness(M: Any, *, dm: float = DM, min_events: int = MIN_EVENTS_B) -> C
     """Completeness magnitude of a catalogue by the goodness-of-fit test of Wiemer and Wyss (2000).
 
     Candidates: every bin centre from the most populated bin (the maximum curvature of the
-    frequency-magnitude distribution, Wiemer and Wyss 2000) upwards while at least
-    ``min_events`` events remain at or above it. At each, the Aki-Utsu b-value is fitted and
-    R = 100 - 100 sum abs(B_i - S_i) / sum B_i compares the observed cumulative counts B_i with
-    the Gutenberg-Richter ones S_i. mc is the first candidate with R >= 95, else the first with
-    R >= 90 (Woessner and Wiemer 2005), else the maximum curvature. In a simulated catalogue
-    nothing goes undetected: mc marks where the slips start to follow Gutenberg-Richter.
+    frequency-magnitude distribution) upwards while at least ``min_events`` events remain at or
+    above it. At each, the Aki-Utsu b-value is fitted and R = 100 - 100 sum abs(B_i - S_i) / sum B_i
+    compares the observed cumulative counts B_i with the Gutenberg-Richter ones S_i. mc is the first
+    candidate with R >= 95, else the first with R >= 90 (Woessner and Wiemer 2005), else the maximum
+    curvature. In a simulated catalogue nothing goes undetected: mc marks where the slips start to
+    follow Gutenberg-Richter.
+
+    Parameters
+    ----------
+    M : array_like
+        Magnitudes.
+    dm : float
+        The bin.
+    min_events : int
+        Fewest events at or above a candidate.
+
+    Returns
+    -------
+    Completeness
+        mc, the rule that chose it, R there and the scan.
     """
     m = bin_magnitudes(M, dm)
     m = m[np.isfinite(m)]
@@ -228,10 +361,25 @@ def completeness(M: Any, *, dm: float = DM, min_events: int = MIN_EVENTS_B) -> C
 
 @dataclass(frozen=True)
 class TruncatedGR:
-    """Doubly truncated Gutenberg-Richter law: magnitudes exponential with rate b ln 10 on [m_min, m_max].
+    """Doubly truncated Gutenberg-Richter law: magnitudes exponential with rate b ln 10 on
+    [m_min, m_max] (:func:`truncated_gr_fit`).
 
-    ``b`` and ``b_err`` (from the Fisher information of the truncated exponential), the range,
-    ``n`` events, ``loglikelihood``; ``tau`` = 1 + (2/3) b, the size exponent it means.
+    Attributes
+    ----------
+    b : float
+        The b-value.
+    b_err : float
+        Its error from the Fisher information of the truncated exponential.
+    m_min : float
+        Lower end of the range.
+    m_max : float
+        Upper end of the range.
+    n : int
+        Events in it.
+    loglikelihood : float
+        The maximised log-likelihood.
+    tau : float
+        1 + (2/3) b, the size exponent it means.
     """
 
     b: float
@@ -252,12 +400,26 @@ def _truncexpon_negll(beta: float, u: np.ndarray, width: float) -> float:
 
 def truncated_gr_fit(M: Any, m_min: float, m_max: float | None = None) -> TruncatedGR:
     """Doubly truncated Gutenberg-Richter fit (Page 1968): maximum likelihood of b for continuous
-    magnitudes on [m_min, m_max] (default m_max: the largest).
+    magnitudes on [m_min, m_max].
 
     The density of u = M - m_min is ``scipy.stats.truncexpon`` with rate beta = b ln 10 cut at
-    m_max - m_min; its likelihood is maximised over beta. For M = (2/3) log10 S this is the
-    power law in S truncated to [S(m_min), S(m_max)] with tau = 1 + (2/3) b, the model of
+    m_max - m_min; its likelihood is maximised over beta. For M = (2/3) log10 S this is the power
+    law in S truncated to [S(m_min), S(m_max)] with tau = 1 + (2/3) b, the model of
     :func:`stickslip.analysis.statistics.fit_power_law`, so the two fits agree.
+
+    Parameters
+    ----------
+    M : array_like
+        Magnitudes (not binned).
+    m_min : float
+        Lower end.
+    m_max : float, optional
+        Upper end (default the largest M).
+
+    Returns
+    -------
+    TruncatedGR
+        b, its error, the range and tau.
     """
     M = np.asarray(M, dtype=np.float64)
     top = float(np.nanmax(M)) if m_max is None else float(m_max)

@@ -57,8 +57,32 @@ NESTED = frozenset({("power_law", "power_law_exp_cutoff")})
 
 @dataclass(frozen=True)
 class CandidateFit:
-    """One candidate's maximum-likelihood fit on [s_min, s_max]: ``params`` by name, the total
-    ``loglikelihood``, ``aic`` = 2 k - 2 log L, and the per-event log-densities (not in ``to_dict``)."""
+    """One candidate distribution's maximum-likelihood fit to slip sizes on [s_min, s_max]
+    (:func:`fit_candidate`).
+
+    Attributes
+    ----------
+    name : str
+        The candidate (:data:`CANDIDATES`).
+    params : dict
+        Its fitted parameters by name.
+    loglikelihood : float
+        The total log-likelihood.
+    n_params : int
+        Parameters fitted (k).
+    aic : float
+        2 k - 2 log L.
+    s_min : float
+        Lower end of the range.
+    s_max : float
+        Upper end of the range.
+    n : int
+        Events in it.
+    logpdf : numpy.ndarray
+        Per-event log-densities (not in ``to_dict``).
+    pdf : callable
+        The fitted density, normalised on the range.
+    """
 
     name: str
     params: dict[str, float]
@@ -130,10 +154,29 @@ def _maximise(negll: Callable[[np.ndarray], float], start: np.ndarray) -> np.nda
 
 
 def fit_candidate(name: str, S: Any, s_min: float, s_max: float = math.inf) -> CandidateFit:
-    """Maximum-likelihood fit of candidate ``name`` (:data:`CANDIDATES`) to the S in [s_min, s_max].
+    """Maximum-likelihood fit of one candidate distribution to the sizes S in [s_min, s_max].
 
     Each density is normalised on [s_min, s_max]; positive parameters are fitted on a log scale.
-    Raises ValueError with fewer than 2 events in range.
+
+    Parameters
+    ----------
+    name : str
+        One of :data:`CANDIDATES`: ``power_law``, ``power_law_exp_cutoff``, ``lognormal``,
+        ``exponential``, ``stretched_exponential``.
+    S : array_like
+        Slip sizes.
+    s_min, s_max : float
+        The range.
+
+    Returns
+    -------
+    CandidateFit
+        The fitted parameters, log-likelihood and AIC.
+
+    Raises
+    ------
+    ValueError
+        With fewer than 2 events in range.
     """
     values = np.asarray(S, dtype=np.float64)
     x = values[np.isfinite(values) & (values >= s_min) & (values <= s_max)]
@@ -228,7 +271,20 @@ def fit_candidate(name: str, S: Any, s_min: float, s_max: float = math.inf) -> C
 
 
 def fit_candidates(S: Any, s_min: float, s_max: float = math.inf) -> dict[str, CandidateFit | str]:
-    """Every candidate of :data:`CANDIDATES` fitted on [s_min, s_max]; a fit that fails is a string saying why."""
+    """Every candidate of :data:`CANDIDATES` fitted on [s_min, s_max].
+
+    Parameters
+    ----------
+    S : array_like
+        Slip sizes.
+    s_min, s_max : float
+        The range.
+
+    Returns
+    -------
+    dict
+        Name -> :class:`CandidateFit`, or a string saying why the fit failed.
+    """
     out: dict[str, CandidateFit | str] = {}
     for name in CANDIDATES:
         # the search passes through parameters where scipy's densities overflow; those are
@@ -245,10 +301,20 @@ def fit_candidates(S: Any, s_min: float, s_max: float = math.inf) -> dict[str, C
 def vuong(logpdf1: Any, logpdf2: Any, *, nested: bool = False) -> dict[str, float]:
     """Log-likelihood ratio test of two fitted densities on the same events (Vuong 1989).
 
-    ``R`` = sum(l1 - l2) (> 0: the first is favoured), ``normalized_ratio`` = R / (sqrt(n) sigma)
-    with sigma the standard deviation of l1 - l2, ``p`` = erfc(abs(R) / sqrt(2 n sigma^2)): the
-    probability of a ratio this far from 0 if both were equally good. ``nested``: the first is
-    the second with one parameter fixed; then p = chi2(1).sf(2 abs(R)) (Wilks).
+    Parameters
+    ----------
+    logpdf1, logpdf2 : array_like
+        Per-event log-densities of the two fits (:attr:`CandidateFit.logpdf`).
+    nested : bool
+        The first is the second with one parameter fixed: then p = chi2(1).sf(2 abs(R)) (Wilks).
+
+    Returns
+    -------
+    dict
+        ``R`` = sum(l1 - l2) (> 0: the first is favoured), ``normalized_ratio`` =
+        R / (sqrt(n) sigma) with sigma the standard deviation of l1 - l2, and ``p`` =
+        erfc(abs(R) / sqrt(2 n sigma^2)): the probability of a ratio this far from 0 if both were
+        equally good.
     """
     d = np.asarray(logpdf1, dtype=np.float64) - np.asarray(logpdf2, dtype=np.float64)
     n = d.size
@@ -265,12 +331,26 @@ def vuong(logpdf1: Any, logpdf2: Any, *, nested: bool = False) -> dict[str, floa
 def compare_distributions(
     S: Any, s_min: float, s_max: float = math.inf, *, significance: float = 0.1
 ) -> dict[str, Any]:
-    """Fit every candidate on [s_min, s_max] and compare the power law with each of the others (Clauset et al.).
+    """Fit every candidate on [s_min, s_max] and compare the power law with each of the others
+    (Clauset, Shalizi and Newman 2009).
 
-    Returns ``fits`` (name -> :meth:`CandidateFit.to_dict`, or a string saying why there is no
-    fit), ``comparisons`` (one per alternative: :func:`vuong` of power law against it and a
-    ``verdict``: "power law", the alternative's name, or "undecided" when p > ``significance``)
-    and ``best_aic``, the candidate of least AIC. The fitted objects are under ``objects``.
+    Parameters
+    ----------
+    S : array_like
+        Slip sizes.
+    s_min, s_max : float
+        The range.
+    significance : float
+        Largest p of a verdict.
+
+    Returns
+    -------
+    dict
+        ``fits`` (name -> :meth:`CandidateFit.to_dict`, or a string saying why there is no fit),
+        ``comparisons`` (one per alternative: :func:`vuong` of power law against it and a
+        ``verdict``: "power law", the alternative's name, or "undecided" when p >
+        ``significance``), ``best_aic`` (the candidate of least AIC) and the fitted objects under
+        ``objects``.
     """
     fits = fit_candidates(S, s_min, s_max)
     pl = fits["power_law"]
@@ -308,14 +388,30 @@ def _draw_truncated_power_law(rng: np.random.Generator, n: int, tau: float, lo: 
 
 
 def power_law_gof(S: Any, s_max: float | None = None, *, sims: int = 200, seed: int = 0) -> dict[str, Any]:
-    """Goodness of fit of the truncated power law of Figs. 7, 8 by the KS bootstrap of Clauset et al. (2009, sec. 4.1).
+    """Goodness of fit of the truncated power law of Figs. 7, 8 by the KS bootstrap of Clauset et al.
+    (2009, sec. 4.1).
 
-    The data's fit (s_min by :func:`~stickslip.analysis.statistics.choose_s_min`, s_max as
-    given or the largest S) has KS distance D. Each of ``sims`` synthetic catalogues has as many
-    sizes up to s_max as the data: each one, with the probability n_tail / n, drawn from the
-    fitted power law, else drawn from the data below s_min; it is fitted the same way (its own
-    s_min) and gives D_k. p = the fraction of D_k >= D: small p (Clauset et al.: p <= 0.1) rejects
-    the power law. Returns D, p, sims, seed and the fit's tau, s_min, s_max, n.
+    The data's fit (s_min by :func:`~stickslip.analysis.statistics.choose_s_min`) has KS distance
+    D. Each synthetic catalogue has as many sizes up to s_max as the data: each one, with the
+    probability n_tail / n, drawn from the fitted power law, else drawn from the data below s_min;
+    it is fitted the same way (its own s_min) and gives D_k.
+
+    Parameters
+    ----------
+    S : array_like
+        Slip sizes.
+    s_max : float, optional
+        Upper end (default the largest S).
+    sims : int
+        Synthetic catalogues.
+    seed : int
+        Their seed.
+
+    Returns
+    -------
+    dict
+        ``D``, ``p`` (the fraction of D_k >= D: small p, p <= 0.1 for Clauset et al., rejects the
+        power law), ``sims``, ``seed`` and the fit's ``tau``, ``s_min``, ``s_max``, ``n``.
     """
     values = np.asarray(S, dtype=np.float64)
     values = values[np.isfinite(values) & (values > 0)]

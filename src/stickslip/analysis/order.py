@@ -22,6 +22,7 @@ from dataclasses import asdict, dataclass
 from typing import Any
 
 import numpy as np
+import xarray as xr
 
 __all__ = [
     "integrated_time",
@@ -34,6 +35,8 @@ __all__ = [
     "quarter_stats",
     "transition_bracket",
     "power_law_fit",
+    "TimeAverage",
+    "time_average",
 ]
 
 #: The three final states of a study point.
@@ -56,12 +59,32 @@ def _autocorrelation(x: np.ndarray) -> np.ndarray:
 
 
 def integrated_time(x: np.ndarray, *, c: float = 6.0) -> float:
-    """Integrated autocorrelation time tau_int = 1/2 + sum_{t>=1} rho(t), in samples.
+    """Integrated autocorrelation time tau_int = 1/2 + sum_{t>=1} rho(t) of a series, in samples.
 
     Summed up to Sokal's self-consistent window, the smallest W with W >= c tau_int(W)
     (A. Sokal, "Monte Carlo methods in statistical mechanics", 1997). Var(mean) ~ 2 tau_int
-    sigma^2 / n. A constant series gives 0.5; a series shorter than its window gives the
-    estimate at the largest window (an underestimate: see ``mean_with_error``'s ``reliable``).
+    sigma^2 / n.
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        The series, equally spaced in time.
+    c : float
+        Window factor of Sokal's rule.
+
+    Returns
+    -------
+    float
+        tau_int in samples; 0.5 for a constant series; for a series shorter than its window the
+        estimate at the largest window (an underestimate: see :func:`mean_with_error`'s
+        ``reliable``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from stickslip.analysis.order import integrated_time
+    >>> float(integrated_time(np.random.default_rng(0).normal(size=20000))) < 0.6  # white noise
+    True
     """
     x = np.asarray(x, dtype=float)
     if x.size < 2 or not np.ptp(x) > 0:
@@ -77,8 +100,19 @@ def integrated_time(x: np.ndarray, *, c: float = 6.0) -> float:
 def batch_means(x: np.ndarray, batch: int) -> tuple[float, int]:
     """Standard error of the mean of ``x`` from non-overlapping batches of ``batch`` samples.
 
-    Returns (error, number of batches); the samples left over at the start are dropped, so the
-    batches end with the series.
+    Parameters
+    ----------
+    x : numpy.ndarray
+        The series.
+    batch : int
+        Samples per batch; the samples left over at the start are dropped, so the batches end
+        with the series.
+
+    Returns
+    -------
+    tuple of (float, int)
+        The error of the mean, the standard deviation of the batch means over sqrt(number of
+        batches), and the number of batches.
     """
     x = np.asarray(x, dtype=float)
     batch = max(int(batch), 1)
@@ -91,10 +125,27 @@ def batch_means(x: np.ndarray, batch: int) -> tuple[float, int]:
 
 @dataclass(frozen=True)
 class MeanEstimate:
-    """A time average with its error: ``mean``, ``err`` (batch means), ``err_tau``
-    (sqrt(2 tau_int var / n)), ``tau_int`` (samples), ``batch`` (samples per batch),
-    ``n_batches``, ``n`` (samples), ``reliable`` (at least :data:`MIN_BATCHES` batches of
-    :data:`BATCH_TAUS` tau_int each)."""
+    """A time average with its error (:func:`mean_with_error`).
+
+    Attributes
+    ----------
+    mean : float
+        The average.
+    err : float
+        Its standard error from batch means.
+    err_tau : float
+        sqrt(2 tau_int var / n), the error from the autocorrelation time.
+    tau_int : float
+        Integrated autocorrelation time, samples.
+    batch : int
+        Samples per batch.
+    n_batches : int
+        Batches.
+    n : int
+        Samples.
+    reliable : bool
+        At least :data:`MIN_BATCHES` batches of :data:`BATCH_TAUS` tau_int each.
+    """
 
     mean: float
     err: float
@@ -112,11 +163,21 @@ class MeanEstimate:
 def mean_with_error(x: np.ndarray) -> MeanEstimate:
     """Mean of a correlated series and its error by batch means.
 
-    The batch length is ``BATCH_TAUS * tau_int`` (:func:`integrated_time`): batches much
-    longer than the correlation time have nearly independent means, and the relative bias of
-    the variance estimate is about 2 tau_int / batch. If the series holds fewer than
-    ``MIN_BATCHES`` such batches, it is cut into ``MIN_BATCHES`` batches and the estimate is
-    flagged ``reliable = False`` (the error is then likely too small).
+    The batch length is ``BATCH_TAUS * tau_int`` (:func:`integrated_time`): batches much longer
+    than the correlation time have nearly independent means, and the relative bias of the variance
+    estimate is about 2 tau_int / batch.
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        The series, equally spaced in time.
+
+    Returns
+    -------
+    MeanEstimate
+        The mean, its error, tau_int and the batches. If the series holds fewer than
+        ``MIN_BATCHES`` batches of ``BATCH_TAUS`` tau_int, it is cut into ``MIN_BATCHES`` batches
+        and the estimate is flagged ``reliable = False`` (the error is then likely too small).
     """
     x = np.asarray(x, dtype=float)
     x = x[np.isfinite(x)]
@@ -137,13 +198,44 @@ def mean_with_error(x: np.ndarray) -> MeanEstimate:
 
 
 def order_parameter(L: np.ndarray, L_ss: float) -> MeanEstimate:
-    """m = 1 - <L>/L_ss with its batch-means error (Fig. 5b as an order parameter)."""
+    """m = 1 - <L>/L_ss with its batch-means error (Fig. 5b as an order parameter).
+
+    Parameters
+    ----------
+    L : numpy.ndarray
+        Samples of L = x_1 - x_N, equally spaced in time.
+    L_ss : float
+        Steady length (:func:`stickslip.models.physics.chain_steady_length`).
+
+    Returns
+    -------
+    MeanEstimate
+        m and its error (:func:`mean_with_error`); m = 0 in steady sliding.
+    """
     return mean_with_error(1.0 - np.asarray(L, dtype=float) / float(L_ss))
 
 
 def quarter_stats(t: np.ndarray, m: np.ndarray, stuck: np.ndarray | None, t_end: float) -> dict[str, float]:
-    """m and the fraction of samples with some block stuck over the third and fourth quarters
-    of ``[0, t_end]`` (what :func:`classify_final_state` compares)."""
+    """m and the fraction of samples with some block stuck over the third and fourth quarters of
+    ``[0, t_end]`` (what :func:`classify_final_state` compares).
+
+    Parameters
+    ----------
+    t : numpy.ndarray
+        Sampling times.
+    m : numpy.ndarray
+        m = 1 - L / L_ss at those times.
+    stuck : numpy.ndarray or None
+        1 where some block is stuck at the sample, else 0 (None: not recorded).
+    t_end : float
+        End of the run.
+
+    Returns
+    -------
+    dict
+        ``m_q3``, ``m_err_q3``, ``m_q4``, ``m_err_q4`` and, with ``stuck``, ``stuck_q3``,
+        ``stuck_q4``.
+    """
     t = np.asarray(t, dtype=float)
     out: dict[str, float] = {}
     for name, lo, hi in (("q3", 0.5, 0.75), ("q4", 0.75, 1.0 + 1e-12)):
@@ -177,6 +269,24 @@ def classify_final_state(
       ``drift_z`` combined errors;
     - ``undecided``: anything else: sliding but not yet steady, stick-slip dying out, or m
       still drifting. Such a point is reported as it is, never averaged as settled.
+
+    Parameters
+    ----------
+    reached_steady : bool
+        Whether the run reached steady sliding.
+    stuck_q3, stuck_q4 : float
+        Fraction of samples with a stuck block in the third and fourth quarters.
+    m_q3, m_err_q3, m_q4, m_err_q4 : float
+        m and its error in those quarters (:func:`quarter_stats`).
+    drift_z : float
+        Largest drift of m between the quarters, in combined errors.
+    decay : float
+        Least ratio of the stuck fractions (fourth over third quarter) of lasting stick-slip.
+
+    Returns
+    -------
+    tuple of (str, str)
+        The state and one line saying why.
     """
     if reached_steady:
         return "steady", "reached steady sliding"
@@ -193,10 +303,28 @@ def classify_final_state(
 def transition_bracket(betas, states) -> dict[str, Any]:
     """Where the final state changes from stick-slip to steady sliding along beta (one N).
 
-    ``lo`` is the largest beta whose run ends in stick-slip, ``hi`` the smallest beta above
-    ``lo`` whose run ends steady; the transition lies in [lo, hi] (estimate: the midpoint,
-    uncertainty: half the width). Undecided points between them are listed, and points that
-    contradict a single transition (steady below ``lo``, stick-slip above ``hi``) are counted.
+    Parameters
+    ----------
+    betas : sequence of float
+        The runs' beta, in any order.
+    states : sequence of str
+        Each run's final state, ``stick-slip``, ``steady`` or ``undecided``
+        (:func:`classify_final_state`).
+
+    Returns
+    -------
+    dict
+        ``lo``, the largest beta whose run ends in stick-slip, and ``hi``, the smallest beta above
+        ``lo`` whose run ends steady: the transition lies in [lo, hi] (``estimate`` the midpoint,
+        ``uncertainty`` half the width; NaN where a side is missing); ``undecided``, the undecided
+        betas between them; ``contradictions``, steady runs below ``lo``.
+
+    Examples
+    --------
+    >>> from stickslip.analysis.order import transition_bracket
+    >>> b = transition_bracket([0.9, 1.0, 1.1, 1.2], ["stick-slip", "stick-slip", "undecided", "steady"])
+    >>> b["lo"], b["hi"], b["undecided"]
+    (1.0, 1.2, [1.1])
     """
     order = np.argsort(np.asarray(betas, dtype=float))
     b = np.asarray(betas, dtype=float)[order]
@@ -228,8 +356,30 @@ def transition_bracket(betas, states) -> dict[str, Any]:
 
 
 def power_law_fit(x, y, yerr=None) -> dict[str, float]:
-    """Least-squares fit of log y = log A + b log x (weights from ``yerr`` if given): the
-    exponent b of m ~ (beta_c - beta)^b, its standard error and A."""
+    """Least-squares fit of log y = log A + b log x, weighted by the relative errors ``yerr / y``
+    when given (the exponent b of m ~ (beta_c - beta)^b, or of beta_t - 1 ~ N^b).
+
+    Parameters
+    ----------
+    x, y : array_like
+        The points; those not positive and finite are left out.
+    yerr : array_like, optional
+        Errors of y.
+
+    Returns
+    -------
+    dict
+        ``b`` and its standard error ``b_err``, the prefactor ``A`` and the points used ``n``;
+        NaN with fewer than 3 points.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from stickslip.analysis.order import power_law_fit
+    >>> fit = power_law_fit([10, 100, 1000], 2.0 * np.array([10, 100, 1000]) ** -0.5)
+    >>> round(fit["b"], 12), round(fit["A"], 12)
+    (-0.5, 2.0)
+    """
     x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
     ok = (x > 0) & (y > 0) & np.isfinite(x) & np.isfinite(y)
     if np.count_nonzero(ok) < 3:
@@ -246,3 +396,85 @@ def power_law_fit(x, y, yerr=None) -> dict[str, float]:
         "A": float(math.exp(coef[1])),
         "n": int(np.count_nonzero(ok)),
     }
+
+
+# Time averages (Fig. 5b)
+@dataclass(frozen=True)
+class TimeAverage:
+    """Time average of a sampled series with a batch-means standard error (Fig. 5b; :func:`time_average`).
+
+    Attributes
+    ----------
+    mean : float
+        The average over the samples with t >= t_from.
+    stderr : float
+        The standard deviation of the means of ``n_batches`` consecutive equal batches over
+        sqrt(n_batches) (stick-slip samples are correlated, so the naive error would be too
+        small); NaN with fewer samples than batches.
+    t_from : float
+        The first sampling time averaged over.
+    t_to : float
+        The last.
+    n_samples : int
+        Samples used.
+    n_batches : int
+        Batches of the error.
+    """
+
+    mean: float
+    stderr: float
+    t_from: float
+    t_to: float
+    n_samples: int
+    n_batches: int
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+def time_average(series: xr.DataArray, t_from: float | None = None, *, n_batches: int = 10) -> TimeAverage:
+    """<L>, the time average of L(t) = x_1 - x_N (or any series on coordinate ``t``) for Fig. 5b,
+    with its error from batch means (:func:`stickslip.analysis.order.batch_means`; the samples left
+    over are dropped at the start).
+
+    Parameters
+    ----------
+    series : xarray.DataArray
+        The samples over coordinate ``t`` (``run.samples["L"]``).
+    t_from : float, optional
+        First time averaged over (default the first sample).
+    n_batches : int
+        Batches of the error.
+
+    Returns
+    -------
+    TimeAverage
+        The mean, its error and the window.
+
+    Raises
+    ------
+    ValueError
+        Without a coordinate ``t``, or without samples at t >= t_from.
+    """
+    if "t" not in series.coords:
+        raise ValueError("series needs a coordinate 't'")
+    t = series["t"].to_numpy()
+    values = series.to_numpy().astype(np.float64)
+    start = float(t.min()) if t_from is None else float(t_from)
+    keep = (t >= start) & np.isfinite(values)
+    y = values[keep]
+    n = int(y.size)
+    if n == 0:
+        raise ValueError(f"no samples at t >= {start:g}")
+    stderr = math.nan
+    if n_batches >= 2 and n >= n_batches:
+        # The project's one batch-means estimator (the order parameter's too).
+        stderr, _ = batch_means(y, n // n_batches)
+    return TimeAverage(
+        mean=float(y.mean()),
+        stderr=stderr,
+        t_from=start,
+        t_to=float(t[keep].max()),
+        n_samples=n,
+        n_batches=int(n_batches),
+    )

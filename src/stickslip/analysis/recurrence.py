@@ -38,7 +38,24 @@ _DISTS = {"exponential": stats.expon, "gamma": stats.gamma, "weibull": stats.wei
 
 
 def inter_event_times(t_start: Any) -> np.ndarray:
-    """Times between successive slip starts (sorted), the recurrence intervals."""
+    """Times between successive slip starts, the recurrence intervals.
+
+    Parameters
+    ----------
+    t_start : array_like
+        Start times of the slips (``events["t_start"]``), in any order.
+
+    Returns
+    -------
+    numpy.ndarray
+        The differences of the sorted start times (one fewer than the slips).
+
+    Examples
+    --------
+    >>> from stickslip.analysis.recurrence import inter_event_times
+    >>> inter_event_times([5.0, 1.0, 2.5]).tolist()
+    [1.5, 2.5]
+    """
     t = np.sort(np.asarray(t_start, dtype=np.float64))
     return np.diff(t)
 
@@ -61,11 +78,26 @@ def _loglik(name: str, dt: np.ndarray, log_params: np.ndarray) -> np.ndarray:
 
 
 def fit_renewal(name: str, dt: Any) -> dict[str, Any]:
-    """Maximum-likelihood fit of renewal model ``name`` (:data:`RENEWAL_MODELS`) to inter-event times ``dt``.
+    """Maximum-likelihood fit of a renewal model to inter-event times.
 
-    Returns ``params`` (by name), ``errors`` (one-sigma, from the observed information),
-    ``loglikelihood``, ``aic``, ``n``, the ``mean`` and ``cv`` the fitted model implies.
-    Raises ValueError for fewer than 2 positive times.
+    Parameters
+    ----------
+    name : str
+        One of :data:`RENEWAL_MODELS`: ``exponential`` (Poisson), ``gamma``, ``weibull``, ``bpt``
+        (Brownian passage time, the inverse Gaussian).
+    dt : array_like
+        Inter-event times (:func:`inter_event_times`).
+
+    Returns
+    -------
+    dict
+        ``params`` (by name), ``errors`` (one-sigma, from the observed information),
+        ``loglikelihood``, ``aic``, ``n``, and the ``mean`` and ``cv`` the fitted model implies.
+
+    Raises
+    ------
+    ValueError
+        For fewer than 2 positive times.
     """
     dt = np.asarray(dt, dtype=np.float64)
     dt = dt[np.isfinite(dt) & (dt > 0)]
@@ -116,7 +148,20 @@ def fit_renewal(name: str, dt: Any) -> dict[str, Any]:
 
 
 def renewal_pdf(fit: dict[str, Any], x: Any) -> np.ndarray:
-    """Density at ``x`` of a fitted renewal model (a record of :func:`fit_renewal`)."""
+    """Density of a fitted renewal model.
+
+    Parameters
+    ----------
+    fit : dict
+        A record of :func:`fit_renewal`.
+    x : array_like
+        Inter-event times at which to evaluate it.
+
+    Returns
+    -------
+    numpy.ndarray
+        The fitted density at ``x``.
+    """
     p, model = fit["params"], fit["model"]
     dist = _DISTS[model]
     if model == "exponential":
@@ -130,10 +175,20 @@ def renewal_pdf(fit: dict[str, Any], x: Any) -> np.ndarray:
 def recurrence(t_start: Any, *, min_intervals: int = MIN_INTERVALS) -> dict[str, Any]:
     """Inter-event times of the slips starting at ``t_start``: their statistics and every renewal fit.
 
-    ``n``, ``mean``, ``median``, ``cv`` (standard deviation over mean: 1 for a Poisson process,
-    below 1 quasi-periodic, above 1 clustered), ``fits`` (:func:`fit_renewal` per model, ranked
-    by ``delta_aic`` from the best, with Akaike ``weight``), ``best``. With fewer than
-    ``min_intervals`` times there is no fit, and ``reason`` says so.
+    Parameters
+    ----------
+    t_start : array_like
+        Start times of the slips.
+    min_intervals : int
+        Fewest inter-event times to fit.
+
+    Returns
+    -------
+    dict
+        ``n``, ``mean``, ``median``, ``cv`` (standard deviation over mean: 1 for a Poisson
+        process, below 1 quasi-periodic, above 1 clustered), ``fits`` (:func:`fit_renewal` per
+        model, ranked by ``delta_aic`` from the best, with Akaike ``weight``), ``best``. With fewer
+        than ``min_intervals`` times there is no fit, and ``reason`` says so.
     """
     dt = inter_event_times(t_start)
     dt = dt[dt > 0]

@@ -116,11 +116,43 @@ def solve_slip_limit(
     n_points: int = 1001,
     dense: bool = True,
 ) -> SlipLimit:
-    """Integrate eq. (3) accurately and locate the stop v = 0 (section 2, Figs. 2 and 3).
+    """Integrate eq. (3), the slip in the limit V -> 0, accurately and locate the stop v = 0
+    (section 2, Figs. 2 and 3).
 
     Uses scipy's DOP853 with a terminal event v = 0 crossed downwards (v starts at 0 with
     v' = (Fs - sigma)/M > 0, so the start is not a crossing). V of ``params`` is not used.
-    Raises :class:`NoStopError` if the block has not stopped by ``t_max``.
+
+    Parameters
+    ----------
+    params : BlockParams, optional
+        The block (default the paper's: K = 10, beta = 1, alpha = 1, Fs = 3).
+    rtol, atol : float
+        Tolerances of the integrator.
+    t_max : float
+        Longest slip looked for.
+    n_points : int
+        Points of the stored curve from the start of the slip to its stop.
+    dense : bool
+        Keep the curve (x', v, theta, f against t - t_c) and the dense output.
+
+    Returns
+    -------
+    SlipLimit
+        The slip's duration a, the force at the stop and b = Fs - force_at_stop, with
+        ``period(V)`` = a + b / (K V), the period law of Fig. 3.
+
+    Raises
+    ------
+    NoStopError
+        If the block has not stopped by ``t_max``.
+
+    Examples
+    --------
+    >>> from stickslip import BlockParams
+    >>> from stickslip.analysis.slip_limit import solve_slip_limit
+    >>> law = solve_slip_limit(BlockParams(), dense=False)
+    >>> print(f"T(V) = {law.law_a:.3f} + {law.law_b:.3f} / (K V)")  # the paper: 1.035 + 3.432 / (K V)
+    T(V) = 1.037 + 3.432 / (K V)
     """
     p = BlockParams() if params is None else params
     _check_can_slip(p)
@@ -234,10 +266,25 @@ def period_sweep(
 ) -> pd.DataFrame:
     """Simulated stick-slip period of eq. (1) at several pulling velocities V (Fig. 3).
 
-    Each V is run from the paper's initial state to the first slip plus ``periods`` + 1/2
-    periods of the law T(V) of eq. (3) (:func:`solve_slip_limit`); the period is the mean of
-    the slip table's ``period`` over the slips after the first. Returns one row per V with
-    the simulated period, its spread, the number of periods averaged and the law's T(V).
+    Each V is run from the paper's initial state to the first slip plus ``periods`` + 1/2 periods
+    of the law T(V) of eq. (3) (:func:`solve_slip_limit`); the period is the mean of the slip
+    table's ``period`` over the slips after the first.
+
+    Parameters
+    ----------
+    params : BlockParams
+        The block; its V is replaced by each of ``V_values``.
+    V_values : iterable of float
+        Pulling velocities, each > 0.
+    periods : int
+        Periods of the law simulated after the first slip.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per V: ``V``, the simulated ``period`` and ``period_std``, ``n_periods``
+        averaged, the law's ``period_law`` T(V), ``rel_dev`` = period / T(V) - 1,
+        ``slip_duration`` and ``force_at_stop``.
     """
     periods = int(check_number("periods", periods, low=1, integer=True))
     V_values = [float(check_number("V", V, low=0.0, low_open=True)) for V in V_values]

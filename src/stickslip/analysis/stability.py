@@ -346,6 +346,16 @@ def chain_critical_beta(p: ChainParams) -> float:
     beta_c = alpha for 0 <= alpha V < 1, whatever K > 0, D and V: long waves are unstable for
     beta < alpha and every k > 0 is stable for beta >= alpha. On the melted branch
     (alpha V >= 1, theta_0 = 0) the state variable decouples and beta_c = 0.
+
+    Parameters
+    ----------
+    p : ChainParams
+        The chain of eq. (4) (its alpha and V).
+
+    Returns
+    -------
+    float
+        beta_c (1 for the paper's alpha = 1).
     """
     return p.alpha if p.alpha * p.V < 1.0 else 0.0
 
@@ -459,19 +469,56 @@ def chain_jacobian(p: ChainParams) -> np.ndarray:
 
 
 def chain_finite_eigenvalues(p: ChainParams) -> np.ndarray:
-    """Eigenvalues of the finite linearised chain (:func:`chain_jacobian`), largest real part first."""
+    """Eigenvalues of the finite linearised chain about steady sliding (:func:`chain_jacobian`:
+    eq. (5) with the ends of docs/model.md, or the law's linearisation for another friction).
+
+    Parameters
+    ----------
+    p : ChainParams
+        The chain; N = 1 is the spring-slider.
+
+    Returns
+    -------
+    numpy.ndarray
+        The 3N complex eigenvalues, largest real part first: steady sliding is linearly stable
+        when the first has a negative real part.
+
+    Examples
+    --------
+    >>> from stickslip import chain_params
+    >>> from stickslip.analysis.stability import chain_finite_eigenvalues
+    >>> bool(chain_finite_eigenvalues(chain_params(N=9, beta=1.2))[0].real < 0)
+    True
+    """
     return _sorted_by_real_part(np.linalg.eigvals(chain_jacobian(p)))
 
 
 def critical_stiffness(p: ChainParams) -> float:
     """Critical spring constant K_c of steady sliding of the finite chain (end drive, free end).
 
-    The K at which the largest real part of the eigenvalues of :func:`chain_jacobian` crosses
-    zero (a Hopf point): steady sliding is unstable for K < K_c. For the spring-slider (N = 1)
-    with rate-and-state friction this is k_c = sigma_n (b - a) / D_c (1 + V^2 / (sigma_n a D_c))
+    The K at which the largest real part of the eigenvalues of :func:`chain_jacobian` crosses zero
+    (a Hopf point): steady sliding is unstable for K < K_c. For the spring-slider (N = 1) with
+    rate-and-state friction this is k_c = sigma_n (b - a) / D_c (1 + V^2 / (sigma_n a D_c))
     (Rice & Ruina 1983; docs/models/rate-state.md). Brent's method on K, bracketed by halving and
-    doubling from K = 1; NaN where no bracket is found (steady sliding stable at every K, as with
-    velocity strengthening, or unstable at every K).
+    doubling from K = 1.
+
+    Parameters
+    ----------
+    p : ChainParams
+        The chain (its K is the unknown).
+
+    Returns
+    -------
+    float
+        K_c; NaN where no bracket is found (steady sliding stable at every K, as with velocity
+        strengthening, or unstable at every K).
+
+    Examples
+    --------
+    >>> from stickslip import chain_params
+    >>> from stickslip.analysis.stability import critical_stiffness
+    >>> round(critical_stiffness(chain_params(friction="rate-state", N=1)), 9)
+    25.5
     """
 
     def growth(K: float) -> float:

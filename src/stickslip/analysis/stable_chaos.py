@@ -35,13 +35,46 @@ __all__ = ["FrontResult", "perturbation_front", "block_differences", "front_posi
 
 def block_differences(ref, twin) -> np.ndarray:
     """Per block, the size of twin - ref: the absolute difference of positions (u = x - V t) plus
-    that of velocities, blocks 1..N."""
+    that of velocities, blocks 1..N.
+
+    Parameters
+    ----------
+    ref, twin : LocatedState
+        The two states.
+
+    Returns
+    -------
+    numpy.ndarray
+        N differences.
+    """
     return np.abs(twin.u[1:-1] - ref.u[1:-1]) + np.abs(twin.v[1:-1] - ref.v[1:-1])
 
 
 def front_position(diff: np.ndarray, block: int, threshold: float) -> int:
-    """Blocks from ``block`` (0-based) out to the farthest block whose difference exceeds
-    ``threshold``, counting ``block`` itself (0 when none exceeds it)."""
+    """How far a perturbation has spread: blocks from ``block`` out to the farthest block whose
+    difference exceeds ``threshold``, counting ``block`` itself.
+
+    Parameters
+    ----------
+    diff : numpy.ndarray
+        Per-block differences (:func:`block_differences`).
+    block : int
+        The block perturbed, 0-based.
+    threshold : float
+        The difference that counts.
+
+    Returns
+    -------
+    int
+        The front's reach in blocks; 0 when no block exceeds the threshold.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from stickslip.analysis.stable_chaos import front_position
+    >>> front_position(np.array([1.0, 0.5, 0.2, 0.0]), 0, 0.3)
+    2
+    """
     hot = np.flatnonzero(np.asarray(diff) > threshold)
     if not hot.size:
         return 0
@@ -50,11 +83,28 @@ def front_position(diff: np.ndarray, block: int, threshold: float) -> int:
 
 @dataclass(frozen=True)
 class FrontResult:
-    """The front of each delta (threshold ``rel`` times the size of delta): ``rows`` of ``delta``,
-    ``reach`` (blocks reached at the end), ``t_reach`` (when it first got there), ``speed``
-    ((reach - 1) / t_reach, blocks per unit time; 0 if it never left the block), ``log_growth``
-    (ln of the largest block difference over delta at the end); ``fronts`` the front against
-    ``times`` for each delta."""
+    """The front of each perturbation size delta (:func:`perturbation_front`), its threshold ``rel``
+    times delta.
+
+    Attributes
+    ----------
+    rows : list of dict
+        One per delta: ``delta``, ``reach`` (blocks reached at the end), ``t_reach`` (when it
+        first got there), ``speed`` ((reach - 1) / t_reach, blocks per unit time; 0 if it never
+        left the block), ``log_growth`` (ln of the largest block difference over delta at the end).
+    times : numpy.ndarray
+        When the fronts were read.
+    fronts : dict
+        delta -> the front against ``times``.
+    block : int
+        The block perturbed (0-based).
+    rel : float
+        The threshold's factor.
+    t_max : float
+        The run length.
+    wall_seconds : float
+        Time taken.
+    """
 
     rows: list[dict[str, Any]]
     times: np.ndarray
@@ -92,12 +142,32 @@ def perturbation_front(
     """Fronts of perturbations of size delta on one block (module docstring; Politi and Torcini,
     arXiv 0902.2545, "propagation of finite perturbations").
 
-    ``start`` is a :class:`~stickslip.run.located.LocatedState` (or what
-    :func:`~stickslip.run.located.start_state` takes); for each delta the twin is ``start`` with
-    the position of ``block`` (0-based; 0 is the block next to the drive of eq. (4)) moved by
-    delta (signed: u = x - V t, so a negative delta on block 0 stretches the spring to the
-    drive); reference and twin run with located switches for ``t_max``, the front read every
-    ``check`` time units.
+    For each delta the twin is ``start`` with the position of ``block`` moved by delta (signed:
+    u = x - V t, so a negative delta on block 0 stretches the spring to the drive); reference and
+    twin run with located switches for ``t_max``.
+
+    Parameters
+    ----------
+    params : ChainParams
+        The chain.
+    start : LocatedState
+        The start (:class:`~stickslip.run.located.LocatedState`, or what
+        :func:`~stickslip.run.located.start_state` takes).
+    deltas : sequence of float
+        Perturbation sizes.
+    t_max : float
+        How long each pair runs.
+    block : int
+        The block moved, 0-based (0 is the block next to the drive of eq. (4)).
+    rel : float
+        A block is in the front when its difference exceeds ``rel`` * delta.
+    check : float
+        Time between readings of the front.
+
+    Returns
+    -------
+    FrontResult
+        Reach, speed and growth per delta, and each front against time.
     """
     from stickslip.run.located import LocatedStepper, start_state
 
@@ -150,9 +220,25 @@ def perturbation_front(
 
 def steady_lifetime(params: ChainParams, t_max: float, *, tol: float = 1e-6, sample_interval: float | None = None):
     """Lifetime of the stick-slip motion of eq. (4) from the paper's start: the time at which every
-    block first slides within ``tol`` of steady sliding (read every ``sample_interval``, default
-    t_max / 2000), or None if not by ``t_max``; returns a dict with ``t_steady`` (or None),
-    ``events`` (slip events before it) and ``wall_seconds``."""
+    block first slides within ``tol`` of steady sliding.
+
+    Parameters
+    ----------
+    params : ChainParams
+        The chain.
+    t_max : float
+        Longest run.
+    tol : float
+        Largest deviation from steady sliding (:func:`stickslip.run.state.steady_deviation`).
+    sample_interval : float, optional
+        Time between readings (default t_max / 2000).
+
+    Returns
+    -------
+    dict
+        ``N``, ``beta``, ``t_steady`` (None if not by ``t_max``), ``t_max``, ``events`` (slip
+        events before it) and ``wall_seconds``.
+    """
     from stickslip.run.driver import run_chain
     from stickslip.run.errors import short_runs_expected
 

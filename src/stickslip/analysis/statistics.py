@@ -1,8 +1,6 @@
-"""Analysis of chain runs: slip-size statistics (Figs. 7, 8), rupture fronts (Fig. 6), time averages (Fig. 5b).
-
-Conventions (docs/model.md): a slip event's size is S = sum_i (x_i(end) - x_i(start)); blocks are
-numbered 1..N. The functions here take the labelled tables of a chain run (``events``,
-``first_move``, ``samples``) and return labelled results: xarray Datasets and frozen dataclasses.
+"""Analysis of chain runs: slip-size statistics (Figs. 7, 8); rupture fronts (Fig. 6) and time
+averages (Fig. 5b) are importable here from :mod:`~stickslip.analysis.fronts` and
+:mod:`~stickslip.analysis.order`. A slip's size is S = sum_i (x_i(end) - x_i(start)) (docs/model.md).
 
 Power-law fit. The paper quotes p(S) ~ S^-tau with tau about 1.5 at beta = 1 (Fig. 7) and
 about 1.6 for small S at beta = 0.2 (Fig. 8). A finite chain cuts the distribution off near
@@ -14,19 +12,15 @@ the largest possible event, so the fit is the maximum-likelihood estimate for a 
 computed here in closed form (the score equation is solved by bracketing). For tau > 1
 ``scipy.stats.truncpareto.fit`` with c and scale fixed solves the same equation (the tests check
 that they agree); it is not called because for tau <= 1, which a fit range of junk can give, it
-falls back to a generic numerical search. The Kolmogorov-Smirnov distance is
-``scipy.stats.ks_1samp``'s and the bootstrap resampling ``scipy.stats.bootstrap``'s. The ``powerlaw``
-package (2.0) was checked and is not used for the estimate: ``powerlaw.Fit(..., xmax=...)``
-keeps the untruncated closed-form estimate 1 + n / sum log(S / s_min) whenever that estimate
-lies in (1.5, 3], i.e. it ignores ``xmax`` exactly in the range of exponents the paper reports
-(for tau = 1.5, s_max / s_min = 1e3 it returns about 1.57). Its truncated likelihood is only
-maximised with ``Power_Law(..., force_numerical_fit=True)``, a Nelder-Mead search with
-tolerance 1e-4; the tests use that as an independent check of this module.
+falls back to a generic numerical search. The KS distance is ``scipy.stats.ks_1samp``'s, the
+bootstrap ``scipy.stats.bootstrap``'s. ``powerlaw.Fit(..., xmax=...)`` (powerlaw 2.0) is not used:
+it keeps the untruncated estimate 1 + n / sum log(S / s_min) whenever it lies in (1.5, 3], the
+range the paper reports (for tau = 1.5, s_max / s_min = 1e3 it returns about 1.57); its
+``Power_Law(..., force_numerical_fit=True)`` is the tests' independent check of this module.
 
-Fit range. Without an explicit s_min the lower end is chosen by :func:`choose_s_min` (least
-Kolmogorov-Smirnov distance over a fixed candidate range; docs/statistics.md), because the
-smallest slips of a chain do not follow the power law: on the beta = 1 run of Fig. 7 the fit
-from the smallest S is rejected outright (KS distance about 0.5).
+Fit range. Without an explicit s_min the lower end is chosen by :func:`choose_s_min`
+(docs/statistics.md): the smallest slips of a chain do not follow the power law (on the
+beta = 1 run of Fig. 7 the fit from the smallest S has KS distance about 0.5).
 """
 
 from __future__ import annotations
@@ -51,8 +45,9 @@ from stickslip.analysis.fronts import (
     pick_front_events,
 )
 
-# Rupture fronts (Fig. 6) live in fronts; their names stay importable here.
-from stickslip.analysis.order import batch_means
+# Rupture fronts (Fig. 6) live in fronts, time averages (Fig. 5b) in order; their names stay
+# importable here.
+from stickslip.analysis.order import TimeAverage, time_average
 
 __all__ = [
     "size_distribution",
@@ -93,17 +88,33 @@ def size_distribution(
 ) -> xr.Dataset:
     """Histogram of slip sizes on logarithmic bins as a probability density (Figs. 7a, 8a).
 
-    ``bins`` is a number of logarithmically equal bins spanning [s_min, s_max] (default: the
-    smallest and the largest positive S), or an increasing array of bin edges. Sizes that are
-    not positive and finite cannot sit on a log axis and are left out (counted in the attrs).
-
     The density is count / (n_binned * width), so sum(density * width) = 1 over the binned
     events: it estimates p(S) itself, and a power law p ~ S^-tau appears with slope -tau. (A
-    plain count per log bin would have slope 1 - tau.)
+    plain count per log bin would have slope 1 - tau.) Sizes that are not positive and finite
+    cannot sit on a log axis and are left out (counted in the attrs).
 
-    Returns a Dataset on dim ``bin`` with coordinate ``S`` (geometric bin centre) and variables
-    ``density``, ``count``, ``width``, ``lower``, ``upper``; attrs ``n_binned``, ``n_total``,
-    ``n_dropped`` (non-positive or non-finite), ``n_outside`` (outside the edges).
+    Parameters
+    ----------
+    S : array_like
+        Slip sizes (``events["S"]``).
+    bins : int or array_like
+        A number of logarithmically equal bins spanning [s_min, s_max], or increasing bin edges.
+    s_min, s_max : float, optional
+        The range of the bins (default the smallest and the largest positive S).
+
+    Returns
+    -------
+    xarray.Dataset
+        On dim ``bin``, coordinate ``S`` (geometric bin centre) and variables ``density``,
+        ``count``, ``width``, ``lower``, ``upper``; attrs ``n_binned``, ``n_total``,
+        ``n_dropped`` (non-positive or non-finite), ``n_outside`` (outside the edges).
+
+    Examples
+    --------
+    >>> from stickslip.analysis.statistics import size_distribution
+    >>> d = size_distribution([1.0, 2.0, 4.0, 8.0, -1.0], bins=[1.0, 4.0, 16.0])
+    >>> d["count"].values.tolist(), d.attrs["n_dropped"], float((d["density"] * d["width"]).sum())
+    ([2, 2], 1, 1.0)
     """
     values, n_dropped = _positive_finite(S)
     if np.ndim(bins) == 0:
@@ -248,15 +259,40 @@ def _resampled_taus(log_ratio: np.ndarray, span: float, axis: int = -1) -> np.nd
 
 @dataclass(frozen=True)
 class PowerLawFit:
-    """Maximum-likelihood exponent of p(S) ~ S^-tau on [s_min, s_max] (Figs. 7a, 8a).
+    """Maximum-likelihood exponent of p(S) ~ S^-tau on [s_min, s_max] (Figs. 7a, 8a;
+    :func:`fit_power_law`).
 
-    ``tau``: the exponent; ``tau_err``: its bootstrap standard error (NaN without bootstrap);
-    ``tau_err_fisher``: the asymptotic error 1 / sqrt(n I(tau)) from the Fisher information;
-    ``n``: events in [s_min, s_max] used for the fit, ``n_total``: all finite positive events;
-    ``s_min_rule``: how s_min was set ("given", or "least KS distance" from :func:`choose_s_min`);
-    ``truncated``: whether the upper cut-off enters the likelihood (False: s_max = inf, the
-    classic estimator); ``loglikelihood``: the maximised log-likelihood; ``ks_distance``: the
-    Kolmogorov-Smirnov distance between the fitted and the empirical CDF on the range.
+    Attributes
+    ----------
+    tau : float
+        The exponent.
+    tau_err : float
+        Its bootstrap standard error (NaN without bootstrap).
+    tau_err_fisher : float
+        The asymptotic error 1 / sqrt(n I(tau)) from the Fisher information.
+    s_min : float
+        Lower end of the fitted range.
+    s_max : float
+        Upper end.
+    n : int
+        Events in [s_min, s_max] used for the fit.
+    n_total : int
+        All finite positive events.
+    bootstrap : int
+        Resamples of the error.
+    seed : int
+        Their seed.
+    truncated : bool
+        Whether the upper cut-off enters the likelihood (False: s_max = inf, the classic
+        estimator).
+    method : str
+        How tau was solved for.
+    loglikelihood : float
+        The maximised log-likelihood.
+    ks_distance : float
+        Kolmogorov-Smirnov distance between the fitted and the empirical CDF on the range.
+    s_min_rule : str
+        How s_min was set: "given", or "least KS distance" (:func:`choose_s_min`).
     """
 
     tau: float
@@ -283,7 +319,28 @@ class PowerLawFit:
 
 
 def truncated_power_law_pdf(s: Any, tau: float, s_min: float, s_max: float = math.inf) -> np.ndarray:
-    """p(S) = S^-tau / Z(tau) on [s_min, s_max], zero outside; the model of :func:`fit_power_law`."""
+    """p(S) = S^-tau / Z(tau) on [s_min, s_max], zero outside: the model of :func:`fit_power_law`.
+
+    Parameters
+    ----------
+    s : array_like
+        Sizes at which to evaluate it.
+    tau : float
+        The exponent.
+    s_min, s_max : float
+        The range (s_max = inf: the untruncated law, tau > 1).
+
+    Returns
+    -------
+    numpy.ndarray
+        The density, integrating to 1 over [s_min, s_max].
+
+    Examples
+    --------
+    >>> from stickslip.analysis.statistics import truncated_power_law_pdf
+    >>> truncated_power_law_pdf([0.5, 1.0, 4.0], 2.0, 1.0).tolist()  # S^-2 on [1, inf)
+    [0.0, 1.0, 0.0625]
+    """
     s = np.asarray(s, dtype=np.float64)
     log_z = _log_normaliser(tau, s_min, s_max)
     inside = (s >= s_min) & (s <= s_max)
@@ -336,10 +393,28 @@ def s_min_scan(
 ) -> pd.DataFrame:
     """The candidates of :func:`choose_s_min` with, for each, n, tau and the KS distance (Figs. 7, 8).
 
-    Candidates: ``n_candidates`` log-spaced values from the smallest positive S to the smaller
-    of its ``max_quantile`` quantile and ``max_fraction`` * s_max (s_max: the largest S if not
-    given); the scan stops at the first candidate that leaves fewer than ``min_events`` events
-    in [s_min, s_max]. Each gets the truncated maximum-likelihood fit on [s_min, s_max].
+    Candidates: ``n_candidates`` log-spaced values from the smallest positive S to the smaller of
+    its ``max_quantile`` quantile and ``max_fraction`` * s_max; the scan stops at the first
+    candidate that leaves fewer than ``min_events`` events in [s_min, s_max]. Each gets the
+    truncated maximum-likelihood fit on [s_min, s_max].
+
+    Parameters
+    ----------
+    S : array_like
+        Slip sizes.
+    s_max : float, optional
+        Upper end of the fits (default the largest S).
+    max_quantile, max_fraction : float
+        The largest candidate: the smaller of this quantile of S and this fraction of s_max.
+    n_candidates : int
+        Candidates scanned.
+    min_events : int
+        Fewest events a fit may use.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per candidate: ``s_min``, ``n``, ``tau``, ``ks_distance``.
     """
     values, _ = _positive_finite(S)
     if values.size == 0:
@@ -365,12 +440,25 @@ def choose_s_min(S: Any, s_max: float | None = None, **candidates: Any) -> float
     """Lower end of the power-law fit of Figs. 7, 8: the s_min with the least KS distance.
 
     Each candidate of :func:`s_min_scan` gets the truncated fit on [s_min, s_max] and its
-    Kolmogorov-Smirnov distance D (the recipe of Clauset, Shalizi and Newman, SIAM Review 51,
-    661 (2009), with the upper cut-off kept). A KS distance computed from n events is only
-    resolved to about 1/sqrt(n), so candidates with D <= D_least + 1/sqrt(n) count as equally
-    good and the smallest of them is taken (the most events). On a clean power law that is the
-    smallest S; below a range of junk it is the start of the power law. ``candidates``: the
-    keywords of :func:`s_min_scan`. With no candidate (too few events) the smallest S is returned.
+    Kolmogorov-Smirnov distance D (the recipe of Clauset, Shalizi and Newman, SIAM Review 51, 661
+    (2009), with the upper cut-off kept). A KS distance computed from n events is only resolved to
+    about 1/sqrt(n), so candidates with D <= D_least + 1/sqrt(n) count as equally good and the
+    smallest of them is taken (the most events). On a clean power law that is the smallest S;
+    below a range of junk it is the start of the power law.
+
+    Parameters
+    ----------
+    S : array_like
+        Slip sizes.
+    s_max : float, optional
+        Upper end of the fits (default the largest S).
+    **candidates
+        The keywords of :func:`s_min_scan`.
+
+    Returns
+    -------
+    float
+        s_min; the smallest S where there is no candidate (too few events).
     """
     scan = s_min_scan(S, s_max, **candidates)
     scan = scan[np.isfinite(scan["ks_distance"])]
@@ -395,18 +483,45 @@ def fit_power_law(
     """Exponent tau of the slip-size distribution p(S) ~ S^-tau by maximum likelihood (Figs. 7, 8).
 
     The fit uses the events with s_min <= S <= s_max and maximises the likelihood of the power
-    law truncated to that range (module docstring). Given s_min and s_max are used as they are.
-    Defaults: s_max = ``cutoff`` when the caller gives one (the size where the system size cuts
-    the distribution off, e.g. the smallest event that spans the chain, Fig. 8), else the
-    largest S (the maximum-likelihood estimate of an upper cut-off); s_min = the least-KS
-    choice of :func:`choose_s_min` on [., s_max] (``s_min_rule`` says which). With
-    ``truncated=False`` the upper cut-off is ignored in the likelihood (s_max = inf, the classic
-    estimator tau = 1 + n / sum log(S/s_min)) but events above ``s_max`` are still left out;
-    that estimate is biased upwards for a cut-off distribution.
+    law truncated to that range (module docstring). With ``truncated=False`` the upper cut-off is
+    ignored in the likelihood (s_max = inf, the classic estimator tau = 1 + n / sum log(S/s_min))
+    but events above ``s_max`` are still left out; that estimate is biased upwards for a cut-off
+    distribution.
 
-    The error ``tau_err`` is the standard deviation of the estimate over ``bootstrap``
-    resamples (with replacement) of the events in range, drawn with
-    ``numpy.random.default_rng(seed)``, at the chosen s_min; ``bootstrap=0`` skips it.
+    Parameters
+    ----------
+    S : array_like
+        Slip sizes (non-positive and non-finite ones are left out).
+    s_min : float, optional
+        Lower end (default the least-KS choice of :func:`choose_s_min` on [., s_max]).
+    s_max : float, optional
+        Upper end (default ``cutoff``, else the largest S, the maximum-likelihood estimate of an
+        upper cut-off).
+    cutoff : float, optional
+        The size where the system size cuts the distribution off (e.g. the smallest event that
+        spans the chain, Fig. 8).
+    bootstrap : int
+        Resamples (with replacement) of the events in range for ``tau_err``, at the chosen s_min;
+        0 skips it.
+    seed : int
+        Seed of the resampling (``numpy.random.default_rng``).
+    truncated : bool
+        Keep the upper cut-off in the likelihood.
+
+    Returns
+    -------
+    PowerLawFit
+        tau, its errors, the range and its events, the log-likelihood and the KS distance.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from stickslip.analysis.statistics import fit_power_law
+    >>> u = np.random.default_rng(1).uniform(size=5000)
+    >>> S = (1.0 - u * (1.0 - 1e3 ** -0.5)) ** -2.0  # p(S) ~ S^-1.5 on [1, 1000]
+    >>> fit = fit_power_law(S, s_min=1.0, s_max=1e3, bootstrap=0)
+    >>> abs(fit.tau - 1.5) < 0.05, fit.n
+    (True, 5000)
     """
     values, _ = _positive_finite(S)
     n_total = int(values.size)
@@ -482,56 +597,4 @@ def fit_power_law(
         loglikelihood=loglik,
         ks_distance=ks,
         s_min_rule=rule,
-    )
-
-
-# ---------------------------------------------------------------------------------------------
-# Time averages (Fig. 5b)
-
-
-@dataclass(frozen=True)
-class TimeAverage:
-    """Time average of a sampled series with a batch-means standard error (Fig. 5b).
-
-    ``mean`` over samples with t >= t_from; ``stderr``: the standard deviation of the means of
-    ``n_batches`` consecutive equal batches over sqrt(n_batches) (stick-slip samples are
-    correlated, so the naive error would be too small); ``n_samples`` used.
-    """
-
-    mean: float
-    stderr: float
-    t_from: float
-    t_to: float
-    n_samples: int
-    n_batches: int
-
-    def to_dict(self) -> dict[str, Any]:
-        return asdict(self)
-
-
-def time_average(series: xr.DataArray, t_from: float | None = None, *, n_batches: int = 10) -> TimeAverage:
-    """<L> = time average of L(t) = x_1 - x_N (or any series on coord ``t``) for Fig. 5b, its error
-    from ``n_batches`` batch means (:func:`stickslip.analysis.order.batch_means`; the samples left
-    over are dropped at the start)."""
-    if "t" not in series.coords:
-        raise ValueError("series needs a coordinate 't'")
-    t = series["t"].to_numpy()
-    values = series.to_numpy().astype(np.float64)
-    start = float(t.min()) if t_from is None else float(t_from)
-    keep = (t >= start) & np.isfinite(values)
-    y = values[keep]
-    n = int(y.size)
-    if n == 0:
-        raise ValueError(f"no samples at t >= {start:g}")
-    stderr = math.nan
-    if n_batches >= 2 and n >= n_batches:
-        # The project's one batch-means estimator (the order parameter's too).
-        stderr, _ = batch_means(y, n // n_batches)
-    return TimeAverage(
-        mean=float(y.mean()),
-        stderr=stderr,
-        t_from=start,
-        t_to=float(t[keep].max()),
-        n_samples=n,
-        n_batches=int(n_batches),
     )

@@ -173,12 +173,47 @@ def model_defaults(name: str, default: Any) -> str:
     return ", ".join(f"{value} ({', '.join(names)})" for value, names in by_value.items())
 
 
+def block_model_defaults(name: str) -> str:
+    """The default of single-block parameter ``name`` in each model of ``--model``
+    (:data:`~stickslip.models.presets.SINGLE_BLOCK`) that reads it, e.g. ``0.001 (sakaguchi),
+    0.05 (batista-carlson)``; one value where every model has the same."""
+    from stickslip.models.presets import SINGLE_BLOCK, block_params
+
+    by_value: dict[str, list[str]] = {}
+    unread = []
+    for model in SINGLE_BLOCK:
+        if not _block_reads(model, name):
+            unread.append(model)
+            continue
+        by_value.setdefault(f"{getattr(block_params(model), name):g}", []).append(model)
+    text = (
+        next(iter(by_value))
+        if len(by_value) == 1 and not unread
+        else ", ".join(f"{value} ({', '.join(names)})" for value, names in by_value.items())
+    )
+    return text + (f"; not read by {', '.join(unread)}" if unread else "")
+
+
+def _block_reads(model: str, name: str) -> bool:
+    """Whether the single block of ``model`` reads ``name``: every field but the start threshold
+    Fs, which only a model whose threshold reads it has (the state threshold is sigma theta)."""
+    from stickslip.models.presets import PRESETS
+
+    return name != "Fs" or "Fs" in PRESETS[model].reads()
+
+
 def add_param_options(
-    parser: argparse.ArgumentParser, params_cls: type, skip: tuple[str, ...] = (), helps: dict[str, str] | None = None
+    parser: argparse.ArgumentParser,
+    params_cls: type,
+    skip: tuple[str, ...] = (),
+    helps: dict[str, str] | None = None,
+    *,
+    block_models: bool = False,
 ) -> None:
     """One option per field of a parameter dataclass (:func:`option_name`; the former spelling
     with underscores still accepted), its help giving the default of each model that reads it
-    (ChainParams) or the dataclass's; ``helps`` replaces the help text of some."""
+    (ChainParams; BlockParams with ``block_models``, for a command with the block's ``--model``)
+    or the dataclass's; ``helps`` replaces the help text of some."""
     from stickslip.models.params import ChainParams
 
     docs = params_cls.field_docs()
@@ -191,7 +226,12 @@ def add_param_options(
         allowed = _range_text(
             meta.get("low"), meta.get("high"), meta.get("low_open", False), meta.get("high_open", False)
         )
-        default = model_defaults(f.name, f.default) if params_cls is ChainParams else f"{f.default}"
+        if params_cls is ChainParams:
+            default = model_defaults(f.name, f.default)
+        elif block_models:
+            default = block_model_defaults(f.name)
+        else:
+            default = f"{f.default:g}" if isinstance(f.default, float) else f"{f.default}"
         flag = option_name(f.name)
         convert = _number(kind, f.name, allowed)
         group.add_argument(
@@ -449,7 +489,7 @@ def add_block_model_option(parser: argparse.ArgumentParser) -> None:
 def block_params_from_args(args: argparse.Namespace, **overrides: Any):
     """Validated BlockParams of ``--model`` with the ``--NAME`` options as overrides."""
     from stickslip.models.params import BlockParams
-    from stickslip.models.presets import PRESETS, block_params
+    from stickslip.models.presets import block_params
 
     values = {
         f.name: getattr(args, f"param_{f.name}")
@@ -458,7 +498,7 @@ def block_params_from_args(args: argparse.Namespace, **overrides: Any):
     }
     values.update(overrides)
     model = getattr(args, "model", None) or "sakaguchi"
-    if "Fs" in values and "Fs" not in PRESETS[model].reads():
+    if "Fs" in values and not _block_reads(model, "Fs"):
         from stickslip.models.params import ParameterError
 
         raise ParameterError(f"--Fs is not a parameter of {model} (its threshold is sigma theta)")

@@ -75,7 +75,7 @@ def register(sub) -> None:
         ),
     )
     add_block_model_option(p)
-    add_param_options(p, BlockParams)
+    add_param_options(p, BlockParams, block_models=True)
     p.add_argument("--t-end", type=float_arg("t_end"), default=None, metavar="T",
                    help="end time of the run (default: first slip + 3.5 periods of T(V))")  # fmt: skip
     p.add_argument("--every", type=float_arg("every"), default=1, metavar="N",

@@ -113,7 +113,7 @@ def register(sub) -> None:
         ),
     )
     add_block_model_option(h)
-    add_param_options(h, BlockParams, skip=("V",))
+    add_param_options(h, BlockParams, skip=("V",), block_models=True)
     h.add_argument("--V-min", dest="V_min", type=float_arg("V_min"), default=hy.DEFAULT_V_MIN,
                    help=f"lowest V (default {hy.DEFAULT_V_MIN:g})")  # fmt: skip
     h.add_argument("--V-max", dest="V_max", type=float_arg("V_max"), default=hy.DEFAULT_V_MAX,

@@ -32,7 +32,6 @@ import shutil
 import sys
 import time
 import traceback
-import warnings
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
@@ -45,10 +44,18 @@ from stickslip import __version__, heartbeat
 from stickslip.experiments.cache import file_digests, sealed
 from stickslip.experiments.cache import read_done as _read_done
 from stickslip.experiments.cache import spec_before as _spec_before
+from stickslip.experiments.sweep_points import (  # noqa: F401 (point_params: importable here, as before)
+    BLOCK_RUN_OPTIONS,
+    CHAIN_RUN_OPTIONS,
+    point_params,
+)
+from stickslip.experiments.sweep_points import chain_run_args as _chain_run_args
+from stickslip.experiments.sweep_points import split_point as _split
+from stickslip.experiments.sweep_points import warn_short_chain_runs as _warn_short_chain_runs
 from stickslip.io import disk_full, run_metadata, write_dataset, write_json, write_table_files
 from stickslip.jsonable import to_jsonable
 from stickslip.models.params import BlockParams, ChainParams
-from stickslip.run.errors import ShortRunWarning, short_runs_expected
+from stickslip.run.errors import short_runs_expected
 
 __all__ = [
     "run_sweep",
@@ -81,16 +88,6 @@ STOP_WAIT_SECONDS = 60.0
 CHECKPOINT_INTERVAL = 120.0  # wall-clock seconds between a chain point's checkpoints
 
 # Keys of a point that are options of the run rather than model parameters.
-CHAIN_RUN_OPTIONS = (
-    "t_end",
-    "integrator",
-    "start",
-    "sample_interval",
-    "average_from",
-    "profile_window",
-    "profile_min_blocks",
-)
-BLOCK_RUN_OPTIONS = ("t_end", "every")
 
 # Columns of the summary table that are not parameters or task results.
 _STATUS_COLUMNS = ("point_dir", "status", "reused", "error", "wall_seconds", "note")
@@ -283,23 +280,57 @@ def run_sweep(
     stop_wait: float = 0.0,
     dashboard: bool = False,
 ) -> SweepResult:
-    """Run ``task`` at every point of a parameter grid, each point an independent Dask task.
+    """Run ``task`` at every point of a parameter grid, each point an independent Dask task
+    (docs/sweeps.md).
 
-    ``points`` are dicts of the varying parameters; each names its directory under ``out_dir``
-    (:func:`point_name`). ``common`` holds settings shared by every point (fixed parameters,
-    run length); the task receives ``{**common, **point}``. A point whose directory holds a
-    ``done.json`` for the same task, point, common settings and package version is not run
-    again, unless its files are damaged (:mod:`stickslip.experiments.cache`: then it runs
-    again and its row's ``note`` says why). Points run on a new local cluster (``n_workers``
-    processes, default one per core, one thread each) or, with ``scheduler`` = address, on an
-    existing cluster. Progress (points done / total, time left) goes to stderr. Writes
-    ``summary.parquet`` and ``summary.csv`` in ``out_dir``: one row per point with its
-    parameters, the fixed settings of ``common``, ``status`` ("ok"/"failed"), ``reused``,
-    ``error``, ``wall_seconds`` and the task's summary fields.
-    The local cluster listens on 127.0.0.1 only and serves no dashboard unless ``dashboard``
-    (then on 127.0.0.1, its address printed on stderr).
-    Interrupted (KeyboardInterrupt), it waits up to ``stop_wait`` seconds for the running points
-    to stop on request (:func:`stop_requested`) before it closes the cluster and re-raises.
+    Each point names its directory under ``out_dir`` (:func:`point_name`). A point whose
+    directory holds a ``done.json`` for the same task, point, common settings and package version
+    is not run again, unless its files are damaged (:mod:`stickslip.experiments.cache`: then it
+    runs again and its row's ``note`` says why). Writes ``summary.parquet`` and ``summary.csv`` in
+    ``out_dir``. The local cluster listens on 127.0.0.1 only.
+
+    Parameters
+    ----------
+    task : callable
+        ``task(point: dict, point_dir: Path) -> dict``, a top-level function (:func:`chain_task`,
+        :func:`block_task`, ...) so that it pickles by reference; it receives
+        ``{**common, **point}`` and returns the point's summary.
+    points : iterable of dict
+        The varying parameters of each point.
+    out_dir : str or Path
+        The sweep's folder.
+    common : dict, optional
+        Settings shared by every point (fixed parameters, run length ``t_end``).
+    scheduler : str, optional
+        Address of an existing Dask scheduler; else a new local cluster.
+    n_workers : int, optional
+        Worker processes of the local cluster (default one per core, one thread each).
+    progress : bool
+        A bar of points done on stderr, where stderr is a terminal.
+    stop_wait : float
+        Interrupted (KeyboardInterrupt), how long to wait for the running points to stop on
+        request (:func:`stop_requested`) before the cluster is closed and the interrupt goes on.
+    dashboard : bool
+        Serve the local cluster's dashboard on 127.0.0.1 and print its address on stderr.
+
+    Returns
+    -------
+    SweepResult
+        ``table``, one row per point with its parameters, the fixed settings of ``common``,
+        ``status`` ("ok"/"failed"), ``reused``, ``error``, ``wall_seconds``, ``point_dir`` and the
+        task's summary fields; and the counts ``n_points``, ``n_run``, ``n_reused``,
+        ``n_failed``.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from dask.distributed import LocalCluster
+    >>> from stickslip.experiments.sweep import demo_task, run_sweep
+    >>> with LocalCluster(n_workers=1, processes=False, dashboard_address=None) as cluster:
+    ...     result = run_sweep(demo_task, [{"x": 1.0}, {"x": 2.0}], tempfile.mkdtemp(), common={"n": 3},
+    ...                        scheduler=cluster.scheduler_address, progress=False)
+    >>> result.table["value"].tolist()  # sum of k^2 x over k = 1..3
+    [14.0, 28.0]
     """
     start = time.perf_counter()
     points = [dict(p) for p in points]
@@ -479,58 +510,6 @@ def _on_terminal() -> bool:
 # Tasks
 
 
-def point_params(kind: str, point: dict[str, Any]):
-    """The parameters of one sweep point: BlockParams, or ChainParams of the point's ``model``
-    preset (default the paper's chain) with the point's other fields as overrides."""
-    params_cls = ChainParams if kind == "chain" else BlockParams
-    fields = {f.name for f in dataclasses.fields(params_cls)}
-    values = {k: v for k, v in point.items() if k in fields}
-    if params_cls is ChainParams:
-        from stickslip.models.presets import chain_params
-
-        return chain_params(values.pop("model", "sakaguchi"), **values)
-    return params_cls(**values)
-
-
-def _split(point: dict[str, Any], params_cls: type, options: tuple[str, ...]) -> tuple[Any, dict[str, Any]]:
-    fields = {f.name for f in dataclasses.fields(params_cls)}
-    unknown = sorted(set(point) - fields - set(options))
-    if unknown:
-        raise ValueError(f"unknown keys for {params_cls.__name__}: {', '.join(unknown)}")
-    params = point_params("chain" if params_cls is ChainParams else "block", point)
-    run_options = {k: v for k, v in point.items() if k in options}
-    if "t_end" not in run_options:
-        raise ValueError("a sweep point needs t_end")
-    return params, run_options
-
-
-def _chain_run_args(point: dict[str, Any]) -> tuple[ChainParams, float, dict[str, Any]]:
-    """The parameters, run length and run options of a chain point (the model's start by default)."""
-    from stickslip.models.presets import PRESETS
-
-    params, options = _split(point, ChainParams, CHAIN_RUN_OPTIONS)
-    t_end = options.pop("t_end")
-    if "start" not in options:  # the model's own start (Carlson-Langer: every block stuck, seeded)
-        preset = PRESETS[params.model]
-        options["start"] = preset.start
-        options["perturbation"] = preset.start_options.get("amplitude", 0.0)
-        options["seed"] = preset.start_options.get("seed", 0)
-    return params, t_end, options
-
-
-def _warn_short_chain_runs(points: list[dict[str, Any]], common: dict[str, Any], names: list[str]) -> None:
-    """One :class:`ShortRunWarning` per chain point too short to leave the loading (run.state.loading_warnings)."""
-    from stickslip.run.state import loading_warnings
-
-    for point, name in zip(points, names, strict=False):
-        try:
-            params, t_end, options = _chain_run_args({**common, **point})
-        except (ValueError, TypeError):
-            continue  # the point itself reports its error when it runs
-        for message in loading_warnings(params, t_end, options.get("average_from"), options["start"]):
-            warnings.warn(f"{name}: {message}", ShortRunWarning, stacklevel=3)
-
-
 def run_chain_point(params: ChainParams, t_end: float, point_dir: str | Path, **options: Any):
     """The chain run (eq. 4 or a relative) of one sweep point, in ``point_dir``: continued from
     its checkpoint when there is one, checkpointed every :data:`CHECKPOINT_INTERVAL` seconds, and
@@ -550,10 +529,23 @@ def run_chain_point(params: ChainParams, t_end: float, point_dir: str | Path, **
 
 
 def chain_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
-    """Run the chain of eq. (4) at one point; its outputs go to ``point_dir``; returns its summary.
+    """Run the chain of eq. (4), or a relative, at one sweep point; its run directory is
+    ``point_dir``.
 
-    ``point`` holds :class:`~stickslip.models.params.ChainParams` fields, ``t_end`` and optionally the
-    run options in :data:`CHAIN_RUN_OPTIONS`.
+    Parameters
+    ----------
+    point : dict
+        :class:`~stickslip.models.params.ChainParams` fields (``model``: a preset, default the
+        paper's chain), ``t_end`` and optionally the run options of :data:`CHAIN_RUN_OPTIONS`;
+        without ``start`` the model's own start.
+    point_dir : Path
+        Where the run writes run.json, state.nc and the tables (and its checkpoint while it
+        runs: an interrupted point goes on from there).
+
+    Returns
+    -------
+    dict
+        The run's summary (``n_events``, ``L_mean``, ``L_steady``, ``state_sha256``, ...).
     """
     params, t_end, options = _chain_run_args(point)
     with short_runs_expected():  # said once, by run_sweep, before the points run

@@ -21,7 +21,9 @@ from __future__ import annotations
 
 import math
 import os
+import tempfile
 import time
+from collections.abc import Sequence
 from pathlib import Path
 from types import SimpleNamespace
 from typing import Any
@@ -35,8 +37,17 @@ from stickslip.experiments.cache import spec_key
 from stickslip.experiments.ladders import params_at
 from stickslip.experiments.study_run import PAGE_FILES, record_outputs
 from stickslip.experiments.transition_page import PER_N_COLUMNS, ROW_COLUMNS, write_page
+from stickslip.models.params import check_number
 
-__all__ = ["ladder_points", "run_transition", "per_n_summary", "ROW_COLUMNS", "PER_N_COLUMNS", "LADDER_NS"]
+__all__ = [
+    "ladder_points",
+    "run_transition",
+    "transition_loop",
+    "per_n_summary",
+    "ROW_COLUMNS",
+    "PER_N_COLUMNS",
+    "LADDER_NS",
+]
 
 #: N of each mode; ``extra_Ns`` (for example 1599) adds chains.
 LADDER_NS = {"tiny": (9,), "quick": (49, 99, 199), "full": (49, 99, 199, 399, 799)}
@@ -149,9 +160,23 @@ def _mean_err(values: list[float], errs: list[float]) -> tuple[float, float]:
 
 
 def per_n_summary(rows: pd.DataFrame) -> pd.DataFrame:
-    """Per N: beta_t and the step of m (and of phi) at beta_t, averaged over the up ladders'
-    replicas with their errors (:func:`_mean_err`), the spread of beta_t between replicas, and the
-    lower edge of the down ladder with half its bracket as error."""
+    """What the rungs of the transition study say per N: the loop's edges and the step at its top.
+
+    Parameters
+    ----------
+    rows : pandas.DataFrame
+        The rungs (the study's table, or :func:`transition_loop`).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per N, the columns :data:`PER_N_COLUMNS`: ``beta_t`` (last beta where the up
+        ladders stick-slip, the mean over their replicas) and ``beta_t_err`` (the larger of the
+        replicas' spread and their half brackets), ``lower_edge`` (middle of the bracket where the
+        down ladder leaves steady sliding) and ``lower_edge_err`` (half the bracket), ``step`` of
+        m and ``step_phi`` of the stuck fraction at beta_t with their errors, ``replicas``,
+        ``undecided`` and ``rungs``.
+    """
     out = []
     if "replica" not in rows:
         rows = rows.assign(replica=0)
@@ -270,10 +295,7 @@ def run_transition(
     # why cached ladders and rungs ran again (their files damaged), for the page
     rerun = [f"{r.point_dir}: {r.note}" for r in result.table.itertuples() if isinstance(getattr(r, "note", None), str)]
     rerun += [f"N = {r['N']} {r['branch']} rung {r['rung']}: {r['note']}" for r in rows if r.get("note")]
-    table = pd.DataFrame(rows)
-    if len(table):
-        table = table[[c for c in ROW_COLUMNS if c in table] + [c for c in table if c not in ROW_COLUMNS]]
-        table = table.sort_values(["N", "branch", "replica", "beta"], kind="stable").reset_index(drop=True)
+    table = _rows_table(rows)
     per_n = per_n_summary(table) if len(table) else pd.DataFrame(columns=PER_N_COLUMNS)
     fits = _fits(per_n) if len(per_n) else {}
     page.mkdir(parents=True, exist_ok=True)
@@ -313,6 +335,93 @@ def run_transition(
     io.write_json(page / "study.json", data)
     write_page(page / "index.html", data)
     return {**data, "page": str(page / "index.html"), "failed": len(failed)}
+
+
+def _rows_table(rows: list[dict[str, Any]]) -> pd.DataFrame:
+    """The rungs as the study's table: :data:`ROW_COLUMNS` first, by N, branch, replica and beta."""
+    table = pd.DataFrame(rows)
+    if len(table):
+        table = table[[c for c in ROW_COLUMNS if c in table] + [c for c in table if c not in ROW_COLUMNS]]
+        table = table.sort_values(["N", "branch", "replica", "beta"], kind="stable").reset_index(drop=True)
+    return table
+
+
+def transition_loop(
+    N: int,
+    *,
+    out_dir: str | Path | None = None,
+    replicas: int = 1,
+    bisections: int = 3,
+    cap_loads: float | None = None,
+    up: Sequence[float] | None = None,
+    down: Sequence[float] | None = None,
+) -> pd.DataFrame:
+    """The hysteresis loop of the chain of eq. (4) across beta_c = 1 at one N, by continuation in
+    beta: the up and down ladders of ``stickslip study transition`` (docs/studies/transition.md),
+    run one after the other in this process.
+
+    The up ladder starts in stick-slip below beta = 1 and hands each rung's final state to the next
+    larger beta until the chain slides steadily; the down ladder starts from steady sliding above
+    the loop and goes down until a block sticks; each then bisects the bracket it found. Every rung
+    stops when its answer is known (:mod:`stickslip.experiments.ladders`). The rungs are those of
+    the study with the same settings, bit for bit: at N = 49 (about 15 s) replica 0 of
+    ``--quick``.
+
+    Parameters
+    ----------
+    N : int
+        Blocks of the chain (the paper's other parameters: K = 10, D = 5, V = 0.001, Fs = 3).
+    out_dir : str or Path, optional
+        Where the ladders keep their rungs; a call with the same settings reuses them. A new
+        temporary folder when not given.
+    replicas : int
+        Up ladders, each from its own seeded start (the study runs 4: where an up ladder leaves
+        stick-slip is a random event near beta_t).
+    bisections : int
+        Bisections of the bracket where each ladder leaves its branch.
+    cap_loads : float, optional
+        Longest rung, in loading times L_ss / V (default the study's: 16 for N <= 99, fewer for
+        longer chains).
+    up, down : sequence of float, optional
+        The ladders' coarse grids in beta (default the study's: 0.8, 0.9, 1 and 1 + k / N,
+        k = 5 ... 80, up; 1 + k / N down to 0.9, down).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per rung, with the columns of the study's table (:data:`ROW_COLUMNS`): ``beta``,
+        ``branch`` (``up``/``down``), ``replica``, the order parameter m = 1 - <L>/L_ss
+        (``order_parameter``) and the stuck fraction (``stuck_fraction``) with their errors,
+        ``final_state``, ``branch_state`` (``stick-slip``/``sliding``), ``loads``, ...
+        :func:`per_n_summary` reads beta_t, the lower edge and the step from it;
+        :func:`stickslip.plotting.ladders.loops_figure` draws it.
+
+    Examples
+    --------
+    >>> from stickslip.experiments.transition_study import per_n_summary, transition_loop
+    >>> rows = transition_loop(9, bisections=0, cap_loads=1.0, up=[0.8, 4.0], down=[4.0, 0.8])
+    >>> [(r.branch, r.beta, r.branch_state) for r in rows.itertuples()]
+    [('down', 0.8, 'stick-slip'), ('down', 4.0, 'sliding'), ('up', 0.8, 'stick-slip'), ('up', 4.0, 'sliding')]
+    """
+    from stickslip.experiments.ladders import ladder_task
+
+    N = int(check_number("N", N, low=1, integer=True))
+    replicas = int(check_number("replicas", replicas, low=1, integer=True))
+    bisections = int(check_number("bisections", bisections, low=0, integer=True))
+    common, _ = ladder_points("quick")
+    grid_up, grid_down = _grids(N, "quick")
+    cap = _cap_loads(N) if cap_loads is None else float(check_number("cap_loads", cap_loads, low=0.0, low_open=True))
+    ladders = [{"direction": "up", "betas": list(up or grid_up), "seed": r, "replica": r} for r in range(replicas)]
+    ladders.append({"direction": "down", "betas": list(down or grid_down), "seed": 0, "replica": 0})
+    points = [{**common, "N": N, "cap_loads": cap, "bisections": bisections, **lad} for lad in ladders]
+    for point in points:  # every rung's parameters refused before any ladder runs
+        for beta in point["betas"]:
+            params_at(point, float(beta))
+    folder = Path(out_dir) if out_dir is not None else Path(tempfile.mkdtemp(prefix="stickslip-transition-"))
+    rows: list[dict[str, Any]] = []
+    for point in points:
+        rows += ladder_task(point, folder / f"N{N}-{point['direction']}-{point['replica']}")["rows"]
+    return _rows_table(rows)
 
 
 def _records(table: pd.DataFrame) -> list[dict[str, Any]]:

@@ -16,7 +16,14 @@ from stickslip.models.pieces import Piece, piece
 
 
 class ParameterError(ValueError):
-    """A parameter is outside its allowed range; the message is one line."""
+    """A parameter is outside its allowed range, or not one the model reads.
+
+    Parameters
+    ----------
+    message : str
+        One line naming the parameter, its allowed range and the value given, e.g.
+        ``K must be > 0 (got -1)``; the commands print it as it is, without a traceback.
+    """
 
 
 def _range_text(low: float | None, high: float | None, low_open: bool, high_open: bool) -> str:

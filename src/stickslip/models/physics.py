@@ -80,8 +80,25 @@ def chain_steady_state(p: ChainParams, t: float = 0.0) -> dict[str, np.ndarray]:
 def chain_steady_length(p: ChainParams) -> float:
     """Total length L = x_1 - x_N of steady sliding, exact discrete form (docs/model.md).
 
-    L_ss = (c / K) N (N - 1) / 2 with c = theta_0 + beta V; 7940.1 for the paper's chain. Zero for
-    the plate drive (every block lags the plate equally); NaN where there is no steady sliding.
+    L_ss = (c / K) N (N - 1) / 2 with c = theta_0 + beta V, the steady friction.
+
+    Parameters
+    ----------
+    p : ChainParams
+        The chain.
+
+    Returns
+    -------
+    float
+        L_ss: 7940.1 for the paper's chain (N = 399); zero for the plate drive (every block lags
+        the plate equally); NaN where there is no steady sliding.
+
+    Examples
+    --------
+    >>> from stickslip import chain_params
+    >>> from stickslip.models.physics import chain_steady_length
+    >>> round(chain_steady_length(chain_params(N=49)), 5)  # c = 1, K = 10: 49 * 48 / 20
+    117.6
     """
     if not has_steady_state(p):
         return float("nan")

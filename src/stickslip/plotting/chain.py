@@ -69,11 +69,26 @@ def snapshot_figure(x: Any, params: ChainParams, t: float, *, ax=None, paper_fig
 
     Top: x_i - V t of the run (solid), of the exact discrete steady sliding solution
     (:func:`~stickslip.models.physics.chain_steady_state`, dashed) and of the paper's continuum form
-    x_i = V t - c/K {N^2 - (i - N)^2}/2 (dotted), all in the frame moving with the pulling point
-    x_0 = V t. Bottom: the run's departure from the exact steady profile, and the continuum
-    form's, which lies c i / (2K) above it (c N / (2K), about 20, at the free end of the paper's chain).
-    ``x`` is x_1..x_N (an array or a DataArray over ``block``). Given ``ax``, only the top panel
-    is drawn, into it.
+    x_i = V t - c/K {N^2 - (i - N)^2}/2 (dotted), in the frame of the pulling point x_0 = V t.
+    Bottom: the run's departure from the exact steady profile, and the continuum form's, which lies
+    c i / (2K) above it (about 20 at the free end of the paper's chain).
+
+    Parameters
+    ----------
+    x : array_like or xarray.DataArray
+        x_1..x_N (``run.state.blocks()["x"]``, or one time of ``run.snapshots``).
+    params : ChainParams
+        The chain (end drive).
+    t : float
+        The snapshot's time.
+    ax : matplotlib.axes.Axes, optional
+        Draw only the top panel, into this Axes.
+    paper_figure : str, optional
+        The paper's figure this is (by default named only for the paper's own runs).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
     """
     xs = _snapshot_array(x, params.N)
     i = np.arange(1, params.N + 1)
@@ -114,14 +129,28 @@ def length_against_beta(
 ) -> Figure:
     """Average total length <L> = <x_1 - x_N> against beta, with steady sliding (the paper's Fig. 5b).
 
-    ``table`` has columns ``beta`` and ``L_mean`` (and optionally ``L_err``, drawn as error
-    bars, and ``final_state``), e.g. a sweep's summary. The dashed line is the exact discrete
-    steady sliding length L_ss = (c/K) N (N - 1) / 2 with the steady friction
-    c = 1 - (1 - beta) V (:func:`~stickslip.models.physics.chain_steady_length`) for the other
-    parameters of ``params``; the paper's printed L = c N^2 / 2 lacks the factor 1/K (docs/model.md)
-    and is not drawn. The dotted vertical line marks beta_c = 1, where the long-wave
-    instability sets in (Fig. 4). With ``final_state``, runs above beta_c that had not settled
-    into steady sliding by their end are drawn with open symbols. Given ``ax``, it is drawn there.
+    The dashed line is the exact discrete steady length L_ss = (c/K) N (N - 1) / 2 with
+    c = 1 - (1 - beta) V (:func:`~stickslip.models.physics.chain_steady_length`); the paper's
+    printed L = c N^2 / 2 lacks the factor 1/K (docs/model.md) and is not drawn. The dotted line
+    marks beta_c, where the long-wave instability sets in (Fig. 4).
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        Columns ``beta`` and ``L_mean``, optionally ``L_err`` (error bars) and ``final_state``
+        (runs above beta_c not settled into steady sliding are drawn open), e.g. a sweep's summary.
+    params : ChainParams
+        The chain's other parameters.
+    beta_c : float
+        The linear threshold marked.
+    ax : matplotlib.axes.Axes, optional
+        Draw into this Axes.
+    paper_figure : str, optional
+        The paper's figure this is.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
     """
     data = table.sort_values("beta")
     beta = data["beta"].to_numpy(dtype=np.float64)
@@ -176,11 +205,11 @@ def length_against_beta(
 
 
 def _event_profiles(profiles: xr.Dataset, event: int) -> xr.Dataset:
-    rows = np.flatnonzero(profiles["event"].values == event)
+    rows = np.flatnonzero(profiles["profile_event"].values == event)
     if rows.size == 0:
         raise ValueError(f"no displacement profiles stored for event {event}")
-    sub = profiles.isel(row=rows)
-    return sub.isel(row=np.argsort(sub["t"].values, kind="stable"))
+    sub = profiles.isel(profile_row=rows)
+    return sub.isel(profile_row=np.argsort(sub["profile_t"].values, kind="stable"))
 
 
 def _nice(x: float) -> float:
@@ -209,9 +238,9 @@ def _waterfall(ax, sub: xr.Dataset, window: float | None, edge: EdgeSpeed | None
     bar at the right gives the Delta x_i scale. At most :data:`MAX_WINDOWS` windows are drawn,
     evenly spaced from the first. ``edge``: the leading edge of each window (marks).
     """
-    dx = sub["dx"].transpose("row", "block").values
+    dx = sub["profile_dx"].transpose("profile_row", "block").values
     blocks = sub["block"].values if "block" in sub.coords else np.arange(1, dx.shape[1] + 1)
-    t = sub["t"].values
+    t = sub["profile_t"].values
     every = max(1, int(math.ceil(dx.shape[0] / MAX_WINDOWS)))
     shown = np.arange(0, dx.shape[0], every)
     n = shown.size
@@ -364,16 +393,41 @@ def fronts_figure(
 
     Left: the displacement Delta x_i = x_i(t + Delta t) - x_i(t) over successive windows of
     Delta t = ``window`` (20 in the paper) from the event's start, stacked upwards in time like
-    the paper's plot, with a scale bar for Delta x_i (``profiles``: dim ``row`` with ``event``,
-    ``t`` and ``dx(row, block)``). Right: the time each block first moved against i, the front
-    speed fitted over the far part of the chain (:func:`~stickslip.analysis.statistics.front_speed`),
-    the sound speed sqrt(K) (3.16 for K = 10) and, for the paper's chain, its c = 1.43 as slopes
-    from the same point. ``edges`` (one :class:`~stickslip.analysis.statistics.EdgeSpeed` or None per
-    front) marks the leading edge of each window in both panels. ``speeds`` (columns
-    ``c_first_move``, ``c_leading_edge``, one row per event that reached block N) adds a last
-    row: the per-event distribution of c by both definitions, with the paper's value and its
-    percentile. Given ``ax`` (one Axes, or two), the first front's windows (and first moves)
-    are drawn there.
+    the paper's plot, with a scale bar for Delta x_i. Right: the time each block first moved
+    against i, the front speed fitted over the far part of the chain
+    (:func:`~stickslip.analysis.statistics.front_speed`), the sound speed sqrt(K) (3.16 for
+    K = 10) and, for the paper's chain, its c = 1.43 as slopes from the same point.
+
+    Parameters
+    ----------
+    profiles : xarray.Dataset
+        The stored windows, ``ChainRun.profiles``: ``profile_dx`` over (``profile_row``,
+        ``block``) with ``profile_event`` and ``profile_t`` per row.
+    first_move : pandas.DataFrame
+        ``ChainRun.first_move``: columns ``event``, ``block``, ``t_first``.
+    fronts : sequence of FrontSpeed
+        The fitted fronts, one per event drawn (:func:`~stickslip.analysis.statistics.front_speed`).
+    params : ChainParams
+        The run's model (titles, sqrt(K), the paper's c only for eq. 4).
+    labels : sequence of str, optional
+        One label per front (default ``event <number>``).
+    window : float or None
+        Delta t of the windows, for the axis label.
+    edges : sequence of EdgeSpeed or None, optional
+        The leading edge of each front's windows, marked in both panels.
+    speeds : pandas.DataFrame, optional
+        Columns ``c_first_move`` and ``c_leading_edge``, one row per event that reached block N:
+        adds a last row, the per-event distribution of c by both definitions with the paper's
+        value and its percentile.
+    ax : matplotlib.axes.Axes or a pair of them, optional
+        Draw the first front's windows (and, given two Axes, its first moves) there.
+    paper_figure : str, optional
+        The paper's figure this drawing is (``"Fig. 6"``); by default named only for the
+        paper's own runs.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
     """
     fronts = list(fronts)
     if not fronts:
@@ -386,7 +440,8 @@ def fronts_figure(
         pair = list(np.ravel(ax))
         sub = _event_profiles(profiles, fronts[0].event)
         _waterfall(pair[0], sub, window, edges[0])
-        pair[0].set_title(f"{labels[0]}, $t_s \\approx {float(sub['t'].values[0]):.6g}$", loc="left", fontsize=8)
+        t0 = float(sub["profile_t"].values[0])
+        pair[0].set_title(f"{labels[0]}, $t_s \\approx {t0:.6g}$", loc="left", fontsize=8)
         if len(pair) > 1:
             _arrivals(pair[1], first_move, fronts[0], params.K, edges[0], paper)
             pair[1].set_title(f"front: blocks {fronts[0].i_min}-{fronts[0].i_max}", loc="left", fontsize=8)
@@ -400,7 +455,7 @@ def fronts_figure(
         sub = _event_profiles(profiles, front.event)
         _waterfall(ax_w, sub, window, edge)
         letter = letters[row] if row < 8 else str(row)
-        t0 = float(sub["t"].values[0])
+        t0 = float(sub["profile_t"].values[0])
         ax_w.set_title(f"({letter}) {label}, $t_s \\approx {t0:.6g}$", loc="left", fontsize=9)
         _arrivals(ax_t, first_move, front, params.K, edge, paper)
         ax_t.set_title(f"front: blocks {front.i_min}-{front.i_max}", loc="left", fontsize=9)
@@ -429,15 +484,37 @@ def sizes_figure(
     ax=None,
     paper_figure: str | None = None,
 ) -> Figure:
-    """Slip sizes: (a) their distribution with the fitted power law, (b) S against event time
-    (the paper's Figs. 7 at beta = 1 and 8 at beta = 0.2).
+    """Slip sizes: (a) their distribution with the fitted power law, (b) S against event time (the
+    paper's Figs. 7 at beta = 1 and 8 at beta = 0.2).
 
-    (a): the density of S on logarithmic bins (:func:`~stickslip.analysis.statistics.size_distribution`,
-    normalised for bin width) with the fitted power law p ~ S^-tau over [s_min, s_max]
-    (scaled by the share of events in that range); ``paper_tau`` adds the paper's exponent
-    (1.5 at beta = 1, about 1.6 at beta = 0.2) as a dotted guide, set below the fit so that
-    both show. (b): S of every event against its start time ``t_start``. The title names the
-    model of ``params`` (else the ``beta`` given); given ``ax``, only (a) is drawn, into it.
+    (a): the density of S on logarithmic bins
+    (:func:`~stickslip.analysis.statistics.size_distribution`) with the fitted power law
+    p ~ S^-tau over [s_min, s_max], scaled by the share of events in that range. (b): S of every
+    event against its start time.
+
+    Parameters
+    ----------
+    events : pandas.DataFrame
+        The events (``S``, ``t_start``), usually the stationary window's.
+    fit : PowerLawFit
+        The fit drawn (:func:`~stickslip.analysis.statistics.fit_power_law`).
+    beta : float, optional
+        For the title, without ``params``.
+    params : ChainParams, optional
+        The model the title names.
+    bins : int or array_like
+        Bins of the density.
+    paper_tau : float, optional
+        The paper's exponent (1.5 at beta = 1, about 1.6 at beta = 0.2) as a dotted guide below
+        the fit.
+    ax : matplotlib.axes.Axes, optional
+        Draw only (a), into this Axes.
+    paper_figure : str, optional
+        The paper's figure this is.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
     """
     S = events["S"].to_numpy(dtype=np.float64)
     dist = size_distribution(S, bins)

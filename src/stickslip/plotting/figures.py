@@ -189,8 +189,8 @@ def _fig5(o: dict[str, Outcome], a: dict[str, Any], d: Path, mode: str) -> list[
     from stickslip.plotting.chain import fig5a_snapshot, fig5b_length
 
     run = a["run1"]
-    snap = run.snapshots.isel(time=-1)
-    t = float(snap["time"])
+    snap = run.snapshots.isel(snapshot_time=-1)
+    t = float(snap["snapshot_time"])
     p = run.params
     fa = io.write_table_files(
         d / "fig5a",
@@ -249,8 +249,8 @@ def _fig6(o: dict[str, Outcome], a: dict[str, Any], d: Path) -> list[ReportFigur
     if not fr["fronts"]:
         raise ValueError("no event with stored profiles to draw")
     ids = [f.event for f in fr["fronts"]]
-    rows = np.flatnonzero(np.isin(run.profiles["event"].values, ids))
-    prof = run.profiles.isel(row=rows)
+    rows = np.flatnonzero(np.isin(run.profiles["profile_event"].values, ids))
+    prof = run.profiles.isel(profile_row=rows)
     f1 = io.write_dataset(d / "fig6.nc", prof)
     fm = run.first_move[run.first_move["event"].isin(ids)]
     f2 = io.write_table_files(d / "fig6_first_move", fm)

@@ -18,8 +18,22 @@ __all__ = ["loops_figure", "scaling_figure"]
 
 
 def loops_figure(rows: pd.DataFrame) -> Figure:
-    """m = 1 - <L>/L_ss (left) and the stuck fraction phi (right) against beta: the up ladder
-    (filled, solid; one line per replica) and the down ladder (open, dashed) of every N."""
+    """The hysteresis loops of the transition of eq. (4) at beta_c = 1: m = 1 - <L>/L_ss (left)
+    and the stuck fraction phi (right) against beta, the up ladder (filled, solid; one line per
+    replica) and the down ladder (open, dashed) of every N.
+
+    Parameters
+    ----------
+    rows : pandas.DataFrame
+        The rungs, one per row: ``N``, ``beta``, ``branch``, optionally ``replica``,
+        ``order_parameter``, ``stuck_fraction`` and their ``_err`` columns (the table of
+        ``stickslip study transition``, or
+        :func:`~stickslip.experiments.transition_study.transition_loop`).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     fig, (ax_m, ax_p) = new_figure(1, 2, width=5.6, height=4.0)
     for k, (N, g) in enumerate(rows.groupby("N")):
         colour = f"C{k % 10}"

@@ -97,7 +97,8 @@ def snapshot(run, t: float | None = None, *, ax=None) -> Figure:
     run : ChainRun
         A run whose model has steady sliding pulled from one end (eq. 4 and the train model).
     t : float, optional
-        A time in ``run.snapshots["time"]`` (``snapshot_times`` of the run); the end if not given.
+        A time in ``run.snapshots["snapshot_time"]`` (``snapshot_times`` of the run); the end if
+        not given.
     ax : matplotlib.axes.Axes, optional
         Draw the snapshot panel alone into this Axes; else a Figure with the residual beneath.
 
@@ -110,11 +111,11 @@ def snapshot(run, t: float | None = None, *, ax=None) -> Figure:
         raise ValueError(f"no steady sliding profile pulled from one end for this model ({model_name(p)})")
     if t is None:
         return snapshot_figure(run.state.blocks()["x"], p, float(run.summary["t_end"]), ax=ax)
-    times = run.snapshots["time"].values
+    times = run.snapshots["snapshot_time"].values
     near = [float(s) for s in times if math.isclose(float(s), float(t), rel_tol=1e-9, abs_tol=0.5 * p.dt)]
     if not near:
         raise ValueError(f"no snapshot stored at t = {t:g} (stored: {', '.join(f'{s:g}' for s in times)})")
-    return snapshot_figure(run.snapshots.sel(time=near[0]), p, near[0], ax=ax)
+    return snapshot_figure(run.snapshots.sel(snapshot_time=near[0]), p, near[0], ax=ax)
 
 
 def sizes(run, *, ax=None, bins: int = 30) -> Figure:
@@ -151,7 +152,7 @@ def fronts(run, *, ax=None) -> Figure:
     -------
     matplotlib.figure.Figure
     """
-    if not run.profiles.sizes.get("row", 0):
+    if not run.profiles.sizes.get("profile_row", 0):
         raise ValueError("no displacement profiles stored (run with profile_window=20)")
     found = front_statistics(run, run.params.N, 0.0)
     if not found["fronts"]:
@@ -168,7 +169,21 @@ def fronts(run, *, ax=None) -> Figure:
 
 
 def run_figures(run, *, max_snapshots: int = 4) -> list[RunFigure]:
-    """The figures ``run`` (a :class:`~stickslip.run.outputs.ChainRun`) supports, in a fixed order."""
+    """The figures a chain run supports, in a fixed order: what ``stickslip plot`` draws.
+
+    Parameters
+    ----------
+    run : ChainRun
+        A run (``run_chain`` or ``load_run``).
+    max_snapshots : int
+        Most stored snapshots drawn (besides the final state).
+
+    Returns
+    -------
+    list of RunFigure
+        Each with its file stem, title and Figure, or None and why it was not drawn (``skipped``:
+        no steady profile for this model, too few events, no stored profiles).
+    """
     p = run.params
     out = []
     if run.samples.sizes.get("t", 0) > 1:
@@ -185,13 +200,13 @@ def run_figures(run, *, max_snapshots: int = 4) -> list[RunFigure]:
                 snapshot_figure(run.state.blocks()["x"], p, t_end),
             )
         )
-        times = run.snapshots["time"].values if "time" in run.snapshots.dims else []
+        times = run.snapshots["snapshot_time"].values
         for t in [t for t in times if not math.isclose(float(t), t_end)][:max_snapshots]:
             out.append(
                 RunFigure(
                     f"snapshot_t{float(t):.6g}",
                     f"snapshot at t = {float(t):g}",
-                    snapshot_figure(run.snapshots.sel(time=t), p, float(t)),
+                    snapshot_figure(run.snapshots.sel(snapshot_time=t), p, float(t)),
                 )
             )
     else:
@@ -220,7 +235,7 @@ def run_figures(run, *, max_snapshots: int = 4) -> list[RunFigure]:
                 f"(a distribution needs {MIN_EVENTS_FOR_SIZES})",
             )
         )
-    if run.profiles.sizes.get("row", 0) and len(events):
+    if run.profiles.sizes.get("profile_row", 0) and len(events):
         fronts = front_statistics(run, p.N, 0.0)
         if fronts["fronts"]:
             fig = fronts_figure(
@@ -266,7 +281,23 @@ def size_numbers(run, stats: dict) -> dict:
 
 
 def draw_run_figures(run, out_dir: str | Path, *, formats: tuple[str, ...] = FIGURE_FORMATS) -> list[dict]:
-    """Save every figure of :func:`run_figures` as OUT_DIR/<stem>.<fmt>; one record per figure."""
+    """Save every figure of :func:`run_figures` as OUT_DIR/<stem>.<fmt>.
+
+    Parameters
+    ----------
+    run : ChainRun
+        A run.
+    out_dir : str or Path
+        The folder (``RUN_DIR/figures`` for ``stickslip plot``).
+    formats : tuple of str
+        File formats.
+
+    Returns
+    -------
+    list of dict
+        One record per figure: ``figure`` (stem), ``title``, and ``files`` written or ``skipped``
+        with why; ``numbers`` where the figure has some (the size fit).
+    """
     records = []
     for item in run_figures(run):
         record = {"figure": item.stem, "title": item.title}

@@ -36,7 +36,21 @@ PAPER = {"color": "0.4", "lw": 1.0, "ls": ":"}  # the paper's own formula where 
 
 
 def new_figure(nrows: int = 1, ncols: int = 1, *, width: float = 5.0, height: float = 3.6, **kw):
-    """A Figure and its axes in the project style (no pyplot state is kept)."""
+    """A Figure and its axes in the project's style; no pyplot state is kept.
+
+    Parameters
+    ----------
+    nrows, ncols : int
+        The grid of Axes.
+    width, height : float
+        Size of one panel, inches.
+    **kw
+        Passed on to :meth:`matplotlib.figure.Figure.subplots` (``sharex``, ``gridspec_kw``, ...).
+
+    Returns
+    -------
+    tuple of (matplotlib.figure.Figure, Axes or array of Axes)
+    """
     with matplotlib.rc_context(RC):
         fig = Figure(figsize=(width * ncols, height * nrows), layout="constrained")
         axes = fig.subplots(nrows, ncols, squeeze=True, **kw)
@@ -48,10 +62,25 @@ FIGURE_FORMATS = ("png", "pdf")
 
 
 def save_figure(fig: Figure, path: str | Path, *, formats: tuple[str, ...] = FIGURE_FORMATS) -> list[Path]:
-    """Save ``fig`` as PATH.png and PATH.pdf (or ``formats``), the format added to the whole name
-    (``lam_beta0.9`` gives ``lam_beta0.9.png``); returns the written paths. Each file
-    is rendered in memory and written atomically (:func:`stickslip.io.write_bytes`), so a full
-    disk leaves no half-written image."""
+    """Save ``fig`` as PATH.png and PATH.pdf (or ``formats``), each file rendered in memory and
+    written atomically (:func:`stickslip.io.write_bytes`), so a full disk leaves no half-written
+    image.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure.
+    path : str or Path
+        The path without format: the format is added to the whole name (``lam_beta0.9`` gives
+        ``lam_beta0.9.png``).
+    formats : tuple of str
+        File formats.
+
+    Returns
+    -------
+    list of Path
+        The files written.
+    """
     import io as _io
 
     from stickslip.io import write_bytes

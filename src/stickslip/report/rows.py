@@ -288,8 +288,8 @@ def _chain_rows(o: Outcome, a: dict[str, Any], mode: str) -> list[ReportRow]:
 
     # Fig. 5(a)
     run = a["run1"]
-    snap = run.snapshots.isel(time=-1)
-    t = float(snap["time"])
+    snap = run.snapshots.isel(snapshot_time=-1)
+    t = float(snap["snapshot_time"])
     ss = chain_steady_state(run.params, t)["x"]
     L_ss = float(run.summary["L_steady"])
     dev = float(np.max(np.abs(snap.values - ss))) / L_ss

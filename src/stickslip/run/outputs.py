@@ -141,13 +141,16 @@ class ChainRun:
         ``block`` (1..N), ``step`` and ``t_first`` = step dt (model time units).
     samples : xarray.Dataset
         ``L`` = x_1 - x_N (model length units) over ``t``, sampled every ``sample_interval``
-        (Fig. 5b); with ``sample_moving``, ``n_moving`` over ``t_moving`` (the same names in
-        state.nc).
+        (Fig. 5b); with ``sample_moving``, ``n_moving`` over ``t_moving``.
     snapshots : xarray.DataArray
-        x_i (model length units) over (``time``, ``block``): the ``snapshot_times`` and the end.
+        ``snapshot_x``: x_i (model length units) over (``snapshot_time``, ``block``), at the
+        ``snapshot_times`` and the end.
     profiles : xarray.Dataset
-        ``dx`` over (``row``, ``block``): x_i(t_next) - x_i(t) over each stored window of an
-        event (Fig. 6), with ``event``, ``t`` and ``t_next`` per row.
+        ``profile_dx`` over (``profile_row``, ``block``): x_i(t + W) - x_i(t) over each stored
+        window of an event (Fig. 6), with ``profile_event`` (the event's number in ``events``),
+        ``profile_t`` (window start) and ``profile_t_next`` (window end) per row.
+
+    Every array has the name it has in the run directory's state.nc (docs/chain.md, "A run directory").
     summary : dict
         Numbers of the run: ``n_events``, ``L_mean``, ``L_steady``, ``t_end``, ``steps``,
         ``wall_seconds``, ``state_sha256`` (the final state's SHA-256), ...
@@ -399,9 +402,9 @@ def _assemble(params, options, integrator, start_info, state, outputs, wall, ste
     order = np.argsort(snap_steps, kind="stable")
     snapshots = xr.DataArray(
         snap_x[order],
-        dims=("time", "block"),
-        coords={"time": np.asarray(snap_steps)[order] * dt, "block": blocks},
-        name="x",
+        dims=("snapshot_time", "block"),
+        coords={"snapshot_time": np.asarray(snap_steps)[order] * dt, "block": blocks},
+        name="snapshot_x",
         attrs={"long_name": "block positions x_i"},
     )
     profiles = _profiles(parts, events, options, params)
@@ -484,11 +487,11 @@ def _profiles(parts, events, options, params) -> xr.Dataset:
             rows_t1.append(pm[b, 1] * params.dt)
     dx = np.array(rows_dx).reshape(-1, params.N)
     return xr.Dataset(
-        {"dx": (("row", "block"), dx, {"long_name": "displacement over the window"})},
+        {"profile_dx": (("profile_row", "block"), dx, {"long_name": "displacement over the window"})},
         coords={
-            "event": ("row", np.array(rows_ev, dtype=np.int64)),
-            "t": ("row", np.array(rows_t0, dtype=np.float64)),
-            "t_next": ("row", np.array(rows_t1, dtype=np.float64)),
+            "profile_event": ("profile_row", np.array(rows_ev, dtype=np.int64)),
+            "profile_t": ("profile_row", np.array(rows_t0, dtype=np.float64)),
+            "profile_t_next": ("profile_row", np.array(rows_t1, dtype=np.float64)),
             "block": np.arange(1, params.N + 1),
         },
         attrs={"window": options.profile_window if options.profile_window else 0.0},

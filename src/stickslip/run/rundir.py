@@ -38,6 +38,7 @@ from stickslip.run.ownership import (  # noqa: F401
 from stickslip.run.runfiles import (  # noqa: F401
     EVENT_DOCS,
     FIRST_MOVE_DOCS,
+    PROFILE_COORDS,
     RUN_FILES,
     SCALE,
     UNITS,
@@ -116,13 +117,11 @@ def _load_run(run_dir: Path) -> ChainRun:
     if "n_moving" in ds:
         samples["n_moving"] = xr.DataArray(ds["n_moving"].values, dims="t_moving")
         samples = samples.assign_coords(t_moving=("t_moving", ds["t_moving"].values))
-    snapshots = ds["snapshot_x"].rename({"snapshot_time": "time"}).rename("x")
+    snapshots = ds["snapshot_x"]
     profiles = xr.Dataset(
-        {"dx": (("row", "block"), ds["profile_dx"].values)},
+        {"profile_dx": (("profile_row", "block"), ds["profile_dx"].values)},
         coords={
-            "event": ("row", ds["profile_event"].values),
-            "t": ("row", ds["profile_t"].values),
-            "t_next": ("row", ds["profile_t_next"].values),
+            **{name: ("profile_row", ds[name].values) for name in PROFILE_COORDS},
             "block": ds["block"].values,
         },
     )

@@ -1,8 +1,9 @@
 """The files of a chain run directory (eq. 4): what :func:`write_run` writes, with their labels.
 
 state.nc (final state, L(t), snapshots and profiles as labelled arrays, CF attributes from
-:data:`VARIABLE_ATTRS`; L over ``t`` as in ``ChainRun.samples``, the time of the final state in
-the attribute ``t_end``; files written before these names had ``t_sample`` and ``t``, and
+:data:`VARIABLE_ATTRS`; every array under the name it has in ``ChainRun.samples``,
+``.snapshots`` and ``.profiles``, the time of the final state in the attribute ``t_end``; files
+written before L's time took the name ``t`` had ``t_sample``, and
 :func:`~stickslip.run.rundir.load_run` reads both), events and first_move (each as .parquet and
 .csv, the columns described by :data:`EVENT_DOCS` and :data:`FIRST_MOVE_DOCS`) and run.json.
 Reading them back is :func:`stickslip.run.rundir.load_run`; owning and locking the directory is
@@ -47,15 +48,18 @@ VARIABLE_ATTRS = {
         "flag_values": np.array([0, 1], dtype=np.int8),
         "flag_meanings": "moving stopped",
     },
-    "t": _model("sampling time t of L (ChainRun.samples' t)"),
+    "t": _model("sampling time t of L"),
     "L": _model("chain length L = x_1 - x_N (Fig. 5b)"),
     "snapshot_time": _model("time of the snapshot"),
     "snapshot_x": _model("block positions x_i at the snapshot time (Fig. 5a)"),
-    "profile_dx": _model("displacement Delta x_i = x_i(t_next) - x_i(t) over one window (Fig. 6)"),
+    "profile_dx": _model("displacement Delta x_i = x_i(profile_t_next) - x_i(profile_t) over one window (Fig. 6)"),
     "profile_event": {"long_name": "slip event of the profile row (events.parquet column event)", "units": "1"},
     "profile_t": _model("start of the profile window"),
     "profile_t_next": _model("end of the profile window"),
 }
+
+#: The per-row quantities of ChainRun.profiles (coordinates in memory, variables in state.nc).
+PROFILE_COORDS = ("profile_event", "profile_t", "profile_t_next")
 
 #: Descriptions of the columns of events.parquet and first_move.parquet (Parquet field metadata).
 EVENT_DOCS = {
@@ -103,11 +107,9 @@ def write_run(run: Any, out_dir: str | Path) -> Path:
             "theta": ("block", b["theta"]),
             "stopped": ("block", b["stopped"].astype(np.int8)),
             "L": run.samples["L"],
-            "snapshot_x": run.snapshots.rename({"time": "snapshot_time"}),
-            "profile_dx": run.profiles["dx"].reset_coords(drop=True).rename({"row": "profile_row"}),
-            "profile_event": ("profile_row", run.profiles["event"].values),
-            "profile_t": ("profile_row", run.profiles["t"].values),
-            "profile_t_next": ("profile_row", run.profiles["t_next"].values),
+            "snapshot_x": run.snapshots,
+            "profile_dx": run.profiles["profile_dx"].reset_coords(drop=True),
+            **{name: ("profile_row", run.profiles[name].values) for name in PROFILE_COORDS},
         },
         coords={"block": blocks},
         attrs={

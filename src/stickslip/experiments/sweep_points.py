@@ -1,0 +1,82 @@
+"""What a point of a parameter sweep holds (:mod:`stickslip.experiments.sweep`): the model's
+parameters, read from the point's fields, and the run options a task takes.
+
+A chain point holds :class:`~stickslip.models.params.ChainParams` fields (with ``model``, a
+preset) and the options of :data:`CHAIN_RUN_OPTIONS`; a block point
+:class:`~stickslip.models.params.BlockParams` fields and :data:`BLOCK_RUN_OPTIONS`. Both need
+``t_end``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import warnings
+from typing import Any
+
+from stickslip.models.params import BlockParams, ChainParams
+from stickslip.run.errors import ShortRunWarning
+
+__all__ = ["CHAIN_RUN_OPTIONS", "BLOCK_RUN_OPTIONS", "point_params", "split_point", "chain_run_args"]
+
+CHAIN_RUN_OPTIONS = (
+    "t_end",
+    "integrator",
+    "start",
+    "sample_interval",
+    "average_from",
+    "profile_window",
+    "profile_min_blocks",
+)
+BLOCK_RUN_OPTIONS = ("t_end", "every")
+
+
+def point_params(kind: str, point: dict[str, Any]):
+    """The parameters of one sweep point: BlockParams, or ChainParams of the point's ``model``
+    preset (default the paper's chain) with the point's other fields as overrides."""
+    params_cls = ChainParams if kind == "chain" else BlockParams
+    fields = {f.name for f in dataclasses.fields(params_cls)}
+    values = {k: v for k, v in point.items() if k in fields}
+    if params_cls is ChainParams:
+        from stickslip.models.presets import chain_params
+
+        return chain_params(values.pop("model", "sakaguchi"), **values)
+    return params_cls(**values)
+
+
+def split_point(point: dict[str, Any], params_cls: type, options: tuple[str, ...]) -> tuple[Any, dict[str, Any]]:
+    fields = {f.name for f in dataclasses.fields(params_cls)}
+    unknown = sorted(set(point) - fields - set(options))
+    if unknown:
+        raise ValueError(f"unknown keys for {params_cls.__name__}: {', '.join(unknown)}")
+    params = point_params("chain" if params_cls is ChainParams else "block", point)
+    run_options = {k: v for k, v in point.items() if k in options}
+    if "t_end" not in run_options:
+        raise ValueError("a sweep point needs t_end")
+    return params, run_options
+
+
+def chain_run_args(point: dict[str, Any]) -> tuple[ChainParams, float, dict[str, Any]]:
+    """The parameters, run length and run options of a chain point (the model's start by default)."""
+    from stickslip.models.presets import PRESETS
+
+    params, options = split_point(point, ChainParams, CHAIN_RUN_OPTIONS)
+    t_end = options.pop("t_end")
+    if "start" not in options:  # the model's own start (Carlson-Langer: every block stuck, seeded)
+        preset = PRESETS[params.model]
+        options["start"] = preset.start
+        options["perturbation"] = preset.start_options.get("amplitude", 0.0)
+        options["seed"] = preset.start_options.get("seed", 0)
+    return params, t_end, options
+
+
+def warn_short_chain_runs(points: list[dict[str, Any]], common: dict[str, Any], names: list[str]) -> None:
+    """One :class:`ShortRunWarning` per chain point too short to leave the loading (run.state.loading_warnings)."""
+    from stickslip.run.state import loading_warnings
+
+    for point, name in zip(points, names, strict=False):
+        try:
+            params, t_end, options = chain_run_args({**common, **point})
+        except (ValueError, TypeError):
+            continue  # the point itself reports its error when it runs
+        for message in loading_warnings(params, t_end, options.get("average_from"), options["start"]):
+            warnings.warn(f"{name}: {message}", ShortRunWarning, stacklevel=3)
