@@ -253,6 +253,47 @@ def add_param_options(
             )
 
 
+def _run_option_fields():
+    """The fields of :class:`~stickslip.run.outputs.RunOptions` with a command-line option, and their metadata."""
+    from stickslip.run.outputs import RunOptions
+
+    return [(f, f.metadata["cli"]) for f in dataclasses.fields(RunOptions) if "cli" in f.metadata]
+
+
+def add_run_options(parser: argparse.ArgumentParser) -> None:
+    """One option per field of :class:`~stickslip.run.outputs.RunOptions` that names one (its
+    metadata ``cli``: spelling, metavar, help; integer, repeatable), default None (the field's
+    default then applies: :func:`run_options_from_args`)."""
+    for _, cli in _run_option_fields():
+        convert = (int_arg if cli.get("integer") else float_arg)(cli["option"], cli.get("allowed", ""))
+        parser.add_argument(
+            f"--{cli['option']}",
+            type=convert,
+            default=None,
+            metavar=cli["metavar"],
+            help=cli["help"],
+            **({"action": "append"} if cli.get("append") else {}),
+        )
+
+
+def run_option_dests() -> tuple[str, ...]:
+    """The names :func:`add_run_options` gives its options in the parsed arguments."""
+    return tuple(cli["option"].replace("-", "_") for _, cli in _run_option_fields())
+
+
+def run_options_from_args(args: argparse.Namespace, t_end: float):
+    """The :class:`~stickslip.run.outputs.RunOptions` of the options :func:`add_run_options`
+    added (the field's default where one is not given), with ``t_end``; not yet validated."""
+    from stickslip.run.outputs import RunOptions
+
+    values: dict[str, Any] = {}
+    for f, cli in _run_option_fields():
+        value = getattr(args, cli["option"].replace("-", "_"), None)
+        if value is not None:
+            values[f.name] = tuple(value) if cli.get("append") else value
+    return RunOptions(t_end=t_end, **values)
+
+
 def params_from_args(params_cls: type, args: argparse.Namespace, **overrides: Any):
     """Build (and so validate) a parameter dataclass from the ``--NAME`` options."""
     values = {}

@@ -12,11 +12,14 @@ from stickslip.cli._common import (
     Result,
     add_json_option,
     add_model_options,
+    add_run_options,
     chain_params_from_args,
     check_out_owned,
     float_arg,
     int_arg,
     owned_out_dir,
+    run_option_dests,
+    run_options_from_args,
 )
 from stickslip.models.params import MAX_PERTURBATION, check_number, steps_for
 from stickslip.run.ownership import PLOT_FOLDER, only_plot_files
@@ -63,50 +66,7 @@ def register(sub) -> None:
         help="keep the checkpoint (tens of MB for long chains) when the run finishes, so that "
         "--resume can continue it to a later --t-end (default: removed)",
     )
-    p.add_argument(
-        "--sample-interval",
-        type=float_arg("sample-interval"),
-        default=None,
-        metavar="T",
-        help="sample L = x_1 - x_N every T time units (default 10)",
-    )
-    p.add_argument(
-        "--average-from",
-        type=float_arg("average-from"),
-        default=None,
-        metavar="T",
-        help="<L> averages the samples with t >= T (default t_end / 2)",
-    )
-    p.add_argument(
-        "--snapshot",
-        type=float_arg("snapshot"),
-        action="append",
-        default=None,
-        metavar="T",
-        help="store all x_i at time T (repeatable; Fig. 5a)",
-    )
-    p.add_argument(
-        "--profile-window",
-        type=float_arg("profile-window"),
-        default=None,
-        metavar="W",
-        help="store the displacement over windows of W during events (Fig. 6 uses 20)",
-    )
-    p.add_argument(
-        "--profile-min-blocks",
-        type=int_arg("profile-min-blocks", ">= 0"),
-        default=None,
-        metavar="M",
-        help="keep profiles only of events with at least M moved blocks",
-    )
-    p.add_argument(
-        "--until-steady",
-        type=float_arg("until-steady"),
-        default=None,
-        metavar="TOL",
-        help="stop once every block slides within TOL of steady sliding (velocities, state "
-        "variables, spring extensions); L is taken from the steady solution from then on",
-    )
+    add_run_options(p)
     p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     add_json_option(p)
     p.set_defaults(handler=run_chain_command)
@@ -253,19 +213,7 @@ def _json_summary(summary: dict, out: Path | None) -> dict:
     return data
 
 
-_FIXED_BY_CHECKPOINT = (
-    "from_dir",
-    "integrator",
-    "start",
-    "perturbation",
-    "seed",
-    "sample_interval",
-    "average_from",
-    "snapshot",
-    "profile_window",
-    "profile_min_blocks",
-    "until_steady",
-)
+_FIXED_BY_CHECKPOINT = ("from_dir", "integrator", "start", "perturbation", "seed", *run_option_dests())
 
 
 def run_chain_command(args: argparse.Namespace) -> Result:
@@ -329,9 +277,6 @@ def run_chain_command(args: argparse.Namespace) -> Result:
         ("start", "paper"),
         ("perturbation", 0.0),
         ("seed", 0),
-        ("sample_interval", 10.0),
-        ("snapshot", []),
-        ("profile_min_blocks", 0),
     ):
         if getattr(args, name) is None:
             setattr(args, name, default)
@@ -347,17 +292,10 @@ def run_chain_command(args: argparse.Namespace) -> Result:
                 raise CommandError(f"{flag} needs --out (a run without a run directory writes no checkpoints)")
     interval = 300.0 if args.checkpoint_interval is None else args.checkpoint_interval
     check_number("checkpoint-interval", interval, low=0.0, low_open=True)
-    check_number("profile-min-blocks", args.profile_min_blocks, low=0, integer=True)
+    options = run_options_from_args(args, t_end)
+    check_number("profile-min-blocks", options.profile_min_blocks, low=0, integer=True)
     # Validate every option before anything is written.
-    chain.RunOptions(
-        t_end=t_end,
-        sample_interval=args.sample_interval,
-        average_from=args.average_from,
-        snapshot_times=tuple(args.snapshot),
-        profile_window=args.profile_window,
-        profile_min_blocks=args.profile_min_blocks,
-        until_steady=args.until_steady,
-    ).validated(params.dt)
+    options.validated(params.dt)
     check_number("perturbation", args.perturbation, low=0.0, high=MAX_PERTURBATION)
     own = _own_files(args.out)
     out = check_out_owned(args.out, own, "stickslip chain", overwrite=args.overwrite)
@@ -373,16 +311,11 @@ def run_chain_command(args: argparse.Namespace) -> Result:
             run = chain.run_chain(
                 params,
                 t_end,
-                integrator=args.integrator,
                 start=args.start if from_state is None else from_state,
+                options=options,
+                integrator=args.integrator,
                 perturbation=args.perturbation,
                 seed=args.seed,
-                sample_interval=args.sample_interval,
-                average_from=args.average_from,
-                snapshot_times=args.snapshot,
-                profile_window=args.profile_window,
-                profile_min_blocks=args.profile_min_blocks,
-                until_steady=args.until_steady,
                 out_dir=out,
                 checkpoint_interval=interval if out else None,
                 progress=progress,

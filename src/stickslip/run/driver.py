@@ -16,35 +16,52 @@ Long runs write checkpoints into their run directory (atomically, with checksums
 wall-clock interval and on SIGINT/SIGTERM; :func:`resume_chain` continues from one and ends
 bit for bit where an uninterrupted run does.
 
-This module holds the driver loop, the progress bar and the signal handling; it also names the
-rest of the chain-run API, which lives beside it: the state (:mod:`stickslip.run.state`), the
-options, buffers and results (:mod:`stickslip.run.outputs`), the checkpoint files
+This module sets a run up, with the hooks its options ask for, and finishes it; the loop, its
+hooks and the checked kernel call shared with :class:`Stepper` are :mod:`stickslip.run.loop`. It
+also names the rest of the chain-run API, which lives beside it: the state
+(:mod:`stickslip.run.state`), the options, buffers and results (:mod:`stickslip.run.outputs`), the checkpoint files
 (:mod:`stickslip.run.checkpoint`), the run directories (:mod:`stickslip.run.rundir`) and the
 errors (:mod:`stickslip.run.errors`).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import time
 import warnings
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from stickslip.kernels import dense, entry, exact, layout, plate
+from stickslip.kernels import layout
 from stickslip.models.params import ChainParams, ParameterError, check_number, steps_for
-from stickslip.models.pieces import stopped_blocks_still
 from stickslip.run import rundir
 
 # The checkpoint file helpers (_read_npz, _write_npz) are named here too, for checks of the files.
 from stickslip.run.checkpoint import CHECKPOINT_FORMAT, Checkpointer, _read_npz, _write_npz  # noqa: F401
 from stickslip.run.errors import ChainRunError, Interrupted, NonFiniteState, ShortRunWarning
+from stickslip.run.loop import (  # _Kernel named here too, for tests that count its calls
+    CheckedAdvance,
+    Checkpoints,
+    ChunkTuning,
+    Hook,
+    Loop,
+    MovingCounts,
+    ProgressHook,
+    Snapshots,
+    SteadyStop,
+    StopRequests,
+    _Kernel,  # noqa: F401
+    _par,
+    _scratch,
+    run_loop,
+)
 from stickslip.run.outputs import EVENT_COLUMNS, ChainRun, RunOptions, _assemble, _Outputs
 from stickslip.run.progress import Progress, SignalFlag, show_progress
 from stickslip.run.rundir import load_run, read_run_id, write_run
-from stickslip.run.state import STARTS, ChainState, initial_state, line_aligned, loading_warnings, steady_deviation
+from stickslip.run.state import STARTS, ChainState, initial_state, loading_warnings, steady_deviation
 from stickslip.run.validate import check_chain_params, check_checkpoint_state, check_start_state
 
 __all__ = [
@@ -70,82 +87,19 @@ __all__ = [
 
 INTEGRATORS = ("exact", "dense")
 
-_KERNELS = {"dense": dense.run_dense, "exact": exact.run_exact, "sparse": plate.run_sparse}
-
-
-def _finite(state: ChainState) -> bool:
-    return bool(np.isfinite(state.x).all() and np.isfinite(state.v).all() and np.isfinite(state.th).all())
-
-
-def _par(p: ChainParams) -> np.ndarray:
-    """The kernels' parameter vector: K, V and dt (the pieces' parameters travel as their named
-    tuples, :meth:`~stickslip.models.piece.Piece.kernel_params`)."""
-    par = np.zeros(layout.PAR_SIZE)
-    par[layout.P_K], par[layout.P_V], par[layout.P_DT] = p.K, p.V, p.dt
-    return par
-
-
-class _Kernel:
-    """One integrator compiled for one model: ``kernel(state, target)`` advances the state.
-
-    The model's pieces are compile-time constants of the kernels (:func:`stickslip.kernels.entry.specialise`).
-    Where stopped blocks keep every bit, ``exact`` is the sparse path (:mod:`stickslip.kernels.plate`),
-    so only the kernel a run uses is compiled.
-    """
-
-    def __init__(self, name, params, state, scratch, par, outputs, ints):
-        if name == "exact" and stopped_blocks_still(params.drive_piece, params.friction_piece):
-            name = "sparse"
-        self.scratch = tuple(scratch)
-        pieces_p = tuple(
-            pc.kernel_params(params) for pc in (params.drive_piece, params.threshold_piece, params.friction_piece)
-        )
-        self.rest = (par, *pieces_p, *outputs.kernel_args())
-        # sample_every, profile_every, profile_min_blocks, stop_all_moving (layout.ChainArgs)
-        self.tail = tuple(np.int64(t) for t in ints)
-        self.pieces = params.codes
-        self.entry = entry.specialise(_KERNELS[name], self._args(state, 0), self.pieces)
-
-    def _args(self, state, target):
-        return layout.ChainArgs(
-            state.x,
-            state.v,
-            state.th,
-            state.mov,
-            *self.scratch,
-            state.first_step,
-            state.x0ev,
-            state.ist,
-            *self.rest,
-            np.int64(target),
-            *self.tail,
-        )
-
-    def __call__(self, state, target):
-        return self.entry(self._args(state, target), *self.pieces)
-
-
-def _scratch(N: int) -> list[np.ndarray]:
-    """The kernels' scratch arrays (predictors, mask, stage-1 rates; ``trig``), the float ones
-    with block 1 at a line's start like the state's (:func:`~stickslip.run.state.line_aligned`)."""
-    return [line_aligned(np.zeros(N + 2)) for _ in range(6)] + [np.zeros(N + 2, dtype=np.int64)]
+# The fields of RunOptions that run_chain also takes as keywords (its signature before RunOptions).
+_RECORDING = tuple(f.name for f in dataclasses.fields(RunOptions) if f.name != "t_end")
 
 
 def run_chain(
     params: ChainParams,
     t_end: float,
     *,
-    integrator: str = "exact",
     start: str | ChainState = "paper",
+    options: RunOptions | None = None,
+    integrator: str = "exact",
     perturbation: float = 0.0,
     seed: int = 0,
-    sample_interval: float = 10.0,
-    average_from: float | None = None,
-    snapshot_times: Sequence[float] = (),
-    profile_window: float | None = None,
-    profile_min_blocks: int = 0,
-    until_steady: float | None = None,
-    sample_moving: bool = False,
     out_dir: str | Path | None = None,
     checkpoint_interval: float | None = None,
     progress: bool | None = None,
@@ -153,6 +107,7 @@ def run_chain(
     run_id: str | None = None,
     keep_checkpoint: bool = False,
     stop_requested: Callable[[], bool] | None = None,
+    **recording: Any,
 ) -> ChainRun:
     """Integrate the chain of eq. (4), or a relative, from ``start`` to ``t_end`` (docs/model.md, "Chain").
 
@@ -163,28 +118,20 @@ def run_chain(
         paper's chain, or another preset, with overrides).
     t_end : float
         End time, in the model's time units (the paper's runs: 2e7 at N = 399).
-    integrator : {'exact', 'dense'}
-        ``exact`` (fast) or ``dense`` (the reference); the same result bit for bit.
     start : {'paper', 'steady', 'rest'} or ChainState
         ``paper``: x = 0, v = 0.1, theta = 0.1, all moving; ``steady``: exact steady sliding
         (perturbed uniformly in [-A, A] with ``perturbation`` A and ``seed``); ``rest``: every
         block stuck at x_i = -A u_i (Carlson-Langer's); or the state of another run.
+    options : RunOptions, optional
+        What the run records and when it stops early: the sampling interval of L (Fig. 5b), the
+        start of <L>'s average, snapshot times (Fig. 5a), the profile window (Fig. 6),
+        ``until_steady`` and ``sample_moving`` (:class:`~stickslip.run.outputs.RunOptions`; its
+        ``t_end`` is this ``t_end``). Its fields may be given as keywords instead
+        (``sample_interval=5.0``, ``snapshot_times=[...]``, ...), not both.
+    integrator : {'exact', 'dense'}
+        ``exact`` (fast) or ``dense`` (the reference); the same result bit for bit.
     perturbation, seed : float, int
         The draw of ``steady`` and ``rest``.
-    sample_interval : float
-        L = x_1 - x_N is sampled every this long (Fig. 5b).
-    average_from : float, optional
-        <L> (``summary['L_mean']``) averages the samples from this time (default t_end / 2).
-    snapshot_times : sequence of float
-        Times at which every x_i is kept (Fig. 5a); the end is always kept.
-    profile_window, profile_min_blocks : float, int, optional
-        Keep x_i every ``profile_window`` during events of at least ``profile_min_blocks``
-        blocks: the rupture fronts of Fig. 6 (the paper's window is 20).
-    until_steady : float, optional
-        Stop at the first sampling time at which every block slides within this tolerance of
-        steady sliding; L is then taken from the steady solution up to t_end.
-    sample_moving : bool
-        Also sample the number of moving blocks (``samples['n_moving']``).
     out_dir : str or Path, optional
         A run directory, owned as ``stickslip chain --out`` owns it (locked; foreign files and an
         earlier run refused): checkpoints every ``checkpoint_interval`` wall-clock seconds and on
@@ -218,16 +165,7 @@ def run_chain(
     check_chain_params(params)
     if integrator not in INTEGRATORS:
         raise ParameterError(f"integrator must be one of {', '.join(INTEGRATORS)} (got {integrator!r})")
-    options = RunOptions(
-        t_end=float(check_number("t_end", t_end, low=0.0, low_open=True)),
-        sample_interval=sample_interval,
-        average_from=average_from,
-        snapshot_times=tuple(float(t) for t in snapshot_times),
-        profile_window=profile_window,
-        profile_min_blocks=int(profile_min_blocks),
-        until_steady=until_steady,
-        sample_moving=bool(sample_moving),
-    ).validated(params.dt)
+    options = _options(options, recording, float(check_number("t_end", t_end, low=0.0, low_open=True)), params.dt)
     if checkpoint_interval is not None:
         check_number("checkpoint_interval", checkpoint_interval, low=0.0, low_open=True)
     check_number("perturbation", perturbation, low=0.0)
@@ -260,6 +198,28 @@ def run_chain(
             keep_checkpoint=keep_checkpoint,
             stop_requested=stop_requested,
         )
+
+
+def _options(options: RunOptions | None, recording: dict[str, Any], t_end: float, dt: float) -> RunOptions:
+    """The run's options: ``options`` or the keywords of its fields, with ``t_end``, checked."""
+    unknown = sorted(set(recording) - set(_RECORDING))
+    if unknown:
+        raise TypeError(f"run_chain() got an unexpected keyword argument {unknown[0]!r}")
+    if options is None:
+        options = RunOptions(**recording)
+    elif recording:
+        raise ParameterError(
+            f"give the run options as options=RunOptions(...) or as keywords, not both (got {', '.join(recording)})"
+        )
+    if options.t_end is not None and options.t_end != t_end:
+        raise ParameterError(f"options.t_end {options.t_end:g} differs from t_end {t_end:g}; give one")
+    return dataclasses.replace(
+        options,
+        t_end=t_end,
+        snapshot_times=tuple(float(t) for t in options.snapshot_times),
+        profile_min_blocks=int(options.profile_min_blocks),
+        sample_moving=bool(options.sample_moving),
+    ).validated(dt)
 
 
 def resume_chain(
@@ -408,9 +368,8 @@ def _drive(
     keep_checkpoint=False,
     stop_requested=None,
 ) -> ChainRun:
-    par = _par(params)
-    N = params.N
-    scratch = _scratch(N)
+    """The run loop (:func:`stickslip.run.loop.run_loop`) with the hooks ``options`` asks for,
+    then the results, written into ``out_dir`` if given."""
     n_end = steps_for(options.t_end, params.dt)
     sample_every = int(round(options.sample_interval / params.dt))
     profile_every = int(round(options.profile_window / params.dt)) if options.profile_window else 0
@@ -423,14 +382,8 @@ def _drive(
     on_l_grid = state.ist[layout.NEXT_SAMPLE] % sample_every == 0
     outputs.moving_from_kernel = options.sample_moving and on_l_grid and last_moving == last_sample
     stop_all_moving = options.until_steady is not None and on_l_grid
-    on_grid = (options.until_steady is not None and not stop_all_moving) or (
-        options.sample_moving and not outputs.moving_from_kernel
-    )
     ints = (sample_every, profile_every, options.profile_min_blocks, int(stop_all_moving))
-    kernel = _Kernel(integrator, params, state, scratch, par, outputs, ints)
-    stops = sorted({steps_for(t, params.dt) for t in options.snapshot_times} | {n_end})
-    done_snaps = set(int(s) for a in outputs.parts["snap_step"] for s in a)
-    steady_at: dict[str, float] = {}
+    advance = CheckedAdvance(integrator, params, state, _scratch(params.N), _par(params), outputs, ints)
     header = {
         "params": params.to_dict(),
         "options": options.to_dict(),
@@ -441,78 +394,29 @@ def _drive(
         header["run_id"] = run_id
     if keep_checkpoint:
         header["keep_checkpoint"] = True
+    hooks: list[Hook] = []
+    if options.snapshot_times:
+        done = set(int(s) for a in outputs.parts["snap_step"] for s in a)
+        hooks.append(Snapshots([steps_for(t, params.dt) for t in options.snapshot_times], done, n_end))
+    if options.sample_moving and not outputs.moving_from_kernel:
+        hooks.append(MovingCounts(sample_every, last_moving))
+    if options.until_steady is not None:
+        hooks.append(SteadyStop(options.until_steady, sample_every, kernel_stops=stop_all_moving))
     # From Python (progress None) the bar waits a second, so that a short run shows none.
     bar = Progress(options.t_end, show_progress(progress), delay=1.0 if progress is None else 0.0)
+    hooks += [ChunkTuning(), ProgressHook(bar)]
     t0 = time.perf_counter()
-    last_ckpt = t0
-    chunk = 200_000
     if out_dir is not None:
         Path(out_dir).mkdir(parents=True, exist_ok=True)
+    loop = Loop(params, state, outputs, n_end)
     with SignalFlag(handle_signals) as flag:
-        try:
-            while True:
-                n = state.step
-                if n in stops and n not in done_snaps and n != n_end:
-                    outputs.add_snapshot(n, state.x)
-                    done_snaps.add(n)
-                moving_due = options.sample_moving and not outputs.moving_from_kernel and n % sample_every == 0
-                if moving_due and n > last_moving:
-                    outputs.add_moving(n, int(np.count_nonzero(state.mov[1:-1])))
-                    last_moving = n
-                if options.until_steady is not None and n % sample_every == 0:
-                    dev = steady_deviation(state, params)
-                    if dev <= options.until_steady:
-                        steady_at = {"t_steady": n * params.dt, "deviation": dev}
-                        break
-                next_stop = min((s for s in stops if s > n), default=n_end)
-                if on_grid:
-                    # Check on a fixed grid of steps, so the stop does not depend on timing.
-                    next_stop = min(next_stop, (n // sample_every + 1) * sample_every)
-                if n >= n_end:
-                    # One more call services outputs due at the final step (its sample).
-                    status = kernel(state, n_end)
-                    if status != layout.DONE and status != layout.NONFINITE:
-                        outputs.flush(state.ist)
-                        continue
-                    break
-                target = min(next_stop, n + chunk)
-                before = state.copy() if integrator == "exact" else None
-                c0 = time.perf_counter()
-                status = kernel(state, target)
-                elapsed = time.perf_counter() - c0
-                if before is not None and not _finite(state):
-                    # The fast kernel does not look for non-finite values; replay this call
-                    # with the reference, which follows the same arithmetic and checks each step.
-                    state = before
-                    reference = _Kernel("dense", params, state, scratch, par, outputs, ints)
-                    status = reference(state, target)
-                if status == layout.NONFINITE:
-                    bad = int(state.ist[layout.BAD_BLOCK])
-                    raise NonFiniteState(
-                        f"state became non-finite at t = {state.step * params.dt:.6g} (step {state.step}) "
-                        f"in block {bad}"
-                    )
-                if status != layout.DONE:
-                    outputs.flush(state.ist)
-                # Aim at about a quarter second per call: responsive to signals and progress.
-                if status == layout.DONE and elapsed > 0:
-                    chunk = int(min(max(chunk * 0.25 / elapsed, 10_000), 50_000_000))
-                now = time.perf_counter()
-                bar.update(state.step * params.dt, int(state.ist[layout.N_EVENTS]))
-                stop = flag.set or (stop_requested is not None and stop_requested())
-                if checkpointer is not None and (
-                    stop or (checkpoint_interval is not None and now - last_ckpt >= checkpoint_interval)
-                ):
-                    outputs.flush(state.ist)
-                    checkpointer.write(state, outputs, dict(header, wall_seconds=wall_before + now - t0))
-                    last_ckpt = now
-                if stop:
-                    raise Interrupted(checkpointer.state_path if checkpointer else None, state.step * params.dt)
-        finally:
-            bar.close()
+        hooks.append(StopRequests(flag, stop_requested))
+        if checkpointer is not None:
+            hooks.append(Checkpoints(checkpointer, checkpoint_interval, header, wall_before, t0))
+        run_loop(loop, advance, hooks, checkpointer.state_path if checkpointer else None)
     outputs.flush(state.ist)
     wall = wall_before + time.perf_counter() - t0
-    run = _assemble(params, options, integrator, start_info, state, outputs, wall, steady_at)
+    run = _assemble(params, options, integrator, start_info, state, outputs, wall, loop.steady_at)
     run.summary["wall_seconds_this_run"] = wall - wall_before  # wall_seconds counts every part of a resumed run
     if run.summary["event_in_progress"]:  # the unfinished event began after the last finished one
         run.summary["in_progress_since"] = float(run.events["t_end"].max()) if len(run.events) else 0.0
@@ -532,9 +436,10 @@ class Stepper:
     :func:`run_chain` without its tables, for methods that restart short runs many times
     (Lyapunov exponents).
 
-    Same kernels, parameters and arrays as :func:`run_chain`, so a trajectory is the one
-    ``run_chain`` gives bit for bit; sampling is switched off (it decides only where a kernel
-    pauses, never what it computes) and the event buffers are emptied and dropped when full.
+    Same kernels, parameters and arrays as :func:`run_chain`, and the same checked call
+    (:class:`~stickslip.run.loop.CheckedAdvance`), so a trajectory is the one ``run_chain`` gives
+    bit for bit; sampling is switched off (it decides only where a kernel pauses, never what it
+    computes) and the event buffers are emptied and dropped when full.
     """
 
     def __init__(self, params: ChainParams, integrator: str = "exact"):
@@ -545,29 +450,19 @@ class Stepper:
         self.par = _par(params)
         self.scratch = _scratch(params.N)
         self.outputs = _Outputs(params.N, False)
-        self._kernels: dict[str, _Kernel] = {}
-
-    def _kernel(self, name: str, state: ChainState) -> _Kernel:
-        if name not in self._kernels:
-            self._kernels[name] = _Kernel(name, self.params, state, self.scratch, self.par, self.outputs, (1, 0, 0, 0))
-        return self._kernels[name]
+        self._advance: CheckedAdvance | None = None
 
     def advance(self, state: ChainState, step: int) -> tuple[ChainState, int]:
         """Advance ``state`` in place to ``step``; returns it and the slip events completed."""
-        ist = state.ist
-        events0 = int(ist[layout.N_EVENTS])
-        ist[layout.NEXT_SAMPLE] = np.iinfo(np.int64).max
+        if self._advance is None:
+            self._advance = CheckedAdvance(
+                self.integrator, self.params, state, self.scratch, self.par, self.outputs, (1, 0, 0, 0)
+            )
+        events0 = int(state.ist[layout.N_EVENTS])
+        state.ist[layout.NEXT_SAMPLE] = np.iinfo(np.int64).max
         while True:
-            before = state.copy() if self.integrator == "exact" else None
-            status = self._kernel(self.integrator, state)(state, step)
-            if before is not None and not _finite(state):
-                state.__dict__.update(before.__dict__)
-                status = self._kernel("dense", state)(state, step)
-            if status == layout.NONFINITE:
-                raise NonFiniteState(
-                    f"state became non-finite at t = {state.step * self.params.dt:.6g} "
-                    f"(step {state.step}) in block {int(ist[layout.BAD_BLOCK])}"
-                )
+            status = self._advance(state, step)
+            ist = state.ist  # after a replay the state holds the copy's arrays
             ist[layout.EV_COUNT] = ist[layout.FM_COUNT] = ist[layout.S_COUNT] = ist[layout.P_COUNT] = 0
             ist[layout.EV_P_FIRST] = 0
             if status == layout.DONE:

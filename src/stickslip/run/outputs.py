@@ -8,7 +8,7 @@ The kernels fill fixed-size buffers (:class:`_Outputs`) that are flushed into Py
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -22,10 +22,20 @@ from stickslip.models.params import MAX_STEPS, ChainParams, ParameterError, chec
 from stickslip.run.state import ChainState
 
 
+def _option(default: Any, option: str, metavar: str, help: str, **more: Any):
+    """A field of :class:`RunOptions` with its command-line option (``stickslip chain --OPTION``):
+    name, metavar and help, and ``integer``, ``allowed`` (the range named when the text is no
+    number) and ``append`` (repeatable) where they apply."""
+    return field(default=default, metadata={"cli": {"option": option, "metavar": metavar, "help": help, **more}})
+
+
 @dataclass(frozen=True)
 class RunOptions:
-    """What a run records besides its state. Times are in the model's time units.
+    """What a run records besides its state, and when it stops early. Times are in the model's
+    time units.
 
+    t_end: the end time (given to :func:`~stickslip.run.driver.run_chain` as its own argument,
+    which fills it in here);
     sample_interval: L = x_1 - x_N is sampled every this long (Fig. 5b);
     average_from: <L> is the mean of the samples with t >= average_from (default t_end / 2);
     snapshot_times: times at which all x_i are stored (Fig. 5a); the final state is always kept;
@@ -36,19 +46,45 @@ class RunOptions:
     sample_moving: if set, the number of moving blocks is sampled at the multiples of
     sample_interval (``samples["n_moving"]`` over ``t_moving``: the fraction of time with some
     block stuck); these are the times of L for a run that starts on one.
+
+    Each field but ``t_end`` and ``sample_moving`` is an option of ``stickslip chain`` (its
+    metadata ``cli``: spelling, metavar and help), from which the command line is built.
     """
 
-    t_end: float
-    sample_interval: float = 10.0
-    average_from: float | None = None
-    snapshot_times: tuple[float, ...] = ()
-    profile_window: float | None = None
-    profile_min_blocks: int = 0
-    until_steady: float | None = None
+    t_end: float | None = None
+    sample_interval: float = _option(
+        10.0, "sample-interval", "T", "sample L = x_1 - x_N every T time units (default 10)"
+    )
+    average_from: float | None = _option(
+        None, "average-from", "T", "<L> averages the samples with t >= T (default t_end / 2)"
+    )
+    snapshot_times: tuple[float, ...] = _option(
+        (), "snapshot", "T", "store all x_i at time T (repeatable; Fig. 5a)", append=True
+    )
+    profile_window: float | None = _option(
+        None, "profile-window", "W", "store the displacement over windows of W during events (Fig. 6 uses 20)"
+    )
+    profile_min_blocks: int = _option(
+        0,
+        "profile-min-blocks",
+        "M",
+        "keep profiles only of events with at least M moved blocks",
+        integer=True,
+        allowed=">= 0",
+    )
+    until_steady: float | None = _option(
+        None,
+        "until-steady",
+        "TOL",
+        "stop once every block slides within TOL of steady sliding (velocities, state "
+        "variables, spring extensions); L is taken from the steady solution from then on",
+    )
     sample_moving: bool = False
 
     def validated(self, dt: float) -> RunOptions:
         """Check every option against the time step (ranges in docs/limits.md); returns self."""
+        if self.t_end is None:
+            raise ParameterError("t_end must be given (run_chain's own argument)")
         steps_for(self.t_end, dt)
         longest = MAX_STEPS * dt
         check_number("sample_interval", self.sample_interval, low=0.0, low_open=True, high=longest)

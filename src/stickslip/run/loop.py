@@ -1,0 +1,311 @@
+"""The run loop of the chain of eq. (4): checked kernel calls, and the hooks that stop them.
+
+A run advances its state by calls to a compiled kernel (:mod:`stickslip.kernels`), each to a
+target step. Between calls the loop serves its concerns, each a :class:`Hook`: snapshots (Fig.
+5a), moving counts, the steady stop, chunk tuning, progress, stop requests (signals, a caller's
+callable) and checkpoints. A hook says at which step it next needs the kernel to stop
+(:meth:`Hook.stop_at`) and acts there (:meth:`Hook.at`) or after each call (:meth:`Hook.after`);
+the kernel is called to the nearest of these steps. Where a kernel stops decides only when the
+hooks act, never what the kernel computes, so the hooks leave every bit of a run as it is.
+
+Every call goes through :class:`CheckedAdvance`, which :func:`~stickslip.run.driver.run_chain`
+and :class:`~stickslip.run.driver.Stepper` share: the fast integrator does not look for
+non-finite values, so the state is checked after each call and, if anything is non-finite, the
+call is replayed from a copy with the reference (``dense``), which checks each step and names the
+step and the block (docs/chain.md, "Non-finite values").
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import numpy as np
+
+from stickslip.kernels import dense, entry, exact, layout, plate
+from stickslip.models.params import ChainParams
+from stickslip.models.pieces import stopped_blocks_still
+from stickslip.run.errors import Interrupted, NonFiniteState
+from stickslip.run.state import ChainState, line_aligned, steady_deviation
+
+NEVER = np.iinfo(np.int64).max  # a hook that needs no stop
+
+_KERNELS = {"dense": dense.run_dense, "exact": exact.run_exact, "sparse": plate.run_sparse}
+
+
+def _finite(state: ChainState) -> bool:
+    return bool(np.isfinite(state.x).all() and np.isfinite(state.v).all() and np.isfinite(state.th).all())
+
+
+def _par(p: ChainParams) -> np.ndarray:
+    """The kernels' parameter vector: K, V and dt (the pieces' parameters travel as their named
+    tuples, :meth:`~stickslip.models.piece.Piece.kernel_params`)."""
+    par = np.zeros(layout.PAR_SIZE)
+    par[layout.P_K], par[layout.P_V], par[layout.P_DT] = p.K, p.V, p.dt
+    return par
+
+
+def _scratch(N: int) -> list[np.ndarray]:
+    """The kernels' scratch arrays (predictors, mask, stage-1 rates; ``trig``), the float ones
+    with block 1 at a line's start like the state's (:func:`~stickslip.run.state.line_aligned`)."""
+    return [line_aligned(np.zeros(N + 2)) for _ in range(6)] + [np.zeros(N + 2, dtype=np.int64)]
+
+
+class _Kernel:
+    """One integrator compiled for one model: ``kernel(state, target)`` advances the state.
+
+    The model's pieces are compile-time constants of the kernels (:func:`stickslip.kernels.entry.specialise`).
+    Where stopped blocks keep every bit, ``exact`` is the sparse path (:mod:`stickslip.kernels.plate`),
+    so only the kernel a run uses is compiled.
+    """
+
+    def __init__(self, name, params, state, scratch, par, outputs, ints):
+        if name == "exact" and stopped_blocks_still(params.drive_piece, params.friction_piece):
+            name = "sparse"
+        self.scratch = tuple(scratch)
+        pieces_p = tuple(
+            pc.kernel_params(params) for pc in (params.drive_piece, params.threshold_piece, params.friction_piece)
+        )
+        self.rest = (par, *pieces_p, *outputs.kernel_args())
+        # sample_every, profile_every, profile_min_blocks, stop_all_moving (layout.ChainArgs)
+        self.tail = tuple(np.int64(t) for t in ints)
+        self.pieces = params.codes
+        self.entry = entry.specialise(_KERNELS[name], self._args(state, 0), self.pieces)
+
+    def _args(self, state, target):
+        return layout.ChainArgs(
+            state.x,
+            state.v,
+            state.th,
+            state.mov,
+            *self.scratch,
+            state.first_step,
+            state.x0ev,
+            state.ist,
+            *self.rest,
+            np.int64(target),
+            *self.tail,
+        )
+
+    def __call__(self, state, target):
+        return self.entry(self._args(state, target), *self.pieces)
+
+
+class CheckedAdvance:
+    """One kernel call of the chain of eq. (4), checked for non-finite values.
+
+    ``advance(state, target)`` runs the integrator's kernel (:class:`_Kernel`) to ``target`` and
+    returns its status (:mod:`stickslip.kernels.layout`). The ``exact`` kernel does not look for
+    non-finite values; if the state holds one after its call, the call is replayed from a copy
+    with ``dense``, which follows the same arithmetic and checks each step. A non-finite state
+    raises :class:`~stickslip.run.errors.NonFiniteState` naming the time, step and block.
+    ``state`` is updated in place (after a replay it holds the copy's arrays).
+    """
+
+    def __init__(self, integrator: str, params: ChainParams, state: ChainState, scratch, par, outputs, ints):
+        self.params = params
+        self._build = (params, state, scratch, par, outputs, ints)
+        self.kernel = _Kernel(integrator, *self._build)
+        self.check = integrator == "exact"
+        self._reference: _Kernel | None = None
+
+    def __call__(self, state: ChainState, target: int) -> int:
+        before = state.copy() if self.check else None
+        status = self.kernel(state, target)
+        if before is not None and not _finite(state):
+            state.__dict__.update(before.__dict__)
+            if self._reference is None:
+                self._reference = _Kernel("dense", *self._build)
+            status = self._reference(state, target)
+        if status == layout.NONFINITE:
+            raise NonFiniteState(
+                f"state became non-finite at t = {state.step * self.params.dt:.6g} (step {state.step}) "
+                f"in block {int(state.ist[layout.BAD_BLOCK])}"
+            )
+        return status
+
+
+class Loop:
+    """What the hooks of one run see: the state, its outputs and the end step; a hook ends the
+    run by returning True from :meth:`Hook.at` or asks it to stop (``stopping``)."""
+
+    def __init__(self, params: ChainParams, state: ChainState, outputs, n_end: int):
+        self.params = params
+        self.state = state
+        self.outputs = outputs
+        self.n_end = n_end
+        self.stopping = False  # a stop was asked for: checkpoint, then Interrupted
+        self.steady_at: dict[str, float] = {}
+
+
+class Hook:
+    """One concern of the run loop. ``stop_at(n)``: the next step after ``n`` at which it needs
+    the kernel to stop (:data:`NEVER` if none); ``at(loop, n)``: act at step ``n`` before the
+    next call (True ends the run there); ``after(loop, status, elapsed, now)``: act after each
+    call, given its status and wall-clock seconds; ``close()``: at the end, however it ends."""
+
+    def stop_at(self, n: int) -> int:
+        """The next step after ``n`` at which the kernel must stop for this hook."""
+        return NEVER
+
+    def at(self, loop: Loop, n: int) -> bool:
+        """Act at step ``n``, before the next call; True ends the run here."""
+        return False
+
+    def after(self, loop: Loop, status: int, elapsed: float, now: float) -> None:
+        """Act after a call that returned ``status`` in ``elapsed`` seconds (``now``: the clock)."""
+
+    def close(self) -> None:
+        """Release what the hook holds, however the run ends."""
+
+
+class Snapshots(Hook):
+    """Every x_i at the given steps (Fig. 5a); the end's is the final state, kept apart."""
+
+    def __init__(self, steps: Sequence[int], done: set[int], n_end: int):
+        self.steps = sorted(set(steps) - {n_end})
+        self.done = done
+
+    def stop_at(self, n):
+        return min((s for s in self.steps if s > n), default=NEVER)
+
+    def at(self, loop, n):
+        if n in self.steps and n not in self.done:
+            loop.outputs.add_snapshot(n, loop.state.x)
+            self.done.add(n)
+        return False
+
+
+def _next_multiple(n: int, every: int) -> int:
+    return (n // every + 1) * every
+
+
+class MovingCounts(Hook):
+    """The number of moving blocks at the multiples of the sampling interval, counted here where
+    the kernel does not count them with L (a start off L's grid, or a checkpoint without them)."""
+
+    def __init__(self, sample_every: int, last: int):
+        self.every, self.last = sample_every, last
+
+    def stop_at(self, n):
+        return _next_multiple(n, self.every)
+
+    def at(self, loop, n):
+        if n % self.every == 0 and n > self.last:
+            loop.outputs.add_moving(n, int(np.count_nonzero(loop.state.mov[1:-1])))
+            self.last = n
+        return False
+
+
+class SteadyStop(Hook):
+    """End the run at the first multiple of the sampling interval at which every block slides
+    within ``tol`` of steady sliding (:func:`~stickslip.run.state.steady_deviation`). On L's grid
+    the kernel stops by itself at the samples with every block moving (only there can the chain
+    slide steadily); off it, the kernel is stopped at each multiple."""
+
+    def __init__(self, tol: float, sample_every: int, kernel_stops: bool):
+        self.tol, self.every, self.kernel_stops = tol, sample_every, kernel_stops
+
+    def stop_at(self, n):
+        return NEVER if self.kernel_stops else _next_multiple(n, self.every)
+
+    def at(self, loop, n):
+        if n % self.every == 0:
+            dev = steady_deviation(loop.state, loop.params)
+            if dev <= self.tol:
+                loop.steady_at = {"t_steady": n * loop.params.dt, "deviation": dev}
+                return True
+        return False
+
+
+class ChunkTuning(Hook):
+    """Calls of about a quarter second, so that signals and progress are answered promptly."""
+
+    def __init__(self, chunk: int = 200_000):
+        self.chunk = chunk
+
+    def stop_at(self, n):
+        return n + self.chunk
+
+    def after(self, loop, status, elapsed, now):
+        if status == layout.DONE and elapsed > 0:
+            self.chunk = int(min(max(self.chunk * 0.25 / elapsed, 10_000), 50_000_000))
+
+
+class ProgressHook(Hook):
+    """The progress bar (:class:`~stickslip.run.progress.Progress`): time reached and events."""
+
+    def __init__(self, bar):
+        self.bar = bar
+
+    def after(self, loop, status, elapsed, now):
+        self.bar.update(loop.state.step * loop.params.dt, int(loop.state.ist[layout.N_EVENTS]))
+
+    def close(self):
+        self.bar.close()
+
+
+class StopRequests(Hook):
+    """A stop asked for by SIGINT/SIGTERM (a :class:`~stickslip.run.progress.SignalFlag`) or by
+    the caller's ``stop_requested()``, looked at after each call: the run checkpoints and raises
+    :class:`~stickslip.run.errors.Interrupted`."""
+
+    def __init__(self, flag, stop_requested: Callable[[], bool] | None):
+        self.flag, self.stop_requested = flag, stop_requested
+
+    def after(self, loop, status, elapsed, now):
+        loop.stopping = self.flag.set or (self.stop_requested is not None and self.stop_requested())
+
+
+class Checkpoints(Hook):
+    """A checkpoint (:class:`~stickslip.run.checkpoint.Checkpointer`) every ``interval`` wall-clock
+    seconds and when a stop is asked for (after :class:`StopRequests`)."""
+
+    def __init__(self, checkpointer, interval: float | None, header: dict[str, Any], wall_before: float, t0: float):
+        self.checkpointer, self.interval, self.header = checkpointer, interval, header
+        self.wall_before, self.t0, self.last = wall_before, t0, t0
+
+    def after(self, loop, status, elapsed, now):
+        if loop.stopping or (self.interval is not None and now - self.last >= self.interval):
+            self.write(loop, now)
+
+    def write(self, loop, now: float) -> None:
+        loop.outputs.flush(loop.state.ist)
+        wall = self.wall_before + now - self.t0
+        self.checkpointer.write(loop.state, loop.outputs, dict(self.header, wall_seconds=wall))
+        self.last = now
+
+
+def run_loop(loop: Loop, advance: CheckedAdvance, hooks: Sequence[Hook], checkpoint_path=None) -> None:
+    """Advance ``loop.state`` to ``loop.n_end`` (or until a hook ends the run), calling the kernel
+    to the nearest step a hook needs and letting each hook act there; a stop asked for raises
+    :class:`~stickslip.run.errors.Interrupted` (after the hooks have checkpointed)."""
+    state, outputs, n_end = loop.state, loop.outputs, loop.n_end
+    try:
+        while True:
+            n = state.step
+            ended = [hook.at(loop, n) for hook in hooks]  # every hook acts before the run ends
+            if any(ended):
+                break
+            if n >= n_end:
+                # One more call services outputs due at the final step (its sample).
+                status = advance.kernel(state, n_end)
+                if status != layout.DONE and status != layout.NONFINITE:
+                    outputs.flush(state.ist)
+                    continue
+                break
+            target = min(n_end, min((hook.stop_at(n) for hook in hooks), default=NEVER))
+            c0 = time.perf_counter()
+            status = advance(state, target)
+            elapsed = time.perf_counter() - c0
+            if status != layout.DONE:
+                outputs.flush(state.ist)
+            now = time.perf_counter()
+            for hook in hooks:
+                hook.after(loop, status, elapsed, now)
+            if loop.stopping:
+                raise Interrupted(checkpoint_path, state.step * loop.params.dt)
+    finally:
+        for hook in hooks:
+            hook.close()

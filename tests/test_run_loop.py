@@ -1,0 +1,118 @@
+"""The run loop of a chain run: its hooks, the checked advance it shares with Stepper, RunOptions
+as run_chain's options and as the command line's run options."""
+
+from __future__ import annotations
+
+import re
+
+import pytest
+
+from chain_helpers import oracle_run
+from stickslip.cli import build_parser
+from stickslip.cli._common import run_options_from_args
+from stickslip.kernels import layout
+from stickslip.models.params import ChainParams, ParameterError
+from stickslip.models.presets import chain_params
+from stickslip.run.driver import NonFiniteState, RunOptions, Stepper, initial_state, run_chain
+from stickslip.run.loop import NEVER, CheckedAdvance, ChunkTuning, Hook, Loop, _par, _scratch, run_loop
+from stickslip.run.outputs import _Outputs
+
+# The final state of the chain of N = 10 blocks run to t = 2e4 (ChainRun's docstring example).
+SHA_N10_2E4 = "ef0a3122809af663"
+
+
+def test_options_given_as_run_options_are_the_keywords_run():
+    """options=RunOptions(...) records what the same keywords record, and ends on the state of
+    the documented example run."""
+    p = chain_params(N=10)
+    fields = dict(sample_interval=2.5, snapshot_times=(5000.0, 1.5e4), profile_window=20.0, sample_moving=True)
+    by_options = run_chain(p, 2e4, options=RunOptions(**fields))
+    by_keywords = run_chain(p, 2e4, **fields)
+    assert by_options.summary["state_sha256"].startswith(SHA_N10_2E4)
+    assert by_options.summary["state_sha256"] == by_keywords.summary["state_sha256"]
+    assert by_options.events.equals(by_keywords.events)
+    assert by_options.samples.equals(by_keywords.samples)
+    assert by_options.snapshots.equals(by_keywords.snapshots)
+    assert by_options.profiles.equals(by_keywords.profiles)
+    assert list(by_options.snapshots["snapshot_time"].values) == [5000.0, 1.5e4, 2e4]
+    assert by_options.options == RunOptions(t_end=2e4, **fields)
+
+
+def test_run_options_refused_twice_or_with_another_end():
+    p = chain_params(N=4)
+    with pytest.raises(ParameterError, match="not both"):
+        run_chain(p, 10.0, options=RunOptions(), sample_interval=5.0)
+    with pytest.raises(ParameterError, match="differs"):
+        run_chain(p, 10.0, options=RunOptions(t_end=20.0))
+    with pytest.raises(TypeError, match="sample_every"):
+        run_chain(p, 10.0, sample_every=5)
+    with pytest.raises(ParameterError, match="t_end must be given"):
+        RunOptions().validated(0.005)
+
+
+class _Stops(Hook):
+    """Asks for the kernel to stop at fixed steps and notes the steps it acts at."""
+
+    def __init__(self, steps):
+        self.steps, self.seen = steps, []
+
+    def stop_at(self, n):
+        return min((s for s in self.steps if s > n), default=NEVER)
+
+    def at(self, loop, n):
+        self.seen.append(n)
+        return False
+
+
+def test_hooks_stop_the_kernel_where_they_ask_and_change_no_bit():
+    """A hook is served at each step it asks for (the kernel stops there), and the run ends on
+    the bits of a run without it (t = 50: 10000 steps of dt = 0.005)."""
+    p = chain_params(N=10)
+    state = initial_state(p, "paper")
+    state.ist[layout.NEXT_SAMPLE] = 0
+    outputs = _Outputs(p.N, False)
+    advance = CheckedAdvance("exact", p, state, _scratch(p.N), _par(p), outputs, (2000, 0, 0, 0))
+    stops = _Stops([1234, 5678, 5679])
+    run_loop(Loop(p, state, outputs, 10000), advance, [stops, ChunkTuning()])
+    assert {0, 1234, 5678, 5679, 10000} <= set(stops.seen)
+    assert state.step == 10000
+    assert state.sha256() == run_chain(p, 50.0).state.sha256()
+
+
+@pytest.mark.parametrize("integrator", ["dense", "exact"])
+def test_stepper_reports_a_nonfinite_state_at_the_oracles_step_and_block(integrator):
+    """Stepper goes through run_chain's checked advance: a stiff spring blows the explicit step
+    up, and the error names the step and block of the plain-Python oracle."""
+    N, K = 5, 1e6
+    p = ChainParams(N=N, K=K)
+    step, block = oracle_run([0.0] * N, [0.1] * N, [0.1] * N, [True] * N, p, 2000).nonfinite
+    with pytest.raises(NonFiniteState) as info:
+        Stepper(p, integrator).advance(initial_state(p, "paper"), 2000)
+    msg = str(info.value)
+    t = re.search(r"t = ([-+0-9.eE]+)", msg)
+    assert float(t.group(1)) == pytest.approx(step * p.dt, rel=1e-5)
+    assert int(re.search(r"block (\d+)", msg).group(1)) == block
+
+
+def test_stepper_ends_where_run_chain_ends():
+    p = chain_params(N=10)
+    state, events = Stepper(p).advance(initial_state(p, "paper"), 4_000_000)
+    assert state.sha256().startswith(SHA_N10_2E4) and events == 69
+
+
+def test_command_line_run_options_are_run_options_fields(capsys):
+    """`stickslip chain` has one option per RunOptions field with a command-line spelling, and
+    they build the RunOptions the run gets (the field's default where not given)."""
+    parser = build_parser()
+    args = parser.parse_args(
+        ["chain", "--sample-interval", "2.5", "--snapshot", "5", "--snapshot", "7", "--profile-min-blocks", "3"]
+    )
+    options = run_options_from_args(args, 100.0)
+    assert options == RunOptions(t_end=100.0, sample_interval=2.5, snapshot_times=(5.0, 7.0), profile_min_blocks=3)
+    with pytest.raises(SystemExit):
+        parser.parse_args(["chain", "--help"])
+    help_text = " ".join(capsys.readouterr().out.split())
+    for flag in ("--sample-interval T", "--average-from T", "--snapshot T", "--profile-window W"):
+        assert flag in help_text
+    assert "--profile-min-blocks M" in help_text and "--until-steady TOL" in help_text
+    assert "--sample-moving" not in help_text
