@@ -37,7 +37,7 @@ from __future__ import annotations
 from numba import njit
 
 from stickslip.kernels.events import _end_event, _overflow, _service, _start_and_first_moves
-from stickslip.kernels.laws import _force, _pull, _right_of_first, _set_ghosts, _threshold, has, law_has_state
+from stickslip.kernels.laws import _force, _pull, _right_of_first, _set_ghosts, _threshold, has
 from stickslip.kernels.layout import (
     _NEVER,
     ACT_HI,
@@ -249,7 +249,7 @@ def run_exact(args, drive, friction, threshold, ends):
                     _stage1_theta(x, v, th, xs, vs, ths, mm, b1, l1, fl - 1, mp, dt, friction)
                 if fh < h1:
                     _stage1_theta(x, v, th, xs, vs, ths, mm, b1, fh + 1, h1, mp, dt, friction)
-            elif law_has_state(friction):
+            elif has(friction, "has_state"):
                 _stage1_theta_only(v, th, ths, b1, l1, h1, mp, dt, friction)
             p2 = _pull(V, n + 1, dt)
             _set_ghosts(xs, ths, N, p2, drive, ends)
@@ -297,14 +297,14 @@ def run_exact(args, drive, friction, threshold, ends):
                         x, v, th, mov, xs, vs, ths, mm, a1, b1, sl, sh, p2, mp, h2, drive, friction
                     )
                 ist[FULL_UPDATES] += sh - sl + 1
-                if law_has_state(friction):
+                if has(friction, "has_state"):
                     if lo < sl:
                         t_lo, t_hi = _stage2_theta(th, ths, v, b1, lo, sl - 1, mp, h2, friction)
                         c_lo, c_hi = _merge(c_lo, c_hi, t_lo, t_hi)
                     if sh < hi:
                         t_lo, t_hi = _stage2_theta(th, ths, v, b1, sh + 1, hi, mp, h2, friction)
                         c_lo, c_hi = _merge(c_lo, c_hi, t_lo, t_hi)
-            elif law_has_state(friction):
+            elif has(friction, "has_state"):
                 c_lo, c_hi = _stage2_theta(th, ths, v, b1, lo, hi, mp, h2, friction)
             # Next step's movers: a stopped block starts only if its force or threshold changed;
             # through the springs that takes a neighbour's move, and only moving blocks change x.

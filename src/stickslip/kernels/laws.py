@@ -21,14 +21,15 @@ through these functions, inlined, so they agree bit for bit. Pieces and layout:
 A friction law is its own module (:mod:`stickslip.models.friction`), and a kernel is compiled for
 one law: it receives the import path of the law's module as a literal string (``friction``) and
 the law's parameters as the module's ``Params`` named tuple (``lp``). :func:`law_accel`,
-:func:`law_rate` and :func:`law_has_state` resolve, when the kernel is compiled, to the module's
-compiled functions (numba's :func:`~numba.extending.overload` on the literal), inlined there:
+:func:`law_rate` resolve, when the kernel is compiled, to the module's compiled functions (numba's
+:func:`~numba.extending.overload` on the literal), inlined there:
 
 * ``accel(f, v, th, lp)``: the force f on a moving block less the law's friction, in the law's
   own order of operations (it fixes the bits);
 * ``rate(thl, th, thr, v, lp)``: dtheta/dt of the block between thl and thr, moving or stopped
   (0.0 for a law without a state variable);
-* ``PIECE.has_state``: whether the law has a state variable (otherwise the kernels skip theta).
+* ``PIECE.has_state``, read as ``has(friction, "has_state")``: whether the law has a state
+  variable (otherwise the kernels skip theta).
 
 So a new law needs no edit here or in any integrator.
 """
@@ -62,11 +63,6 @@ def law_rate(friction, thl, th, thr, v, lp):
     return _module(friction).rate(thl, th, thr, v, lp)
 
 
-def law_has_state(friction):
-    """Whether the law ``friction`` has a state variable (its ``PIECE.has_state``)."""
-    return _module(friction).PIECE.has_state
-
-
 @overload(law_accel, prefer_literal=True)
 def _law_accel(friction, f, v, th, lp):
     law = _module(friction)
@@ -91,16 +87,6 @@ def _law_rate(friction, thl, th, thr, v, lp):
         return fn(thl, th, thr, v, lp)
 
     return impl
-
-
-@overload(law_has_state, inline="always", prefer_literal=True)
-def _law_has_state(friction):
-    law = _module(friction)
-    if law is None:
-        return None
-    if law.PIECE.has_state:
-        return lambda friction: True
-    return lambda friction: False
 
 
 def call(piece, name, *args):

@@ -352,28 +352,9 @@ def advance(
     location over the whole chain (the reference of :mod:`stickslip.kernels.located_fast`).
     """
     return _steps(
-        u,
-        v,
-        th,
-        mov,
-        n_end,
-        par,
-        lp,
-        tp,
-        dp,
-        drive,
-        friction,
-        threshold,
-        ends,
-        sc,
-        cand,
-        moved,
-        ist,
-        evf,
-        ev_t,
-        ev_i,
-        False,
-    )
+        u, v, th, mov, n_end, par, lp, tp, dp, drive, friction, threshold, ends,
+        sc, cand, moved, ist, evf, ev_t, ev_i, False,
+    )  # fmt: skip
 
 
 @njit(cache=True, _nrt=False)
