@@ -208,7 +208,7 @@ def _refused(run_dir: Path, **kw) -> ChainRunError:
 @pytest.mark.parametrize("target", ["state.npz", "part-000000.npz"])
 def test_flipped_array_bytes_are_refused(run_dir, target):
     path = run_dir / "checkpoint" / target
-    arrays, _, _ = C._read_npz(path)
+    arrays, _, _ = C.read_npz(path)
     name = "x" if target == "state.npz" else "ev_int"
     assert arrays[name].size > 0
     _flip(path, _array_offset(path, arrays[name]))
@@ -247,8 +247,8 @@ def test_missing_part_file_is_refused(run_dir):
 
 def test_other_checkpoint_format_is_refused(run_dir):
     path = run_dir / "checkpoint" / "state.npz"
-    arrays, header, _ = C._read_npz(path)
-    C._write_npz(path, arrays, dict(header, format=C.CHECKPOINT_FORMAT + 1))
+    arrays, header, _ = C.read_npz(path)
+    C.write_npz(path, arrays, dict(header, format=C.CHECKPOINT_FORMAT + 1))
     msg = str(_refused(run_dir))
     assert "format" in msg and str(C.CHECKPOINT_FORMAT + 1) in msg
 
@@ -267,7 +267,7 @@ def test_a_point_continues_a_usable_checkpoint_and_reruns_past_a_damaged_one(run
         m.setattr(C, "run_chain", lambda *a, **k: pytest.fail("a usable checkpoint must be continued"))
         assert_same_run(C.continue_or_run(SMALL, 100.0, run_dir, checkpoint_interval=60.0), reference)
     path = run_dir / "checkpoint" / "state.npz"
-    arrays, _, _ = C._read_npz(path)
+    arrays, _, _ = C.read_npz(path)
     _flip(path, _array_offset(path, arrays["x"]))
     fresh = []
     monkeypatch.setattr(C, "run_chain", lambda *a, **k: fresh.append(1) or run_chain(*a, **k))
@@ -284,17 +284,17 @@ def test_checkpoint_arrays_that_do_not_fit_are_refused(tmp_path, run_dir, mismat
     bounds). 'ist-one-entry-short' is a state vector of an earlier layout under the same
     format number."""
     path = run_dir / "checkpoint" / "state.npz"
-    arrays, header, _ = C._read_npz(path)
+    arrays, header, _ = C.read_npz(path)
     if mismatch == "arrays-of-N=4":
         other = tmp_path / "other"
         run_chain(SMALL.replace(N=4), 100.0, out_dir=other, keep_checkpoint=True)
-        arrays, _, _ = C._read_npz(other / "checkpoint" / "state.npz")
-        C._write_npz(path, arrays, header)
+        arrays, _, _ = C.read_npz(other / "checkpoint" / "state.npz")
+        C.write_npz(path, arrays, header)
         _refused(run_dir)
     else:
         # in a separate process: until refused, the kernels write past the end of this array
         arrays["ist"] = arrays["ist"][:-1].copy()
-        C._write_npz(path, arrays, header)
+        C.write_npz(path, arrays, header)
         before = _digest_tree(run_dir)
         proc = run_cli_subprocess("chain", "--resume", str(run_dir), "--t-end", "200", "--no-progress")
         assert proc.returncode == 2, proc.stderr
@@ -306,13 +306,13 @@ def test_stray_part_files_are_ignored(run_dir, resumed_reference):
     """A part written by a checkpoint that was killed before its state file is not used."""
     ckpt = run_dir / "checkpoint"
     bogus = {"ev_int": np.zeros((3, layout.EV_INT_COLS), dtype=np.int64), "ev_S": np.ones(3)}
-    C._write_npz(ckpt / "part-000001.npz", bogus, {"format": C.CHECKPOINT_FORMAT})
+    C.write_npz(ckpt / "part-000001.npz", bogus, {"format": C.CHECKPOINT_FORMAT})
     assert_same_run(resume_chain(run_dir, t_end=200.0), resumed_reference)
 
 
 def test_cli_refuses_a_corrupt_checkpoint(capsys, run_dir):
     path = run_dir / "checkpoint" / "state.npz"
-    arrays, _, _ = C._read_npz(path)
+    arrays, _, _ = C.read_npz(path)
     _flip(path, _array_offset(path, arrays["x"]))
     before = _digest_tree(run_dir)
     status, out, err = run_cli(capsys, "chain", "--resume", str(run_dir), "--json", "--no-progress")

@@ -58,7 +58,7 @@ def _launch_and_signal(out_dir, sig, delay):
 
 
 def _checkpoint_step(out_dir) -> int:
-    arrays, _, _ = C._read_npz(out_dir / "checkpoint" / "state.npz")
+    arrays, _, _ = C.read_npz(out_dir / "checkpoint" / "state.npz")
     return int(arrays["ist"][layout.STEP])
 
 

@@ -195,11 +195,11 @@ def test_swapped_checkpoint_refused(tmp_path, capsys):
 @pytest.mark.parametrize("craft", ["step", "act", "count", "parts", "integrator", "sample"])
 def test_crafted_checkpoint_refused(craft, tmp_path, capsys):
     from stickslip.kernels import layout
-    from stickslip.run.checkpoint import _read_npz, _write_npz
+    from stickslip.run.checkpoint import read_npz, write_npz
 
     run = _finished_run(tmp_path / "r")
     path = run / "checkpoint" / "state.npz"
-    arrays, header, _ = _read_npz(path)
+    arrays, header, _ = read_npz(path)
     ist = arrays["ist"]
     if craft == "step":
         ist[layout.STEP] = -5
@@ -214,7 +214,7 @@ def test_crafted_checkpoint_refused(craft, tmp_path, capsys):
         header["integrator"] = "bogus"
     else:
         header["options"]["sample_interval"] = 0
-    _write_npz(path, arrays, header)
+    write_npz(path, arrays, header)
     capsys.readouterr()
     assert main(["chain", "--resume", str(run), "--t-end", "800", "--no-progress"]) == 2
     err = capsys.readouterr().err

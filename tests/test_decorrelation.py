@@ -87,21 +87,79 @@ def test_growth_power_of_synthetic_laws():
     assert math.isnan(growth_power(d, log_law, [True, False, False, False]))
 
 
+def _rows(table):
+    """Rows of (delta, seed, decorrelated) from {seed: {delta: decorrelated}}."""
+    return [{"delta": d, "seed": s, "decorrelated": f} for s, by in table.items() for d, f in by.items()]
+
+
+#: Synthetic n(delta) of three windows: seed 0 from 1e-4 on, seed 1 at 1e-6 and 1e-2 (not monotone),
+#: seed 2 never; no window at 1e-8.
+THRESHOLD = _rows(
+    {
+        0: {1e-8: False, 1e-6: False, 1e-4: True, 1e-2: True},
+        1: {1e-8: False, 1e-6: True, 1e-4: False, 1e-2: True},
+        2: {1e-8: False, 1e-6: False, 1e-4: False, 1e-2: False},
+    }
+)
+NEVER = _rows({s: {d: False for d in (1e-12, 1e-6, 1e-1)} for s in (0, 1)})
+
+
 def test_verdict_on_synthetic_inputs():
-    d = np.array(DELTAS)
-    log_n = np.round(3.0 * np.log(1 / d))
-    power_n = np.round(1e-3 / d)
-    yes = [True] * 4
-    assert verdict(0.05, 0.001, d, log_n, yes) == "chaotic"
-    assert verdict(0.05, 0.001, d, [0] * 4, [False] * 4) == "chaotic"  # the flow decides
-    assert verdict(1e-5, 2e-5, d, log_n, yes) == "stable chaos"
-    assert verdict(1e-5, 2e-5, d, power_n, yes) == "regular"
-    assert verdict(1e-5, 2e-5, d, log_n, [True, True, True, False]) == "regular"
-    assert verdict(-0.3, 0.01, d, log_n, yes) == "regular"
-    assert verdict(0.003, 0.002, d, log_n, yes) == "stable chaos"  # within 2 errors
-    assert verdict(0.003, 0.002, d, log_n, yes, sigmas=1.0) == "chaotic"
-    assert verdict(None, None, d, log_n, yes) == "undetermined"
-    assert verdict(float("nan"), 0.1, d, log_n, yes) == "undetermined"
+    chaotic = verdict(0.05, 0.001, NEVER, window=1000)
+    assert chaotic.label == "chaotic"  # the flow decides, whatever the sequences do
+    regular = verdict(-1e-6, 3e-6, NEVER, window=1000)
+    assert regular.label == "regular" and regular.window == 1000 and regular.threshold is None
+    assert regular.text.startswith("regular over 1000 slips for delta <= 0.1")
+    stable = verdict(1e-7, 1e-7, THRESHOLD, window=1000)
+    assert stable.label == "stable chaos" and stable.threshold == (1e-8, 1e-6)
+    assert (stable.windows_decorrelated, stable.windows) == (2, 3)
+    assert "at delta >= 1e-06 (delta* 1e-06 .. 0.0001), never at delta <= 1e-08" in stable.text
+    # an exponent below zero beyond its errors does not make a finite threshold regular
+    assert verdict(-0.3, 0.01, THRESHOLD, window=1000).label == "stable chaos"
+    assert verdict(0.003, 0.002, THRESHOLD, window=1000).label == "stable chaos"  # within 2 errors
+    assert verdict(0.003, 0.002, THRESHOLD, window=1000, sigmas=1.0).label == "chaotic"
+    # the smallest delta decorrelated: no threshold within the list
+    low = _rows({0: {1e-8: True, 1e-6: True}})
+    assert verdict(1e-7, 1e-7, low, window=500).label == "undetermined"
+    assert verdict(None, None, THRESHOLD, window=1000).label == "undetermined"
+    assert verdict(float("nan"), 0.1, THRESHOLD, window=1000).label == "undetermined"
+    d = stable.to_dict()
+    assert d["verdict"] == "stable chaos" and d["threshold_below"] == 1e-8 and d["threshold_low"] == 1e-6
+
+
+def test_delta_star_by_hand():
+    from stickslip.analysis.threshold import delta_star
+
+    out = delta_star(THRESHOLD)
+    assert out["per_seed"] == [1e-4, 1e-6, None] and out["censored"] == 1
+    assert out["per_seed_monotone"] == [1e-4, 1e-2, None]
+    # log10 delta* = -4, -6: mean -5, sample std sqrt(2), standard error sqrt(2) / sqrt(2) = 1
+    assert out["log10_mean"] == pytest.approx(-5.0) and out["log10_err"] == pytest.approx(1.0)
+    assert out["geometric_mean"] == pytest.approx(1e-5)
+    assert (out["low"], out["high"], out["below"]) == (1e-6, 1e-4, 1e-8)
+    one = delta_star(_rows({0: {1e-3: False, 1e-1: True}}))
+    assert one["per_seed"] == [0.1] and math.isnan(one["log10_err"]) and one["below"] == 1e-3
+    none = delta_star(NEVER)
+    assert none["geometric_mean"] is None and none["censored"] == 2 and math.isnan(none["log10_mean"])
+    with pytest.raises(ValueError, match="lacks"):
+        delta_star(THRESHOLD[:-1])
+
+
+def test_threshold_fit_by_hand():
+    from stickslip.analysis.threshold import threshold_fit
+
+    # x = log10 N = 1, 1, 2, 2; y = -3, -5, -4, -6: slope -1, intercept -3, residuals +-1,
+    # s^2 = 4 / 2, sum (x - 1.5)^2 = 1, so the slope's error is sqrt(2): no trend at two errors
+    fit = threshold_fit([10, 100, 1000], [[1e-3, 1e-5], [1e-4, 1e-6], [None]])
+    assert fit["slope"] == pytest.approx(-1.0) and fit["intercept"] == pytest.approx(-3.0)
+    assert fit["slope_err"] == pytest.approx(math.sqrt(2.0))
+    assert (fit["points"], fit["censored"], fit["Ns"], fit["trend"]) == (4, 1, [10, 100], "none")
+    exact = threshold_fit([10, 100, 1000], [[1e-2], [1e-3], [1e-4]])
+    assert exact["slope"] == pytest.approx(-1.0) and exact["slope_err"] == pytest.approx(0.0, abs=1e-12)
+    assert exact["trend"] == "shrinks"
+    assert threshold_fit([10, 100, 1000], [[1e-4], [1e-3], [1e-2]])["trend"] == "grows"
+    short = threshold_fit([10, 10], [[1e-3], [1e-4]])  # one N: no slope
+    assert math.isnan(short["slope"]) and short["trend"] == "none"
 
 
 def test_cli_decorrelation_json(capsys):

@@ -60,30 +60,27 @@ def test_exponents_table():
         assert _same(ratio, row["excess"]) and int(observed) == row["observed"] and _same(expected, row["expected"])
 
 
+def _threshold(cell: str, row: dict, kind: str) -> None:
+    """A cell "G (L .. H)" of delta*: the geometric mean over the windows and the range."""
+    if row.get(f"delta_star_{kind}_censored") is None:
+        assert cell == "", (kind, cell)
+        return
+    gm, low, high = re.fullmatch(r"(\S+) \((\S+) \.\. (\S+)\)", cell).groups()
+    assert gm == f"{row[f'delta_star_{kind}']:.1e}".replace("e-0", "e-"), (kind, cell)
+    assert float(low) == row[f"delta_star_{kind}_low"] and float(high) == row[f"delta_star_{kind}_high"], (kind, cell)
+
+
 def test_chaos_table():
     ((_, table),) = _tables("chaos")
-    rows = {(r["model"], r["beta"], r["d0"]): r for r in _rows("chaos")}
+    rows = {(r["model"], r["N"], r["beta"]): r for r in _rows("chaos")}
     assert len(table) == len(rows)
-    columns = ("n_decorr_1e-12", "n_decorr_1e-10", "n_decorr_1e-08", "n_decorr_1e-06")
-    for model, N, beta, d0, lam, err, lam0, err0, n_decorr, compared, pooled, peak, verdict in table:
-        row = rows[(model, float(beta) if beta else None, float(d0))]
-        assert int(N) == row["N"] and verdict == row["verdict"]
-        assert _same(lam, row["lyapunov"]) and _same(err, row["lyapunov_err"]), (model, beta)
-        assert _same(lam0, row["lyapunov_dt0"]) and _same(err0, row["lyapunov_dt0_err"]), (model, beta)
-        assert int(compared) == row["decorrelation_compared"]
-        n = [None if c.strip() == "never" else int(c) for c in n_decorr.split(",")]
-        expected = [None if row[c] is None else int(row[c]) for c in columns]
-        assert n == expected or (n == [None] and expected == [None] * 4), (model, beta)
-        if row["fsle_pooled"] is None:
-            assert pooled == "none"
-        else:
-            value, error = pooled.split(" +- ")
-            assert _same(value, row["fsle_pooled"]) and _same(error, row["fsle_pooled_err"])
-        if row["fsle_peak"] is None:
-            assert peak == "none"
-        else:
-            value, at = re.match(r"(\S+) \((\S+)\)", peak).groups()
-            assert _same(value, row["fsle_peak"]) and _same(at, row["fsle_peak_delta"])
+    for model, N, beta, lam, err, slips, state, fs, v, verdict in table:
+        row = rows[(model, int(N), float(beta) if beta else None)]
+        assert verdict == row["verdict"], (model, N, beta)
+        assert _same(lam, row["lyapunov_dt0"]) and _same(err, row["lyapunov_dt0_err"]), (model, N, beta)
+        assert int(slips) == row["flow_slips"]
+        for kind, cell in zip(("state", "Fs", "V"), (state, fs, v), strict=True):
+            _threshold(cell, row, kind)
 
 
 @pytest.mark.parametrize("which", [0, 1])

@@ -1,14 +1,21 @@
-"""Figures of the flow's chaos tests: the data of flow.json is what is drawn (issue 26)."""
+"""Figures of the chaos study: the data of flow.json is what is drawn (issues 26 and 35)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pandas as pd
 
-from stickslip.plotting.chaos import decorrelation_figure, flow_ladder_figure, fsle_figure
+from stickslip.plotting.chaos import decorrelation_figure, flow_ladder_figure, threshold_figure
+
+
+def _dec(rows):
+    return {"decorrelation": [{"delta": d, "seed": s, "events": n, "decorrelated": f} for d, s, n, f in rows]}
+
 
 LADDER = {
     "label": "two-blocks, N = 2",
+    "N": 2,
+    "beta": None,
     "ladder": [
         {"dt": 0.005, "lyapunov": 0.02545, "lyapunov_err": 0.00062},
         {"dt": 0.0025, "lyapunov": 0.02563, "lyapunov_err": 0.00046},
@@ -17,22 +24,12 @@ LADDER = {
     "lyapunov_dt0": 0.0261,
     "lyapunov_dt0_err": 0.0004,
     "dt2_slope": -30.0,
-    "finite_size": {
-        "fsle": [
-            {"delta": 1e-8, "rate": 0.03, "rate_err": 0.003, "cycles": 4},
-            {"delta": 2e-8, "rate": None, "rate_err": None, "cycles": 0},  # NaN as JSON writes it
-            {"delta": 4e-8, "rate": 0.05, "rate_err": None, "cycles": 1},
-        ]
-    },
-    "decorrelation": [
-        {"delta": 1e-12, "events": 26, "decorrelated": True},
-        {"delta": 1e-10, "events": 24, "decorrelated": True},
-        {"delta": 1e-8, "events": 17, "decorrelated": True},
-        {"delta": 1e-6, "events": 4, "decorrelated": True},
-    ],
+    "decorrelation": {"state": _dec([(1e-12, 0, 26, True), (1e-10, 0, 24, True), (1e-8, 0, 17, True)])},
 }
 REGULAR = {
     "label": "eq. (4), N = 99, beta = 1",
+    "N": 99,
+    "beta": 1.0,
     "ladder": [
         {"dt": 0.005, "lyapunov": -4e-6, "lyapunov_err": 3e-6},
         {"dt": 0.0025, "lyapunov": -5e-6, "lyapunov_err": 3e-6},
@@ -40,10 +37,10 @@ REGULAR = {
     "lyapunov_dt0": -5.3e-6,
     "lyapunov_dt0_err": 3e-6,
     "dt2_slope": 0.05,
-    "decorrelation": [
-        {"delta": 1e-12, "events": 70, "decorrelated": False},
-        {"delta": 1e-6, "events": 70, "decorrelated": False},
-    ],
+    "decorrelation": {
+        "state": _dec([(1e-6, 0, 1000, False), (1e-2, 0, 56, True), (1e-6, 1, 1000, False), (1e-2, 1, 1000, False)]),
+        "Fs": _dec([(1e-6, 0, 300, True), (1e-2, 0, 4, True)]),
+    },
 }
 
 
@@ -66,28 +63,42 @@ def test_flow_ladder_figure_draws_the_rungs_and_the_fit_down_to_zero():
     assert [a.get_title() for a in fig.axes if a.get_visible()] == [LADDER["label"], REGULAR["label"]]
 
 
-def test_fsle_figure_is_log_log_and_leaves_out_rows_without_doublings():
-    fig = fsle_figure([LADDER, REGULAR])
-    ax = fig.axes[0]
-    assert ax.get_xscale() == "log" and ax.get_yscale() == "log"
-    (drawn,) = [c for c in ax.containers if c.get_label() == LADDER["label"]]
-    x, y = _xy(drawn.lines[0])
-    assert np.allclose(x, [1e-8, 4e-8]) and np.allclose(y, [0.03, 0.05])
-    assert [t.get_text() for t in ax.get_legend().get_texts()] == [LADDER["label"]]  # REGULAR has none
-
-
-def test_decorrelation_figure_marks_runs_that_never_decorrelated():
+def test_decorrelation_figure_has_a_panel_per_kind_and_N_and_marks_runs_that_never_decorrelated():
     fig = decorrelation_figure([LADDER, REGULAR])
-    ax = fig.axes[0]
+    visible = [a.get_title() for a in fig.axes if a.get_visible()]
+    assert visible == ["state, N = 99", "state, relatives", "Fs, N = 99"]  # no Fs of the relatives
+    ax = next(a for a in fig.axes if a.get_title() == "state, N = 99")
     assert ax.get_xscale() == "log"
-    lines = {(line.get_label(), line.get_marker()): _xy(line) for line in ax.get_lines()}
-    x, y = lines[(LADDER["label"], "None")]
-    assert np.allclose(x, [1e-12, 1e-10, 1e-8, 1e-6]) and np.allclose(y, [26, 24, 17, 4])
-    open_markers = [xy for (lab, m), xy in lines.items() if m == "^" and xy[0].size]
-    assert len(open_markers) == 1 and np.allclose(open_markers[0][1], [70, 70])
+    lines = [_xy(line) + (line.get_marker(), line.get_markerfacecolor()) for line in ax.get_lines()]
+    # window 0: a line through both deltas, a filled marker at 1e-2 (56 slips), an open one at 1e-6
+    assert any(np.allclose(x, [1e-6, 1e-2]) and np.allclose(y, [1000, 56]) and m == "None" for x, y, m, _ in lines)
+    filled = [(x, y) for x, y, m, fc in lines if m == "o" and fc != "none" and x.size]
+    opened = [(x, y) for x, y, m, fc in lines if m in ("o", "s") and fc == "none" and x.size]
+    assert len(filled) == 1 and np.allclose(filled[0][0], [1e-2]) and np.allclose(filled[0][1], [56])
+    assert sorted(float(v) for x, _ in opened for v in x) == [1e-6, 1e-6, 1e-2]  # window 1 never
 
 
-def test_study_draws_the_three_figures_from_the_points_flow_json(tmp_path):
+def test_threshold_figure_draws_each_window_the_mean_and_the_fit():
+    points = [
+        {"N": 49, "beta": 0.5, "kind": "state", "per_seed": [1e-4, 1e-2, None], "geometric_mean": 1e-3}
+        | {"log10_err": 1.0},
+        {"N": 199, "beta": 0.5, "kind": "state", "per_seed": [1e-3, 1e-3], "geometric_mean": 1e-3, "log10_err": 0.0},
+    ]
+    fit = {"beta": 0.5, "kind": "state", "slope": -0.5, "slope_err": 0.3, "intercept": -2.0, "Ns": [49, 199]}
+    fig = threshold_figure(points, [fit])
+    (ax,) = [a for a in fig.axes if a.get_visible()]
+    assert ax.get_xscale() == "log" and ax.get_yscale() == "log"
+    dots = [_xy(line) for line in ax.get_lines() if line.get_marker() == "."]
+    assert sorted(y for _, ys in dots for y in ys) == [1e-4, 1e-3, 1e-3, 1e-2]  # the censored window left out
+    (dashed,) = [line for line in ax.get_lines() if line.get_linestyle() == "--"]
+    x, y = _xy(dashed)
+    assert np.allclose(y, 10.0 ** (-2.0 - 0.5 * np.log10(x))) and x[0] == 49 and np.isclose(x[-1], 199)
+    (bars, *_), *_ = [c for c in ax.containers]
+    assert np.isclose(_xy(bars)[1][0], 1e-3)
+    assert "beta = 0.5: -0.50 +- 0.30" in [t.get_text() for t in ax.get_legend().get_texts()]
+
+
+def test_study_draws_its_figures_and_the_rows_of_n_from_the_points_flow_json(tmp_path):
     from stickslip import io
     from stickslip.experiments.studies import study
     from stickslip.experiments.study_findings import draw
@@ -96,30 +107,24 @@ def test_study_draws_the_three_figures_from_the_points_flow_json(tmp_path):
     points = tmp_path / "runs" / spec.dirname / "points"
     for name, data in (("a", LADDER), ("b", REGULAR)):
         io.write_json(points / name / "flow.json", {k: v for k, v in data.items() if k != "label"})
+    seeds = {"delta_star_state_seed0": 1e-2, "delta_star_state_seed1": np.nan, "delta_star_state": 1e-2}
+    seeds |= {"delta_star_state_err_log10": np.nan, "delta_star_state_low": 1e-2, "delta_star_state_high": 1e-2}
     table = pd.DataFrame(
         [
-            {
-                "model": "two-blocks",
-                "N": 2,
-                "beta": np.nan,
-                "point_dir": "a",
-                "lyapunov": 0.04,
-                "lyapunov_err": 0.001,
-                "d0": 1e-10,
-            },
-            {
-                "model": "sakaguchi",
-                "N": 99,
-                "beta": 1.0,
-                "point_dir": "b",
-                "lyapunov": 0.0,
-                "lyapunov_err": 1e-6,
-                "d0": 1e-10,
-            },
+            {"model": "two-blocks", "N": 2, "beta": np.nan, "point_dir": "a", "seeds": 1},
+            {"model": "sakaguchi", "N": 99, "beta": 1.0, "point_dir": "b", "seeds": 2}
+            | seeds
+            | {"delta_star_state_censored": 1},
         ]
     )
     figs = draw(spec, table, tmp_path / "chaos")
     names = [f["name"] for f in figs]
-    assert names == ["lyapunov_beta", "flow_ladder", "fsle", "decorrelation"]
+    assert names == ["decorrelation", "flow_ladder", "threshold"]
     for name in names:
         assert (tmp_path / "chaos" / f"{name}.png").stat().st_size > 1000
+    rows = pd.read_csv(tmp_path / "chaos" / "decorrelation.csv")
+    assert len(rows) == 3 + 4 + 2  # every n(delta) row of both points
+    assert rows[(rows["N"] == 99) & (rows["kind"] == "state") & (rows["delta"] == 0.01)]["events"].tolist() == [
+        56,
+        1000,
+    ]

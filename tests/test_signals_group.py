@@ -152,11 +152,11 @@ def test_sigterm_to_the_process_group_of_a_study(tmp_path):
     state = point / "checkpoint" / "state.npz"
     assert state.is_file() and not (point / "done.json").exists()
     from stickslip.kernels import layout
-    from stickslip.run.checkpoint import _read_npz
+    from stickslip.run.checkpoint import read_npz
 
-    step = int(_read_npz(state)[0]["ist"][layout.STEP])
+    step = int(read_npz(state)[0]["ist"][layout.STEP])
     assert step > 0, "the stop checkpoint holds the work done"
     # the next start continues from there: stopped again, its checkpoint has moved on
     status, _, stderr, _ = _launch_in_group(argv, lambda: True, signal.SIGTERM, settle=15.0)
     assert status == 130, stderr
-    assert int(_read_npz(state)[0]["ist"][layout.STEP]) > step
+    assert int(read_npz(state)[0]["ist"][layout.STEP]) > step

@@ -25,7 +25,7 @@ from stickslip.analysis.order import (
     order_parameter,
     transition_bracket,
 )
-from stickslip.experiments.studies import Study, study
+from stickslip.experiments.studies import Study, point_params, study
 from stickslip.experiments.study_run import run_study
 
 
@@ -265,45 +265,191 @@ def test_sample_moving_leaves_the_run_unchanged(tmp_path):
     assert np.array_equal(back.samples["n_moving"].values, n)
 
 
-# --- chaos: the largest Lyapunov exponent as a study ----------------------------------------
+# --- chaos: flow exponent, decorrelation, delta* and the verdict as a study -----------------
+
+
+def _delta_star_by_hand(rows, seed):
+    """The smallest delta whose twin disagreed in window ``seed`` (None: none did)."""
+    hits = [r["delta"] for r in rows if r["seed"] == seed and r["decorrelated"] and r["delta"] > 0]
+    return min(hits) if hits else None
 
 
 def test_tiny_chaos_study_end_to_end(tmp_path, cluster):
+    from stickslip import io
     from stickslip.analysis.decorrelation import VERDICTS
-    from stickslip.analysis.stability import chain_finite_eigenvalues
-    from stickslip.models.params import ChainParams
 
     spec = study("chaos", "tiny")
     first = run_study(spec, tmp_path, scheduler=cluster, progress=False)
-    assert first["failed"] == 0 and first["run"] == len(spec.points) == 5
+    assert first["failed"] == 0 and first["run"] == len(spec.points) == 7
     rows = first["rows"]
-    for key in ("model", "N", "beta", "lyapunov", "lyapunov_err", "t_end", "renormalisations"):
+    for key in ("verdict", "verdict_text", "lyapunov_dt0", "lyapunov_dt0_err", "flow_slips", "window"):
         assert all(key in r for r in rows)
-    # steady sliding of N = 4 at beta = 1.5, V = 0.5: separations decay at the least stable
-    # eigenvalue of the linearised chain (eq. 5), a negative number
-    steady = next(r for r in rows if r["model"] == "sakaguchi" and r["N"] == 4)
-    expected = float(chain_finite_eigenvalues(ChainParams(N=4, beta=1.5, V=0.5))[0].real)
-    assert expected < 0 and steady["lyapunov"] < 0
-    assert abs(steady["lyapunov"] - expected) <= 0.03 * abs(expected)
-    # the flow (located switches, dt -> 0) has the same eigenvalue; it contracts: regular
-    assert abs(steady["lyapunov_dt0"] - expected) <= 0.05 * abs(expected)
-    assert steady["verdict"] == "regular"
     assert all(r["verdict"] in VERDICTS for r in rows)
-    assert all(math.isfinite(r["lyapunov_dt0_err"]) for r in rows)
-    # (400 - 0.1 * 400) / 5 = 72 counted renormalisations
-    assert steady["renormalisations"] == 72
-    family = {r["model"]: r for r in rows if r["model"] != "sakaguchi"}
-    assert set(family) == {"two-blocks", "carlson-langer"}
-    assert family["two-blocks"]["N"] == 2 and family["carlson-langer"]["N"] == 16
-    assert all(r["beta"] is None for r in family.values())
-    assert all(math.isfinite(r["lyapunov"]) for r in rows)
-    assert (tmp_path / "chaos" / "lyapunov_beta.png").is_file()
-    point = tmp_path / "runs" / spec.dirname / "points"
-    assert len(list(point.glob("*/renormalisations.parquet"))) == 5
+    chain = [r for r in rows if r["model"] == "sakaguchi"]
+    assert sorted((r["N"], r["beta"]) for r in chain) == [(n, b) for n in (5, 9) for b in (0.5, 0.9, 1.0)]
+    assert all(r["loaded"] is True and r["window"] == 40 for r in chain)
+    points = tmp_path / "runs" / spec.dirname / "points"
+    for r in rows:
+        flow = io.read_json(points / r["point_dir"] / "flow.json")
+        kinds = ("state", "Fs", "V") if r["model"] == "sakaguchi" else ("state",)
+        assert tuple(flow["decorrelation"]) == kinds
+        for kind in kinds:
+            dec = flow["decorrelation"][kind]["decorrelation"]
+            assert len(dec) == 3 * r["seeds"]
+            per_seed = [_delta_star_by_hand(dec, s) for s in range(r["seeds"])]
+            got = [r[f"delta_star_{kind}_seed{s}"] for s in range(r["seeds"])]
+            assert got == per_seed, (r["point_dir"], kind)
+            assert r[f"delta_star_{kind}_censored"] == per_seed.count(None)
+        # the verdict by its rule: the exponent within 2 errors, then the state's windows
+        lam, err = r["lyapunov_dt0"], r["lyapunov_dt0_err"]
+        state = flow["decorrelation"]["state"]["decorrelation"]
+        smallest = min(x["delta"] for x in state)
+        if lam > 2 * err:
+            expected = "chaotic"
+        elif not any(x["decorrelated"] for x in state):
+            expected = "regular"
+        elif any(x["decorrelated"] for x in state if x["delta"] == smallest):
+            expected = "undetermined"
+        else:
+            expected = "stable chaos"
+        assert r["verdict"] == expected, r["point_dir"]
+        if expected == "regular":
+            assert r["verdict_text"].startswith("regular over 40 slips for delta <= 0.1")
+        assert len(flow["ladder"]) == 2 and flow["flow_slips"] == min(x["events"] for x in flow["ladder"])
+    for name in ("decorrelation", "flow_ladder", "threshold"):
+        assert (tmp_path / "chaos" / f"{name}.png").is_file()
+    assert len(pd.read_csv(tmp_path / "chaos" / "decorrelation.csv")) == sum(
+        3 * r["seeds"] * (3 if r["model"] == "sakaguchi" else 1) for r in rows
+    )
+    fits = first["findings"]["fits"]
+    assert {(f["beta"], f["kind"]) for f in fits} == {(b, k) for b in (0.5, 0.9, 1.0) for k in ("state", "Fs", "V")}
     json.dumps(first, allow_nan=True)
     second = run_study(spec, tmp_path, scheduler=cluster, progress=False)
-    assert second["run"] == 0 and second["reused"] == 5
-    assert [r["lyapunov"] for r in second["rows"]] == [r["lyapunov"] for r in rows]
+    assert second["run"] == 0 and second["reused"] == 7
+    assert [r["verdict_text"] for r in second["rows"]] == [r["verdict_text"] for r in rows]
+
+
+def test_an_interrupted_chaos_point_keeps_its_finished_parts(tmp_path):
+    """A point whose task stopped after some parts runs only the others again, and gives the same
+    row; a study's stop request stops it within a part; a part made with other settings is not
+    reused."""
+    from stickslip.experiments.chaos_verdict import chaos_point
+    from stickslip.experiments.sweep import STOP_FILE
+    from stickslip.run.errors import Interrupted
+
+    spec = study("chaos", "tiny")
+    cfg = {**spec.common, **next(p for p in spec.points if p.get("N") == 5 and p.get("beta") == 0.9)}
+    params = point_params(cfg)
+    point = tmp_path / "points" / "p"
+    first = chaos_point(cfg, params, point)
+    parts = sorted((point / "parts").glob("*.json"))
+    assert [p.name for p in parts] == [
+        "decorrelation-Fs.json",
+        "decorrelation-V.json",
+        "decorrelation-state.json",
+        "flow-rung-0.json",
+        "flow-rung-1.json",
+    ]
+    stamps = {p: p.stat().st_mtime_ns for p in parts}
+    (point / "parts" / "flow-rung-1.json").unlink()
+    (point / "flow.json").unlink()
+    (tmp_path / "points" / STOP_FILE).touch()
+    with pytest.raises(Interrupted):
+        chaos_point(cfg, params, point)
+    assert not (point / "parts" / "flow-rung-1.json").exists()
+    (tmp_path / "points" / STOP_FILE).unlink()
+    again = chaos_point(cfg, params, point)
+    assert {k: v for k, v in again.items() if k != "point_wall_seconds"} == {
+        k: v for k, v in first.items() if k != "point_wall_seconds"
+    }
+    kept = [p for p in parts if p.name != "flow-rung-1.json"]
+    assert all(p.stat().st_mtime_ns == stamps[p] for p in kept)
+    # an edited part is not reused
+    edited = point / "parts" / "decorrelation-V.json"
+    record = json.loads(edited.read_text())
+    record["result"]["decorrelation"][0]["decorrelated"] = not record["result"]["decorrelation"][0]["decorrelated"]
+    edited.write_text(json.dumps(record))
+    stamp = edited.stat().st_mtime_ns
+    third = chaos_point(cfg, params, point)
+    assert {k: v for k, v in third.items() if k != "point_wall_seconds"} == {
+        k: v for k, v in first.items() if k != "point_wall_seconds"
+    }
+    assert edited.stat().st_mtime_ns != stamp
+    assert all(p.stat().st_mtime_ns == stamps[p] for p in kept if p != edited)
+    other = chaos_point({**cfg, "seeds": 1}, params, point)  # other settings: every part again
+    assert all(p.stat().st_mtime_ns != stamps[p] for p in kept)
+    assert other["windows"] == 1
+
+
+def test_chaos_findings_state_verdicts_thresholds_and_fits():
+    """The findings from rows alone: the verdict of each point with its text, delta* per kind
+    from the per-window columns, and the slope of log10 delta* on log10 N (by hand: the points
+    (1, -3), (1, -5), (2, -4), (2, -6) have slope -1 with standard error sqrt(2))."""
+    from stickslip.experiments.study_findings import conclusions
+
+    nan = float("nan")
+
+    def chain(N, beta, s0, s1, verdict):
+        return {
+            "model": "sakaguchi",
+            "N": N,
+            "beta": beta,
+            "seeds": 2,
+            "loaded": True,
+            "lyapunov_dt0": -1e-6,
+            "lyapunov_dt0_err": 2e-6,
+            "flow_slips": 320,
+            "verdict": verdict,
+            "verdict_text": f"{verdict}: text",
+            "delta_star_state": 1e-4,
+            "delta_star_state_err_log10": 1.0,
+            "delta_star_state_low": min(s0, s1),
+            "delta_star_state_high": max(s0, s1),
+            "delta_star_state_censored": 0,
+            "delta_star_state_seed0": s0,
+            "delta_star_state_seed1": s1,
+        }
+
+    rows = [chain(10, 0.5, 1e-3, 1e-5, "stable chaos"), chain(100, 0.5, 1e-4, 1e-6, "regular")]
+    rows.append(
+        {"model": "two-blocks", "N": 2, "beta": nan, "seeds": 1, "lyapunov_dt0": 0.026, "lyapunov_dt0_err": 4e-4}
+        | {"flow_slips": 900, "verdict": "chaotic", "verdict_text": "chaotic: text", "loaded": True}
+    )
+    out = conclusions(study("chaos", "quick"), pd.DataFrame(rows))
+    assert out["verdicts"] == {
+        "stable chaos": ["beta = 0.5 (N = 10)"],
+        "regular": ["beta = 0.5 (N = 100)"],
+        "chaotic": ["two blocks (N = 2)"],
+    }
+    assert (
+        "beta = 0.5 (N = 10): flow exponent -1e-06 +- 2e-06 (each rung counting at least 320 slips)"
+        in (out["statements"][0])
+    )
+    (fit,) = out["fits"]
+    assert (fit["beta"], fit["kind"], fit["Ns"], fit["trend"]) == (0.5, "state", [10, 100], "none")
+    assert fit["slope"] == pytest.approx(-1.0) and fit["slope_err"] == pytest.approx(math.sqrt(2.0))
+    assert [t["per_seed"] for t in out["thresholds"]] == [[1e-3, 1e-5], [1e-4, 1e-6]]
+    assert any("beta = 0.5: -1.00 +- 1.41 (no trend)" in line for line in out["statements"])
+    assert any(line.startswith("Loading: every chain point") for line in out["statements"])
+
+
+@pytest.mark.slow
+def test_a_quick_chain_point_counts_its_slips():
+    """One point of ``--quick`` (N = 49, beta = 1): the flow's ladder rungs count at least 300 slips,
+    the windows 1000, and the row has the study's columns (about a minute)."""
+    import tempfile
+
+    from stickslip.experiments.chaos_verdict import MIN_FLOW_SLIPS, chaos_point
+    from stickslip.experiments.study_run import TABLE_COLUMNS
+
+    spec = study("chaos", "quick")
+    cfg = {**spec.common, **next(p for p in spec.points if p.get("N") == 49 and p.get("beta") == 1.0)}
+    with tempfile.TemporaryDirectory() as d:
+        row = chaos_point(cfg, point_params(cfg), Path(d))
+    assert row["flow_slips"] >= MIN_FLOW_SLIPS and row["window"] == 1000 and row["loaded"] is True
+    point_keys = set(cfg) | {"model", "N", "beta"}
+    assert set(TABLE_COLUMNS["chaos"]) <= set(row) | point_keys
+    assert row["verdict_text"].startswith(row["verdict"])
 
 
 def test_bad_study_input_is_one_line_and_exit_2(tmp_path):
@@ -328,62 +474,3 @@ def test_bad_study_input_is_one_line_and_exit_2(tmp_path):
         assert len(error_lines(proc.stderr)) == 1, (argv, proc.stderr)
         assert proc.stdout == ""
     assert not (tmp_path / "o").exists()  # refused before the output folder is made
-
-
-def test_chaos_findings_judge_the_relatives_on_the_exponents_they_have():
-    """A value of d0 at which the twin fell onto the reference has no exponent (-inf, stored as
-    empty): the relative is judged on the others and the lost one is named with its merges."""
-    from stickslip.experiments.study_findings import conclusions
-
-    rows = [
-        {"model": "two-blocks", "N": 2, "beta": None, "d0": d0, "lyapunov": lam, "lyapunov_err": err, "merges": m}
-        for d0, lam, err, m in ((1e-11, None, None, 6), (1e-10, 0.0443, 0.00066, 0), (1e-8, 0.0474, 0.00077, 0))
-    ]
-    out = conclusions(study("chaos", "quick"), pd.DataFrame(rows))
-    (line,) = out["statements"]
-    assert out["family"]["two-blocks"]["positive_3sigma"] is True
-    assert "chaotic (positive beyond 3 errors) at d0 = 1e-10, 1e-08" in line
-    assert "no exponent at d0 = 1e-11 (the twin fell onto the reference 6 times" in line
-    assert "spread over d0 0.0031" in line
-
-
-def test_chaos_findings_name_the_verdict_of_each_point():
-    from stickslip.experiments.study_findings import conclusions
-
-    rows = [
-        {"model": "sakaguchi", "N": 99, "beta": b, "lyapunov": 0.0, "lyapunov_err": 1e-5, "lyapunov_per_event": 0.0}
-        | {"verdict": v}
-        for b, v in ((0.5, "regular"), (1.0, "stable chaos"))
-    ]
-    rows.append(
-        {"model": "two-blocks", "N": 2, "beta": None, "d0": 1e-10, "lyapunov": 0.044, "lyapunov_err": 0.001}
-        | {"verdict": "chaotic", "merges": 0}
-    )
-    out = conclusions(study("chaos", "quick"), pd.DataFrame(rows))
-    assert out["verdicts"] == {
-        "regular": ["beta = 0.5 (N = 99)"],
-        "stable chaos": ["beta = 1 (N = 99)"],
-        "chaotic": ["two blocks (N = 2)"],
-    }
-    assert (
-        "regular at beta = 0.5 (N = 99); stable chaos at beta = 1 (N = 99); chaotic at two blocks (N = 2)"
-        in (out["statements"][-1])
-    )
-
-
-def test_chaos_findings_summarise_the_finite_size_exponents():
-    from stickslip.experiments.study_findings import conclusions
-
-    nan = float("nan")
-    rows = [
-        {"model": "sakaguchi", "N": 99, "beta": 1.0, "lyapunov": 0.0, "lyapunov_err": 1e-5, "verdict": "regular"}
-        | {"lyapunov_per_event": 0.0}
-        | {"fsle_pooled": nan, "fsle_pooled_err": nan, "fsle_peak": nan, "fsle_peak_delta": nan, "fsle_unfinished": 4},
-        {"model": "two-blocks", "N": 2, "beta": nan, "d0": 1e-10, "lyapunov": 0.044, "lyapunov_err": 0.001}
-        | {"verdict": "chaotic", "merges": 0, "fsle_pooled": 0.0143, "fsle_pooled_err": 0.002}
-        | {"fsle_peak": 9.47, "fsle_peak_delta": 0.0512, "fsle_unfinished": 0},
-    ]
-    out = conclusions(study("chaos", "quick"), pd.DataFrame(rows))
-    (line,) = [s for s in out["statements"] if s.startswith("Finite-size exponent")]
-    assert "beta = 1 (N = 99): no doubling below 1e-6, none, 4 cycles unfinished" in line
-    assert "two-blocks: 0.014, largest 9.5 at delta = 0.051" in line

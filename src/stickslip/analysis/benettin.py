@@ -21,6 +21,7 @@ from __future__ import annotations
 import math
 import sys
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any, Protocol
 
@@ -32,6 +33,8 @@ from stickslip.models.params import ChainParams, ParameterError, check_number, s
 D0_MAX = 1e-3
 
 METHOD = "Benettin et al. (1980) two-trajectory method with renormalisation"
+#: Renormalisations between two questions to ``stop_requested`` (a file's existence).
+STOP_CHECK = 64
 
 
 class TwoTrajectoryEngine(Protocol):
@@ -250,6 +253,7 @@ def two_trajectory_exponent(
     extra: dict[str, Any] | None = None,
     progress: bool = False,
     wall0: float | None = None,
+    stop_requested: Callable[[], bool] | None = None,
 ) -> LyapunovResult:
     """The largest Lyapunov exponent by Benettin et al. (1980) over ``engine`` (module docstring).
 
@@ -260,7 +264,8 @@ def two_trajectory_exponent(
     less its component along the engine's neutral direction, gives ln(d / d0) and the twin is
     put back d0 away along it on the reference's branch (a fresh random direction if nothing is
     left there: the twin fell onto the reference). d0 is the realised distance after the twin's
-    rounding, so ln(d / d0) carries no bias from it.
+    rounding, so ln(d / d0) carries no bias from it. ``stop_requested``, if given, is asked every
+    :data:`STOP_CHECK` renormalisations whether to stop (:class:`stickslip.run.errors.Interrupted`).
     """
     wall0 = time.perf_counter() if wall0 is None else wall0
     params = engine.params
@@ -307,6 +312,10 @@ def two_trajectory_exponent(
             if bar is not None:
                 bar.update(taus[-1])
             n = n_next
+            if stop_requested is not None and len(times) % STOP_CHECK == 0 and stop_requested():
+                from stickslip.run.errors import Interrupted
+
+                raise Interrupted(None, n * dt)
     finally:
         if bar is not None:
             bar.close()

@@ -11,17 +11,17 @@ changes its size continuously with delta, by a factor that grows with the slip (
 of the chain at N = 99 by 64 delta under a relative change delta of Fs); :data:`SIZE_RTOL` = 0.1
 leaves that to the slip's identity (docs/lyapunov.md). n(delta), the slips that agree before the
 first disagreement, is what :func:`sequence_decorrelation` measures. A chaotic flow (largest
-exponent lambda > 0) gives n ~ ln(1/delta) / (lambda T) with T the mean time between events; a
-regular one never decorrelates, or only after a number of events that grows as a power of
-1/delta (a separation growing linearly in time); "stable chaos" (Politi and Torcini, arXiv
-0902.2545) is a flow exponent of zero together with finite perturbations that decorrelate the
-sequence after a number of events growing as ln(1/delta) or slower, the discrete start and stop
-decisions amplifying them.
+exponent lambda > 0) gives n ~ ln(1/delta) / (lambda T) with T the mean time between slips,
+whatever delta; a finite-amplitude instability decorrelates the sequence only above a threshold
+delta* (:mod:`stickslip.analysis.threshold`), below which the slips stay the same.
 
-:func:`verdict` turns lambda of the flow with its error and n(delta) into one of
-:data:`VERDICTS`; it reads the growth of n with 1/delta through the exponent of a power law,
-d ln(n + 1) / d ln(1/delta): about 1 / ln(1/delta), 0.03 to 0.07 over 1e-12 .. 1e-6, for
-logarithmic growth, 0.5 to 1 for a separation growing as a power of time.
+:func:`verdict` turns the flow's exponent with its error and the state's n(delta) over windows of
+slips into one of :data:`VERDICTS`: ``chaotic`` (a positive exponent), ``stable chaos`` (no
+positive exponent, yet decorrelation within the window above a finite threshold while smaller
+deltas never decorrelate: Politi, Livi, Oppo and Kapral, Europhys. Lett. 22, 571 (1993); Politi
+and Torcini, arXiv 0902.2545), ``regular`` (no positive exponent and no decorrelation: regular
+over the window's slips for the deltas tested, and only so) or ``undetermined``.
+:func:`growth_power` is the slope of ln(n + 1) against ln(1/delta), reported with the rows.
 """
 
 from __future__ import annotations
@@ -37,8 +37,6 @@ from stickslip.models.params import ChainParams, ParameterError, check_number
 VERDICTS = ("chaotic", "stable chaos", "regular", "undetermined")
 #: The deltas of the study's decorrelation tables.
 DELTAS = (1e-12, 1e-10, 1e-8, 1e-6)
-#: Largest power-law exponent of n(delta) still counted as growth like ln(1/delta) or slower.
-MAX_POWER = 0.25
 
 
 #: What a twin differs from the reference in (``--perturb``): its state, or Fs or V (relative).
@@ -398,37 +396,95 @@ def growth_power(deltas, events, decorrelated) -> float:
     return float(np.polyfit(np.log(1.0 / d[ok]), np.log(n[ok] + 1.0), 1)[0])
 
 
-def verdict(
-    lyapunov: float | None,
-    lyapunov_err: float | None,
-    deltas,
-    events,
-    decorrelated,
-    *,
-    sigmas: float = 2.0,
-    max_power: float = MAX_POWER,
-) -> str:
-    """One of :data:`VERDICTS` (issue 26, item 4; Politi and Torcini, arXiv 0902.2545).
+@dataclass(frozen=True)
+class Verdict:
+    """What the flow's exponent and the decorrelation of the slip sequence say (:func:`verdict`).
 
-    ``chaotic``: the exponent of the flow above ``sigmas`` errors. ``stable chaos``: within
-    ``sigmas`` errors of zero, and every delta > 0 decorrelated with n(delta) growing no faster
-    than a power ``max_power`` of 1/delta (:func:`growth_power`; ln(1/delta) growth gives about
-    0.05). ``regular``: otherwise (below zero beyond its errors, a delta that never decorrelated,
-    or n growing as a larger power). ``undetermined``: no finite exponent or error.
+    ``label``: one of :data:`VERDICTS`; ``text``: the label with what it holds for (the window of
+    slips, the deltas); ``window``: slips compared per window (the smallest over the windows);
+    ``delta_min``, ``delta_max``: the smallest and largest delta tested; ``threshold``: the bracket
+    (``below``, ``low``] of :func:`stickslip.analysis.threshold.delta_star` where some window
+    decorrelated; ``windows_decorrelated``, ``windows``: how many windows decorrelated at some delta.
     """
-    if lyapunov is None or lyapunov_err is None:
-        return "undetermined"
-    lam, err = float(lyapunov), float(lyapunov_err)
+
+    label: str
+    text: str
+    window: int | None
+    delta_min: float | None
+    delta_max: float | None
+    threshold: tuple[float | None, float] | None
+    windows_decorrelated: int
+    windows: int
+
+    def to_dict(self) -> dict[str, Any]:
+        """The fields, for JSON and the study's table."""
+        return {
+            "verdict": self.label,
+            "verdict_text": self.text,
+            "verdict_window": self.window,
+            "verdict_delta_min": self.delta_min,
+            "verdict_delta_max": self.delta_max,
+            "threshold_below": None if self.threshold is None else self.threshold[0],
+            "threshold_low": None if self.threshold is None else self.threshold[1],
+            "windows_decorrelated": self.windows_decorrelated,
+            "windows": self.windows,
+        }
+
+
+def verdict(lyapunov, lyapunov_err, rows, *, window: int | None, sigmas: float = 2.0) -> Verdict:
+    """The verdict of one point (docs/lyapunov.md, "The verdict"): one of :data:`VERDICTS`.
+
+    ``lyapunov``, ``lyapunov_err``: the flow's exponent at dt -> 0 and its error; ``rows``: the
+    decorrelation rows of the state's perturbation (``delta``, ``seed``, ``decorrelated``) over
+    windows of ``window`` slips.
+
+    - ``undetermined``: no finite exponent or error; or no finite threshold although the exponent
+      is not positive: the smallest delta tested already decorrelated in some window;
+    - ``chaotic``: the exponent above ``sigmas`` errors (a positive largest exponent);
+    - ``stable chaos``: the exponent not above ``sigmas`` errors, yet some window decorrelated
+      within its slips at a delta of the list, while at the smallest delta tested (and every delta
+      up to the bracket's ``below``) no window did: a finite-amplitude instability without a
+      positive exponent (Politi, Livi, Oppo and Kapral, Europhys. Lett. 22, 571, 1993; Politi
+      and Torcini, arXiv 0902.2545);
+    - ``regular``: the exponent not above ``sigmas`` errors and no window decorrelated at any
+      delta: regular over ``window`` slips for delta up to the largest tested, and only so.
+    """
+    from stickslip.analysis.threshold import delta_star
+
+    rows = [r for r in rows if float(r["delta"]) > 0.0]
+    if not rows:
+        raise ParameterError("the verdict needs decorrelation rows with deltas above 0")
+    ds = delta_star(rows)
+    d_min, d_max = ds["deltas"][0], ds["deltas"][-1]
+    k = len(ds["seeds"]) - ds["censored"]
+    base = {
+        "window": None if window is None else int(window),
+        "delta_min": d_min,
+        "delta_max": d_max,
+        "windows_decorrelated": k,
+        "windows": len(ds["seeds"]),
+    }
+    span = f"{window} slips" if window is not None else "the window"
+    finite = lyapunov is not None and lyapunov_err is not None
+    lam = float(lyapunov) if finite else math.nan
+    err = float(lyapunov_err) if finite else math.nan
     if not (math.isfinite(lam) and math.isfinite(err)):
-        return "undetermined"
+        return Verdict("undetermined", "undetermined: no finite exponent of the flow", threshold=None, **base)
     if lam > sigmas * err:
-        return "chaotic"
-    if lam < -sigmas * err:
-        return "regular"
-    d = np.asarray(deltas, dtype=float)
-    dec = np.asarray(decorrelated, dtype=bool)
-    pos = d > 0
-    if np.count_nonzero(pos) < 2 or not dec[pos].all():
-        return "regular"
-    power = growth_power(d[pos], np.asarray(events, dtype=float)[pos], dec[pos])
-    return "stable chaos" if math.isfinite(power) and power <= max_power else "regular"
+        text = f"chaotic: the flow's exponent {lam:.3g} +- {err:.2g} is above {sigmas:g} errors"
+        return Verdict("chaotic", text, threshold=None, **base)
+    if k == 0:
+        text = f"regular over {span} for delta <= {d_max:g} (no window of {len(ds['seeds'])} decorrelated)"
+        return Verdict("regular", text, threshold=None, **base)
+    if ds["below"] is None:
+        text = (
+            f"undetermined: no positive exponent, but delta = {d_min:g}, the smallest tested, "
+            f"decorrelated within {span}: the threshold lies below the deltas tested"
+        )
+        return Verdict("undetermined", text, threshold=(None, ds["low"]), **base)
+    text = (
+        f"stable chaos: no positive exponent; decorrelated within {span} in {k} of "
+        f"{len(ds['seeds'])} windows, at delta >= {ds['low']:g} (delta* {ds['low']:g} .. {ds['high']:g}), "
+        f"never at delta <= {ds['below']:g}"
+    )
+    return Verdict("stable chaos", text, threshold=(ds["below"], ds["low"]), **base)

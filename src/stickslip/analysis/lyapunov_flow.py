@@ -195,6 +195,7 @@ def flow_lyapunov(
     flow_floor: float = 1e-9,
     max_wait: int | None = None,
     progress: bool = False,
+    stop_requested=None,
 ) -> LyapunovResult:
     """Largest Lyapunov exponent of the equations with switches at the step ``params.dt``.
 
@@ -205,7 +206,8 @@ def flow_lyapunov(
     (less its component along the flow with ``neutral='remove'``, module docstring) gives
     ln(d / d0) and the twin is put back d0 away along it. Counted and averaged as in
     :func:`stickslip.analysis.lyapunov.largest_lyapunov`: one loop,
-    :func:`stickslip.analysis.benettin.two_trajectory_exponent` with :class:`LocatedEngine`.
+    :func:`stickslip.analysis.benettin.two_trajectory_exponent` with :class:`LocatedEngine`
+    (``stop_requested``: asked now and then whether to stop, as there).
     """
     t_end, interval, d0, transient, align, segments = check_run(params, t_end, interval, d0, transient, align, segments)
     dt = params.dt
@@ -228,6 +230,7 @@ def flow_lyapunov(
         extra={"neutral": neutral},
         progress=progress,
         wall0=wall0,
+        stop_requested=stop_requested,
     )
 
 

@@ -53,6 +53,14 @@ def add_options(p: argparse.ArgumentParser) -> None:
         help="--decorrelation: slips with the same start block and number of blocks disagree when "
         "their sizes differ by more than R of the larger (default 0.1)",
     )
+    p.add_argument(
+        "--state-cache",
+        default=None,
+        metavar="DIR",
+        help="--decorrelation on the grid: keep the engine's state at --transient in DIR (checksummed, "
+        "named by the model, start and transient) and start from it when it is there, so that "
+        "several commands share one transient",
+    )
 
 
 #: (option, attribute) of :func:`add_options`, refused without ``--decorrelation``.
@@ -62,6 +70,7 @@ OPTIONS = (
     ("--events", "events"),
     ("--seeds", "seeds"),
     ("--rtol", "rtol"),
+    ("--state-cache", "state_cache"),
 )
 
 
@@ -100,8 +109,10 @@ def run(params, args: argparse.Namespace) -> Result:
             raise CommandError(f"--t-end must exceed --transient (got {args.t_end:g} and {args.transient:g})")
         t_max = args.t_end - args.transient
     located = args.switches == "located"
+    if located and args.state_cache is not None:
+        raise CommandError("--state-cache keeps the engine's state: it needs --switches grid")
     source = LocatedSequences(params) if located else GridSequences(params)
-    start = _start(params, args, located)
+    start, loading = _start(params, args, located)
     say = None
     if not args.no_progress and sys.stderr.isatty():
 
@@ -121,6 +132,8 @@ def run(params, args: argparse.Namespace) -> Result:
         progress=say,
     )
     data = {"params": params.to_dict(), "switches": args.switches, "transient": args.transient, **res.to_dict()}
+    if loading is not None:
+        data["loading"] = loading
     lines = [f"{'delta':>8} {'seed':>4} {'slips agreeing':>15} {'t decorrelated':>15}"]
     for r in res.rows:
         n = f"{r['events']}" if r["decorrelated"] else f"all {r['events']}"
@@ -129,12 +142,20 @@ def run(params, args: argparse.Namespace) -> Result:
     windows = ", ".join(f"{w['reference_events']} slips in {w['t_window']:.6g}" for w in res.windows)
     lines.append(f"perturbed: {perturb}; reference windows: {windows}")
     lines.append(f"slips disagree: other start block, other number of blocks, or sizes beyond rtol {rtol:g}")
+    if loading is not None:
+        first = loading["first_slip_reaching_block_N"]
+        reach = (
+            "no slip moved block N" if first is None else f"the first slip that moved block N started at {first:.6g}"
+        )
+        verdict = "loaded" if loading["loaded"] else "NOT loaded"
+        lines.append(f"transient {args.transient:g}: {reach}; {verdict} ({loading['loaded_rule']})")
     return Result(data, "\n".join(lines))
 
 
 def _start(params, args, located: bool):
-    """The loaded state at ``--transient`` from ``--start``: the engine's state (grid) or the
-    located integrator's (located, as before)."""
+    """The state at ``--transient`` from ``--start`` and, on the grid, the transient's loading
+    check (:func:`stickslip.run.loaded.loaded_state`, kept in ``--state-cache``): the engine's
+    state (grid) or the located integrator's (located, as before; no check)."""
     from stickslip.models.params import steps_for
 
     if located:
@@ -142,19 +163,18 @@ def _start(params, args, located: bool):
 
         ref = start_state(params, args.start, perturbation=args.perturbation, seed=args.seed)
         ref, _ = LocatedStepper(params).advance(ref, steps_for(args.transient, params.dt))
-        return ref
-    from stickslip.run.driver import run_chain
-    from stickslip.run.errors import short_runs_expected
+        return ref, None
+    from stickslip.run.loaded import loaded_state
     from stickslip.run.state import initial_state
 
     if args.transient > 0:
-        with short_runs_expected():  # only the state at the transient's end is used
-            return run_chain(
-                params,
-                args.transient,
-                start=args.start,
-                perturbation=args.perturbation,
-                seed=args.seed,
-                sample_interval=args.transient,
-            ).state
-    return initial_state(params, args.start, amplitude=args.perturbation, seed=args.seed)
+        loaded = loaded_state(
+            params,
+            args.transient,
+            start=args.start,
+            perturbation=args.perturbation,
+            seed=args.seed,
+            cache=args.state_cache,
+        )
+        return loaded.state, loaded.info
+    return initial_state(params, args.start, amplitude=args.perturbation, seed=args.seed), None

@@ -4,7 +4,8 @@
 
 NAME is ``transition`` (order parameter against beta and N), ``phase-diagram`` (final state over
 (alpha, beta) and (D, beta), two starts), ``exponents`` (slip-size exponent against beta, and
-Carlson-Langer) or ``chaos`` (largest Lyapunov exponent against beta, two blocks, Carlson-Langer).
+Carlson-Langer) or ``chaos`` (the flow's exponent, slip decorrelation and its threshold delta*
+against N at beta = 0.5, 0.9, 1, and the verdict; two blocks, Carlson-Langer).
 Every point is cached and reused (only if its files are whole: a damaged point runs again); an
 interrupted study resumes; a failed point is reported and retried by the next call. DIR is owned
 as a chain's run directory is: no foreign files (``--overwrite`` removes this study's own files

@@ -1,246 +1,333 @@
-"""The verdict of one point of ``stickslip study chaos``: chaotic, stable chaos or regular.
+"""One point of ``stickslip study chaos``: a loaded state, the flow's exponent, n(delta), delta*
+and the verdict (docs/studies/chaos.md).
 
-A point that names ``flow_t`` and ``decorrelation_t`` continues its model from the engine's
-state at the end of the transient with located switches (:mod:`stickslip.run.located`): the
-exponent of the flow over ``flow_t`` at dt, dt/2, dt/4 extrapolated to dt -> 0
-(:func:`stickslip.analysis.lyapunov_flow.flow_ladder`), and the decorrelation of the event
-sequence over ``decorrelation_t`` for delta in :data:`stickslip.analysis.decorrelation.DELTAS`
-(:func:`stickslip.analysis.decorrelation.event_decorrelation`); the two give the verdict
-(:func:`stickslip.analysis.decorrelation.verdict`).
+A point is one model at one N and beta. From the engine's state at the end of its transient
+(:func:`stickslip.run.loaded.loaded_state`, kept in the point's folder with its loading check):
+
+- the flow's largest exponent by two trajectories with located switches
+  (:func:`stickslip.analysis.lyapunov_flow.flow_lyapunov`) at dt, dt/2, dt/4 over ``flow_t``, each
+  rung counting some 300 slips or more in the chain's points, extrapolated to dt -> 0
+  (:func:`stickslip.analysis.lyapunov_flow.extrapolate`);
+- n(delta) on the engine's map over windows of ``events`` slips, for each kind of perturbation
+  (state, Fs, V), each delta and ``seeds`` consecutive windows
+  (:func:`stickslip.analysis.decorrelation.sequence_decorrelation`, the measurement of
+  ``stickslip lyapunov --decorrelation``), and delta* per kind
+  (:func:`stickslip.analysis.threshold.delta_star`);
+- the verdict (:func:`stickslip.analysis.decorrelation.verdict`) from the exponent and the
+  state's n(delta).
+
+Every part (each rung, each kind) is written to ``parts/`` in the point's folder as it finishes
+and read back, not run again, when the point runs again with the same settings, and the transient
+keeps its finished chunks: an interrupted point loses at most the part it was in. A study that is
+interrupted asks its points to stop (:func:`stickslip.experiments.sweep.stop_requested`); a point
+stops within a chunk of the transient, 64 renormalisations of a rung or one twin.
 """
 
 from __future__ import annotations
 
 import math
+import time
 from pathlib import Path
 from typing import Any
 
 __all__ = [
-    "verdict_point",
-    "check_verdict",
-    "delta_column",
-    "flow_lengths",
-    "verdict_once",
     "chaos_points",
-    "fsle_summary",
+    "chaos_point",
+    "check_point",
     "located_start",
+    "DELTAS_FULL",
+    "DELTAS_QUICK",
+    "TRANSIENTS",
+    "MIN_FLOW_SLIPS",
+    "threshold_columns",
+    "kinds_of",
 ]
 
-FLOW_KEYS = ("flow_t", "decorrelation_t")
-VERDICT_KEYS = (*FLOW_KEYS, "fsle_cycles", "fsle_t")
-#: Finite-size exponents of a point: thresholds from FSLE_MIN to FSLE_MAX (ratio 2), distance
-#: read every FSLE_CHECK time units; rows below FSLE_POOLED are pooled into one rate.
-FSLE_MIN, FSLE_MAX, FSLE_CHECK, FSLE_POOLED = 1e-8, 0.1, 0.5, 1e-6
+#: The deltas of ``--full`` (and of docs/studies/decorrelation-grid.json): 1e-12, 1e-11, ..., 1e-1.
+DELTAS_FULL = tuple(float(f"1e{k}") for k in range(-12, 0))
+DELTAS_QUICK = (1e-10, 1e-8, 1e-6, 1e-5, 1e-4, 1e-3, 1e-2, 1e-1)
+#: Transients of the paper's chain from its start: at least twice the start of the first slip that
+#: moves block N at beta = 0.5, 0.9, 1 (measured, docs/studies/chaos.md, "Loaded before comparing");
+#: 2.5 loading times N (N - 1) / (2 K V) at N = 399 and 799.
+TRANSIENTS = {49: 5e5, 99: 1.5e6, 199: 5e6, 399: 2e7, 799: 8e7}
+#: Slips each rung of a chain point's ladder should count (the page reports what they did).
+MIN_FLOW_SLIPS = 300
+_KEYS = ("transient", "kinds", "deltas", "seeds", "events", "flow_t")
 
 
-def flow_lengths(flow_t: float, decorrelation_t: float, fsle_cycles: int = 0, fsle_t: float = 0.0) -> dict[str, Any]:
-    """A point's lengths of the located runs behind its verdict: the flow ladder, the
-    decorrelation run and (with ``fsle_cycles``) finite-size cycles of at most ``fsle_t`` each."""
-    out: dict[str, Any] = {"flow_t": flow_t, "decorrelation_t": decorrelation_t}
-    if fsle_cycles:
-        out.update({"fsle_cycles": int(fsle_cycles), "fsle_t": float(fsle_t)})
-    return out
+def kinds_of(cfg: dict[str, Any]) -> list[str]:
+    """A point's kinds of perturbation: a list, or one text with commas."""
+    kinds = cfg["kinds"]
+    return [k.strip() for k in kinds.split(",")] if isinstance(kinds, str) else [str(k) for k in kinds]
 
 
-def verdict_once(point: dict[str, Any], d0: float) -> dict[str, Any]:
-    """``point`` without the verdict's lengths unless d0 = 1e-10: one verdict per relative, the
-    other values of d0 only show the spread of the gridded exponent."""
-    return {k: v for k, v in point.items() if d0 == 1e-10 or k not in VERDICT_KEYS}
+def threshold_columns(kind: str) -> tuple[str, ...]:
+    """Table columns of delta* of one kind: geometric mean, its error in decades, range, censored."""
+    base = f"delta_star_{kind}"
+    return (base, f"{base}_err_log10", f"{base}_low", f"{base}_high", f"{base}_censored")
 
 
-def delta_column(delta: float) -> str:
-    """Table column of n(delta): ``n_decorr_1e-12`` etc."""
-    return f"n_decorr_{delta:g}"
-
-
-def check_verdict(cfg: dict[str, Any], params, options: dict[str, Any]) -> None:
-    """Raise ParameterError (one line) unless the verdict's run lengths of a point are valid."""
+def check_point(cfg: dict[str, Any], params) -> None:
+    """Raise ParameterError (one line) unless a chaos point's settings make a valid measurement."""
     from stickslip.analysis.benettin import check_run
+    from stickslip.analysis.decorrelation import PERTURBATIONS
     from stickslip.models.params import ParameterError, check_number
 
-    if not any(k in cfg for k in FLOW_KEYS):
-        return
-    if not all(k in cfg for k in FLOW_KEYS):
-        raise ParameterError(f"a chaos point with a verdict needs both {' and '.join(FLOW_KEYS)}")
-    check_number("decorrelation_t", cfg["decorrelation_t"], low=0.0, low_open=True)
-    if "fsle_cycles" in cfg:
-        check_number("fsle_cycles", cfg["fsle_cycles"], low=1, integer=True)
-        check_number("fsle_t", cfg.get("fsle_t"), low=0.0, low_open=True)
-    if params.ends_piece.wall and float(options.get("transient", 0.0)) > 0.0:
-        raise ParameterError("the verdict's located runs restart the clock: fixed ends (which read t) are refused")
-    interval = float(options.get("interval", 10.0))
-    check_run(params, float(cfg["flow_t"]), interval, float(options.get("d0", 1e-10)), 0.0, None, 10)
+    missing = [k for k in _KEYS if k not in cfg]
+    if missing:
+        raise ParameterError(f"a chaos point needs {', '.join(missing)}")
+    check_number("transient", cfg["transient"], low=0.0, low_open=True)
+    check_number("events", cfg["events"], low=1, integer=True)
+    check_number("seeds", cfg["seeds"], low=1, integer=True)
+    for kind in kinds_of(cfg):
+        if kind not in PERTURBATIONS:
+            raise ParameterError(f"kinds must be among {', '.join(PERTURBATIONS)} (got {kind!r})")
+    if "state" not in kinds_of(cfg):
+        raise ParameterError("a chaos point's verdict needs the kind 'state'")
+    for d in cfg["deltas"]:
+        check_number("delta", d, low=0.0, low_open=True, high=1.0)
+    if params.ends_piece.wall:
+        raise ParameterError("the chaos study restarts the clock: fixed ends (which read t) are refused")
+    check_run(
+        params, float(cfg["flow_t"]), float(cfg.get("interval", 10.0)), float(cfg.get("d0", 1e-10)), 0.0, None, 10
+    )
 
 
 def located_start(params, options: dict[str, Any]):
     """The located state at the end of ``options["transient"]`` (the engine's run of eq. (4) or a
     relative up to there from ``options["start"]``, clock restarted; docs/lyapunov.md)."""
-    from stickslip.run.driver import run_chain
-    from stickslip.run.errors import short_runs_expected
+    from stickslip.run.loaded import loaded_state
     from stickslip.run.located import LocatedState, start_state
 
     transient = float(options.get("transient", 0.0))
     kw = {"perturbation": options["perturbation"], "seed": options["seed"]}
     if transient <= 0.0:
         return start_state(params, options["start"], **kw)
-    with short_runs_expected():
-        run = run_chain(params, transient, start=options["start"], sample_interval=transient, **kw)
+    state = loaded_state(params, transient, start=options["start"], **kw).state
     # the drive's frame does not read t: every rung of the ladder can start at t = 0 (fixed
     # ends read it, and are refused here)
-    return LocatedState.from_chain_state(run.state, params, restart_clock=True)
+    return LocatedState.from_chain_state(state, params, restart_clock=True)
 
 
-def verdict_point(cfg: dict[str, Any], params, options: dict[str, Any], point_dir: Path) -> dict[str, Any]:
-    """``lyapunov_dt0``, ``lyapunov_dt0_err``, n(delta) (NaN where the sequences still agreed at
-    the end), its power-law exponent and ``verdict`` of a chaos point; the ladder and the
-    decorrelation table also go to ``flow.json`` in ``point_dir``."""
-    from stickslip import io
-    from stickslip.analysis.decorrelation import DELTAS, event_decorrelation, verdict
-    from stickslip.analysis.fsle import LocatedPair, finite_size_exponents, thresholds
-    from stickslip.analysis.lyapunov_flow import flow_ladder
+class _Parts:
+    """The finished parts of a point (``parts/NAME.json``), each with the settings it was made with
+    and its own checksum (:func:`stickslip.experiments.cache.sealed`): an edited or foreign part is
+    computed again."""
 
-    check_verdict(cfg, params, options)
-    start = located_start(params, options)
-    flow_t = float(cfg["flow_t"])
-    ladder = flow_ladder(
-        params,
-        flow_t,
-        levels=int(cfg.get("levels", 3)),
-        start=start,
-        interval=float(options.get("interval", 10.0)),
-        d0=float(options.get("d0", 1e-10)),
-        direction_seed=int(options.get("direction_seed", 0)),
-        segments=int(options.get("segments", 10)),
-    )
-    dec = event_decorrelation(
-        params, start, DELTAS, t_max=float(cfg["decorrelation_t"]), direction_seed=int(options.get("direction_seed", 0))
-    )
-    d = dec.to_dict()
-    rows = dec.rows
-    label = verdict(
-        ladder.lyapunov_dt0,
-        ladder.lyapunov_dt0_err,
-        [r["delta"] for r in rows],
-        [r["events"] for r in rows],
-        [r["decorrelated"] for r in rows],
-    )
-    info = {**ladder.to_dict(), **d, "verdict": label}
-    fsle_cols: dict[str, Any] = {}
-    if int(cfg.get("fsle_cycles", 0)) > 0:
-        pair = LocatedPair(params, start, direction_seed=int(options.get("direction_seed", 0)))
-        res = finite_size_exponents(
-            pair,
-            thresholds(FSLE_MIN, FSLE_MAX),
-            cycles=int(cfg["fsle_cycles"]),
-            check_steps=max(1, int(round(FSLE_CHECK / params.dt))),
-            max_cycle_time=float(cfg["fsle_t"]),
-            pooled_below=FSLE_POOLED,
-        )
-        fsle = res.to_dict()
-        info["finite_size"] = fsle
-        fsle_cols = fsle_summary(fsle)
+    def __init__(self, folder: Path, spec: dict[str, Any]):
+        self.folder = folder
+        self.spec = spec
+
+    def get(self, name: str, compute) -> dict[str, Any]:
+        from stickslip import io
+        from stickslip.experiments.cache import canonical, record_digest, sealed
+
+        path = self.folder / f"{name}.json"
+        want = canonical({**self.spec, "part": name})
+        if path.is_file():
+            try:
+                kept = io.read_json(path)
+            except (OSError, ValueError):
+                kept = None
+            if (
+                isinstance(kept, dict)
+                and kept.get("spec") == want
+                and isinstance(kept.get("result"), dict)
+                and kept.get("sha256") == record_digest(kept)
+            ):
+                return kept["result"]
+        io.write_json(path, {"spec": want, "result": compute()})
+        record = io.read_json(path)  # as a reused part reads it (NaN as null), then sealed
+        io.write_json(path, sealed(record))
+        return record["result"]
+
+
+def chaos_point(cfg: dict[str, Any], params, point_dir: Path) -> dict[str, Any]:
+    """One point (module docstring) of the model ``params`` (:func:`stickslip.experiments.studies.point_params`
+    of ``cfg``): writes ``flow.json`` (loading check, ladder, n(delta) of every
+    kind, delta*, verdict) into ``point_dir`` and returns the table's columns."""
+    from stickslip import __version__, io
+    from stickslip.analysis.decorrelation import GridSequences, sequence_decorrelation, verdict
+    from stickslip.analysis.lyapunov_flow import extrapolate, flow_lyapunov
+    from stickslip.analysis.threshold import delta_star
+    from stickslip.experiments.sweep import stop_requested
+    from stickslip.models.presets import PRESETS
+    from stickslip.run.loaded import loaded_state
+    from stickslip.run.located import LocatedState
+
+    wall0 = time.perf_counter()
+    check_point(cfg, params)
+    preset = PRESETS[params.model]
+    start = cfg.get("start", preset.start)
+    perturbation = float(cfg.get("perturbation", preset.start_options.get("amplitude", 0.0)))
+    if start == "paper":
+        perturbation = 0.0
+    seed = int(cfg.get("seed", preset.start_options.get("seed", 0)))
     point_dir = Path(point_dir)
+    transient = float(cfg["transient"])
+    stop = stop_requested(point_dir)
+    loaded = loaded_state(
+        params,
+        transient,
+        start=start,
+        perturbation=perturbation,
+        seed=seed,
+        cache=point_dir / "state",
+        stop_requested=stop,
+    )
+    spec = {k: v for k, v in cfg.items()} | {"version": __version__}
+    parts = _Parts(point_dir / "parts", spec)
+    direction_seed = int(cfg.get("direction_seed", 0))
+    interval, d0 = float(cfg.get("interval", 10.0)), float(cfg.get("d0", 1e-10))
+    flow_t, levels = float(cfg["flow_t"]), int(cfg.get("levels", 3))
+    located = LocatedState.from_chain_state(loaded.state, params, restart_clock=True)
+
+    def rung(k: int):
+        p = params.replace(dt=params.dt / 2**k)
+        res = flow_lyapunov(
+            p,
+            flow_t,
+            start=located,
+            interval=interval,
+            d0=d0,
+            direction_seed=direction_seed,
+            segments=int(cfg.get("segments", 10)),
+            stop_requested=stop,
+        )
+        return res.to_dict()
+
+    rungs = [parts.get(f"flow-rung-{k}", lambda k=k: rung(k)) for k in range(levels)]
+    lam0, err0, slope = extrapolate(
+        [r["dt"] for r in rungs], [_num(r["lyapunov"]) for r in rungs], [_num(r["lyapunov_err"]) for r in rungs]
+    )
+    decorrelation, thresholds = {}, {}
+    for kind in kinds_of(cfg):
+
+        def measure(kind=kind):
+            res = sequence_decorrelation(
+                GridSequences(params),
+                loaded.state,
+                [float(d) for d in cfg["deltas"]],
+                perturbation=kind,
+                events=int(cfg["events"]),
+                seeds=int(cfg["seeds"]),
+                direction_seed=direction_seed,
+                progress=lambda _line: _stop_now(stop),
+            )
+            return res.to_dict()
+
+        decorrelation[kind] = parts.get(f"decorrelation-{kind}", measure)
+        thresholds[kind] = delta_star(decorrelation[kind]["decorrelation"])
+    windows = decorrelation["state"]["decorrelation_windows"]
+    window = min(int(w["reference_events"]) for w in windows)
+    v = verdict(lam0, err0, decorrelation["state"]["decorrelation"], window=window)
+    ladder = [
+        {k: r[k] for k in ("dt", "lyapunov", "lyapunov_err", "renormalisations", "events", "waits", "wall_seconds")}
+        for r in rungs
+    ]
+    flow_slips = min(int(r["events"]) for r in rungs)
+    info = {
+        "loading": loaded.info,
+        "ladder": ladder,
+        "lyapunov_dt0": lam0,
+        "lyapunov_dt0_err": err0,
+        "dt2_slope": slope,
+        "flow_t": flow_t,
+        "flow_slips": flow_slips,
+        "interval": interval,
+        "d0": d0,
+        "decorrelation": decorrelation,
+        "thresholds": thresholds,
+        **v.to_dict(),
+    }
     point_dir.mkdir(parents=True, exist_ok=True)
     io.write_json(point_dir / "flow.json", info)
     out: dict[str, Any] = {
-        "lyapunov_dt0": ladder.lyapunov_dt0,
-        "lyapunov_dt0_err": ladder.lyapunov_dt0_err,
-        "flow_t": flow_t,
-        "decorrelation_t": dec.t_max,
-        "decorrelation_compared": dec.reference_events,
-        "decorrelation_power": d["decorrelation_power"],
-        "verdict": label,
-        **fsle_cols,
+        "loaded": bool(loaded.info["loaded"]),
+        "first_slip_reaching_block_N": loaded.info["first_slip_reaching_block_N"],
+        "lyapunov_dt0": lam0,
+        "lyapunov_dt0_err": err0,
+        "flow_slips": flow_slips,
+        "window": window,
+        "n_deltas": len(cfg["deltas"]),
+        **v.to_dict(),
+        "point_wall_seconds": time.perf_counter() - wall0,
     }
-    for r in rows:
-        out[delta_column(r["delta"])] = float(r["events"]) if r["decorrelated"] else math.nan
+    for kind, th in thresholds.items():
+        mean, err, low, high, censored = threshold_columns(kind)
+        out.update(
+            {
+                mean: _num(th["geometric_mean"]),
+                err: _num(th["log10_err"]),
+                low: _num(th["low"]),
+                high: _num(th["high"]),
+                censored: int(th["censored"]),
+            }
+        )
+        for s, value in zip(th["seeds"], th["per_seed"], strict=True):
+            out[f"{mean}_seed{s}"] = _num(value)
     return out
 
 
-def fsle_summary(fsle: dict[str, Any]) -> dict[str, Any]:
-    """Table columns of a point's finite-size exponents (Aurell et al. 1997,
-    :func:`stickslip.analysis.fsle.finite_size_exponents`): the pooled rate below 1e-6 with its
-    error, the largest row rate and its delta, and the cycles that never reached the top."""
-    rows = [r for r in fsle["fsle"] if r["cycles"] > 0 and math.isfinite(r["rate"])]
-    peak = max(rows, key=lambda r: r["rate"]) if rows else None
-    return {
-        "fsle_pooled": fsle.get("pooled_rate", math.nan),
-        "fsle_pooled_err": fsle.get("pooled_rate_err", math.nan),
-        "fsle_peak": peak["rate"] if peak else math.nan,
-        "fsle_peak_delta": peak["delta"] if peak else math.nan,
-        "fsle_unfinished": int(fsle["unfinished"]),
-    }
+def _stop_now(stop) -> None:
+    """Raise :class:`stickslip.run.errors.Interrupted` if the study asked its points to stop."""
+    if stop():
+        from stickslip.run.errors import Interrupted
+
+        raise Interrupted(None, math.nan)
 
 
-_CHAOS_BETAS_QUICK = tuple(round(0.2 + 0.1 * k, 3) for k in range(11))
-_CHAOS_BETAS_FULL = (0.2, 0.6, 1.0, 1.2)
+def _num(x) -> float:
+    return math.nan if x is None else float(x)
 
 
-def chaos_points(mode: str) -> tuple[list[dict[str, Any]], tuple[float, ...]]:
-    """The points of ``stickslip study chaos`` in ``mode`` and the relatives' values of d0: the
-    paper's chain (eq. 4) over beta, two blocks and Carlson-Langer at their standard parameters,
-    each with the lengths of its verdict's located runs (:func:`flow_lengths`)."""
-    _flow = flow_lengths
-    # Transients: the chain needs about one loading time (4.85e5 at N = 99, 1.97e6 at N = 199)
-    # before its length fluctuates about its mean (docs/lyapunov.md); the plate-driven relatives
-    # forget their start within 2e3.
+def chaos_points(mode: str) -> tuple[list[dict[str, Any]], dict[str, Any]]:
+    """The points of ``stickslip study chaos`` in ``mode`` and the settings they share: the
+    paper's chain (eq. 4) at several N and beta = 0.5, 0.9, 1, and two blocks and Carlson-Langer at
+    their standard parameters (the verdict's known answers: chaotic), dearest first. A point's
+    own keys override the shared ones (the relatives' interval, kinds and ladder length)."""
+    betas = (0.5, 0.9, 1.0)
+    # a rung of 1.2e5 time units counts 0.9 of it: some 360 slips of the chain at every N (1000 slips
+    # take 2.9e5 to 3.0e5, docs/studies/chaos.md); --full counts five times as many (at N = 799 the
+    # growth of a separation comes in rare large slips, and 360 slips hold only a few of them)
     if mode == "tiny":
-        chain = [
-            {"N": 9, "beta": b, "t_end": 6000.0, "transient": 3000.0, "interval": 10.0, **_flow(200.0, 300.0, 2, 100.0)}
-            for b in (0.6, 1.2)
-        ]
-        # steady sliding well above the inverse transition: the exponent is the least stable
-        # eigenvalue of eq. (5), negative (docs/lyapunov.md, checks with known answers)
-        chain.append(
-            {
-                "N": 4,
-                "beta": 1.5,
-                "V": 0.5,
-                "start": "steady",
-                "perturbation": 1e-3,
-                "t_end": 400.0,
-                "transient": 0.0,
-                "interval": 5.0,
-                **_flow(100.0, 100.0),
-            }
-        )
-        family = [
-            {"model": "two-blocks", "t_end": 600.0, "transient": 100.0, **_flow(200.0, 600.0, 2, 200.0)},
-            {"model": "carlson-langer", "N": 16, "t_end": 300.0, "transient": 100.0, **_flow(100.0, 200.0, 2, 50.0)},
-        ]
-        d0s: tuple[float, ...] = (1e-10,)
+        Ns, deltas, seeds, events, flow_t, levels = (5, 9), (1e-8, 1e-4, 1e-1), 2, 40, 2000.0, 2
+        transients = {5: 1e4, 9: 2e4}
+        family = [{"model": "two-blocks", "transient": 100.0, "flow_t": 200.0, "events": 30, "seeds": 1}]
     elif mode == "quick":
-        chain = [
-            {"N": 99, "beta": b, "t_end": 6e5, "transient": 5e5, "interval": 10.0, **_flow(500.0, 5e3, 3, 1e3)}
-            for b in _CHAOS_BETAS_QUICK
-        ]
+        Ns, deltas, seeds, events, flow_t, levels = (49, 99, 199), DELTAS_QUICK, 2, 1000, 1.2e5, 3
+        transients = TRANSIENTS
         family = [
-            {"model": "two-blocks", "t_end": 4.2e4, "transient": 2e3, **_flow(2e3, 4e3, 3, 1e3)},
-            {"model": "carlson-langer", "t_end": 2.2e4, "transient": 2e3, **_flow(500.0, 2e3, 3, 200.0)},
+            {"model": "two-blocks", "transient": 2e3, "flow_t": 1.2e4, "seeds": 1},
+            {"model": "carlson-langer", "transient": 2e3, "flow_t": 1e3, "seeds": 1},
         ]
-        d0s = (1e-10,)
     else:
-        chain = [
-            {"N": 99, "beta": b, "t_end": 1.1e6, "transient": 1e6, "interval": 10.0, **_flow(1e3, 5e3, 3, 1e3)}
-            for b in _CHAOS_BETAS_FULL
-        ]
-        chain += [
-            {"N": 199, "beta": b, "t_end": 2.05e6, "transient": 2e6, "interval": 10.0, **_flow(500.0, 3e3, 2, 1e3)}
-            for b in (1.0,)
-        ]
+        Ns, deltas, seeds, events, flow_t, levels = (49, 99, 199, 399, 799), DELTAS_FULL, 3, 1000, 6e5, 3
+        transients = TRANSIENTS
         family = [
-            {"model": "two-blocks", "t_end": 1.02e5, "transient": 2e3, **_flow(1e4, 1e4, 10, 1e3)},
-            {"model": "carlson-langer", "t_end": 2.2e4, "transient": 2e3, **_flow(1e3, 2e3, 5, 200.0)},
+            {"model": "two-blocks", "transient": 2e3, "flow_t": 1.2e4},
+            {"model": "carlson-langer", "transient": 2e3, "flow_t": 1e3},
         ]
-        d0s = (1e-10,)
-    points = [{"model": "sakaguchi", "start": "paper", **c, "d0": 1e-10} for c in chain]
-    points += [
-        {**verdict_once(f, d0), "interval": 1.0, "start": "rest", "perturbation": 0.01, "seed": 0, "d0": d0}
-        for f in family
-        for d0 in d0s
+    shared = {
+        "kinds": ["state", "Fs", "V"],
+        "deltas": list(deltas),
+        "seeds": seeds,
+        "events": events,
+        "flow_t": flow_t,
+        "levels": levels,
+        "interval": 10.0,
+        # above the rounding floor of positions of order L_ss ~ N^2 / (2 K): at N = 799 the
+        # exponent is the same for d0 = 1e-8 .. 1e-6 and grows spuriously below 1e-9
+        # (docs/studies/chaos.md, "d0 and the rounding floor")
+        "d0": 1e-8,
+    }
+    points: list[dict[str, Any]] = [
+        {"model": "sakaguchi", "start": "paper", "N": N, "beta": b, "transient": transients[N]}
+        for N in Ns
+        for b in betas
     ]
-    # Longest first: a shorter tail on a few workers.
-    points.sort(
-        key=lambda p: -(p["t_end"] - p["transient"] + p.get("decorrelation_t", 0.0)) * p.get("N", 100) / p["interval"]
-    )
-    return points, d0s
+    points += [
+        {**f, "start": "rest", "perturbation": 0.01, "seed": 0, "kinds": "state", "interval": 1.0} for f in family
+    ]
+    points.sort(key=lambda p: -(p.get("N", 100) ** 2) * p["transient"] ** 0.5)
+    return points, shared

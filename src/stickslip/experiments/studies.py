@@ -14,9 +14,11 @@ recorded and retried by the next call, interrupted runs continue from their chec
 * ``phase-diagram``: final state and m over (alpha, beta) and over (D, beta) at N = 99, each
   point started from the paper's start and from perturbed steady sliding (hysteresis).
 * ``exponents``: the slip-size exponent tau (Figs. 7, 8) against beta, and for Carlson-Langer.
-* ``chaos``: the largest Lyapunov exponent (:func:`stickslip.analysis.lyapunov.largest_lyapunov`)
-  against beta for the paper's chain at N = 99 (section 3, "chaotic motion"), and for two blocks
-  and Carlson-Langer at their standard parameters.
+* ``chaos``: is the paper's chain chaotic at the onset (section 3, "chaotic motion")? At several N
+  and beta = 0.5, 0.9, 1 from a loaded state: the flow's largest exponent over some 300 slips,
+  the decorrelation of the slip sequence over 1000 slips against the size of a perturbation
+  (state, Fs, V), its threshold delta* and the verdict
+  (:mod:`stickslip.experiments.chaos_verdict`); two blocks and Carlson-Langer as known answers.
 
 The runners that turn the points' results into tables, figures and pages are in
 :mod:`stickslip.experiments.study_run`.
@@ -33,8 +35,8 @@ import numpy as np
 
 from stickslip import __version__
 from stickslip.experiments.cache import canonical, spec_key
-from stickslip.experiments.chaos_verdict import chaos_points, check_verdict
-from stickslip.models.presets import is_paper
+from stickslip.experiments.chaos_verdict import chaos_points
+from stickslip.models.presets import PRESETS, is_paper
 
 __all__ = [
     "Study",
@@ -44,7 +46,7 @@ __all__ = [
     "study_point_task",
     "study_command",
     "check_point",
-    "lyapunov_point",
+    "point_params",
     "loading_time",
 ]
 
@@ -235,21 +237,25 @@ def _exponents(mode: str) -> Study:
 
 
 def _chaos(mode: str) -> Study:
-    points, d0s = chaos_points(mode)
-    chain = [p for p in points if is_paper(p["model"])]
+    points, shared = chaos_points(mode)
+    chain = [{**shared, **p} for p in points if is_paper(p["model"])]
     Ns = sorted({p["N"] for p in chain})
-    transients = sorted({p["transient"] for p in chain})
-    common = {"analysis": "lyapunov", "segments": 10, "direction_seed": 0}
-    n_chain = len(chain)
+    betas = sorted({p["beta"] for p in chain})
+    first = chain[0]
+    transients = ", ".join(f"{p['transient']:g}" for p in sorted(chain, key=lambda p: p["N"]) if p["beta"] == betas[0])
+    family = " and ".join(PRESETS[p["model"]].label or p["model"] for p in points if not is_paper(p["model"]))
+    common = {"analysis": "chaos", "segments": 10, "direction_seed": 0, **shared}
     return Study(
         "chaos",
         mode,
         common,
         tuple(points),
         note=(
-            f"{mode}: eq. (4) at N = {', '.join(map(str, Ns))}, {n_chain} points in beta, "
-            f"transients {', '.join(f'{t:g}' for t in transients)}, d0 = 1e-10; two blocks "
-            f"and Carlson-Langer at standard parameters, d0 = {', '.join(f'{d:g}' for d in d0s)}"
+            f"{mode}: eq. (4) at N = {', '.join(map(str, Ns))}, beta = {', '.join(f'{b:g}' for b in betas)}, "
+            f"from loaded states (transients {transients}); "
+            f"flow ladders of {first['flow_t']:g} time units; n(delta) for {len(first['deltas'])} deltas "
+            f"({first['deltas'][0]:g} .. {first['deltas'][-1]:g}), perturbations of the state, Fs and V, "
+            f"{first['seeds']} windows of {first['events']} slips; {family} at standard parameters"
         ),
     )
 
@@ -306,117 +312,30 @@ def point_run_options(cfg: dict[str, Any], params) -> tuple[float, dict[str, Any
     return t_end, options
 
 
-_LYAPUNOV_OPTIONS = ("interval", "d0", "transient", "align", "segments", "direction_seed")
-
-
-def lyapunov_options(cfg: dict[str, Any], params) -> tuple[float, dict[str, Any]]:
-    """Run length and :func:`~stickslip.analysis.lyapunov.largest_lyapunov` options of a chaos
-    point (start, perturbation and seed default to the model's preset), checked as that
-    function checks them."""
-    from stickslip.analysis.benettin import check_run
-    from stickslip.models.presets import PRESETS
-
-    preset = PRESETS[params.model]
-    t_end = float(cfg["t_end"])
-    options: dict[str, Any] = {k: cfg[k] for k in _LYAPUNOV_OPTIONS if k in cfg}
-    options["start"] = cfg.get("start", preset.start)
-    options["perturbation"] = float(cfg.get("perturbation", preset.start_options.get("amplitude", 0.0)))
-    options["seed"] = int(cfg.get("seed", preset.start_options.get("seed", 0)))
-    if options["start"] == "paper":
-        options["perturbation"] = 0.0
-    check_run(
-        params,
-        t_end,
-        options.get("interval", 10.0),
-        options.get("d0", 1e-10),
-        options.get("transient", 0.0),
-        options.get("align"),
-        options.get("segments", 10),
-    )
-    return t_end, options
-
-
 def check_point(cfg: dict[str, Any]) -> None:
     """Raise ParameterError (one line) unless a point's merged settings make a valid run."""
     params = point_params(cfg)
-    if cfg.get("analysis") == "lyapunov":
-        check_verdict(cfg, params, lyapunov_options(cfg, params)[1])
+    if cfg.get("analysis") == "chaos":
+        from stickslip.experiments.chaos_verdict import check_point as check_chaos
+
+        check_chaos(cfg, params)
     else:
         point_run_options(cfg, params)
-
-
-def lyapunov_point(cfg: dict[str, Any], point_dir: Path) -> dict[str, Any]:
-    """One point of ``chaos``: the largest Lyapunov exponent of a model of the family
-    (Benettin et al. 1980, :func:`stickslip.analysis.lyapunov.largest_lyapunov`), written to
-    ``lyapunov.json`` and ``renormalisations.parquet`` (every renormalisation: end time,
-    ln(d/d0), length, counted) in ``point_dir``. Adds the exponent per slip event, and with
-    ``flow_t`` the exponent of the flow, n(delta) and the verdict
-    (:func:`stickslip.experiments.chaos_verdict.verdict_point`)."""
-    from stickslip import io
-    from stickslip.analysis.lyapunov import largest_lyapunov
-
-    params = point_params(cfg)
-    t_end, options = lyapunov_options(cfg, params)
-    res = largest_lyapunov(params, t_end, **options)
-    point_dir = Path(point_dir)
-    point_dir.mkdir(parents=True, exist_ok=True)
-    import pandas as pd
-
-    io.write_table_files(
-        point_dir / "renormalisations",
-        pd.DataFrame({"t": res.times, "log_growth": res.log_growth, "duration": res.durations, "counted": res.counted}),
-        descriptions={
-            "t": "end of the interval",
-            "log_growth": "ln(d / d0) over the interval",
-            "duration": "length of the interval",
-            "counted": "enters the exponent",
-        },
-    )
-    info = res.to_dict()
-    io.write_json(point_dir / "lyapunov.json", info)
-    counted_time = float(np.sum(res.durations[res.counted]))
-    per_event = res.lyapunov * counted_time / res.events if res.events > 0 else math.nan
-    keep = (
-        "lyapunov",
-        "lyapunov_err",
-        "t_end",
-        "renormalisations",
-        "d0",
-        "interval",
-        "transient",
-        "align",
-        "segments",
-        "events",
-        "merges",
-        "max_log_growth",
-        "reference_sha256",
-        "start",
-    )
-    out = {
-        "model": params.model,
-        **{k: info[k] for k in keep},
-        "counted_time": counted_time,
-        "lyapunov_per_event": per_event,
-        "run_wall_seconds": float(res.wall_seconds),
-    }
-    if "flow_t" in cfg:
-        from stickslip.experiments.chaos_verdict import verdict_point
-
-        out.update(verdict_point(cfg, params, options, point_dir))
-    return out
 
 
 def study_point_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     """One point of a study: the chain run and its analysis (a task of ``run_sweep``).
 
     ``analysis = "order"``: :func:`order_summary`; ``"sizes"``: :func:`sizes_summary`;
-    ``"lyapunov"``: :func:`lyapunov_point` (no chain run record, only the exponent's data).
+    ``"chaos"``: :func:`stickslip.experiments.chaos_verdict.chaos_point` (no chain run record).
     Returns the summary stored in the point's ``done.json``.
     """
     from stickslip.experiments.sweep import run_chain_point
 
-    if point.get("analysis") == "lyapunov":
-        return lyapunov_point(point, point_dir)
+    if point.get("analysis") == "chaos":
+        from stickslip.experiments.chaos_verdict import chaos_point
+
+        return chaos_point(point, point_params(point), Path(point_dir))
     params = point_params(point)
     t_end, options = point_run_options(point, params)
     point_dir = Path(point_dir)

@@ -199,105 +199,10 @@ def _exponents(table: pd.DataFrame) -> dict[str, Any]:
 
 
 def _chaos(table: pd.DataFrame) -> dict[str, Any]:
-    """Statements on the largest Lyapunov exponents: is each distinguishable from zero, and how
-    the chain of eq. (4) compares with its plate-driven relatives."""
-    out: dict[str, Any] = {"statements": [], "chain": {}, "family": {}}
-    say = out["statements"].append
-    chain = table[table["model"].map(is_paper)].sort_values("beta")
-    lam = chain["lyapunov"].to_numpy(float)
-    err = chain["lyapunov_err"].to_numpy(float)
-    ok = np.isfinite(lam) & np.isfinite(err) & (err > 0)
-    if ok.any():
-        z = lam[ok] / err[ok]
-        pos, neg = chain["beta"][ok][z > 3].tolist(), chain["beta"][ok][z < -3].tolist()
-        bound = float(np.max(np.abs(lam[ok]) + 2 * err[ok]))
-        out["chain"] = {"n": int(ok.sum()), "positive_3sigma": pos, "negative_3sigma": neg, "bound_2sigma": bound}
-        Ns = sorted(int(n) for n in chain["N"].unique())
-        say(
-            f"eq. (4), N = {', '.join(map(str, Ns))}: lambda within 3 error bars of zero at "
-            f"{int(np.count_nonzero(np.abs(z) <= 3))} of {int(ok.sum())} values of beta "
-            f"(|lambda| + 2 errors <= {_g(bound, 2)} per unit time everywhere)"
-            + (f"; positive beyond 3 errors at beta = {', '.join(f'{b:g}' for b in pos)}" if pos else "")
-            + (f"; negative beyond 3 errors at beta = {', '.join(f'{b:g}' for b in neg)}" if neg else "")
-            + "."
-        )
-        per_event = chain["lyapunov_per_event"].to_numpy(float)[ok]
-        if np.isfinite(per_event).any():
-            say(
-                f"eq. (4): per slip event, lambda ranges over [{_g(np.nanmin(per_event), 2)}, "
-                f"{_g(np.nanmax(per_event), 2)}]."
-            )
-    for model, g in table[~table["model"].map(is_paper)].groupby("model"):
-        rows = g.sort_values("d0")
-        vals = ", ".join(f"{_g(r.lyapunov)} +- {_g(r.lyapunov_err, 2)} (d0 = {r.d0:g})" for r in rows.itertuples())
-        lam_m = rows["lyapunov"].to_numpy(float)
-        err_m = rows["lyapunov_err"].to_numpy(float)
-        # A twin that falls onto the reference makes the exponent -inf (no number): judge the
-        # values of d0 that gave one, and name the others.
-        fin = np.isfinite(lam_m) & np.isfinite(err_m)
-        positive = bool(fin.any() and np.all(lam_m[fin] > 3 * err_m[fin]))
-        out["family"][model] = {
-            "lyapunov": lam_m.tolist(),
-            "lyapunov_err": err_m.tolist(),
-            "d0": rows["d0"].tolist(),
-            "positive_3sigma": positive,
-        }
-        verdict = "chaotic (positive beyond 3 errors)" if positive else "not positive beyond 3 errors"
-        if not fin.any():
-            verdict = "no finite exponent"
-        elif not fin.all():
-            verdict += f" at d0 = {', '.join(f'{d:g}' for d in rows['d0'][fin])}"
-        if fin.sum() > 1:
-            verdict += f"; spread over d0 {_g(np.ptp(lam_m[fin]), 2)} against errors of {_g(np.max(err_m[fin]), 2)}"
-        lost = [
-            f"d0 = {r.d0:g} (the twin fell onto the reference {int(r.merges)} times: d0 at the rounding floor)"
-            if "merges" in rows and np.isfinite(r.merges) and r.merges > 0
-            else f"d0 = {r.d0:g}"
-            for r, f in zip(rows.itertuples(), fin, strict=True)
-            if not f
-        ]
-        if lost:
-            verdict += "; no exponent at " + ", ".join(lost)
-        say(f"{model} (N = {int(rows['N'].iloc[0])}): lambda = {vals}: {verdict}.")
-    _verdicts(table, out)
-    return out
+    """The chaos study's findings (:func:`stickslip.experiments.chaos_findings.conclusions`)."""
+    from stickslip.experiments.chaos_findings import conclusions as chaos_conclusions
 
-
-def _verdicts(table: pd.DataFrame, out: dict[str, Any]) -> None:
-    """One statement: which points the flow exponent and the decorrelation of the event sequence
-    call chaotic, stable chaos or regular (:func:`stickslip.analysis.decorrelation.verdict`)."""
-    if "verdict" not in table.columns or not table["verdict"].notna().any():
-        return
-    rows = table[table["verdict"].notna()]
-    out["verdicts"] = {}
-    parts = []
-    for label, g in rows.groupby("verdict", sort=False):
-        names = [PRESETS[r.model].point_label(r.beta, r.N) for r in g.itertuples()]
-        out["verdicts"][label] = names
-        parts.append(f"{label} at {', '.join(names)}")
-    if "fsle_unfinished" in rows.columns and rows["fsle_unfinished"].notna().any():
-        parts_f = []
-        for r in rows[rows["fsle_unfinished"].notna()].itertuples():
-            # the relatives have no beta (their friction has none)
-            name = f"beta = {r.beta:g} (N = {int(r.N)})" if _finite(r.beta) else r.model
-            pooled = f"{_g(r.fsle_pooled, 2)}" if _finite(r.fsle_pooled) else "no doubling below 1e-6"
-            peak = (
-                f"largest {_g(r.fsle_peak, 2)} at delta = {r.fsle_peak_delta:.2g}" if _finite(r.fsle_peak) else "none"
-            )
-            parts_f.append(
-                f"{name}: {pooled}, {peak}"
-                + (
-                    f", {int(r.fsle_unfinished)} cycles unfinished"
-                    if _finite(r.fsle_unfinished) and r.fsle_unfinished
-                    else ""
-                )
-            )
-        out["statements"].append("Finite-size exponent (pooled below 1e-6; largest row): " + "; ".join(parts_f) + ".")
-    out["statements"].append(
-        "Verdict (flow exponent at dt -> 0, decorrelation of the event sequence against delta): "
-        + "; ".join(parts)
-        + "."
-    )
+    return chaos_conclusions(table)
 
 
 def draw(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[dict[str, Any]]:
@@ -351,16 +256,9 @@ def draw(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[dict[str, Any
             )
         )
     elif spec.name == "chaos":
-        figs.append(
-            (
-                "lyapunov_beta",
-                pl.chaos_figure(table),
-                "Largest Lyapunov exponent (Benettin et al. two-trajectory method, d0 = 1e-10 unless "
-                "marked) against beta for eq. (4), error bars from 10 segments; right: two blocks and "
-                "Carlson-Langer at standard parameters as marked points.",
-            )
-        )
-        figs += _flow_figures(spec, table, page_dir)
+        from stickslip.experiments.chaos_findings import figures as chaos_figures
+
+        figs += chaos_figures(table, Path(page_dir).parent / "runs" / spec.dirname / "points", page_dir)
     else:
         figs.append(
             (
@@ -374,60 +272,4 @@ def draw(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[dict[str, Any
     for name, fig, caption in figs:
         save_figure(fig, page_dir / name)
         out.append({"name": name, "image": f"{name}.png", "pdf": f"{name}.pdf", "caption": caption, "command": cmd})
-    return out
-
-
-def chaos_curves(table: pd.DataFrame, points_dir: Path) -> list[dict[str, Any]]:
-    """The ``flow.json`` of every chaos point that has one (ladder, finite-size exponents,
-    decorrelation: :func:`stickslip.experiments.chaos_verdict.verdict_point`), labelled by model,
-    N and beta; chain points by N then beta, the relatives last."""
-    from stickslip import io
-
-    curves = []
-    if "point_dir" not in table.columns:
-        return curves
-    for r in table.itertuples():
-        path = Path(points_dir) / str(r.point_dir) / "flow.json"
-        if not path.is_file():
-            continue
-        chain = _finite(r.beta)  # the relatives have no beta
-        label = f"eq. (4), N = {int(r.N)}, beta = {r.beta:g}" if chain else f"{r.model}, N = {int(r.N)}"
-        key = (0, int(r.N), float(r.beta)) if chain else (1, 0, 0.0)
-        curves.append((key, {"label": label, **io.read_json(path)}))
-    return [c for _, c in sorted(curves, key=lambda x: x[0])]
-
-
-def _flow_figures(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[tuple[str, Any, str]]:
-    """lambda of the flow against dt, the FSLE against delta and n(delta) against delta, from the
-    points' ``flow.json`` (:mod:`stickslip.plotting.chaos`)."""
-    from stickslip.plotting import chaos as pc
-
-    curves = chaos_curves(table, Path(page_dir).parent / "runs" / spec.dirname / "points")
-    if not curves:
-        return []
-    out = [
-        (
-            "flow_ladder",
-            pc.flow_ladder_figure(curves),
-            "Largest exponent of the flow (located switches, the time shift removed) at dt, dt/2, "
-            "dt/4, with the fit lambda_0 + c dt^2 and lambda_0 (square) at dt = 0.",
-        )
-    ]
-    if any(c.get("finite_size") for c in curves):
-        out.append(
-            (
-                "fsle",
-                pc.fsle_figure(curves),
-                "Finite-size Lyapunov exponent ln 2 / <time from delta to 2 delta> against delta "
-                "(located switches); rows with no finished doubling are left out.",
-            )
-        )
-    out.append(
-        (
-            "decorrelation",
-            pc.decorrelation_figure(curves),
-            "Slip events whose sizes agree (to 1e-3) between runs started delta apart; open "
-            "triangles: still agreeing after all the events compared.",
-        )
-    )
     return out

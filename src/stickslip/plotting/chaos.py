@@ -1,16 +1,18 @@
-"""Figures of the flow's chaos tests (docs/lyapunov.md, "The flow: located switches").
+"""Figures of the chaos study (docs/studies/chaos.md, docs/lyapunov.md).
 
-Each function takes a list of curves, one per point: a dict with ``label`` and the data of the
-point's ``flow.json`` (:func:`stickslip.experiments.chaos_verdict.verdict_point`):
+:func:`flow_ladder_figure` and :func:`decorrelation_figure` take a list of curves, one per point:
+a dict with ``label``, ``N`` and ``beta`` (None for the relatives) and the data of the point's
+``flow.json`` (:func:`stickslip.experiments.chaos_verdict.chaos_point`):
 
 * :func:`flow_ladder_figure`: the largest exponent of the flow against dt (``ladder`` rows of
   ``dt``, ``lyapunov``, ``lyapunov_err``) with the fit lambda(dt) = lambda_0 + c dt^2
   (``lyapunov_dt0``, ``lyapunov_dt0_err``, ``dt2_slope``) drawn down to dt = 0;
-* :func:`fsle_figure`: the finite-size Lyapunov exponent lambda(delta) = ln 2 / <tau(delta)>
-  (Aurell et al. 1997; ``finite_size`` with rows of ``delta``, ``rate``, ``rate_err``);
-* :func:`decorrelation_figure`: the number of slip events n(delta) that agree between two runs
-  started delta apart (``decorrelation`` rows of ``delta``, ``events``, ``decorrelated``); runs
-  that still agreed at the end are drawn as open markers at the number of events compared.
+* :func:`decorrelation_figure`: n(delta), the slips that agree between a reference and a twin
+  started delta apart (``decorrelation``: for each kind of perturbation, rows of ``delta``,
+  ``seed``, ``events``, ``decorrelated``), one panel per kind and N, one line per beta and
+  window; windows that still agreed at the end are open markers at the slips compared;
+* :func:`threshold_figure`: delta* against N (:func:`stickslip.analysis.threshold.delta_star`,
+  :func:`~stickslip.analysis.threshold.threshold_fit`), one panel per kind, one colour per beta.
 """
 
 from __future__ import annotations
@@ -23,7 +25,7 @@ from matplotlib.figure import Figure
 
 from stickslip.plotting.style import new_figure
 
-__all__ = ["flow_ladder_figure", "fsle_figure", "decorrelation_figure"]
+__all__ = ["flow_ladder_figure", "decorrelation_figure", "threshold_figure"]
 
 
 def _f(x) -> float:
@@ -69,48 +71,103 @@ def flow_ladder_figure(curves: list[dict[str, Any]]) -> Figure:
     return fig
 
 
-def fsle_figure(curves: list[dict[str, Any]]) -> Figure:
-    """Finite-size exponent lambda(delta) = ln 2 / <tau(delta)> against delta (log axes, Aurell
-    et al. 1997), one line per point; rows without a finished doubling are left out."""
-    fig, ax = new_figure(width=5.6, height=3.8)
-    for k, c in enumerate(curves):
-        fsle = (c.get("finite_size") or {}).get("fsle", [])
-        rows = [r for r in fsle if r["cycles"] and math.isfinite(_f(r["rate"])) and _f(r["rate"]) > 0]
-        if not rows:
-            continue
-        d = np.array([_f(r["delta"]) for r in rows], dtype=float)
-        rate = np.array([_f(r["rate"]) for r in rows], dtype=float)
-        err = np.nan_to_num(np.array([_f(r["rate_err"]) for r in rows], dtype=float))
-        ax.errorbar(d, rate, yerr=err, fmt="o-", ms=3, lw=1, capsize=1.5, color=f"C{k % 10}", label=c.get("label", ""))
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    ax.set_xlabel(r"separation $\delta$")
-    ax.set_ylabel(r"FSLE $\lambda(\delta) = \ln 2 / \langle\tau(\delta)\rangle$")
-    if ax.get_legend_handles_labels()[0]:
-        ax.legend(fontsize=6, ncols=2)
-    return fig
+_MARKERS = ("o", "s", "D", "v", "^")
 
 
 def decorrelation_figure(curves: list[dict[str, Any]]) -> Figure:
-    """n(delta), the slip events that agree (sizes within 1e-3) between runs started delta apart,
-    against delta (log x), one line per point; open markers: still agreeing after the number of
-    events compared (a lower bound)."""
-    fig, ax = new_figure(width=5.6, height=3.8)
-    for k, c in enumerate(curves):
-        rows = c.get("decorrelation", [])
-        d = np.array([r["delta"] for r in rows if r["delta"] > 0], dtype=float)
-        if not d.size:
-            continue
-        n = np.array([r["events"] for r in rows if r["delta"] > 0], dtype=float)
-        dec = np.array([bool(r["decorrelated"]) for r in rows if r["delta"] > 0])
-        color = f"C{k % 10}"
-        ax.plot(d, n, "-", lw=1, color=color, label=c.get("label", ""))
-        ax.plot(d[dec], n[dec], "o", ms=4, color=color)
-        ax.plot(d[~dec], n[~dec], "^", ms=6, mfc="none", color=color)
-    ax.set_xscale("log")
-    ax.set_xlabel(r"initial separation $\delta$")
-    ax.set_ylabel(r"events in agreement $n(\delta)$")
-    ax.set_ylim(bottom=0)
-    if ax.get_legend_handles_labels()[0]:
-        ax.legend(fontsize=6, ncols=2, title="open triangles: never decorrelated", title_fontsize=6)
+    """n(delta) against delta (log x): rows of panels are the kinds of perturbation, columns the
+    chain's N (then the relatives); in each panel one colour per beta and one marker per window
+    (seed), filled where the twin disagreed, open at the slips compared where it never did."""
+    kinds = [k for k in ("state", "Fs", "V") if any(k in (c.get("decorrelation") or {}) for c in curves)]
+    columns: list[Any] = sorted({int(c["N"]) for c in curves if c.get("beta") is not None})
+    if any(c.get("beta") is None for c in curves):
+        columns.append("relatives")
+    nrows, ncols = max(1, len(kinds)), max(1, len(columns))
+    fig, axes = new_figure(nrows, ncols, width=2.6, height=2.2)
+    axes = np.asarray(axes, dtype=object).reshape(nrows, ncols)
+    betas = sorted({float(c["beta"]) for c in curves if c.get("beta") is not None})
+    for i, kind in enumerate(kinds):
+        for j, col in enumerate(columns):
+            ax = axes[i][j]
+            mine = [c for c in curves if (c.get("beta") is None) == (col == "relatives")]
+            if col != "relatives":
+                mine = [c for c in mine if int(c["N"]) == col]
+            drawn = False
+            for c in mine:
+                rows = [r for r in (c.get("decorrelation") or {}).get(kind, {}).get("decorrelation", [])]
+                if not rows:
+                    continue
+                drawn = True
+                b = c.get("beta")
+                color = f"C{betas.index(float(b)) % 10}" if b is not None else f"C{(len(betas) + mine.index(c)) % 10}"
+                name = f"beta = {float(b):g}" if b is not None else c.get("label", "")
+                for s in sorted({int(r["seed"]) for r in rows}):
+                    rs = sorted((r for r in rows if int(r["seed"]) == s and r["delta"] > 0), key=lambda r: r["delta"])
+                    d = np.array([r["delta"] for r in rs], dtype=float)
+                    n = np.array([r["events"] for r in rs], dtype=float)
+                    dec = np.array([bool(r["decorrelated"]) for r in rs])
+                    m = _MARKERS[s % len(_MARKERS)]
+                    ax.plot(d, n, "-", lw=0.6, color=color, alpha=0.6, label=name if s == 0 else None)
+                    ax.plot(d[dec], n[dec], m, ms=3, color=color, ls="none")
+                    ax.plot(d[~dec], n[~dec], m, ms=4, mfc="none", color=color, ls="none")
+            if not drawn:
+                ax.set_visible(False)
+                continue
+            ax.set_xscale("log")
+            ax.set_ylim(bottom=-0.03 * max(ax.get_ylim()[1], 1.0))
+            title = f"N = {col}" if col != "relatives" else "relatives"
+            ax.set_title(f"{kind}, {title}", fontsize=8)
+            ax.tick_params(labelsize=7)
+            if i == nrows - 1:
+                ax.set_xlabel(r"$\delta$", fontsize=8)
+            if j == 0:
+                ax.set_ylabel(r"slips in agreement $n(\delta)$", fontsize=8)
+            if ax.get_legend_handles_labels()[0]:
+                ax.legend(fontsize=6)
+    return fig
+
+
+def threshold_figure(points: list[dict[str, Any]], fits: list[dict[str, Any]]) -> Figure:
+    """delta* against N (log axes), one panel per kind of perturbation: each window's delta*
+    (small markers), the geometric mean over the windows with its standard error (factor
+    10^(+-err)), and the least-squares line of log10 delta* on log10 N for each beta (dashed).
+
+    ``points``: dicts with ``N``, ``beta``, ``kind``, ``per_seed`` (None where censored),
+    ``geometric_mean``, ``log10_err``; ``fits``: dicts with ``beta``, ``kind``, ``slope``,
+    ``intercept``, ``Ns``."""
+    kinds = [k for k in ("state", "Fs", "V") if any(p["kind"] == k for p in points)]
+    fig, axes = new_figure(1, max(1, len(kinds)), width=3.0, height=2.8)
+    axes = np.asarray(axes, dtype=object).reshape(1, -1)
+    betas = sorted({float(p["beta"]) for p in points})
+    for ax, kind in zip(axes[0], kinds, strict=False):
+        for p in (p for p in points if p["kind"] == kind):
+            k = betas.index(float(p["beta"]))
+            color = f"C{k % 10}"
+            shift = 1.0 + 0.04 * (k - (len(betas) - 1) / 2)  # beside each other at one N
+            vals = [v for v in p["per_seed"] if v is not None]
+            ax.plot([p["N"] * shift] * len(vals), vals, ".", ms=3, color=color, alpha=0.6)
+            gm, err = p.get("geometric_mean"), _f(p.get("log10_err"))
+            if gm is not None:
+                e = err if math.isfinite(err) else 0.0
+                yerr = [[gm - gm * 10**-e], [gm * 10**e - gm]]
+                ax.errorbar([p["N"] * shift], [gm], yerr=yerr, fmt="o", ms=4, color=color, capsize=2)
+        for f in (f for f in fits if f["kind"] == kind):
+            if not math.isfinite(_f(f.get("slope"))) or not f.get("Ns"):
+                continue
+            color = f"C{betas.index(float(f['beta'])) % 10}"
+            N = np.geomspace(min(f["Ns"]), max(f["Ns"]), 20)
+            label = f"beta = {float(f['beta']):g}: {f['slope']:+.2f} +- {_f(f.get('slope_err')):.2f}"
+            ax.plot(N, 10.0 ** (f["intercept"] + f["slope"] * np.log10(N)), "--", lw=1, color=color, label=label)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        Ns = sorted({int(p["N"]) for p in points if p["kind"] == kind})
+        ax.set_xticks(Ns, [str(n) for n in Ns])
+        ax.set_xticks([], minor=True)
+        ax.set_xlim(min(Ns) / 1.4, max(Ns) * 1.4)
+        ax.set_title(f"perturbation: {kind}", fontsize=8)
+        ax.set_xlabel("N", fontsize=8)
+        ax.tick_params(labelsize=7)
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(fontsize=6, title="slope of log delta* on log N", title_fontsize=6)
+    axes[0][0].set_ylabel(r"threshold $\delta^*$", fontsize=8)
     return fig

@@ -22,7 +22,6 @@ __all__ = [
     "collapse_figure",
     "phase_map_figure",
     "exponents_figure",
-    "chaos_figure",
     "STATE_STYLE",
 ]
 
@@ -166,60 +165,4 @@ def exponents_figure(table: pd.DataFrame) -> Figure:
     a2.set_xlabel(r"$\beta$")
     a2.set_ylabel("great-event excess (observed / power law)")
     a2.legend(fontsize=7)
-    return fig
-
-
-#: Marker of each plate-driven relative in the chaos figure.
-FAMILY_MARKERS = {"two-blocks": "s", "carlson-langer": "D"}
-
-
-def chaos_figure(table: pd.DataFrame) -> Figure:
-    """Largest Lyapunov exponent lambda against beta for the chain of eq. (4) (section 3,
-    "chaotic motion"; Benettin et al. 1980, error bars from segment means), with the linear
-    threshold beta_c = alpha = 1 (Fig. 4) dotted; right panel: two blocks and Carlson-Langer as
-    marked points, one per d0 (their exponents are orders of magnitude larger)."""
-    fig, (a1, a2) = new_figure(1, 2, width=4.4, height=3.6, gridspec_kw={"width_ratios": [2.2, 1]})
-    chain = table[table["model"].map(is_paper)].sort_values("beta")
-    for k, (N, g) in enumerate(sorted(chain.groupby("N"), key=lambda x: x[0])):
-        a1.errorbar(
-            g["beta"],
-            g["lyapunov"],
-            yerr=g["lyapunov_err"],
-            fmt="o-",
-            color=f"C{k}",
-            ms=4,
-            lw=1,
-            capsize=2,
-            label=f"eq. (4), N = {int(N)}",
-        )
-    a1.axhline(0.0, color="0.3", lw=0.8)
-    a1.axvline(1.0, color="0.5", lw=0.8, ls=":", label=r"$\beta_c = \alpha = 1$")
-    a1.set_xlabel(r"$\beta$")
-    a1.set_ylabel(r"largest Lyapunov exponent $\lambda$")
-    a1.ticklabel_format(axis="y", style="sci", scilimits=(-3, 3))
-    if a1.get_legend_handles_labels()[0]:
-        a1.legend(fontsize=7)
-    family = table[~table["model"].map(is_paper)]
-    models = [m for m in FAMILY_MARKERS if m in set(family["model"])]
-    models += sorted(set(family["model"]) - set(models))
-    for i, model in enumerate(models):
-        g = family[family["model"] == model].sort_values("d0")
-        offsets = np.linspace(-0.15, 0.15, len(g)) if len(g) > 1 else np.zeros(1)
-        for off, r in zip(offsets, g.itertuples(), strict=False):
-            a2.errorbar(
-                [i + off],
-                [r.lyapunov],
-                yerr=[r.lyapunov_err],
-                fmt=FAMILY_MARKERS.get(model, "o"),
-                color=f"C{3 + i}",
-                ms=6,
-                capsize=2,
-            )
-            if len(g) > 1:
-                a2.annotate(f"{r.d0:g}", (i + off, r.lyapunov), fontsize=6, xytext=(3, 3), textcoords="offset points")
-    a2.axhline(0.0, color="0.3", lw=0.8)
-    a2.set_xticks(range(len(models)), [m.replace("-", "\n") for m in models], fontsize=8)
-    a2.set_xlim(-0.6, len(models) - 0.4)
-    a2.set_ylabel(r"$\lambda$")
-    a2.set_title("relatives, standard parameters", fontsize=8)
     return fig

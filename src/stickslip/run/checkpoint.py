@@ -36,7 +36,7 @@ def _checksum(arrays: dict[str, np.ndarray], header: dict[str, Any]) -> str:
     return h.hexdigest()
 
 
-def _write_npz(path: Path, arrays: dict[str, np.ndarray], header: dict[str, Any]) -> str:
+def write_npz(path: Path, arrays: dict[str, np.ndarray], header: dict[str, Any]) -> str:
     """Write arrays + a JSON header + their checksum to ``path`` atomically; returns the checksum."""
     from stickslip.io import atomic_path
 
@@ -52,8 +52,8 @@ def _write_npz(path: Path, arrays: dict[str, np.ndarray], header: dict[str, Any]
     return digest
 
 
-def _read_npz(path: Path) -> tuple[dict[str, np.ndarray], dict[str, Any], str]:
-    """Read and verify a file written by :func:`_write_npz`; raises ChainRunError if corrupt."""
+def read_npz(path: Path) -> tuple[dict[str, np.ndarray], dict[str, Any], str]:
+    """Read and verify a file written by :func:`write_npz`; raises ChainRunError if corrupt."""
     try:
         with np.load(path, allow_pickle=False) as z:
             arrays = {k: z[k] for k in z.files}
@@ -112,19 +112,19 @@ class Checkpointer:
         self.dir.mkdir(parents=True, exist_ok=True)
         new = outputs.take_new(self.since)
         name = f"part-{len(self.parts):06d}.npz"
-        digest = _write_npz(self.dir / name, new, {"format": CHECKPOINT_FORMAT})
+        digest = write_npz(self.dir / name, new, {"format": CHECKPOINT_FORMAT})
         self.parts.append({"file": name, "sha256": digest})
         arrays = {k: getattr(state, k) for k in ChainState.ARRAYS}
         full_header = dict(
             header, format=CHECKPOINT_FORMAT, parts=self.parts, version=__version__, ist_size=layout.IST_SIZE
         )
-        _write_npz(self.state_path, arrays, full_header)
+        write_npz(self.state_path, arrays, full_header)
         return self.state_path
 
     def load(self) -> tuple[ChainState, dict[str, Any], dict[str, list[np.ndarray]]]:
         if not self.state_path.exists():
             raise ChainRunError(f"no checkpoint in {self.dir.parent} (missing {self.state_path.name})")
-        arrays, header, _ = _read_npz(self.state_path)
+        arrays, header, _ = read_npz(self.state_path)
         if header.get("format") != CHECKPOINT_FORMAT:
             raise ChainRunError(
                 f"checkpoint format {header.get('format')} is not supported (this version reads {CHECKPOINT_FORMAT})"
@@ -144,7 +144,7 @@ class Checkpointer:
         ):
             raise ChainRunError(f"checkpoint in {self.dir.parent} lists its parts wrongly")
         for entry in listed:
-            part_arrays, _, digest = _read_npz(self.dir / entry["file"])
+            part_arrays, _, digest = read_npz(self.dir / entry["file"])
             if digest != entry["sha256"]:
                 raise ChainRunError(f"checkpoint part {entry['file']} does not match the state file")
             for key in PART_KEYS:

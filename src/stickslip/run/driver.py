@@ -39,8 +39,8 @@ from stickslip.kernels import layout
 from stickslip.models.params import ChainParams, ParameterError, check_number, steps_for
 from stickslip.run import rundir
 
-# The checkpoint file helpers (_read_npz, _write_npz) are named here too, for checks of the files.
-from stickslip.run.checkpoint import CHECKPOINT_FORMAT, Checkpointer, _read_npz, _write_npz  # noqa: F401
+# The checkpoint file helpers (read_npz, write_npz) are named here too, for checks of the files.
+from stickslip.run.checkpoint import CHECKPOINT_FORMAT, Checkpointer, read_npz, write_npz  # noqa: F401
 from stickslip.run.errors import ChainRunError, Interrupted, NonFiniteState, ShortRunWarning
 from stickslip.run.loop import (  # _Kernel named here too, for tests that count its calls
     CheckedAdvance,
