@@ -19,7 +19,8 @@ bit for bit where an uninterrupted run does.
 This module sets a run up, with the hooks its options ask for, and finishes it; the loop, its
 hooks and the checked kernel call shared with :class:`Stepper` are :mod:`stickslip.run.loop`. It
 also names the rest of the chain-run API, which lives beside it: the state
-(:mod:`stickslip.run.state`), the options, buffers and results (:mod:`stickslip.run.outputs`), the checkpoint files
+(:mod:`stickslip.run.state`), the options (:mod:`stickslip.run.options`), buffers and results
+(:mod:`stickslip.run.outputs`), the checkpoint files
 (:mod:`stickslip.run.checkpoint`), the run directories (:mod:`stickslip.run.rundir`) and the
 errors (:mod:`stickslip.run.errors`).
 """

@@ -98,6 +98,14 @@ class RunOptions:
 
     The fields from ``integrator`` on say how the run runs; all but ``integrator`` are marked
     ``control`` and are not part of what a run records (:meth:`recorded`).
+
+    Examples
+    --------
+    >>> from stickslip import RunOptions
+    >>> options = RunOptions(sample_interval=5.0, integrator="dense", out_dir="runs/a", progress=False)
+    >>> kept = options.recorded()  # what the run's ChainRun keeps
+    >>> kept.sample_interval, kept.integrator, kept.out_dir, kept.progress
+    (5.0, 'dense', None, None)
     """
 
     t_end: float | None = None
