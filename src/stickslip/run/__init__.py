@@ -14,7 +14,8 @@ run's loop (:class:`~stickslip.run.loop.Hook`, which sees a :class:`~stickslip.r
 
 from importlib import import_module
 
-#: Names loaded on first use (the loop loads the compiled kernels), and the module of each.
+#: Names loaded on first use (the loop loads the compiled kernels), and the module of each; no
+#: ``__all__``, so that the reference documents each once, in its own module.
 _LAZY = {
     "run_chain": "stickslip.run.driver",
     "resume_chain": "stickslip.run.driver",
@@ -22,8 +23,6 @@ _LAZY = {
     "Hook": "stickslip.run.loop",
     "Loop": "stickslip.run.loop",
 }
-
-__all__ = list(_LAZY)
 
 
 def __getattr__(name: str):

@@ -44,6 +44,8 @@ class RunOptions:
     Times are in the model's time units. Given to :func:`~stickslip.run.driver.run_chain` as
     ``options=``; the fields with a command-line spelling are the options of ``stickslip chain``
     (their metadata ``cli``: spelling, metavar and help), from which the command line is built.
+    The fields from ``integrator`` on say how the run runs; all but ``integrator`` are marked
+    ``control`` and are not part of what a run records (:meth:`recorded`).
 
     Attributes
     ----------
@@ -95,9 +97,6 @@ class RunOptions:
     hooks : tuple of Hook
         The caller's own concerns of the run loop (:class:`~stickslip.run.loop.Hook`), served
         after the run's own recording hooks; they change no bit of the run.
-
-    The fields from ``integrator`` on say how the run runs; all but ``integrator`` are marked
-    ``control`` and are not part of what a run records (:meth:`recorded`).
 
     Examples
     --------
