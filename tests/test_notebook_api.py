@@ -28,6 +28,8 @@ DOCTEST_MODULES = (
     "stickslip.models.params",
     "stickslip.models.presets",
     "stickslip.run.driver",
+    "stickslip.run.options",
+    "stickslip.run.loop",
     "stickslip.run.outputs",
     "stickslip.run.rundir",
     "stickslip.run.block",

@@ -13,8 +13,9 @@ from stickslip.cli._common import run_options_from_args
 from stickslip.kernels import layout
 from stickslip.models.params import ChainParams, ParameterError
 from stickslip.models.presets import chain_params
-from stickslip.run.driver import NonFiniteState, RunOptions, Stepper, initial_state, run_chain
-from stickslip.run.loop import NEVER, CheckedAdvance, ChunkTuning, Hook, Loop, _par, _scratch, run_loop
+from stickslip.run import Hook, Loop, RunOptions, resume_chain, run_chain
+from stickslip.run.driver import Interrupted, NonFiniteState, Stepper, initial_state, load_run
+from stickslip.run.loop import NEVER, CheckedAdvance, ChunkTuning, _par, _scratch, run_loop
 from stickslip.run.outputs import _Outputs
 
 # The final state of the chain of N = 10 blocks run to t = 2e4 (ChainRun's docstring example).
@@ -38,16 +39,34 @@ def test_options_given_as_run_options_are_the_keywords_run():
     assert by_options.options == RunOptions(t_end=2e4, **fields)
 
 
-def test_run_options_refused_twice_or_with_another_end():
+def test_keywords_replace_the_fields_of_run_options_and_bad_ones_are_refused():
     p = chain_params(N=4)
-    with pytest.raises(ParameterError, match="not both"):
-        run_chain(p, 10.0, options=RunOptions(), sample_interval=5.0)
+    run = run_chain(p, 10.0, options=RunOptions(sample_interval=2.0, integrator="dense"), sample_interval=5.0)
+    assert run.options == RunOptions(t_end=10.0, sample_interval=5.0, integrator="dense")
+    assert list(run.samples["t"].values) == [0.0, 5.0, 10.0]
     with pytest.raises(ParameterError, match="differs"):
         run_chain(p, 10.0, options=RunOptions(t_end=20.0))
     with pytest.raises(TypeError, match="sample_every"):
         run_chain(p, 10.0, sample_every=5)
     with pytest.raises(ParameterError, match="t_end must be given"):
         RunOptions().validated(0.005)
+    with pytest.raises(ParameterError, match="integrator must be one of exact, dense"):
+        run_chain(p, 10.0, integrator="euler")
+    with pytest.raises(ParameterError, match="checkpoint_interval"):
+        run_chain(p, 10.0, options=RunOptions(checkpoint_interval=0.0))
+    with pytest.raises(ParameterError, match="hooks must be Hook instances"):
+        run_chain(p, 10.0, hooks=[print])
+
+
+def test_a_run_keeps_what_it_recorded_not_how_it_ran(tmp_path):
+    """A ChainRun's options, fresh or read back from its run directory, are what the run recorded
+    and its integrator; where it wrote, its progress and its hooks are not kept."""
+    p = chain_params(N=4)
+    how = RunOptions(integrator="dense", out_dir=tmp_path / "run", progress=False, hooks=[Hook()], run_id=None)
+    run = run_chain(p, 10.0, options=how, sample_interval=2.5)
+    assert run.options == RunOptions(t_end=10.0, sample_interval=2.5, integrator="dense")
+    assert load_run(tmp_path / "run").options == run.options
+    assert run.summary["integrator"] == "dense"
 
 
 class _Stops(Hook):
@@ -77,6 +96,61 @@ def test_hooks_stop_the_kernel_where_they_ask_and_change_no_bit():
     assert {0, 1234, 5678, 5679, 10000} <= set(stops.seen)
     assert state.step == 10000
     assert state.sha256() == run_chain(p, 50.0).state.sha256()
+
+
+class _Every(Hook):
+    """A caller's hook: the kernel stops at the multiples of ``every`` steps, and x, v, theta are
+    kept there; an ``end`` step ends the run."""
+
+    def __init__(self, every, end=None):
+        self.every, self.end, self.kept, self.closed = every, end, {}, 0
+
+    def stop_at(self, n):
+        return (n // self.every + 1) * self.every
+
+    def at(self, loop, n):
+        if n % self.every == 0:
+            s = loop.state
+            self.kept[n] = (s.x.copy(), s.v.copy(), s.th.copy(), s.mov.copy())
+        return n == self.end
+
+    def close(self):
+        self.closed += 1
+
+
+def _same_bits(kept, state):
+    now = (state.x, state.v, state.th, state.mov)
+    return all(a[1:-1].tobytes() == b[1:-1].tobytes() for a, b in zip(kept, now, strict=True))
+
+
+@pytest.mark.parametrize("integrator", ["exact", "dense"])
+def test_a_callers_hook_acts_at_its_steps_on_the_state_of_a_run_that_ends_there(integrator):
+    """A hook given as RunOptions(hooks=...) acts at each multiple of 1234 steps (off L's grid of
+    2000) and there sees, bit for bit, the final state of a run to that time; the run itself ends
+    on the bits of a run without it, and the hook is closed once."""
+    p = chain_params(N=10)
+    hook = _Every(1234)
+    run = run_chain(p, 50.0, options=RunOptions(integrator=integrator, hooks=[hook]))
+    assert sorted(hook.kept) == [0, 1234, 2468, 3702, 4936, 6170, 7404, 8638, 9872]
+    for n in (1234, 6170, 9872):
+        assert _same_bits(hook.kept[n], run_chain(p, n * p.dt, integrator=integrator).state), n
+    assert run.summary["state_sha256"] == run_chain(p, 50.0).summary["state_sha256"]
+    assert hook.closed == 1
+
+
+def test_a_hook_ends_a_run_and_serves_a_resumed_one(tmp_path):
+    """A hook's True ends the run at its step; resume_chain serves a hook given to it from the
+    checkpoint's step on, and ends where an uninterrupted run ends."""
+    p = chain_params(N=10)
+    early = run_chain(p, 50.0, hooks=[_Every(1000, end=3000)])
+    assert early.steps == 3000 and early.state.sha256() == run_chain(p, 15.0).state.sha256()
+    asked = iter([False, True])
+    with pytest.raises(Interrupted):
+        run_chain(p, 2e4, out_dir=tmp_path / "r", stop_requested=lambda: next(asked, True))
+    hook = _Every(500_000)
+    resumed = resume_chain(tmp_path / "r", hooks=[hook])
+    assert min(hook.kept) > 0 and sorted(hook.kept) == list(range(min(hook.kept), 4_000_001, 500_000))
+    assert resumed.summary["state_sha256"].startswith(SHA_N10_2E4)
 
 
 @pytest.mark.parametrize("integrator", ["dense", "exact"])
@@ -116,3 +190,34 @@ def test_command_line_run_options_are_run_options_fields(capsys):
         assert flag in help_text
     assert "--profile-min-blocks M" in help_text and "--until-steady TOL" in help_text
     assert "--sample-moving" not in help_text
+
+
+def test_command_line_run_control_options_are_run_options_fields(capsys, monkeypatch):
+    """--integrator, --out, --checkpoint-interval, --keep-checkpoint and --no-progress are made
+    from RunOptions' fields too: the parsed options are the fields, and --help gives each the
+    help its field carries."""
+    import dataclasses
+
+    parser = build_parser()
+    control = ["--integrator", "dense", "--out", "d", "--checkpoint-interval", "5", "--keep-checkpoint"]
+    options = run_options_from_args(parser.parse_args(["chain", *control, "--no-progress"]), 100.0)
+    expected = dict(integrator="dense", out_dir="d", checkpoint_interval=5.0, keep_checkpoint=True, progress=False)
+    assert options == RunOptions(t_end=100.0, **expected)
+    assert run_options_from_args(parser.parse_args(["chain"]), 100.0) == RunOptions(t_end=100.0)
+    with pytest.raises(SystemExit):
+        parser.parse_args(["chain", "--integrator", "euler"])
+    assert "invalid choice: 'euler'" in capsys.readouterr().err
+    monkeypatch.setenv("COLUMNS", "1000")  # one line per option: no help text broken across lines
+    with pytest.raises(SystemExit):
+        build_parser().parse_args(["chain", "--help"])
+    help_text = " ".join(capsys.readouterr().out.split())
+    spelled = {
+        "integrator": "--integrator {exact,dense}",
+        "out_dir": "--out DIR",
+        "checkpoint_interval": "--checkpoint-interval SECONDS",
+        "keep_checkpoint": "--keep-checkpoint",
+        "progress": "--no-progress",
+    }
+    fields = {f.name: f for f in dataclasses.fields(RunOptions)}
+    for name, flag in spelled.items():
+        assert f"{flag} {fields[name].metadata['cli']['help']}" in help_text, name

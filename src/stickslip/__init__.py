@@ -32,6 +32,8 @@ from stickslip.models.params import BlockParams, ChainParams, ParameterError  # 
 #: Names loaded on first use, and the module that holds each.
 _LAZY = {
     "run_chain": "stickslip.run.driver",
+    "RunOptions": "stickslip.run.options",
+    "Hook": "stickslip.run.loop",
     "chain_params": "stickslip.models.presets",
     "largest_lyapunov": "stickslip.analysis.lyapunov",
     "resume_chain": "stickslip.run.driver",

@@ -253,43 +253,58 @@ def add_param_options(
             )
 
 
-def _run_option_fields():
-    """The fields of :class:`~stickslip.run.outputs.RunOptions` with a command-line option, and their metadata."""
-    from stickslip.run.outputs import RunOptions
+def _run_option_fields(control: bool | None = None):
+    """The fields of :class:`~stickslip.run.options.RunOptions` with a command-line option, and
+    their metadata (``control``: only those that say how a run runs, or only the others)."""
+    from stickslip.run.options import RunOptions
 
-    return [(f, f.metadata["cli"]) for f in dataclasses.fields(RunOptions) if "cli" in f.metadata]
+    return [
+        (f, f.metadata["cli"])
+        for f in dataclasses.fields(RunOptions)
+        if "cli" in f.metadata and (control is None or f.metadata["control"] == control)
+    ]
+
+
+def _run_option_dest(cli: dict[str, Any]) -> str:
+    return cli["option"].replace("-", "_")
 
 
 def add_run_options(parser: argparse.ArgumentParser) -> None:
-    """One option per field of :class:`~stickslip.run.outputs.RunOptions` that names one (its
-    metadata ``cli``: spelling, metavar, help; integer, repeatable), default None (the field's
-    default then applies: :func:`run_options_from_args`)."""
+    """One option per field of :class:`~stickslip.run.options.RunOptions` that names one (its
+    metadata ``cli``: spelling, metavar, help; a number, an integer, text, a choice, a flag or
+    repeatable), default None (the field's default then applies: :func:`run_options_from_args`)."""
     for _, cli in _run_option_fields():
-        convert = (int_arg if cli.get("integer") else float_arg)(cli["option"], cli.get("allowed", ""))
-        parser.add_argument(
-            f"--{cli['option']}",
-            type=convert,
-            default=None,
-            metavar=cli["metavar"],
-            help=cli["help"],
-            **({"action": "append"} if cli.get("append") else {}),
-        )
+        kwargs: dict[str, Any] = {"default": None, "help": cli["help"]}
+        if "flag" in cli:
+            kwargs["action"] = "store_true"
+        elif "choices" in cli:
+            kwargs["choices"] = cli["choices"]
+        else:
+            kwargs["metavar"] = cli["metavar"]
+            if not cli.get("text"):
+                kwargs["type"] = (int_arg if cli.get("integer") else float_arg)(cli["option"], cli.get("allowed", ""))
+            if cli.get("append"):
+                kwargs["action"] = "append"
+        parser.add_argument(f"--{cli['option']}", dest=_run_option_dest(cli), **kwargs)
 
 
-def run_option_dests() -> tuple[str, ...]:
-    """The names :func:`add_run_options` gives its options in the parsed arguments."""
-    return tuple(cli["option"].replace("-", "_") for _, cli in _run_option_fields())
+def run_option_dests(control: bool | None = False) -> tuple[str, ...]:
+    """The names :func:`add_run_options` gives its options in the parsed arguments (by default
+    those of what a run records and its integrator: the options a checkpoint fixes)."""
+    return tuple(_run_option_dest(cli) for _, cli in _run_option_fields(control))
 
 
 def run_options_from_args(args: argparse.Namespace, t_end: float):
-    """The :class:`~stickslip.run.outputs.RunOptions` of the options :func:`add_run_options`
+    """The :class:`~stickslip.run.options.RunOptions` of the options :func:`add_run_options`
     added (the field's default where one is not given), with ``t_end``; not yet validated."""
-    from stickslip.run.outputs import RunOptions
+    from stickslip.run.options import RunOptions
 
     values: dict[str, Any] = {}
     for f, cli in _run_option_fields():
-        value = getattr(args, cli["option"].replace("-", "_"), None)
-        if value is not None:
+        value = getattr(args, _run_option_dest(cli), None)
+        if value is not None and "flag" in cli:
+            values[f.name] = cli["flag"] if value else f.default
+        elif value is not None:
             values[f.name] = tuple(value) if cli.get("append") else value
     return RunOptions(t_end=t_end, **values)
 

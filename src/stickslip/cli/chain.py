@@ -4,6 +4,7 @@ located integrator's dense against its fast form)."""
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import sys
 from pathlib import Path
 
@@ -39,35 +40,14 @@ def register(sub) -> None:
     )
     _add_run_options(p)
     _add_from_option(p)
-    p.add_argument(
-        "--integrator",
-        choices=("exact", "dense"),
-        default=None,
-        help="exact (default, fast) or dense (reference); both give the same answer bit for bit",
-    )
-    p.add_argument("--out", metavar="DIR", help="run directory: results, checkpoints, run.json")
     p.add_argument("--resume", metavar="DIR", help="continue the run in DIR from its checkpoint")
-    p.add_argument(
-        "--checkpoint-interval",
-        type=float_arg("checkpoint-interval", "> 0"),
-        default=None,
-        metavar="SECONDS",
-        help="wall-clock seconds between checkpoints (default 300; needs --out)",
-    )
     p.add_argument(
         "--overwrite",
         action="store_true",
         help="replace this package's files in --out (other files there are left alone)",
     )
-    p.add_argument(
-        "--keep-checkpoint",
-        action="store_true",
-        default=None,
-        help="keep the checkpoint (tens of MB for long chains) when the run finishes, so that "
-        "--resume can continue it to a later --t-end (default: removed)",
-    )
+    # What the run records, its integrator, --out, checkpoints, progress: RunOptions' fields.
     add_run_options(p)
-    p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     add_json_option(p)
     p.set_defaults(handler=run_chain_command)
 
@@ -213,7 +193,7 @@ def _json_summary(summary: dict, out: Path | None) -> dict:
     return data
 
 
-_FIXED_BY_CHECKPOINT = ("from_dir", "integrator", "start", "perturbation", "seed", *run_option_dests())
+_FIXED_BY_CHECKPOINT = ("from_dir", "start", "perturbation", "seed", *run_option_dests())
 
 
 def run_chain_command(args: argparse.Namespace) -> Result:
@@ -308,20 +288,23 @@ def run_chain_command(args: argparse.Namespace) -> Result:
             raise CommandError(f"{out} already holds a finished run; choose another --out or give --overwrite")
     try:
         with owned_out_dir(out, own, "stickslip chain", overwrite=args.overwrite, run_id=True) as out:
-            run = chain.run_chain(
-                params,
-                t_end,
-                start=args.start if from_state is None else from_state,
-                options=options,
-                integrator=args.integrator,
-                perturbation=args.perturbation,
-                seed=args.seed,
+            # The command's own defaults: a progress bar on any terminal, checkpoints every
+            # `interval` and on signals where it writes, into the folder it owns.
+            options = dataclasses.replace(
+                options,
                 out_dir=out,
                 checkpoint_interval=interval if out else None,
                 progress=progress,
                 handle_signals=out is not None,
                 run_id=read_run_id(out) if out else None,
-                keep_checkpoint=bool(args.keep_checkpoint),
+            )
+            run = chain.run_chain(
+                params,
+                t_end,
+                start=args.start if from_state is None else from_state,
+                perturbation=args.perturbation,
+                seed=args.seed,
+                options=options,
             )
     except chain.ChainRunError as exc:
         sys.stderr.write(f"stickslip chain: error: {exc}\n")

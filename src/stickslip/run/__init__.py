@@ -6,4 +6,32 @@ output buffers and results
 (:mod:`~stickslip.run.outputs`), checkpoints (:mod:`~stickslip.run.checkpoint`) and run
 directories (:mod:`~stickslip.run.rundir`); :mod:`~stickslip.run.block` runs the single block;
 :mod:`~stickslip.run.bench` times the chain's integrators.
+
+Public here: :func:`~stickslip.run.driver.run_chain` and :func:`~stickslip.run.driver.resume_chain`,
+their options (:class:`~stickslip.run.options.RunOptions`), and the hooks a caller adds to a
+run's loop (:class:`~stickslip.run.loop.Hook`, which sees a :class:`~stickslip.run.loop.Loop`).
 """
+
+from importlib import import_module
+
+#: Names loaded on first use (the loop loads the compiled kernels), and the module of each; no
+#: ``__all__``, so that the reference documents each once, in its own module.
+_LAZY = {
+    "run_chain": "stickslip.run.driver",
+    "resume_chain": "stickslip.run.driver",
+    "RunOptions": "stickslip.run.options",
+    "Hook": "stickslip.run.loop",
+    "Loop": "stickslip.run.loop",
+}
+
+
+def __getattr__(name: str):
+    if name in _LAZY:
+        value = getattr(import_module(_LAZY[name]), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'stickslip.run' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_LAZY))

@@ -19,7 +19,8 @@ bit for bit where an uninterrupted run does.
 This module sets a run up, with the hooks its options ask for, and finishes it; the loop, its
 hooks and the checked kernel call shared with :class:`Stepper` are :mod:`stickslip.run.loop`. It
 also names the rest of the chain-run API, which lives beside it: the state
-(:mod:`stickslip.run.state`), the options, buffers and results (:mod:`stickslip.run.outputs`), the checkpoint files
+(:mod:`stickslip.run.state`), the options (:mod:`stickslip.run.options`), buffers and results
+(:mod:`stickslip.run.outputs`), the checkpoint files
 (:mod:`stickslip.run.checkpoint`), the run directories (:mod:`stickslip.run.rundir`) and the
 errors (:mod:`stickslip.run.errors`).
 """
@@ -29,7 +30,7 @@ from __future__ import annotations
 import dataclasses
 import time
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -58,7 +59,8 @@ from stickslip.run.loop import (  # _Kernel named here too, for tests that count
     _scratch,
     run_loop,
 )
-from stickslip.run.outputs import EVENT_COLUMNS, ChainRun, RunOptions, _assemble, _Outputs
+from stickslip.run.options import INTEGRATORS, RunOptions
+from stickslip.run.outputs import EVENT_COLUMNS, ChainRun, _assemble, _Outputs
 from stickslip.run.progress import Progress, SignalFlag, show_progress
 from stickslip.run.rundir import load_run, read_run_id, write_run
 from stickslip.run.state import STARTS, ChainState, initial_state, loading_warnings, steady_deviation
@@ -85,10 +87,8 @@ __all__ = [
     "STARTS",
 ]
 
-INTEGRATORS = ("exact", "dense")
-
-# The fields of RunOptions that run_chain also takes as keywords (its signature before RunOptions).
-_RECORDING = tuple(f.name for f in dataclasses.fields(RunOptions) if f.name != "t_end")
+# The fields of RunOptions that run_chain also takes as keywords.
+_FIELDS = tuple(f.name for f in dataclasses.fields(RunOptions) if f.name != "t_end")
 
 
 def run_chain(
@@ -96,18 +96,10 @@ def run_chain(
     t_end: float,
     *,
     start: str | ChainState = "paper",
-    options: RunOptions | None = None,
-    integrator: str = "exact",
     perturbation: float = 0.0,
     seed: int = 0,
-    out_dir: str | Path | None = None,
-    checkpoint_interval: float | None = None,
-    progress: bool | None = None,
-    handle_signals: bool = False,
-    run_id: str | None = None,
-    keep_checkpoint: bool = False,
-    stop_requested: Callable[[], bool] | None = None,
-    **recording: Any,
+    options: RunOptions | None = None,
+    **overrides: Any,
 ) -> ChainRun:
     """Integrate the chain of eq. (4), or a relative, from ``start`` to ``t_end`` (docs/model.md, "Chain").
 
@@ -122,28 +114,22 @@ def run_chain(
         ``paper``: x = 0, v = 0.1, theta = 0.1, all moving; ``steady``: exact steady sliding
         (perturbed uniformly in [-A, A] with ``perturbation`` A and ``seed``); ``rest``: every
         block stuck at x_i = -A u_i (Carlson-Langer's); or the state of another run.
+    perturbation : float
+        The size A of the draw of ``steady`` and ``rest``.
+    seed : int
+        The seed of that draw.
     options : RunOptions, optional
-        What the run records and when it stops early: the sampling interval of L (Fig. 5b), the
-        start of <L>'s average, snapshot times (Fig. 5a), the profile window (Fig. 6),
-        ``until_steady`` and ``sample_moving`` (:class:`~stickslip.run.outputs.RunOptions`; its
-        ``t_end`` is this ``t_end``). Its fields may be given as keywords instead
-        (``sample_interval=5.0``, ``snapshot_times=[...]``, ...), not both.
-    integrator : {'exact', 'dense'}
-        ``exact`` (fast) or ``dense`` (the reference); the same result bit for bit.
-    perturbation, seed : float, int
-        The draw of ``steady`` and ``rest``.
-    out_dir : str or Path, optional
-        A run directory, owned as ``stickslip chain --out`` owns it (locked; foreign files and an
-        earlier run refused): checkpoints every ``checkpoint_interval`` wall-clock seconds and on
-        SIGINT/SIGTERM (``handle_signals``), the results at the end. Without it nothing is
-        written; :meth:`ChainRun.save` writes the same folder afterwards.
-    progress : bool, optional
-        Show a progress bar: ``None`` (default) where the session is interactive (a Jupyter
-        notebook, the interpreter on a terminal), ``True`` on any terminal, ``False`` never.
-    run_id, keep_checkpoint, stop_requested
-        The run directory's id in every checkpoint; keep the checkpoint at the end (to continue
-        to a later t_end with :func:`resume_chain`); a callable asked between chunks of about
-        a quarter second whether to stop as a signal does (checkpoint, then :class:`Interrupted`).
+        What the run records, when it stops early and how it runs
+        (:class:`~stickslip.run.options.RunOptions`; its ``t_end`` is this ``t_end``): the
+        sampling interval of L (Fig. 5b), the start of <L>'s average, snapshot times (Fig. 5a),
+        the profile window (Fig. 6), ``until_steady``, ``sample_moving``; the integrator
+        (``exact`` or ``dense``, the same bits), the run directory ``out_dir`` with its
+        checkpoints, the progress bar, signals, ``stop_requested`` and the caller's own
+        ``hooks`` (:class:`~stickslip.run.loop.Hook`).
+    **overrides
+        Fields of :class:`~stickslip.run.options.RunOptions` by name (``integrator="dense"``,
+        ``sample_interval=5.0``, ``out_dir=...``): they replace those of ``options`` (or of the
+        defaults).
 
     Returns
     -------
@@ -163,11 +149,7 @@ def run_chain(
     (65, 65, 4000000)
     """
     check_chain_params(params)
-    if integrator not in INTEGRATORS:
-        raise ParameterError(f"integrator must be one of {', '.join(INTEGRATORS)} (got {integrator!r})")
-    options = _options(options, recording, float(check_number("t_end", t_end, low=0.0, low_open=True)), params.dt)
-    if checkpoint_interval is not None:
-        check_number("checkpoint_interval", checkpoint_interval, low=0.0, low_open=True)
+    options = _options(options, overrides, float(check_number("t_end", t_end, low=0.0, low_open=True)), params.dt)
     check_number("perturbation", perturbation, low=0.0)
     if isinstance(start, ChainState):
         check_start_state(start, params, t_end=options.t_end)
@@ -180,45 +162,34 @@ def run_chain(
             warnings.warn(message, ShortRunWarning, stacklevel=2)
     state.ist[layout.NEXT_SAMPLE] = state.step
     outputs = _Outputs(params.N, options.profile_window is not None)
-    with rundir.run_dir_for_run(out_dir, run_id) as run_id:  # owned as the command owns its --out
-        return _drive(
-            params,
-            options,
-            integrator,
-            start_info,
-            state,
-            outputs,
-            run_id=run_id,
-            out_dir=out_dir,
-            checkpointer=Checkpointer(Path(out_dir)) if out_dir else None,
-            checkpoint_interval=checkpoint_interval,
-            progress=progress,
-            handle_signals=handle_signals,
-            wall_before=0.0,
-            keep_checkpoint=keep_checkpoint,
-            stop_requested=stop_requested,
-        )
+    out_dir = options.out_dir
+    with rundir.run_dir_for_run(out_dir, options.run_id) as run_id:  # owned as the command owns its --out
+        options = dataclasses.replace(options, run_id=run_id)
+        checkpointer = Checkpointer(Path(out_dir)) if out_dir else None
+        return _drive(params, options, start_info, state, outputs, checkpointer=checkpointer, wall_before=0.0)
 
 
-def _options(options: RunOptions | None, recording: dict[str, Any], t_end: float, dt: float) -> RunOptions:
-    """The run's options: ``options`` or the keywords of its fields, with ``t_end``, checked."""
-    unknown = sorted(set(recording) - set(_RECORDING))
+def _options(options: RunOptions | None, overrides: dict[str, Any], t_end: float, dt: float) -> RunOptions:
+    """The run's options: ``options`` (or the defaults) with the fields in ``overrides`` replaced
+    and ``t_end``, checked."""
+    unknown = sorted(set(overrides) - set(_FIELDS))
     if unknown:
         raise TypeError(f"run_chain() got an unexpected keyword argument {unknown[0]!r}")
-    if options is None:
-        options = RunOptions(**recording)
-    elif recording:
-        raise ParameterError(
-            f"give the run options as options=RunOptions(...) or as keywords, not both (got {', '.join(recording)})"
-        )
+    options = RunOptions() if options is None else options
     if options.t_end is not None and options.t_end != t_end:
         raise ParameterError(f"options.t_end {options.t_end:g} differs from t_end {t_end:g}; give one")
+    options = dataclasses.replace(options, **overrides)
+    hooks = tuple(options.hooks)
+    for hook in hooks:
+        if not isinstance(hook, Hook):
+            raise ParameterError(f"hooks must be Hook instances (stickslip.run.Hook; got {type(hook).__name__})")
     return dataclasses.replace(
         options,
         t_end=t_end,
         snapshot_times=tuple(float(t) for t in options.snapshot_times),
         profile_min_blocks=int(options.profile_min_blocks),
         sample_moving=bool(options.sample_moving),
+        hooks=hooks,
     ).validated(dt)
 
 
@@ -232,6 +203,7 @@ def resume_chain(
     expect_params: ChainParams | None = None,
     keep_checkpoint: bool | None = None,
     stop_requested: Callable[[], bool] | None = None,
+    hooks: Sequence[Hook] = (),
 ) -> ChainRun:
     """Continue the run in ``run_dir`` from its checkpoint to its t_end (or a later ``t_end``),
     ending bit for bit where an uninterrupted :func:`run_chain` ends.
@@ -242,8 +214,16 @@ def resume_chain(
         The run directory of an interrupted run (or one kept with ``keep_checkpoint``).
     t_end : float, optional
         A later end time than the run's own.
-    checkpoint_interval, progress, handle_signals, stop_requested
-        As for :func:`run_chain`.
+    checkpoint_interval : float, optional
+        Wall-clock seconds between checkpoints (:class:`~stickslip.run.options.RunOptions`).
+    progress : bool, optional
+        The progress bar, as for :func:`run_chain`.
+    handle_signals : bool
+        Stop on SIGINT/SIGTERM: checkpoint, then :class:`Interrupted`.
+    stop_requested : callable, optional
+        Asked after each kernel call whether to stop as a signal does.
+    hooks : sequence of Hook
+        The caller's own concerns of the run loop (:class:`~stickslip.run.loop.Hook`).
     expect_params : ChainParams, optional
         Refuse a checkpoint made with other parameters.
     keep_checkpoint : bool, optional
@@ -265,10 +245,7 @@ def resume_chain(
     state, header, parts = ckpt.load()
     try:
         params = ChainParams(**header["params"])
-        options = RunOptions.from_dict(header["options"]).validated(params.dt)
-        integrator = header["integrator"]
-        if integrator not in INTEGRATORS:
-            raise ParameterError(f"integrator must be one of {', '.join(INTEGRATORS)} (got {integrator!r})")
+        options = RunOptions.from_dict(header["options"], header["integrator"]).validated(params.dt)
     except (KeyError, TypeError, ValueError, AttributeError) as exc:
         raise ChainRunError(f"checkpoint in {run_dir} has an unusable header ({exc})") from None
     run_id = header.get("run_id")
@@ -286,30 +263,30 @@ def resume_chain(
         t_end = float(check_number("t_end", t_end, low=0.0))
         if steps_for(t_end, params.dt) < state.step:
             raise ParameterError(f"t_end must be >= the checkpoint's time {state.step * params.dt:g} (got {t_end:g})")
-        options = RunOptions(**{**options.__dict__, "t_end": t_end})
-    outputs = _Outputs(params.N, options.profile_window is not None)
-    outputs.parts = parts
-    ckpt.since = {k: len(v) for k, v in parts.items()}
+        options = dataclasses.replace(options, t_end=t_end)
     if keep_checkpoint is None:
         keep_checkpoint = header.get("keep_checkpoint") is True
-    with rundir.run_dir_for_resume(run_dir):  # locked as chain --resume locks it
-        return _drive(
-            params,
-            options,
-            integrator,
-            header["start"],
-            state,
-            outputs,
-            run_id=run_id,
+    options = _options(
+        options,
+        dict(
             out_dir=run_dir,
-            checkpointer=ckpt,
             checkpoint_interval=checkpoint_interval,
             progress=progress,
             handle_signals=handle_signals,
-            wall_before=float(header.get("wall_seconds", 0.0)),
+            run_id=run_id,
             keep_checkpoint=keep_checkpoint,
             stop_requested=stop_requested,
-        )
+            hooks=hooks,
+        ),
+        options.t_end,
+        params.dt,
+    )
+    outputs = _Outputs(params.N, options.profile_window is not None)
+    outputs.parts = parts
+    ckpt.since = {k: len(v) for k, v in parts.items()}
+    with rundir.run_dir_for_resume(run_dir):  # locked as chain --resume locks it
+        wall_before = float(header.get("wall_seconds", 0.0))
+        return _drive(params, options, header["start"], state, outputs, checkpointer=ckpt, wall_before=wall_before)
 
 
 def continue_or_run(
@@ -350,26 +327,9 @@ def continue_or_run(
         )
 
 
-def _drive(
-    params,
-    options,
-    integrator,
-    start_info,
-    state,
-    outputs,
-    *,
-    out_dir,
-    checkpointer,
-    checkpoint_interval,
-    progress,
-    handle_signals,
-    wall_before,
-    run_id=None,
-    keep_checkpoint=False,
-    stop_requested=None,
-) -> ChainRun:
-    """The run loop (:func:`stickslip.run.loop.run_loop`) with the hooks ``options`` asks for,
-    then the results, written into ``out_dir`` if given."""
+def _drive(params, options, start_info, state, outputs, *, checkpointer, wall_before) -> ChainRun:
+    """The run loop (:func:`stickslip.run.loop.run_loop`) with the hooks ``options`` asks for and
+    the caller's own, then the results, written into ``options.out_dir`` if given."""
     n_end = steps_for(options.t_end, params.dt)
     sample_every = int(round(options.sample_interval / params.dt))
     profile_every = int(round(options.profile_window / params.dt)) if options.profile_window else 0
@@ -383,6 +343,7 @@ def _drive(
     outputs.moving_from_kernel = options.sample_moving and on_l_grid and last_moving == last_sample
     stop_all_moving = options.until_steady is not None and on_l_grid
     ints = (sample_every, profile_every, options.profile_min_blocks, int(stop_all_moving))
+    integrator, out_dir, progress = options.integrator, options.out_dir, options.progress
     advance = CheckedAdvance(integrator, params, state, _scratch(params.N), _par(params), outputs, ints)
     header = {
         "params": params.to_dict(),
@@ -390,9 +351,9 @@ def _drive(
         "integrator": integrator,
         "start": start_info,
     }
-    if run_id is not None:
-        header["run_id"] = run_id
-    if keep_checkpoint:
+    if options.run_id is not None:
+        header["run_id"] = options.run_id
+    if options.keep_checkpoint:
         header["keep_checkpoint"] = True
     hooks: list[Hook] = []
     if options.snapshot_times:
@@ -404,19 +365,19 @@ def _drive(
         hooks.append(SteadyStop(options.until_steady, sample_every, kernel_stops=stop_all_moving))
     # From Python (progress None) the bar waits a second, so that a short run shows none.
     bar = Progress(options.t_end, show_progress(progress), delay=1.0 if progress is None else 0.0)
-    hooks += [ChunkTuning(), ProgressHook(bar)]
+    hooks += [*options.hooks, ChunkTuning(), ProgressHook(bar)]
     t0 = time.perf_counter()
     if out_dir is not None:
         Path(out_dir).mkdir(parents=True, exist_ok=True)
     loop = Loop(params, state, outputs, n_end)
-    with SignalFlag(handle_signals) as flag:
-        hooks.append(StopRequests(flag, stop_requested))
+    with SignalFlag(options.handle_signals) as flag:
+        hooks.append(StopRequests(flag, options.stop_requested))
         if checkpointer is not None:
-            hooks.append(Checkpoints(checkpointer, checkpoint_interval, header, wall_before, t0))
+            hooks.append(Checkpoints(checkpointer, options.checkpoint_interval, header, wall_before, t0))
         run_loop(loop, advance, hooks, checkpointer.state_path if checkpointer else None)
     outputs.flush(state.ist)
     wall = wall_before + time.perf_counter() - t0
-    run = _assemble(params, options, integrator, start_info, state, outputs, wall, loop.steady_at)
+    run = _assemble(params, options.recorded(), integrator, start_info, state, outputs, wall, loop.steady_at)
     run.summary["wall_seconds_this_run"] = wall - wall_before  # wall_seconds counts every part of a resumed run
     if run.summary["event_in_progress"]:  # the unfinished event began after the last finished one
         run.summary["in_progress_since"] = float(run.events["t_end"].max()) if len(run.events) else 0.0
@@ -426,7 +387,7 @@ def _drive(
         if checkpointer is not None:
             checkpointer.write(state, outputs, dict(header, wall_seconds=wall))
         write_run(run, out_dir)
-        if not keep_checkpoint:
+        if not options.keep_checkpoint:
             drop_checkpoint(out_dir)
     return run
 

@@ -127,8 +127,25 @@ class CheckedAdvance:
 
 
 class Loop:
-    """What the hooks of one run see: the state, its outputs and the end step; a hook ends the
-    run by returning True from :meth:`Hook.at` or asks it to stop (``stopping``)."""
+    """What the hooks of one run of the chain of eq. (4) see (:class:`Hook`).
+
+    Attributes
+    ----------
+    params : ChainParams
+        The run's model and parameters (``params.dt``: the step).
+    state : ChainState
+        The state, at step ``state.step`` (t = step dt). A hook reads it and never changes it:
+        it is the run's own state, and a changed bit changes the run.
+    outputs : object
+        The run's output buffers (the hooks of :mod:`stickslip.run.loop` add to them).
+    n_end : int
+        The step the run ends at.
+    stopping : bool
+        Set by a hook's :meth:`Hook.after` to stop the run as a signal does (checkpoint, then
+        :class:`~stickslip.run.errors.Interrupted`).
+    steady_at : dict
+        Where the steady stop ended the run (``t_steady``, ``deviation``), else empty.
+    """
 
     def __init__(self, params: ChainParams, state: ChainState, outputs, n_end: int):
         self.params = params
@@ -140,10 +157,54 @@ class Loop:
 
 
 class Hook:
-    """One concern of the run loop. ``stop_at(n)``: the next step after ``n`` at which it needs
-    the kernel to stop (:data:`NEVER` if none); ``at(loop, n)``: act at step ``n`` before the
-    next call (True ends the run there); ``after(loop, status, elapsed, now)``: act after each
-    call, given its status and wall-clock seconds; ``close()``: at the end, however it ends."""
+    """One concern of the run loop of the chain of eq. (4): a base class for the caller's own,
+    given to :func:`~stickslip.run.driver.run_chain` as ``hooks=[...]`` (a field of
+    :class:`~stickslip.run.options.RunOptions`) or to :func:`~stickslip.run.driver.resume_chain`.
+
+    The loop calls the kernel to the nearest step any hook asks for, and between calls serves
+    every hook. The contract, each method optional:
+
+    * ``stop_at(n)``: the next step after ``n`` at which this hook needs the kernel to stop
+      (:attr:`NEVER` if none). The kernel stops at every step asked for that is not after the
+      run's end.
+    * ``at(loop, n)``: act at step ``n`` (``loop.state.step``), before the next call. It is
+      called at the run's first step, at every step any hook asked for, at the last step, and
+      wherever else the kernel stopped (its buffers filled), so a hook checks ``n`` itself.
+      True ends the run there (a short run, as ``until_steady`` ends one).
+    * ``after(loop, status, elapsed, now)``: act after each kernel call, given its status,
+      its wall-clock seconds and the clock (:func:`time.perf_counter`); setting
+      ``loop.stopping`` stops the run as a signal does.
+    * ``close()``: release what the hook holds, once, however the run ends.
+
+    A hook reads ``loop.state`` and ``loop.params`` (:class:`Loop`) and never changes the state;
+    where the kernel stops decides only when the hooks act, never what it computes, so a hook
+    changes no bit of a run.
+
+    Attributes
+    ----------
+    NEVER : int
+        What :meth:`stop_at` returns for no stop (the largest int64).
+
+    Examples
+    --------
+    >>> import stickslip
+    >>> from stickslip.run import Hook
+    >>> class EveryThousand(Hook):
+    ...     def __init__(self):
+    ...         self.steps = []
+    ...     def stop_at(self, n):
+    ...         return (n // 1000 + 1) * 1000
+    ...     def at(self, loop, n):
+    ...         if n % 1000 == 0:
+    ...             self.steps.append(n)
+    ...         return False
+    >>> hook = EveryThousand()
+    >>> run = stickslip.run_chain(stickslip.chain_params(N=10), 20.0, start="steady", hooks=[hook])
+    >>> hook.steps
+    [0, 1000, 2000, 3000, 4000]
+    """
+
+    NEVER = NEVER
 
     def stop_at(self, n: int) -> int:
         """The next step after ``n`` at which the kernel must stop for this hook."""

@@ -1,4 +1,5 @@
-"""What a chain run (eq. 4) records and returns: :class:`RunOptions`, :class:`ChainRun`, the output buffers.
+"""What a chain run (eq. 4) returns: :class:`ChainRun`, and the output buffers (what a run records
+is asked for by :class:`~stickslip.run.options.RunOptions`, also importable from here).
 
 The kernels fill fixed-size buffers (:class:`_Outputs`) that are flushed into Python-side parts;
 :func:`_assemble` turns the parts into the event table (docs/model.md, "Slip events"), the first moves
@@ -8,7 +9,7 @@ The kernels fill fixed-size buffers (:class:`_Outputs`) that are flushed into Py
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -18,109 +19,9 @@ import xarray as xr
 
 from stickslip.kernels import layout
 from stickslip.models import physics
-from stickslip.models.params import MAX_STEPS, ChainParams, ParameterError, check_number, steps_for
+from stickslip.models.params import ChainParams, steps_for
+from stickslip.run.options import RunOptions
 from stickslip.run.state import ChainState
-
-
-def _option(default: Any, option: str, metavar: str, help: str, **more: Any):
-    """A field of :class:`RunOptions` with its command-line option (``stickslip chain --OPTION``):
-    name, metavar and help, and ``integer``, ``allowed`` (the range named when the text is no
-    number) and ``append`` (repeatable) where they apply."""
-    return field(default=default, metadata={"cli": {"option": option, "metavar": metavar, "help": help, **more}})
-
-
-@dataclass(frozen=True)
-class RunOptions:
-    """What a run records besides its state, and when it stops early. Times are in the model's
-    time units.
-
-    t_end: the end time (given to :func:`~stickslip.run.driver.run_chain` as its own argument,
-    which fills it in here);
-    sample_interval: L = x_1 - x_N is sampled every this long (Fig. 5b);
-    average_from: <L> is the mean of the samples with t >= average_from (default t_end / 2);
-    snapshot_times: times at which all x_i are stored (Fig. 5a); the final state is always kept;
-    profile_window: if set, x_i is stored every this long during each event, for the
-    displacement over windows of Fig. 6, for events with >= profile_min_blocks moved blocks;
-    until_steady: if set, the run stops at the first sampling time at which every block slides
-    and the state is within this tolerance of steady sliding (:func:`steady_deviation`);
-    sample_moving: if set, the number of moving blocks is sampled at the multiples of
-    sample_interval (``samples["n_moving"]`` over ``t_moving``: the fraction of time with some
-    block stuck); these are the times of L for a run that starts on one.
-
-    Each field but ``t_end`` and ``sample_moving`` is an option of ``stickslip chain`` (its
-    metadata ``cli``: spelling, metavar and help), from which the command line is built.
-    """
-
-    t_end: float | None = None
-    sample_interval: float = _option(
-        10.0, "sample-interval", "T", "sample L = x_1 - x_N every T time units (default 10)"
-    )
-    average_from: float | None = _option(
-        None, "average-from", "T", "<L> averages the samples with t >= T (default t_end / 2)"
-    )
-    snapshot_times: tuple[float, ...] = _option(
-        (), "snapshot", "T", "store all x_i at time T (repeatable; Fig. 5a)", append=True
-    )
-    profile_window: float | None = _option(
-        None, "profile-window", "W", "store the displacement over windows of W during events (Fig. 6 uses 20)"
-    )
-    profile_min_blocks: int = _option(
-        0,
-        "profile-min-blocks",
-        "M",
-        "keep profiles only of events with at least M moved blocks",
-        integer=True,
-        allowed=">= 0",
-    )
-    until_steady: float | None = _option(
-        None,
-        "until-steady",
-        "TOL",
-        "stop once every block slides within TOL of steady sliding (velocities, state "
-        "variables, spring extensions); L is taken from the steady solution from then on",
-    )
-    sample_moving: bool = False
-
-    def validated(self, dt: float) -> RunOptions:
-        """Check every option against the time step (ranges in docs/limits.md); returns self."""
-        if self.t_end is None:
-            raise ParameterError("t_end must be given (run_chain's own argument)")
-        steps_for(self.t_end, dt)
-        longest = MAX_STEPS * dt
-        check_number("sample_interval", self.sample_interval, low=0.0, low_open=True, high=longest)
-        if round(self.sample_interval / dt) < 1:
-            raise ParameterError(f"sample_interval must be >= dt = {dt:g} (got {self.sample_interval!r})")
-        if self.average_from is not None:
-            check_number("average_from", self.average_from, low=0.0, high=self.t_end)
-        for t in self.snapshot_times:
-            check_number("snapshot time", t, low=0.0, high=self.t_end)
-        if self.profile_window is not None:
-            check_number("profile_window", self.profile_window, low=0.0, low_open=True, high=longest)
-            if round(self.profile_window / dt) < 1:
-                raise ParameterError(f"profile_window must be >= dt = {dt:g} (got {self.profile_window!r})")
-        check_number("profile_min_blocks", self.profile_min_blocks, low=0, integer=True)
-        if self.until_steady is not None:
-            check_number("until_steady", self.until_steady, low=0.0, low_open=True)
-        return self
-
-    def to_dict(self) -> dict[str, Any]:
-        return {
-            "t_end": self.t_end,
-            "sample_interval": self.sample_interval,
-            "average_from": self.average_from,
-            "snapshot_times": list(self.snapshot_times),
-            "profile_window": self.profile_window,
-            "profile_min_blocks": self.profile_min_blocks,
-            "until_steady": self.until_steady,
-            "sample_moving": bool(self.sample_moving),
-        }
-
-    @classmethod
-    def from_dict(cls, d: dict[str, Any]) -> RunOptions:
-        d = dict(d)
-        d["snapshot_times"] = tuple(d.get("snapshot_times", ()))
-        return cls(**d)
-
 
 EVENT_COLUMNS = [
     "event",
@@ -150,7 +51,8 @@ class ChainRun:
     params : ChainParams
         The model and its parameters.
     options : RunOptions
-        What the run recorded (t_end, sampling interval, snapshot times, profile window).
+        What the run recorded (t_end, sampling interval, snapshot times, profile window) and its
+        integrator (:meth:`RunOptions.recorded`: not where it was written, nor its hooks).
     integrator : str
         ``'exact'`` or ``'dense'`` (the same result bit for bit).
     start : dict

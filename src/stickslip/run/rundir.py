@@ -18,7 +18,8 @@ import xarray as xr
 
 from stickslip.kernels import layout
 from stickslip.models.params import ChainParams
-from stickslip.run.outputs import ChainRun, RunOptions
+from stickslip.run.options import RunOptions
+from stickslip.run.outputs import ChainRun
 
 # The directory's files and its ownership, named here as before they had modules of their own.
 from stickslip.run.ownership import (  # noqa: F401
@@ -127,7 +128,7 @@ def _load_run(run_dir: Path) -> ChainRun:
     )
     return ChainRun(
         params,
-        RunOptions.from_dict(meta["options"]),
+        RunOptions.from_dict(meta["options"], meta["integrator"]),
         meta["integrator"],
         meta["start"],
         state,
