@@ -104,29 +104,27 @@ def test_transition_bracket():
 
 
 def test_quick_specs_cover_the_brief():
-    t = study("transition", "quick")
-    assert sorted({p["N"] for p in t.points}) == [49, 99, 199]
-    betas = sorted({p["beta"] for p in t.points})
-    assert betas[0] <= 0.6 and betas[-1] >= 1.4 and max(np.diff([b for b in betas if 0.9 <= b <= 1.1])) <= 0.05 + 1e-9
-    assert all(p["t_end"] >= 2.5 * p["N"] * (p["N"] - 1) / (2 * 10 * 0.001) for p in t.points)
-    f = study("transition", "full")
-    assert sorted({p["N"] for p in f.points}) == [49, 99, 199, 399, 799]
     ph = study("phase-diagram", "quick")
     assert {p["start"] for p in ph.points} == {"paper", "steady"} and {p["N"] for p in ph.points} == {99}
+    assert {(p["alpha"], p["D"]) for p in ph.points} >= {(0.5, 5.0), (1.5, 5.0), (1.0, 0.5), (1.0, 50.0)}
+    assert all(p["t_end"] >= 2.5 * 99 * 98 / (2 * 10 * 0.001) for p in ph.points)
     ex = study("exponents", "quick")
     assert {p["model"] for p in ex.points} == {"sakaguchi", "carlson-langer"}
     # the key ignores the point list, so adding a point keeps the directory
-    assert Study("transition", "tiny", t.common, t.points[:2]).key() == Study("transition", "tiny", t.common).key()
+    assert Study("phase-diagram", "quick", ph.common, ph.points[:2]).key() == ph.key()
 
 
 # --- a tiny study end to end -----------------------------------------------------------------
 
 
 def _tiny(points=None) -> Study:
-    common = dict(study("transition", "tiny").common)
+    common = dict(study("phase-diagram", "tiny").common)
     common["n_samples"] = 400
-    points = points or [{"N": 5, "beta": 0.8, "t_end": 3000.0}, {"N": 5, "beta": 1.4, "t_end": 3000.0}]
-    return Study("transition", "tiny", common, tuple(points))
+    points = points or [
+        {"N": 5, "alpha": 1.0, "D": 5.0, "beta": 0.8, "t_end": 3000.0, "start": "paper"},
+        {"N": 5, "alpha": 1.0, "D": 5.0, "beta": 1.4, "t_end": 3000.0, "start": "paper"},
+    ]
+    return Study("phase-diagram", "tiny", common, tuple(points))
 
 
 def _science(rows) -> pd.DataFrame:
@@ -162,9 +160,9 @@ def test_tiny_study_end_to_end(tmp_path, cluster):
         assert all(key in r for r in rows)
     assert {r["final_state"] for r in rows} <= {"steady", "stick-slip", "undecided"}
     page = Path(first["page"])
-    assert page.is_file() and "order parameter" in page.read_text().lower()
-    table = pd.read_parquet(tmp_path / "transition" / "table.parquet")
-    assert len(table) == 2 and (tmp_path / "transition" / "order_parameter.png").is_file()
+    assert page.is_file() and "phase-diagram" in page.read_text().lower()
+    table = pd.read_parquet(tmp_path / "phase-diagram" / "table.parquet")
+    assert len(table) == 2 and (tmp_path / "phase-diagram" / "phase_alpha_beta.png").is_file()
     json.dumps(first, allow_nan=True)
     # a second call reuses every point and gives the same table
     second = run_study(_tiny(), tmp_path, scheduler=cluster, progress=False)
@@ -174,7 +172,8 @@ def test_tiny_study_end_to_end(tmp_path, cluster):
 
 def test_failed_point_is_reported_and_retried_alone(tmp_path, cluster):
     # K = 1e6 passes the checks made up front but makes Heun blow up: the run raises on its worker
-    points = [{"N": 5, "beta": 0.8, "t_end": 2000.0}, {"N": 5, "beta": 1.4, "t_end": 2000.0, "K": 1e6}]
+    cell = {"N": 5, "alpha": 1.0, "D": 5.0, "t_end": 2000.0, "start": "paper"}
+    points = [{**cell, "beta": 0.8}, {**cell, "beta": 1.4, "K": 1e6}]
     first = run_study(_tiny(points), tmp_path, scheduler=cluster, progress=False)
     assert first["failed"] == 1 and first["run"] == 2
     assert "non-finite" in first["failed_points"][0]["error"]

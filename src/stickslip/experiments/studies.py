@@ -8,9 +8,8 @@ that run, carried out on a Dask worker by :func:`study_point_task` through
 :func:`stickslip.experiments.sweep.run_sweep`: finished points are reused, failed ones are
 recorded and retried by the next call, interrupted runs continue from their checkpoints.
 
-* ``transition``: the order parameter m = 1 - <L>/L_ss against beta for several N (section 3,
-  Fig. 5b as a phase transition), its error bar, the fraction of time with some block stuck, the
-  event rate, the largest event and the final state.
+* ``transition``: run by continuation in beta (:mod:`stickslip.experiments.transition_study`),
+  not by points of this module.
 * ``phase-diagram``: final state and m over (alpha, beta) and over (D, beta) at N = 99, each
   point started from the paper's start and from perturbed steady sliding (hysteresis).
 * ``exponents``: the slip-size exponent tau (Figs. 7, 8) against beta, and for Carlson-Langer.
@@ -108,42 +107,6 @@ def _t_end(N: int, loads: float) -> float:
 
 # ---------------------------------------------------------------------------------------------
 # The spec sets
-
-_T_BETAS_QUICK = (0.6, 0.7, 0.8, 0.9, 0.95, 0.975, 1.0, 1.025, 1.05, 1.1, 1.2, 1.4)
-_T_BETAS_FULL = tuple(sorted({round(0.6 + 0.05 * k, 3) for k in range(17)} | {0.975, 0.99, 1.01, 1.025}))
-
-
-def _transition(mode: str) -> Study:
-    if mode == "tiny":
-        Ns, betas, loads = (9,), (0.8, 1.2), 2.5
-    elif mode == "quick":
-        Ns, betas, loads = (49, 99, 199), _T_BETAS_QUICK, 2.5
-    else:
-        Ns, betas, loads = (49, 99, 199, 399, 799), _T_BETAS_FULL, 4.0
-    # Longest runs first, for a shorter tail on a few workers: large N, then large beta (runs
-    # that slide update every block at every step until they settle; stick-slip is cheap).
-    points = [
-        {"N": N, "beta": b, "t_end": _t_end(N, loads)}
-        for N in sorted(Ns, reverse=True)
-        for b in sorted(betas, reverse=True)
-    ]
-    common = {
-        **_PAPER,
-        "model": "sakaguchi",
-        "start": "paper",
-        "loads": loads,
-        "average_fraction": 0.5,
-        "n_samples": 20000 if mode != "tiny" else 2000,
-        "until_steady": UNTIL_STEADY,
-        "analysis": "order",
-    }
-    return Study(
-        "transition",
-        mode,
-        common,
-        tuple(points),
-        note=f"{mode}: N in {list(Ns)}, {len(betas)} values of beta, runs of {loads:g} loading times",
-    )
 
 
 def _phase_diagram(mode: str) -> Study:
@@ -260,7 +223,7 @@ def _chaos(mode: str) -> Study:
     )
 
 
-_BUILDERS = {"transition": _transition, "phase-diagram": _phase_diagram, "exponents": _exponents, "chaos": _chaos}
+_BUILDERS = {"phase-diagram": _phase_diagram, "exponents": _exponents, "chaos": _chaos}
 
 
 def study(name: str, mode: str = "quick") -> Study:

@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from stickslip.analysis.order import power_law_fit, transition_bracket
+from stickslip.analysis.order import transition_bracket
 from stickslip.experiments.studies import Study, study_command
 from stickslip.models.presets import PRESETS, is_paper
 
@@ -32,99 +32,7 @@ def conclusions(spec: Study, table: pd.DataFrame) -> dict[str, Any]:
     """Findings of a study from the rows of its finished points."""
     if not len(table):
         return {"statements": ["no finished points"]}
-    return {"transition": _transition, "phase-diagram": _phase, "exponents": _exponents, "chaos": _chaos}[spec.name](
-        table
-    )
-
-
-def _transition(table: pd.DataFrame) -> dict[str, Any]:
-    out: dict[str, Any] = {"per_N": {}, "statements": []}
-    say = out["statements"].append
-    undecided = table[table["final_state"] == "undecided"]
-    if len(undecided):
-        say(
-            "Undecided points (still changing at the end, not averaged as settled): "
-            + ", ".join(f"N = {r.N}, beta = {r.beta:g}" for r in undecided.itertuples())
-            + "."
-        )
-    for N, g in sorted(table.groupby("N"), key=lambda x: x[0]):
-        g = g.sort_values("beta")
-        br = transition_bracket(g["beta"], g["final_state"])
-        below = g[(g["beta"] < 1.0) & (g["final_state"] == "stick-slip")]
-        fit = power_law_fit(
-            1.0 - below["beta"].to_numpy(float),
-            below["order_parameter"].to_numpy(float),
-            below["order_parameter_err"].to_numpy(float),
-        )
-        above = g[g["beta"] > 1.0]
-        not_steady = above[above["final_state"] != "steady"]
-        jump = math.nan
-        if math.isfinite(br["lo"]) and math.isfinite(br["hi"]):
-            m_lo = float(g.loc[g["beta"] == br["lo"], "order_parameter"].iloc[0])
-            m_hi = float(g.loc[g["beta"] == br["hi"], "order_parameter"].iloc[0])
-            jump = m_lo - m_hi
-        m_max = float(g["order_parameter"].max())
-        stuck_above = float(above["stuck_fraction"].mean()) if len(above) else math.nan
-        out["per_N"][int(N)] = {
-            **br,
-            "fit": fit,
-            "jump": jump,
-            "m_max": m_max,
-            "betas_above_1_not_steady": not_steady["beta"].tolist(),
-            "mean_stuck_fraction_above_1": stuck_above,
-        }
-        if math.isfinite(br["estimate"]):
-            where = (
-                f"between beta = {br['lo']:g} (last stick-slip) and {br['hi']:g} (first steady): "
-                f"beta_t = {br['estimate']:.3g} +- {br['uncertainty']:.2g}"
-            )
-        elif math.isfinite(br["lo"]):
-            where = f"above beta = {br['lo']:g}: every point up to the largest beta still stick-slips or is undecided"
-        else:
-            where = "not bracketed: no point ends in stick-slip"
-        if br["undecided"]:
-            where += f" (undecided inside the bracket: {br['undecided']})"
-        say(f"N = {N}: transition {where}.")
-        if math.isfinite(jump):
-            kind = (
-                "small against the range of m, consistent with a continuous transition at this resolution"
-                if abs(jump) < 0.25 * max(m_max, 1e-12)
-                else "a visible jump"
-            )
-            say(f"N = {N}: m falls by {_g(jump)} across the bracket (max m = {_g(m_max)}): {kind}.")
-        if math.isfinite(fit["b"]):
-            say(
-                f"N = {N}: m ~ (1 - beta)^b for beta < 1 with b = {fit['b']:.2f} +- {fit['b_err']:.2f} "
-                f"({fit['n']} points)."
-            )
-    pn = out["per_N"]
-    Ns = sorted(pn)
-    if len(Ns) > 1:
-        counts = ", ".join(
-            f"N = {N}: {len(pn[N]['betas_above_1_not_steady'])} of "
-            f"{int((table[(table['N'] == N)]['beta'] > 1).sum())} "
-            f"(stuck fraction {_g(pn[N]['mean_stuck_fraction_above_1'])})"
-            for N in Ns
-        )
-        n_not = [len(pn[N]["betas_above_1_not_steady"]) for N in Ns]
-        trend = "shrinks" if n_not[-1] < n_not[0] else "grows" if n_not[-1] > n_not[0] else "does not change"
-        say(
-            f"Points above beta = 1 not in steady sliding at the end ({counts}): with N the stick-slip region "
-            f"above beta = 1 {trend} at these run lengths (runs of the same number of loading times)."
-        )
-        bs = [pn[N]["fit"]["b"] for N in Ns if math.isfinite(pn[N]["fit"]["b"])]
-        if len(bs) > 1:
-            errs = [pn[N]["fit"]["b_err"] for N in Ns if math.isfinite(pn[N]["fit"]["b"])]
-            agree = max(bs) - min(bs) <= 2 * math.hypot(max(errs), max(errs))
-            say(
-                f"Collapse: exponents b = {', '.join(f'{b:.2f}' for b in bs)} "
-                + (
-                    "agree within errors: m(1 - beta) needs no N-dependent rescaling."
-                    if agree
-                    else "differ: no simple collapse of m against 1 - beta."
-                )
-            )
-    return out
+    return {"phase-diagram": _phase, "exponents": _exponents, "chaos": _chaos}[spec.name](table)
 
 
 def _phase(table: pd.DataFrame) -> dict[str, Any]:
@@ -214,33 +122,7 @@ def draw(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[dict[str, Any
     figs: list[tuple[str, Any, str]] = []
     if not len(table):
         return []
-    if spec.name == "transition":
-        fits = {int(N): conclusions(spec, table)["per_N"][int(N)]["fit"] for N in table["N"].unique()}
-        figs.append(
-            (
-                "order_parameter",
-                pl.order_parameter_figure(table),
-                "Order parameter m = 1 - <L>/L_ss against beta for each N (second half of each run; "
-                "batch-means error bars; large open circles: undecided).",
-            )
-        )
-        if table["t_steady"].notna().any():
-            figs.append(
-                (
-                    "steady_time",
-                    pl.steady_time_figure(table),
-                    "Time to reach steady sliding (every block within 1e-6 of it), in loading times, "
-                    "where it was reached.",
-                )
-            )
-        figs.append(
-            (
-                "collapse",
-                pl.collapse_figure(table, fits),
-                "m against 1 - beta (log-log) for the stick-slip points below beta = 1, with power-law fits.",
-            )
-        )
-    elif spec.name == "phase-diagram":
+    if spec.name == "phase-diagram":
         figs.append(
             (
                 "phase_alpha_beta",

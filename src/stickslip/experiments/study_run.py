@@ -32,21 +32,6 @@ __all__ = ["run_study", "study_command", "TABLE_COLUMNS"]
 
 #: The leading columns of each study's table (the rest follow).
 TABLE_COLUMNS = {
-    "transition": [
-        "N",
-        "beta",
-        "order_parameter",
-        "order_parameter_err",
-        "final_state",
-        "stuck_fraction",
-        "event_rate",
-        "S_max",
-        "max_blocks",
-        "t_steady",
-        "tau_int",
-        "err_reliable",
-        "t_end",
-    ],
     "phase-diagram": [
         "N",
         "alpha",
