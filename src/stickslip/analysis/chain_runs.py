@@ -25,6 +25,10 @@ from stickslip.models.params import ChainParams
 from stickslip.models.physics import chain_steady_length
 from stickslip.run.state import steady_deviation
 
+#: Tolerance of steady sliding (largest deviation of v, theta and the springs from it) where the
+#: studies and the reproduction stop a chain run or call its final state steady.
+UNTIL_STEADY = 1e-6
+
 # choose_s_min lives in stickslip.analysis.statistics; the name is kept importable from here.
 __all__ = [
     "stationary_from",
@@ -159,7 +163,7 @@ def final_state(summary: dict[str, Any], state, params: ChainParams, tolerance: 
 
     Steady sliding: the run stopped there (``until_steady``), or its final state is within
     ``tolerance`` of it (:func:`stickslip.run.state.steady_deviation`; ``stickslip reproduce``
-    uses :data:`stickslip.experiments.specs.UNTIL_STEADY`), which for beta > 1 it never leaves.
+    uses :data:`UNTIL_STEADY`), which for beta > 1 it never leaves.
     Otherwise stick-slip if events happened in the averaged second half or some block is stopped
     at the end.
 
@@ -404,7 +408,7 @@ def chain_analysis(outcome) -> dict[str, Any]:
     Parameters
     ----------
     outcome : Outcome
-        The :class:`~stickslip.experiments.specs.Outcome` of a ``chain_runs`` experiment: its
+        The :class:`~stickslip.outcome.Outcome` of a ``chain_runs`` experiment: its
         options name the sweep's N, the figures' N and their run length.
 
     Returns

@@ -32,15 +32,15 @@ from typing import Any
 import numpy as np
 
 from stickslip import io
+from stickslip.analysis.chain_runs import UNTIL_STEADY
 from stickslip.experiments.cache import canonical
 from stickslip.jsonable import to_jsonable
+from stickslip.models.presets import paper_parameters
 
-__all__ = ["ladder_task", "run_rung", "perturbed", "ladder_rows", "UNTIL_STEADY", "DIRECTIONS"]
+__all__ = ["ladder_task", "run_rung", "perturbed", "ladder_rows", "DIRECTIONS"]
 
-#: Tolerance of steady sliding (largest deviation of v, theta, springs), as in the studies.
-UNTIL_STEADY = 1e-6
 DIRECTIONS = ("up", "down")
-_PAPER = {"K": 10.0, "D": 5.0, "V": 0.001, "Fs": 3.0, "alpha": 1.0, "dt": 0.005}
+_PAPER = paper_parameters("N", "beta")
 
 
 def params_at(cfg: dict[str, Any], beta: float):

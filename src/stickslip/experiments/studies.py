@@ -33,9 +33,10 @@ from typing import Any
 import numpy as np
 
 from stickslip import __version__
+from stickslip.analysis.chain_runs import UNTIL_STEADY
 from stickslip.experiments.cache import canonical, spec_key
 from stickslip.experiments.chaos_verdict import chaos_points
-from stickslip.models.presets import PRESETS, is_paper
+from stickslip.models.presets import PRESETS, is_paper, paper_parameters
 
 __all__ = [
     "Study",
@@ -52,10 +53,7 @@ __all__ = [
 STUDIES = ("transition", "phase-diagram", "exponents", "chaos")
 #: ``tiny`` runs every study on chains of a few blocks in seconds (tests); its numbers mean nothing.
 MODES = ("quick", "full", "tiny")
-#: Tolerance of the stop at steady sliding (largest deviation of v, theta, springs).
-UNTIL_STEADY = 1e-6
-
-_PAPER = {"K": 10.0, "D": 5.0, "V": 0.001, "Fs": 3.0, "alpha": 1.0, "dt": 0.005}
+_PAPER = paper_parameters("N", "beta")
 
 
 @dataclass(frozen=True)

@@ -23,11 +23,12 @@ __all__ = ["paper_start_m", "paper_start_check", "longer_check", "rung_start_sta
 def paper_start_m(N: int, beta: float, loads: float = 4.0) -> dict[str, Any]:
     """m and its batch-means error over the second half of a run of ``loads`` loading times of the
     chain of eq. (4) from the paper's start (the estimator of the point-by-point study)."""
-    from stickslip.experiments.studies import _PAPER, _t_end, order_summary
+    from stickslip.analysis.chain_runs import UNTIL_STEADY
+    from stickslip.experiments.studies import _t_end, order_summary
     from stickslip.models.presets import chain_params
     from stickslip.run.driver import run_chain
 
-    p = chain_params("sakaguchi", N=N, beta=beta, **_PAPER)
+    p = chain_params("sakaguchi", N=N, beta=beta)
     t_end = _t_end(N, loads)
     run = run_chain(
         p,
@@ -36,7 +37,7 @@ def paper_start_m(N: int, beta: float, loads: float = 4.0) -> dict[str, Any]:
         sample_interval=t_end / 20000,
         average_from=0.5 * t_end,
         sample_moving=True,
-        until_steady=1e-6,
+        until_steady=UNTIL_STEADY,
     )
     s = order_summary(run, p, 0.5 * t_end)
     return {

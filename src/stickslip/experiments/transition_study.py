@@ -38,6 +38,7 @@ from stickslip.experiments.ladders import params_at
 from stickslip.experiments.study_run import PAGE_FILES, record_outputs
 from stickslip.experiments.transition_page import PER_N_COLUMNS, ROW_COLUMNS, write_page
 from stickslip.models.params import check_number
+from stickslip.models.presets import paper_parameters
 
 __all__ = [
     "ladder_points",
@@ -55,7 +56,6 @@ LADDER_NS = {"tiny": (9,), "quick": (49, 99, 199), "full": (49, 99, 199, 399, 79
 #: random event near beta_t (at N = 99 five seeds gave beta_t from 1.11 to 1.20), so beta_t and
 #: the step are means over replicas with the spread between them as their error.
 REPLICAS = {"tiny": 2, "quick": 4, "full": 4}
-_PAPER = {"K": 10.0, "D": 5.0, "V": 0.001, "Fs": 3.0, "alpha": 1.0, "dt": 0.005}
 
 
 def _cap_loads(N: int) -> float:
@@ -91,7 +91,7 @@ def ladder_points(mode: str, extra_Ns: tuple[int, ...] = ()) -> tuple[dict[str, 
     up ladder of the largest chain is the longest task: it sets the wall time on a few workers)."""
     Ns = tuple(sorted(set(LADDER_NS[mode]) | set(int(n) for n in extra_Ns)))
     common = {
-        **_PAPER,
+        **paper_parameters("N", "beta"),
         "model": "sakaguchi",
         "target": 0.006,
         "segment_loads": 0.25,
