@@ -25,7 +25,8 @@ from stickslip.analysis.order import (
     order_parameter,
     transition_bracket,
 )
-from stickslip.experiments.studies import Study, point_params, study
+from stickslip.experiments.studies import Study, study
+from stickslip.experiments.studies.chain_point import point_params
 from stickslip.experiments.study_run import run_study
 
 
@@ -238,12 +239,12 @@ def test_an_interrupted_study_stops_its_running_ladder(tmp_path):
     # the quick transition starts with its dearest ladder, N = 199 up: minutes of work
     argv = ["study", "transition", "--quick", "--workers", "1", "--out", str(out), "--no-progress"]
     status, stdout, stderr = signal_when_running(
-        argv, lambda: bool(list(out.glob("runs/*/ladders/*/point.json"))), signal.SIGTERM, settle=3.0
+        argv, lambda: bool(list(out.glob("runs/*/points/*/point.json"))), signal.SIGTERM, settle=3.0
     )
     assert status == 130, stderr
     assert stdout == ""
     assert len(stderr.splitlines()) == 1 and "interrupted" in stderr, stderr
-    (ladder,) = [p.parent for p in out.glob("runs/*/ladders/*/point.json")]
+    (ladder,) = [p.parent for p in out.glob("runs/*/points/*/point.json")]
     assert "direction=up_N=199" in ladder.name
     assert not (ladder / "error.json").exists() and not (ladder / "done.json").exists()
     assert not (ladder.parent / STOP_FILE).exists()
@@ -384,7 +385,7 @@ def test_chaos_findings_state_verdicts_thresholds_and_fits():
     """The findings from rows alone: the verdict of each point with its text, delta* per kind
     from the per-window columns, and the slope of log10 delta* on log10 N (by hand: the points
     (1, -3), (1, -5), (2, -4), (2, -6) have slope -1 with standard error sqrt(2))."""
-    from stickslip.experiments.study_findings import conclusions
+    from stickslip.experiments.studies.chaos import conclusions
 
     nan = float("nan")
 
@@ -473,3 +474,32 @@ def test_bad_study_input_is_one_line_and_exit_2(tmp_path):
         assert len(error_lines(proc.stderr)) == 1, (argv, proc.stderr)
         assert proc.stdout == ""
     assert not (tmp_path / "o").exists()  # refused before the output folder is made
+
+
+# --- per-study help ----------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("name", "says"),
+    [
+        ("transition", ["continuation in beta", "N in [49, 99, 199]", "15 ladders", "loops and scaling"]),
+        ("phase-diagram", ["(alpha, beta)", "35 cells", "70 runs", "phase_alpha_beta"]),
+        ("exponents", ["slip-size exponent tau", "N = 199", "6 runs", "tau_beta"]),
+        ("chaos", ["delta*", "N = 49, 99, 199", "11 points", "decorrelation.csv"]),
+    ],
+)
+def test_each_study_has_its_own_help(name, says, capsys):
+    """`stickslip study NAME --help` is the study's own text: what it measures, its grid and
+    size in --quick (35 cells of the phase diagram, two starts each: docs/studies/phase-diagram.md),
+    its cost and its outputs; only the transition takes --extra-n."""
+    from stickslip.cli import main
+
+    with pytest.raises(SystemExit) as stop:
+        main(["study", name, "--help"])
+    assert stop.value.code == 0
+    text = " ".join(capsys.readouterr().out.split())
+    assert f"usage: stickslip study {name}" in text
+    for words in says:
+        assert words in text, words
+    assert "minutes on two cores" in text and "index.html" in text
+    assert ("--extra-n" in text) == (name == "transition")

@@ -24,6 +24,7 @@ rungs and continues with the first unfinished one.
 from __future__ import annotations
 
 import math
+import re
 import time
 from io import BytesIO
 from pathlib import Path
@@ -214,6 +215,24 @@ def _rung_settings(cfg: dict[str, Any]) -> dict[str, Any]:
 
 #: The files of a rung's folder, each recorded with its SHA-256 in rung.json.
 RUNG_FILES = ("state.npz", "samples.npz")
+
+
+def ladder_entry(path: Path, rel: str = ""):
+    """Whether an entry of a ladder's folder is the ladder's: the sweep's bookkeeping, and its
+    ``rungs`` folder, holding only rungs (``<k>-beta<b>``) of ``rung.json`` and
+    :data:`RUNG_FILES`. True or False, or for a folder the test of its entries (the walk of
+    :func:`stickslip.experiments.study_run.foreign_files`)."""
+    from stickslip.experiments.cache import BOOKKEEPING
+
+    def rung(p: Path, r: str) -> bool:
+        return p.is_file() and p.name in ("rung.json", *RUNG_FILES)
+
+    def rungs(p: Path, r: str):
+        return rung if p.is_dir() and re.fullmatch(r"\d{2,}-beta[^/]+", p.name) else False
+
+    if path.name == "rungs" and path.is_dir():
+        return rungs
+    return path.is_file() and path.name in BOOKKEEPING
 
 
 def _replay(rdir: Path, spec: dict[str, Any], params) -> tuple[dict[str, Any] | None, str | None]:

@@ -1,9 +1,9 @@
 """Checks that the transition study by continuation measures what the runs from the paper's start
-measure (:mod:`stickslip.experiments.transition_study`).
+measure (:mod:`stickslip.experiments.studies.transition`).
 
 * :func:`paper_start_check`: m = 1 - <L>/L_ss from the paper's start (x_i = 0, section 3) over the
   second half of a run of 4 loading times (the old study's estimator,
-  :func:`stickslip.experiments.studies.order_summary`) against the up ladder's m at the same
+  :func:`stickslip.experiments.studies.chain_point.order_summary`) against the up ladder's m at the same
   (N, beta): the difference in units of the combined error.
 * :func:`longer_check`: a rung run again from the same start state for ``factor`` times its
   adaptive length, without the stop rule; its m against the adaptive one.
@@ -24,12 +24,12 @@ def paper_start_m(N: int, beta: float, loads: float = 4.0) -> dict[str, Any]:
     """m and its batch-means error over the second half of a run of ``loads`` loading times of the
     chain of eq. (4) from the paper's start (the estimator of the point-by-point study)."""
     from stickslip.analysis.chain_runs import UNTIL_STEADY
-    from stickslip.experiments.studies import _t_end, order_summary
+    from stickslip.experiments.studies.chain_point import order_summary, t_end_of
     from stickslip.models.presets import chain_params
     from stickslip.run.driver import run_chain
 
     p = chain_params("sakaguchi", N=N, beta=beta)
-    t_end = _t_end(N, loads)
+    t_end = t_end_of(N, loads)
     run = run_chain(
         p,
         t_end,
