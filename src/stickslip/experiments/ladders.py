@@ -38,9 +38,8 @@ from stickslip.experiments.cache import canonical
 from stickslip.jsonable import to_jsonable
 from stickslip.models.presets import paper_parameters
 
-__all__ = ["ladder_task", "run_rung", "perturbed", "ladder_rows", "DIRECTIONS"]
+__all__ = ["ladder_task", "run_rung", "perturbed", "ladder_entry"]
 
-DIRECTIONS = ("up", "down")
 _PAPER = paper_parameters("N", "beta")
 
 
@@ -353,8 +352,3 @@ def ladder_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
         "outside": outside,
         "rows": rows,
     }
-
-
-def ladder_rows(summaries: list[dict[str, Any]]) -> list[dict[str, Any]]:
-    """The rungs of every finished ladder, one row each."""
-    return [row for s in summaries for row in s.get("rows", [])]
