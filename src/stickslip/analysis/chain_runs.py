@@ -25,10 +25,6 @@ from stickslip.models.params import ChainParams
 from stickslip.models.physics import chain_steady_length
 from stickslip.run.state import steady_deviation
 
-#: Tolerance of steady sliding (largest deviation of v, theta and the springs from it) where the
-#: studies and the reproduction stop a chain run or call its final state steady.
-UNTIL_STEADY = 1e-6
-
 # choose_s_min lives in stickslip.analysis.statistics; the name is kept importable from here.
 __all__ = [
     "stationary_from",
@@ -163,7 +159,7 @@ def final_state(summary: dict[str, Any], state, params: ChainParams, tolerance: 
 
     Steady sliding: the run stopped there (``until_steady``), or its final state is within
     ``tolerance`` of it (:func:`stickslip.run.state.steady_deviation`; ``stickslip reproduce``
-    uses :data:`UNTIL_STEADY`), which for beta > 1 it never leaves.
+    uses :data:`stickslip.models.physics.UNTIL_STEADY`), which for beta > 1 it never leaves.
     Otherwise stick-slip if events happened in the averaged second half or some block is stopped
     at the end.
 

@@ -47,12 +47,31 @@ def register(sub) -> None:
             "`stickslip study NAME --help` describes one study: its grid, its cost and its outputs."
         ),
     )
-    names = p.add_subparsers(dest="name", metavar="NAME", required=True, title="studies")
+    names = p.add_subparsers(
+        dest="name",
+        metavar="NAME",
+        required=True,
+        title="studies",
+        parser_class=type("StudyParser", (_LazyDescription, type(p)), {}),
+    )
     for name in STUDIES:
         plan = design(name)
-        q = names.add_parser(name, help=plan.summary, description=plan.describe())
+        q = names.add_parser(name, help=plan.summary)
+        q.describe = plan.describe
         _options(q, plan)
         q.set_defaults(handler=run, study_options=[o.dest for o in plan.options])
+
+
+class _LazyDescription:
+    """Mixed into a study's parser: its description (its module's text, made from the study's
+    specs in every mode: a second or so) is made only when its help is asked for."""
+
+    describe = None
+
+    def format_help(self) -> str:
+        if self.description is None and self.describe is not None:
+            self.description = self.describe()
+        return super().format_help()
 
 
 def _options(p: argparse.ArgumentParser, plan) -> None:

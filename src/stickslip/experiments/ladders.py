@@ -33,9 +33,9 @@ from typing import Any
 import numpy as np
 
 from stickslip import io
-from stickslip.analysis.chain_runs import UNTIL_STEADY
 from stickslip.experiments.cache import canonical
 from stickslip.jsonable import to_jsonable
+from stickslip.models.physics import UNTIL_STEADY
 from stickslip.models.presets import paper_parameters
 
 __all__ = ["ladder_task", "run_rung", "perturbed", "ladder_entry"]

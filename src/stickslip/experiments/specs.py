@@ -32,8 +32,8 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from stickslip import __version__
-from stickslip.analysis.chain_runs import UNTIL_STEADY
 from stickslip.experiments.cache import canonical, spec_key
+from stickslip.models.physics import UNTIL_STEADY
 from stickslip.models.presets import block_params, paper_parameters
 
 __all__ = [

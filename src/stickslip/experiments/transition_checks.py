@@ -23,8 +23,8 @@ __all__ = ["paper_start_m", "paper_start_check", "longer_check", "rung_start_sta
 def paper_start_m(N: int, beta: float, loads: float = 4.0) -> dict[str, Any]:
     """m and its batch-means error over the second half of a run of ``loads`` loading times of the
     chain of eq. (4) from the paper's start (the estimator of the point-by-point study)."""
-    from stickslip.analysis.chain_runs import UNTIL_STEADY
     from stickslip.experiments.studies.chain_point import order_summary, t_end_of
+    from stickslip.models.physics import UNTIL_STEADY
     from stickslip.models.presets import chain_params
     from stickslip.run.driver import run_chain
 

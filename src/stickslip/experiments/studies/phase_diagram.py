@@ -15,10 +15,9 @@ from typing import Any
 
 import pandas as pd
 
-from stickslip.analysis.chain_runs import UNTIL_STEADY
-from stickslip.analysis.order import transition_bracket
 from stickslip.experiments.studies import Design, Study
 from stickslip.experiments.studies.chain_point import check_point, order_task, t_end_of
+from stickslip.models.physics import UNTIL_STEADY
 from stickslip.models.presets import paper_parameters
 
 __all__ = ["DESIGN"]
@@ -74,6 +73,8 @@ def build(mode: str) -> Study:
 def findings(spec: Study, table: pd.DataFrame) -> dict[str, Any]:
     """Cells where the two starts disagree, the settled cells on the side of beta_c = alpha that
     linear stability predicts, and the bracket of the transition for each alpha and each D."""
+    from stickslip.analysis.order import transition_bracket
+
     out: dict[str, Any] = {"statements": [], "disagree": []}
     say = out["statements"].append
     n_cells = agree_lin = n_lin = 0

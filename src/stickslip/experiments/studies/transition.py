@@ -29,7 +29,6 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from stickslip.analysis.adaptive import STOP_BATCHES
 from stickslip.experiments.ladders import ladder_entry, ladder_task, params_at
 from stickslip.experiments.studies import Design, Option, Study
 from stickslip.jsonable import table_records
@@ -86,6 +85,8 @@ def _grids(N: int, mode: str) -> tuple[list[float], list[float]]:
 def ladder_points(mode: str, extra_Ns: tuple[int, ...] = ()) -> tuple[dict[str, Any], list[dict[str, Any]]]:
     """The shared settings and the ladders (one per N and direction) of a mode; large N first (the
     up ladder of the largest chain is the longest task: it sets the wall time on a few workers)."""
+    from stickslip.analysis.adaptive import STOP_BATCHES
+
     Ns = tuple(sorted(set(LADDER_NS[mode]) | set(int(n) for n in extra_Ns)))
     common = {
         **paper_parameters("N", "beta"),
