@@ -503,3 +503,20 @@ def test_each_study_has_its_own_help(name, says, capsys):
         assert words in text, words
     assert "minutes on two cores" in text and "index.html" in text
     assert ("--extra-n" in text) == (name == "transition")
+
+
+def test_sizes_summary_fits_the_events_after_the_transient_only():
+    """The exponents study's analysis of one run: the events counted are those that start at or
+    after t_from (counted here by hand); with fewer than 20 of them there is no fit, and it says why."""
+    from stickslip.analysis.chain_runs import sizes_summary
+    from stickslip.models.presets import chain_params
+    from stickslip.run.driver import run_chain
+
+    run = run_chain(chain_params("sakaguchi", N=12), 6e4)
+    starts = np.sort(run.events["t_start"].to_numpy())
+    t_from = 2e4
+    out = sizes_summary(run, t_from, bootstrap=0)
+    assert out["n_events"] == int((starts >= t_from).sum()) >= 20 and out["t_from"] == t_from
+    assert 1.0 < out["tau"] < 3.0 and out["n_fit"] <= out["n_events"] and out["spanning"] == "max_block"
+    few = sizes_summary(run, float(starts[-5]), bootstrap=0)
+    assert few["n_events"] == 5 and math.isnan(few["tau"]) and few["error_note"].startswith("only 5 events")

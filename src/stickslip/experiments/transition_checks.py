@@ -3,7 +3,7 @@ measure (:mod:`stickslip.experiments.studies.transition`).
 
 * :func:`paper_start_check`: m = 1 - <L>/L_ss from the paper's start (x_i = 0, section 3) over the
   second half of a run of 4 loading times (the old study's estimator,
-  :func:`stickslip.experiments.studies.chain_point.order_summary`) against the up ladder's m at the same
+  :func:`stickslip.analysis.order.order_summary`) against the up ladder's m at the same
   (N, beta): the difference in units of the combined error.
 * :func:`longer_check`: a rung run again from the same start state for ``factor`` times its
   adaptive length, without the stop rule; its m against the adaptive one.
@@ -23,7 +23,8 @@ __all__ = ["paper_start_m", "paper_start_check", "longer_check", "rung_start_sta
 def paper_start_m(N: int, beta: float, loads: float = 4.0) -> dict[str, Any]:
     """m and its batch-means error over the second half of a run of ``loads`` loading times of the
     chain of eq. (4) from the paper's start (the estimator of the point-by-point study)."""
-    from stickslip.experiments.studies.chain_point import order_summary, t_end_of
+    from stickslip.analysis.order import order_summary
+    from stickslip.experiments.studies.chain_point import t_end_of
     from stickslip.models.physics import UNTIL_STEADY
     from stickslip.models.presets import chain_params
     from stickslip.run.driver import run_chain

@@ -4,8 +4,9 @@ Each point is one chain run of eq. (4) (or of a relative of it, :mod:`stickslip.
 plus the analysis of that run, carried out on a Dask worker through
 :func:`stickslip.experiments.sweep.run_sweep`: finished points are reused, failed ones are
 recorded and retried by the next call, interrupted runs continue from their checkpoints.
-:func:`order_task` gives the order parameter and the final state, :func:`sizes_task` the
-slip-size exponent.
+:func:`order_task` gives the order parameter and the final state
+(:func:`stickslip.analysis.order.order_summary`), :func:`sizes_task` the slip-size exponent
+(:func:`stickslip.analysis.chain_runs.sizes_summary`).
 """
 
 from __future__ import annotations
@@ -13,8 +14,6 @@ from __future__ import annotations
 import math
 from pathlib import Path
 from typing import Any
-
-import numpy as np
 
 __all__ = ["order_task", "sizes_task", "check_point", "point_params", "loading_time", "t_end_of"]
 
@@ -93,122 +92,24 @@ def _run(point: dict[str, Any], point_dir: Path):
 
 
 def order_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
-    """One chain run and its order parameter and final state (:func:`order_summary`), a task of
-    ``run_sweep``; returns the summary stored in the point's ``done.json``."""
+    """One chain run and its order parameter and final state, a task of ``run_sweep``; returns
+    the summary stored in the point's ``done.json``."""
+    from stickslip.analysis.order import order_summary
+
     run, params, options, base = _run(point, point_dir)
     return {**base, **order_summary(run, params, options["average_from"])}
 
 
 def sizes_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
-    """One chain run and its slip-size exponent (:func:`sizes_summary`), a task of ``run_sweep``;
-    returns the summary stored in the point's ``done.json``."""
+    """One chain run and its slip-size exponent over the events after its transient, a task of
+    ``run_sweep``; returns the summary stored in the point's ``done.json``."""
+    from stickslip.analysis.chain_runs import sizes_summary
+
     run, _, _, base = _run(point, point_dir)
-    return {**base, **sizes_summary(run, point)}
-
-
-def order_summary(run, params, t_from: float) -> dict[str, Any]:
-    """The order parameter m = 1 - <L>/L_ss over t >= ``t_from`` with its batch-means error, the
-    fraction of samples with some block stuck, the event rate and largest event over the same
-    window, the time steady sliding was reached, and the final state
-    (:func:`stickslip.analysis.order.classify_final_state`)."""
-    from stickslip.analysis.order import classify_final_state, order_parameter, quarter_stats
-    from stickslip.models.physics import chain_steady_length
-
-    L_ss = chain_steady_length(params)
-    s = run.summary
-    t_end = float(run.options.t_end)
-    dt_s = float(run.options.sample_interval)
-    t = run.samples["t"].values
-    L = run.samples["L"].values
-    tm = run.samples["t_moving"].values
-    stuck = (run.samples["n_moving"].values < params.N).astype(float)
-    reached = bool(s.get("stopped_early", False))
-    if reached:
-        # steady sliding from t_steady on: L = L_ss and nothing stuck at the remaining sample times
-        t_rest = (
-            np.arange(math.floor(float(s["t_steady"]) / dt_s + 1e-9) + 1, math.floor(t_end / dt_s + 1e-9) + 1) * dt_s
-        )
-        t = np.concatenate([t[t < t_rest[0]] if t_rest.size else t, t_rest])
-        L = np.concatenate([run.samples["L"].values[: t.size - t_rest.size], np.full(t_rest.size, L_ss)])
-        tm_keep = tm < t_rest[0] if t_rest.size else np.ones(tm.size, bool)
-        tm = np.concatenate([tm[tm_keep], t_rest])
-        stuck = np.concatenate([stuck[tm_keep], np.zeros(t_rest.size)])
-    m = 1.0 - L / L_ss
-    late = t >= t_from - 1e-9
-    est = order_parameter(L[late], L_ss)
-    late_m = tm >= t_from - 1e-9
-    stuck_fraction = float(stuck[late_m].mean()) if late_m.any() else math.nan
-    q = quarter_stats(t, m, None, t_end)
-    q.update({k: v for k, v in quarter_stats(tm, np.zeros(tm.size), stuck, t_end).items() if k.startswith("stuck")})
-    state, reason = classify_final_state(
-        reached_steady=reached,
-        stuck_q3=q["stuck_q3"],
-        stuck_q4=q["stuck_q4"],
-        m_q3=q["m_q3"],
-        m_err_q3=q["m_err_q3"],
-        m_q4=q["m_q4"],
-        m_err_q4=q["m_err_q4"],
+    t_from = float(point.get("transient", point.get("average_fraction", 0.5))) * float(run.options.t_end)
+    spanning, seed, bootstrap = (
+        point.get("spanning", "max_block"),
+        int(point.get("seed", 0)),
+        int(point.get("bootstrap", 200)),
     )
-    ev = run.events[run.events["t_start"] >= t_from]
-    window = t_end - t_from
-    return {
-        "order_parameter": est.mean,
-        "order_parameter_err": est.err,
-        "order_parameter_err_tau": est.err_tau,
-        "tau_int": est.tau_int * dt_s,
-        "batch_time": est.batch * dt_s,
-        "n_batches": est.n_batches,
-        "err_reliable": est.reliable,
-        "L_mean": float(np.mean(L[late])) if late.any() else math.nan,
-        "L_steady": L_ss,
-        "stuck_fraction": stuck_fraction,
-        "event_rate": len(ev) / window if window > 0 else math.nan,
-        "n_events": int(len(ev)),
-        "S_max": float(ev["S"].max()) if len(ev) else 0.0,
-        "max_blocks": int(ev["n_blocks"].max()) if len(ev) else 0,
-        "t_steady": float(s["t_steady"]) if reached else None,
-        "final_state": state,
-        "final_reason": reason,
-        **q,
-    }
-
-
-def sizes_summary(run, cfg: dict[str, Any]) -> dict[str, Any]:
-    """Slip-size exponent tau (truncated power law below the smallest spanning event, s_min by
-    least KS distance, bootstrap error), the fitted range and the excess of great events
-    (:func:`stickslip.analysis.chain_runs.size_statistics`) over the events after the transient."""
-    from stickslip.analysis.chain_runs import size_statistics
-
-    t_end = float(run.options.t_end)
-    t_from = float(cfg.get("transient", cfg.get("average_fraction", 0.5))) * t_end
-    events = run.events[run.events["t_start"] >= t_from]
-    spanning = cfg.get("spanning", "max_block")
-    out: dict[str, Any] = {"t_from": t_from, "n_events": int(len(events)), "spanning": spanning}
-    if len(events) < 20:
-        out.update(tau=math.nan, tau_err=math.nan, error_note=f"only {len(events)} events after t = {t_from:g}")
-        return out
-    st = size_statistics(
-        events,
-        run.params.N,
-        small_only=True,
-        seed=int(cfg.get("seed", 0)),
-        spanning=spanning,
-        bootstrap=int(cfg.get("bootstrap", 200)),
-    )
-    fit = st["fit"]
-    out.update(
-        tau=fit.tau,
-        tau_err=fit.tau_err,
-        tau_err_fisher=fit.tau_err_fisher,
-        s_min=fit.s_min,
-        s_max=fit.s_max,
-        n_fit=fit.n,
-        ks_distance=fit.ks_distance,
-        n_spanning=st["n_spanning"],
-        s_span=st["s_span"],
-        S_max=st["S_max"],
-        excess=st["excess"],
-        observed=st["observed"],
-        expected=st["expected"],
-    )
-    return out
+    return {**base, **sizes_summary(run, t_from, spanning=spanning, seed=seed, bootstrap=bootstrap)}
