@@ -1,6 +1,6 @@
 """A second Ctrl-C stops a study at once (docs/limits.md, "Signals to whole process groups"): the
 driver closes its cluster without being cut short, so it neither waits for the cluster to be
-closed again at exit nor leaves its stop request (``ladders/stop-requested``) behind."""
+closed again at exit nor leaves its stop request (``points/stop-requested``) behind."""
 
 from __future__ import annotations
 
@@ -26,7 +26,7 @@ def _double_sigint(out, gap, to_group):
     send = (lambda s: os.killpg(proc.pid, s)) if to_group else proc.send_signal
     try:
         deadline = time.monotonic() + 180
-        while not list(out.glob("runs/*/ladders/*/point.json")):
+        while not list(out.glob("runs/*/points/*/point.json")):
             assert proc.poll() is None, proc.communicate()
             assert time.monotonic() < deadline, "no ladder started"
             time.sleep(0.05)
@@ -58,4 +58,4 @@ def test_a_second_ctrl_c_stops_at_once(gap, to_group, tmp_path):
     assert stdout == "" and "Traceback" not in stderr, stderr
     assert stderr.count("\n") == 1 and "interrupted" in stderr, stderr
     assert waited < 8.0, f"took {waited:.1f} s after the first Ctrl-C"
-    assert not list(out.glob("runs/*/ladders/stop-requested")), "the stop request is left behind"
+    assert not list(out.glob("runs/*/points/stop-requested")), "the stop request is left behind"

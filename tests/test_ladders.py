@@ -12,13 +12,13 @@ from scipy.signal import lfilter
 from chain_helpers import run_cli_subprocess
 from stickslip.analysis.adaptive import assess, mser_cut
 from stickslip.experiments.ladders import ladder_task, perturbed
-from stickslip.experiments.transition_study import (
+from stickslip.experiments.studies.transition import (
     PER_N_COLUMNS,
     ladder_points,
     per_n_summary,
-    run_transition,
     transition_loop,
 )
+from stickslip.experiments.study_run import run_study
 from stickslip.models.params import ParameterError
 from stickslip.models.presets import chain_params
 from stickslip.run.state import ChainState
@@ -189,38 +189,42 @@ def test_tiny_transition_study_and_its_json(tmp_path):
     first = run_cli_subprocess(*argv, timeout=300)
     assert first.returncode == 0, first.stderr
     data = json.loads(first.stdout)
-    assert (
-        data["meta"]["ladders"] == 3 and data["meta"]["workers"] == 1
-    )  # two up replicas, one down and data["meta"]["cores"] >= 1
+    assert data["points"] == 3 and data["run"] == 3  # two up replicas, one down
     row_keys = {"N", "beta", "branch", "order_parameter", "order_parameter_err", "stuck_fraction",
                 "stuck_fraction_err", "final_state", "t_end", "start"}  # fmt: skip
     assert all(row_keys <= set(r) for r in data["rows"])
     assert {r["branch"] for r in data["rows"]} == {"up", "down"}
-    assert set(PER_N_COLUMNS) <= set(data["per_N"][0])
+    assert set(PER_N_COLUMNS) <= set(data["findings"]["per_N"][0])
     assert all(r["final_reason"] for r in data["rows"] if r["final_state"] == "undecided")
     assert (out / "transition" / "loops.png").is_file() and (out / "transition" / "index.html").is_file()
     assert {r["replica"] for r in data["rows"] if r["branch"] == "up"} == {0, 1}
-    assert data["per_N"][0]["replicas"] == 2
+    assert data["findings"]["per_N"][0]["replicas"] == 2
+    assert data["findings"]["rungs"] == len(data["rows"]) and "Per N" in (out / "transition" / "index.html").read_text()
     second = json.loads(run_cli_subprocess(*argv, timeout=300).stdout)
-    assert second["meta"]["ladders_reused"] == 3 and second["rows"] == data["rows"]
+    assert second["reused"] == 3 and second["rows"] == data["rows"]
 
 
 def test_extra_n_only_for_the_transition_study(tmp_path):
     r = run_cli_subprocess("study", "chaos", "--extra-n", "1599", "--out", str(tmp_path))
-    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1
+    assert r.returncode == 2 and "unrecognized arguments: --extra-n" in r.stderr.strip().splitlines()[-1]
+    r = run_cli_subprocess("study", "transition", "--extra-n", "2", "--out", str(tmp_path))
+    assert r.returncode == 2 and r.stderr.strip().splitlines() == [
+        "stickslip study: error: extra-n must be >= 3 and <= 1e+06 (got 2)"
+    ]
+    assert not any(tmp_path.iterdir())
 
 
-def test_run_transition_resumes_a_ladder_from_its_finished_rungs(tmp_path):
+def test_the_transition_study_resumes_a_ladder_from_its_finished_rungs(tmp_path):
     """A ladder whose task was interrupted (no done.json) replays its finished rungs: the rows come
     back bit for bit and the rungs are not run again."""
-    first = run_transition(tmp_path, "tiny", n_workers=1, progress=False)
-    ladders = sorted((tmp_path / "runs").glob("*/ladders/*/done.json"))
+    first = run_study("transition", tmp_path, "tiny", n_workers=1, progress=False)
+    ladders = sorted((tmp_path / "runs").glob("*/points/*/done.json"))
     assert len(ladders) == 3
     for done in ladders:
         done.unlink()
-    stamps = {p: p.stat().st_mtime_ns for p in tmp_path.glob("runs/*/ladders/*/rungs/*/rung.json")}
-    second = run_transition(tmp_path, "tiny", n_workers=1, progress=False)
-    assert second["meta"]["ladders_run"] == 3 and second["rows"] == first["rows"]
+    stamps = {p: p.stat().st_mtime_ns for p in tmp_path.glob("runs/*/points/*/rungs/*/rung.json")}
+    second = run_study("transition", tmp_path, "tiny", n_workers=1, progress=False)
+    assert second["run"] == 3 and second["rows"] == first["rows"]
     assert {p: p.stat().st_mtime_ns for p in stamps} == stamps
 
 

@@ -34,7 +34,7 @@ DOCTEST_MODULES = (
     "stickslip.run.rundir",
     "stickslip.run.block",
     "stickslip.plotting",
-    "stickslip.experiments.transition_study",
+    "stickslip.experiments.studies.transition",
     "stickslip.experiments.sweep",
     "stickslip.analysis.adaptive",
     "stickslip.analysis.chain_runs",
@@ -89,7 +89,7 @@ def test_the_public_names_are_those_of_the_api():
     assert len(names) > 90
     for name in ("stickslip.largest_lyapunov", "stickslip.run_chain", "stickslip.plotting.sizes",
                  "stickslip.analysis.statistics.fit_power_law", "stickslip.analysis.stability.critical_stiffness",
-                 "stickslip.experiments.transition_study.transition_loop"):  # fmt: skip
+                 "stickslip.experiments.studies.transition.transition_loop"):  # fmt: skip
         assert name in names, name
 
 

@@ -10,9 +10,9 @@ import pandas as pd
 import pytest
 from matplotlib.figure import Figure
 
-from stickslip.experiments.studies import Study
+from stickslip.experiments.studies import Study, design
+from stickslip.experiments.studies.transition import PER_N_COLUMNS, ROW_COLUMNS
 from stickslip.experiments.study_run import _write_page
-from stickslip.experiments.transition_page import PER_N_COLUMNS, ROW_COLUMNS, write_page
 from stickslip.pages import cell
 from stickslip.plotting.style import save_figure
 
@@ -61,7 +61,7 @@ def study_page(tmp_path):
         "runs": "runs/x",
     }
     path = tmp_path / "index.html"
-    _write_page(path, spec, meta, {"statements": [f"beta_t {NASTY}"]}, figures, table)
+    _write_page(path, spec, design("phase-diagram"), meta, {"statements": [f"beta_t {NASTY}"]}, figures, table, table)
     return path.read_text()
 
 
@@ -92,30 +92,26 @@ def test_study_page_escapes_text(study_page):
 
 
 def test_transition_page(tmp_path):
+    """The transition's page: its per-N table before the rungs, an undecided rung marked, a rung
+    run again because its files were damaged listed."""
     row = dict.fromkeys(ROW_COLUMNS)
-    rows = [
-        {**row, "N": 40, "beta": 0.9, "final_state": "sliding", "order_parameter": 0.987654},
-        {**row, "N": 40, "beta": 1.1, "final_state": "undecided", "role": NASTY},
-    ]
+    rows = pd.DataFrame(
+        [
+            {**row, "N": 40, "beta": 0.9, "final_state": "sliding", "order_parameter": 0.987654, "note": None},
+            {**row, "N": 40, "beta": 1.1, "final_state": "undecided", "role": NASTY, "note": "samples.npz is missing"},
+        ]
+    )
     per_n = [{**dict.fromkeys(PER_N_COLUMNS), "N": 40, "beta_t": 1.0123456, "undecided": 1, "rungs": 2}]
-    meta = {
-        "mode": "tiny",
-        "command": "stickslip study transition --tiny",
-        "ladders": 1,
-        "ladders_run": 1,
-        "ladders_reused": 0,
-        "failed": 0,
-        "rungs": 2,
-        "undecided": 1,
-        "wall_seconds": 1.0,
-        "workers": 1,
-        "cores": 2,
-        "version": "9.9",
-    }
-    data = {"meta": meta, "statements": [NASTY], "figures": ["loops.png"], "per_N": per_n, "rows": rows}
+    meta = {"command": "stickslip study transition --tiny", "points": 1, "run": 1, "reused": 0, "failed": 0}
+    meta |= {"wall_seconds": 1.0, "compute_seconds": 0.5, "version": "9.9", "runs": "runs/x"}
+    points = pd.DataFrame({"point_dir": ["ladder"], "status": ["ok"], "note": [None]})
+    spec = Study("transition", "tiny", note="tiny")
+    figures = [{"name": "loops", "image": "loops.png", "pdf": "loops.pdf", "caption": "loops", "command": "c"}]
     path = tmp_path / "index.html"
-    write_page(path, data)
+    found = {"statements": [NASTY], "per_N": per_n}
+    _write_page(path, spec, design("transition"), meta, found, figures, points, rows)
     page = path.read_text()
+    assert page.index("<h2>Per N</h2>") < page.index("<h2>Table</h2>")
     per_n_cells = _cells(page, 0)
     assert per_n_cells[0][:2] == ["40", "1.012"] and per_n_cells[0][-2:] == ["1", "2"]
     rung_cells = _cells(page, 1)
@@ -123,7 +119,8 @@ def test_transition_page(tmp_path):
     assert rung_cells[0][ROW_COLUMNS.index("order_parameter")] == "0.9877"
     assert rung_cells[1][ROW_COLUMNS.index("role")] == ESCAPED
     assert page.count('<tr class="undecided">') == 1
-    assert "0 run again because their files were damaged" in page
+    assert "1 cached points ran again because their files were damaged" in page
+    assert "row 1: samples.npz is missing" in page
     assert "<script>" not in page and page.count(ESCAPED) == 2
     assert 'src="loops.png"' in page  # no PNG there: linked, not embedded
 

@@ -100,8 +100,8 @@ def test_threshold_figure_draws_each_window_the_mean_and_the_fit():
 
 def test_study_draws_its_figures_and_the_rows_of_n_from_the_points_flow_json(tmp_path):
     from stickslip import io
-    from stickslip.experiments.studies import study
-    from stickslip.experiments.study_findings import draw
+    from stickslip.experiments.studies import design, study
+    from stickslip.experiments.study_run import _draw
 
     spec = study("chaos", "tiny")
     points = tmp_path / "runs" / spec.dirname / "points"
@@ -117,7 +117,8 @@ def test_study_draws_its_figures_and_the_rows_of_n_from_the_points_flow_json(tmp
             | {"delta_star_state_censored": 1},
         ]
     )
-    figs = draw(spec, table, tmp_path / "chaos")
+    (tmp_path / "chaos").mkdir()
+    figs = _draw(spec, design("chaos"), table, tmp_path / "chaos")
     names = [f["name"] for f in figs]
     assert names == ["decorrelation", "flow_ladder", "threshold"]
     for name in names:

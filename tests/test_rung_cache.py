@@ -13,7 +13,7 @@ import pytest
 
 from stickslip.experiments.cache import damage, sealed
 from stickslip.experiments.ladders import ladder_task
-from stickslip.experiments.transition_study import ladder_points
+from stickslip.experiments.studies.transition import ladder_points
 
 DAMAGED = 1  # a grid rung whose final state the next rung starts from
 
@@ -164,7 +164,7 @@ def transition(tmp_path_factory):
 
 
 def _rung_dir(out):
-    return sorted(out.glob("runs/transition-*/ladders/*/rungs/*"))[0]
+    return sorted(out.glob("runs/transition-*/points/*/rungs/*"))[0]
 
 
 # (case, where the user's file goes); before, a file in a rung folder was accepted
@@ -204,6 +204,6 @@ def test_the_page_lists_a_rung_run_again(transition, tmp_path, capsys):
     capsys.readouterr()
     assert main(["study", "transition", "--tiny", "--workers", "1", "--no-progress", "--out", str(out), "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
-    assert data["meta"]["ladders_damaged"] == 1 and data["meta"]["rungs_damaged"] == 1
+    assert data["damaged"] == 1 and data["findings"]["rungs_damaged"] == 1
     page = (out / "transition" / "index.html").read_text()
     assert "ran again because their files were damaged" in page and "samples.npz is missing" in page

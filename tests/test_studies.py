@@ -25,7 +25,8 @@ from stickslip.analysis.order import (
     order_parameter,
     transition_bracket,
 )
-from stickslip.experiments.studies import Study, point_params, study
+from stickslip.experiments.studies import Study, study
+from stickslip.experiments.studies.chain_point import point_params
 from stickslip.experiments.study_run import run_study
 
 
@@ -104,29 +105,27 @@ def test_transition_bracket():
 
 
 def test_quick_specs_cover_the_brief():
-    t = study("transition", "quick")
-    assert sorted({p["N"] for p in t.points}) == [49, 99, 199]
-    betas = sorted({p["beta"] for p in t.points})
-    assert betas[0] <= 0.6 and betas[-1] >= 1.4 and max(np.diff([b for b in betas if 0.9 <= b <= 1.1])) <= 0.05 + 1e-9
-    assert all(p["t_end"] >= 2.5 * p["N"] * (p["N"] - 1) / (2 * 10 * 0.001) for p in t.points)
-    f = study("transition", "full")
-    assert sorted({p["N"] for p in f.points}) == [49, 99, 199, 399, 799]
     ph = study("phase-diagram", "quick")
     assert {p["start"] for p in ph.points} == {"paper", "steady"} and {p["N"] for p in ph.points} == {99}
+    assert {(p["alpha"], p["D"]) for p in ph.points} >= {(0.5, 5.0), (1.5, 5.0), (1.0, 0.5), (1.0, 50.0)}
+    assert all(p["t_end"] >= 2.5 * 99 * 98 / (2 * 10 * 0.001) for p in ph.points)
     ex = study("exponents", "quick")
     assert {p["model"] for p in ex.points} == {"sakaguchi", "carlson-langer"}
     # the key ignores the point list, so adding a point keeps the directory
-    assert Study("transition", "tiny", t.common, t.points[:2]).key() == Study("transition", "tiny", t.common).key()
+    assert Study("phase-diagram", "quick", ph.common, ph.points[:2]).key() == ph.key()
 
 
 # --- a tiny study end to end -----------------------------------------------------------------
 
 
 def _tiny(points=None) -> Study:
-    common = dict(study("transition", "tiny").common)
+    common = dict(study("phase-diagram", "tiny").common)
     common["n_samples"] = 400
-    points = points or [{"N": 5, "beta": 0.8, "t_end": 3000.0}, {"N": 5, "beta": 1.4, "t_end": 3000.0}]
-    return Study("transition", "tiny", common, tuple(points))
+    points = points or [
+        {"N": 5, "alpha": 1.0, "D": 5.0, "beta": 0.8, "t_end": 3000.0, "start": "paper"},
+        {"N": 5, "alpha": 1.0, "D": 5.0, "beta": 1.4, "t_end": 3000.0, "start": "paper"},
+    ]
+    return Study("phase-diagram", "tiny", common, tuple(points))
 
 
 def _science(rows) -> pd.DataFrame:
@@ -162,9 +161,9 @@ def test_tiny_study_end_to_end(tmp_path, cluster):
         assert all(key in r for r in rows)
     assert {r["final_state"] for r in rows} <= {"steady", "stick-slip", "undecided"}
     page = Path(first["page"])
-    assert page.is_file() and "order parameter" in page.read_text().lower()
-    table = pd.read_parquet(tmp_path / "transition" / "table.parquet")
-    assert len(table) == 2 and (tmp_path / "transition" / "order_parameter.png").is_file()
+    assert page.is_file() and "phase-diagram" in page.read_text().lower()
+    table = pd.read_parquet(tmp_path / "phase-diagram" / "table.parquet")
+    assert len(table) == 2 and (tmp_path / "phase-diagram" / "phase_alpha_beta.png").is_file()
     json.dumps(first, allow_nan=True)
     # a second call reuses every point and gives the same table
     second = run_study(_tiny(), tmp_path, scheduler=cluster, progress=False)
@@ -174,7 +173,8 @@ def test_tiny_study_end_to_end(tmp_path, cluster):
 
 def test_failed_point_is_reported_and_retried_alone(tmp_path, cluster):
     # K = 1e6 passes the checks made up front but makes Heun blow up: the run raises on its worker
-    points = [{"N": 5, "beta": 0.8, "t_end": 2000.0}, {"N": 5, "beta": 1.4, "t_end": 2000.0, "K": 1e6}]
+    cell = {"N": 5, "alpha": 1.0, "D": 5.0, "t_end": 2000.0, "start": "paper"}
+    points = [{**cell, "beta": 0.8}, {**cell, "beta": 1.4, "K": 1e6}]
     first = run_study(_tiny(points), tmp_path, scheduler=cluster, progress=False)
     assert first["failed"] == 1 and first["run"] == 2
     assert "non-finite" in first["failed_points"][0]["error"]
@@ -239,12 +239,12 @@ def test_an_interrupted_study_stops_its_running_ladder(tmp_path):
     # the quick transition starts with its dearest ladder, N = 199 up: minutes of work
     argv = ["study", "transition", "--quick", "--workers", "1", "--out", str(out), "--no-progress"]
     status, stdout, stderr = signal_when_running(
-        argv, lambda: bool(list(out.glob("runs/*/ladders/*/point.json"))), signal.SIGTERM, settle=3.0
+        argv, lambda: bool(list(out.glob("runs/*/points/*/point.json"))), signal.SIGTERM, settle=3.0
     )
     assert status == 130, stderr
     assert stdout == ""
     assert len(stderr.splitlines()) == 1 and "interrupted" in stderr, stderr
-    (ladder,) = [p.parent for p in out.glob("runs/*/ladders/*/point.json")]
+    (ladder,) = [p.parent for p in out.glob("runs/*/points/*/point.json")]
     assert "direction=up_N=199" in ladder.name
     assert not (ladder / "error.json").exists() and not (ladder / "done.json").exists()
     assert not (ladder.parent / STOP_FILE).exists()
@@ -385,7 +385,7 @@ def test_chaos_findings_state_verdicts_thresholds_and_fits():
     """The findings from rows alone: the verdict of each point with its text, delta* per kind
     from the per-window columns, and the slope of log10 delta* on log10 N (by hand: the points
     (1, -3), (1, -5), (2, -4), (2, -6) have slope -1 with standard error sqrt(2))."""
-    from stickslip.experiments.study_findings import conclusions
+    from stickslip.experiments.studies.chaos import conclusions
 
     nan = float("nan")
 
@@ -474,3 +474,49 @@ def test_bad_study_input_is_one_line_and_exit_2(tmp_path):
         assert len(error_lines(proc.stderr)) == 1, (argv, proc.stderr)
         assert proc.stdout == ""
     assert not (tmp_path / "o").exists()  # refused before the output folder is made
+
+
+# --- per-study help ----------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("name", "says"),
+    [
+        ("transition", ["continuation in beta", "N in [49, 99, 199]", "15 ladders", "loops and scaling"]),
+        ("phase-diagram", ["(alpha, beta)", "35 cells", "70 runs", "phase_alpha_beta"]),
+        ("exponents", ["slip-size exponent tau", "N = 199", "6 runs", "tau_beta"]),
+        ("chaos", ["delta*", "N = 49, 99, 199", "11 points", "decorrelation.csv"]),
+    ],
+)
+def test_each_study_has_its_own_help(name, says, capsys):
+    """`stickslip study NAME --help` is the study's own text: what it measures, its grid and
+    size in --quick (35 cells of the phase diagram, two starts each: docs/studies/phase-diagram.md),
+    its cost and its outputs; only the transition takes --extra-n."""
+    from stickslip.cli import main
+
+    with pytest.raises(SystemExit) as stop:
+        main(["study", name, "--help"])
+    assert stop.value.code == 0
+    text = " ".join(capsys.readouterr().out.split())
+    assert f"usage: stickslip study {name}" in text
+    for words in says:
+        assert words in text, words
+    assert "minutes on two cores" in text and "index.html" in text
+    assert ("--extra-n" in text) == (name == "transition")
+
+
+def test_sizes_summary_fits_the_events_after_the_transient_only():
+    """The exponents study's analysis of one run: the events counted are those that start at or
+    after t_from (counted here by hand); with fewer than 20 of them there is no fit, and it says why."""
+    from stickslip.analysis.chain_runs import sizes_summary
+    from stickslip.models.presets import chain_params
+    from stickslip.run.driver import run_chain
+
+    run = run_chain(chain_params("sakaguchi", N=12), 6e4)
+    starts = np.sort(run.events["t_start"].to_numpy())
+    t_from = 2e4
+    out = sizes_summary(run, t_from, bootstrap=0)
+    assert out["n_events"] == int((starts >= t_from).sum()) >= 20 and out["t_from"] == t_from
+    assert 1.0 < out["tau"] < 3.0 and out["n_fit"] <= out["n_events"] and out["spanning"] == "max_block"
+    few = sizes_summary(run, float(starts[-5]), bootstrap=0)
+    assert few["n_events"] == 5 and math.isnan(few["tau"]) and few["error_note"].startswith("only 5 events")

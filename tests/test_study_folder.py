@@ -278,10 +278,10 @@ def test_transition_study_owns_its_folder(tmp_path, capsys):
     assert (out / "transition" / "table.csv").read_text() == "the user's own"
     (out / "transition" / "table.csv").unlink()
     assert main([*argv, "--out", str(out)]) == 0
-    first = json.loads(capsys.readouterr().out)["meta"]
-    assert first["ladders_run"] == 3 and first["ladders_reused"] == 0
+    first = json.loads(capsys.readouterr().out)
+    assert first["run"] == 3 and first["reused"] == 0
     assert main([*argv, "--out", str(out)]) == 0, "its own page, manifest and ladders are not foreign"
-    again = json.loads(capsys.readouterr().out)["meta"]
-    assert again["ladders_run"] == 0 and again["ladders_reused"] == 3
+    again = json.loads(capsys.readouterr().out)
+    assert again["run"] == 0 and again["reused"] == 3
     assert main([*argv, "--out", str(out), "--overwrite"]) == 0
-    assert json.loads(capsys.readouterr().out)["meta"]["ladders_run"] == 3, "--overwrite ran its ladders again"
+    assert json.loads(capsys.readouterr().out)["run"] == 3, "--overwrite ran its ladders again"

@@ -30,3 +30,11 @@ def to_jsonable(obj: Any) -> Any:
     if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
         return to_jsonable(dataclasses.asdict(obj))
     return obj
+
+
+def table_records(table) -> list[dict[str, Any]]:
+    """The rows of a pandas DataFrame as JSON-able dicts, missing values as None (the rows of a
+    study's ``study.json`` and ``--json``)."""
+    if not len(table):
+        return []
+    return to_jsonable(table.astype(object).where(table.notna(), None).to_dict(orient="records"))

@@ -3,8 +3,7 @@
 Every page is a jinja2 template shipped with the package (``stickslip/templates``), rendered with
 autoescape on, so text from a run (a caption, an error message, a command) can never become
 markup. The report (:mod:`stickslip.report.writer`) and the studies
-(:mod:`stickslip.experiments.study_run`, :mod:`stickslip.experiments.transition_page`) write
-their pages through :func:`write_page`.
+(:mod:`stickslip.experiments.study_run`) write their pages through :func:`write_page`.
 """
 
 from __future__ import annotations

@@ -34,6 +34,7 @@ __all__ = [
     "final_state",
     "choose_s_min",
     "size_statistics",
+    "sizes_summary",
     "front_speeds",
     "front_statistics",
     "chain_analysis",
@@ -159,7 +160,7 @@ def final_state(summary: dict[str, Any], state, params: ChainParams, tolerance: 
 
     Steady sliding: the run stopped there (``until_steady``), or its final state is within
     ``tolerance`` of it (:func:`stickslip.run.state.steady_deviation`; ``stickslip reproduce``
-    uses :data:`stickslip.experiments.specs.UNTIL_STEADY`), which for beta > 1 it never leaves.
+    uses :data:`stickslip.models.physics.UNTIL_STEADY`), which for beta > 1 it never leaves.
     Otherwise stick-slip if events happened in the averaged second half or some block is stopped
     at the end.
 
@@ -404,7 +405,7 @@ def chain_analysis(outcome) -> dict[str, Any]:
     Parameters
     ----------
     outcome : Outcome
-        The :class:`~stickslip.experiments.specs.Outcome` of a ``chain_runs`` experiment: its
+        The :class:`~stickslip.outcome.Outcome` of a ``chain_runs`` experiment: its
         options name the sweep's N, the figures' N and their run length.
 
     Returns
@@ -464,3 +465,51 @@ def sweep_table(a: dict[str, Any]) -> pd.DataFrame:
         "wall_seconds",
     ]
     return t[[c for c in cols if c in t.columns]].reset_index(drop=True)
+
+
+def sizes_summary(
+    run, t_from: float, *, spanning: str = "max_block", seed: int = 0, bootstrap: int = 200
+) -> dict[str, Any]:
+    """The slip-size exponent tau of one chain run (Figs. 7, 8) over its events from ``t_from``.
+
+    Parameters
+    ----------
+    run : ChainRun
+        The run.
+    t_from : float
+        Events that start before it (the transient) are left out.
+    spanning, seed, bootstrap
+        As :func:`size_statistics` takes them: what counts as a spanning event, the seed and the
+        number of the bootstrap resamples.
+
+    Returns
+    -------
+    dict
+        ``t_from``, ``n_events``, ``spanning`` and, with 20 events or more, tau of the truncated
+        power law below the smallest spanning event (s_min by least KS distance) with its
+        bootstrap and Fisher errors, the fitted range, the KS distance and the excess of great
+        events (observed and expected); else tau = NaN and an ``error_note``.
+    """
+    events = run.events[run.events["t_start"] >= t_from]
+    out: dict[str, Any] = {"t_from": t_from, "n_events": int(len(events)), "spanning": spanning}
+    if len(events) < 20:
+        out.update(tau=math.nan, tau_err=math.nan, error_note=f"only {len(events)} events after t = {t_from:g}")
+        return out
+    st = size_statistics(events, run.params.N, small_only=True, seed=seed, spanning=spanning, bootstrap=bootstrap)
+    fit = st["fit"]
+    out.update(
+        tau=fit.tau,
+        tau_err=fit.tau_err,
+        tau_err_fisher=fit.tau_err_fisher,
+        s_min=fit.s_min,
+        s_max=fit.s_max,
+        n_fit=fit.n,
+        ks_distance=fit.ks_distance,
+        n_spanning=st["n_spanning"],
+        s_span=st["s_span"],
+        S_max=st["S_max"],
+        excess=st["excess"],
+        observed=st["observed"],
+        expected=st["expected"],
+    )
+    return out

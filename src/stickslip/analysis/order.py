@@ -25,6 +25,7 @@ import numpy as np
 import xarray as xr
 
 __all__ = [
+    "order_summary",
     "integrated_time",
     "batch_means",
     "MeanEstimate",
@@ -430,6 +431,91 @@ class TimeAverage:
 
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)
+
+
+def order_summary(run, params, t_from: float) -> dict[str, Any]:
+    """The order parameter m = 1 - <L>/L_ss of one chain run of eq. (4) (section 3, Fig. 5b read
+    as a phase transition) and its final state.
+
+    Parameters
+    ----------
+    run : ChainRun
+        The run, sampled with ``sample_moving`` (its samples hold ``t``, ``L``, ``t_moving`` and
+        ``n_moving``); a run stopped at steady sliding counts as steady from ``t_steady`` to its
+        ``t_end``.
+    params : ChainParams
+        Its parameters (for L_ss and N).
+    t_from : float
+        Start of the window averaged over.
+
+    Returns
+    -------
+    dict
+        m over t >= ``t_from`` with its batch-means error (:func:`order_parameter`), the fraction
+        of samples with some block stuck, the event rate and largest event in the window, the
+        time steady sliding was reached, the statistics of the last two quarters
+        (:func:`quarter_stats`) and the final state with its reason
+        (:func:`classify_final_state`).
+    """
+    from stickslip.models.physics import chain_steady_length
+
+    L_ss = chain_steady_length(params)
+    s = run.summary
+    t_end = float(run.options.t_end)
+    dt_s = float(run.options.sample_interval)
+    t = run.samples["t"].values
+    L = run.samples["L"].values
+    tm = run.samples["t_moving"].values
+    stuck = (run.samples["n_moving"].values < params.N).astype(float)
+    reached = bool(s.get("stopped_early", False))
+    if reached:
+        # steady sliding from t_steady on: L = L_ss and nothing stuck at the remaining sample times
+        t_rest = (
+            np.arange(math.floor(float(s["t_steady"]) / dt_s + 1e-9) + 1, math.floor(t_end / dt_s + 1e-9) + 1) * dt_s
+        )
+        t = np.concatenate([t[t < t_rest[0]] if t_rest.size else t, t_rest])
+        L = np.concatenate([run.samples["L"].values[: t.size - t_rest.size], np.full(t_rest.size, L_ss)])
+        tm_keep = tm < t_rest[0] if t_rest.size else np.ones(tm.size, bool)
+        tm = np.concatenate([tm[tm_keep], t_rest])
+        stuck = np.concatenate([stuck[tm_keep], np.zeros(t_rest.size)])
+    m = 1.0 - L / L_ss
+    late = t >= t_from - 1e-9
+    est = order_parameter(L[late], L_ss)
+    late_m = tm >= t_from - 1e-9
+    stuck_fraction = float(stuck[late_m].mean()) if late_m.any() else math.nan
+    q = quarter_stats(t, m, None, t_end)
+    q.update({k: v for k, v in quarter_stats(tm, np.zeros(tm.size), stuck, t_end).items() if k.startswith("stuck")})
+    state, reason = classify_final_state(
+        reached_steady=reached,
+        stuck_q3=q["stuck_q3"],
+        stuck_q4=q["stuck_q4"],
+        m_q3=q["m_q3"],
+        m_err_q3=q["m_err_q3"],
+        m_q4=q["m_q4"],
+        m_err_q4=q["m_err_q4"],
+    )
+    ev = run.events[run.events["t_start"] >= t_from]
+    window = t_end - t_from
+    return {
+        "order_parameter": est.mean,
+        "order_parameter_err": est.err,
+        "order_parameter_err_tau": est.err_tau,
+        "tau_int": est.tau_int * dt_s,
+        "batch_time": est.batch * dt_s,
+        "n_batches": est.n_batches,
+        "err_reliable": est.reliable,
+        "L_mean": float(np.mean(L[late])) if late.any() else math.nan,
+        "L_steady": L_ss,
+        "stuck_fraction": stuck_fraction,
+        "event_rate": len(ev) / window if window > 0 else math.nan,
+        "n_events": int(len(ev)),
+        "S_max": float(ev["S"].max()) if len(ev) else 0.0,
+        "max_blocks": int(ev["n_blocks"].max()) if len(ev) else 0,
+        "t_steady": float(s["t_steady"]) if reached else None,
+        "final_state": state,
+        "final_reason": reason,
+        **q,
+    }
 
 
 def time_average(series: xr.DataArray, t_from: float | None = None, *, n_batches: int = 10) -> TimeAverage:

@@ -440,7 +440,7 @@ def _refuse_ignored(args) -> None:
 def _lifetimes(params, args) -> Result:
     """`--lifetimes`: :func:`stickslip.analysis.stable_chaos.steady_lifetime` at each N."""
     from stickslip.analysis.stable_chaos import steady_lifetime
-    from stickslip.experiments.studies import loading_time
+    from stickslip.experiments.studies.chain_point import loading_time
 
     try:
         Ns = [int(s) for s in args.lifetimes.split(",") if s.strip()]

@@ -2,10 +2,8 @@
 
     stickslip study NAME [--quick | --full] [--out DIR] [--scheduler ADDRESS] [--workers N] [--json]
 
-NAME is ``transition`` (order parameter against beta and N), ``phase-diagram`` (final state over
-(alpha, beta) and (D, beta), two starts), ``exponents`` (slip-size exponent against beta, and
-Carlson-Langer) or ``chaos`` (the flow's exponent, slip decorrelation and its threshold delta*
-against N at beta = 0.5, 0.9, 1, and the verdict; two blocks, Carlson-Langer).
+NAME is one of :data:`stickslip.experiments.studies.STUDIES`; ``stickslip study NAME --help``
+prints what the study's module says of it (its grid, its cost, its outputs).
 Every point is cached and reused (only if its files are whole: a damaged point runs again); an
 interrupted study resumes; a failed point is reported and retried by the next call. DIR is owned
 as a chain's run directory is: no foreign files (``--overwrite`` removes this study's own files
@@ -36,18 +34,48 @@ DEFAULT_OUT = "studies"
 
 
 def register(sub) -> None:
-    """Add the ``study`` subcommand."""
-    from stickslip.experiments.studies import STUDIES
+    """Add the ``study`` subcommand, with one subcommand per study whose ``--help`` is its
+    module's description (:class:`~stickslip.experiments.studies.Design`)."""
+    from stickslip.experiments.studies import STUDIES, design
 
     p = sub.add_parser(
         "study",
         help="run a study the paper leaves open (transition, phase-diagram, exponents, chaos); writes a page",
         description=(
             "Run every point of a study on Dask (reusing finished points), then write its table "
-            "(Parquet, CSV), figures and an HTML page under DIR/NAME/."
+            "(Parquet, CSV), figures and an HTML page under DIR/NAME/. "
+            "`stickslip study NAME --help` describes one study: its grid, its cost and its outputs."
         ),
     )
-    p.add_argument("name", choices=STUDIES, metavar="NAME", help=f"one of {', '.join(STUDIES)}")
+    names = p.add_subparsers(
+        dest="name",
+        metavar="NAME",
+        required=True,
+        title="studies",
+        parser_class=type("StudyParser", (_LazyDescription, type(p)), {}),
+    )
+    for name in STUDIES:
+        plan = design(name)
+        q = names.add_parser(name, help=plan.summary)
+        q.describe = plan.describe
+        _options(q, plan)
+        q.set_defaults(handler=run, study_options=[o.dest for o in plan.options])
+
+
+class _LazyDescription:
+    """Mixed into a study's parser: its description (its module's text, made from the study's
+    specs in every mode: a second or so) is made only when its help is asked for."""
+
+    describe = None
+
+    def format_help(self) -> str:
+        if self.description is None and self.describe is not None:
+            self.description = self.describe()
+        return super().format_help()
+
+
+def _options(p: argparse.ArgumentParser, plan) -> None:
+    """The options every study takes, then the study's own."""
     mode = p.add_mutually_exclusive_group()
     mode.add_argument(
         "--quick",
@@ -65,37 +93,23 @@ def register(sub) -> None:
     )
     mode.add_argument("--tiny", dest="mode", action="store_const", const="tiny", help=argparse.SUPPRESS)
     p.set_defaults(mode="quick")
-    p.add_argument(
-        "--extra-n",
-        type=int,
-        action="append",
-        default=[],
-        metavar="N",
-        help="transition only: add a chain of N blocks (both ladders), e.g. 1599; repeatable",
-    )
+    for o in plan.options:
+        p.add_argument(o.flag, dest=o.dest, type=int, action="append", default=[], metavar=o.metavar, help=o.help)
     p.add_argument("--out", default=DEFAULT_OUT, metavar="DIR", help=f"output directory (default {DEFAULT_OUT})")
     add_overwrite_option(p)
     add_dask_options(p)
     add_json_option(p)
-    p.set_defaults(handler=run)
 
 
 def run(args: argparse.Namespace) -> Result:
-    """Handler of ``stickslip study``: the output folder is checked and locked before the first
-    point starts (:func:`_claim`)."""
+    """Handler of ``stickslip study NAME``: the output folder is checked and locked before the
+    first point starts (:func:`_claim`)."""
+    from stickslip.experiments.studies import study
     from stickslip.experiments.study_run import run_study
 
     _, workers = dask_options(args)
-    if args.extra_n and (args.name != "transition" or min(args.extra_n) < 3):
-        raise CommandError("--extra-n takes chains of at least 3 blocks, for the transition study only")
-    from stickslip.models.params import MAX_BLOCKS, check_number
-
-    for n in args.extra_n or ():  # before any ladder runs
-        check_number("extra-n", n, low=3, high=MAX_BLOCKS, integer=True)
-    spec = _spec(args)
+    spec = study(args.name, args.mode, **{d: tuple(getattr(args, d)) for d in args.study_options})
     with _claim(args.out, spec, overwrite=args.overwrite) as out:
-        if args.name == "transition":
-            return _transition(args, out, workers)
         try:
             with sigterm_as_interrupt():
                 result = run_study(
@@ -107,9 +121,8 @@ def run(args: argparse.Namespace) -> Result:
                     dashboard=args.dashboard,
                 )
         except KeyboardInterrupt:
-            return interrupted(
-                "study", out, f"finished points in {out} are kept, chain runs continue from their checkpoints"
-            )
+            kept = f"finished points in {out} are kept, chain runs continue from their checkpoints"
+            return interrupted("study", out, kept)
         except OSError as exc:
             if is_disk_full(exc):
                 raise
@@ -154,54 +167,6 @@ def _claim(path: str, spec, *, overwrite: bool) -> Iterator[Path]:
         if is_disk_full(exc) or out.is_dir():
             raise
         raise CommandError(f"cannot create output directory {out}: {exc.strerror}") from None
-
-
-def _spec(args: argparse.Namespace):
-    """The spec whose folder the study owns: the study's, or for ``transition`` (run by
-    continuation in beta) its name and runs folder."""
-    from stickslip.experiments.studies import study
-
-    if args.name == "transition":
-        from stickslip.experiments.transition_study import study_folder
-
-        return study_folder(args.mode, tuple(args.extra_n))
-    return study(args.name, args.mode)
-
-
-def _transition(args: argparse.Namespace, out, workers) -> Result:
-    """The transition study by continuation in beta (:mod:`stickslip.experiments.transition_study`)."""
-    import shlex
-    import sys
-
-    from stickslip.experiments.transition_study import run_transition
-
-    command = "stickslip " + " ".join(shlex.quote(a) for a in sys.argv[1:])
-    try:
-        with sigterm_as_interrupt():
-            result = run_transition(
-                out,
-                args.mode,
-                extra_Ns=tuple(args.extra_n),
-                scheduler=args.scheduler,
-                n_workers=workers,
-                progress=not args.no_progress,
-                command=command,
-                dashboard=args.dashboard,
-            )
-    except KeyboardInterrupt:
-        return interrupted("study", out, f"finished rungs in {out} are kept; the ladders continue from them")
-    except OSError as exc:
-        if is_disk_full(exc):
-            raise
-        raise CommandError(f"cannot run the study: {exc}") from None
-    meta = result["meta"]
-    lines = [
-        f"stickslip study transition --{meta['mode']}: {meta['ladders']} ladders ({meta['failed']} failed), "
-        f"{meta['rungs']} rungs, {meta['wall_seconds']} s"
-    ]
-    lines += [f"  {s}" for s in result["statements"]]
-    lines.append(f"page: {result['page']}")
-    return Result(result, "\n".join(lines), status=1 if result["failed"] else 0)
 
 
 def _text(result: dict) -> str:

@@ -64,13 +64,9 @@ def canonical(value: Any) -> Any:
     return whole(json.loads(json.dumps(to_jsonable(value), sort_keys=True)))
 
 
-def spec_key(spec: dict[str, Any], *, separators: tuple[str, str] = COMPACT) -> str:
-    """First 12 hex digits of the SHA-256 of ``spec`` as JSON with sorted keys.
-
-    ``separators`` are json's; a run directory named with other separators keeps its name only if
-    its key is computed with the same ones (the transition study's use json's default).
-    """
-    text = json.dumps(spec, sort_keys=True, separators=separators)
+def spec_key(spec: dict[str, Any]) -> str:
+    """First 12 hex digits of the SHA-256 of ``spec`` as compact JSON with sorted keys."""
+    text = json.dumps(spec, sort_keys=True, separators=COMPACT)
     return hashlib.sha256(text.encode()).hexdigest()[:12]
 
 

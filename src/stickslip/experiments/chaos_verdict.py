@@ -31,7 +31,6 @@ from pathlib import Path
 from typing import Any
 
 __all__ = [
-    "chaos_points",
     "chaos_point",
     "check_point",
     "located_start",
@@ -143,9 +142,10 @@ class _Parts:
 
 
 def chaos_point(cfg: dict[str, Any], params, point_dir: Path) -> dict[str, Any]:
-    """One point (module docstring) of the model ``params`` (:func:`stickslip.experiments.studies.point_params`
-    of ``cfg``): writes ``flow.json`` (loading check, ladder, n(delta) of every
-    kind, delta*, verdict) into ``point_dir`` and returns the table's columns."""
+    """One point (module docstring) of the model ``params``
+    (:func:`stickslip.experiments.studies.chain_point.point_params` of ``cfg``): writes
+    ``flow.json`` (loading check, ladder, n(delta) of every kind, delta*, verdict) into
+    ``point_dir`` and returns the table's columns."""
     from stickslip import __version__, io
     from stickslip.analysis.decorrelation import GridSequences, sequence_decorrelation, verdict
     from stickslip.analysis.lyapunov_flow import extrapolate, flow_lyapunov
@@ -279,55 +279,3 @@ def _stop_now(stop) -> None:
 
 def _num(x) -> float:
     return math.nan if x is None else float(x)
-
-
-def chaos_points(mode: str) -> tuple[list[dict[str, Any]], dict[str, Any]]:
-    """The points of ``stickslip study chaos`` in ``mode`` and the settings they share: the
-    paper's chain (eq. 4) at several N and beta = 0.5, 0.9, 1, and two blocks and Carlson-Langer at
-    their standard parameters (the verdict's known answers: chaotic), dearest first. A point's
-    own keys override the shared ones (the relatives' interval, kinds and ladder length)."""
-    betas = (0.5, 0.9, 1.0)
-    # a rung of 1.2e5 time units counts 0.9 of it: some 360 slips of the chain at every N (1000 slips
-    # take 2.9e5 to 3.0e5, docs/studies/chaos.md); --full counts five times as many (at N = 799 the
-    # growth of a separation comes in rare large slips, and 360 slips hold only a few of them)
-    if mode == "tiny":
-        Ns, deltas, seeds, events, flow_t, levels = (5, 9), (1e-8, 1e-4, 1e-1), 2, 40, 2000.0, 2
-        transients = {5: 1e4, 9: 2e4}
-        family = [{"model": "two-blocks", "transient": 100.0, "flow_t": 200.0, "events": 30, "seeds": 1}]
-    elif mode == "quick":
-        Ns, deltas, seeds, events, flow_t, levels = (49, 99, 199), DELTAS_QUICK, 2, 1000, 1.2e5, 3
-        transients = TRANSIENTS
-        family = [
-            {"model": "two-blocks", "transient": 2e3, "flow_t": 1.2e4, "seeds": 1},
-            {"model": "carlson-langer", "transient": 2e3, "flow_t": 1e3, "seeds": 1},
-        ]
-    else:
-        Ns, deltas, seeds, events, flow_t, levels = (49, 99, 199, 399, 799), DELTAS_FULL, 3, 1000, 6e5, 3
-        transients = TRANSIENTS
-        family = [
-            {"model": "two-blocks", "transient": 2e3, "flow_t": 1.2e4},
-            {"model": "carlson-langer", "transient": 2e3, "flow_t": 1e3},
-        ]
-    shared = {
-        "kinds": ["state", "Fs", "V"],
-        "deltas": list(deltas),
-        "seeds": seeds,
-        "events": events,
-        "flow_t": flow_t,
-        "levels": levels,
-        "interval": 10.0,
-        # above the rounding floor of positions of order L_ss ~ N^2 / (2 K): at N = 799 the
-        # exponent is the same for d0 = 1e-8 .. 1e-6 and grows spuriously below 1e-9
-        # (docs/studies/chaos.md, "d0 and the rounding floor")
-        "d0": 1e-8,
-    }
-    points: list[dict[str, Any]] = [
-        {"model": "sakaguchi", "start": "paper", "N": N, "beta": b, "transient": transients[N]}
-        for N in Ns
-        for b in betas
-    ]
-    points += [
-        {**f, "start": "rest", "perturbation": 0.01, "seed": 0, "kinds": "state", "interval": 1.0} for f in family
-    ]
-    points.sort(key=lambda p: -(p.get("N", 100) ** 2) * p["transient"] ** 0.5)
-    return points, shared

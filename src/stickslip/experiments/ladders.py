@@ -24,6 +24,7 @@ rungs and continues with the first unfinished one.
 from __future__ import annotations
 
 import math
+import re
 import time
 from io import BytesIO
 from pathlib import Path
@@ -34,13 +35,12 @@ import numpy as np
 from stickslip import io
 from stickslip.experiments.cache import canonical
 from stickslip.jsonable import to_jsonable
+from stickslip.models.physics import UNTIL_STEADY
+from stickslip.models.presets import paper_parameters
 
-__all__ = ["ladder_task", "run_rung", "perturbed", "ladder_rows", "UNTIL_STEADY", "DIRECTIONS"]
+__all__ = ["ladder_task", "run_rung", "perturbed", "ladder_entry"]
 
-#: Tolerance of steady sliding (largest deviation of v, theta, springs), as in the studies.
-UNTIL_STEADY = 1e-6
-DIRECTIONS = ("up", "down")
-_PAPER = {"K": 10.0, "D": 5.0, "V": 0.001, "Fs": 3.0, "alpha": 1.0, "dt": 0.005}
+_PAPER = paper_parameters("N", "beta")
 
 
 def params_at(cfg: dict[str, Any], beta: float):
@@ -216,6 +216,24 @@ def _rung_settings(cfg: dict[str, Any]) -> dict[str, Any]:
 RUNG_FILES = ("state.npz", "samples.npz")
 
 
+def ladder_entry(path: Path, rel: str = ""):
+    """Whether an entry of a ladder's folder is the ladder's: the sweep's bookkeeping, and its
+    ``rungs`` folder, holding only rungs (``<k>-beta<b>``) of ``rung.json`` and
+    :data:`RUNG_FILES`. True or False, or for a folder the test of its entries (the walk of
+    :func:`stickslip.experiments.study_run.foreign_files`)."""
+    from stickslip.experiments.cache import BOOKKEEPING
+
+    def rung(p: Path, r: str) -> bool:
+        return p.is_file() and p.name in ("rung.json", *RUNG_FILES)
+
+    def rungs(p: Path, r: str):
+        return rung if p.is_dir() and re.fullmatch(r"\d{2,}-beta[^/]+", p.name) else False
+
+    if path.name == "rungs" and path.is_dir():
+        return rungs
+    return path.is_file() and path.name in BOOKKEEPING
+
+
 def _replay(rdir: Path, spec: dict[str, Any], params) -> tuple[dict[str, Any] | None, str | None]:
     """The row and final state of the rung stored in ``rdir`` if it was run from ``spec`` and is
     whole: its record as written (its SHA-256), every file present with the checksum recorded
@@ -334,8 +352,3 @@ def ladder_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
         "outside": outside,
         "rows": rows,
     }
-
-
-def ladder_rows(summaries: list[dict[str, Any]]) -> list[dict[str, Any]]:
-    """The rungs of every finished ladder, one row each."""
-    return [row for s in summaries for row in s.get("rows", [])]

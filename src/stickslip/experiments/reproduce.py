@@ -41,19 +41,12 @@ import pandas as pd
 from stickslip import heartbeat, io
 from stickslip.analysis.chain_runs import chain_analysis, final_state
 from stickslip.experiments.cache import damage, file_digests, read_record, sealed
-from stickslip.experiments.specs import (
-    UNTIL_STEADY,
-    Experiment,
-    Outcome,
-    experiments,
-)
-from stickslip.experiments.specs import (
-    chain_common as _chain_common,
-)
-from stickslip.experiments.specs import (
-    point_settings as _point_settings,
-)
+from stickslip.experiments.specs import Experiment, experiments
 from stickslip.models.params import BlockParams, ChainParams
+from stickslip.models.physics import UNTIL_STEADY
+from stickslip.outcome import Outcome
+from stickslip.outcome import chain_common as _chain_common
+from stickslip.outcome import point_settings as _point_settings
 from stickslip.plotting.figures import draw_figures
 from stickslip.report.rows import report_rows
 from stickslip.report.writer import write_report

@@ -26,15 +26,15 @@ every block moves every step and nothing changes but the position of the pulling
 
 from __future__ import annotations
 
-import math
+import dataclasses
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 from stickslip import __version__
 from stickslip.experiments.cache import canonical, spec_key
-from stickslip.models.params import ChainParams
+from stickslip.models.physics import UNTIL_STEADY
+from stickslip.models.presets import block_params, paper_parameters
 
 __all__ = [
     "Experiment",
@@ -44,9 +44,6 @@ __all__ = [
     "experiment",
     "chain_points",
     "FIGURES",
-    "Outcome",
-    "point_settings",
-    "chain_common",
 ]
 
 MODES = ("quick", "full", "smoke")
@@ -148,13 +145,9 @@ class Experiment:
 # The spec sets
 
 
-#: The paper's chain (section 3) apart from beta and N.
-_CHAIN = {"K": 10.0, "D": 5.0, "V": 0.001, "Fs": 3.0, "alpha": 1.0, "dt": 0.005}
-#: The paper's single block (section 2, Fig. 1).
-_BLOCK = {"K": 10.0, "V": 0.001, "beta": 1.0, "alpha": 1.0, "Fs": 3.0, "M": 1.0, "sigma": 1.0, "dt": 0.005}
-
-#: Tolerance of the stop at steady sliding for beta > 1 (largest deviation of v, theta, springs).
-UNTIL_STEADY = 1e-6
+#: The paper's chain (section 3) apart from beta and N, and its single block (section 2, Fig. 1).
+_CHAIN = paper_parameters("N", "beta")
+_BLOCK = {k: v for k, v in dataclasses.asdict(block_params()).items() if k != "threshold"}
 
 # Just above beta = 1 (1.025 to 1.1) the chain stick-slips for a very long time: at N = 99 it
 # still does at t = 1e7, so such a point at N = 399 costs a whole run of the sliding regime
@@ -292,44 +285,3 @@ def experiment(mode: str, name: str) -> Experiment:
         if exp.name == name:
             return exp
     raise KeyError(f"no experiment {name!r} in mode {mode!r}")
-
-
-# ---------------------------------------------------------------------------------------------
-# Outcomes, and the settings of one chain point
-
-
-@dataclass
-class Outcome:
-    """An experiment's loaded result: ``data`` (runner-specific), ``summary``, whether reused."""
-
-    experiment: Experiment
-    run_dir: Path
-    data: dict[str, Any]
-    summary: dict[str, Any]
-    reused: bool
-    wall_seconds: float
-
-
-_CHAIN_FIELDS = ("N", "K", "D", "V", "beta", "alpha", "Fs", "dt")
-
-
-def point_settings(cfg: dict[str, Any]) -> tuple[ChainParams, float, dict[str, Any]]:
-    """Parameters, t_end and run options of one chain point from its merged settings."""
-    params = ChainParams(**{k: cfg[k] for k in _CHAIN_FIELDS if k in cfg})
-    t_end = float(cfg["t_end_by_N"][str(params.N)])
-    options: dict[str, Any] = {
-        "sample_interval": float(cfg["sample_interval"]),
-        "average_from": float(cfg["average_fraction"]) * t_end,
-        "until_steady": float(cfg["until_steady"]) if params.beta > float(cfg["until_steady_above"]) else None,
-    }
-    if params.N == int(cfg["profile_N"]) and any(math.isclose(params.beta, float(b)) for b in cfg["profile_betas"]):
-        options["profile_window"] = float(cfg["profile_window"])
-        options["profile_min_blocks"] = int(float(cfg["profile_min_fraction"]) * params.N)
-    return params, t_end, options
-
-
-def chain_common(exp: Experiment) -> dict[str, Any]:
-    """The settings every chain point of ``exp`` shares: its parameters and options, less the point lists."""
-    common = dict(exp.params)
-    common.update({k: v for k, v in exp.options.items() if k not in ("points", "sweep_N", "figure_N")})
-    return common

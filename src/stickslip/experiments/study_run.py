@@ -1,20 +1,20 @@
 """Running a study (``stickslip study NAME``): its points on Dask, its table, figures and page.
 
-:func:`run_study` takes a :class:`~stickslip.experiments.studies.Study`, runs its points through
+:func:`run_study` takes a :class:`~stickslip.experiments.studies.Study` and the
+:class:`~stickslip.experiments.studies.Design` of its module, runs its points through
 :func:`stickslip.experiments.sweep.run_sweep` (each point reused if done, failed points recorded
-and retried next time, interrupted chain runs continued from their checkpoints), builds the
-study's table (:mod:`stickslip.analysis.order` for the conclusions drawn from it), draws its
-figures (:mod:`stickslip.plotting.studies`) and writes its page. Layout::
+and retried next time, interrupted points continued from their checkpoints), builds the study's
+table, asks its module for the findings and figures and writes its page. It names no study.
+Layout::
 
-    OUT/runs/<name>-<key>/points/<point>/   one chain run and its analysis per point
-    OUT/<name>/table.parquet, table.csv     the study's table, one row per point
+    OUT/runs/<name>-<key>/points/<point>/   one point (a chain run and its analysis, a ladder, ...)
+    OUT/<name>/table.parquet, table.csv     the study's table
     OUT/<name>/<figure>.png|.pdf            its figures
-    OUT/<name>/study.json, index.html       the conclusions, the commands, the page
+    OUT/<name>/study.json, index.html       the findings, the commands, the page
 """
 
 from __future__ import annotations
 
-import re
 import sys
 import time
 from pathlib import Path
@@ -24,96 +24,11 @@ import numpy as np
 import pandas as pd
 
 from stickslip import __version__, io
-from stickslip.experiments.studies import Study, study, study_command, study_point_task
-from stickslip.jsonable import to_jsonable
+from stickslip.experiments.studies import Design, Study, design, study, study_command
+from stickslip.jsonable import table_records
 from stickslip.pages import image_src, write_page
 
-__all__ = ["run_study", "study_command", "TABLE_COLUMNS"]
-
-#: The leading columns of each study's table (the rest follow).
-TABLE_COLUMNS = {
-    "transition": [
-        "N",
-        "beta",
-        "order_parameter",
-        "order_parameter_err",
-        "final_state",
-        "stuck_fraction",
-        "event_rate",
-        "S_max",
-        "max_blocks",
-        "t_steady",
-        "tau_int",
-        "err_reliable",
-        "t_end",
-    ],
-    "phase-diagram": [
-        "N",
-        "alpha",
-        "D",
-        "beta",
-        "start",
-        "final_state",
-        "order_parameter",
-        "order_parameter_err",
-        "stuck_fraction",
-        "t_steady",
-        "t_end",
-    ],
-    "exponents": [
-        "model",
-        "N",
-        "beta",
-        "tau",
-        "tau_err",
-        "s_min",
-        "s_max",
-        "n_fit",
-        "n_events",
-        "excess",
-        "observed",
-        "expected",
-        "n_spanning",
-        "S_max",
-        "t_end",
-    ],
-    "chaos": [
-        "model",
-        "N",
-        "beta",
-        "verdict",
-        "verdict_text",
-        "lyapunov_dt0",
-        "lyapunov_dt0_err",
-        "flow_slips",
-        "window",
-        "delta_star_state",
-        "delta_star_state_err_log10",
-        "delta_star_state_low",
-        "delta_star_state_high",
-        "delta_star_state_censored",
-        "delta_star_Fs",
-        "delta_star_Fs_err_log10",
-        "delta_star_Fs_low",
-        "delta_star_Fs_high",
-        "delta_star_Fs_censored",
-        "delta_star_V",
-        "delta_star_V_err_log10",
-        "delta_star_V_low",
-        "delta_star_V_high",
-        "delta_star_V_censored",
-        "threshold_below",
-        "threshold_low",
-        "windows_decorrelated",
-        "windows",
-        "transient",
-        "loaded",
-        "first_slip_reaching_block_N",
-        "flow_t",
-        "seeds",
-        "n_deltas",
-    ],
-}
+__all__ = ["run_study", "study_command", "foreign_files", "remove_study_files", "MANIFEST"]
 
 
 def _log(enabled: bool, t0: float, text: str) -> None:
@@ -134,33 +49,46 @@ def run_study(
 ) -> dict[str, Any]:
     """Run (or reuse) every point of a study and write its table, figures and page under ``out_dir``.
 
-    ``spec`` is a :class:`Study` or a study name (then ``mode`` picks its spec set). Points run
-    on a local Dask cluster of ``n_workers`` processes or on the cluster at ``scheduler``.
-    Progress goes to stderr when ``progress`` and stderr is a terminal; ``dashboard`` serves the
-    local cluster's dashboard on 127.0.0.1 (its address on stderr). Returns the table as
-    records, the conclusions, failed points with their errors, paths and times.
+    Parameters
+    ----------
+    spec : Study or str
+        The study, or a study's name (then ``mode`` picks its spec set).
+    out_dir : str or Path
+        The output folder: ``runs/<name>-<key>/`` and the page folder ``<name>/``.
+    mode : str
+        The mode when ``spec`` is a name.
+    scheduler : str, optional
+        Address of an existing Dask scheduler; else a local cluster of ``n_workers`` processes.
+    n_workers : int, optional
+        Worker processes of the local cluster (default one per core).
+    progress : bool
+        Progress on stderr when it is a terminal.
+    dashboard : bool
+        Serve the local cluster's dashboard on 127.0.0.1 (its address on stderr).
+
+    Returns
+    -------
+    dict
+        The counts and times (``points``, ``run``, ``reused``, ``damaged``, ``failed``,
+        ``wall_seconds``, ``compute_seconds``), the ``findings``, the ``rows`` of the table, the
+        failed points with their errors and the paths.
     """
     from stickslip.experiments.sweep import STOP_WAIT_SECONDS, _on_terminal, run_sweep
 
     t0 = time.perf_counter()
     spec = study(spec, mode) if isinstance(spec, str) else spec
+    plan = design(spec.name)
     out = Path(out_dir)
     run_dir = out / "runs" / spec.dirname
     page_dir = out / spec.name
     show = progress and _on_terminal()
-    from stickslip.experiments.studies import check_point
-
     for p in spec.points:  # validate every point before any work starts
-        check_point({**spec.common, **p})
-    _log(
-        show,
-        t0,
-        f"{spec.name} --{spec.mode}: {len(spec.points)} points in {run_dir} "
-        f"({'scheduler ' + scheduler if scheduler else 'local cluster'}); finished points are reused",
-    )
+        plan.check({**spec.common, **p})
+    where = "scheduler " + scheduler if scheduler else "local cluster"
+    _log(show, t0, f"{spec.name} --{spec.mode}: {len(spec.points)} points in {run_dir} ({where}); reusing finished")
     io.write_json(run_dir / "study-spec.json", spec.spec())
     result = run_sweep(
-        study_point_task,
+        plan.task,
         [dict(p) for p in spec.points],
         run_dir / "points",
         common=dict(spec.common),
@@ -170,16 +98,15 @@ def run_study(
         stop_wait=STOP_WAIT_SECONDS,
         dashboard=dashboard,
     )
-    table = _study_table(spec, result.table)
-    failed = table[table["status"] != "ok"]
+    points = _points_table(spec, plan, result.table)
+    failed = points[points["status"] != "ok"]
+    table = plan.rows(points) if plan.rows else points
     page_dir.mkdir(parents=True, exist_ok=True)
     record_outputs(out, [page_dir / name for name in PAGE_FILES])
     io.write_table_files(page_dir / "table", table)
-    ok = table[table["status"] == "ok"]
-    from stickslip.experiments import study_findings
-
-    findings = study_findings.conclusions(spec, ok)
-    figures = study_findings.draw(spec, ok, page_dir)
+    ok = table[table["status"] == "ok"] if "status" in table else table
+    findings = plan.findings(spec, ok) if len(ok) else {"statements": ["no finished points"]}
+    figures = _draw(spec, plan, ok, page_dir)
     # the page folder held only the manifest's files when the study began (foreign_files)
     record_outputs(out, [p for p in page_dir.iterdir() if p.is_file() and not p.name.startswith(".")])
     wall = time.perf_counter() - t0
@@ -190,18 +117,18 @@ def run_study(
         "version": __version__,
         "command": study_command(spec.name, spec.mode),
         "note": spec.note,
-        "points": len(table),
+        "points": len(points),
         "run": result.n_run,
         "reused": result.n_reused,
         "damaged": result.n_damaged,
         "failed": int(len(failed)),
         "wall_seconds": round(wall, 1),
-        "compute_seconds": round(float(np.nansum(table["wall_seconds"].to_numpy(dtype=float))), 1),
+        "compute_seconds": round(float(np.nansum(points["wall_seconds"].to_numpy(dtype=float))), 1),
         "runs": str(run_dir),
     }
-    records = _records(table)
+    records = table_records(table)
     io.write_json(page_dir / "study.json", {"meta": meta, "findings": findings, "figures": figures, "rows": records})
-    _write_page(page_dir / "index.html", spec, meta, findings, figures, table)
+    _write_page(page_dir / "index.html", spec, plan, meta, findings, figures, points, table)
     _log(show, t0, f"page: {page_dir / 'index.html'} ({wall:.1f} s)")
     return {
         **meta,
@@ -215,37 +142,43 @@ def run_study(
     }
 
 
-def _study_table(spec: Study, sweep_table: pd.DataFrame) -> pd.DataFrame:
+def _points_table(spec: Study, plan: Design, sweep_table: pd.DataFrame) -> pd.DataFrame:
     """The sweep's table with the shared settings filled in and the study's columns first."""
+    from stickslip.models.presets import PRESETS
+
     table = sweep_table.copy()
     for key in ("N", "alpha", "D", "beta", "model"):
         if key not in table.columns and key in spec.common:
             table[key] = spec.common[key]
     if "model" in table.columns:
         table["model"] = table["model"].fillna(spec.common.get("model", "sakaguchi"))
-    if "N" in table.columns and "model" in table.columns:
-        # a relative run at its preset's N carries no N in its point
-        from stickslip.models.presets import PRESETS
-
-        missing = table["N"].isna()
-        if missing.any():
+        if "N" in table.columns and table["N"].isna().any():
+            # a relative run at its preset's N carries no N in its point
+            missing = table["N"].isna()
             table.loc[missing, "N"] = [PRESETS[m].params["N"] for m in table.loc[missing, "model"]]
             table["N"] = table["N"].astype("int64")
-    if "beta" in table.columns and "model" in table.columns:
-        # models whose friction reads no beta (velocity weakening) have none
-        from stickslip.models.presets import PRESETS
-
-        no_beta = [m for m in table["model"].unique() if "beta" not in PRESETS[m].reads()]
-        table.loc[table["model"].isin(no_beta), "beta"] = np.nan
+        if "beta" in table.columns:
+            # models whose friction reads no beta (velocity weakening) have none
+            no_beta = [m for m in table["model"].unique() if "beta" not in PRESETS[m].reads()]
+            table.loc[table["model"].isin(no_beta), "beta"] = np.nan
     if "final_state" in table.columns:
         table.loc[table["status"] != "ok", "final_state"] = "failed"
-    lead = [c for c in TABLE_COLUMNS[spec.name] if c in table.columns]
-    rest = [c for c in table.columns if c not in lead]
-    return table[lead + rest].reset_index(drop=True)
+    lead = [c for c in plan.columns if c in table.columns]
+    return table[lead + [c for c in table.columns if c not in lead]].reset_index(drop=True)
 
 
-def _records(table: pd.DataFrame) -> list[dict[str, Any]]:
-    return to_jsonable(table.astype(object).where(table.notna(), None).to_dict(orient="records"))
+def _draw(spec: Study, plan: Design, table: pd.DataFrame, page_dir: Path) -> list[dict[str, Any]]:
+    """Draw the study's figures into ``page_dir`` (PNG and PDF); returns their descriptions."""
+    from stickslip.plotting.style import save_figure
+
+    if not len(table):
+        return []
+    out = []
+    for name, fig, caption in plan.figures(spec, table, page_dir):
+        save_figure(fig, page_dir / name)  # atomic: a full disk leaves no half-written image
+        command = study_command(spec.name, spec.mode)
+        out.append({"name": name, "image": f"{name}.png", "pdf": f"{name}.pdf", "caption": caption, "command": command})
+    return out
 
 
 # ---------------------------------------------------------------------------------------------
@@ -255,18 +188,25 @@ def _records(table: pd.DataFrame) -> list[dict[str, Any]]:
 def _write_page(
     path: Path,
     spec: Study,
+    plan: Design,
     meta: dict[str, Any],
     findings: dict[str, Any],
     figures: list[dict[str, Any]],
+    points: pd.DataFrame,
     table: pd.DataFrame,
 ) -> None:
     """Write the study's ``index.html``: the command, the counts, what the data say, the figures
-    (embedded) and the table, failed points marked."""
-    damaged = []
-    if "note" in table.columns and table["note"].notna().any():
-        damaged = [f"{r.point_dir}: {r.note}" for r in table.itertuples() if isinstance(r.note, str)]
-    cols = [c for c in TABLE_COLUMNS[spec.name] if c in table.columns] + ["status", "error"]
-    rows = [{**r, "_class": "failed" if r.get("status") != "ok" else ""} for r in table.to_dict(orient="records")]
+    (embedded), the study's further tables and its table, failed points and undecided rows marked,
+    and the cached points (or the rows within them) that ran again because their files were damaged."""
+    damaged = [f"{r.point_dir}: {r.note}" for r in points.itertuples() if isinstance(getattr(r, "note", None), str)]
+    if plan.rows and "note" in table:
+        damaged += [f"row {k}: {note}" for k, note in enumerate(table["note"]) if isinstance(note, str)]
+    cols = [c for c in plan.columns if c in table.columns] + [c for c in ("status", "error") if c in table.columns]
+
+    def mark(r: dict[str, Any]) -> str:
+        return "failed" if r.get("status", "ok") != "ok" else "undecided" if r.get("final_state") == "undecided" else ""
+
+    tables = [{"title": t, "cols": c, "rows": rows} for t, c, rows in (plan.tables(findings) if plan.tables else [])]
     write_page(
         path,
         "study.html.j2",
@@ -277,8 +217,9 @@ def _write_page(
         damaged=damaged,
         statements=findings.get("statements", []),
         figures=[{**fig, "src": image_src(fig["image"], path.parent)} for fig in figures],
+        tables=tables,
         cols=cols,
-        rows=rows,
+        rows=[{**r, "_class": mark(r)} for r in table.to_dict(orient="records")],
     )
 
 
@@ -312,12 +253,10 @@ def foreign_files(out: str | Path, spec: Study) -> list[str]:
     """The entries of the output folder ``out`` that no study of this package wrote (relative
     paths): at its top anything but the runs folder, the study pages and the manifest; in a page
     folder anything not in the manifest; in the runs folder anything but the folders of studies
-    (``<name>-<key>``) holding their spec, their points (each with its point.json) and the sweep's
-    summary; in a transition study's ladder anything but its bookkeeping and its rungs' files.
-    ``spec`` is the study about to run (its page names are checked even before the page folder
+    (``<name>-<key>``) holding their spec, their points (each with its point.json, holding what
+    the study's :attr:`~stickslip.experiments.studies.Design.point_entry` allows) and the sweep's
+    summary. ``spec`` is the study about to run (its page names are checked even before the page folder
     exists)."""
-    from stickslip.experiments.cache import BOOKKEEPING
-    from stickslip.experiments.ladders import RUNG_FILES
     from stickslip.experiments.studies import STUDIES
     from stickslip.experiments.sweep import POINT_FILE, STOP_FILE, SUMMARY_NAME
     from stickslip.run.rundir import LOCK_FILES, is_temporary
@@ -342,34 +281,27 @@ def foreign_files(out: str | Path, spec: Study) -> list[str]:
     def page(path: Path, rel: str):
         return rel in own and path.is_file()
 
-    def points(path: Path, rel: str):
-        summary = {f"{SUMMARY_NAME}.parquet", f"{SUMMARY_NAME}.csv", STOP_FILE}
-        return (path.is_file() and path.name in summary) or (path / POINT_FILE).is_file()
+    def points_of(plan):
+        def points(path: Path, rel: str):
+            summary = {f"{SUMMARY_NAME}.parquet", f"{SUMMARY_NAME}.csv", STOP_FILE}
+            if path.is_file():
+                return path.name in summary
+            return (path / POINT_FILE).is_file() and (plan.point_entry or True)
 
-    def rung(path: Path, rel: str):
-        return path.is_file() and path.name in ("rung.json", *RUNG_FILES)
-
-    def rungs(path: Path, rel: str):
-        return rung if path.is_dir() and re.fullmatch(r"\d{2,}-beta[^/]+", path.name) else False
-
-    def ladder(path: Path, rel: str):  # a ladder's folder: the sweep's bookkeeping and its rungs
-        if path.name == "rungs" and path.is_dir():
-            return rungs
-        return path.is_file() and path.name in BOOKKEEPING
-
-    def ladders(path: Path, rel: str):
-        return ladder if path.is_dir() and (path / POINT_FILE).is_file() else points(path, rel)
-
-    def study_runs(path: Path, rel: str):
-        if path.name == "ladders" and path.is_dir():  # a transition study's points are ladders
-            return ladders
-        if path.name == "points" and path.is_dir():
-            return points
-        return path.name == "study-spec.json" and path.is_file()
+        return points
 
     def runs(path: Path, rel: str):
-        ok = path.is_dir() and any(path.name.startswith(f"{name}-") for name in STUDIES)
-        return study_runs if ok else False
+        names = [name for name in STUDIES if path.name.startswith(f"{name}-")]
+        if not (path.is_dir() and names):
+            return False
+        points = points_of(design(names[0]))
+
+        def study_runs(path: Path, rel: str):
+            if path.name == "points" and path.is_dir():
+                return points
+            return path.name == "study-spec.json" and path.is_file()
+
+        return study_runs
 
     def top(path: Path, rel: str):
         if path.name in LOCK_FILES or (path.name == MANIFEST and path.is_file()):

@@ -1,9 +1,9 @@
 """Checks that the transition study by continuation measures what the runs from the paper's start
-measure (:mod:`stickslip.experiments.transition_study`).
+measure (:mod:`stickslip.experiments.studies.transition`).
 
 * :func:`paper_start_check`: m = 1 - <L>/L_ss from the paper's start (x_i = 0, section 3) over the
   second half of a run of 4 loading times (the old study's estimator,
-  :func:`stickslip.experiments.studies.order_summary`) against the up ladder's m at the same
+  :func:`stickslip.analysis.order.order_summary`) against the up ladder's m at the same
   (N, beta): the difference in units of the combined error.
 * :func:`longer_check`: a rung run again from the same start state for ``factor`` times its
   adaptive length, without the stop rule; its m against the adaptive one.
@@ -23,12 +23,14 @@ __all__ = ["paper_start_m", "paper_start_check", "longer_check", "rung_start_sta
 def paper_start_m(N: int, beta: float, loads: float = 4.0) -> dict[str, Any]:
     """m and its batch-means error over the second half of a run of ``loads`` loading times of the
     chain of eq. (4) from the paper's start (the estimator of the point-by-point study)."""
-    from stickslip.experiments.studies import _PAPER, _t_end, order_summary
+    from stickslip.analysis.order import order_summary
+    from stickslip.experiments.studies.chain_point import t_end_of
+    from stickslip.models.physics import UNTIL_STEADY
     from stickslip.models.presets import chain_params
     from stickslip.run.driver import run_chain
 
-    p = chain_params("sakaguchi", N=N, beta=beta, **_PAPER)
-    t_end = _t_end(N, loads)
+    p = chain_params("sakaguchi", N=N, beta=beta)
+    t_end = t_end_of(N, loads)
     run = run_chain(
         p,
         t_end,
@@ -36,7 +38,7 @@ def paper_start_m(N: int, beta: float, loads: float = 4.0) -> dict[str, Any]:
         sample_interval=t_end / 20000,
         average_from=0.5 * t_end,
         sample_moving=True,
-        until_steady=1e-6,
+        until_steady=UNTIL_STEADY,
     )
     s = order_summary(run, p, 0.5 * t_end)
     return {

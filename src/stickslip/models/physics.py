@@ -10,6 +10,10 @@ import numpy as np
 
 from stickslip.models.params import BlockParams, ChainParams
 
+#: Tolerance of steady sliding (largest deviation of v, theta and the springs from it) where the
+#: studies and the reproduction stop a chain run or call its final state steady.
+UNTIL_STEADY = 1e-6
+
 
 def sliding_friction(V: float, beta: float) -> float:
     """Friction of steady sliding, c = theta_0 + beta v_0 = 1 - (1 - beta) V (sections 2, 3)."""

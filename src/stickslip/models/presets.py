@@ -72,6 +72,16 @@ _BC_NOTE = (
 PAPER = "sakaguchi"
 
 
+def paper_parameters(*omit: str) -> dict[str, Any]:
+    """The parameters of the paper's chain (eq. 4, section 3: K = 10, D = 5, V = 0.001, beta = 1,
+    alpha = 1, Fs = 3, dt = 0.005, N = 399) as its preset holds them, less the fields in ``omit``.
+
+    >>> paper_parameters("N", "beta")
+    {'K': 10.0, 'D': 5.0, 'V': 0.001, 'alpha': 1.0, 'Fs': 3.0, 'dt': 0.005}
+    """
+    return {k: v for k, v in PRESETS[PAPER].params.items() if k not in omit}
+
+
 def is_paper(model: str) -> bool:
     """Whether a study's row is of the paper's chain (eq. 4) rather than one of its relatives."""
     return model == PAPER

@@ -15,7 +15,7 @@ back with :func:`~stickslip.run.rundir.load_run`), each drawn into ``ax`` when o
 and from tables: :func:`length_against_beta` (Fig. 5b), :func:`snapshot_figure`,
 :func:`sizes_figure`, :func:`fronts_figure`, and :func:`loops_figure` (the hysteresis loops of the
 transition at beta_c = 1, from
-:func:`~stickslip.experiments.transition_study.transition_loop`). The paper's names (``fig5a_snapshot``,
+:func:`~stickslip.experiments.studies.transition.transition_loop`). The paper's names (``fig5a_snapshot``,
 ``fig5b_length``, ``fig6_fronts``, ``fig7_8_sizes``) stay as aliases. Titles name the model and
 the parameters it reads; "Fig. N" appears only on the paper's own runs.
 :mod:`stickslip.plotting.figures` draws the report of ``stickslip reproduce``.

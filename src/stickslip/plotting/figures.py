@@ -18,8 +18,8 @@ import xarray as xr
 
 from stickslip import io
 from stickslip.analysis.chain_runs import fig6_start_note, sweep_table
-from stickslip.experiments.specs import Outcome
 from stickslip.models.params import ChainParams
+from stickslip.outcome import Outcome
 from stickslip.report.commands import block_command, chain_command, hysteresis_command, sweep_command
 from stickslip.report.writer import ReportFigure
 

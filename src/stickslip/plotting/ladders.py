@@ -2,7 +2,7 @@
 hysteresis loops of the order parameters against beta, and beta_t(N) - 1 and the step of m at
 beta_t against N on log axes with their fitted power laws.
 
-Each function takes the study's rows or per-N table (:mod:`stickslip.experiments.transition_study`)
+Each function takes the study's rows or per-N table (:mod:`stickslip.experiments.studies.transition`)
 and returns a matplotlib Figure.
 """
 
@@ -28,7 +28,7 @@ def loops_figure(rows: pd.DataFrame) -> Figure:
         The rungs, one per row: ``N``, ``beta``, ``branch``, optionally ``replica``,
         ``order_parameter``, ``stuck_fraction`` and their ``_err`` columns (the table of
         ``stickslip study transition``, or
-        :func:`~stickslip.experiments.transition_study.transition_loop`).
+        :func:`~stickslip.experiments.studies.transition.transition_loop`).
 
     Returns
     -------

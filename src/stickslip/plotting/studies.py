@@ -1,6 +1,4 @@
-"""Figures of the studies (``stickslip study``): the order parameter against beta, the time to
-reach steady sliding, the collapse of m against 1 - beta, the phase diagrams, tau against beta and
-the largest Lyapunov exponent against beta.
+"""Figures of the studies (``stickslip study``): the phase diagrams and tau against beta.
 
 Each function takes the study's table (one row per point, :mod:`stickslip.experiments.study_run`)
 and returns a matplotlib Figure.
@@ -17,9 +15,6 @@ from stickslip.models.presets import PRESETS, is_paper
 from stickslip.plotting.style import new_figure
 
 __all__ = [
-    "order_parameter_figure",
-    "steady_time_figure",
-    "collapse_figure",
     "phase_map_figure",
     "exponents_figure",
     "STATE_STYLE",
@@ -27,81 +22,6 @@ __all__ = [
 
 #: Marker colour of each final state.
 STATE_STYLE = {"steady": "C0", "stick-slip": "C3", "undecided": "C1", "failed": "0.5"}
-
-
-def order_parameter_figure(table: pd.DataFrame) -> Figure:
-    """m = 1 - <L>/L_ss against beta, one curve per N, error bars from batch means; open
-    markers for runs whose final state is undecided (section 3, Fig. 5b as an order parameter)."""
-    fig, ax = new_figure(width=6.0, height=4.0)
-    for k, (N, g) in enumerate(sorted(table.groupby("N"), key=lambda x: x[0])):
-        g = g.sort_values("beta")
-        color = f"C{k}"
-        ax.errorbar(
-            g["beta"],
-            g["order_parameter"],
-            yerr=g["order_parameter_err"],
-            color=color,
-            lw=1,
-            marker="o",
-            ms=4,
-            capsize=2,
-            label=f"N = {N}",
-        )
-        und = g[g["final_state"] == "undecided"]
-        ax.plot(und["beta"], und["order_parameter"], "o", ms=9, mfc="none", mec=color)
-    ax.axvline(1.0, color="0.5", lw=0.8, ls=":")
-    ax.axhline(0.0, color="0.5", lw=0.8)
-    ax.set_xlabel(r"$\beta$")
-    ax.set_ylabel(r"$m = 1 - \langle L\rangle / L_\mathrm{ss}$")
-    ax.legend(title="large open circle: undecided")
-    return fig
-
-
-def steady_time_figure(table: pd.DataFrame) -> Figure:
-    """Time at which the run reached steady sliding, in loading times L_ss/V, against beta."""
-    fig, ax = new_figure(width=6.0, height=4.0)
-    for k, (N, g) in enumerate(sorted(table.groupby("N"), key=lambda x: x[0])):
-        g = g[g["t_steady"].notna()].sort_values("beta")
-        if len(g):
-            load = N * (N - 1) / (2.0 * 10.0 * 0.001)
-            ax.plot(g["beta"], g["t_steady"].astype(float) / load, "o-", color=f"C{k}", ms=4, label=f"N = {N}")
-    ax.set_xlabel(r"$\beta$")
-    ax.set_ylabel(r"$t_\mathrm{steady}\,/\,(L_\mathrm{ss}/V)$")
-    if ax.get_legend_handles_labels()[0]:
-        ax.legend()
-    return fig
-
-
-def collapse_figure(table: pd.DataFrame, fits: dict | None = None) -> Figure:
-    """m against 1 - beta on log-log axes for every N (stick-slip points with m > 0): curves
-    that fall on one another need no N-dependent rescaling; dashed: the fitted power laws."""
-    fig, ax = new_figure(width=6.0, height=4.0)
-    for k, (N, g) in enumerate(sorted(table.groupby("N"), key=lambda x: x[0])):
-        g = g[(g["beta"] < 1.0) & (g["order_parameter"] > 0)].sort_values("beta")
-        if not len(g):
-            continue
-        x = 1.0 - g["beta"].to_numpy(float)
-        ax.errorbar(
-            x,
-            g["order_parameter"],
-            yerr=g["order_parameter_err"],
-            fmt="o",
-            color=f"C{k}",
-            ms=4,
-            capsize=2,
-            label=f"N = {N}",
-        )
-        f = (fits or {}).get(int(N))
-        if f and np.isfinite(f.get("b", np.nan)):
-            xx = np.geomspace(x.min(), x.max(), 20)
-            ax.plot(xx, f["A"] * xx ** f["b"], "--", color=f"C{k}", lw=0.8)
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    ax.set_xlabel(r"$1 - \beta$")
-    ax.set_ylabel(r"$m$")
-    if ax.get_legend_handles_labels()[0]:
-        ax.legend()
-    return fig
 
 
 def phase_map_figure(table: pd.DataFrame, x: str, title: str) -> Figure:

@@ -1,12 +1,12 @@
 """The ``stickslip`` command lines that reproduce a row or a figure of the report.
 
-Each takes the :class:`~stickslip.experiments.specs.Outcome` of the experiment behind the row
+Each takes the :class:`~stickslip.outcome.Outcome` of the experiment behind the row
 or figure and names the command (and its options) that computes the same thing.
 """
 
 from __future__ import annotations
 
-from stickslip.experiments.specs import Outcome, chain_common, point_settings
+from stickslip.outcome import Outcome, chain_common, point_settings
 
 
 def g(x: float) -> str:

@@ -16,8 +16,8 @@ import pandas as pd
 
 from stickslip.analysis.chain_runs import fig6_start_note, sweep_table
 from stickslip.analysis.statistics import central_interval
-from stickslip.experiments.specs import Outcome
 from stickslip.models.physics import chain_steady_state
+from stickslip.outcome import Outcome
 from stickslip.report.commands import chain_command, hysteresis_command, sweep_command
 from stickslip.report.commands import g as _g
 from stickslip.report.writer import ReportRow

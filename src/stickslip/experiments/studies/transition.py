@@ -13,41 +13,38 @@ and retried, an interrupted one continues from its last finished rung). From the
   with ``step_err``, and ``step_phi`` of the stuck fraction;
 * power laws beta_t - 1 ~ N^b and (size of the step) ~ N^b (:func:`stickslip.analysis.order.power_law_fit`).
 
-Layout: ``OUT/runs/transition-<key>/ladders/<ladder>/rungs/...`` and ``OUT/transition/`` (table,
+Layout: ``OUT/runs/transition-<key>/points/<ladder>/rungs/...`` and ``OUT/transition/`` (table,
 figures, ``study.json``, ``index.html``).
 """
 
 from __future__ import annotations
 
+import json
 import math
-import os
 import tempfile
-import time
 from collections.abc import Sequence
 from pathlib import Path
-from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
 import pandas as pd
 
-from stickslip import __version__, io
-from stickslip.analysis.adaptive import STOP_BATCHES
-from stickslip.experiments.cache import spec_key
-from stickslip.experiments.ladders import params_at
-from stickslip.experiments.study_run import PAGE_FILES, record_outputs
-from stickslip.experiments.transition_page import PER_N_COLUMNS, ROW_COLUMNS, write_page
-from stickslip.models.params import check_number
+from stickslip.experiments.ladders import ladder_entry, ladder_task, params_at
+from stickslip.experiments.studies import Design, Option, Study
+from stickslip.jsonable import table_records
+from stickslip.models.params import MAX_BLOCKS, check_number
+from stickslip.models.presets import paper_parameters
 
-__all__ = [
-    "ladder_points",
-    "run_transition",
-    "transition_loop",
-    "per_n_summary",
-    "ROW_COLUMNS",
-    "PER_N_COLUMNS",
-    "LADDER_NS",
-]
+__all__ = ["DESIGN", "ladder_points", "transition_loop", "per_n_summary", "ROW_COLUMNS", "PER_N_COLUMNS", "LADDER_NS"]
+
+#: The leading columns of the study's rows (one per rung) and of its per-N table.
+ROW_COLUMNS = (
+    "N beta branch replica order_parameter order_parameter_err stuck_fraction stuck_fraction_err final_state "
+    "branch_state t_end loads tau_int_loads t_cut_loads err_reliable role start final_reason wall_seconds"
+).split()
+PER_N_COLUMNS = (
+    "N beta_t beta_t_err lower_edge lower_edge_err step step_err step_phi step_phi_err beta_t_spread replicas"
+).split()
 
 #: N of each mode; ``extra_Ns`` (for example 1599) adds chains.
 LADDER_NS = {"tiny": (9,), "quick": (49, 99, 199), "full": (49, 99, 199, 399, 799)}
@@ -55,7 +52,6 @@ LADDER_NS = {"tiny": (9,), "quick": (49, 99, 199), "full": (49, 99, 199, 399, 79
 #: random event near beta_t (at N = 99 five seeds gave beta_t from 1.11 to 1.20), so beta_t and
 #: the step are means over replicas with the spread between them as their error.
 REPLICAS = {"tiny": 2, "quick": 4, "full": 4}
-_PAPER = {"K": 10.0, "D": 5.0, "V": 0.001, "Fs": 3.0, "alpha": 1.0, "dt": 0.005}
 
 
 def _cap_loads(N: int) -> float:
@@ -89,9 +85,11 @@ def _grids(N: int, mode: str) -> tuple[list[float], list[float]]:
 def ladder_points(mode: str, extra_Ns: tuple[int, ...] = ()) -> tuple[dict[str, Any], list[dict[str, Any]]]:
     """The shared settings and the ladders (one per N and direction) of a mode; large N first (the
     up ladder of the largest chain is the longest task: it sets the wall time on a few workers)."""
+    from stickslip.analysis.adaptive import STOP_BATCHES
+
     Ns = tuple(sorted(set(LADDER_NS[mode]) | set(int(n) for n in extra_Ns)))
     common = {
-        **_PAPER,
+        **paper_parameters("N", "beta"),
         "model": "sakaguchi",
         "target": 0.006,
         "segment_loads": 0.25,
@@ -116,17 +114,23 @@ def ladder_points(mode: str, extra_Ns: tuple[int, ...] = ()) -> tuple[dict[str, 
     return common, points
 
 
-def study_folder(mode: str, extra_Ns: tuple[int, ...] = ()) -> SimpleNamespace:
-    """What the study of ``mode`` owns in its output folder: the page folder ``name`` and the runs
-    folder ``runs/<dirname>`` (the :class:`~stickslip.experiments.studies.Study` fields the
-    folder's owner reads)."""
-    common, _ = ladder_points(mode, extra_Ns)
-    return SimpleNamespace(name="transition", dirname=f"transition-{_key(common)}")
+def build(mode: str, extra_Ns: Sequence[int] = ()) -> Study:
+    """The study of ``mode``: :func:`ladder_points`, with chains of ``extra_Ns`` blocks added."""
+    for n in extra_Ns:
+        check_number("extra-n", n, low=3, high=MAX_BLOCKS, integer=True)
+    common, points = ladder_points(mode, tuple(extra_Ns))
+    Ns = sorted({p["N"] for p in points})
+    note = (
+        f"{mode}: N in {Ns}, {common['replicas']} up ladders and one down ladder per N, rungs to an "
+        f"error of m of {common['target']:g}, {common['bisections']} bisections of each bracket"
+    )
+    return Study("transition", mode, common, tuple(points), note=note)
 
 
-def _key(common: dict[str, Any]) -> str:
-    # json's default separators, as when the first runs were written: their folders keep their names
-    return spec_key({"study": "transition-ladders", "common": common, "version": __version__}, separators=(", ", ": "))
+def check(cfg: dict[str, Any]) -> None:
+    """Refuse a ladder whose chain at one of its betas is not a valid chain (ParameterError)."""
+    for beta in cfg["betas"]:
+        params_at(cfg, float(beta))
 
 
 def _replica_edge(up: pd.DataFrame) -> dict[str, Any] | None:
@@ -236,105 +240,42 @@ def _statements(per_n: pd.DataFrame, fits: dict[str, Any], rows: pd.DataFrame) -
     return say
 
 
-def _figures(rows: pd.DataFrame, per_n: pd.DataFrame, fits: dict[str, Any], out: Path) -> list[str]:
-    from stickslip.plotting.ladders import loops_figure, scaling_figure
-    from stickslip.plotting.style import FIGURE_FORMATS, save_figure
-
-    names = []
-    for name, fig in (("loops", loops_figure(rows)), ("scaling", scaling_figure(per_n, fits))):
-        record_outputs(out.parent, [out / f"{name}.{fmt}" for fmt in FIGURE_FORMATS])
-        save_figure(fig, out / name)  # atomic: a full disk leaves no half-written image
-        names.append(f"{name}.png")
-    return names
+def rungs(sweep: pd.DataFrame) -> pd.DataFrame:
+    """The study's table, one row per rung, from the sweep's (one row per ladder)."""
+    ok = sweep[sweep["status"] == "ok"] if "status" in sweep else sweep.iloc[:0]
+    rows = [r for text in ok.get("rows", []) for r in (json.loads(text) if isinstance(text, str) else text)]
+    return _rows_table(rows)
 
 
-def run_transition(
-    out_dir: str | Path,
-    mode: str = "quick",
-    *,
-    extra_Ns: tuple[int, ...] = (),
-    scheduler: str | None = None,
-    n_workers: int | None = None,
-    progress: bool = True,
-    command: str | None = None,
-    dashboard: bool = False,
-) -> dict[str, Any]:
-    """Run (or resume) every ladder of the transition study and write its table, figures and page
-    under ``out_dir/transition``. Returns the rows, the per-N summary, the fits and the run's
-    wall time, workers and cores."""
-    from stickslip.experiments.ladders import ladder_task
-    from stickslip.experiments.sweep import STOP_WAIT_SECONDS, _on_terminal, point_name, run_sweep
-
-    t0 = time.perf_counter()
-    common, points = ladder_points(mode, extra_Ns)
-    out = Path(out_dir)
-    run_dir = out / "runs" / f"transition-{_key(common)}"
-    page = out / "transition"
-    io.write_json(run_dir / "study-spec.json", {"common": common, "ladders": points, "version": __version__})
-    result = run_sweep(
-        ladder_task,
-        points,
-        run_dir / "ladders",
-        common=common,
-        scheduler=scheduler,
-        n_workers=n_workers,
-        progress=progress and _on_terminal(),
-        stop_wait=STOP_WAIT_SECONDS,
-        dashboard=dashboard,
-    )
-    rows: list[dict[str, Any]] = []
-    failed = []
-    for p in points:
-        d = run_dir / "ladders" / point_name(p)
-        try:
-            rec = io.read_json(d / "done.json")
-            rows += rec["summary"]["rows"]
-        except (OSError, ValueError, KeyError):
-            err = d / "error.json"
-            failed.append({"ladder": point_name(p), "error": io.read_json(err).get("error") if err.is_file() else None})
-    # why cached ladders and rungs ran again (their files damaged), for the page
-    rerun = [f"{r.point_dir}: {r.note}" for r in result.table.itertuples() if isinstance(getattr(r, "note", None), str)]
-    rerun += [f"N = {r['N']} {r['branch']} rung {r['rung']}: {r['note']}" for r in rows if r.get("note")]
-    table = _rows_table(rows)
+def findings(spec: Study, table: pd.DataFrame) -> dict[str, Any]:
+    """beta_t, the lower edge and the step at beta_t per N (:func:`per_n_summary`), their power
+    laws in N and the statements of the page."""
     per_n = per_n_summary(table) if len(table) else pd.DataFrame(columns=PER_N_COLUMNS)
     fits = _fits(per_n) if len(per_n) else {}
-    page.mkdir(parents=True, exist_ok=True)
-    figures = _figures(table, per_n, fits, page) if len(table) else []
-    wall = time.perf_counter() - t0
-    meta = {
-        "study": "transition",
-        "mode": mode,
-        "command": command or f"stickslip study transition --{mode}",
-        "version": __version__,
-        "wall_seconds": round(wall, 1),
-        "workers": n_workers or os.cpu_count(),
-        "cores": os.cpu_count(),
-        "ladders": len(points),
-        "ladders_run": result.n_run,
-        "ladders_reused": result.n_reused,
-        "ladders_damaged": result.n_damaged,  # cached ladders run again: their files were damaged
-        "rungs_damaged": sum(1 for r in rows if r.get("note")),  # cached rungs run again: their files were damaged
-        "failed": len(failed),
+    return {
+        "statements": _statements(per_n, fits, table) if len(table) else [],
+        "fits": fits,
+        "per_N": table_records(per_n),
         "rungs": len(table),
         "undecided": int((table["final_state"] == "undecided").sum()) if len(table) else 0,
-        "runs": str(run_dir),
+        "rungs_damaged": int(table["note"].notna().sum()) if "note" in table else 0,
     }
-    statements = _statements(per_n, fits, table) if len(table) else []
-    data = {
-        "meta": meta,
-        "statements": statements,
-        "fits": fits,
-        "per_N": _records(per_n),
-        "rows": _records(table),
-        "figures": figures,
-        "failed_ladders": failed,
-        "damaged": rerun,
-    }
-    record_outputs(out, [page / n for n in PAGE_FILES])
-    io.write_table_files(page / "table", table)
-    io.write_json(page / "study.json", data)
-    write_page(page / "index.html", data)
-    return {**data, "page": str(page / "index.html"), "failed": len(failed)}
+
+
+def figures(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[tuple[str, Any, str]]:
+    """The loops of m and the stuck fraction against beta, and the scaling of beta_t - 1 and the
+    step with N (:mod:`stickslip.plotting.ladders`)."""
+    from stickslip.plotting.ladders import loops_figure, scaling_figure
+
+    per_n = per_n_summary(table)
+    return [
+        ("loops", loops_figure(table), "m and the stuck fraction against beta: up ladders and the down ladder, per N."),
+        ("scaling", scaling_figure(per_n, _fits(per_n)), "beta_t - 1 and the step of m at beta_t against N."),
+    ]
+
+
+def _per_n_table(found: dict[str, Any]) -> list[tuple[str, list[str], list[dict[str, Any]]]]:
+    return [("Per N", PER_N_COLUMNS + ["undecided", "rungs"], found.get("per_N", []))]
 
 
 def _rows_table(rows: list[dict[str, Any]]) -> pd.DataFrame:
@@ -398,13 +339,11 @@ def transition_loop(
 
     Examples
     --------
-    >>> from stickslip.experiments.transition_study import per_n_summary, transition_loop
+    >>> from stickslip.experiments.studies.transition import per_n_summary, transition_loop
     >>> rows = transition_loop(9, bisections=0, cap_loads=1.0, up=[0.8, 4.0], down=[4.0, 0.8])
     >>> [(r.branch, r.beta, r.branch_state) for r in rows.itertuples()]
     [('down', 0.8, 'stick-slip'), ('down', 4.0, 'sliding'), ('up', 0.8, 'stick-slip'), ('up', 4.0, 'sliding')]
     """
-    from stickslip.experiments.ladders import ladder_task
-
     N = int(check_number("N", N, low=1, integer=True))
     replicas = int(check_number("replicas", replicas, low=1, integer=True))
     bisections = int(check_number("bisections", bisections, low=0, integer=True))
@@ -424,9 +363,37 @@ def transition_loop(
     return _rows_table(rows)
 
 
-def _records(table: pd.DataFrame) -> list[dict[str, Any]]:
-    from stickslip.jsonable import to_jsonable
+def describe() -> str:
+    """The text of ``stickslip study transition --help``."""
+    quick, full = build("quick"), build("full")
+    return (
+        "Where does the chain of eq. (4) leave stick-slip as beta crosses 1, and how does that change "
+        "with N? By continuation in beta: for each N, up ladders start in stick-slip below beta = 1 "
+        "and hand each rung's final state to the next larger beta until the chain slides; a down "
+        "ladder starts from steady sliding and goes down until a block sticks; each bisects the "
+        "bracket it finds. Each rung stops when its answer is known (error of m, steady sliding "
+        "reached, or its cap). "
+        f"Grid: --quick {quick.note.split(': ', 1)[1]} ({len(quick.points)} ladders, 5 to 11 minutes "
+        f"on two cores); --full {full.note.split(': ', 1)[1]} ({len(full.points)} ladders, about 45 "
+        "minutes on two free cores); --extra-n adds a chain (1599: hours). Outputs in "
+        "DIR/transition/: table.parquet and table.csv (one row per rung: m, the stuck fraction, "
+        "their errors, the final state), loops and scaling (PNG, PDF), study.json (with beta_t, "
+        "the lower edge and the step per N and their power laws in N), index.html."
+    )
 
-    if not len(table):
-        return []
-    return to_jsonable(table.astype(object).where(table.notna(), None).to_dict(orient="records"))
+
+DESIGN = Design(
+    name="transition",
+    summary="the edges of the stick-slip loop at beta = 1 against N, by continuation in beta",
+    describe=describe,
+    build=build,
+    task=ladder_task,
+    check=check,
+    findings=findings,
+    figures=figures,
+    columns=tuple(ROW_COLUMNS),
+    rows=rungs,
+    tables=_per_n_table,
+    point_entry=ladder_entry,
+    options=(Option("--extra-n", "extra_Ns", "N", "add a chain of N blocks (both ladders), e.g. 1599; repeatable"),),
+)

@@ -1,4 +1,11 @@
-"""What ``stickslip study chaos`` finds: the statements of its page, delta* against N, its figures.
+"""``stickslip study chaos``: is the chain of eq. (4) chaotic at the onset (section 3, "chaotic
+motion")? Its points, its findings (delta* against N) and its figures (docs/studies/chaos.md).
+
+At several N and beta = 0.5, 0.9, 1 from a loaded state: the flow's largest exponent over some 300
+slips, the decorrelation of the slip sequence over 1000 slips against the size of a perturbation
+(state, Fs, V), its threshold delta* and the verdict (one point:
+:func:`stickslip.experiments.chaos_verdict.chaos_point`); two blocks and Carlson-Langer as known
+answers.
 
 From the table (one row per point, :func:`stickslip.experiments.chaos_verdict.chaos_point`):
 each point's verdict with the window it holds for, the flow's exponent and the slips its rungs
@@ -16,12 +23,100 @@ from typing import Any
 
 import pandas as pd
 
-from stickslip.experiments.chaos_verdict import threshold_columns
+from stickslip.experiments.chaos_verdict import DELTAS_FULL, DELTAS_QUICK, TRANSIENTS, threshold_columns
+from stickslip.experiments.studies import Design, Study
+from stickslip.experiments.studies.chain_point import point_params
 from stickslip.models.presets import PRESETS, is_paper
 
-__all__ = ["conclusions", "curves", "figures", "decorrelation_table"]
+__all__ = ["DESIGN", "chaos_points", "conclusions", "curves", "figures", "decorrelation_table"]
 
 KINDS = ("state", "Fs", "V")
+
+
+def chaos_points(mode: str) -> tuple[list[dict[str, Any]], dict[str, Any]]:
+    """The points of ``stickslip study chaos`` in ``mode`` and the settings they share: the
+    paper's chain (eq. 4) at several N and beta = 0.5, 0.9, 1, and two blocks and Carlson-Langer at
+    their standard parameters (the verdict's known answers: chaotic), dearest first. A point's
+    own keys override the shared ones (the relatives' interval, kinds and ladder length)."""
+    betas = (0.5, 0.9, 1.0)
+    # a rung of 1.2e5 time units counts 0.9 of it: some 360 slips of the chain at every N (1000 slips
+    # take 2.9e5 to 3.0e5, docs/studies/chaos.md); --full counts five times as many (at N = 799 the
+    # growth of a separation comes in rare large slips, and 360 slips hold only a few of them)
+    if mode == "tiny":
+        Ns, deltas, seeds, events, flow_t, levels = (5, 9), (1e-8, 1e-4, 1e-1), 2, 40, 2000.0, 2
+        transients = {5: 1e4, 9: 2e4}
+        family = [{"model": "two-blocks", "transient": 100.0, "flow_t": 200.0, "events": 30, "seeds": 1}]
+    elif mode == "quick":
+        Ns, deltas, seeds, events, flow_t, levels = (49, 99, 199), DELTAS_QUICK, 2, 1000, 1.2e5, 3
+        transients = TRANSIENTS
+        family = [
+            {"model": "two-blocks", "transient": 2e3, "flow_t": 1.2e4, "seeds": 1},
+            {"model": "carlson-langer", "transient": 2e3, "flow_t": 1e3, "seeds": 1},
+        ]
+    else:
+        Ns, deltas, seeds, events, flow_t, levels = (49, 99, 199, 399, 799), DELTAS_FULL, 3, 1000, 6e5, 3
+        transients = TRANSIENTS
+        family = [
+            {"model": "two-blocks", "transient": 2e3, "flow_t": 1.2e4},
+            {"model": "carlson-langer", "transient": 2e3, "flow_t": 1e3},
+        ]
+    shared = {
+        "kinds": ["state", "Fs", "V"],
+        "deltas": list(deltas),
+        "seeds": seeds,
+        "events": events,
+        "flow_t": flow_t,
+        "levels": levels,
+        "interval": 10.0,
+        # above the rounding floor of positions of order L_ss ~ N^2 / (2 K): at N = 799 the
+        # exponent is the same for d0 = 1e-8 .. 1e-6 and grows spuriously below 1e-9
+        # (docs/studies/chaos.md, "d0 and the rounding floor")
+        "d0": 1e-8,
+    }
+    points: list[dict[str, Any]] = [
+        {"model": "sakaguchi", "start": "paper", "N": N, "beta": b, "transient": transients[N]}
+        for N in Ns
+        for b in betas
+    ]
+    points += [
+        {**f, "start": "rest", "perturbation": 0.01, "seed": 0, "kinds": "state", "interval": 1.0} for f in family
+    ]
+    points.sort(key=lambda p: -(p.get("N", 100) ** 2) * p["transient"] ** 0.5)
+    return points, shared
+
+
+def build(mode: str) -> Study:
+    """The study of ``mode``: :func:`chaos_points` and the settings they share."""
+    points, shared = chaos_points(mode)
+    chain = [{**shared, **p} for p in points if is_paper(p["model"])]
+    Ns = sorted({p["N"] for p in chain})
+    betas = sorted({p["beta"] for p in chain})
+    first = chain[0]
+    transients = ", ".join(f"{p['transient']:g}" for p in sorted(chain, key=lambda p: p["N"]) if p["beta"] == betas[0])
+    family = " and ".join(PRESETS[p["model"]].label or p["model"] for p in points if not is_paper(p["model"]))
+    common = {"analysis": "chaos", "segments": 10, "direction_seed": 0, **shared}
+    note = (
+        f"{mode}: eq. (4) at N = {', '.join(map(str, Ns))}, beta = {', '.join(f'{b:g}' for b in betas)}, "
+        f"from loaded states (transients {transients}); "
+        f"flow ladders of {first['flow_t']:g} time units; n(delta) for {len(first['deltas'])} deltas "
+        f"({first['deltas'][0]:g} .. {first['deltas'][-1]:g}), perturbations of the state, Fs and V, "
+        f"{first['seeds']} windows of {first['events']} slips; {family} at standard parameters"
+    )
+    return Study("chaos", mode, common, tuple(points), note=note)
+
+
+def task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
+    """One point on a worker (:func:`stickslip.experiments.chaos_verdict.chaos_point`)."""
+    from stickslip.experiments.chaos_verdict import chaos_point
+
+    return chaos_point(point, point_params(point), Path(point_dir))
+
+
+def check(cfg: dict[str, Any]) -> None:
+    """Refuse a point's merged settings (:func:`stickslip.experiments.chaos_verdict.check_point`)."""
+    from stickslip.experiments.chaos_verdict import check_point
+
+    check_point(cfg, point_params(cfg))
 
 
 def _finite(x) -> bool:
@@ -81,7 +176,7 @@ def fits(points: list[dict[str, Any]]) -> list[dict[str, Any]]:
     return out
 
 
-def conclusions(table: pd.DataFrame) -> dict[str, Any]:
+def conclusions(spec: Study | None, table: pd.DataFrame) -> dict[str, Any]:
     """Statements, verdicts, delta* and its fits of a chaos study's rows (module docstring)."""
     out: dict[str, Any] = {"statements": [], "verdicts": {}, "points": []}
     say = out["statements"].append
@@ -181,13 +276,14 @@ def decorrelation_table(found: list[dict[str, Any]]) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def figures(table: pd.DataFrame, points_dir: Path, page_dir: Path) -> list[tuple[str, Any, str]]:
-    """The study's figures (name, Figure, caption) and ``decorrelation.csv``/``.parquet`` in
-    ``page_dir`` (every n(delta) row)."""
+def figures(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[tuple[str, Any, str]]:
+    """The study's figures (name, Figure, caption), from each point's ``flow.json`` in its runs
+    folder beside ``page_dir``, and ``decorrelation.csv``/``.parquet`` in ``page_dir`` (every
+    n(delta) row)."""
     from stickslip import io
     from stickslip.plotting import chaos as pc
 
-    found = curves(table, points_dir)
+    found = curves(table, Path(page_dir).parent / "runs" / spec.dirname / "points")
     if not found:
         return []
     io.write_table_files(Path(page_dir) / "decorrelation", decorrelation_table(found))
@@ -218,3 +314,40 @@ def figures(table: pd.DataFrame, points_dir: Path, page_dir: Path) -> list[tuple
             )
         )
     return out
+
+
+def describe() -> str:
+    """The text of ``stickslip study chaos --help``."""
+    quick, full = build("quick"), build("full")
+    return (
+        "Is the chain of eq. (4) chaotic at the onset of stick-slip? For each point, from a loaded "
+        "state: the flow's largest exponent (two trajectories with located switches at dt, dt/2, "
+        "dt/4, extrapolated to dt -> 0), the number of slips n(delta) that agree between a run and a "
+        "twin perturbed by delta (the state, Fs or V), the threshold delta* and the verdict "
+        "(chaotic, stable chaos, regular or undetermined); two blocks and Carlson-Langer as known answers. "
+        f"Grid: --quick {quick.note.split(': ', 1)[1]} ({len(quick.points)} points, about 8 minutes "
+        f"on two cores); --full {full.note.split(': ', 1)[1]} ({len(full.points)} points, about an "
+        "hour on two cores). Outputs in DIR/chaos/: table.parquet and table.csv (one row per point: "
+        "verdict, exponent, delta* per kind), decorrelation.csv, decorrelation, flow_ladder and "
+        "threshold (PNG, PDF), study.json, index.html."
+    )
+
+
+_COLUMNS = "model N beta verdict verdict_text lyapunov_dt0 lyapunov_dt0_err flow_slips window"
+for _kind in KINDS:
+    _COLUMNS += f" delta_star_{_kind} delta_star_{_kind}_err_log10 delta_star_{_kind}_low"
+    _COLUMNS += f" delta_star_{_kind}_high delta_star_{_kind}_censored"
+_COLUMNS += " threshold_below threshold_low windows_decorrelated windows transient loaded"
+_COLUMNS += " first_slip_reaching_block_N flow_t seeds n_deltas"
+
+DESIGN = Design(
+    name="chaos",
+    summary="the flow's exponent, slip decorrelation and its threshold delta* against N; the verdict",
+    describe=describe,
+    build=build,
+    task=task,
+    check=check,
+    findings=conclusions,
+    figures=figures,
+    columns=tuple(_COLUMNS.split()),
+)

@@ -1,0 +1,164 @@
+"""The studies the paper leaves open (``stickslip study NAME``): one module each.
+
+A study's module says everything about it in one :class:`Design`: its points in each mode (a
+:class:`Study`), the task that runs one point on a Dask worker, its findings and figures from the
+table of its finished points, the columns of its page and the text of ``stickslip study NAME
+--help``. :func:`stickslip.experiments.study_run.run_study` runs any of them (points on Dask with
+the cache, resume and folder ownership of :func:`stickslip.experiments.sweep.run_sweep`) without
+naming one.
+
+* :mod:`~stickslip.experiments.studies.transition`: the stick-slip transition at beta = 1 as N
+  grows, by continuation in beta (ladders of chain runs);
+* :mod:`~stickslip.experiments.studies.phase_diagram`: final state and m over (alpha, beta) and
+  (D, beta), from two starts;
+* :mod:`~stickslip.experiments.studies.exponents`: the slip-size exponent tau against beta, and
+  Carlson-Langer;
+* :mod:`~stickslip.experiments.studies.chaos`: is the chain chaotic at the onset (the flow's
+  exponent, the decorrelation of slips, its threshold delta*)?
+
+A :class:`Study`'s key hashes its name, the settings every point shares and the package version
+(not the point list, so a point added to a study keeps the directory and runs only the new point).
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+from stickslip import __version__
+from stickslip.experiments.cache import canonical, spec_key
+
+__all__ = ["Study", "Design", "Option", "STUDIES", "MODES", "design", "study", "study_command"]
+
+#: The studies, each the module of its name (``-`` read as ``_``) in this package.
+STUDIES = ("transition", "phase-diagram", "exponents", "chaos")
+#: ``tiny`` runs every study on chains of a few blocks in seconds (tests); its numbers mean nothing.
+MODES = ("quick", "full", "tiny")
+
+
+@dataclass(frozen=True)
+class Study:
+    """One study in one mode as data: ``name`` (one of :data:`STUDIES`), ``mode``, ``common``
+    (settings every point shares: model parameters, run options, analysis), ``points`` (the
+    varying settings of each point) and a ``note`` for the page. The result depends on ``name``,
+    ``common``, the points and the package version only."""
+
+    name: str
+    mode: str
+    common: dict[str, Any] = field(default_factory=dict)
+    points: tuple[dict[str, Any], ...] = ()
+    note: str = ""
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "common", canonical(dict(self.common)))
+        object.__setattr__(self, "points", tuple(canonical(dict(p)) for p in self.points))
+
+    def spec(self) -> dict[str, Any]:
+        """What the results depend on: name, shared settings, points, package version."""
+        return canonical(
+            {"study": self.name, "common": self.common, "points": list(self.points), "version": __version__}
+        )
+
+    def key(self) -> str:
+        """First 12 hex digits of the SHA-256 of the spec without its points."""
+        spec = self.spec()
+        spec.pop("points")
+        return spec_key(spec)
+
+    @property
+    def dirname(self) -> str:
+        """The study's runs folder: ``<name>-<key>``."""
+        return f"{self.name}-{self.key()}"
+
+
+@dataclass(frozen=True)
+class Option:
+    """A command-line option of one study (repeatable, an integer each time): ``flag``, the
+    keyword ``dest`` of its :attr:`Design.build`, ``metavar`` and ``help``."""
+
+    flag: str
+    dest: str
+    metavar: str
+    help: str
+
+
+@dataclass(frozen=True)
+class Design:
+    """What a study's module says of it.
+
+    - ``name``, ``summary`` (one line for ``stickslip study --help``) and ``describe`` (the text
+      of ``stickslip study NAME --help``: what it measures, its grid, its cost, its outputs);
+    - ``build(mode, **options)``: the :class:`Study` of a mode;
+    - ``task(point, point_dir)``: one point on a worker (a task of ``run_sweep``);
+    - ``check(cfg)``: refuse a point's merged settings (ParameterError) before any work starts;
+    - ``findings(study, table)``: what the table of finished rows says (``statements`` first);
+    - ``figures(study, table, page_dir)``: (name, Figure, caption) for each figure;
+    - ``columns``: the leading columns of its table and page;
+    - ``rows(table)``: the study's table from the sweep's (one row per point when None);
+    - ``tables(findings)``: further tables of its page, as (title, columns, records);
+    - ``options``: its own command-line options;
+    - ``point_entry(path, rel)``: for a study whose points write a known layout, whether an
+      entry of a point's folder is the point's (True, False, or for a folder the test of its
+      entries); without it a point's folder is the point's.
+    """
+
+    name: str
+    summary: str
+    describe: Callable[[], str]
+    build: Callable[..., Study]
+    task: Callable[..., dict[str, Any]]
+    check: Callable[[dict[str, Any]], None]
+    findings: Callable[[Study, Any], dict[str, Any]]
+    figures: Callable[..., list[tuple[str, Any, str]]]
+    columns: tuple[str, ...]
+    rows: Callable[[Any], Any] | None = None
+    tables: Callable[[dict[str, Any]], list[tuple[str, list[str], list[dict[str, Any]]]]] | None = None
+    options: tuple[Option, ...] = ()
+    point_entry: Callable[..., Any] | None = None
+
+
+def design(name: str) -> Design:
+    """The :class:`Design` of study ``name`` (:data:`STUDIES`), from its module.
+
+    Parameters
+    ----------
+    name : str
+        One of :data:`STUDIES`.
+
+    Returns
+    -------
+    Design
+        The module's ``DESIGN``.
+    """
+    if name not in STUDIES:
+        raise ValueError(f"study must be one of {', '.join(STUDIES)} (got {name!r})")
+    return importlib.import_module(f"{__name__}.{name.replace('-', '_')}").DESIGN
+
+
+def study(name: str, mode: str = "quick", **options: Any) -> Study:
+    """The spec of study ``name`` in ``mode``.
+
+    Parameters
+    ----------
+    name : str
+        One of :data:`STUDIES`.
+    mode : str
+        One of :data:`MODES`.
+    **options
+        The study's own options (:attr:`Design.options`), e.g. ``extra_Ns`` of the transition.
+
+    Returns
+    -------
+    Study
+        Its shared settings and points.
+    """
+    if mode not in MODES:
+        raise ValueError(f"mode must be one of {', '.join(MODES)} (got {mode!r})")
+    return design(name).build(mode, **options)
+
+
+def study_command(name: str, mode: str) -> str:
+    """The command line that computes study ``name`` in ``mode`` (shown beside each figure)."""
+    return f"stickslip study {name} --{mode} --out DIR"

@@ -1,0 +1,115 @@
+"""One point of a study that is one chain run and its analysis (the phase diagram, the exponents).
+
+Each point is one chain run of eq. (4) (or of a relative of it, :mod:`stickslip.models.presets`)
+plus the analysis of that run, carried out on a Dask worker through
+:func:`stickslip.experiments.sweep.run_sweep`: finished points are reused, failed ones are
+recorded and retried by the next call, interrupted runs continue from their checkpoints.
+:func:`order_task` gives the order parameter and the final state
+(:func:`stickslip.analysis.order.order_summary`), :func:`sizes_task` the slip-size exponent
+(:func:`stickslip.analysis.chain_runs.sizes_summary`).
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+__all__ = ["order_task", "sizes_task", "check_point", "point_params", "loading_time", "t_end_of"]
+
+
+def loading_time(N: int, K: float = 10.0, V: float = 0.001) -> float:
+    """L_ss / V at c = 1: the time the pulling point takes to stretch the chain to its steady
+    length, ``N (N - 1) / (2 K V)`` (docs/model.md, "Steady sliding")."""
+    return N * (N - 1) / (2.0 * K * V)
+
+
+def t_end_of(N: int, loads: float) -> float:
+    """Run length: ``loads`` loading times of a chain of ``N`` blocks (the paper's K and V),
+    rounded up to 3 significant digits."""
+    t = loads * loading_time(N)
+    scale = 10.0 ** (math.floor(math.log10(t)) - 2)
+    return math.ceil(t / scale) * scale
+
+
+# ---------------------------------------------------------------------------------------------
+# One point: a chain run and its analysis, on a worker
+
+_PARAM_FIELDS = ("N", "K", "D", "V", "beta", "alpha", "Fs", "dt", "l", "nu")
+
+
+def point_params(cfg: dict[str, Any]):
+    """The :class:`~stickslip.models.params.ChainParams` of a point's merged settings."""
+    from stickslip.models.presets import chain_params
+
+    return chain_params(cfg.get("model", "sakaguchi"), **{k: cfg[k] for k in _PARAM_FIELDS if k in cfg})
+
+
+def point_run_options(cfg: dict[str, Any], params) -> tuple[float, dict[str, Any]]:
+    """Run length and :func:`~stickslip.run.driver.run_chain` options of a point."""
+    from stickslip.models.presets import PRESETS
+
+    t_end = float(cfg["t_end"])
+    preset = PRESETS[params.model]
+    start = cfg.get("start", preset.start)
+    options: dict[str, Any] = {
+        "start": start,
+        "perturbation": float(cfg.get("perturbation", preset.start_options.get("amplitude", 0.0))),
+        "seed": int(cfg.get("seed", preset.start_options.get("seed", 0))),
+        "sample_interval": max(t_end / float(cfg.get("n_samples", 2000)), params.dt),
+        "average_from": float(cfg.get("average_fraction", 0.5)) * t_end,
+        "sample_moving": cfg.get("analysis") == "order",
+    }
+    if start == "paper":
+        options["perturbation"] = 0.0
+    if cfg.get("until_steady"):
+        options["until_steady"] = float(cfg["until_steady"])
+    return t_end, options
+
+
+def check_point(cfg: dict[str, Any]) -> None:
+    """Raise ParameterError (one line) unless a point's merged settings make a valid run."""
+    point_run_options(cfg, point_params(cfg))
+
+
+def _run(point: dict[str, Any], point_dir: Path):
+    """The point's chain run (continued from its checkpoint), its parameters, options and the
+    summary fields every point stores."""
+    from stickslip.experiments.sweep import run_chain_point
+
+    params = point_params(point)
+    t_end, options = point_run_options(point, params)
+    run = run_chain_point(params, t_end, Path(point_dir), **options)
+    base = {
+        "model": params.model,
+        "t_end": t_end,
+        "t_reached": float(run.summary["t_reached"]),
+        "n_events_total": int(run.summary["n_events"]),
+        "run_wall_seconds": float(run.summary["wall_seconds"]),
+        "block_updates": int(run.summary["block_updates"]),
+    }
+    return run, params, options, base
+
+
+def order_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
+    """One chain run and its order parameter and final state, a task of ``run_sweep``; returns
+    the summary stored in the point's ``done.json``."""
+    from stickslip.analysis.order import order_summary
+
+    run, params, options, base = _run(point, point_dir)
+    return {**base, **order_summary(run, params, options["average_from"])}
+
+
+def sizes_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
+    """One chain run and its slip-size exponent over the events after its transient, a task of
+    ``run_sweep``; returns the summary stored in the point's ``done.json``."""
+    from stickslip.analysis.chain_runs import sizes_summary
+
+    run, _, _, base = _run(point, point_dir)
+    t_from = float(point.get("transient", point.get("average_fraction", 0.5))) * float(run.options.t_end)
+    spanning, seed, bootstrap = (
+        point.get("spanning", "max_block"),
+        int(point.get("seed", 0)),
+        int(point.get("bootstrap", 200)),
+    )
+    return {**base, **sizes_summary(run, t_from, spanning=spanning, seed=seed, bootstrap=bootstrap)}
