@@ -15,7 +15,8 @@ from chain_helpers import error_lines, is_real_command
 from stickslip.cli import main
 from stickslip.experiments import reproduce as rp
 from stickslip.experiments import specs as ex
-from stickslip.io import read_json
+from stickslip.experiments.sweep import DONE_FILE
+from stickslip.io import read_json, read_table
 
 #: docs/model.md, last table: (where, a word of the quantity) for every number the paper states;
 #: eq. 3 states two numbers and gets two rows.
@@ -100,31 +101,25 @@ def test_spec_sets_of_every_mode():
 # Reuse of a single experiment
 
 
-def test_run_experiment_computes_once_and_reuses(tmp_path, monkeypatch):
+def test_run_experiment_computes_once_and_reuses(tmp_path):
     exp = ex.experiment("smoke", "chain-modes")
-    calls = []
-    runner = rp._RUNNERS["chain_modes"]
-
-    def counting(*args, **kw):
-        calls.append(1)
-        return runner.compute(*args, **kw)
-
-    monkeypatch.setitem(rp._RUNNERS, "chain_modes", rp._Runner(counting, runner.load))
-    first = rp.run_experiment(exp, tmp_path)
-    second = rp.run_experiment(exp, tmp_path)
-    assert len(calls) == 1 and not first.reused and second.reused
+    first = rp.run_experiment(exp, tmp_path, n_workers=1)
+    done = tmp_path / exp.dirname / DONE_FILE
+    stamp = done.stat().st_mtime_ns
+    second = rp.run_experiment(exp, tmp_path, n_workers=1)
+    assert not first.reused and second.reused and done.stat().st_mtime_ns == stamp
     assert second.summary == first.summary
-    assert (tmp_path / exp.dirname / rp.RESULT_FILE).is_file()
     changed = ex.Experiment(exp.name, exp.kind, exp.params, options={**exp.options, "n_k": 101})
-    third = rp.run_experiment(changed, tmp_path)
-    assert len(calls) == 2 and not third.reused and third.run_dir != first.run_dir
+    third = rp.run_experiment(changed, tmp_path, n_workers=1)
+    assert not third.reused and third.run_dir != first.run_dir
+    assert done.stat().st_mtime_ns == stamp
 
 
 @pytest.mark.parametrize("damage", ["summary edited", "file changed", "file deleted", "no checksums"])
 def test_a_damaged_result_is_run_again(tmp_path, damage):
     exp = ex.experiment("smoke", "slip-limit")
     first = rp.run_experiment(exp, tmp_path)
-    path = tmp_path / exp.dirname / rp.RESULT_FILE
+    path = tmp_path / exp.dirname / DONE_FILE
     record = read_json(path)
     assert record["files"], "the record lists the files it stands for"
     rel = sorted(record["files"])[0]
@@ -150,9 +145,9 @@ def test_a_damaged_result_is_run_again(tmp_path, damage):
 def test_a_result_of_another_spec_in_the_same_directory_is_not_reused(tmp_path):
     exp = ex.experiment("smoke", "slip-limit")
     rp.run_experiment(exp, tmp_path)
-    record = read_json(tmp_path / exp.dirname / rp.RESULT_FILE)
+    record = read_json(tmp_path / exp.dirname / DONE_FILE)
     record["spec"]["version"] = "0.0.0-other"
-    (tmp_path / exp.dirname / rp.RESULT_FILE).write_text(json.dumps(record))
+    (tmp_path / exp.dirname / DONE_FILE).write_text(json.dumps(record))
     assert not rp.run_experiment(exp, tmp_path).reused
 
 
@@ -258,7 +253,7 @@ def test_second_call_reuses_every_result_and_only_redraws(smoke, monkeypatch):
         monkeypatch.setitem(rp._RUNNERS, kind, rp._Runner(boom, runner.load))
     import stickslip.experiments.sweep
 
-    monkeypatch.setattr(stickslip.experiments.sweep, "run_sweep", boom)
+    monkeypatch.setattr(stickslip.experiments.sweep, "_compute", boom)  # no point is sent to Dask
     before = read_json(out / "report.json")
     result = rp.reproduce(out, "smoke", progress=False)
     assert all(e["reused"] for e in result["experiments"])
@@ -273,8 +268,8 @@ def test_chain_runs_of_the_smoke_set_are_on_disk_per_point(smoke):
     for p in exp.options["points"]:
         d = points / f"beta={p['beta']:g}_N={p['N']}"
         assert (d / "done.json").is_file() and (d / "run.json").is_file()
-    table = read_json(out / "runs" / exp.dirname / rp.RESULT_FILE)["summary"]["points"]
-    assert {(r["N"], r["beta"]) for r in table} == {(p["N"], p["beta"]) for p in exp.options["points"]}
+    table = read_table(points / "summary.parquet")
+    assert set(zip(table["N"], table["beta"], strict=True)) == {(p["N"], p["beta"]) for p in exp.options["points"]}
 
 
 # ---------------------------------------------------------------------------------------------

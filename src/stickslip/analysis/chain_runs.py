@@ -20,6 +20,7 @@ from stickslip.analysis.statistics import (
     front_speed,
     leading_edge_speed,
     pick_front_events,
+    time_average,
 )
 from stickslip.models.params import ChainParams
 from stickslip.models.physics import chain_steady_length
@@ -35,6 +36,7 @@ __all__ = [
     "choose_s_min",
     "size_statistics",
     "sizes_summary",
+    "run_summary",
     "front_speeds",
     "front_statistics",
     "chain_analysis",
@@ -153,6 +155,42 @@ def run_size_statistics(run, *, small_only: bool, seed: int = 0, bootstrap: int 
         events, run.params.N, small_only=small_only, seed=seed, spanning=spanning, bootstrap=bootstrap
     )
     return {**out, "t_from": stationary_from(run), "spanning": spanning}
+
+
+def run_summary(run, params: ChainParams, average_from: float, tolerance: float) -> dict[str, Any]:
+    """The summary of one chain run of Figs. 5-8 (``stickslip reproduce``): the run's own with the
+    events after ``average_from``, the batch-means error of <L> (Fig. 5b; zero for a run stopped
+    at steady sliding) and the final state (section 3, :func:`final_state`).
+
+    Parameters
+    ----------
+    run : ChainRun
+        The run.
+    params : ChainParams
+        Its model.
+    average_from : float
+        Start of the averaging window of <L>.
+    tolerance : float
+        Largest deviation from steady sliding taken as steady.
+
+    Returns
+    -------
+    dict
+        The run's summary with ``n_events_late``, ``t_last_event``, ``L_err``, ``final_state`` and
+        ``steady_deviation_final``.
+    """
+    s = dict(run.summary)
+    s["n_events_late"] = int((run.events["t_start"] >= average_from).sum())
+    s["t_last_event"] = float(run.events["t_end"].max()) if len(run.events) else None
+    if s.get("stopped_early", False):
+        s["L_err"] = 0.0
+    else:
+        try:
+            s["L_err"] = time_average(run.samples["L"], average_from).stderr
+        except ValueError:
+            s["L_err"] = math.nan
+    s["final_state"], s["steady_deviation_final"] = final_state(s, run.state, params, tolerance)
+    return s
 
 
 def final_state(summary: dict[str, Any], state, params: ChainParams, tolerance: float) -> tuple[str, float]:

@@ -8,7 +8,7 @@ document of everything its result depends on, the package version included.
   so ``K = 10`` and ``K = 10.0`` are the same spec;
 - :func:`spec_key` names it: the first 12 hex digits of the SHA-256 of its JSON text, the stem of
   its run directory (``<name>-<key>``);
-- :func:`read_record` gives a stored result (``result.json`` of ``reproduce``, ``done.json`` of a
+- :func:`read_record` gives a stored result (``done.json`` of a
   sweep's point) only if it was made from the same spec: anything else is computed again;
 - a finished point of a sweep records the checksum of every file it wrote
   (:func:`file_digests`); it is reused only if its summary is there and every file matches

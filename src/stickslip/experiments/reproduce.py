@@ -1,23 +1,23 @@
 """Reproduce the paper: run every experiment, draw every figure, compare every stated number.
 
-:func:`reproduce` takes the spec set of a mode (:func:`stickslip.experiments.specs.experiments`) and,
-for each experiment, either loads its stored result or computes it, then draws the figures and
-writes the report (:mod:`stickslip.report.writer`). Layout of the output directory::
+:func:`reproduce` takes the spec set of a mode (:func:`stickslip.experiments.specs.experiments`),
+runs each experiment as a point of :func:`stickslip.experiments.sweep.run_sweep` (the runner of the
+studies too: its cache, resume and Dask), loads the results, draws the figures and writes the
+report (:mod:`stickslip.report.writer`). Layout of the output directory::
 
     DIR/
       runs/<name>-<key>/      one directory per experiment (key: hash of its spec and the
-                              package version); ``result.json`` is written last and marks it done
+                              package version); the sweep's ``done.json`` is written last
       runs/chain-runs-<key>/points/beta=1_N=199/ ...
                               one chain run per point (run.json, state.nc, events.parquet,
-                              first_move.parquet, checkpoint/), run on Dask by
-                              :func:`stickslip.experiments.sweep.run_sweep`
+                              first_move.parquet, checkpoint/)
+      runs/summary.parquet    the sweep of the experiments of sections 2 and Fig. 4
       figures/<stem>.png|.pdf one image per figure of the paper, and the data drawn beside it
       report.json, report.html
 
-A second call with the same mode finds every ``result.json`` and only redraws. A chain run
-that was interrupted continues from its last checkpoint (:func:`stickslip.run.driver.resume_chain`);
-finished chain runs are kept by the sweep's own ``done.json`` records, so adding a value of
-beta to a spec only runs the new point.
+A second call with the same mode finds every ``done.json`` and only redraws. A chain run that
+was interrupted continues from its last checkpoint (:func:`stickslip.run.driver.resume_chain`);
+adding a value of beta to a spec only runs the new point.
 
 This module holds the runners (one per kind of experiment) and the driver; they use the model
 code (:mod:`stickslip.run`, :mod:`stickslip.analysis`). The analysis of the chain runs is
@@ -27,7 +27,6 @@ of stated numbers :mod:`stickslip.report.rows`.
 
 from __future__ import annotations
 
-import math
 import sys
 import time
 from collections.abc import Callable
@@ -40,8 +39,8 @@ import pandas as pd
 
 from stickslip import heartbeat, io
 from stickslip.analysis.chain_runs import chain_analysis, final_state
-from stickslip.experiments.cache import damage, file_digests, read_record, sealed
 from stickslip.experiments.specs import Experiment, experiments
+from stickslip.jsonable import table_records
 from stickslip.models.params import BlockParams, ChainParams
 from stickslip.models.physics import UNTIL_STEADY
 from stickslip.outcome import Outcome
@@ -54,13 +53,12 @@ from stickslip.report.writer import write_report
 __all__ = [
     "reproduce",
     "run_experiment",
+    "run_experiments",
+    "experiment_task",
     "chain_point_task",
     "report_rows",
     "ReproduceError",
-    "RESULT_FILE",
 ]
-
-RESULT_FILE = "result.json"
 
 
 class ReproduceError(RuntimeError):
@@ -86,54 +84,109 @@ class _Log:
 
 
 # ---------------------------------------------------------------------------------------------
-# Running experiments (with reuse)
+# Running experiments (with reuse): every one a point of a sweep (run_sweep)
 
 
-def _stored(run_dir: Path, exp: Experiment, log: Callable[[str], None] | None = None) -> dict[str, Any] | None:
-    """The stored ``result.json`` of ``exp`` if it is there, made from the same spec, as written
-    (sealed) and with every file it recorded present with its checksum; else None, and a line on
-    ``log`` saying why a record of this spec is not reused."""
-    record = read_record(run_dir / RESULT_FILE, exp.spec())
-    if record is None:
-        return None
-    reason = damage(run_dir, record)
-    if reason:
-        if log is not None:
-            log(f"{exp.name}: not reused, {reason}: running it again")
-        return None
-    return record
-
-
-def run_experiment(
-    exp: Experiment,
+def run_experiments(
+    exps: list[Experiment],
     runs_dir: str | Path,
     *,
     scheduler: str | None = None,
     n_workers: int | None = None,
     log: Callable[[str], None] | None = None,
-) -> Outcome:
+) -> dict[str, Outcome]:
+    """Compute the experiments into ``runs_dir``, or load those already there: each one a point of
+    :func:`stickslip.experiments.sweep.run_sweep` (its cache, resume and Dask).
+
+    The experiments of sections 2 and Fig. 4 are the points of one sweep over ``runs_dir``, each
+    in ``<name>-<key>/``; the chain runs of Figs. 5-8 are the points of a sweep of their own in
+    ``chain-runs-<key>/points/``. A point is reused only if its ``done.json`` holds the same spec
+    (kind, parameters, run length, options, package version), is as written and every file it
+    recorded matches its checksum (:func:`stickslip.experiments.cache.damage`).
+
+    Parameters
+    ----------
+    exps : list of Experiment
+        The experiments (:func:`stickslip.experiments.specs.experiments`).
+    runs_dir : str or Path
+        The runs folder of the reproduction.
+    scheduler : str, optional
+        Address of an existing Dask scheduler; else a local cluster of ``n_workers`` processes.
+    n_workers : int, optional
+        Worker processes of the local cluster (default one per core).
+    log : callable, optional
+        Takes the progress lines.
+
+    Returns
+    -------
+    dict
+        The :class:`~stickslip.outcome.Outcome` of each experiment by its name, in the order given.
+    """
+    from stickslip.experiments.sweep import DONE_FILE
+
+    log = log or (lambda text: None)
+    runs = Path(runs_dir)
+    kw = {"scheduler": scheduler, "n_workers": n_workers, "log": log}
+    single = [e for e in exps if e.kind != "chain_runs"]
+    outcomes: dict[str, Outcome] = {}
+    if single:
+        points = [{k: v for k, v in e.spec().items() if k != "version"} for e in single]
+        table = _sweep(experiment_task, points, runs, names=[e.dirname for e in single], **kw)
+        for exp, row in zip(single, table.itertuples(), strict=True):
+            summary = io.read_json(runs / exp.dirname / DONE_FILE)["summary"]
+            data = _RUNNERS[exp.kind].load(exp, runs / exp.dirname, summary)
+            outcomes[exp.name] = Outcome(exp, runs / exp.dirname, data, summary, bool(row.reused), row.wall_seconds)
+    for exp in exps:
+        if exp.kind == "chain_runs":
+            outcomes[exp.name] = _chain_runs(exp, runs / exp.dirname, **kw)
+    return {e.name: outcomes[e.name] for e in exps}
+
+
+def run_experiment(exp: Experiment, runs_dir: str | Path, **options: Any) -> Outcome:
     """Compute one experiment into ``runs_dir/<name>-<key>/``, or load it if already there.
 
-    The stored result is reused only if its ``result.json`` holds the same spec (kind,
-    parameters, run length, options, package version), is as written and every file it recorded
-    matches its checksum (:func:`stickslip.experiments.cache.damage`). Chain runs go to Dask
-    (``scheduler`` address, or a local cluster of ``n_workers`` processes).
+    Parameters
+    ----------
+    exp : Experiment
+        The experiment.
+    runs_dir : str or Path
+        The runs folder.
+    **options
+        ``scheduler``, ``n_workers`` and ``log`` of :func:`run_experiments`.
+
+    Returns
+    -------
+    Outcome
+        Its result, loaded.
     """
-    log = log or (lambda text: None)
-    runner = _RUNNERS[exp.kind]
-    run_dir = Path(runs_dir) / exp.dirname
-    record = _stored(run_dir, exp, log)
-    reused = record is not None
-    if record is None:
-        run_dir.mkdir(parents=True, exist_ok=True)
-        (run_dir / RESULT_FILE).unlink(missing_ok=True)
-        start = time.perf_counter()
-        summary = runner.compute(exp, run_dir, scheduler=scheduler, n_workers=n_workers, log=log)
-        record = {"spec": exp.spec(), "name": exp.name, "summary": summary, "wall_seconds": time.perf_counter() - start}
-        record = sealed({**record, "files": file_digests(run_dir)})
-        io.write_json(run_dir / RESULT_FILE, record)
-    data = runner.load(exp, run_dir, record["summary"])
-    return Outcome(exp, run_dir, data, record["summary"], reused, float(record.get("wall_seconds", math.nan)))
+    return run_experiments([exp], runs_dir, **options)[exp.name]
+
+
+def experiment_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
+    """One experiment of sections 2 and Fig. 4 (``point``: its spec less the package version), as
+    a task of :func:`stickslip.experiments.sweep.run_sweep`: its runner computes it into
+    ``point_dir`` and returns its summary."""
+    exp = Experiment(point_dir.name, point["kind"], point["params"], point["t_end"], point["options"])
+    return _RUNNERS[exp.kind].compute(exp, point_dir)
+
+
+def _sweep(task: Callable[..., dict[str, Any]], points: list[dict[str, Any]], out: Path, *, log, **kw) -> pd.DataFrame:
+    """``run_sweep`` of ``points``, the reused ones and those run again because damaged said on
+    ``log``; a failed point raises ReproduceError."""
+    from stickslip.experiments.sweep import STOP_WAIT_SECONDS, run_sweep
+
+    show = bool(getattr(log, "enabled", False))
+    result = run_sweep(task, points, out, stop_wait=STOP_WAIT_SECONDS, progress=show, **kw)
+    table = result.table
+    for r in table.itertuples():
+        state = f"not reused, {r.note}" if isinstance(getattr(r, "note", None), str) else None
+        state = state or ("reused" if r.reused else f"computed in {r.wall_seconds:.1f} s")
+        log(f"{r.point_dir}: {state}")
+    failed = table[table["status"] != "ok"]
+    if len(failed):
+        lines = "; ".join(f"{r.point_dir}: {r.error}" for r in failed.itertuples())
+        raise ReproduceError(f"{len(failed)} run(s) failed ({lines}); run again to retry them")
+    return table
 
 
 @dataclass(frozen=True)
@@ -328,61 +381,25 @@ def chain_point_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     Returns the run's summary with <L> and its batch-means error (Fig. 5b) and the final state
     ("steady sliding" or "stick-slip", section 3).
     """
-    from stickslip.analysis.statistics import time_average
+    from stickslip.analysis.chain_runs import run_summary
     from stickslip.experiments.sweep import run_chain_point
 
     params, t_end, options = _point_settings(point)
     run = run_chain_point(params, t_end, point_dir, **options)
-    s = dict(run.summary)
-    stopped_early = bool(s.get("stopped_early", False))
-    avg_from = options["average_from"]
-    late = run.events[run.events["t_start"] >= avg_from]
-    s["n_events_late"] = int(len(late))
-    s["t_last_event"] = float(run.events["t_end"].max()) if len(run.events) else None
-    if stopped_early:
-        s["L_err"] = 0.0
-    else:
-        try:
-            s["L_err"] = time_average(run.samples["L"], avg_from).stderr
-        except ValueError:
-            s["L_err"] = math.nan
-    s["final_state"], s["steady_deviation_final"] = final_state(s, run.state, params, UNTIL_STEADY)
-    s["t_end_requested"] = t_end
-    return s
+    return {**run_summary(run, params, options["average_from"], UNTIL_STEADY), "t_end_requested": t_end}
 
 
-def _compute_chain_runs(exp: Experiment, run_dir: Path, *, scheduler=None, n_workers=None, log=None) -> dict[str, Any]:
-    """All chain runs of the experiment as one Dask sweep (Figs. 5-8)."""
-    from stickslip.experiments.sweep import STOP_WAIT_SECONDS, run_sweep
-
+def _chain_runs(exp: Experiment, run_dir: Path, *, log, **kw: Any) -> Outcome:
+    """All chain runs of the experiment as one Dask sweep (Figs. 5-8), loaded."""
     points = [dict(p) for p in exp.options["points"]]
     common = _chain_common(exp)
     for p in points:  # validate every point before any work starts
         _point_settings({**common, **p})
-    if log:
-        log(
-            f"chain runs: {len(points)} points on Dask "
-            f"({'scheduler ' + scheduler if scheduler else 'local cluster'}); finished points are reused"
-        )
-    result = run_sweep(
-        chain_point_task,
-        points,
-        run_dir / "points",
-        common=common,
-        scheduler=scheduler,
-        n_workers=n_workers,
-        stop_wait=STOP_WAIT_SECONDS,
-        progress=bool(getattr(log, "enabled", False)),
-    )
-    failed = result.table[result.table["status"] != "ok"]
-    if len(failed):
-        lines = "; ".join(f"{r.point_dir}: {r.error}" for r in failed.itertuples())
-        raise ReproduceError(f"{len(failed)} chain run(s) failed ({lines}); run again to retry them")
-    return {"points": _records(result.table), "n_run": result.n_run, "n_reused": result.n_reused}
-
-
-def _records(table: pd.DataFrame) -> list[dict[str, Any]]:
-    return table.astype(object).where(table.notna(), None).to_dict(orient="records")
+    log(f"chain runs: {len(points)} points on Dask ({kw['scheduler'] or 'local cluster'}); finished points are reused")
+    table = _sweep(chain_point_task, points, run_dir / "points", common=common, log=log, **kw)
+    summary = {"points": table_records(table)}
+    wall = float(np.nansum(table["wall_seconds"].to_numpy(dtype=float)))
+    return Outcome(exp, run_dir, _load_chain_runs(exp, run_dir, summary), summary, bool(table["reused"].all()), wall)
 
 
 def _load_chain_runs(exp: Experiment, run_dir: Path, summary: dict[str, Any]) -> dict[str, Any]:
@@ -419,7 +436,6 @@ _RUNNERS: dict[str, _Runner] = {
     "block_stability": _Runner(_compute_block_stability, _load_block_stability),
     "hysteresis": _Runner(_compute_hysteresis, _load_hysteresis),
     "chain_modes": _Runner(_compute_chain_modes, _load_chain_modes),
-    "chain_runs": _Runner(_compute_chain_runs, _load_chain_runs),
 }
 
 
@@ -439,29 +455,20 @@ def reproduce(
 
     Runs (or reuses) every experiment of ``mode`` (:func:`stickslip.experiments.specs.experiments`),
     draws every figure as PNG and PDF with its data, and writes ``report.json`` and
-    ``report.html`` with one row per number of docs/model.md's last table. Chain runs go through
-    :func:`stickslip.experiments.sweep.run_sweep` on a local Dask cluster (``n_workers`` processes, default
-    one per core) or on the cluster at ``scheduler``. Progress goes to stderr when ``progress``.
-    Returns what the command prints: mode, paths, the rows, the figures, and per experiment
-    whether it was reused and how long it took.
+    ``report.html`` with one row per number of docs/model.md's last table. The experiments are
+    points of :func:`stickslip.experiments.sweep.run_sweep` (:func:`run_experiments`) on a local
+    Dask cluster (``n_workers`` processes, default one per core) or on the cluster at
+    ``scheduler``. Progress goes to stderr when ``progress``. Returns what the command prints:
+    mode, paths, the rows, the figures, and per experiment whether it was reused and how long it
+    took.
     """
     start = time.perf_counter()
     specs = experiments(mode)
     out = Path(out_dir)
     runs = out / "runs"
     log = _Log(progress)
-    outcomes: dict[str, Outcome] = {}
-    for i, exp in enumerate(specs, 1):
-        head = f"({i}/{len(specs)}) {exp.name} [{', '.join(exp.figures) or 'numbers'}]"
-        stored = _stored(runs / exp.dirname, exp) is not None
-        log(f"{head}: {'stored result, reusing' if stored else 'computing'} in runs/{exp.dirname}")
-        outcome = run_experiment(exp, runs, scheduler=scheduler, n_workers=n_workers, log=log)
-        if not outcome.reused:
-            log(
-                f"{head}: done in {time.perf_counter() - start:.1f} s since start "
-                f"({outcome.wall_seconds:.1f} s for this experiment)"
-            )
-        outcomes[exp.name] = outcome
+    log(f"{len(specs)} experiments in {runs}; finished ones are reused")
+    outcomes = run_experiments(specs, runs, scheduler=scheduler, n_workers=n_workers, log=log)
     log("analysing the chain runs")
     analysis = chain_analysis(outcomes["chain-runs"]) if "chain-runs" in outcomes else None
     log("drawing figures")

@@ -279,6 +279,7 @@ def run_sweep(
     progress: bool = True,
     stop_wait: float = 0.0,
     dashboard: bool = False,
+    names: list[str] | None = None,
 ) -> SweepResult:
     """Run ``task`` at every point of a parameter grid, each point an independent Dask task
     (docs/sweeps.md).
@@ -312,6 +313,9 @@ def run_sweep(
         request (:func:`stop_requested`) before the cluster is closed and the interrupt goes on.
     dashboard : bool
         Serve the local cluster's dashboard on 127.0.0.1 and print its address on stderr.
+    names : list of str, optional
+        The points' folder names, where the points name themselves (the experiments of
+        ``reproduce``, ``<name>-<key>``); by default :func:`point_name`.
 
     Returns
     -------
@@ -336,7 +340,7 @@ def run_sweep(
     points = [dict(p) for p in points]
     common = dict(common or {})
     out = Path(out_dir)
-    names = [point_name(p) for p in points]
+    names = list(names) if names is not None else [point_name(p) for p in points]
     duplicates = sorted({n for n in names if names.count(n) > 1})
     if duplicates:
         raise ValueError(f"points repeat: {', '.join(duplicates)}")
