@@ -38,7 +38,7 @@ import numpy as np
 import pandas as pd
 
 from stickslip import heartbeat, io
-from stickslip.analysis.chain_runs import chain_analysis, final_state
+from stickslip.analysis.chain_runs import chain_analysis
 from stickslip.experiments.specs import Experiment, experiments
 from stickslip.jsonable import table_records
 from stickslip.models.params import BlockParams, ChainParams
@@ -195,10 +195,16 @@ class _Runner:
     load: Callable[[Experiment, Path, dict[str, Any]], dict[str, Any]]
 
 
+def _reads(key: str, file: str) -> Callable[[Experiment, Path, dict[str, Any]], dict[str, Any]]:
+    """The loader of an experiment whose result is one file of its folder: ``{key: its data}``."""
+    read = io.read_table if file.endswith(".parquet") else io.read_dataset
+    return lambda exp, run_dir, summary: {key: read(run_dir / file)}
+
+
 # --- block_run: eq. (1), Figs. 1 and 2 -------------------------------------------------------
 
 
-def _compute_block_run(exp: Experiment, run_dir: Path, **_: Any) -> dict[str, Any]:
+def _compute_block_run(exp: Experiment, run_dir: Path) -> dict[str, Any]:
     """Eq. (1) at the paper's parameters with every step stored (Figs. 1, 2)."""
     from stickslip.run.block import simulate_block
 
@@ -230,7 +236,7 @@ def _load_block_run(exp: Experiment, run_dir: Path, summary: dict[str, Any]) -> 
 # --- slip_limit: eq. (3) ---------------------------------------------------------------------
 
 
-def _compute_slip_limit(exp: Experiment, run_dir: Path, **_: Any) -> dict[str, Any]:
+def _compute_slip_limit(exp: Experiment, run_dir: Path) -> dict[str, Any]:
     """Eq. (3) accurately (DOP853, event v = 0) and with the Heun step of the paper."""
     from stickslip.analysis.slip_limit import heun_slip_limit, solve_slip_limit
 
@@ -259,7 +265,7 @@ def _load_slip_limit(exp: Experiment, run_dir: Path, summary: dict[str, Any]) ->
 # --- period_sweep: Fig. 3 --------------------------------------------------------------------
 
 
-def _compute_period_sweep(exp: Experiment, run_dir: Path, **_: Any) -> dict[str, Any]:
+def _compute_period_sweep(exp: Experiment, run_dir: Path) -> dict[str, Any]:
     """Simulated stick-slip period at log-spaced V (Fig. 3)."""
     from stickslip.analysis.slip_limit import paper_V_values, period_sweep
 
@@ -276,14 +282,10 @@ def _compute_period_sweep(exp: Experiment, run_dir: Path, **_: Any) -> dict[str,
     }
 
 
-def _load_period_sweep(exp: Experiment, run_dir: Path, summary: dict[str, Any]) -> dict[str, Any]:
-    return {"table": io.read_table(run_dir / "periods.parquet")}
-
-
 # --- block_stability: eq. (2) ----------------------------------------------------------------
 
 
-def _compute_block_stability(exp: Experiment, run_dir: Path, **_: Any) -> dict[str, Any]:
+def _compute_block_stability(exp: Experiment, run_dir: Path) -> dict[str, Any]:
     """Hopf point at the spec's beta, stability for all V at ``beta_stable``, the stability map."""
     from stickslip.analysis import stability as st
 
@@ -312,14 +314,10 @@ def _compute_block_stability(exp: Experiment, run_dir: Path, **_: Any) -> dict[s
     }
 
 
-def _load_block_stability(exp: Experiment, run_dir: Path, summary: dict[str, Any]) -> dict[str, Any]:
-    return {"map": io.read_dataset(run_dir / "stability_map.nc")}
-
-
 # --- hysteresis: section 2 -------------------------------------------------------------------
 
 
-def _compute_hysteresis(exp: Experiment, run_dir: Path, **_: Any) -> dict[str, Any]:
+def _compute_hysteresis(exp: Experiment, run_dir: Path) -> dict[str, Any]:
     """V raised slowly and lowered again for the single block (the inverse transition, sec. 2)."""
     from stickslip.analysis import hysteresis as hy
 
@@ -328,14 +326,10 @@ def _compute_hysteresis(exp: Experiment, run_dir: Path, **_: Any) -> dict[str, A
     return result.summary()
 
 
-def _load_hysteresis(exp: Experiment, run_dir: Path, summary: dict[str, Any]) -> dict[str, Any]:
-    return {"data": io.read_dataset(run_dir / "hysteresis.nc")}
-
-
 # --- chain_modes: eq. (5), Fig. 4 ------------------------------------------------------------
 
 
-def _compute_chain_modes(exp: Experiment, run_dir: Path, **_: Any) -> dict[str, Any]:
+def _compute_chain_modes(exp: Experiment, run_dir: Path) -> dict[str, Any]:
     """Fourier modes of the linearised chain at the betas of Fig. 4, and the critical beta."""
     from stickslip.analysis import stability as st
 
@@ -360,10 +354,6 @@ def _compute_chain_modes(exp: Experiment, run_dir: Path, **_: Any) -> dict[str, 
         "critical_beta_numeric": st.chain_critical_beta_numeric(p),
         "per_beta": per_beta,
     }
-
-
-def _load_chain_modes(exp: Experiment, run_dir: Path, summary: dict[str, Any]) -> dict[str, Any]:
-    return {"modes": io.read_dataset(run_dir / "fig4.nc")}
 
 
 # --- chain_runs: eq. (4), Figs. 5-8, on Dask -------------------------------------------------
@@ -397,45 +387,33 @@ def _chain_runs(exp: Experiment, run_dir: Path, *, log, **kw: Any) -> Outcome:
         _point_settings({**common, **p})
     log(f"chain runs: {len(points)} points on Dask ({kw['scheduler'] or 'local cluster'}); finished points are reused")
     table = _sweep(chain_point_task, points, run_dir / "points", common=common, log=log, **kw)
+    # as the table was read back from JSON when a record of the experiment held it; the final
+    # state of each run is its task's (analysis.chain_runs.run_summary)
     summary = {"points": table_records(table)}
-    wall = float(np.nansum(table["wall_seconds"].to_numpy(dtype=float)))
-    return Outcome(exp, run_dir, _load_chain_runs(exp, run_dir, summary), summary, bool(table["reused"].all()), wall)
-
-
-def _load_chain_runs(exp: Experiment, run_dir: Path, summary: dict[str, Any]) -> dict[str, Any]:
-    from stickslip.experiments.sweep import point_name
-    from stickslip.run import driver as chain
-
     table = pd.DataFrame(summary["points"])
     cache: dict[tuple[int, float], Any] = {}
 
     def get(N: int, beta: float):
         """The full run at (N, beta), read from its directory when first asked for."""
+        from stickslip.experiments.sweep import point_name
+        from stickslip.run.driver import load_run
+
         key = (int(N), float(beta))
         if key not in cache:
-            cache[key] = chain.load_run(run_dir / "points" / point_name({"N": int(N), "beta": float(beta)}))
+            cache[key] = load_run(run_dir / "points" / point_name({"N": int(N), "beta": float(beta)}))
         return cache[key]
 
-    # Classify every run from its stored final state, so stored runs follow the current rule.
-    params = {k: v for k, v in exp.params.items()}
-    states, deviations = [], []
-    for r in table.itertuples():
-        p = ChainParams(**{**params, "N": int(r.N), "beta": float(r.beta)})
-        state, deviation = final_state(r._asdict(), get(r.N, r.beta).state, p, UNTIL_STEADY)
-        states.append(state)
-        deviations.append(deviation)
-    table["final_state"] = states
-    table["steady_deviation_final"] = deviations
-    return {"table": table, "run": get}
+    wall = float(np.nansum(table["wall_seconds"].to_numpy(dtype=float)))
+    return Outcome(exp, run_dir, {"table": table, "run": get}, summary, bool(table["reused"].all()), wall)
 
 
 _RUNNERS: dict[str, _Runner] = {
     "block_run": _Runner(_compute_block_run, _load_block_run),
     "slip_limit": _Runner(_compute_slip_limit, _load_slip_limit),
-    "period_sweep": _Runner(_compute_period_sweep, _load_period_sweep),
-    "block_stability": _Runner(_compute_block_stability, _load_block_stability),
-    "hysteresis": _Runner(_compute_hysteresis, _load_hysteresis),
-    "chain_modes": _Runner(_compute_chain_modes, _load_chain_modes),
+    "period_sweep": _Runner(_compute_period_sweep, _reads("table", "periods.parquet")),
+    "block_stability": _Runner(_compute_block_stability, _reads("map", "stability_map.nc")),
+    "hysteresis": _Runner(_compute_hysteresis, _reads("data", "hysteresis.nc")),
+    "chain_modes": _Runner(_compute_chain_modes, _reads("modes", "fig4.nc")),
 }
 
 
