@@ -100,6 +100,7 @@ def test_ctrl_c_in_a_terminal_stops_a_sweep(tmp_path):
     out = tmp_path / "sweep"
     pid, fd = pty.fork()
     if pid == 0:  # the child: the command in the foreground of the pty
+        signal.signal(signal.SIGINT, signal.SIG_DFL)  # as a shell leaves it, even where ours ignores it
         os.environ.update(cli_env())
         cmd = stickslip_cmd() + [*SWEEP, "--out", str(out)]
         os.execvp(cmd[0], cmd)
