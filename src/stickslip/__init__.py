@@ -15,9 +15,10 @@ The main API is importable from here; the simulators load on first use, so that
 ``import stickslip`` stays light.
 """
 
-from importlib import import_module
 from importlib.metadata import PackageNotFoundError
 from importlib.metadata import version as _version
+
+from stickslip.lazy import lazy_names
 
 try:
     __version__ = _version("stickslip")
@@ -44,13 +45,4 @@ _LAZY = {
 __all__ = ["BlockParams", "ChainParams", "ParameterError", "__version__", *_LAZY]
 
 
-def __getattr__(name: str):
-    if name in _LAZY:
-        value = getattr(import_module(_LAZY[name]), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module 'stickslip' has no attribute {name!r}")
-
-
-def __dir__():
-    return sorted(set(globals()) | set(_LAZY))
+__getattr__, __dir__ = lazy_names(__name__, _LAZY)

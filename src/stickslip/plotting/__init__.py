@@ -30,7 +30,7 @@ $L(t)$
 eq. (4): $N=10$, $K=10$, $V=0.001$, $\\beta=1$, $\\alpha=1$, $D=5$, $F_s=3$
 """
 
-from importlib import import_module
+from stickslip.lazy import lazy_names
 
 #: Names loaded on first use (matplotlib and the analysis load with them), and their modules.
 _LAZY = {
@@ -56,13 +56,4 @@ _LAZY = {
 __all__ = list(_LAZY)
 
 
-def __getattr__(name: str):
-    if name in _LAZY:
-        value = getattr(import_module(_LAZY[name]), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module 'stickslip.plotting' has no attribute {name!r}")
-
-
-def __dir__():
-    return sorted(set(globals()) | set(_LAZY))
+__getattr__, __dir__ = lazy_names(__name__, _LAZY)

@@ -12,7 +12,7 @@ their options (:class:`~stickslip.run.options.RunOptions`), and the hooks a call
 run's loop (:class:`~stickslip.run.loop.Hook`, which sees a :class:`~stickslip.run.loop.Loop`).
 """
 
-from importlib import import_module
+from stickslip.lazy import lazy_names
 
 #: Names loaded on first use (the loop loads the compiled kernels), and the module of each; no
 #: ``__all__``, so that the reference documents each once, in its own module.
@@ -25,13 +25,4 @@ _LAZY = {
 }
 
 
-def __getattr__(name: str):
-    if name in _LAZY:
-        value = getattr(import_module(_LAZY[name]), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module 'stickslip.run' has no attribute {name!r}")
-
-
-def __dir__():
-    return sorted(set(globals()) | set(_LAZY))
+__getattr__, __dir__ = lazy_names(__name__, _LAZY)
