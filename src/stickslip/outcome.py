@@ -2,7 +2,8 @@
 one chain run of Figs. 5-8 (``stickslip reproduce``).
 
 Below :mod:`stickslip.experiments`, :mod:`stickslip.plotting` and :mod:`stickslip.report`, so that
-each reads an experiment's result without importing the code that computes it.
+each reads an experiment's result without importing the code that computes it. The experiments are
+the points of the paper's studies (:data:`stickslip.experiments.studies.PAPER`).
 """
 
 from __future__ import annotations
@@ -14,21 +15,33 @@ from typing import Any
 
 from stickslip.models.params import ChainParams
 
-__all__ = ["Outcome", "point_settings", "chain_common"]
+__all__ = ["Outcome", "Results", "point_settings", "chain_params"]
 
 
 @dataclass
 class Outcome:
-    """An experiment's loaded result: its spec (``experiment``, an
-    :class:`~stickslip.experiments.specs.Experiment`), its run directory, ``data`` (what its runner
-    loads), ``summary``, whether it was reused and how long it took."""
+    """An experiment's loaded result: the ``settings`` its task received (the point merged with
+    the study's shared settings), its folder (``run_dir``), ``data`` (what its loader reads),
+    ``summary``, whether it was reused and how long it took."""
 
-    experiment: Any
+    settings: dict[str, Any]
     run_dir: Path
     data: dict[str, Any]
     summary: dict[str, Any]
     reused: bool
     wall_seconds: float
+
+
+@dataclass
+class Results:
+    """What the findings and figures of one of the paper's studies read: the ``outcomes`` of its
+    experiments by name, the ``analysis`` of the chain runs of Figs. 5-8
+    (:func:`stickslip.analysis.chain_runs.chain_analysis`; None for the other studies) and the
+    ``mode``."""
+
+    outcomes: dict[str, Outcome]
+    analysis: dict[str, Any] | None
+    mode: str
 
 
 _CHAIN_FIELDS = ("N", "K", "D", "V", "beta", "alpha", "Fs", "dt")
@@ -40,8 +53,8 @@ def point_settings(cfg: dict[str, Any]) -> tuple[ChainParams, float, dict[str, A
     Parameters
     ----------
     cfg : dict
-        The point's N and beta merged with its experiment's shared settings
-        (:func:`chain_common`).
+        The point's N and beta merged with the shared settings of the chain runs
+        (:mod:`stickslip.experiments.studies.figs5_8`).
 
     Returns
     -------
@@ -50,7 +63,7 @@ def point_settings(cfg: dict[str, Any]) -> tuple[ChainParams, float, dict[str, A
         (sample interval, start of the average, the stop at steady sliding above
         ``until_steady_above``, Fig. 6's profile window at ``profile_N`` and ``profile_betas``).
     """
-    params = ChainParams(**{k: cfg[k] for k in _CHAIN_FIELDS if k in cfg})
+    params = chain_params(cfg)
     t_end = float(cfg["t_end_by_N"][str(params.N)])
     options: dict[str, Any] = {
         "sample_interval": float(cfg["sample_interval"]),
@@ -63,19 +76,7 @@ def point_settings(cfg: dict[str, Any]) -> tuple[ChainParams, float, dict[str, A
     return params, t_end, options
 
 
-def chain_common(exp: Any) -> dict[str, Any]:
-    """The settings every chain run of Figs. 5-8 shares.
-
-    Parameters
-    ----------
-    exp : Experiment
-        The ``chain_runs`` experiment of a reproduction.
-
-    Returns
-    -------
-    dict
-        Its parameters and options, less the point lists.
-    """
-    common = dict(exp.params)
-    common.update({k: v for k, v in exp.options.items() if k not in ("points", "sweep_N", "figure_N")})
-    return common
+def chain_params(cfg: dict[str, Any], **changes: Any) -> ChainParams:
+    """The chain of eq. (4) that the settings ``cfg`` of the chain runs of Figs. 5-8 name, with
+    ``changes`` (e.g. ``N``) applied."""
+    return ChainParams(**{**{k: cfg[k] for k in _CHAIN_FIELDS if k in cfg}, **changes})

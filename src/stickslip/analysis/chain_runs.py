@@ -437,14 +437,13 @@ def fig6_start_note(a: dict[str, Any]) -> str:
 
 
 def chain_analysis(outcome) -> dict[str, Any]:
-    """Everything Figs. 5-8 and their rows need from the chain runs of one experiment of
-    ``stickslip reproduce``.
+    """Everything Figs. 5-8 and their rows need from the chain runs of ``stickslip reproduce``.
 
     Parameters
     ----------
     outcome : Outcome
-        The :class:`~stickslip.outcome.Outcome` of a ``chain_runs`` experiment: its
-        options name the sweep's N, the figures' N and their run length.
+        The :class:`~stickslip.outcome.Outcome` of the chain runs: its settings name the
+        sweep's N, the figures' N and their run length.
 
     Returns
     -------
@@ -453,7 +452,7 @@ def chain_analysis(outcome) -> dict[str, Any]:
         stationary events and size statistics (``sizes1``, ``sizes02``; None with fewer than 10
         events), the rupture fronts (``fronts``), ``t_from``, ``sweep_N``, ``figure_N``, ``t_fig``.
     """
-    opts = outcome.experiment.options
+    opts = outcome.settings
     table = outcome.data["table"]
     sweep_N, fig_N = int(opts["sweep_N"]), int(opts["figure_N"])
     t_fig = float(opts["t_end_by_N"][str(fig_N)])

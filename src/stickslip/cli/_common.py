@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from stickslip.experiments.studies import MANIFEST, PAPER
 from stickslip.jsonable import to_jsonable
 from stickslip.models.params import _range_text
 
@@ -381,7 +382,7 @@ OUT_FILES: dict[str, frozenset[str]] = {
     | _figures("fig4", "mode_growth"),
     "hysteresis": frozenset({"hysteresis.nc", "hysteresis.json"}) | _figures("hysteresis"),
     "sweep": frozenset({"summary.parquet", "summary.csv"}),
-    "reproduce": frozenset({"runs", "figures", "report.json", "report.html", "experiments.json"}),
+    "reproduce": frozenset({"runs", *PAPER, "report.json", "report.html", MANIFEST}),
 }
 
 
@@ -391,7 +392,7 @@ def package_files() -> frozenset[str]:
     directory mixes the results of two commands (a block's run.json beside a chain's state.nc)."""
     from stickslip.run.rundir import LOCK_FILES, OWN_FILES, RUN_ID_FILE
 
-    files = frozenset().union(*OUT_FILES.values()) - {"runs", "figures"}
+    files = frozenset().union(*OUT_FILES.values()) - {"runs", *PAPER}
     return files | (OWN_FILES - LOCK_FILES - {RUN_ID_FILE})
 
 

@@ -5,8 +5,8 @@
 ``--quick`` (default) runs the pipeline on shorter chain runs in minutes; ``--full`` uses the
 paper's N = 399 and t = 2e7 (hours; resumable: run the same command again). Results already
 computed for the same spec and package version are reused, so a second call only redraws.
-Writes DIR/figures (PNG, PDF and data per figure), DIR/runs (the experiments), report.json and
-report.html. See docs/reproduce.md.
+Writes one page folder per study of the paper (DIR/figs1-4, DIR/figs5-8: PNG, PDF and data per
+figure), DIR/runs (the experiments), report.json and report.html. See docs/reproduce.md.
 """
 
 from __future__ import annotations
@@ -107,8 +107,9 @@ def _text(result: dict) -> str:
     width = max(len(r["where"]) for r in result["rows"]) if result["rows"] else 0
     for r in result["rows"]:
         lines.append(f"  {r['where']:<{width}}  {r['agreement'][:60]:<60}  {r['quantity']}")
-    reused = sum(e["reused"] for e in result["experiments"])
-    lines.append(f"experiments: {len(result['experiments'])} ({reused} reused); figures: {len(result['figures'])}")
+    for s in result["studies"]:
+        lines.append(f"  {s['study']}: {s['points']} points ({s['reused']} reused); page {s['page']}")
+    lines.append(f"figures: {len(result['figures'])}")
     for name, why in result["figures_not_drawn"].items():
         lines.append(f"  not drawn: {name}: {why}")
     lines.append(f"report: {result['report_html']}")

@@ -1,7 +1,7 @@
 """How an experiment is described and cached, for ``reproduce``, sweeps and studies alike.
 
-An experiment (an :class:`~stickslip.experiments.specs.Experiment` of ``reproduce``, a
-:class:`~stickslip.experiments.studies.Study`, one point of a sweep) is a *spec*: a plain JSON
+An experiment (a :class:`~stickslip.experiments.studies.Study`, among them those of
+``reproduce``, or one point of a sweep) is a *spec*: a plain JSON
 document of everything its result depends on, the package version included.
 
 - :func:`canonical` puts a spec in one form (sorted keys, tuples as lists, whole floats as ints),

@@ -24,7 +24,7 @@ import numpy as np
 import pandas as pd
 
 from stickslip import __version__, io
-from stickslip.experiments.studies import Design, Study, design, study, study_command
+from stickslip.experiments.studies import MANIFEST, Design, Study, design, study, study_command
 from stickslip.jsonable import table_records
 from stickslip.pages import image_src, write_page
 
@@ -97,6 +97,7 @@ def run_study(
         progress=show,
         stop_wait=STOP_WAIT_SECONDS,
         dashboard=dashboard,
+        names=[plan.point_name(p) for p in spec.points] if plan.point_name else None,
     )
     points = _points_table(spec, plan, result.table)
     failed = points[points["status"] != "ok"]
@@ -105,8 +106,9 @@ def run_study(
     record_outputs(out, [page_dir / name for name in PAGE_FILES])
     io.write_table_files(page_dir / "table", table)
     ok = table[table["status"] == "ok"] if "status" in table else table
-    findings = plan.findings(spec, ok) if len(ok) else {"statements": ["no finished points"]}
-    figures = _draw(spec, plan, ok, page_dir)
+    data = plan.load(spec, ok, run_dir / "points") if plan.load and len(ok) else ok
+    findings = plan.findings(spec, data) if len(ok) else {"statements": ["no finished points"]}
+    figures, not_drawn = _draw(spec, plan, data, page_dir) if len(ok) else ([], {})
     # the page folder held only the manifest's files when the study began (foreign_files)
     record_outputs(out, [p for p in page_dir.iterdir() if p.is_file() and not p.name.startswith(".")])
     wall = time.perf_counter() - t0
@@ -127,6 +129,8 @@ def run_study(
         "runs": str(run_dir),
     }
     records = table_records(table)
+    if not_drawn:
+        meta["figures_not_drawn"] = not_drawn
     io.write_json(page_dir / "study.json", {"meta": meta, "findings": findings, "figures": figures, "rows": records})
     _write_page(page_dir / "index.html", spec, plan, meta, findings, figures, points, table)
     _log(show, t0, f"page: {page_dir / 'index.html'} ({wall:.1f} s)")
@@ -137,6 +141,7 @@ def run_study(
         "table_file": str(page_dir / "table.parquet"),
         "findings": findings,
         "figures": figures,
+        "figures_not_drawn": not_drawn,
         "failed_points": [{"point": r.point_dir, "error": r.error} for r in failed.itertuples()],
         "rows": records,
     }
@@ -167,18 +172,21 @@ def _points_table(spec: Study, plan: Design, sweep_table: pd.DataFrame) -> pd.Da
     return table[lead + [c for c in table.columns if c not in lead]].reset_index(drop=True)
 
 
-def _draw(spec: Study, plan: Design, table: pd.DataFrame, page_dir: Path) -> list[dict[str, Any]]:
-    """Draw the study's figures into ``page_dir`` (PNG and PDF); returns their descriptions."""
+def _draw(spec: Study, plan: Design, data: Any, page_dir: Path) -> tuple[list[dict[str, Any]], dict[str, str]]:
+    """Draw the study's figures into ``page_dir`` (PNG and PDF); returns their descriptions and,
+    for each figure the results cannot give, why."""
     from stickslip.plotting.style import save_figure
 
-    if not len(table):
-        return []
-    out = []
-    for name, fig, caption in plan.figures(spec, table, page_dir):
+    out, not_drawn = [], {}
+    for name, fig, caption, *extra in plan.figures(spec, data, page_dir):
+        if fig is None:
+            not_drawn[name] = caption
+            continue
         save_figure(fig, page_dir / name)  # atomic: a full disk leaves no half-written image
         command = study_command(spec.name, spec.mode)
-        out.append({"name": name, "image": f"{name}.png", "pdf": f"{name}.pdf", "caption": caption, "command": command})
-    return out
+        entry = {"name": name, "image": f"{name}.png", "pdf": f"{name}.pdf", "caption": caption, "command": command}
+        out.append({**entry, **(extra[0] if extra else {})})
+    return out, not_drawn
 
 
 # ---------------------------------------------------------------------------------------------
@@ -226,8 +234,6 @@ def _write_page(
 # ---------------------------------------------------------------------------------------------
 # The study's folder: what it owns
 
-#: The record, at the top of a study's output folder, of every page file its studies wrote.
-MANIFEST = ".stickslip-study.json"
 #: The files of a study's page besides its figures.
 PAGE_FILES = ("table.parquet", "table.csv", "study.json", "index.html")
 

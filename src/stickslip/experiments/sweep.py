@@ -314,8 +314,8 @@ def run_sweep(
     dashboard : bool
         Serve the local cluster's dashboard on 127.0.0.1 and print its address on stderr.
     names : list of str, optional
-        The points' folder names, where the points name themselves (the experiments of
-        ``reproduce``, ``<name>-<key>``); by default :func:`point_name`.
+        The points' folder names, where the points name themselves (a study's
+        :attr:`~stickslip.experiments.studies.Design.point_name`); by default :func:`point_name`.
 
     Returns
     -------

@@ -1,7 +1,10 @@
 """The paper's figures (Figs. 1-8 and the two of section 2) drawn from a reproduction's results.
 
-:func:`draw_figures` writes each figure as PNG and PDF into ``figures/``, with the data drawn
-beside it (NetCDF or CSV), and returns the report's entries for them; the drawing itself is in
+:func:`section2_figures` and :func:`chain_figures` draw the figures of the paper's two studies
+(:data:`stickslip.experiments.studies.PAPER`): each writes the data drawn in a figure (NetCDF or
+CSV) into the study's page folder and gives the figure as its study's ``figures`` hook does,
+``(stem, Figure, caption, entry)`` with the report's label, data files and command in ``entry``,
+or ``(stems, None, reason)`` for figures these results cannot give. The drawing itself is in
 :mod:`stickslip.plotting.block`, :mod:`stickslip.plotting.stability` and
 :mod:`stickslip.plotting.chain`.
 """
@@ -18,35 +21,18 @@ import xarray as xr
 
 from stickslip import io
 from stickslip.analysis.chain_runs import fig6_start_note, sweep_table
-from stickslip.models.params import ChainParams
-from stickslip.outcome import Outcome
+from stickslip.outcome import Outcome, chain_params
 from stickslip.report.commands import block_command, chain_command, hysteresis_command, sweep_command
-from stickslip.report.writer import ReportFigure
+
+#: A drawn figure: its stem, the figure, its caption and the further fields of its report entry.
+Drawn = tuple[str, Any, str, dict[str, Any]]
 
 
-def _save(fig, figures_dir: Path, stem: str) -> tuple[str, str]:
-    """Save a figure as figures/<stem>.png and .pdf; return both paths relative to the report."""
-    from stickslip.plotting.style import save_figure
-
-    save_figure(fig, figures_dir / stem)
-    return f"figures/{stem}.png", f"figures/{stem}.pdf"
+def _figure(stem: str, label: str, caption: str, fig, data: list[Path], command: str = "") -> Drawn:
+    return stem, fig, caption, {"figure": label, "data": [p.name for p in data], "command": command}
 
 
-def _figure(
-    stem: str, label: str, caption: str, figures_dir: Path, fig, data: list[Path], command: str = ""
-) -> ReportFigure:
-    png, pdf = _save(fig, figures_dir, stem)
-    return ReportFigure(
-        figure=label,
-        image=png,
-        caption=caption,
-        pdf=pdf,
-        data=tuple(f"figures/{p.name}" for p in data),
-        command=command,
-    )
-
-
-def _fig1_2(o: dict[str, Outcome], d: Path) -> list[ReportFigure]:
+def _fig1_2(o: dict[str, Outcome], d: Path) -> list[Drawn]:
     """Figs. 1 and 2 from the block run and eq. (3)."""
     from stickslip.plotting.block import fig1_position, fig2_slip, slip_window
 
@@ -61,7 +47,6 @@ def _fig1_2(o: dict[str, Outcome], d: Path) -> list[ReportFigure]:
             "Time evolution of x of the single block, eq. (1), at M = alpha = beta = "
             "sigma = 1, K = 10, V = 0.001, Fs = 3 (Heun, dt = 0.005, from x = v = 0, theta = 0.1): "
             "stick-slip with period 344.",
-            d,
             fig1_position(run),
             [f1],
             block_command(o["block"]),
@@ -88,7 +73,6 @@ def _fig1_2(o: dict[str, Outcome], d: Path) -> list[ReportFigure]:
             "(a) v(t - t_c) during the second slip of the run of Fig. 1 (solid) "
             "and of eq. (3) (dashed); (b) the phase portrait (v, theta). The paper: the curves "
             "overlap.",
-            d,
             fig2_slip(run, law),
             [f2],
             block_command(o["block"]),
@@ -97,7 +81,7 @@ def _fig1_2(o: dict[str, Outcome], d: Path) -> list[ReportFigure]:
     return figs
 
 
-def _fig3(o: dict[str, Outcome], d: Path) -> list[ReportFigure]:
+def _fig3(o: dict[str, Outcome], d: Path) -> list[Drawn]:
     """Fig. 3: period against V with the law T = a + b / (K V) of eq. (3)."""
     from stickslip.plotting.block import fig3_period
 
@@ -111,7 +95,6 @@ def _fig3(o: dict[str, Outcome], d: Path) -> list[ReportFigure]:
             f"Period of stick-slip against V: simulated (marks) and "
             f"T = {law.law_a:.4f} + {law.law_b:.4f} / (K V) from eq. (3) (dashed; the paper: "
             "T = 1.035 + 3.432 / (K V)).",
-            d,
             fig3_period(table, law),
             f,
             "stickslip block --fig3 --out DIR",
@@ -119,7 +102,7 @@ def _fig3(o: dict[str, Outcome], d: Path) -> list[ReportFigure]:
     ]
 
 
-def _stability_map(o: dict[str, Outcome], d: Path) -> list[ReportFigure]:
+def _stability_map(o: dict[str, Outcome], d: Path) -> list[Drawn]:
     """Section 2: the Hopf curve V_c(beta) of the single block at K = 10 (eq. 2)."""
     from stickslip.plotting.stability import plot_stability_map
 
@@ -133,7 +116,6 @@ def _stability_map(o: dict[str, Outcome], d: Path) -> list[ReportFigure]:
             "Linear stability of steady sliding of the single "
             "block at K = 10: largest Re(lambda) of eq. (2) over (beta, V) and the Hopf curve V_c(beta). "
             "The paper: V_c = 0.106 at beta = 0.08; stable for all V at beta = 1.",
-            d,
             fig,
             [f],
             "stickslip stability block --K 10 --beta 0.08 --out DIR",
@@ -141,7 +123,7 @@ def _stability_map(o: dict[str, Outcome], d: Path) -> list[ReportFigure]:
     ]
 
 
-def _hysteresis(o: dict[str, Outcome], d: Path) -> list[ReportFigure]:
+def _hysteresis(o: dict[str, Outcome], d: Path) -> list[Drawn]:
     """Section 2: V raised slowly and lowered again; the inverse transition at V_up."""
     from stickslip.plotting.stability import plot_hysteresis
 
@@ -154,7 +136,6 @@ def _hysteresis(o: dict[str, Outcome], d: Path) -> list[ReportFigure]:
             "Single block, beta = 1, Fs = 3, K = 10: "
             "largest and least v at each V as V is raised slowly and lowered again. Stick-slip "
             "(min v = 0) ends at V_up (the paper: 0.345).",
-            d,
             plot_hysteresis(data),
             [f],
             hysteresis_command(o["hysteresis"], draw=True),
@@ -162,7 +143,7 @@ def _hysteresis(o: dict[str, Outcome], d: Path) -> list[ReportFigure]:
     ]
 
 
-def _fig4(o: dict[str, Outcome], d: Path) -> list[ReportFigure]:
+def _fig4(o: dict[str, Outcome], d: Path) -> list[Drawn]:
     """Fig. 4: real parts of the two largest eigenvalues of the Fourier modes of eq. (5)."""
     from stickslip.plotting.stability import plot_fig4
 
@@ -175,7 +156,6 @@ def _fig4(o: dict[str, Outcome], d: Path) -> list[ReportFigure]:
             "Real parts of the two largest eigenvalues of the Fourier modes of the "
             "linearised chain, eq. (5), against k at beta = 0.5, 1, 1.5 (K = 10, D = 5). Right: long "
             "waves, unstable for beta < 1.",
-            d,
             plot_fig4(ds),
             [f],
             "stickslip stability chain --K 10 --D 5 --beta 1 --out DIR",
@@ -183,7 +163,7 @@ def _fig4(o: dict[str, Outcome], d: Path) -> list[ReportFigure]:
     ]
 
 
-def _fig5(o: dict[str, Outcome], a: dict[str, Any], d: Path, mode: str) -> list[ReportFigure]:
+def _fig5(o: dict[str, Outcome], a: dict[str, Any], d: Path, mode: str) -> list[Drawn]:
     """Fig. 5: (a) snapshot at the end of the beta = 1 run; (b) <L> against beta."""
     from stickslip.models.physics import chain_steady_profile_paper, chain_steady_state
     from stickslip.plotting.chain import fig5a_snapshot, fig5b_length
@@ -210,7 +190,6 @@ def _fig5(o: dict[str, Outcome], a: dict[str, Any], d: Path, mode: str) -> list[
             f"Snapshot of x_i at t = {t:.3g} at beta = 1 (N = {p.N}), in the frame "
             "of the pulling point, against the exact discrete steady sliding profile (dashed) and the "
             "paper's continuum form (dotted).",
-            d,
             fig5a_snapshot(snap, p, t, paper_figure="Fig. 5(a)"),
             fa,
             chain_command(o["chain-runs"], p.N, 1.0, plot="snapshot_final"),
@@ -218,7 +197,7 @@ def _fig5(o: dict[str, Outcome], a: dict[str, Any], d: Path, mode: str) -> list[
     ]
     sweep = sweep_table(a)
     fb = io.write_table_files(d / "fig5b", sweep)
-    q = ChainParams(**{k: v for k, v in o["chain-runs"].experiment.params.items()}, N=a["sweep_N"])
+    q = chain_params(o["chain-runs"].settings, N=a["sweep_N"])
     steady_note = ", ".join(f"{b:g}" for b in sweep.loc[sweep["final_state"] == "steady sliding", "beta"])
     figs.append(
         _figure(
@@ -230,7 +209,6 @@ def _fig5(o: dict[str, Outcome], a: dict[str, Any], d: Path, mode: str) -> list[
             "(dashed); dotted: beta_c = 1. Runs that reached steady sliding (beta = "
             f"{steady_note or 'none'}) were stopped there and count L_ss from then on; open symbols: "
             "runs above beta_c that had not settled into steady sliding by their end.",
-            d,
             fig5b_length(sweep, q, paper_figure="Fig. 5(b)"),
             fb,
             sweep_command(o["chain-runs"], mode),
@@ -239,7 +217,7 @@ def _fig5(o: dict[str, Outcome], a: dict[str, Any], d: Path, mode: str) -> list[
     return figs
 
 
-def _fig6(o: dict[str, Outcome], a: dict[str, Any], d: Path) -> list[ReportFigure]:
+def _fig6(o: dict[str, Outcome], a: dict[str, Any], d: Path) -> list[Drawn]:
     """Fig. 6: rupture fronts of a large and an intermediate event at beta = 1, and c per event."""
     from stickslip.analysis.statistics import central_interval
     from stickslip.plotting.chain import PAPER_FRONT_SPEED, fig6_fronts
@@ -297,7 +275,6 @@ def _fig6(o: dict[str, Outcome], a: dict[str, Any], d: Path) -> list[ReportFigur
             "fig6",
             "Fig. 6",
             caption,
-            d,
             fig,
             [f1, *f2, *f3, *f4],
             chain_command(o["chain-runs"], run.params.N, 1.0, plot="fronts"),
@@ -305,7 +282,7 @@ def _fig6(o: dict[str, Outcome], a: dict[str, Any], d: Path) -> list[ReportFigur
     ]
 
 
-def _fig7_8(o: dict[str, Outcome], a: dict[str, Any], d: Path, which: str) -> list[ReportFigure]:
+def _fig7_8(o: dict[str, Outcome], a: dict[str, Any], d: Path, which: str) -> list[Drawn]:
     """Figs. 7 (beta = 1) and 8 (beta = 0.2): slip-size distribution and S against time."""
     from stickslip.analysis.statistics import size_distribution
     from stickslip.plotting.chain import fig7_8_sizes
@@ -334,7 +311,6 @@ def _fig7_8(o: dict[str, Outcome], a: dict[str, Any], d: Path, which: str) -> li
             stem,
             label,
             caption,
-            d,
             fig7_8_sizes(events, fit, beta, paper_tau=paper_tau, paper_figure=label),
             [*f1, f2],
             chain_command(o["chain-runs"], N, beta, plot="sizes"),
@@ -342,41 +318,44 @@ def _fig7_8(o: dict[str, Outcome], a: dict[str, Any], d: Path, which: str) -> li
     ]
 
 
-def draw_figures(
-    outcomes: dict[str, Outcome],
-    analysis: dict[str, Any] | None,
-    out_dir: Path,
-    mode: str,
-    log: Callable[[str], None] | None = None,
-) -> tuple[list[ReportFigure], dict[str, str]]:
-    """Draw every figure of the paper (Figs. 1-8 and the two of section 2) into ``out_dir/figures``.
-
-    Returns the report entries and, for a figure that cannot be drawn from these results (e.g.
-    no event reached block N in a tiny run), the reason, by figure stem.
-    """
-    d = Path(out_dir) / "figures"
-    d.mkdir(parents=True, exist_ok=True)
-    figures: list[ReportFigure] = []
-    not_drawn: dict[str, str] = {}
-    steps: list[tuple[str, Callable[[], list[ReportFigure]]]] = [
-        ("fig1, fig2", lambda: _fig1_2(outcomes, d)),
-        ("fig3", lambda: _fig3(outcomes, d)),
-        ("stability_map", lambda: _stability_map(outcomes, d)),
-        ("hysteresis", lambda: _hysteresis(outcomes, d)),
-        ("fig4", lambda: _fig4(outcomes, d)),
-    ]
-    if analysis is not None:
-        steps += [
-            ("fig5a, fig5b", lambda: _fig5(outcomes, analysis, d, mode)),
-            ("fig6", lambda: _fig6(outcomes, analysis, d)),
-            ("fig7", lambda: _fig7_8(outcomes, analysis, d, "7")),
-            ("fig8", lambda: _fig7_8(outcomes, analysis, d, "8")),
-        ]
+def _draw(steps: list[tuple[str, Callable[[], list[Drawn]]]]) -> list[tuple]:
+    """Each step's figures, or for a step these results cannot give (e.g. no event reached block N
+    in a tiny run) its stems with the reason."""
+    out: list[tuple] = []
     for name, draw in steps:
         try:
-            figures += draw()
+            out += draw()
         except (ValueError, KeyError, IndexError) as exc:
-            not_drawn[name] = f"{type(exc).__name__}: {exc}"
-            if log:
-                log(f"{name} not drawn: {exc}")
-    return figures, not_drawn
+            out.append((name, None, f"{type(exc).__name__}: {exc}"))
+    return out
+
+
+def section2_figures(outcomes: dict[str, Outcome], page_dir: Path) -> list[tuple]:
+    """Figs. 1-4 and the two figures of section 2 (the stability map, the hysteresis sweep) from the
+    outcomes of the experiments of :mod:`stickslip.experiments.studies.figs1_4`, their data
+    written into ``page_dir``."""
+    d = Path(page_dir)
+    return _draw(
+        [
+            ("fig1, fig2", lambda: _fig1_2(outcomes, d)),
+            ("fig3", lambda: _fig3(outcomes, d)),
+            ("stability_map", lambda: _stability_map(outcomes, d)),
+            ("hysteresis", lambda: _hysteresis(outcomes, d)),
+            ("fig4", lambda: _fig4(outcomes, d)),
+        ]
+    )
+
+
+def chain_figures(outcome: Outcome, analysis: dict[str, Any], page_dir: Path, mode: str) -> list[tuple]:
+    """Figs. 5-8 from the chain runs of :mod:`stickslip.experiments.studies.figs5_8` and their
+    ``analysis`` (:func:`stickslip.analysis.chain_runs.chain_analysis`), their data written into
+    ``page_dir``."""
+    d, o = Path(page_dir), {"chain-runs": outcome}
+    return _draw(
+        [
+            ("fig5a, fig5b", lambda: _fig5(o, analysis, d, mode)),
+            ("fig6", lambda: _fig6(o, analysis, d)),
+            ("fig7", lambda: _fig7_8(o, analysis, d, "7")),
+            ("fig8", lambda: _fig7_8(o, analysis, d, "8")),
+        ]
+    )

@@ -6,7 +6,7 @@ or figure and names the command (and its options) that computes the same thing.
 
 from __future__ import annotations
 
-from stickslip.outcome import Outcome, chain_common, point_settings
+from stickslip.outcome import Outcome, point_settings
 
 
 def g(x: float) -> str:
@@ -16,13 +16,13 @@ def g(x: float) -> str:
 
 def block_command(o: Outcome) -> str:
     """The ``stickslip block`` command of the block run (Figs. 1, 2)."""
-    return f"stickslip block --t-end {g(o.experiment.t_end)} --out DIR"
+    return f"stickslip block --t-end {g(o.settings['t_end'])} --out DIR"
 
 
 def hysteresis_command(o: Outcome, *, draw: bool = False) -> str:
     """The ``stickslip hysteresis`` command of the sweep of V (section 2): printing its numbers,
     or with ``draw`` writing its figure (hysteresis.png) into DIR."""
-    s = o.experiment.options
+    s = o.settings["options"]
     return (
         f"stickslip hysteresis --K 10 --beta 1 --Fs 3 --V-min {g(s['V_min'])} --V-max {g(s['V_max'])} "
         f"--dV {g(s['dV'])} --time-per-step {g(s['time_per_step'])} --transient {g(s['transient'])} "
@@ -34,7 +34,7 @@ def chain_command(o: Outcome, N: int, beta: float, *, plot: str | None = None) -
     """The ``stickslip chain`` command of one chain run of the experiment; with ``plot`` (a figure
     of ``stickslip plot``: snapshot_final, sizes, fronts, ...) followed by the command that draws
     it from the run directory."""
-    cfg = {**chain_common(o.experiment), "N": N, "beta": beta}
+    cfg = {**o.settings, "N": N, "beta": beta}
     params, t_end, opts = point_settings(cfg)
     parts = [
         f"stickslip chain --N {N} --beta {g(beta)} --t-end {g(t_end)}",
@@ -50,6 +50,12 @@ def chain_command(o: Outcome, N: int, beta: float, *, plot: str | None = None) -
     return " ".join(parts)
 
 
+def reproduce_command(mode: str) -> str:
+    """The ``stickslip reproduce`` command of a mode."""
+    return f"stickslip reproduce --{mode} --out DIR"
+
+
 def sweep_command(o: Outcome, mode: str) -> str:
-    """The reproduce command whose Dask sweep gives the chain runs of Fig. 5(b)."""
-    return f"stickslip reproduce --{mode} --out DIR  (chain runs on Dask: runs/{o.experiment.dirname}/points)"
+    """The reproduce command whose Dask sweep gives the chain runs of Fig. 5(b) (``o.run_dir``:
+    the folder of their points)."""
+    return f"{reproduce_command(mode)}  (chain runs on Dask: runs/{o.run_dir.parent.name}/{o.run_dir.name})"

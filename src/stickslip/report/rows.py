@@ -3,7 +3,9 @@
 One :class:`~stickslip.report.writer.ReportRow` per stated number: section 2 (Hopf point,
 stability at beta = 1, the inverse transition), eq. (3) (duration and force at stop), Fig. 3
 (the period law), Fig. 4 (long-wave instability), section 3 (final states) and Figs. 5-8 from
-the chain runs, each with the paper's value, this run's, whether they agree and the command.
+the chain runs, each with the paper's value, this run's, whether they agree and the command:
+:func:`section2_rows` and :func:`chain_rows`, the findings of the paper's two studies
+(:data:`stickslip.experiments.studies.PAPER`).
 """
 
 from __future__ import annotations
@@ -43,8 +45,9 @@ def _f(x: Any, digits: int = 4) -> str:
     return f"{x:.{digits}g}"
 
 
-def _section2_rows(o: dict[str, Outcome]) -> list[ReportRow]:
-    """Rows of section 2, eq. (3) and Figs. 3 and 4: the same computation in every mode."""
+def section2_rows(o: dict[str, Outcome]) -> list[ReportRow]:
+    """Rows of section 2, eq. (3) and Figs. 3 and 4 (the same computation in every mode), from the
+    outcomes of the experiments of :mod:`stickslip.experiments.studies.figs1_4` by name."""
     rows = []
     st = o["stability-block"].summary
     Vc = st["hopf_V"]
@@ -182,7 +185,7 @@ def _final_state_row(o: Outcome, a: dict[str, Any], mode: str) -> ReportRow:
         if r.beta <= 1.0 and state != "stick-slip":
             contradicts.append(r.beta)
         if r.beta > 1.0 and state != "steady sliding":
-            t_run = float(o.experiment.options["t_end_by_N"][str(int(r.N))])
+            t_run = float(o.settings["t_end_by_N"][str(int(r.N))])
             unsettled.append(f"{r.beta:g} (N = {r.N}, t = {_g(t_run)})")
     if mode == "smoke":
         agrees, reason = None, "smoke run: tiny chains"
@@ -205,8 +208,8 @@ def _final_state_row(o: Outcome, a: dict[str, Any], mode: str) -> ReportRow:
         "every run at beta <= 1 stick-slips in its second half; every run at beta > 1 slides steadily at the end",
         sweep_command(o, mode),
         na_reason=reason,
-        note=f"runs at beta > {_g(o.experiment.options['until_steady_above'])} stop once every block slides within "
-        f"{_g(o.experiment.options['until_steady'])} of steady sliding (v, theta and spring extensions); "
+        note=f"runs at beta > {_g(o.settings['until_steady_above'])} stop once every block slides within "
+        f"{_g(o.settings['until_steady'])} of steady sliding (v, theta and spring extensions); "
         "from there on nothing changes",
     )
 
@@ -275,8 +278,9 @@ def front_speed_row(
     )
 
 
-def _chain_rows(o: Outcome, a: dict[str, Any], mode: str) -> list[ReportRow]:
-    """Rows of section 3 and Figs. 5-8 from the chain runs."""
+def chain_rows(o: Outcome, a: dict[str, Any], mode: str) -> list[ReportRow]:
+    """Rows of section 3 and Figs. 5-8 from the chain runs (``o``) and their analysis ``a``
+    (:func:`stickslip.analysis.chain_runs.chain_analysis`)."""
     rows = [_final_state_row(o, a, mode)]
     smoke = mode == "smoke"
 
@@ -423,11 +427,21 @@ def _chain_rows(o: Outcome, a: dict[str, Any], mode: str) -> list[ReportRow]:
     return rows
 
 
-def report_rows(outcomes: dict[str, Outcome], analysis: dict[str, Any] | None, mode: str) -> list[ReportRow]:
-    """One :class:`~stickslip.report.writer.ReportRow` per number of docs/model.md's last table (eq. 3 gives two)."""
-    rows = _section2_rows(outcomes)
-    if analysis is not None:
-        chain_rows = _chain_rows(outcomes["chain-runs"], analysis, mode)
-        # report order of docs/model.md: sec. 2 rows, eq. 3, Fig. 3, Fig. 4, sec. 3, Figs. 5-8
-        rows += chain_rows
-    return rows
+#: The columns of the stated numbers on a study's page.
+ROW_COLUMNS = ("where", "quantity", "paper", "value", "agreement")
+
+
+def findings_of(rows: list[ReportRow] | None) -> dict[str, Any]:
+    """The findings of one of the paper's studies: its ``rows`` of stated numbers (as dicts) and a
+    statement per row; without rows (an experiment did not finish), a statement that says so."""
+    if rows is None:
+        return {"statements": ["not every experiment finished: no stated numbers"], "rows": []}
+    return {
+        "statements": [f"{r.where}: {r.quantity}: {r.agreement}" for r in rows],
+        "rows": [r.to_dict() for r in rows],
+    }
+
+
+def stated_numbers(found: dict[str, Any]) -> list[tuple[str, list[str], list[dict[str, Any]]]]:
+    """The table of stated numbers on the page of one of the paper's studies (its findings' rows)."""
+    return [("The paper's stated numbers", list(ROW_COLUMNS), found.get("rows", []))]

@@ -16,6 +16,14 @@ naming one.
 * :mod:`~stickslip.experiments.studies.chaos`: is the chain chaotic at the onset (the flow's
   exponent, the decorrelation of slips, its threshold delta*)?
 
+The paper's own figures and stated numbers are studies of the same shape (:data:`PAPER`), each
+with one page; ``stickslip reproduce`` runs them with the same runner and gathers their rows and
+figures into one report (:mod:`stickslip.experiments.reproduce`):
+
+* :mod:`~stickslip.experiments.studies.figs1_4`: the single block of section 2 (Figs. 1-3, the
+  Hopf point, the inverse transition) and the Fourier modes of the chain (Fig. 4);
+* :mod:`~stickslip.experiments.studies.figs5_8`: the chain runs of section 3 (Figs. 5-8).
+
 A :class:`Study`'s key hashes its name, the settings every point shares and the package version
 (not the point list, so a point added to a study keeps the directory and runs only the new point).
 """
@@ -30,10 +38,14 @@ from typing import Any
 from stickslip import __version__
 from stickslip.experiments.cache import canonical, spec_key
 
-__all__ = ["Study", "Design", "Option", "STUDIES", "MODES", "design", "study", "study_command"]
+__all__ = ["Study", "Design", "Option", "STUDIES", "PAPER", "MANIFEST", "MODES", "design", "study", "study_command"]
 
 #: The studies, each the module of its name (``-`` read as ``_``) in this package.
 STUDIES = ("transition", "phase-diagram", "exponents", "chaos")
+#: The studies of ``stickslip reproduce`` (the paper's figures and stated numbers), in report order.
+PAPER = ("figs1-4", "figs5-8")
+#: The record, at the top of a study's output folder, of every page file its studies wrote.
+MANIFEST = ".stickslip-study.json"
 #: ``tiny`` runs every study on chains of a few blocks in seconds (tests); its numbers mean nothing.
 MODES = ("quick", "full", "tiny")
 
@@ -101,7 +113,16 @@ class Design:
     - ``options``: its own command-line options;
     - ``point_entry(path, rel)``: for a study whose points write a known layout, whether an
       entry of a point's folder is the point's (True, False, or for a folder the test of its
-      entries); without it a point's folder is the point's.
+      entries); without it a point's folder is the point's;
+    - ``load(study, table, points_dir)``: for a study whose findings and figures read its
+      points' files, what they read in place of the table (loaded once);
+    - ``point_name(point)``: a point's folder name (default
+      :func:`stickslip.experiments.sweep.point_name`);
+    - ``command(mode)``: the command line that computes the study (default ``stickslip study
+      NAME --MODE --out DIR``).
+
+    ``figures`` gives ``(name, None, reason)`` for a figure the results cannot give, and may add
+    a dict of further fields of the figure's entry (its data files, the command that draws it).
     """
 
     name: str
@@ -117,6 +138,9 @@ class Design:
     tables: Callable[[dict[str, Any]], list[tuple[str, list[str], list[dict[str, Any]]]]] | None = None
     options: tuple[Option, ...] = ()
     point_entry: Callable[..., Any] | None = None
+    load: Callable[..., Any] | None = None
+    point_name: Callable[[dict[str, Any]], str] | None = None
+    command: Callable[[str], str] | None = None
 
 
 def design(name: str) -> Design:
@@ -125,14 +149,14 @@ def design(name: str) -> Design:
     Parameters
     ----------
     name : str
-        One of :data:`STUDIES`.
+        One of :data:`STUDIES` or :data:`PAPER`.
 
     Returns
     -------
     Design
         The module's ``DESIGN``.
     """
-    if name not in STUDIES:
+    if name not in STUDIES + PAPER:
         raise ValueError(f"study must be one of {', '.join(STUDIES)} (got {name!r})")
     return importlib.import_module(f"{__name__}.{name.replace('-', '_')}").DESIGN
 
@@ -161,4 +185,5 @@ def study(name: str, mode: str = "quick", **options: Any) -> Study:
 
 def study_command(name: str, mode: str) -> str:
     """The command line that computes study ``name`` in ``mode`` (shown beside each figure)."""
-    return f"stickslip study {name} --{mode} --out DIR"
+    command = design(name).command
+    return command(mode) if command else f"stickslip study {name} --{mode} --out DIR"
