@@ -13,8 +13,7 @@ import pytest
 
 from stickslip import __version__
 from stickslip.experiments.cache import canonical, read_record, spec_key
-from stickslip.experiments.specs import Experiment
-from stickslip.experiments.studies import Study, study
+from stickslip.experiments.studies import Study, figs1_4, figs5_8, study
 
 
 def _sha12(text: str) -> str:
@@ -34,19 +33,10 @@ def test_spec_key_is_the_sha256_of_compact_sorted_json():
     assert spec_key({"b": [1, 2], "a": "x"}) == _sha12('{"a":"x","b":[1,2]}')
 
 
-def test_experiment_key_leaves_out_its_points():
-    exp = Experiment(
-        "chain-runs", "chain_runs", params={"K": 10.0, "beta": 0.5}, t_end=2e6, options={"points": [1], "w": (1, 2)}
-    )
-    text = (
-        '{"kind":"chain_runs","options":{"w":[1,2]},"params":{"K":10,"beta":0.5},"t_end":2000000,'
-        f'"version":"{__version__}"}}'
-    )
-    assert exp.key() == _sha12(text) and exp.dirname == f"chain-runs-{_sha12(text)}"
-    assert (
-        Experiment("chain-runs", "chain_runs", params={"K": 10, "beta": 0.5}, t_end=2e6, options={"w": [1, 2]}).key()
-        == exp.key()
-    )
+def test_an_experiment_of_the_paper_names_its_folder_by_its_settings():
+    point = canonical({"experiment": "slip-limit", "params": {"K": 10.0, "beta": 0.5}, "options": {"w": (1, 2)}})
+    text = '{"experiment":"slip-limit","options":{"w":[1,2]},"params":{"K":10,"beta":0.5}}'
+    assert figs1_4.point_name(point) == f"slip-limit-{_sha12(text)}"
 
 
 def test_study_key_leaves_out_its_points():
@@ -57,8 +47,8 @@ def test_study_key_leaves_out_its_points():
 
 
 def test_every_study_names_its_folder_the_same_way():
-    for name in ("transition", "chaos"):
-        spec = study(name, "tiny")
+    for spec in (study("transition", "tiny"), study("chaos", "tiny"), figs5_8.build("smoke")):
+        name = spec.name
         text = json.dumps(
             {"common": spec.common, "study": name, "version": __version__}, sort_keys=True, separators=(",", ":")
         )

@@ -14,9 +14,12 @@ import pytest
 from chain_helpers import error_lines, is_real_command
 from stickslip.cli import main
 from stickslip.experiments import reproduce as rp
-from stickslip.experiments import specs as ex
+from stickslip.experiments.cache import spec_key
+from stickslip.experiments.studies import Study, figs1_4, figs5_8
+from stickslip.experiments.study_run import run_study
 from stickslip.experiments.sweep import DONE_FILE
 from stickslip.io import read_json, read_table
+from stickslip.outcome import point_settings
 
 #: docs/model.md, last table: (where, a word of the quantity) for every number the paper states;
 #: eq. 3 states two numbers and gets two rows.
@@ -35,132 +38,133 @@ MODEL_ROWS = [
     ("Fig. 7", "beta = 1"),
     ("Fig. 8", "beta = 0.2"),
 ]
+#: The figures of a reproduction: the paper's Figs. 1-8 and the two of section 2.
+FIGURES = {"fig1", "fig2", "fig3", "stability_map", "hysteresis", "fig4", "fig5a", "fig5b", "fig6", "fig7", "fig8"}
+#: The experiments of section 2 and Fig. 4, in the order they run.
+EXPERIMENTS = ["block", "slip-limit", "period-sweep", "stability-block", "hysteresis", "chain-modes"]
 
 
 # ---------------------------------------------------------------------------------------------
-# Specs
+# The paper's studies
 
 
-def test_spec_key_depends_on_what_the_result_depends_on_only():
-    e = ex.Experiment("a", "chain_modes", {"K": 10.0, "D": 5.0}, options={"betas": [0.5, 1.0]})
-    assert (
-        e.key()
-        == ex.Experiment(
-            "b", "chain_modes", {"D": 5, "K": 10}, options={"betas": (0.5, 1.0)}, figures=("fig4",), note="label"
-        ).key()
-    )
-    assert len(e.key()) == 12 and e.dirname == f"a-{e.key()}"
-    assert e.key() != ex.Experiment("a", "chain_modes", {"K": 10.0, "D": 4.0}, options={"betas": [0.5, 1.0]}).key()
-    assert e.key() != ex.Experiment("a", "chain_modes", {"K": 10.0, "D": 5.0}, options={"betas": [0.5]}).key()
-    assert (
-        e.key()
-        != ex.Experiment("a", "chain_modes", {"K": 10.0, "D": 5.0}, t_end=1.0, options={"betas": [0.5, 1.0]}).key()
-    )
-    assert e.key() != ex.Experiment("a", "block_run", {"K": 10.0, "D": 5.0}, options={"betas": [0.5, 1.0]}).key()
-
-
-def test_spec_key_includes_the_package_version(monkeypatch):
-    e = ex.Experiment("a", "slip_limit", {"K": 10.0})
-    before = e.key()
-    monkeypatch.setattr(ex, "__version__", "999.0")
-    assert e.key() != before and e.spec()["version"] == "999.0"
-
-
-def test_chain_points_are_left_out_of_the_directory_key_but_not_the_spec():
-    e1 = ex.Experiment("c", "chain_runs", {"K": 10.0}, options={"points": [{"N": 9, "beta": 1.0}], "x": 1})
-    e2 = ex.Experiment(
-        "c", "chain_runs", {"K": 10.0}, options={"points": [{"N": 9, "beta": 1.0}, {"N": 9, "beta": 0.5}], "x": 1}
-    )
-    assert e1.key() == e2.key()
-    assert e1.spec() != e2.spec()
-
-
-def test_spec_sets_of_every_mode():
-    for mode in ex.MODES:
-        specs = ex.experiments(mode)
-        names = [e.name for e in specs]
+def test_the_studies_of_every_mode():
+    for mode in rp.MODES:
+        small = figs1_4.build(mode)
+        assert small.name == "figs1-4" and small.mode == mode
+        assert [p["experiment"] for p in small.points] == EXPERIMENTS
+        names = [figs1_4.point_name(p) for p in small.points]
         assert len(set(names)) == len(names)
-        assert {e.kind for e in specs} == set(ex.KINDS)
-        drawn = {stem for e in specs for stem in e.figures}
-        assert drawn == {stem for stem, _ in ex.FIGURES}
-    full = ex.experiment("full", "chain-runs")
-    assert {p["N"] for p in full.options["points"]} == {399}
-    assert full.options["t_end_by_N"] == {"399": 2e7}
-    betas = sorted(p["beta"] for p in full.options["points"])
+        chains = figs5_8.build(mode)
+        assert chains.name == "figs5-8" and chains.dirname != small.dirname
+    full = figs5_8.build("full")
+    assert {p["N"] for p in full.points} == {399}
+    assert full.common["t_end_by_N"] == {"399": 2e7}
+    betas = sorted(p["beta"] for p in full.points)
     assert 0.2 in betas and 1.0 in betas and min(betas) <= 0.2 and max(betas) > 1.0
     assert sum(0.9 <= b <= 1.1 for b in betas) >= 5  # enough points around the transition
-    quick = ex.experiment("quick", "chain-runs")
-    assert {"N": 199, "beta": 1.0} in quick.options["points"] and {"N": 199, "beta": 0.2} in quick.options["points"]
+    quick = figs5_8.build("quick")
+    assert {"N": 199, "beta": 1} in quick.points and {"N": 199, "beta": 0.2} in quick.points
+    assert quick.common["t_end_by_N"] == {"99": 2e6, "199": 4e6}
     with pytest.raises(ValueError, match="mode"):
-        ex.experiments("medium")
-    with pytest.raises(ValueError, match="kind"):
-        ex.Experiment("x", "nonsense")
+        rp.reproduce("never", "medium")
+
+
+def test_an_experiments_folder_is_named_by_its_settings():
+    block = figs1_4.build("quick").points[0]
+    assert figs1_4.point_name(block) == f"block-{spec_key(block)}" and len(spec_key(block)) == 12
+    assert figs1_4.point_name({**block, "t_end": 2001}) != figs1_4.point_name(block)
+    assert figs1_4.point_name(figs1_4.build("smoke").points[0]) != figs1_4.point_name(block)
+
+
+def test_chain_points_are_left_out_of_the_folder_key_but_not_the_spec():
+    quick = figs5_8.build("quick")
+    fewer = Study(quick.name, quick.mode, quick.common, quick.points[:2])
+    assert fewer.dirname == quick.dirname and fewer.spec() != quick.spec()
+    longer = Study(quick.name, quick.mode, {**quick.common, "t_end_by_N": {"99": 1e6, "199": 4e6}}, quick.points)
+    assert longer.dirname != quick.dirname
 
 
 # ---------------------------------------------------------------------------------------------
 # Reuse of a single experiment
 
 
-def test_run_experiment_computes_once_and_reuses(tmp_path):
-    exp = ex.experiment("smoke", "chain-modes")
-    first = rp.run_experiment(exp, tmp_path, n_workers=1)
-    done = tmp_path / exp.dirname / DONE_FILE
+def _one(name, mode="smoke", **options):
+    """The study of section 2 and Fig. 4 with only its experiment ``name`` (options changed)."""
+    point = next(p for p in figs1_4.build(mode).points if p["experiment"] == name)
+    if options:
+        point = {**point, "options": {**point["options"], **options}}
+    return Study("figs1-4", mode, {}, (point,)), point
+
+
+def _done(out, spec, point):
+    return out / "runs" / spec.dirname / "points" / figs1_4.point_name(point) / DONE_FILE
+
+
+def test_an_experiment_is_computed_once_and_reused(tmp_path):
+    spec, point = _one("chain-modes")
+    first = run_study(spec, tmp_path, n_workers=1, progress=False)
+    done = _done(tmp_path, spec, point)
     stamp = done.stat().st_mtime_ns
-    second = rp.run_experiment(exp, tmp_path, n_workers=1)
-    assert not first.reused and second.reused and done.stat().st_mtime_ns == stamp
-    assert second.summary == first.summary
-    changed = ex.Experiment(exp.name, exp.kind, exp.params, options={**exp.options, "n_k": 101})
-    third = rp.run_experiment(changed, tmp_path, n_workers=1)
-    assert not third.reused and third.run_dir != first.run_dir
+    second = run_study(spec, tmp_path, n_workers=1, progress=False)
+    assert (first["run"], first["reused"]) == (1, 0) and (second["run"], second["reused"]) == (0, 1)
     assert done.stat().st_mtime_ns == stamp
+    assert second["rows"][0]["critical_beta"] == first["rows"][0]["critical_beta"]
+    changed, other = _one("chain-modes", n_k=101)
+    third = run_study(changed, tmp_path, n_workers=1, progress=False)
+    assert third["run"] == 1 and _done(tmp_path, changed, other) != done
+    assert done.stat().st_mtime_ns == stamp, "the other settings' result stays"
+    assert run_study(spec, tmp_path, n_workers=1, progress=False)["reused"] == 1
 
 
 @pytest.mark.parametrize("damage", ["summary edited", "file changed", "file deleted", "no checksums"])
 def test_a_damaged_result_is_run_again(tmp_path, damage):
-    exp = ex.experiment("smoke", "slip-limit")
-    first = rp.run_experiment(exp, tmp_path)
-    path = tmp_path / exp.dirname / DONE_FILE
+    spec, point = _one("slip-limit")
+    run_study(spec, tmp_path, n_workers=1, progress=False)
+    path = _done(tmp_path, spec, point)
     record = read_json(path)
+    summary = record["summary"]
     assert record["files"], "the record lists the files it stands for"
     rel = sorted(record["files"])[0]
     if damage == "summary edited":
         key = sorted(record["summary"])[0]
-        record["summary"][key] = 42
+        record["summary"] = {**summary, key: 42}
         path.write_text(json.dumps(record))
     elif damage == "file changed":
-        with open(tmp_path / exp.dirname / rel, "ab") as fh:
+        with open(path.parent / rel, "ab") as fh:
             fh.write(b" ")
     elif damage == "file deleted":
-        (tmp_path / exp.dirname / rel).unlink()
+        (path.parent / rel).unlink()
     else:
         del record["files"], record["sha256"]
         path.write_text(json.dumps(record))
-    lines = []
-    again = rp.run_experiment(exp, tmp_path, log=lines.append)
-    assert not again.reused and again.summary == first.summary
-    assert any("not reused" in line for line in lines)
-    assert rp.run_experiment(exp, tmp_path).reused
+    again = run_study(spec, tmp_path, n_workers=1, progress=False)
+    assert (again["run"], again["reused"], again["damaged"]) == (1, 0, 1)
+    assert read_json(path)["summary"] == summary
+    assert "damaged" in (tmp_path / "figs1-4" / "index.html").read_text()
+    assert run_study(spec, tmp_path, n_workers=1, progress=False)["reused"] == 1
 
 
 def test_a_result_of_another_spec_in_the_same_directory_is_not_reused(tmp_path):
-    exp = ex.experiment("smoke", "slip-limit")
-    rp.run_experiment(exp, tmp_path)
-    record = read_json(tmp_path / exp.dirname / DONE_FILE)
+    spec, point = _one("slip-limit")
+    run_study(spec, tmp_path, n_workers=1, progress=False)
+    path = _done(tmp_path, spec, point)
+    record = read_json(path)
     record["spec"]["version"] = "0.0.0-other"
-    (tmp_path / exp.dirname / DONE_FILE).write_text(json.dumps(record))
-    assert not rp.run_experiment(exp, tmp_path).reused
+    path.write_text(json.dumps(record))
+    assert run_study(spec, tmp_path, n_workers=1, progress=False)["reused"] == 0
 
 
 def test_chain_task_continues_from_a_checkpoint(tmp_path, monkeypatch):
     from stickslip.run import driver as chain
 
-    exp = ex.experiment("smoke", "chain-runs")
-    point = {**rp._chain_common(exp), "N": 19, "beta": 1.0}
-    first = rp.chain_point_task(point, tmp_path / "done")
+    spec = figs5_8.build("smoke")
+    point = {**spec.common, "N": 19, "beta": 1.0}
+    first = figs5_8.chain_point_task(point, tmp_path / "done")
     assert (tmp_path / "done" / "run.json").is_file()
     assert not (tmp_path / "done" / "checkpoint").exists(), "a finished point keeps no checkpoint"
     # A run killed while writing its results: the checkpoint is there, the results are not.
-    params, t_end, options = rp._point_settings(point)
+    params, t_end, options = point_settings(point)
     killed = tmp_path / "killed"  # a folder of its own: run_chain refuses one holding other files
     chain.run_chain(params, t_end, out_dir=killed, keep_checkpoint=True, **options)
     assert (killed / "checkpoint" / "state.npz").is_file()
@@ -171,7 +175,7 @@ def test_chain_task_continues_from_a_checkpoint(tmp_path, monkeypatch):
         raise AssertionError("a run with a checkpoint must continue from it")
 
     monkeypatch.setattr(chain, "run_chain", no_fresh_run)
-    again = rp.chain_point_task(point, killed)
+    again = figs5_8.chain_point_task(point, killed)
     assert again["state_sha256"] == first["state_sha256"]
     assert again["n_events"] == first["n_events"]
     assert (killed / "run.json").is_file()
@@ -227,7 +231,7 @@ def test_every_figure_is_drawn_with_png_pdf_and_data(smoke):
     assert not printed["figures_not_drawn"]
     assert "figures_not_drawn" not in report["meta"]
     images = {Path(f["image"]).stem for f in report["figures"]}
-    assert images == {stem for stem, _ in ex.FIGURES}
+    assert images == FIGURES and len(report["figures"]) == len(FIGURES)
     for f in report["figures"]:
         assert (out / f["image"]).stat().st_size > 1000
         assert (out / f["pdf"]).stat().st_size > 1000
@@ -249,27 +253,38 @@ def test_second_call_reuses_every_result_and_only_redraws(smoke, monkeypatch):
     def boom(*a, **k):
         raise AssertionError("a stored result was computed again")
 
-    for kind, runner in list(rp._RUNNERS.items()):
-        monkeypatch.setitem(rp._RUNNERS, kind, rp._Runner(boom, runner.load))
     import stickslip.experiments.sweep
 
     monkeypatch.setattr(stickslip.experiments.sweep, "_compute", boom)  # no point is sent to Dask
     before = read_json(out / "report.json")
     result = rp.reproduce(out, "smoke", progress=False)
-    assert all(e["reused"] for e in result["experiments"])
+    assert [s["study"] for s in result["studies"]] == ["figs1-4", "figs5-8"]
+    assert all(s["reused"] == s["points"] and s["run"] == 0 for s in result["studies"])
     after = read_json(out / "report.json")
     assert [r["value"] for r in after["rows"]] == [r["value"] for r in before["rows"]]
 
 
 def test_chain_runs_of_the_smoke_set_are_on_disk_per_point(smoke):
     out, _ = smoke
-    exp = ex.experiment("smoke", "chain-runs")
-    points = out / "runs" / exp.dirname / "points"
-    for p in exp.options["points"]:
+    spec = figs5_8.build("smoke")
+    points = out / "runs" / spec.dirname / "points"
+    for p in spec.points:
         d = points / f"beta={p['beta']:g}_N={p['N']}"
         assert (d / "done.json").is_file() and (d / "run.json").is_file()
     table = read_table(points / "summary.parquet")
-    assert set(zip(table["N"], table["beta"], strict=True)) == {(p["N"], p["beta"]) for p in exp.options["points"]}
+    assert set(zip(table["N"], table["beta"], strict=True)) == {(p["N"], p["beta"]) for p in spec.points}
+
+
+def test_each_study_of_the_paper_has_its_page(smoke):
+    out, _ = smoke
+    small = {"fig1", "fig2", "fig3", "stability_map", "hysteresis", "fig4"}
+    for name, stems, rows in (("figs1-4", small, MODEL_ROWS[:7]), ("figs5-8", FIGURES - small, MODEL_ROWS[7:])):
+        found = read_json(out / name / "study.json")
+        assert [r["where"] for r in found["findings"]["rows"]] == [w for w, _ in rows], name
+        assert {f["name"] for f in found["figures"]} == stems, name
+        assert (out / name / "table.parquet").is_file()
+        page = (out / name / "index.html").read_text()
+        assert "stickslip reproduce --smoke --out DIR" in page and "The paper&#39;s stated numbers" in page
 
 
 # ---------------------------------------------------------------------------------------------
@@ -308,12 +323,10 @@ def test_help_lists_the_modes(capsys):
 
 def test_plot_reproduce_and_catalog_give_the_same_tau_on_the_same_run(smoke, tmp_path, capsys):
     """One stationary window (analysis.chain_runs.stationary_from) and one fit for all three."""
-    from stickslip.analysis.chain_runs import chain_analysis
-
     out, _ = smoke
-    exp = ex.experiment("smoke", "chain-runs")
-    a = chain_analysis(rp.run_experiment(exp, out / "runs"))
-    points = out / "runs" / exp.dirname / "points"
+    spec = figs5_8.build("smoke")
+    points = out / "runs" / spec.dirname / "points"
+    a = figs5_8.DESIGN.load(spec, read_table(points / "summary.parquet"), points).analysis
     for beta, key, reading in ((1.0, "sizes1", "whole_range"), (0.2, "sizes02", "below_spanning")):
         run_dir = points / f"beta={beta:g}_N={a['figure_N']}"
         tau = a[key]["fit"].tau

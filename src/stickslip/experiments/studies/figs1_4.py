@@ -2,8 +2,10 @@
 (Figs. 1-3, the Hopf point of eq. 2, the inverse transition), the slip of eq. (3) and the Fourier
 modes of the chain, eq. (5).
 
-Each point is one experiment, named by ``experiment`` (its folder's name), with its model
-parameters (``params``), run length (``t_end``, the block run only) and ``options``; its runner
+Each point is one experiment, named by ``experiment``, with its model parameters (``params``),
+run length (``t_end``, the block run only) and ``options``; its folder is ``<experiment>-<key>``
+(:func:`point_name`), so a changed experiment gets a folder of its own and the old result stays
+for the settings that made it. Its runner
 here computes it on a worker and its loader reads it back for the rows
 (:func:`stickslip.report.rows.section2_rows`) and the figures
 (:func:`stickslip.plotting.figures.section2_figures`). Every mode takes seconds; ``smoke`` shortens
@@ -22,6 +24,7 @@ import numpy as np
 import pandas as pd
 
 from stickslip import io
+from stickslip.experiments.cache import spec_key
 from stickslip.experiments.studies import Design, Study
 from stickslip.models.params import BlockParams, ChainParams
 from stickslip.models.presets import block_params, paper_parameters
@@ -240,17 +243,24 @@ def check(cfg: dict[str, Any]) -> None:
     (ChainParams if cfg["experiment"] == "chain-modes" else BlockParams)(**cfg["params"])
 
 
+def point_name(point: dict[str, Any]) -> str:
+    """An experiment's folder: ``<experiment>-<key>``, the key hashing its settings
+    (:func:`stickslip.experiments.cache.spec_key`)."""
+    return f"{point['experiment']}-{spec_key(point)}"
+
+
 def load(spec: Study, table: pd.DataFrame, points_dir: Path) -> Results | None:
-    """Every experiment's result read back from its folder (None unless every one finished)."""
+    """Every experiment's result read back from its folder (None unless each experiment of
+    section 2 and Fig. 4 finished)."""
     from stickslip.experiments.sweep import DONE_FILE
 
     rows = {r.point_dir: r for r in table.itertuples()}
-    if len(rows) < len(spec.points):
+    if {p["experiment"] for p in spec.points if point_name(p) in rows} != set(_RUNNERS):
         return None
     outcomes = {}
     for point in spec.points:
         name, cfg = point["experiment"], {**spec.common, **point}
-        run_dir, row = points_dir / name, rows[name]
+        run_dir, row = points_dir / point_name(point), rows[point_name(point)]
         summary = io.read_json(run_dir / DONE_FILE)["summary"]
         data = _RUNNERS[name].load(cfg, run_dir, summary)
         outcomes[name] = Outcome(cfg, run_dir, data, summary, bool(row.reused), float(row.wall_seconds))
@@ -293,6 +303,6 @@ DESIGN = Design(
     columns=("experiment", "t_end", "params", "options"),
     tables=stated_numbers,
     load=load,
-    point_name=lambda point: point["experiment"],
+    point_name=point_name,
     command=reproduce_command,
 )
