@@ -12,7 +12,7 @@ import json
 import pytest
 
 from stickslip import __version__
-from stickslip.experiments.cache import canonical, read_record, spec_key
+from stickslip.experiments.cache import canonical, file_digests, read_done, sealed, spec_key
 from stickslip.experiments.studies import Study, figs1_4, figs5_8, study
 
 
@@ -55,17 +55,18 @@ def test_every_study_names_its_folder_the_same_way():
         assert spec.dirname == f"{name}-{_sha12(text)}"
 
 
-def test_read_record_only_for_the_same_spec(tmp_path):
-    spec = {"kind": "block_run", "version": __version__}
-    path = tmp_path / "result.json"
-    assert read_record(path, spec) is None  # not there
-    path.write_text(json.dumps({"spec": spec, "summary": {"x": 1}}))
-    assert read_record(path, spec) == {"spec": spec, "summary": {"x": 1}}
-    assert read_record(path, {**spec, "version": "other"}) is None
-    path.write_text('{"spec": ')
-    assert read_record(path, spec) is None  # unreadable
-    path.write_text("[1, 2]")
-    assert read_record(path, spec) is None
+def test_read_done_only_for_the_same_spec(tmp_path):
+    spec = {"task": "t", "version": __version__}
+    assert read_done(tmp_path, spec) == (None, None)  # not there
+    (tmp_path / "x.txt").write_text("result")
+    record = sealed({"spec": spec, "summary": {"x": 1}, "files": file_digests(tmp_path)})
+    (tmp_path / "done.json").write_text(json.dumps(record))
+    assert read_done(tmp_path, spec) == (record, None)
+    assert read_done(tmp_path, {**spec, "version": "other"}) == (None, None)
+    (tmp_path / "done.json").write_text('{"spec": ')
+    assert read_done(tmp_path, spec) == (None, "done.json is unreadable")
+    (tmp_path / "done.json").write_text("[1, 2]")
+    assert read_done(tmp_path, spec) == (None, None)
 
 
 @pytest.mark.parametrize("value", [1.5, 2**53 + 2.0])

@@ -8,8 +8,8 @@ document of everything its result depends on, the package version included.
   so ``K = 10`` and ``K = 10.0`` are the same spec;
 - :func:`spec_key` names it: the first 12 hex digits of the SHA-256 of its JSON text, the stem of
   its run directory (``<name>-<key>``);
-- :func:`read_record` gives a stored result (``done.json`` of a
-  sweep's point) only if it was made from the same spec: anything else is computed again;
+- :func:`read_done` gives a stored result (``done.json`` of a sweep's point) only if it was
+  made from the same spec: anything else is computed again;
 - a finished point of a sweep records the checksum of every file it wrote
   (:func:`file_digests`); it is reused only if its summary is there and every file matches
   (:func:`damage`, :func:`read_done`), otherwise it runs again and the table and the study's page
@@ -31,7 +31,6 @@ from stickslip.jsonable import to_jsonable
 __all__ = [
     "canonical",
     "spec_key",
-    "read_record",
     "read_done",
     "spec_before",
     "file_digests",
@@ -68,16 +67,6 @@ def spec_key(spec: dict[str, Any]) -> str:
     """First 12 hex digits of the SHA-256 of ``spec`` as compact JSON with sorted keys."""
     text = json.dumps(spec, sort_keys=True, separators=COMPACT)
     return hashlib.sha256(text.encode()).hexdigest()[:12]
-
-
-def read_record(path: str | Path, spec: dict[str, Any]) -> dict[str, Any] | None:
-    """The JSON record stored at ``path`` if it is there, readable and made from ``spec`` (its
-    ``"spec"`` field equal to it), else None."""
-    try:
-        record = read_json(path)
-    except (OSError, ValueError):
-        return None
-    return record if isinstance(record, dict) and record.get("spec") == spec else None
 
 
 #: Files of a point's folder that are not part of its result (the sweep's own bookkeeping).

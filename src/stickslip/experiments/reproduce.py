@@ -21,10 +21,12 @@ adding a value of beta to a study only runs the new point.
 
 from __future__ import annotations
 
+import sys
 import time
 from pathlib import Path
 from typing import Any
 
+from stickslip import heartbeat
 from stickslip.experiments.studies import PAPER, design
 from stickslip.experiments.study_run import run_study
 from stickslip.report.writer import ReportFigure, ReportRow, write_report
@@ -37,6 +39,13 @@ MODES = ("quick", "full", "smoke")
 
 class ReproduceError(RuntimeError):
     """An experiment could not be completed (e.g. a chain run failed); the message says which."""
+
+
+def _log(enabled: bool, t0: float, text: str) -> None:
+    heartbeat.note(text)
+    if enabled:
+        sys.stderr.write(f"[reproduce {time.perf_counter() - t0:6.1f} s] {text}\n")
+        sys.stderr.flush()
 
 
 def _figure(study: str, entry: dict[str, Any]) -> ReportFigure:
@@ -77,7 +86,14 @@ def reproduce(
     results = []
     for name in PAPER:
         spec = design(name).build(mode)
-        results.append(run_study(spec, out, scheduler=scheduler, n_workers=n_workers, progress=progress))
+        r = run_study(spec, out, scheduler=scheduler, n_workers=n_workers, progress=progress)
+        results.append(r)
+        _log(
+            progress,
+            start,
+            f"{name}: {r['points']} points, {r['reused']} reused, {r['damaged']} damaged and run "
+            f"again, {r['run']} run ({r['compute_seconds']:.1f} s), {r['failed']} failed; page {r['page']}",
+        )
     failed = [f"{r['study']}/{p['point']}: {p['error']}" for r in results for p in r["failed_points"]]
     if failed:
         raise ReproduceError(f"{len(failed)} run(s) failed ({'; '.join(failed)}); run again to retry them")
@@ -107,6 +123,7 @@ def reproduce(
     if not_drawn:
         meta["figures_not_drawn"] = not_drawn
     paths = write_report(out, rows, figures, meta)
+    _log(progress, start, f"report: {paths['html']}")
     return {
         "mode": mode,
         "out": str(out),
