@@ -287,6 +287,25 @@ def test_each_study_of_the_paper_has_its_page(smoke):
         assert "stickslip reproduce --smoke --out DIR" in page and "The paper&#39;s stated numbers" in page
 
 
+def test_a_failed_chain_run_is_named_and_run_again(smoke, tmp_path):
+    import shutil
+
+    out = tmp_path / "repro"
+    shutil.copytree(smoke[0], out)
+    spec = figs5_8.build("smoke")
+    point = out / "runs" / spec.dirname / "points" / "beta=1_N=19"
+    shutil.rmtree(point)
+    point.mkdir()
+    (point / "state.nc").mkdir()  # where the run writes its final state: it fails
+    with pytest.raises(rp.ReproduceError, match=r"1 run\(s\) failed \(figs5-8/beta=1_N=19: .*state.nc"):
+        rp.reproduce(out, "smoke", n_workers=1, progress=False)
+    assert (point / "error.json").is_file()
+    (point / "state.nc").rmdir()
+    result = rp.reproduce(out, "smoke", n_workers=1, progress=False)
+    assert [(s["run"], s["reused"]) for s in result["studies"]] == [(0, 6), (1, 2)]
+    assert (point / "done.json").is_file() and len(result["rows"]) == len(MODEL_ROWS)
+
+
 # ---------------------------------------------------------------------------------------------
 # Command line
 
