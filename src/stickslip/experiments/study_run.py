@@ -70,7 +70,8 @@ def run_study(
     -------
     dict
         The counts and times (``points``, ``run``, ``reused``, ``damaged``, ``failed``,
-        ``wall_seconds``, ``compute_seconds``), the ``findings``, the ``rows`` of the table, the
+        ``wall_seconds``, ``compute_seconds``), the ``findings``, the ``figures`` (and in
+        ``figures_not_drawn`` why a figure could not be drawn), the ``rows`` of the table, the
         failed points with their errors and the paths.
     """
     from stickslip.experiments.sweep import STOP_WAIT_SECONDS, _on_terminal, run_sweep
