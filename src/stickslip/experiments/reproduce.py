@@ -91,8 +91,8 @@ def reproduce(
         _log(
             progress,
             start,
-            f"{name}: {r['points']} points, {r['reused']} reused, {r['damaged']} damaged and run "
-            f"again, {r['run']} run ({r['compute_seconds']:.1f} s), {r['failed']} failed; page {r['page']}",
+            f"{name}: {r['points']} points ({r['reused']} reused, {r['damaged']} damaged and run again, "
+            f"{r['run']} run, {r['failed']} failed; {r['compute_seconds']:.1f} s of point runs); page {r['page']}",
         )
     failed = [f"{r['study']}/{p['point']}: {p['error']}" for r in results for p in r["failed_points"]]
     if failed:

@@ -200,18 +200,8 @@ def _compute_chain_modes(cfg: dict[str, Any], run_dir: Path) -> dict[str, Any]:
     betas = [float(b) for b in cfg["options"]["betas"]]
     ds = st.fig4_data(p, betas=betas, k=np.linspace(0.0, np.pi, int(cfg["options"]["n_k"])))
     io.write_dataset(run_dir / "fig4.nc", ds)
-    per_beta = []
-    for b in betas:
-        s = st.chain_stability(p.replace(beta=b))
-        per_beta.append(
-            {
-                "beta": b,
-                "max_growth_rate": s.max_growth_rate,
-                "k_at_max": s.k_at_max,
-                "unstable": s.unstable,
-                "marginal": s.marginal,
-            }
-        )
+    keys = ("max_growth_rate", "k_at_max", "unstable", "marginal")
+    per_beta = [{"beta": b, **{k: getattr(st.chain_stability(p.replace(beta=b)), k) for k in keys}} for b in betas]
     return {
         "critical_beta": st.chain_critical_beta(p),
         "critical_beta_numeric": st.chain_critical_beta_numeric(p),
