@@ -26,8 +26,8 @@ from stickslip.analysis.order import (
     transition_bracket,
 )
 from stickslip.experiments.studies import Study, study
-from stickslip.experiments.studies.chain_point import point_params
 from stickslip.experiments.study_run import run_study
+from stickslip.experiments.sweep_points import point_params
 
 
 def _ar1(rng, phi: float, n: int) -> np.ndarray:
@@ -339,7 +339,7 @@ def test_an_interrupted_chaos_point_keeps_its_finished_parts(tmp_path):
 
     spec = study("chaos", "tiny")
     cfg = {**spec.common, **next(p for p in spec.points if p.get("N") == 5 and p.get("beta") == 0.9)}
-    params = point_params(cfg)
+    params = point_params("chain", cfg)
     point = tmp_path / "points" / "p"
     first = chaos_point(cfg, params, point)
     parts = sorted((point / "parts").glob("*.json"))
@@ -445,7 +445,7 @@ def test_a_quick_chain_point_counts_its_slips():
     spec = study("chaos", "quick")
     cfg = {**spec.common, **next(p for p in spec.points if p.get("N") == 49 and p.get("beta") == 1.0)}
     with tempfile.TemporaryDirectory() as d:
-        row = chaos_point(cfg, point_params(cfg), Path(d))
+        row = chaos_point(cfg, point_params("chain", cfg), Path(d))
     assert row["flow_slips"] >= MIN_FLOW_SLIPS and row["window"] == 1000 and row["loaded"] is True
     point_keys = set(cfg) | {"model", "N", "beta"}
     assert set(TABLE_COLUMNS["chaos"]) <= set(row) | point_keys
