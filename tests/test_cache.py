@@ -12,7 +12,7 @@ import json
 import pytest
 
 from stickslip import __version__
-from stickslip.experiments.cache import canonical, file_digests, read_done, sealed, spec_key
+from stickslip.experiments.cache import canonical, read_done, sealed, spec_key
 from stickslip.experiments.studies import Study, figs1_4, figs5_8, study
 
 
@@ -55,18 +55,22 @@ def test_every_study_names_its_folder_the_same_way():
         assert spec.dirname == f"{name}-{_sha12(text)}"
 
 
-def test_read_done_only_for_the_same_spec(tmp_path):
-    spec = {"task": "t", "version": __version__}
-    assert read_done(tmp_path, spec) == (None, None)  # not there
-    (tmp_path / "x.txt").write_text("result")
-    record = sealed({"spec": spec, "summary": {"x": 1}, "files": file_digests(tmp_path)})
-    (tmp_path / "done.json").write_text(json.dumps(record))
-    assert read_done(tmp_path, spec) == (record, None)
-    assert read_done(tmp_path, {**spec, "version": "other"}) == (None, None)
-    (tmp_path / "done.json").write_text('{"spec": ')
-    assert read_done(tmp_path, spec) == (None, "done.json is unreadable")
-    (tmp_path / "done.json").write_text("[1, 2]")
-    assert read_done(tmp_path, spec) == (None, None)
+def test_read_done_only_for_the_same_spec_and_a_sealed_record(tmp_path):
+    spec = {"kind": "block_run", "version": __version__}
+    path = tmp_path / "done.json"
+    assert read_done(path, spec) == (None, None)  # not there
+    record = {"spec": spec, "summary": {"x": 1}, "files": {}}
+    path.write_text(json.dumps(record))
+    assert read_done(path, spec) == (None, "it records no checksum of itself")
+    path.write_text(json.dumps(sealed(record)))
+    assert read_done(path, spec)[0]["summary"] == {"x": 1}
+    assert read_done(path, {**spec, "version": "other"}) == (None, None)  # another spec's record
+    path.write_text(json.dumps({**sealed(record), "summary": {"x": 2}}))
+    assert "changed after it was written" in read_done(path, spec)[1]
+    path.write_text('{"spec": ')
+    assert read_done(path, spec) == (None, "done.json is unreadable")
+    path.write_text("[1, 2]")
+    assert read_done(path, spec) == (None, None)
 
 
 @pytest.mark.parametrize("value", [1.5, 2**53 + 2.0])

@@ -94,7 +94,7 @@ DAMAGES = [
     ("row edited", _edit_record(lambda r: r["row"].update(order_parameter=42.0)), "changed after it was written"),
     ("row's final hash edited", _edit_record(lambda r: r["row"].update(final_sha256="0" * 64)), "changed after"),
     ("record without checksums", _edit_record(lambda r: r.pop("files")), "records no checksums of its files"),
-    ("record without its own checksum", _edit_record(lambda r: r.pop("sha256")), "changed after it was written"),
+    ("record without its own checksum", _edit_record(lambda r: r.pop("sha256")), "no checksum of itself"),
     ("rung.json unreadable", lambda r: (r / "rung.json").write_text("{half"), "rung.json is unreadable"),
 ]
 

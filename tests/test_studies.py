@@ -26,8 +26,8 @@ from stickslip.analysis.order import (
     transition_bracket,
 )
 from stickslip.experiments.studies import Study, study
-from stickslip.experiments.studies.chain_point import point_params
 from stickslip.experiments.study_run import run_study
+from stickslip.experiments.sweep_points import point_params
 
 
 def _ar1(rng, phi: float, n: int) -> np.ndarray:
@@ -339,7 +339,7 @@ def test_an_interrupted_chaos_point_keeps_its_finished_parts(tmp_path):
 
     spec = study("chaos", "tiny")
     cfg = {**spec.common, **next(p for p in spec.points if p.get("N") == 5 and p.get("beta") == 0.9)}
-    params = point_params(cfg)
+    params = point_params("chain", cfg)
     point = tmp_path / "points" / "p"
     first = chaos_point(cfg, params, point)
     parts = sorted((point / "parts").glob("*.json"))
@@ -445,7 +445,7 @@ def test_a_quick_chain_point_counts_its_slips():
     spec = study("chaos", "quick")
     cfg = {**spec.common, **next(p for p in spec.points if p.get("N") == 49 and p.get("beta") == 1.0)}
     with tempfile.TemporaryDirectory() as d:
-        row = chaos_point(cfg, point_params(cfg), Path(d))
+        row = chaos_point(cfg, point_params("chain", cfg), Path(d))
     assert row["flow_slips"] >= MIN_FLOW_SLIPS and row["window"] == 1000 and row["loaded"] is True
     point_keys = set(cfg) | {"model", "N", "beta"}
     assert set(TABLE_COLUMNS["chaos"]) <= set(row) | point_keys
@@ -520,3 +520,26 @@ def test_sizes_summary_fits_the_events_after_the_transient_only():
     assert 1.0 < out["tau"] < 3.0 and out["n_fit"] <= out["n_events"] and out["spanning"] == "max_block"
     few = sizes_summary(run, float(starts[-5]), bootstrap=0)
     assert few["n_events"] == 5 and math.isnan(few["tau"]) and few["error_note"].startswith("only 5 events")
+
+
+def test_tiny_exponents_study_draws_the_family_beside_fig8(tmp_path, cluster):
+    """Carlson-Langer's slip sizes beside eq. (4) at beta = 0.2 (Fig. 8), drawn from the points'
+    own runs: each panel's fit is its point's row (the same events after the same transient)."""
+    from stickslip.experiments.studies.exponents import _family_panels
+
+    spec = study("exponents", "tiny")
+    result = run_study(spec, tmp_path, scheduler=cluster, progress=False)
+    assert result["failed"] == 0
+    rows = {(r["model"], r["beta"]): r for r in result["rows"]}
+    cl, fig8 = rows[("carlson-langer", None)], rows[("sakaguchi", 0.2)]
+    assert cl["spanning"] == "n_blocks" and fig8["spanning"] == "max_block"
+    table = pd.read_parquet(tmp_path / "exponents" / "table.parquet")
+    panels = _family_panels(spec, table, tmp_path / "runs" / spec.dirname / "points")
+    titles = [title for title, _, _ in panels]
+    assert titles[0].startswith("Carlson-Langer") and titles[1].startswith("eq. (4), beta = 0.2")
+    for (_, events, stats), row in zip(panels, (cl, fig8), strict=True):
+        assert len(events) == row["n_events"] and (events["t_start"] >= row["t_from"]).all()
+        assert stats["fit"].tau == row["tau"] and stats["fit"].n == row["n_fit"]
+    names = [f["name"] for f in result["figures"]]
+    assert names == ["tau_beta", "family_sizes"]
+    assert (tmp_path / "exponents" / "family_sizes.pdf").read_bytes().startswith(b"%PDF")

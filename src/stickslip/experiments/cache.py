@@ -8,8 +8,8 @@ document of everything its result depends on, the package version included.
   so ``K = 10`` and ``K = 10.0`` are the same spec;
 - :func:`spec_key` names it: the first 12 hex digits of the SHA-256 of its JSON text, the stem of
   its run directory (``<name>-<key>``);
-- :func:`read_done` gives a stored result (``done.json`` of a sweep's point) only if it was
-  made from the same spec: anything else is computed again;
+- :func:`read_done` gives a stored result (``done.json`` of a sweep's point, ``rung.json`` of a
+  ladder's rung) only if it was made from the same spec: anything else is computed again;
 - a finished point of a sweep records the checksum of every file it wrote
   (:func:`file_digests`); it is reused only if its summary is there and every file matches
   (:func:`damage`, :func:`read_done`), otherwise it runs again and the table and the study's page
@@ -73,19 +73,22 @@ def spec_key(spec: dict[str, Any]) -> str:
 BOOKKEEPING = frozenset({"done.json", "error.json", "point.json"})
 
 
-def read_done(point_dir: Path, spec: dict[str, Any]) -> tuple[dict[str, Any] | None, str | None]:
-    """The stored record of a finished point with this spec, or None; and why a record of this
-    spec is not reused (its files damaged, :func:`damage`)."""
-    path = point_dir / "done.json"
+def read_done(
+    path: str | Path, spec: dict[str, Any], field: str = "summary"
+) -> tuple[dict[str, Any] | None, str | None]:
+    """The sealed record at ``path`` (a point's done.json, a rung's rung.json, a part of a point)
+    made from ``spec``, with its ``field``, itself as written and its files whole, or None; and why
+    a record of this spec is not reused (:func:`damage`; None when there is none)."""
+    path = Path(path)
     if not path.is_file():
         return None, None
     try:
         record = read_json(path)
     except (OSError, ValueError):
-        return None, "done.json is unreadable"
+        return None, f"{path.name} is unreadable"
     if not isinstance(record, dict) or record.get("spec") != spec:
         return None, None
-    reason = damage(point_dir, record)
+    reason = damage(path.parent, record, field)
     return (None, reason) if reason else (record, None)
 
 
@@ -134,13 +137,13 @@ def sealed(record: dict[str, Any]) -> dict[str, Any]:
     return {**record, "sha256": record_digest(record)}
 
 
-def damage(point_dir: str | Path, record: dict[str, Any]) -> str | None:
+def damage(point_dir: str | Path, record: dict[str, Any], field: str = "summary") -> str | None:
     """Why the finished point in ``point_dir`` (its done.json ``record``) cannot be reused, or None
-    when its summary is there, the record is as written (:func:`sealed`) and every file it
+    when its ``field`` is there, the record is as written (:func:`sealed`) and every file it
     recorded is present with its checksum."""
-    summary, files = record.get("summary"), record.get("files")
-    if not isinstance(summary, dict):
-        return "its summary is missing"
+    result, files = record.get(field), record.get("files")
+    if not isinstance(result, dict):
+        return f"its {field} is missing"
     if not isinstance(files, dict):
         return "it records no checksums of its files"
     if not isinstance(record.get("sha256"), str):

@@ -119,23 +119,14 @@ class _Parts:
 
     def get(self, name: str, compute) -> dict[str, Any]:
         from stickslip import io
-        from stickslip.experiments.cache import canonical, record_digest, sealed
+        from stickslip.experiments.cache import canonical, read_done, sealed
 
         path = self.folder / f"{name}.json"
         want = canonical({**self.spec, "part": name})
-        if path.is_file():
-            try:
-                kept = io.read_json(path)
-            except (OSError, ValueError):
-                kept = None
-            if (
-                isinstance(kept, dict)
-                and kept.get("spec") == want
-                and isinstance(kept.get("result"), dict)
-                and kept.get("sha256") == record_digest(kept)
-            ):
-                return kept["result"]
-        io.write_json(path, {"spec": want, "result": compute()})
+        kept, _ = read_done(path, want, "result")
+        if kept is not None:
+            return kept["result"]
+        io.write_json(path, {"spec": want, "result": compute(), "files": {}})
         record = io.read_json(path)  # as a reused part reads it (NaN as null), then sealed
         io.write_json(path, sealed(record))
         return record["result"]
@@ -143,7 +134,7 @@ class _Parts:
 
 def chaos_point(cfg: dict[str, Any], params, point_dir: Path) -> dict[str, Any]:
     """One point (module docstring) of the model ``params``
-    (:func:`stickslip.experiments.studies.chain_point.point_params` of ``cfg``): writes
+    (:func:`stickslip.experiments.sweep_points.point_params` of ``cfg``): writes
     ``flow.json`` (loading check, ladder, n(delta) of every kind, delta*, verdict) into
     ``point_dir`` and returns the table's columns."""
     from stickslip import __version__, io
@@ -151,30 +142,16 @@ def chaos_point(cfg: dict[str, Any], params, point_dir: Path) -> dict[str, Any]:
     from stickslip.analysis.lyapunov_flow import extrapolate, flow_lyapunov
     from stickslip.analysis.threshold import delta_star
     from stickslip.experiments.sweep import stop_requested
-    from stickslip.models.presets import PRESETS
+    from stickslip.experiments.sweep_points import preset_start
     from stickslip.run.loaded import loaded_state
     from stickslip.run.located import LocatedState
 
     wall0 = time.perf_counter()
     check_point(cfg, params)
-    preset = PRESETS[params.model]
-    start = cfg.get("start", preset.start)
-    perturbation = float(cfg.get("perturbation", preset.start_options.get("amplitude", 0.0)))
-    if start == "paper":
-        perturbation = 0.0
-    seed = int(cfg.get("seed", preset.start_options.get("seed", 0)))
     point_dir = Path(point_dir)
-    transient = float(cfg["transient"])
     stop = stop_requested(point_dir)
-    loaded = loaded_state(
-        params,
-        transient,
-        start=start,
-        perturbation=perturbation,
-        seed=seed,
-        cache=point_dir / "state",
-        stop_requested=stop,
-    )
+    start = preset_start(params, cfg)
+    loaded = loaded_state(params, float(cfg["transient"]), **start, cache=point_dir / "state", stop_requested=stop)
     spec = {k: v for k, v in cfg.items()} | {"version": __version__}
     parts = _Parts(point_dir / "parts", spec)
     direction_seed = int(cfg.get("direction_seed", 0))

@@ -45,10 +45,9 @@ _PAPER = paper_parameters("N", "beta")
 
 def params_at(cfg: dict[str, Any], beta: float):
     """The chain of eq. (4) with the ladder's settings at ``beta``."""
-    from stickslip.models.presets import chain_params
+    from stickslip.experiments.sweep_points import point_params
 
-    fields = {k: cfg[k] for k in ("K", "D", "V", "Fs", "alpha", "dt") if k in cfg}
-    return chain_params("sakaguchi", N=int(cfg["N"]), beta=float(beta), **fields)
+    return point_params("chain", {**cfg, "N": int(cfg["N"]), "beta": float(beta)})
 
 
 def perturbed(state, amplitude: float, seed: int):
@@ -65,24 +64,11 @@ def perturbed(state, amplitude: float, seed: int):
     return s
 
 
-def _save_state(path: Path, state) -> None:
-    from stickslip.run.rundir import write_state_file
-
-    write_state_file(path, state)
-
-
 def _save_npz(path: Path, arrays: dict) -> None:
     """Arrays to ``path``, built in memory and written atomically (a full disk leaves no half file)."""
     buf = BytesIO()
     np.savez(buf, **arrays)
     io.write_bytes(path, buf.getvalue())
-
-
-def _load_state(path: Path):
-    """The state of a rung's ``state.npz``; ValueError (one line) if it is missing or damaged."""
-    from stickslip.run.rundir import read_state_file
-
-    return read_state_file(path)
 
 
 def run_rung(params, state, cfg: dict[str, Any], *, leave_stops: bool = False, stop_requested=None) -> dict[str, Any]:
@@ -239,29 +225,20 @@ def _replay(rdir: Path, spec: dict[str, Any], params) -> tuple[dict[str, Any] | 
     whole: its record as written (its SHA-256), every file present with the checksum recorded
     when it was written, the state the one its row names and one a run can go on from. Else
     None, and why a stored rung of this spec is not reused (None when there is none)."""
-    from stickslip.experiments.cache import files_damage, record_digest
+    from stickslip.experiments.cache import read_done
     from stickslip.models.params import ParameterError
+    from stickslip.run.rundir import read_state_file
     from stickslip.run.validate import check_start_state
 
-    path = rdir / "rung.json"
-    if not path.is_file():
-        return None, None
-    try:
-        rec = io.read_json(path)
-    except (OSError, ValueError):
-        return None, "rung.json is unreadable"
-    if not isinstance(rec, dict) or rec.get("spec") != spec:
-        return None, None  # another rung's record (another start or settings): not this rung
-    files, row = rec.get("files"), rec.get("row")
-    if not isinstance(files, dict) or set(files) != set(RUNG_FILES) or not isinstance(row, dict):
-        return None, "rung.json records no checksums of its files"
-    if rec.get("sha256") != record_digest(rec):
-        return None, "rung.json was changed after it was written (checksum)"
-    why = files_damage(rdir, files)
-    if why is not None:
+    # another rung's record (another start or settings) is not this rung's: (None, None)
+    rec, why = read_done(rdir / "rung.json", spec, "row")
+    if rec is None:
         return None, why
+    row = rec["row"]
+    if set(rec["files"]) != set(RUNG_FILES):
+        return None, "rung.json records no checksums of its files"
     try:
-        state = _load_state(rdir / "state.npz")
+        state = read_state_file(rdir / "state.npz")
         if state.sha256() != row.get("final_sha256"):
             return None, "state.npz is not the final state its row records"
         check_start_state(state, params, where="state.npz")
@@ -277,6 +254,7 @@ def _rung(
     same state with the same settings and its files are whole (:func:`_replay`), else run and
     written; a rung run again because its stored files were damaged says so in its row's ``note``."""
     from stickslip.experiments.cache import file_sha256, sealed
+    from stickslip.run.rundir import write_state_file
 
     rdir = ladder_dir / "rungs" / f"{index:02d}-beta{beta:.6g}"
     sha = state.sha256()
@@ -294,7 +272,7 @@ def _rung(
     row = to_jsonable(row)  # as a replay reads it back (NaN and inf become None)
     rdir.mkdir(parents=True, exist_ok=True)
     (rdir / "rung.json").unlink(missing_ok=True)  # no record while its files are rewritten
-    _save_state(rdir / "state.npz", res["state"])
+    write_state_file(rdir / "state.npz", res["state"])
     _save_npz(rdir / "samples.npz", res["samples"])
     files = {name: file_sha256(rdir / name) for name in RUNG_FILES}
     io.write_json(rdir / "rung.json", sealed({"spec": spec, "row": row, "files": files}))

@@ -351,7 +351,7 @@ def run_sweep(
     if task is chain_task:
         _warn_short_chain_runs(points, common, names)
     specs = [_spec(task, p, common) for p in points]
-    found = [_read_done(out / n, s) for n, s in zip(names, specs, strict=False)]
+    found = [_read_done(out / n / DONE_FILE, s) for n, s in zip(names, specs, strict=False)]
     records: list[dict[str, Any] | None] = [r for r, _ in found]
     damaged = {k: why for k, (_, why) in enumerate(found) if why}
     reused = [r is not None for r in records]

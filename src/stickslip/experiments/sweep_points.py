@@ -16,7 +16,7 @@ from typing import Any
 from stickslip.models.params import BlockParams, ChainParams
 from stickslip.run.errors import ShortRunWarning
 
-__all__ = ["CHAIN_RUN_OPTIONS", "BLOCK_RUN_OPTIONS", "point_params", "split_point", "chain_run_args"]
+__all__ = ["CHAIN_RUN_OPTIONS", "BLOCK_RUN_OPTIONS", "point_params", "split_point", "chain_run_args", "preset_start"]
 
 CHAIN_RUN_OPTIONS = (
     "t_end",
@@ -43,6 +43,19 @@ def point_params(kind: str, point: dict[str, Any]):
     return params_cls(**values)
 
 
+def preset_start(params: ChainParams, cfg: dict[str, Any]) -> dict[str, Any]:
+    """A chain point's ``start``, ``perturbation`` and ``seed`` (:func:`stickslip.run.driver.run_chain`):
+    the point's own, else those of its model's preset (:mod:`stickslip.models.presets`); the paper's
+    start (x_i = 0, section 3) is never perturbed."""
+    from stickslip.models.presets import PRESETS
+
+    preset = PRESETS[params.model]
+    start = cfg.get("start", preset.start)
+    amplitude = float(cfg.get("perturbation", preset.start_options.get("amplitude", 0.0)))
+    seed = int(cfg.get("seed", preset.start_options.get("seed", 0)))
+    return {"start": start, "perturbation": 0.0 if start == "paper" else amplitude, "seed": seed}
+
+
 def split_point(point: dict[str, Any], params_cls: type, options: tuple[str, ...]) -> tuple[Any, dict[str, Any]]:
     fields = {f.name for f in dataclasses.fields(params_cls)}
     unknown = sorted(set(point) - fields - set(options))
@@ -57,15 +70,10 @@ def split_point(point: dict[str, Any], params_cls: type, options: tuple[str, ...
 
 def chain_run_args(point: dict[str, Any]) -> tuple[ChainParams, float, dict[str, Any]]:
     """The parameters, run length and run options of a chain point (the model's start by default)."""
-    from stickslip.models.presets import PRESETS
-
     params, options = split_point(point, ChainParams, CHAIN_RUN_OPTIONS)
     t_end = options.pop("t_end")
     if "start" not in options:  # the model's own start (Carlson-Langer: every block stuck, seeded)
-        preset = PRESETS[params.model]
-        options["start"] = preset.start
-        options["perturbation"] = preset.start_options.get("amplitude", 0.0)
-        options["seed"] = preset.start_options.get("seed", 0)
+        options.update(preset_start(params, {}))
     return params, t_end, options
 
 

@@ -15,7 +15,9 @@ import math
 from pathlib import Path
 from typing import Any
 
-__all__ = ["order_task", "sizes_task", "check_point", "point_params", "loading_time", "t_end_of"]
+from stickslip.experiments.sweep_points import point_params, preset_start
+
+__all__ = ["order_task", "sizes_task", "check_point", "loading_time", "t_end_of"]
 
 
 def loading_time(N: int, K: float = 10.0, V: float = 0.001) -> float:
@@ -35,33 +37,16 @@ def t_end_of(N: int, loads: float) -> float:
 # ---------------------------------------------------------------------------------------------
 # One point: a chain run and its analysis, on a worker
 
-_PARAM_FIELDS = ("N", "K", "D", "V", "beta", "alpha", "Fs", "dt", "l", "nu")
-
-
-def point_params(cfg: dict[str, Any]):
-    """The :class:`~stickslip.models.params.ChainParams` of a point's merged settings."""
-    from stickslip.models.presets import chain_params
-
-    return chain_params(cfg.get("model", "sakaguchi"), **{k: cfg[k] for k in _PARAM_FIELDS if k in cfg})
-
 
 def point_run_options(cfg: dict[str, Any], params) -> tuple[float, dict[str, Any]]:
     """Run length and :func:`~stickslip.run.driver.run_chain` options of a point."""
-    from stickslip.models.presets import PRESETS
-
     t_end = float(cfg["t_end"])
-    preset = PRESETS[params.model]
-    start = cfg.get("start", preset.start)
     options: dict[str, Any] = {
-        "start": start,
-        "perturbation": float(cfg.get("perturbation", preset.start_options.get("amplitude", 0.0))),
-        "seed": int(cfg.get("seed", preset.start_options.get("seed", 0))),
+        **preset_start(params, cfg),
         "sample_interval": max(t_end / float(cfg.get("n_samples", 2000)), params.dt),
         "average_from": float(cfg.get("average_fraction", 0.5)) * t_end,
         "sample_moving": cfg.get("analysis") == "order",
     }
-    if start == "paper":
-        options["perturbation"] = 0.0
     if cfg.get("until_steady"):
         options["until_steady"] = float(cfg["until_steady"])
     return t_end, options
@@ -69,7 +54,7 @@ def point_run_options(cfg: dict[str, Any], params) -> tuple[float, dict[str, Any
 
 def check_point(cfg: dict[str, Any]) -> None:
     """Raise ParameterError (one line) unless a point's merged settings make a valid run."""
-    point_run_options(cfg, point_params(cfg))
+    point_run_options(cfg, point_params("chain", cfg))
 
 
 def _run(point: dict[str, Any], point_dir: Path):
@@ -77,7 +62,7 @@ def _run(point: dict[str, Any], point_dir: Path):
     summary fields every point stores."""
     from stickslip.experiments.sweep import run_chain_point
 
-    params = point_params(point)
+    params = point_params("chain", point)
     t_end, options = point_run_options(point, params)
     run = run_chain_point(params, t_end, Path(point_dir), **options)
     base = {

@@ -25,7 +25,7 @@ import pandas as pd
 
 from stickslip.experiments.chaos_verdict import DELTAS_FULL, DELTAS_QUICK, TRANSIENTS, threshold_columns
 from stickslip.experiments.studies import Design, Study
-from stickslip.experiments.studies.chain_point import point_params
+from stickslip.experiments.sweep_points import point_params
 from stickslip.models.presets import PRESETS, is_paper
 
 __all__ = ["DESIGN", "chaos_points", "conclusions", "curves", "figures", "decorrelation_table"]
@@ -109,14 +109,14 @@ def task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     """One point on a worker (:func:`stickslip.experiments.chaos_verdict.chaos_point`)."""
     from stickslip.experiments.chaos_verdict import chaos_point
 
-    return chaos_point(point, point_params(point), Path(point_dir))
+    return chaos_point(point, point_params("chain", point), Path(point_dir))
 
 
 def check(cfg: dict[str, Any]) -> None:
     """Refuse a point's merged settings (:func:`stickslip.experiments.chaos_verdict.check_point`)."""
     from stickslip.experiments.chaos_verdict import check_point
 
-    check_point(cfg, point_params(cfg))
+    check_point(cfg, point_params("chain", cfg))
 
 
 def _finite(x) -> bool:

@@ -21,6 +21,10 @@ from stickslip.models.presets import PRESETS, is_paper
 __all__ = ["DESIGN"]
 
 
+def _finite(x) -> bool:
+    return x is not None and math.isfinite(float(x))
+
+
 def _g(x: float, digits: int = 3) -> str:
     return "n/a" if x is None or not math.isfinite(float(x)) else f"{float(x):.{digits}g}"
 
@@ -80,14 +84,50 @@ def findings(spec: Study, table: pd.DataFrame) -> dict[str, Any]:
 
 
 def figures(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[tuple[str, Any, str]]:
-    """tau and the great-event excess against beta (:func:`stickslip.plotting.studies.exponents_figure`)."""
+    """tau and the great-event excess against beta (:func:`stickslip.plotting.studies.exponents_figure`),
+    and the slip-size densities of Carlson-Langer beside eq. (4) at the smallest beta (Fig. 8's
+    0.2), each with its power law (:func:`stickslip.plotting.family.family_sizes`)."""
+    from stickslip.plotting.family import family_sizes
     from stickslip.plotting.studies import exponents_figure
 
     caption = (
         "Slip-size exponent tau (truncated power law below the smallest spanning event, "
         "bootstrap errors) and great-event excess against beta; Carlson-Langer as a band."
     )
-    return [("tau_beta", exponents_figure(table), caption)]
+    out = [("tau_beta", exponents_figure(table), caption)]
+    panels = _family_panels(spec, table, Path(page_dir).parent / "runs" / spec.dirname / "points")
+    if len(panels) == 2:
+        caption = (
+            "Slip-size density p(S) on logarithmic bins, log-log, of the events after each run's transient. "
+            "Dashed: the truncated power-law fit on its range; dotted: the same power law continued; "
+            "vertical line: the smallest system-spanning event, with the count of events above it "
+            "against the power law's prediction."
+        )
+        out.append(("family_sizes", family_sizes(panels), caption))
+    return out
+
+
+def _family_panels(spec: Study, table: pd.DataFrame, points: Path) -> list[tuple[str, pd.DataFrame, dict[str, Any]]]:
+    """(title, events, statistics) of the relative's run and of eq. (4) at its smallest beta, each
+    fitted as its point was (:func:`stickslip.analysis.chain_runs.size_statistics`); none without a fit."""
+    from stickslip import io
+    from stickslip.analysis.chain_runs import size_statistics
+
+    fitted = table[np.isfinite(table["tau"].astype(float))] if "tau" in table else table.iloc[:0]
+    chain = fitted[fitted["model"].map(is_paper)].sort_values("beta")
+    rows = [r for _, r in fitted[~fitted["model"].map(is_paper)].iterrows()][:1] + [r for _, r in chain.iterrows()][:1]
+    panels = []
+    for r in rows:
+        events = io.read_table(points / r["point_dir"] / "events.parquet")
+        events = events[events["t_start"] >= float(r["t_from"])]
+        seed = int(r["seed"]) if _finite(r.get("seed")) else 0  # as sizes_task: the point's, else 0
+        bootstrap = int(r["bootstrap"]) if _finite(r.get("bootstrap")) else 200
+        stats = size_statistics(
+            events, int(r["N"]), small_only=True, seed=seed, spanning=r["spanning"], bootstrap=bootstrap
+        )
+        label = ("eq. (4), " if is_paper(r["model"]) else "") + PRESETS[r["model"]].point_label(r["beta"], int(r["N"]))
+        panels.append((f"{label}, t = {float(r['t_end']):g} (events from {float(r['t_from']):g})", events, stats))
+    return panels
 
 
 def describe() -> str:
@@ -101,7 +141,8 @@ def describe() -> str:
         f"on two cores); --full {full.note.split(': ', 1)[1]} ({len(full.points)} runs, about 25 minutes on "
         "two cores). "
         "Outputs in DIR/exponents/: table.parquet and table.csv (one row per run: tau, its error, the "
-        "fitted range, the excess), tau_beta (PNG, PDF), study.json, index.html."
+        "fitted range, the excess), tau_beta and family_sizes (Carlson-Langer beside beta = 0.2; PNG, PDF), "
+        "study.json, index.html."
     )
 
 

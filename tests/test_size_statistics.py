@@ -1,8 +1,8 @@
-"""Slip-size statistics across the family: Carlson-Langer beside Fig. 8 (experiments/family.py)."""
+"""The slip-size fit of Figs. 7, 8 and the exponents study (analysis.chain_runs.size_statistics) on
+synthetic power laws: it gives back their exponent, and great events added show as an excess."""
 
 from __future__ import annotations
 
-import json
 import math
 
 import numpy as np
@@ -10,7 +10,6 @@ import pandas as pd
 import pytest
 
 from stickslip.analysis.chain_runs import size_statistics
-from stickslip.experiments.family import cl_statistics
 
 N = 50
 
@@ -51,38 +50,3 @@ def test_added_great_events_show_as_excess():
 def test_spanning_choice_is_checked():
     with pytest.raises(ValueError, match="spanning"):
         size_statistics(_power_law_events(1.6, 100, 10.0, 0), N, small_only=True, spanning="blocks")
-
-
-def test_cl_statistics_returns_its_numbers_and_files(tmp_path):
-    res = cl_statistics(4e3, tmp_path, fig8_N=19, fig8_t_end=4e4, bootstrap=10)
-    keys = {
-        "model",
-        "N",
-        "t_end",
-        "t_from",
-        "n_events",
-        "n_spanning",
-        "s_span",
-        "tau",
-        "tau_err",
-        "s_min",
-        "s_max",
-        "n_fit",
-        "excess",
-        "observed",
-        "expected",
-        "spanning",
-    }
-    for name, model, n in (("carlson_langer", "carlson-langer", 100), ("fig8", "sakaguchi", 19)):
-        assert keys <= set(res[name])
-        assert res[name]["model"] == model and res[name]["N"] == n
-        assert res[name]["n_events"] > 0
-    assert res["carlson_langer"]["spanning"] == "n_blocks"
-    assert res["fig8"]["spanning"] == "max_block"
-    assert (tmp_path / "family_sizes.png").stat().st_size > 0
-    assert (tmp_path / "family_sizes.pdf").read_bytes().startswith(b"%PDF")
-    drawn = pd.read_parquet(tmp_path / "family_sizes.parquet")
-    assert set(drawn["model"]) == {"carlson-langer", "fig8"} and (drawn["S"] > 0).all()
-    pd.testing.assert_frame_equal(pd.read_csv(tmp_path / "family_sizes.csv"), drawn, check_dtype=False)
-    stored = json.loads((tmp_path / "family_sizes.json").read_text())
-    assert stored["carlson_langer"]["tau"] == pytest.approx(res["carlson_langer"]["tau"])
