@@ -126,7 +126,7 @@ def _family_panels(spec: Study, table: pd.DataFrame, points: Path) -> list[tuple
             events, int(r["N"]), small_only=True, seed=seed, spanning=r["spanning"], bootstrap=bootstrap
         )
         label = ("eq. (4), " if is_paper(r["model"]) else "") + PRESETS[r["model"]].point_label(r["beta"], int(r["N"]))
-        panels.append((f"{label}, t = {float(r['t_end']):g} (events from {float(r['t_from']):g})", events, stats))
+        panels.append((f"{label}\nevents from t = {float(r['t_from']):.3g} to {float(r['t_end']):.3g}", events, stats))
     return panels
 
 
