@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -291,3 +292,28 @@ def test_chain_from_the_final_state_of_another_run(tmp_path):
     assert bad.returncode == 2 and len(bad.stderr.strip().splitlines()) == 1
     bad = run_cli_subprocess("chain", "--N", "6", "--from", str(first), "--start", "steady")
     assert bad.returncode == 2
+
+
+def test_a_longer_run_of_a_rung_restarts_from_the_state_it_started_from(tmp_path):
+    """write_checks on a finished tiny study: the longer run of an up-ladder rung starts from the
+    state that rung started from (the hash its row records) and runs past the rung's own length."""
+    from stickslip.experiments.transition_checks import rung_start_state, write_checks
+
+    result = run_study("transition", tmp_path, "tiny", n_workers=1, progress=False)
+    up = [r for r in result["rows"] if r["branch"] == "up" and r["replica"] == 0 and r["role"] == "grid"]
+    row = up[1]
+    runs = Path(result["runs"])
+    checks = write_checks(
+        tmp_path / "transition" / "study.json", runs, tmp_path / "checks.json",
+        paper_Ns=(), longer=((row["N"], row["beta"]),), factor=2.0, n_workers=1,
+    )  # fmt: skip
+    (long,) = checks["longer"]
+    assert long["beta"] == row["beta"] and long["adaptive_m"] == row["order_parameter"]
+    assert long["long_loads"] > row["loads"] and json.loads((tmp_path / "checks.json").read_text())["longer"]
+    ladder = next(
+        p.parent
+        for p in runs.glob("points/*/done.json")
+        if "direction=up" in p.parent.name and "replica=0" in p.parent.name
+    )
+    state, stored = rung_start_state(ladder, int(row["rung"]), {})
+    assert state.sha256() == stored["start_sha256"] == up[0]["final_sha256"]

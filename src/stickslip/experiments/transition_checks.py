@@ -80,7 +80,8 @@ def rung_start_state(ladder_dir: str | Path, index: int, cfg: dict[str, Any]):
     """The state rung ``index`` of an up ladder started from: the loaded start for rung 0, else the
     final state of rung ``index - 1`` (grid rungs of the up ladder hand over so); checked against
     the SHA-256 the rung recorded."""
-    from stickslip.experiments.ladders import _load_state, params_at
+    from stickslip.experiments.ladders import params_at
+    from stickslip.run.rundir import read_state_file
     from stickslip.run.state import ChainState
 
     rungs = sorted((Path(ladder_dir) / "rungs").iterdir())
@@ -88,7 +89,7 @@ def rung_start_state(ladder_dir: str | Path, index: int, cfg: dict[str, Any]):
     if index == 0:
         state = ChainState.steady(params_at(cfg, rec["row"]["beta"]), float(cfg["perturbation"]), int(cfg["seed"]))
     else:
-        state = _load_state(rungs[index - 1] / "state.npz")
+        state = read_state_file(rungs[index - 1] / "state.npz")
     if state.sha256() != rec["row"]["start_sha256"]:
         raise ValueError(f"rung {index} in {ladder_dir} did not start from the state before it")
     return state, rec["row"]
@@ -129,10 +130,10 @@ def write_checks(
     factor: float = 4.0,
     n_workers: int = 2,
 ) -> dict[str, Any]:
-    """Both checks for a finished study (its ``study.json`` and ``runs`` folder), in parallel on a
-    local process pool, written to ``path`` as JSON: the paper-start comparison for the up
-    ladders of ``paper_Ns`` below beta = 0.95 and the longer runs of the up-ladder grid rungs
-    (N, beta) in ``longer``."""
+    """Both checks for a finished study (its ``study.json`` and its runs folder
+    ``runs/transition-<key>``), in parallel on a local process pool, written to ``path`` as JSON:
+    the paper-start comparison for the up ladders of ``paper_Ns`` below beta = 0.95 and the longer
+    runs of the up-ladder grid rungs (N, beta) in ``longer``."""
     from concurrent.futures import ProcessPoolExecutor
 
     from stickslip.experiments.sweep import point_name
@@ -149,9 +150,9 @@ def write_checks(
             if r["branch"] == "up" and r.get("replica", 0) == 0 and r["beta"] < 0.95
         ]
         for N, beta in longer:
-            (lad,) = [p for p in spec["ladders"] if p["N"] == N and p["direction"] == "up" and p.get("replica", 0) == 0]
+            (lad,) = [p for p in spec["points"] if p["N"] == N and p["direction"] == "up" and p.get("replica", 0) == 0]
             cfg = {**spec["common"], **lad}
-            ldir = Path(runs_dir) / "ladders" / point_name(lad)
+            ldir = Path(runs_dir) / "points" / point_name(lad)
             (row,) = [
                 r
                 for r in data["rows"]
