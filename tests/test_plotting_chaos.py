@@ -118,7 +118,8 @@ def test_study_draws_its_figures_and_the_rows_of_n_from_the_points_flow_json(tmp
         ]
     )
     (tmp_path / "chaos").mkdir()
-    figs = _draw(spec, design("chaos"), table, tmp_path / "chaos")
+    figs, not_drawn = _draw(spec, design("chaos"), table, tmp_path / "chaos")
+    assert not_drawn == {}
     names = [f["name"] for f in figs]
     assert names == ["decorrelation", "flow_ladder", "threshold"]
     for name in names:
