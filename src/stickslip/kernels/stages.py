@@ -119,10 +119,12 @@ def _stage1_theta(x, v, th, xs, vs, ths, mm, b1, lo, hi, mp, dt, friction):
 
 @njit(cache=True, _nrt=False)
 def _stage1_theta_only(v, th, ths, b1, lo, hi, mp, dt, friction):
-    """Stage 1 for blocks lo..hi in a step in which no block moves.
+    """Stage 1 for stopped blocks lo..hi whose predictors of x and v and mask nothing reads: in a
+    step in which no block moves, or not next to a block that may move (stage 2 reads those of
+    its movers' neighbours only).
 
-    Then nothing reads the predictors of x and v or the mask, so only the state variable's
-    derivative and predictor are written (see _stage1_theta for why this is exact).
+    So only the state variable's derivative and predictor are written (see _stage1_theta for why
+    this is exact).
     """
     one = np.uint64(1)
     for i in range(np.uint64(lo), np.uint64(hi) + one):
