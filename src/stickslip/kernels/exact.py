@@ -117,6 +117,10 @@ def run_exact(args, drive, friction, threshold, ends):
         # run stages' arrays for overlap once per run rather than once per step (measured).
         ra0 = ra
         rb0 = rb
+        # The mid-step mask on the run is 1 in every step of it: written once, in the first step
+        # with the run within the updated blocks, and again after a step without (whose general
+        # stages may have written it).
+        mm_run = False
         while True:
             if ra != ra0 or rb != rb0:
                 break
@@ -231,6 +235,8 @@ def run_exact(args, drive, friction, threshold, ends):
             # The run, when it lies within [fl, fh] and [lo, hi] (as it should: its blocks moved in
             # the last step): no start rule there; the general stages on either side of it.
             run_in = ra0 <= rb0 and fl <= ra0 and rb0 <= fh and lo <= ra0 and rb0 <= hi
+            if not run_in:
+                mm_run = False
             if fl <= fh:
                 if run_in:
                     first = ra0
@@ -247,7 +253,11 @@ def run_exact(args, drive, friction, threshold, ends):
                     rp = rb0 + (ra0 - rb0 - 1) % 4
                     if rp > N:
                         rp = rb0
-                    _stage1_run(x, v, th, xs, vs, ths, mm, a1, b1, ra0, rp, p1, mp, dt, drive, friction)
+                    _stage1_run(x, v, th, xs, vs, ths, a1, b1, ra0, rp, p1, mp, dt, drive, friction)
+                    if not mm_run:
+                        for i in range(ra0, rb0 + 1):
+                            mm[i] = 1.0
+                        mm_run = True
                     if (
                         fh == rb0 + 1
                         and mov[fh] == 0.0
@@ -312,8 +322,10 @@ def run_exact(args, drive, friction, threshold, ends):
                     c_lo, c_hi = _merge(c_lo, c_hi, ra0, rb0)
                     moved_before += rb0 - ra0 + 1
                     if stops_run:
+                        # The stop rule on the run (_stage2_run stored v as computed).
                         for i in range(ra0, rb0 + 1):
                             keep = v[i] > 0.0
+                            v[i] = v[i] if keep else 0.0
                             mov[i] = 1.0 if keep else 0.0
                             moved_after += 1 if keep else 0
                     else:

@@ -202,11 +202,13 @@ def _stage2(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, p, mp, h2, drive, fr
 
 
 @njit(cache=True, _nrt=False, inline="always")
-def _stage1_run(x, v, th, xs, vs, ths, mm, a1, b1, lo, hi, p, mp, dt, drive, friction):
+def _stage1_run(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, dt, drive, friction):
     """Stage 1 for blocks lo..hi that all move at t_n (a run of sliding blocks).
 
     A moving block moves in this step whatever its force (start rule), so the mask is 1 and
-    no start is looked for; the expressions are those of :func:`_stage1` with m = 1.
+    no start is looked for; the expressions are those of :func:`_stage1` with m = 1. The mask
+    itself is not written: it stays 1 on the run from step to step, and the caller sets it
+    once per run.
     """
     K, dp = mp[0], mp[1]
     one = np.uint64(1)
@@ -214,7 +216,6 @@ def _stage1_run(x, v, th, xs, vs, ths, mm, a1, b1, lo, hi, p, mp, dt, drive, fri
         f = _force(x[i - one], x[i], x[i + one], K, dp, p, drive)
         a = _accel(f, th[i], v[i], 1.0, mp, friction)
         b = _dtheta(th[i - one], th[i], th[i + one], v[i], mp, friction)
-        mm[i] = 1.0
         a1[i] = a
         b1[i] = b
         xs[i] = x[i] + dt * v[i]
@@ -227,7 +228,8 @@ def _stage2_run(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, h2, drive, frictio
     """Stage 2, corrector and stop rule for a run lo..hi of blocks moving in this step.
 
     As :func:`_stage2_all` on the run: the moving flags are not written and the changes not
-    tracked (the caller counts the run as changed); returns whether some block stopped.
+    tracked (the caller counts the run as changed); returns whether some block stopped. The
+    velocity is stored as computed: where a block stopped (rare), the caller sets it to 0.
     """
     K, dp = mp[0], mp[1]
     one = np.uint64(1)
@@ -239,9 +241,8 @@ def _stage2_run(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, h2, drive, frictio
         x[i] = x[i] + h2 * (v[i] + vs[i])
         vn = v[i] + h2 * (a1[i] + a2)
         th[i] = th[i] + h2 * (b1[i] + b2)
-        keep = vn > 0.0
-        v[i] = vn if keep else 0.0
-        stops |= not keep
+        v[i] = vn
+        stops |= not vn > 0.0
     return stops
 
 
