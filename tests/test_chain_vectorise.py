@@ -54,7 +54,7 @@ def _example_args(name: str) -> tuple:
         "_stage1_theta": (*a[:8], lo, hi, mp, dt, state),
         "_stage1_theta_only": (*a[:4], lo, hi, mp, dt, state),
         "_stage2_theta": (*a[:4], lo, hi, mp, 0.5 * dt, state),
-        "_stage1_run": (*a[:9], lo, hi, p, mp, dt, end, state),
+        "_stage1_run": (*a[:8], lo, hi, p, mp, dt, end, state),
         "_stage2_run": (*a[:8], lo, hi, p, mp, 0.5 * dt, end, state),
     }[name]
 

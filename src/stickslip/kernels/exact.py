@@ -30,6 +30,14 @@ inner loop in which the run's bounds are fixed, so that the run stages' overlap 
 once per run. The driver hands over arrays whose block 1 starts a 64-byte line
 (:func:`stickslip.run.state.line_aligned`; docs/performance.md, "The run's bounds per run, and
 aligned arrays").
+
+Three more savings keep every bit (docs/performance.md, "Fewer scalar blocks in the partly stuck
+step"): stage 1 of the run covers whole vectors of blocks, the up to three blocks past it
+getting a moving block's values that the general stages then overwrite; the one block past the
+run that the start rule leaves stopped gets the stopped blocks' stage 1; and a stopped block of
+the interval gets its stage-1 predictors of x and v and its mask only next to the blocks that may
+move (stage 2 reads them from the neighbours of its movers alone), the others their state
+variable's derivative and predictor only.
 """
 
 from __future__ import annotations
@@ -109,6 +117,10 @@ def run_exact(args, drive, friction, threshold, ends):
         # run stages' arrays for overlap once per run rather than once per step (measured).
         ra0 = ra
         rb0 = rb
+        # The mid-step mask on the run is 1 in every step of it: written once, in the first step
+        # with the run within the updated blocks, and again after a step without (whose general
+        # stages may have written it).
+        mm_run = False
         while True:
             if ra != ra0 or rb != rb0:
                 break
@@ -223,6 +235,8 @@ def run_exact(args, drive, friction, threshold, ends):
             # The run, when it lies within [fl, fh] and [lo, hi] (as it should: its blocks moved in
             # the last step): no start rule there; the general stages on either side of it.
             run_in = ra0 <= rb0 and fl <= ra0 and rb0 <= fh and lo <= ra0 and rb0 <= hi
+            if not run_in:
+                mm_run = False
             if fl <= fh:
                 if run_in:
                     first = ra0
@@ -233,8 +247,28 @@ def run_exact(args, drive, friction, threshold, ends):
                         )
                         if f_ <= l_:
                             first = f_
-                    _stage1_run(x, v, th, xs, vs, ths, mm, a1, b1, ra0, rb0, p1, mp, dt, drive, friction)
-                    if rb0 < fh:
+                    # Over whole vectors of 4 blocks, not one at a time at the end: the up to 3
+                    # blocks past the run get a moving block's values, which the stages below
+                    # overwrite wherever stage 2 and the bookkeeping read them (measured: 1-2%).
+                    rp = rb0 + (ra0 - rb0 - 1) % 4
+                    if rp > N:
+                        rp = rb0
+                    _stage1_run(x, v, th, xs, vs, ths, a1, b1, ra0, rp, p1, mp, dt, drive, friction)
+                    if not mm_run:
+                        for i in range(ra0, rb0 + 1):
+                            mm[i] = 1.0
+                        mm_run = True
+                    if (
+                        fh == rb0 + 1
+                        and mov[fh] == 0.0
+                        and not _force(x[fh - 1], x[fh], x[fh + 1], K, dp, p1, drive)
+                        > _threshold(th[fh], tp, threshold)
+                    ):
+                        # The one block past the run stays stopped (the start rule of _stage1): it
+                        # gets the stopped blocks' stage 1 below, equal to _stage1's but for a1 and
+                        # vs, which are read only for a block that moves.
+                        fh = rb0
+                    elif rb0 < fh:
                         f_, l_, s_ = _stage1(
                             x, v, th, mov, xs, vs, ths, mm, a1, b1, rb0 + 1, fh, p1, mp, dt, drive, friction, threshold
                         )
@@ -245,10 +279,19 @@ def run_exact(args, drive, friction, threshold, ends):
                     first, last, starts = _stage1(
                         x, v, th, mov, xs, vs, ths, mm, a1, b1, fl, fh, p1, mp, dt, drive, friction, threshold
                     )
+                # Blocks that stay stopped: stage 2 reads the predictors and the mask only next to
+                # [fl, fh] (the neighbours of its movers), so farther blocks need their theta alone
+                # (on a ring, blocks 1 and N are neighbours: all of them).
                 if l1 < fl:
-                    _stage1_theta(x, v, th, xs, vs, ths, mm, b1, l1, fl - 1, mp, dt, friction)
+                    a_ = l1 if has(ends, "ring") else fl - 1
+                    if l1 < a_:
+                        _stage1_theta_only(v, th, ths, b1, l1, a_ - 1, mp, dt, friction)
+                    _stage1_theta(x, v, th, xs, vs, ths, mm, b1, a_, fl - 1, mp, dt, friction)
                 if fh < h1:
-                    _stage1_theta(x, v, th, xs, vs, ths, mm, b1, fh + 1, h1, mp, dt, friction)
+                    b_ = h1 if has(ends, "ring") else fh + 1
+                    _stage1_theta(x, v, th, xs, vs, ths, mm, b1, fh + 1, b_, mp, dt, friction)
+                    if b_ < h1:
+                        _stage1_theta_only(v, th, ths, b1, b_ + 1, h1, mp, dt, friction)
             elif has(friction, "has_state"):
                 _stage1_theta_only(v, th, ths, b1, l1, h1, mp, dt, friction)
             p2 = _pull(V, n + 1, dt)
@@ -279,8 +322,10 @@ def run_exact(args, drive, friction, threshold, ends):
                     c_lo, c_hi = _merge(c_lo, c_hi, ra0, rb0)
                     moved_before += rb0 - ra0 + 1
                     if stops_run:
+                        # The stop rule on the run (_stage2_run stored v as computed).
                         for i in range(ra0, rb0 + 1):
                             keep = v[i] > 0.0
+                            v[i] = v[i] if keep else 0.0
                             mov[i] = 1.0 if keep else 0.0
                             moved_after += 1 if keep else 0
                     else:

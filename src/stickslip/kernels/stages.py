@@ -119,10 +119,12 @@ def _stage1_theta(x, v, th, xs, vs, ths, mm, b1, lo, hi, mp, dt, friction):
 
 @njit(cache=True, _nrt=False)
 def _stage1_theta_only(v, th, ths, b1, lo, hi, mp, dt, friction):
-    """Stage 1 for blocks lo..hi in a step in which no block moves.
+    """Stage 1 for stopped blocks lo..hi whose predictors of x and v and mask nothing reads: in a
+    step in which no block moves, or not next to a block that may move (stage 2 reads those of
+    its movers' neighbours only).
 
-    Then nothing reads the predictors of x and v or the mask, so only the state variable's
-    derivative and predictor are written (see _stage1_theta for why this is exact).
+    So only the state variable's derivative and predictor are written (see _stage1_theta for why
+    this is exact).
     """
     one = np.uint64(1)
     for i in range(np.uint64(lo), np.uint64(hi) + one):
@@ -200,24 +202,30 @@ def _stage2(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, p, mp, h2, drive, fr
 
 
 @njit(cache=True, _nrt=False, inline="always")
-def _stage1_run(x, v, th, xs, vs, ths, mm, a1, b1, lo, hi, p, mp, dt, drive, friction):
+def _stage1_run(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, dt, drive, friction):
     """Stage 1 for blocks lo..hi that all move at t_n (a run of sliding blocks).
 
     A moving block moves in this step whatever its force (start rule), so the mask is 1 and
-    no start is looked for; the expressions are those of :func:`_stage1` with m = 1.
+    no start is looked for; the expressions are those of :func:`_stage1` with m = 1. The mask
+    itself is not written: it stays 1 on the run from step to step, and the caller sets it
+    once per run.
     """
     K, dp = mp[0], mp[1]
     one = np.uint64(1)
     for i in range(np.uint64(lo), np.uint64(hi) + one):
-        f = _force(x[i - one], x[i], x[i + one], K, dp, p, drive)
-        a = _accel(f, th[i], v[i], 1.0, mp, friction)
-        b = _dtheta(th[i - one], th[i], th[i + one], v[i], mp, friction)
-        mm[i] = 1.0
+        # The block's own values read once, before the stores: the compiler cannot tell that the
+        # arrays do not overlap and would read again after each store (measured: 2% of the run).
+        xi = x[i]
+        vi = v[i]
+        ti = th[i]
+        f = _force(x[i - one], xi, x[i + one], K, dp, p, drive)
+        a = _accel(f, ti, vi, 1.0, mp, friction)
+        b = _dtheta(th[i - one], ti, th[i + one], vi, mp, friction)
+        xs[i] = xi + dt * vi
+        vs[i] = vi + dt * a
+        ths[i] = ti + dt * b
         a1[i] = a
         b1[i] = b
-        xs[i] = x[i] + dt * v[i]
-        vs[i] = v[i] + dt * a
-        ths[i] = th[i] + dt * b
 
 
 @njit(cache=True, _nrt=False, inline="always")
@@ -225,21 +233,27 @@ def _stage2_run(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, h2, drive, frictio
     """Stage 2, corrector and stop rule for a run lo..hi of blocks moving in this step.
 
     As :func:`_stage2_all` on the run: the moving flags are not written and the changes not
-    tracked (the caller counts the run as changed); returns whether some block stopped.
+    tracked (the caller counts the run as changed); returns whether some block stopped. The
+    velocity is stored as computed: where a block stopped (rare), the caller sets it to 0.
     """
     K, dp = mp[0], mp[1]
     one = np.uint64(1)
     stops = False
     for i in range(np.uint64(lo), np.uint64(hi) + one):
+        # Read once, stored last (as in _stage1_run).
+        vi = v[i]
+        vsi = vs[i]
+        tsi = ths[i]
         f2 = _force(xs[i - one], xs[i], xs[i + one], K, dp, p, drive)
-        a2 = _accel(f2, ths[i], vs[i], 1.0, mp, friction)
-        b2 = _dtheta(ths[i - one], ths[i], ths[i + one], vs[i], mp, friction)
-        x[i] = x[i] + h2 * (v[i] + vs[i])
-        vn = v[i] + h2 * (a1[i] + a2)
-        th[i] = th[i] + h2 * (b1[i] + b2)
-        keep = vn > 0.0
-        v[i] = vn if keep else 0.0
-        stops |= not keep
+        a2 = _accel(f2, tsi, vsi, 1.0, mp, friction)
+        b2 = _dtheta(ths[i - one], tsi, ths[i + one], vsi, mp, friction)
+        xn = x[i] + h2 * (vi + vsi)
+        vn = vi + h2 * (a1[i] + a2)
+        thn = th[i] + h2 * (b1[i] + b2)
+        x[i] = xn
+        v[i] = vn
+        th[i] = thn
+        stops |= not vn > 0.0
     return stops
 
 
