@@ -157,7 +157,7 @@ def design(name: str) -> Design:
         The module's ``DESIGN``.
     """
     if name not in STUDIES + PAPER:
-        raise ValueError(f"study must be one of {', '.join(STUDIES)} (got {name!r})")
+        raise ValueError(f"study must be one of {', '.join(STUDIES + PAPER)} (got {name!r})")
     return importlib.import_module(f"{__name__}.{name.replace('-', '_')}").DESIGN
 
 
