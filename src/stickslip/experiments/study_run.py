@@ -80,7 +80,7 @@ def run_study(
     spec = study(spec, mode) if isinstance(spec, str) else spec
     plan = design(spec.name)
     out = Path(out_dir)
-    run_dir = out / "runs" / spec.dirname
+    run_dir = spec.runs_dir(out)
     page_dir = out / spec.name
     show = progress and _on_terminal()
     for p in spec.points:  # validate every point before any work starts
@@ -335,6 +335,6 @@ def remove_study_files(out: str | Path, spec: Study) -> None:
         path = out / rel
         if path.parent == page_dir and path.is_file():
             path.unlink()
-    shutil.rmtree(out / "runs" / spec.dirname, ignore_errors=True)
+    shutil.rmtree(spec.runs_dir(out), ignore_errors=True)
     if own:
         io.write_json(out / MANIFEST, {"files": sorted(p for p in own if (out / p).exists())})

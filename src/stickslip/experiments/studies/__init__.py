@@ -31,14 +31,29 @@ A :class:`Study`'s key hashes its name, the settings every point shares and the 
 from __future__ import annotations
 
 import importlib
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 from stickslip import __version__
 from stickslip.experiments.cache import canonical, spec_key
 
-__all__ = ["Study", "Design", "Option", "STUDIES", "PAPER", "MANIFEST", "MODES", "design", "study", "study_command"]
+__all__ = [
+    "Study",
+    "Design",
+    "Option",
+    "STUDIES",
+    "PAPER",
+    "MANIFEST",
+    "MODES",
+    "design",
+    "study",
+    "study_command",
+    "finite",
+    "short",
+]
 
 #: The studies, each the module of its name (``-`` read as ``_``) in this package.
 STUDIES = ("transition", "phase-diagram", "exponents", "chaos")
@@ -83,6 +98,24 @@ class Study:
     def dirname(self) -> str:
         """The study's runs folder: ``<name>-<key>``."""
         return f"{self.name}-{self.key()}"
+
+    def runs_dir(self, out: str | Path) -> Path:
+        """The study's runs folder under the output folder ``out``: ``out/runs/<name>-<key>``
+        (its points in ``points/``, each study's page in ``out/<name>``)."""
+        return Path(out) / "runs" / self.dirname
+
+
+def finite(x: Any) -> bool:
+    """Whether ``x`` is a finite number (None, NaN, text: not), for the studies' tables."""
+    try:
+        return x is not None and math.isfinite(float(x))
+    except (TypeError, ValueError):
+        return False
+
+
+def short(x: Any, digits: int = 3) -> str:
+    """``x`` to ``digits`` significant digits for a study's statements, "n/a" unless :func:`finite`."""
+    return f"{float(x):.{digits}g}" if finite(x) else "n/a"
 
 
 @dataclass(frozen=True)

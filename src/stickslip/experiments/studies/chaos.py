@@ -24,7 +24,7 @@ from typing import Any
 import pandas as pd
 
 from stickslip.experiments.chaos_verdict import DELTAS_FULL, DELTAS_QUICK, TRANSIENTS, threshold_columns
-from stickslip.experiments.studies import Design, Study
+from stickslip.experiments.studies import Design, Study, finite, short
 from stickslip.experiments.sweep_points import point_params
 from stickslip.models.presets import PRESETS, is_paper
 
@@ -119,22 +119,11 @@ def check(cfg: dict[str, Any]) -> None:
     check_point(cfg, point_params("chain", cfg))
 
 
-def _finite(x) -> bool:
-    try:
-        return x is not None and math.isfinite(float(x))
-    except (TypeError, ValueError):
-        return False
-
-
-def _g(x, digits: int = 3) -> str:
-    return f"{float(x):.{digits}g}" if _finite(x) else "n/a"
-
-
 def _per_seed(row: pd.Series, kind: str) -> list[float | None]:
     """The per-window delta* of ``kind`` in a row (``delta_star_<kind>_seed<k>``; None: censored)."""
     base = f"{threshold_columns(kind)[0]}_seed"
     cols = [f"{base}{k}" for k in range(int(row["seeds"]))]
-    return [float(row[c]) if c in row.index and _finite(row[c]) else None for c in cols]
+    return [float(row[c]) if c in row.index and finite(row[c]) else None for c in cols]
 
 
 def thresholds(table: pd.DataFrame) -> list[dict[str, Any]]:
@@ -145,7 +134,7 @@ def thresholds(table: pd.DataFrame) -> list[dict[str, Any]]:
     for _, row in chain.iterrows():
         for kind in KINDS:
             mean, err, low, high, censored = threshold_columns(kind)
-            if mean not in row.index or not _finite(row.get(censored)):
+            if mean not in row.index or not finite(row.get(censored)):
                 continue
             out.append(
                 {
@@ -153,10 +142,10 @@ def thresholds(table: pd.DataFrame) -> list[dict[str, Any]]:
                     "beta": float(row["beta"]),
                     "kind": kind,
                     "per_seed": _per_seed(row, kind),
-                    "geometric_mean": float(row[mean]) if _finite(row[mean]) else None,
-                    "log10_err": float(row[err]) if _finite(row[err]) else math.nan,
-                    "low": float(row[low]) if _finite(row[low]) else None,
-                    "high": float(row[high]) if _finite(row[high]) else None,
+                    "geometric_mean": float(row[mean]) if finite(row[mean]) else None,
+                    "log10_err": float(row[err]) if finite(row[err]) else math.nan,
+                    "low": float(row[low]) if finite(row[low]) else None,
+                    "high": float(row[high]) if finite(row[high]) else None,
                     "censored": int(row[censored]),
                 }
             )
@@ -186,25 +175,25 @@ def conclusions(spec: Study | None, table: pd.DataFrame) -> dict[str, Any]:
     for _, r in rows.iterrows():
         name = PRESETS[r["model"]].point_label(r["beta"], r["N"])
         lam, err = r.get("lyapunov_dt0"), r.get("lyapunov_dt0_err")
-        slips = int(r["flow_slips"]) if _finite(r.get("flow_slips")) else None
+        slips = int(r["flow_slips"]) if finite(r.get("flow_slips")) else None
         loaded = bool(r.get("loaded")) if r.get("loaded") is not None else None
         out["points"].append(
             {
                 "point": name,
                 "model": r["model"],
                 "N": int(r["N"]),
-                "beta": float(r["beta"]) if _finite(r.get("beta")) else None,
+                "beta": float(r["beta"]) if finite(r.get("beta")) else None,
                 "verdict": r.get("verdict"),
                 "verdict_text": r.get("verdict_text"),
-                "lyapunov_dt0": float(lam) if _finite(lam) else None,
-                "lyapunov_dt0_err": float(err) if _finite(err) else None,
+                "lyapunov_dt0": float(lam) if finite(lam) else None,
+                "lyapunov_dt0_err": float(err) if finite(err) else None,
                 "flow_slips": slips,
                 "loaded": loaded,
             }
         )
         out["verdicts"].setdefault(r.get("verdict"), []).append(name)
         say(
-            f"{name}: flow exponent {_g(lam)} +- {_g(err, 2)} (each rung counting at least {slips} slips); "
+            f"{name}: flow exponent {short(lam)} +- {short(err, 2)} (each rung counting at least {slips} slips); "
             f"{r.get('verdict_text')}."
         )
     say("Verdicts: " + "; ".join(f"{label} at {', '.join(names)}" for label, names in out["verdicts"].items()) + ".")
@@ -283,7 +272,7 @@ def figures(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[tuple[str,
     from stickslip import io
     from stickslip.plotting import chaos as pc
 
-    found = curves(table, Path(page_dir).parent / "runs" / spec.dirname / "points")
+    found = curves(table, spec.runs_dir(Path(page_dir).parent) / "points")
     if not found:
         return []
     io.write_table_files(Path(page_dir) / "decorrelation", decorrelation_table(found))

@@ -14,19 +14,11 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from stickslip.experiments.studies import Design, Study
+from stickslip.experiments.studies import Design, Study, finite, short
 from stickslip.experiments.studies.chain_point import check_point, sizes_task, t_end_of
 from stickslip.models.presets import PRESETS, is_paper
 
 __all__ = ["DESIGN"]
-
-
-def _finite(x) -> bool:
-    return x is not None and math.isfinite(float(x))
-
-
-def _g(x: float, digits: int = 3) -> str:
-    return "n/a" if x is None or not math.isfinite(float(x)) else f"{float(x):.{digits}g}"
 
 
 def build(mode: str) -> Study:
@@ -66,11 +58,11 @@ def findings(spec: Study, table: pd.DataFrame) -> dict[str, Any]:
     for r in table.sort_values(["model", "beta"]).itertuples():
         label = PRESETS[r.model].point_label(r.beta, r.N, with_N=False)
         say(
-            f"{label}: tau = {_g(r.tau)} +- {_g(getattr(r, 'tau_err', math.nan), 2)} on S in "
-            f"[{_g(getattr(r, 's_min', math.nan))}, {_g(getattr(r, 's_max', math.nan))}] "
-            f"({_g(getattr(r, 'n_fit', math.nan))} of {r.n_events} events), great-event excess "
-            f"{_g(getattr(r, 'excess', math.nan))} ({getattr(r, 'observed', 'n/a')} observed / "
-            f"{_g(getattr(r, 'expected', math.nan))} expected)."
+            f"{label}: tau = {short(r.tau)} +- {short(getattr(r, 'tau_err', math.nan), 2)} on S in "
+            f"[{short(getattr(r, 's_min', math.nan))}, {short(getattr(r, 's_max', math.nan))}] "
+            f"({short(getattr(r, 'n_fit', math.nan))} of {r.n_events} events), great-event excess "
+            f"{short(getattr(r, 'excess', math.nan))} ({getattr(r, 'observed', 'n/a')} observed / "
+            f"{short(getattr(r, 'expected', math.nan))} expected)."
         )
     chain = table[table["model"].map(is_paper)].sort_values("beta")
     ok = chain[np.isfinite(chain["tau"].astype(float))]
@@ -95,7 +87,7 @@ def figures(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[tuple[str,
         "bootstrap errors) and great-event excess against beta; Carlson-Langer as a band."
     )
     out = [("tau_beta", exponents_figure(table), caption)]
-    panels = _family_panels(spec, table, Path(page_dir).parent / "runs" / spec.dirname / "points")
+    panels = _family_panels(spec, table, spec.runs_dir(Path(page_dir).parent) / "points")
     if len(panels) == 2:
         caption = (
             "Slip-size density p(S) on logarithmic bins, log-log, of the events after each run's transient. "
@@ -120,8 +112,8 @@ def _family_panels(spec: Study, table: pd.DataFrame, points: Path) -> list[tuple
     for r in rows:
         events = io.read_table(points / r["point_dir"] / "events.parquet")
         events = events[events["t_start"] >= float(r["t_from"])]
-        seed = int(r["seed"]) if _finite(r.get("seed")) else 0  # as sizes_task: the point's, else 0
-        bootstrap = int(r["bootstrap"]) if _finite(r.get("bootstrap")) else 200
+        seed = int(r["seed"]) if finite(r.get("seed")) else 0  # as sizes_task: the point's, else 0
+        bootstrap = int(r["bootstrap"]) if finite(r.get("bootstrap")) else 200
         stats = size_statistics(
             events, int(r["N"]), small_only=True, seed=seed, spanning=r["spanning"], bootstrap=bootstrap
         )
