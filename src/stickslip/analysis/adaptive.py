@@ -22,6 +22,7 @@ samples so far and says whether the point may stop. Three pieces:
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import asdict, dataclass
 from typing import Any
 
@@ -29,7 +30,7 @@ import numpy as np
 
 from stickslip.analysis.order import MeanEstimate, mean_with_error
 
-__all__ = ["mser_cut", "Assessment", "assess", "STUCK_SLIDING", "STOP_BATCHES"]
+__all__ = ["mser_cut", "Assessment", "assess", "run_rung", "STUCK_SLIDING", "STOP_BATCHES"]
 
 #: A kept window whose time-averaged stuck fraction is below this is sliding (no block sticks).
 STUCK_SLIDING = 1e-3
@@ -159,3 +160,122 @@ def assess(t: np.ndarray, m: np.ndarray, phi: np.ndarray, target: float, min_bat
     else:
         reason = f"error of m {m_est.err:.2g} above the target {target:g}"
     return Assessment(m_est, phi_est, float(t[cut]), decided, sliding, reason)
+
+
+def run_rung(params, state, cfg: dict[str, Any], *, leave_stops: bool = False, stop_requested=None) -> dict[str, Any]:
+    """One rung of the transition study: the chain of eq. (4) at ``params`` from ``state`` in
+    segments (the first ``first_segment_loads`` loading times, then doubling up to
+    ``segment_loads``) until its answer is known: :func:`assess` decides with the stuck fraction
+    at least :data:`STUCK_SLIDING` over a window of half a loading time or more (stick-slip);
+    steady sliding is reached (every block within ``UNTIL_STEADY`` of it) or every block slides
+    with the deviation falling; with ``leave_stops`` (the down ladder), a block sticks; or the cap
+    of ``cap_loads`` loading times (then ``undecided``, with the reason). Returns the row (m,
+    its error, the stuck fraction phi and its error, final state and reason, times in model time
+    and loading times) with ``state`` (the final :class:`~stickslip.run.state.ChainState`) and
+    ``samples`` (arrays t, L, n_moving)."""
+    from stickslip.models.physics import UNTIL_STEADY, chain_steady_length, loading_time
+    from stickslip.run.driver import run_chain
+    from stickslip.run.state import steady_deviation
+
+    L_ss, t_load, dt = chain_steady_length(params), loading_time(params), params.dt
+    every = max(int(round(t_load / float(cfg["samples_per_load"]) / dt)), 1)
+    sample_interval = every * dt
+    target, cap = float(cfg["target"]), float(cfg["cap_loads"]) * t_load
+    seg, seg_max = float(cfg["first_segment_loads"]) * t_load, float(cfg["segment_loads"]) * t_load
+    t_start = state.step * dt
+    devs = [steady_deviation(state, params)]
+    t_s: list[np.ndarray] = []
+    L_s: list[np.ndarray] = []
+    n_s: list[np.ndarray] = []
+    wall0 = time.perf_counter()
+    final, reason, reached, a = "undecided", "", False, None
+    while True:
+        t_now = state.step * dt
+        # segment ends on the sample grid, so no two segments sample the same step twice
+        t_target = (math.floor((t_now + seg) / sample_interval + 1e-9) + 1) * sample_interval
+        run = run_chain(
+            params,
+            t_target,
+            start=state,
+            sample_interval=sample_interval,
+            until_steady=UNTIL_STEADY,
+            sample_moving=True,
+            stop_requested=stop_requested,
+        )
+        state = run.state
+        t, L = run.samples["t"].values, run.samples["L"].values
+        nm = run.samples["n_moving"].values
+        k = min(t.size, nm.size)
+        keep = t[:k] > (t_s[-1][-1] if t_s else -1.0)
+        t_s.append(t[:k][keep])
+        L_s.append(L[:k][keep])
+        n_s.append(nm[:k][keep])
+        devs.append(steady_deviation(state, params))
+        seg_stuck = bool(n_s[-1].size and n_s[-1].min() < params.N)
+        elapsed = state.step * dt - t_start
+        if run.summary.get("stopped_early"):
+            final, reached = "steady", True
+            reason = (
+                f"steady sliding reached at t = {float(run.summary['t_steady']):.6g} (deviation <= {UNTIL_STEADY:g})"
+            )
+            break
+        t_all, L_all, n_all = (np.concatenate(x) for x in (t_s, L_s, n_s))
+        m = 1.0 - L_all / L_ss
+        phi = 1.0 - n_all / params.N
+        a = assess(t_all, m, phi, target, int(cfg.get("stop_batches", STOP_BATCHES)))
+        # Leaving stick-slip (up), a falling deviation says sliding; near beta = 1 from below (down)
+        # fast modes decay while the slow one grows, so there only reaching steady sliding counts.
+        falling = len(devs) >= 2 and math.isfinite(devs[-2]) and devs[-1] < 0.5 * devs[-2]
+        if not leave_stops and not seg_stuck and falling:
+            final = "steady"
+            reason = f"every block slides, deviation from steady sliding falling ({devs[-2]:.2g} -> {devs[-1]:.2g})"
+            break
+        if leave_stops and seg_stuck:
+            final = "stick-slip"
+            reason = f"left steady sliding: {params.N - int(n_s[-1].min())} blocks stuck at once"
+            break
+        # a window shorter than half a loading time may hold no event at all (m constant, error 0)
+        long_enough = t_all[-1] - a.t_cut >= 0.5 * t_load
+        if a.decided and a.phi.mean >= STUCK_SLIDING and long_enough:
+            final, reason = "stick-slip", a.reason
+            break
+        if elapsed >= cap - 1e-9:
+            why = a.reason if not a.decided or long_enough else "kept window shorter than half a loading time"
+            reason = f"cap of {cfg['cap_loads']:g} loading times: {why}"
+            break
+        seg = min(2.0 * seg, seg_max, cap - elapsed) if cap - elapsed > 0 else seg
+    t_all = np.concatenate(t_s) if t_s else np.zeros(0)
+    L_all = np.concatenate(L_s) if L_s else np.zeros(0)
+    n_all = np.concatenate(n_s) if n_s else np.zeros(0)
+    row: dict[str, Any] = {
+        "N": params.N,
+        "beta": params.beta,
+        "final_state": final,
+        "final_reason": reason,
+        "t_start": t_start,
+        "t_end": state.step * dt,
+        "loads": (state.step * dt - t_start) / t_load,
+        "loading_time": t_load,
+        "deviation_end": devs[-1],
+        "wall_seconds": time.perf_counter() - wall0,
+    }
+    if reached or a is None or (final == "steady" and a.phi.mean < STUCK_SLIDING):
+        # steady sliding: L = L_ss and every block moves, so m = phi = 0 exactly
+        est = {"order_parameter": 0.0, "order_parameter_err": 0.0, "stuck_fraction": 0.0, "stuck_fraction_err": 0.0}
+        row.update(est, sliding=True, tau_int=math.nan, tau_int_loads=math.nan, n_batches=0, t_cut_loads=math.nan)
+        row["err_reliable"] = True
+    else:
+        row.update(
+            order_parameter=a.m.mean,
+            order_parameter_err=a.m.err,
+            stuck_fraction=a.phi.mean,
+            stuck_fraction_err=a.phi.err,
+            sliding=a.sliding,
+            tau_int=a.m.tau_int * sample_interval,
+            tau_int_loads=a.m.tau_int * sample_interval / t_load,
+            n_batches=a.m.n_batches,
+            err_reliable=a.m.reliable,
+            t_cut_loads=(a.t_cut - t_start) / t_load,
+        )
+    row["branch_state"] = "sliding" if row["sliding"] else "stick-slip"
+    return {"row": row, "state": state, "samples": {"t": t_all, "L": L_all, "n_moving": n_all}}

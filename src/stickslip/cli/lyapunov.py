@@ -381,7 +381,7 @@ def _decorrelation(params, args) -> Result:
 def _fronts(params, args) -> Result:
     """`--switches located --fronts`: :func:`stickslip.analysis.stable_chaos.perturbation_front`."""
     from stickslip.analysis.stable_chaos import perturbation_front
-    from stickslip.experiments.chaos_verdict import located_start
+    from stickslip.run.loaded import located_start
 
     if not args.t_end > args.transient:
         raise CommandError(f"--t-end must exceed --transient (got {args.t_end:g} and {args.transient:g})")
@@ -390,9 +390,7 @@ def _fronts(params, args) -> Result:
     check_number("front-block", args.front_block, low=0, high=params.N - 1, integer=True)
     if params.ends_piece.wall and args.transient > 0:
         raise CommandError("--fronts restarts the clock after --transient: fixed ends (which read t) are refused")
-    start = located_start(
-        params, {"transient": args.transient, "start": args.start, "perturbation": args.perturbation, "seed": args.seed}
-    )
+    start = located_start(params, args.transient, start=args.start, perturbation=args.perturbation, seed=args.seed)
     res = perturbation_front(
         params, start, (1e-10, 1e-6, 1e-3, 1e-2), t_max=args.t_end - args.transient, block=args.front_block
     )

@@ -33,7 +33,6 @@ from typing import Any
 __all__ = [
     "chaos_point",
     "check_point",
-    "located_start",
     "DELTAS_FULL",
     "DELTAS_QUICK",
     "TRANSIENTS",
@@ -92,22 +91,6 @@ def check_point(cfg: dict[str, Any], params) -> None:
     )
 
 
-def located_start(params, options: dict[str, Any]):
-    """The located state at the end of ``options["transient"]`` (the engine's run of eq. (4) or a
-    relative up to there from ``options["start"]``, clock restarted; docs/lyapunov.md)."""
-    from stickslip.run.loaded import loaded_state
-    from stickslip.run.located import LocatedState, start_state
-
-    transient = float(options.get("transient", 0.0))
-    kw = {"perturbation": options["perturbation"], "seed": options["seed"]}
-    if transient <= 0.0:
-        return start_state(params, options["start"], **kw)
-    state = loaded_state(params, transient, start=options["start"], **kw).state
-    # the drive's frame does not read t: every rung of the ladder can start at t = 0 (fixed
-    # ends read it, and are refused here)
-    return LocatedState.from_chain_state(state, params, restart_clock=True)
-
-
 class _Parts:
     """The finished parts of a point (``parts/NAME.json``), each with the settings it was made with
     and its own checksum (:func:`stickslip.experiments.cache.sealed`): an edited or foreign part is
@@ -144,7 +127,6 @@ def chaos_point(cfg: dict[str, Any], params, point_dir: Path) -> dict[str, Any]:
     from stickslip.experiments.sweep import stop_requested
     from stickslip.experiments.sweep_points import preset_start
     from stickslip.run.loaded import loaded_state
-    from stickslip.run.located import LocatedState
 
     wall0 = time.perf_counter()
     check_point(cfg, params)
@@ -157,7 +139,7 @@ def chaos_point(cfg: dict[str, Any], params, point_dir: Path) -> dict[str, Any]:
     direction_seed = int(cfg.get("direction_seed", 0))
     interval, d0 = float(cfg.get("interval", 10.0)), float(cfg.get("d0", 1e-10))
     flow_t, levels = float(cfg["flow_t"]), int(cfg.get("levels", 3))
-    located = LocatedState.from_chain_state(loaded.state, params, restart_clock=True)
+    located = loaded.located(params)
 
     def rung(k: int):
         p = params.replace(dt=params.dt / 2**k)

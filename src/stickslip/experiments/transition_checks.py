@@ -22,25 +22,20 @@ __all__ = ["paper_start_m", "paper_start_check", "longer_check", "rung_start_sta
 
 def paper_start_m(N: int, beta: float, loads: float = 4.0) -> dict[str, Any]:
     """m and its batch-means error over the second half of a run of ``loads`` loading times of the
-    chain of eq. (4) from the paper's start (the estimator of the point-by-point study)."""
+    chain of eq. (4) from the paper's start: a point of the phase diagram's kind
+    (:func:`stickslip.experiments.studies.chain_point.point_run_options`) with 20000 samples."""
     from stickslip.analysis.order import order_summary
-    from stickslip.experiments.studies.chain_point import t_end_of
+    from stickslip.experiments.studies.chain_point import point_run_options, t_end_of
+    from stickslip.experiments.sweep_points import point_params
     from stickslip.models.physics import UNTIL_STEADY
-    from stickslip.models.presets import chain_params
     from stickslip.run.driver import run_chain
 
-    p = chain_params("sakaguchi", N=N, beta=beta)
-    t_end = t_end_of(N, loads)
-    run = run_chain(
-        p,
-        t_end,
-        start="paper",
-        sample_interval=t_end / 20000,
-        average_from=0.5 * t_end,
-        sample_moving=True,
-        until_steady=UNTIL_STEADY,
-    )
-    s = order_summary(run, p, 0.5 * t_end)
+    cfg = {"N": N, "beta": beta, "t_end": t_end_of(N, loads), "start": "paper", "n_samples": 20000}
+    cfg |= {"analysis": "order", "until_steady": UNTIL_STEADY}
+    p = point_params("chain", cfg)
+    t_end, options = point_run_options(cfg, p)
+    run = run_chain(p, t_end, **options)
+    s = order_summary(run, p, options["average_from"])
     return {
         "N": N,
         "beta": beta,
@@ -98,7 +93,8 @@ def rung_start_state(ladder_dir: str | Path, index: int, cfg: dict[str, Any]):
 def longer_check(ladder_dir: str | Path, index: int, cfg: dict[str, Any], factor: float = 4.0) -> dict[str, Any]:
     """Rung ``index`` run again from its start for ``factor`` times its adaptive length (no stop
     rule, the same transient cut): its m and error against the adaptive ones."""
-    from stickslip.experiments.ladders import params_at, run_rung
+    from stickslip.analysis.adaptive import run_rung
+    from stickslip.experiments.ladders import params_at
 
     state, row = rung_start_state(ladder_dir, index, cfg)
     long_cfg = {**cfg, "target": 0.0, "cap_loads": factor * float(row["loads"])}

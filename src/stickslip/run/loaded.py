@@ -36,7 +36,15 @@ from stickslip.models.params import ChainParams, check_number
 from stickslip.run.errors import ChainRunError
 from stickslip.run.state import ChainState, model_of
 
-__all__ = ["LoadedState", "loaded_state", "loading_summary", "loaded_spec", "LOADED_FACTOR", "STRETCHES"]
+__all__ = [
+    "LoadedState",
+    "loaded_state",
+    "located_start",
+    "loading_summary",
+    "loaded_spec",
+    "LOADED_FACTOR",
+    "STRETCHES",
+]
 
 #: T0 counts as loaded when it is at least this many times the first slip that moved block N.
 LOADED_FACTOR = 2.0
@@ -59,6 +67,13 @@ class LoadedState:
 
     state: ChainState = field(repr=False)
     info: dict[str, Any]
+
+    def located(self, params: ChainParams):
+        """The state as the located integrator's start, clock restarted (docs/lyapunov.md): the
+        drive's frame does not read t, so every measurement from it can start at t = 0."""
+        from stickslip.run.located import LocatedState
+
+        return LocatedState.from_chain_state(self.state, params, restart_clock=True)
 
 
 def loaded_spec(params: ChainParams, transient: float, start: str, perturbation: float, seed: int) -> dict[str, Any]:
@@ -261,3 +276,14 @@ def _read(path: Path, spec: dict[str, Any], params: ChainParams) -> tuple[ChainS
         return None
     state = ChainState(**{k: arrays[k].copy() for k in ChainState.ARRAYS}, model=model_of(params))
     return state, header
+
+
+def located_start(params: ChainParams, transient: float, *, start: str, perturbation: float, seed: int):
+    """The located integrator's start at the end of ``transient``: the engine's run of eq. (4) or
+    a relative up to there from ``start`` (:func:`loaded_state`), clock restarted; at
+    ``transient`` 0 the start itself (:func:`stickslip.run.located.start_state`)."""
+    from stickslip.run.located import start_state
+
+    if transient <= 0.0:
+        return start_state(params, start, perturbation=perturbation, seed=seed)
+    return loaded_state(params, transient, start=start, perturbation=perturbation, seed=seed).located(params)

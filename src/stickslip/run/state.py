@@ -119,12 +119,21 @@ class ChainState:
         [-amplitude, amplitude] drawn from numpy's default generator with ``seed``.
         """
         s = physics.chain_steady_state(p, 0.0)
-        x, v = s["x"].copy(), s["v"].copy()
+        state = cls.from_blocks(s["x"].copy(), s["v"].copy(), s["theta"], np.zeros(p.N, bool)).of(p)
+        return state.perturbed(amplitude, seed)
+
+    def perturbed(self, amplitude: float, seed: int) -> ChainState:
+        """A copy with x_i and v_i of every moving block shifted by independent uniform numbers in
+        [-amplitude, amplitude] (numpy's default generator with ``seed``: N numbers for x, then N
+        for v), as :meth:`steady` perturbs steady sliding and the transition study's down ladder
+        each hand-over."""
+        s = self.copy()
         if amplitude > 0:
             rng = np.random.default_rng(seed)
-            x += rng.uniform(-amplitude, amplitude, p.N)
-            v += rng.uniform(-amplitude, amplitude, p.N)
-        return cls.from_blocks(x, v, s["theta"], np.zeros(p.N, bool)).of(p)
+            moving = s.mov[1:-1] != 0.0
+            s.x[1:-1] += np.where(moving, rng.uniform(-amplitude, amplitude, s.N), 0.0)
+            s.v[1:-1] += np.where(moving, rng.uniform(-amplitude, amplitude, s.N), 0.0)
+        return s
 
     @classmethod
     def rest(cls, p: ChainParams, amplitude: float = 0.01, seed: int = 0) -> ChainState:
