@@ -9,22 +9,17 @@ Each point is one chain run and its order parameter
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 from typing import Any
 
 import pandas as pd
 
-from stickslip.experiments.studies import Design, Study
+from stickslip.experiments.studies import Design, Study, short
 from stickslip.experiments.studies.chain_point import check_point, order_task, t_end_of
 from stickslip.models.physics import UNTIL_STEADY
 from stickslip.models.presets import paper_parameters
 
 __all__ = ["DESIGN"]
-
-
-def _g(x: float) -> str:
-    return "n/a" if x is None or not math.isfinite(float(x)) else f"{float(x):.3g}"
 
 
 def build(mode: str) -> Study:
@@ -100,14 +95,14 @@ def findings(spec: Study, table: pd.DataFrame) -> dict[str, Any]:
     for a, g in table[(table["D"] == 5.0) & (table["start"] == "paper")].groupby("alpha"):
         br = transition_bracket(g["beta"], g["final_state"])
         say(
-            f"alpha = {a:g} (D = 5, paper's start): last stick-slip beta = {_g(br['lo'])}, first steady above it "
-            f"= {_g(br['hi'])} (beta_c = alpha = {a:g})."
+            f"alpha = {a:g} (D = 5, paper's start): last stick-slip beta = {short(br['lo'])}, first steady above it "
+            f"= {short(br['hi'])} (beta_c = alpha = {a:g})."
         )
     for d, g in table[(table["alpha"] == 1.0) & (table["start"] == "paper")].groupby("D"):
         br = transition_bracket(g["beta"], g["final_state"])
         say(
-            f"D = {d:g} (alpha = 1, paper's start): last stick-slip beta = {_g(br['lo'])}, first steady above it "
-            f"= {_g(br['hi'])}."
+            f"D = {d:g} (alpha = 1, paper's start): last stick-slip beta = {short(br['lo'])}, first steady above it "
+            f"= {short(br['hi'])}."
         )
     return out
 
