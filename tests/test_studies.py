@@ -333,7 +333,7 @@ def test_an_interrupted_chaos_point_keeps_its_finished_parts(tmp_path):
     """A point whose task stopped after some parts runs only the others again, and gives the same
     row; a study's stop request stops it within a part; a part made with other settings is not
     reused."""
-    from stickslip.experiments.chaos_verdict import chaos_point
+    from stickslip.experiments.studies.chaos import chaos_point
     from stickslip.experiments.sweep import STOP_FILE
     from stickslip.run.errors import Interrupted
 
@@ -439,7 +439,7 @@ def test_a_quick_chain_point_counts_its_slips():
     the windows 1000, and the row has the study's columns (about a minute)."""
     import tempfile
 
-    from stickslip.experiments.chaos_verdict import MIN_FLOW_SLIPS, chaos_point
+    from stickslip.experiments.studies.chaos import MIN_FLOW_SLIPS, chaos_point
     from stickslip.experiments.study_run import TABLE_COLUMNS
 
     spec = study("chaos", "quick")

@@ -2,7 +2,7 @@
 
 :func:`flow_ladder_figure` and :func:`decorrelation_figure` take a list of curves, one per point:
 a dict with ``label``, ``N`` and ``beta`` (None for the relatives) and the data of the point's
-``flow.json`` (:func:`stickslip.experiments.chaos_verdict.chaos_point`):
+``flow.json`` (:func:`stickslip.experiments.studies.chaos.chaos_point`):
 
 * :func:`flow_ladder_figure`: the largest exponent of the flow against dt (``ladder`` rows of
   ``dt``, ``lyapunov``, ``lyapunov_err``) with the fit lambda(dt) = lambda_0 + c dt^2
