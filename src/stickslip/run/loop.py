@@ -17,6 +17,7 @@ step and the block (docs/chain.md, "Non-finite values").
 
 from __future__ import annotations
 
+import bisect
 import time
 from collections.abc import Callable, Sequence
 from typing import Any
@@ -225,14 +226,17 @@ class Snapshots(Hook):
     """Every x_i at the given steps (Fig. 5a); the end's is the final state, kept apart."""
 
     def __init__(self, steps: Sequence[int], done: set[int], n_end: int):
-        self.steps = sorted(set(steps) - {n_end})
+        self.wanted = set(steps) - {n_end}
+        self.steps = sorted(self.wanted)
         self.done = done
 
     def stop_at(self, n):
-        return min((s for s in self.steps if s > n), default=NEVER)
+        # a search, not a scan: a run may ask for many thousands of snapshots
+        k = bisect.bisect_right(self.steps, n)
+        return self.steps[k] if k < len(self.steps) else NEVER
 
     def at(self, loop, n):
-        if n in self.steps and n not in self.done:
+        if n in self.wanted and n not in self.done:
             loop.outputs.add_snapshot(n, loop.state.x)
             self.done.add(n)
         return False
