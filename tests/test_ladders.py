@@ -108,6 +108,73 @@ def test_up_ladder_hands_states_on_and_bisects(tmp_path):
     assert again["rows"] == rows
 
 
+def test_an_interrupted_rung_goes_on_from_its_last_segment(tmp_path, monkeypatch):
+    """A rung stopped after a segment keeps its progress (progress.npz) and, run again, goes on
+    from there. Stopped after every segment of every rung, the ladder ends with the rows and the
+    final states of the ladder run without a stop, bit for bit."""
+    import stickslip.experiments.ladders as ladders
+    import stickslip.run.driver as driver
+    from stickslip.kernels import layout
+    from stickslip.run.checkpoint import read_npz
+    from stickslip.run.errors import Interrupted
+
+    cfg = _tiny_ladder("up", [0.8, 4.0]) | {"bisections": 0}
+    whole = ladder_task(cfg, tmp_path / "whole")["rows"]
+    keep, run_chain = ladders._keep_progress, driver.run_chain
+    kept, starts = [], []
+
+    def stop_after_keeping(path, spec, progress):
+        keep(path, spec, progress)
+        kept.append(int(read_npz(path)[0]["ist"][layout.STEP]))
+        raise Interrupted(None, math.nan)
+
+    def watch(params, t_end, *, start, **kw):
+        starts.append(start.step)
+        return run_chain(params, t_end, start=start, **kw)
+
+    monkeypatch.setattr(ladders, "_keep_progress", stop_after_keeping)
+    monkeypatch.setattr(driver, "run_chain", watch)
+    rows, stops = None, 0
+    while rows is None and stops < 100:
+        try:
+            rows = ladder_task(cfg, tmp_path / "stopped")["rows"]
+        except Interrupted:
+            stops += 1
+    # both rungs were stopped, each time the next call's first segment began where the kept one ended
+    assert stops == len(kept) >= 3 and not list(tmp_path.glob("stopped/rungs/*/progress.npz"))
+    assert all(step in starts[1:] for step in kept)
+    drop = ("wall_seconds",)
+    assert [{k: v for k, v in r.items() if k not in drop} for r in rows] == [
+        {k: v for k, v in r.items() if k not in drop} for r in whole
+    ]
+    files = [sorted((tmp_path / d).glob("rungs/*/*.npz")) for d in ("whole", "stopped")]
+    assert [p.name for p in files[0]] == [p.name for p in files[1]] == ["samples.npz", "state.npz"] * 2
+    assert all(a.read_bytes() == b.read_bytes() for a, b in zip(*files, strict=True))
+
+
+def test_a_rungs_progress_reads_back_only_for_its_own_spec(tmp_path):
+    from stickslip.experiments.ladders import _keep_progress, _progress
+
+    p = chain_params("sakaguchi", N=7, beta=1.2)
+    state = ChainState.steady(p, 1e-3, 1)
+    kept = {"state": state, "seg": 12.5, "t_start": 0.0, "devs": [math.inf, 0.25, 0.125], "wall_seconds": 3.0}
+    kept |= {"t": np.array([1.0, 2.0]), "L": np.array([5.0, 5.5]), "n_moving": np.array([7, 6])}
+    path = tmp_path / "rungs" / "00-beta1.2" / "progress.npz"
+    _keep_progress(path, {"start_sha256": "a"}, kept)
+    back = _progress(path, {"start_sha256": "a"}, p)
+    assert back["state"].sha256() == state.sha256() and back["devs"] == kept["devs"]
+    assert {k: back[k] for k in ("seg", "t_start", "wall_seconds")} == {
+        "seg": 12.5,
+        "t_start": 0.0,
+        "wall_seconds": 3.0,
+    }
+    assert all(np.array_equal(back[k], kept[k]) and back[k].dtype == kept[k].dtype for k in ("t", "L", "n_moving"))
+    assert _progress(path, {"start_sha256": "b"}, p) is None  # another rung's progress
+    assert _progress(path, {"start_sha256": "a"}, chain_params("sakaguchi", N=8, beta=1.2)) is None
+    path.write_bytes(path.read_bytes()[:-20])  # a damaged file: the rung starts over
+    assert _progress(path, {"start_sha256": "a"}, p) is None
+
+
 def test_down_ladder_leaves_steady_sliding_below_one(tmp_path):
     """Linear stability of steady sliding: above beta = 1 a small kick decays, below it grows and
     blocks stick. The down ladder brackets that edge."""

@@ -138,26 +138,27 @@ def test_ctrl_c_in_a_terminal_stops_a_sweep(tmp_path):
 
 @pytest.mark.slow
 def test_sigterm_to_the_process_group_of_a_study(tmp_path):
-    """The quick transition study (its first point, N = 199, runs for minutes) stopped by SIGTERM
-    to every process of it: one line, status 130, the point's checkpoint kept; the next start
-    continues that point from it."""
+    """The quick transition study (its first ladder, N = 199, runs for minutes) stopped by SIGTERM
+    to every process of it: one line, status 130, the running rung's progress kept; the next
+    start continues that rung from it."""
     out = tmp_path / "studies"
     argv = ["study", "transition", "--quick", "--workers", "1", "--out", str(out), "--no-progress"]
     status, stdout, stderr, waited = _launch_in_group(
-        argv, lambda: bool(list(out.glob("runs/*/points/*/point.json"))), signal.SIGTERM, settle=3.0
+        argv, lambda: bool(list(out.glob("runs/*/points/*/rungs/*/progress.npz"))), signal.SIGTERM, settle=1.0
     )
     assert status == 130 and stdout == "", stderr
     assert stderr.count("\n") == 1 and "Traceback" not in stderr, stderr
     assert waited < 30
     (point,) = [p.parent for p in out.glob("runs/*/points/*/point.json")]
-    state = point / "checkpoint" / "state.npz"
-    assert state.is_file() and not (point / "done.json").exists()
+    (progress,) = point.glob("rungs/*/progress.npz")
+    assert not (point / "done.json").exists() and not (progress.parent / "rung.json").exists()
     from stickslip.kernels import layout
     from stickslip.run.checkpoint import read_npz
 
-    step = int(read_npz(state)[0]["ist"][layout.STEP])
-    assert step > 0, "the stop checkpoint holds the work done"
-    # the next start continues from there: stopped again, its checkpoint has moved on
+    step = int(read_npz(progress)[0]["ist"][layout.STEP])
+    assert step > 0, "the kept progress holds the work done"
+    # the next start continues from there: stopped again, the rung has moved on (or is written)
     status, _, stderr, _ = _launch_in_group(argv, lambda: True, signal.SIGTERM, settle=15.0)
     assert status == 130, stderr
-    assert int(read_npz(state)[0]["ist"][layout.STEP]) > step
+    written = (progress.parent / "rung.json").is_file()
+    assert written or int(read_npz(progress)[0]["ist"][layout.STEP]) > step

@@ -162,7 +162,9 @@ def assess(t: np.ndarray, m: np.ndarray, phi: np.ndarray, target: float, min_bat
     return Assessment(m_est, phi_est, float(t[cut]), decided, sliding, reason)
 
 
-def run_rung(params, state, cfg: dict[str, Any], *, leave_stops: bool = False, stop_requested=None) -> dict[str, Any]:
+def run_rung(
+    params, state, cfg: dict[str, Any], *, leave_stops: bool = False, stop_requested=None, resume=None, save=None
+) -> dict[str, Any]:
     """One rung of the transition study: the chain of eq. (4) at ``params`` from ``state`` in
     segments (the first ``first_segment_loads`` loading times, then doubling up to
     ``segment_loads``) until its answer is known: :func:`assess` decides with the stuck fraction
@@ -172,7 +174,12 @@ def run_rung(params, state, cfg: dict[str, Any], *, leave_stops: bool = False, s
     of ``cap_loads`` loading times (then ``undecided``, with the reason). Returns the row (m,
     its error, the stuck fraction phi and its error, final state and reason, times in model time
     and loading times) with ``state`` (the final :class:`~stickslip.run.state.ChainState`) and
-    ``samples`` (arrays t, L, n_moving)."""
+    ``samples`` (arrays t, L, n_moving).
+
+    After each segment that does not end the rung, ``save`` (if given) gets the rung's progress
+    (``state``, the next segment's length ``seg``, ``t_start``, ``devs``, the samples ``t``, ``L``,
+    ``n_moving`` and ``wall_seconds``); given back as ``resume``, the rung goes on from there with
+    the result of an uninterrupted rung (each segment is a run continued from the state before)."""
     from stickslip.models.physics import UNTIL_STEADY, chain_steady_length, loading_time
     from stickslip.run.driver import run_chain
     from stickslip.run.state import steady_deviation
@@ -188,6 +195,10 @@ def run_rung(params, state, cfg: dict[str, Any], *, leave_stops: bool = False, s
     L_s: list[np.ndarray] = []
     n_s: list[np.ndarray] = []
     wall0 = time.perf_counter()
+    if resume is not None:
+        state, seg, t_start, devs = resume["state"], resume["seg"], resume["t_start"], list(resume["devs"])
+        t_s, L_s, n_s = ([resume[k]] if resume["t"].size else [] for k in ("t", "L", "n_moving"))
+        wall0 -= resume["wall_seconds"]
     final, reason, reached, a = "undecided", "", False, None
     while True:
         t_now = state.step * dt
@@ -244,6 +255,9 @@ def run_rung(params, state, cfg: dict[str, Any], *, leave_stops: bool = False, s
             reason = f"cap of {cfg['cap_loads']:g} loading times: {why}"
             break
         seg = min(2.0 * seg, seg_max, cap - elapsed) if cap - elapsed > 0 else seg
+        if save is not None:
+            progress = {"state": state, "seg": seg, "t_start": t_start, "devs": devs, "t": t_all, "L": L_all}
+            save(progress | {"n_moving": n_all, "wall_seconds": time.perf_counter() - wall0})
     t_all = np.concatenate(t_s) if t_s else np.zeros(0)
     L_all = np.concatenate(L_s) if L_s else np.zeros(0)
     n_all = np.concatenate(n_s) if n_s else np.zeros(0)

@@ -17,8 +17,9 @@ the error of m below the target from at least 16 batches of 10 tau_int; steady s
 (every block within :data:`UNTIL_STEADY` of it) or every block sliding with the deviation falling;
 on the down ladder, a block stuck (it left steady sliding); or the cap, then ``undecided`` with the
 reason. Each finished rung is written to ``<ladder>/rungs/<k>-beta<b>/`` (``rung.json``, the final
-state ``state.npz``, the samples ``samples.npz``); a ladder started again replays its finished
-rungs and continues with the first unfinished one.
+state ``state.npz``, the samples ``samples.npz``), and a running rung keeps its progress after each
+segment there (``progress.npz``); a ladder started again replays its finished rungs and continues
+the first unfinished one from its last finished segment, with the result of an uninterrupted rung.
 """
 
 from __future__ import annotations
@@ -69,17 +70,19 @@ def _rung_settings(cfg: dict[str, Any]) -> dict[str, Any]:
 
 #: The files of a rung's folder, each recorded with its SHA-256 in rung.json.
 RUNG_FILES = ("state.npz", "samples.npz")
+#: A running rung's progress after its last finished segment (gone once the rung is written).
+PROGRESS_FILE = "progress.npz"
 
 
 def ladder_entry(path: Path, rel: str = ""):
     """Whether an entry of a ladder's folder is the ladder's: the sweep's bookkeeping, and its
-    ``rungs`` folder, holding only rungs (``<k>-beta<b>``) of ``rung.json`` and
-    :data:`RUNG_FILES`. True or False, or for a folder the test of its entries (the walk of
+    ``rungs`` folder, holding only rungs (``<k>-beta<b>``) of ``rung.json``,
+    :data:`RUNG_FILES` and :data:`PROGRESS_FILE`. True or False, or for a folder the test of its entries (the walk of
     :func:`stickslip.experiments.study_run.foreign_files`)."""
     from stickslip.experiments.cache import BOOKKEEPING
 
     def rung(p: Path, r: str) -> bool:
-        return p.is_file() and p.name in ("rung.json", *RUNG_FILES)
+        return p.is_file() and p.name in ("rung.json", PROGRESS_FILE, *RUNG_FILES)
 
     def rungs(p: Path, r: str):
         return rung if p.is_dir() and re.fullmatch(r"\d{2,}-beta[^/]+", p.name) else False
@@ -116,6 +119,44 @@ def _replay(rdir: Path, spec: dict[str, Any], params) -> tuple[dict[str, Any] | 
     return {"row": row, "state": state}, None
 
 
+def _keep_progress(path: Path, spec: dict[str, Any], progress: dict[str, Any]) -> None:
+    """A rung's progress after a segment (:func:`stickslip.analysis.adaptive.run_rung`) to ``path``,
+    with its spec and checksum (:func:`stickslip.run.checkpoint.write_npz`): an interrupted rung
+    loses at most the segment it was in."""
+    from stickslip.run.checkpoint import write_npz
+    from stickslip.run.state import ChainState
+
+    state = progress["state"]
+    arrays = {k: getattr(state, k) for k in ChainState.ARRAYS}
+    arrays |= {k: np.asarray(progress[k]) for k in ("t", "L", "n_moving")}
+    arrays["devs"] = np.asarray(progress["devs"], dtype=float)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    write_npz(path, arrays, {"spec": spec} | {k: float(progress[k]) for k in ("seg", "t_start", "wall_seconds")})
+
+
+def _progress(path: Path, spec: dict[str, Any], params) -> dict[str, Any] | None:
+    """The progress kept at ``path`` by :func:`_keep_progress` if it is whole, of this rung's spec
+    and its state one a run can go on from; else None (the rung starts over)."""
+    from stickslip.models.params import ParameterError
+    from stickslip.run.checkpoint import read_npz
+    from stickslip.run.errors import ChainRunError
+    from stickslip.run.state import ChainState, model_of
+    from stickslip.run.validate import check_start_state
+
+    if not path.is_file():
+        return None
+    try:
+        arrays, header, _ = read_npz(path)
+        if header.get("spec") != spec:
+            return None
+        state = ChainState(**{k: arrays[k].copy() for k in ChainState.ARRAYS}, model=model_of(params))
+        check_start_state(state, params, where=path.name)
+        out = {k: arrays[k] for k in ("t", "L", "n_moving")} | {"devs": arrays["devs"].tolist(), "state": state}
+        return out | {k: float(header[k]) for k in ("seg", "t_start", "wall_seconds")}
+    except (ChainRunError, ParameterError, KeyError, TypeError, ValueError):
+        return None
+
+
 def _rung(
     ladder_dir: Path, index: int, beta: float, state, start: str, cfg: dict[str, Any], role: str = "grid", **kw
 ) -> dict[str, Any]:
@@ -135,7 +176,9 @@ def _rung(
     stored, why = _replay(rdir, spec, params)
     if stored is not None:
         return stored
-    res = run_rung(params, state, cfg, **kw)
+    progress = rdir / PROGRESS_FILE
+    resume = _progress(progress, spec, params)
+    res = run_rung(params, state, cfg, resume=resume, save=lambda p: _keep_progress(progress, spec, p), **kw)
     row = {**res["row"], "branch": cfg["direction"], "replica": int(cfg.get("replica", 0)), "seed": int(cfg["seed"])}
     row.update(rung=index, role=role, start=start, start_sha256=sha)
     row["final_sha256"] = res["state"].sha256()
@@ -146,6 +189,7 @@ def _rung(
     _save_npz(rdir / "samples.npz", res["samples"])
     files = {name: file_sha256(rdir / name) for name in RUNG_FILES}
     io.write_json(rdir / "rung.json", sealed({"spec": spec, "row": row, "files": files}))
+    progress.unlink(missing_ok=True)
     if why is not None:  # this run's row says why the stored rung was not reused
         row = {**row, "note": f"cached rung damaged ({why}): run again"}
     return {"row": row, "state": res["state"]}

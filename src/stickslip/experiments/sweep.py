@@ -471,15 +471,18 @@ def _compute(
             _stop_points(stop_file, list(futures), stop_wait)
         raise
     finally:
-        from stickslip.experiments.worker_signals import deferred_interrupts
+        from stickslip.run.progress import SignalFlag
 
-        with deferred_interrupts():  # a second Ctrl-C does not cut the closing short
+        # a second Ctrl-C while the cluster closes is raised after it: the closing is not cut short
+        with SignalFlag(True) as second:
             if bar is not None:
                 bar.close()
             client.close()
             if cluster is not None:
                 cluster.close()
             stop_file.unlink(missing_ok=True)
+        if second.set:
+            raise KeyboardInterrupt
 
 
 def _stop_points(stop_file: Path, futures: list, timeout: float) -> None:

@@ -39,28 +39,3 @@ class StopOnSignal(WorkerPlugin):
         if threading.current_thread() is threading.main_thread():
             for sig in (signal.SIGINT, signal.SIGTERM):
                 signal.signal(sig, _stop)
-
-
-class deferred_interrupts:  # noqa: N801 (a context manager named as the statement reads)
-    """Within the block (the driver closing its cluster), SIGINT and SIGTERM are noted, not raised:
-    a second Ctrl-C no longer cuts the closing short, which left the cluster to be closed again at
-    exit (seconds) and the stop request behind. A signal noted raises KeyboardInterrupt when the
-    block ends, unless one is already on its way."""
-
-    def __enter__(self):
-        self.got = False
-        self.previous = {}
-        if threading.current_thread() is threading.main_thread():
-            for sig in (signal.SIGINT, signal.SIGTERM):
-                self.previous[sig] = signal.signal(sig, self._note)
-        return self
-
-    def _note(self, signum, frame) -> None:
-        self.got = True
-
-    def __exit__(self, kind, value, tb) -> bool:
-        for sig, handler in self.previous.items():
-            signal.signal(sig, handler)
-        if self.got and kind is None:
-            raise KeyboardInterrupt
-        return False

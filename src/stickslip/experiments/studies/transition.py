@@ -3,7 +3,8 @@ continuation in beta (:mod:`stickslip.experiments.ladders`).
 
 For each N an ``up`` and a ``down`` ladder run as independent Dask tasks
 (:func:`stickslip.experiments.sweep.run_sweep`: a finished ladder is reused, a failed one recorded
-and retried, an interrupted one continues from its last finished rung). From the rungs:
+and retried, an interrupted one continues its running rung from its last finished segment). From
+the rungs:
 
 * ``beta_t`` (last beta where the up ladder stick-slips) and ``beta_t_err`` (half the bracket to the
   first sliding beta, after bisection);
