@@ -79,7 +79,7 @@ BAD = [
     ("stability chain --model train --out foreign", "notes.txt"),
     ("hysteresis --time-per-step 10 --out foreign", "notes.txt"),
     ("sweep block --t-end 10 --out foreign", "notes.txt"),
-    ("reproduce --smoke --out foreign", "notes.txt"),
+    ("reproduce --tiny --out foreign", "notes.txt"),
     ("chain --t-end 10 --out foreign", "notes.txt"),
     ("block --t-end 10 --overwrite", "--overwrite"),
     ("stability block --overwrite", "--overwrite"),
@@ -265,7 +265,7 @@ WRITERS = [
     "hysteresis --time-per-step 10 --out {out}",
     "sweep block --t-end 10 --out {out}",
     "plot {run} --out {out}",
-    "reproduce --smoke --out {out}",
+    "reproduce --tiny --out {out}",
     "chain --N 3 --t-end 10 --no-progress --out {out}",
 ]
 

@@ -1,6 +1,6 @@
 """`stickslip reproduce`: spec hashing and reuse, the report's rows and figures, the command line.
 
-The whole pipeline runs once per module on the tiny ``smoke`` spec set (chains of N = 19, a
+The whole pipeline runs once per module on the tiny spec set (``--tiny``) (chains of N = 19, a
 coarse hysteresis sweep) on a local Dask cluster of two workers: about 15 s.
 """
 
@@ -15,7 +15,7 @@ from chain_helpers import error_lines, is_real_command
 from stickslip.cli import main
 from stickslip.experiments import reproduce as rp
 from stickslip.experiments.cache import spec_key
-from stickslip.experiments.studies import Study, figs1_4, figs5_8
+from stickslip.experiments.studies import MODES, Study, figs1_4, figs5_8
 from stickslip.experiments.study_run import run_study
 from stickslip.experiments.sweep import DONE_FILE
 from stickslip.io import read_json, read_table
@@ -49,7 +49,7 @@ EXPERIMENTS = ["block", "slip-limit", "period-sweep", "stability-block", "hyster
 
 
 def test_the_studies_of_every_mode():
-    for mode in rp.MODES:
+    for mode in MODES:
         small = figs1_4.build(mode)
         assert small.name == "figs1-4" and small.mode == mode
         assert [p["experiment"] for p in small.points] == EXPERIMENTS
@@ -74,7 +74,7 @@ def test_an_experiments_folder_is_named_by_its_settings():
     block = figs1_4.build("quick").points[0]
     assert figs1_4.point_name(block) == f"block-{spec_key(block)}" and len(spec_key(block)) == 12
     assert figs1_4.point_name({**block, "t_end": 2001}) != figs1_4.point_name(block)
-    assert figs1_4.point_name(figs1_4.build("smoke").points[0]) != figs1_4.point_name(block)
+    assert figs1_4.point_name(figs1_4.build("tiny").points[0]) != figs1_4.point_name(block)
 
 
 def test_chain_points_are_left_out_of_the_folder_key_but_not_the_spec():
@@ -89,7 +89,7 @@ def test_chain_points_are_left_out_of_the_folder_key_but_not_the_spec():
 # Reuse of a single experiment
 
 
-def _one(name, mode="smoke", **options):
+def _one(name, mode="tiny", **options):
     """The study of section 2 and Fig. 4 with only its experiment ``name`` (options changed)."""
     point = next(p for p in figs1_4.build(mode).points if p["experiment"] == name)
     if options:
@@ -158,7 +158,7 @@ def test_a_result_of_another_spec_in_the_same_directory_is_not_reused(tmp_path):
 def test_chain_task_continues_from_a_checkpoint(tmp_path, monkeypatch):
     from stickslip.run import driver as chain
 
-    spec = figs5_8.build("smoke")
+    spec = figs5_8.build("tiny")
     point = {**spec.common, "N": 19, "beta": 1.0}
     first = figs5_8.chain_point_task(point, tmp_path / "done")
     assert (tmp_path / "done" / "run.json").is_file()
@@ -182,24 +182,24 @@ def test_chain_task_continues_from_a_checkpoint(tmp_path, monkeypatch):
 
 
 # ---------------------------------------------------------------------------------------------
-# The whole pipeline (smoke spec set)
+# The whole pipeline (the tiny spec set)
 
 
 @pytest.fixture(scope="module")
-def smoke(tmp_path_factory):
+def tiny_run(tmp_path_factory):
     out = tmp_path_factory.mktemp("repro")
     import contextlib
     import io as _io
 
     buf = _io.StringIO()
     with contextlib.redirect_stdout(buf):
-        status = main(["reproduce", "--smoke", "--out", str(out), "--workers", "2", "--no-progress", "--json"])
+        status = main(["reproduce", "--tiny", "--out", str(out), "--workers", "2", "--no-progress", "--json"])
     assert status == 0
     return out, json.loads(buf.getvalue())
 
 
-def test_report_has_a_row_for_every_stated_number(smoke):
-    out, printed = smoke
+def test_report_has_a_row_for_every_stated_number(tiny_run):
+    out, printed = tiny_run
     report = read_json(out / "report.json")
     rows = report["rows"]
     assert len(rows) == len(MODEL_ROWS)
@@ -217,7 +217,7 @@ def test_report_has_a_row_for_every_stated_number(smoke):
     by = {(r["where"], r["quantity"].split(",")[0]): r for r in rows}
     assert by[("sec. 2", "Hopf point of steady sliding")]["agrees"] is True
     assert by[("Fig. 4", "long-wave instability of steady sliding of the chain")]["agrees"] is True
-    # the smoke chains settle nothing
+    # the tiny chains settle nothing
     assert all(r["agrees"] is None for r in rows[7:])
     assert printed["rows"] == rows
     html = (out / "report.html").read_text()
@@ -225,8 +225,8 @@ def test_report_has_a_row_for_every_stated_number(smoke):
         assert where in html
 
 
-def test_every_figure_is_drawn_with_png_pdf_and_data(smoke):
-    out, printed = smoke
+def test_every_figure_is_drawn_with_png_pdf_and_data(tiny_run):
+    out, printed = tiny_run
     report = read_json(out / "report.json")
     assert not printed["figures_not_drawn"]
     assert "figures_not_drawn" not in report["meta"]
@@ -247,8 +247,8 @@ def test_every_figure_is_drawn_with_png_pdf_and_data(smoke):
     assert html.count("data:image/png;base64,") == len(report["figures"])
 
 
-def test_second_call_reuses_every_result_and_only_redraws(smoke, monkeypatch):
-    out, _ = smoke
+def test_second_call_reuses_every_result_and_only_redraws(tiny_run, monkeypatch):
+    out, _ = tiny_run
 
     def boom(*a, **k):
         raise AssertionError("a stored result was computed again")
@@ -257,16 +257,16 @@ def test_second_call_reuses_every_result_and_only_redraws(smoke, monkeypatch):
 
     monkeypatch.setattr(stickslip.experiments.sweep, "_compute", boom)  # no point is sent to Dask
     before = read_json(out / "report.json")
-    result = rp.reproduce(out, "smoke", progress=False)
+    result = rp.reproduce(out, "tiny", progress=False)
     assert [s["study"] for s in result["studies"]] == ["figs1-4", "figs5-8"]
     assert all(s["reused"] == s["points"] and s["run"] == 0 for s in result["studies"])
     after = read_json(out / "report.json")
     assert [r["value"] for r in after["rows"]] == [r["value"] for r in before["rows"]]
 
 
-def test_chain_runs_of_the_smoke_set_are_on_disk_per_point(smoke):
-    out, _ = smoke
-    spec = figs5_8.build("smoke")
+def test_chain_runs_of_the_tiny_set_are_on_disk_per_point(tiny_run):
+    out, _ = tiny_run
+    spec = figs5_8.build("tiny")
     points = out / "runs" / spec.dirname / "points"
     for p in spec.points:
         d = points / f"beta={p['beta']:g}_N={p['N']}"
@@ -275,8 +275,8 @@ def test_chain_runs_of_the_smoke_set_are_on_disk_per_point(smoke):
     assert set(zip(table["N"], table["beta"], strict=True)) == {(p["N"], p["beta"]) for p in spec.points}
 
 
-def test_each_study_of_the_paper_has_its_page(smoke):
-    out, _ = smoke
+def test_each_study_of_the_paper_has_its_page(tiny_run):
+    out, _ = tiny_run
     small = {"fig1", "fig2", "fig3", "stability_map", "hysteresis", "fig4"}
     for name, stems, rows in (("figs1-4", small, MODEL_ROWS[:7]), ("figs5-8", FIGURES - small, MODEL_ROWS[7:])):
         found = read_json(out / name / "study.json")
@@ -284,24 +284,24 @@ def test_each_study_of_the_paper_has_its_page(smoke):
         assert {f["name"] for f in found["figures"]} == stems, name
         assert (out / name / "table.parquet").is_file()
         page = (out / name / "index.html").read_text()
-        assert "stickslip reproduce --smoke --out DIR" in page and "The paper&#39;s stated numbers" in page
+        assert "stickslip reproduce --tiny --out DIR" in page and "The paper&#39;s stated numbers" in page
 
 
-def test_a_failed_chain_run_is_named_and_run_again(smoke, tmp_path):
+def test_a_failed_chain_run_is_named_and_run_again(tiny_run, tmp_path):
     import shutil
 
     out = tmp_path / "repro"
-    shutil.copytree(smoke[0], out)
-    spec = figs5_8.build("smoke")
+    shutil.copytree(tiny_run[0], out)
+    spec = figs5_8.build("tiny")
     point = out / "runs" / spec.dirname / "points" / "beta=1_N=19"
     shutil.rmtree(point)
     point.mkdir()
     (point / "state.nc").mkdir()  # where the run writes its final state: it fails
     with pytest.raises(rp.ReproduceError, match=r"1 run\(s\) failed \(figs5-8/beta=1_N=19: .*state.nc"):
-        rp.reproduce(out, "smoke", n_workers=1, progress=False)
+        rp.reproduce(out, "tiny", n_workers=1, progress=False)
     assert (point / "error.json").is_file()
     (point / "state.nc").rmdir()
-    result = rp.reproduce(out, "smoke", n_workers=1, progress=False)
+    result = rp.reproduce(out, "tiny", n_workers=1, progress=False)
     assert [(s["run"], s["reused"]) for s in result["studies"]] == [(0, 6), (1, 2)]
     assert (point / "done.json").is_file() and len(result["rows"]) == len(MODEL_ROWS)
 
@@ -337,13 +337,19 @@ def test_help_lists_the_modes(capsys):
         main(["reproduce", "--help"])
     assert exc.value.code == 0
     text = capsys.readouterr().out
-    assert "--quick" in text and "--full" in text and "--scheduler" in text and "--smoke" not in text
+    assert (
+        "--quick" in text
+        and "--full" in text
+        and "--scheduler" in text
+        and "--tiny" not in text
+        and "--smoke" not in text
+    )
 
 
-def test_plot_reproduce_and_catalog_give_the_same_tau_on_the_same_run(smoke, tmp_path, capsys):
+def test_plot_reproduce_and_catalog_give_the_same_tau_on_the_same_run(tiny_run, tmp_path, capsys):
     """One stationary window (analysis.chain_runs.stationary_from) and one fit for all three."""
-    out, _ = smoke
-    spec = figs5_8.build("smoke")
+    out, _ = tiny_run
+    spec = figs5_8.build("tiny")
     points = out / "runs" / spec.dirname / "points"
     a = figs5_8.DESIGN.load(spec, read_table(points / "summary.parquet"), points).analysis
     for beta, key, reading in ((1.0, "sizes1", "whole_range"), (0.2, "sizes02", "below_spanning")):
@@ -359,3 +365,19 @@ def test_plot_reproduce_and_catalog_give_the_same_tau_on_the_same_run(smoke, tmp
         assert catalog["window"]["t_from"] == plotted["numbers"]["t_from"] == a["t_from"]
         assert catalog["sizes"][reading]["tau"] == tau
         assert plotted["numbers"]["tau" if reading == "whole_range" else "tau_below_span"] == tau
+
+
+def test_a_study_of_the_paper_runs_alone_with_its_help(tmp_path, capsys):
+    """`stickslip study figs1-4` runs the study of section 2 and Fig. 4 by itself, with the page
+    `stickslip reproduce` writes for it; its --help says its grid, its cost and its outputs."""
+    with pytest.raises(SystemExit) as exc:
+        main(["study", "figs5-8", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert exc.value.code == 0 and "Grid: --quick" in text and "Outputs in DIR/figs5-8/" in text
+    out = tmp_path / "studies"
+    assert main(["study", "figs1-4", "--tiny", "--out", str(out), "--workers", "1", "--no-progress", "--json"]) == 0
+    printed = json.loads(capsys.readouterr().out)
+    assert printed["study"] == "figs1-4" and printed["points"] == len(EXPERIMENTS) and printed["failed"] == 0
+    assert {Path(f).stem for f in printed["figures"]} == {"fig1", "fig2", "fig3", "stability_map", "hysteresis", "fig4"}
+    found = read_json(out / "figs1-4" / "study.json")
+    assert [r["where"] for r in found["findings"]["rows"]] == [w for w, _ in MODEL_ROWS[:7]]

@@ -57,8 +57,9 @@ def register(sub) -> None:
         const="full",
         help="the paper's chains (N = 399, t = 2e7): hours; run again to resume",
     )
-    # A tiny spec set that exercises the whole pipeline in seconds; used by the tests.
-    mode.add_argument("--smoke", dest="mode", action="store_const", const="smoke", help=argparse.SUPPRESS)
+    # A tiny spec set that exercises the whole pipeline in seconds (the tests'); --smoke, its old name.
+    for flag in ("--tiny", "--smoke"):
+        mode.add_argument(flag, dest="mode", action="store_const", const="tiny", help=argparse.SUPPRESS)
     p.set_defaults(mode="quick")
     p.add_argument(
         "--out",

@@ -1,8 +1,10 @@
-"""`stickslip study`: the studies the paper leaves open, with a page per study.
+"""`stickslip study`: the studies the paper leaves open, and the paper's own, with a page per study.
 
     stickslip study NAME [--quick | --full] [--out DIR] [--scheduler ADDRESS] [--workers N] [--json]
 
-NAME is one of :data:`stickslip.experiments.studies.STUDIES`; ``stickslip study NAME --help``
+NAME is one of :data:`stickslip.experiments.studies.STUDIES` or of
+:data:`~stickslip.experiments.studies.PAPER` (the two studies ``stickslip reproduce`` runs and
+gathers into its report); ``stickslip study NAME --help``
 prints what the study's module says of it (its grid, its cost, its outputs).
 Every point is cached and reused (only if its files are whole: a damaged point runs again); an
 interrupted study resumes; a failed point is reported and retried by the next call. DIR is owned
@@ -36,11 +38,12 @@ DEFAULT_OUT = "studies"
 def register(sub) -> None:
     """Add the ``study`` subcommand, with one subcommand per study whose ``--help`` is its
     module's description (:class:`~stickslip.experiments.studies.Design`)."""
-    from stickslip.experiments.studies import STUDIES, design
+    from stickslip.experiments.studies import PAPER, STUDIES, design
 
     p = sub.add_parser(
         "study",
-        help="run a study the paper leaves open (transition, phase-diagram, exponents, chaos); writes a page",
+        help="run a study the paper leaves open (transition, phase-diagram, exponents, chaos) or one of "
+        "the paper's own (figs1-4, figs5-8); writes a page",
         description=(
             "Run every point of a study on Dask (reusing finished points), then write its table "
             "(Parquet, CSV), figures and an HTML page under DIR/NAME/. "
@@ -54,7 +57,7 @@ def register(sub) -> None:
         title="studies",
         parser_class=type("StudyParser", (_LazyDescription, type(p)), {}),
     )
-    for name in STUDIES:
+    for name in STUDIES + PAPER:
         plan = design(name)
         q = names.add_parser(name, help=plan.summary)
         q.describe = plan.describe

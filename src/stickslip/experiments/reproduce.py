@@ -27,14 +27,11 @@ from pathlib import Path
 from typing import Any
 
 from stickslip import heartbeat
-from stickslip.experiments.studies import PAPER, design
+from stickslip.experiments.studies import PAPER, study
 from stickslip.experiments.study_run import run_study
 from stickslip.report.writer import ReportFigure, ReportRow, write_report
 
-__all__ = ["reproduce", "ReproduceError", "MODES"]
-
-#: The modes of a reproduction; ``smoke`` is a tiny set for the tests whose numbers mean nothing.
-MODES = ("quick", "full", "smoke")
+__all__ = ["reproduce", "ReproduceError"]
 
 
 class ReproduceError(RuntimeError):
@@ -71,21 +68,19 @@ def reproduce(
     """Reproduce the paper's Figs. 1-8 and stated numbers into ``out_dir`` (``stickslip reproduce``).
 
     Runs (or reuses) every point of each study of :data:`~stickslip.experiments.studies.PAPER`
-    in ``mode`` (one of :data:`MODES`) on a local Dask cluster (``n_workers`` processes, default
-    one per core) or on the cluster at ``scheduler``; each study draws its figures (PNG, PDF
-    and their data) and writes its page; then ``report.json`` and ``report.html`` get one row
-    per number of docs/model.md's last table and every figure. Progress goes to stderr when
-    ``progress`` and stderr is a terminal. Raises :class:`ReproduceError`, after every study
-    ran, when a point failed. Returns what the command prints: mode, paths, the rows, the
-    figures, and per study its counts and times.
+    in ``mode`` (one of :data:`~stickslip.experiments.studies.MODES`) on a local Dask cluster
+    (``n_workers`` processes, default one per core) or on the cluster at ``scheduler``; each
+    study draws its figures (PNG, PDF and their data) and writes its page; then ``report.json``
+    and ``report.html`` get one row per number of docs/model.md's last table and every figure.
+    Progress goes to stderr when ``progress`` and stderr is a terminal. Raises
+    :class:`ReproduceError`, after every study ran, when a point failed. Returns what the command
+    prints: mode, paths, the rows, the figures, and per study its counts and times.
     """
-    if mode not in MODES:
-        raise ValueError(f"mode must be one of {', '.join(MODES)} (got {mode!r})")
     start = time.perf_counter()
     out = Path(out_dir)
     results = []
     for name in PAPER:
-        spec = design(name).build(mode)
+        spec = study(name, mode)
         r = run_study(spec, out, scheduler=scheduler, n_workers=n_workers, progress=progress)
         results.append(r)
         _log(

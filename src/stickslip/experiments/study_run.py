@@ -264,7 +264,7 @@ def foreign_files(out: str | Path, spec: Study) -> list[str]:
     the study's :attr:`~stickslip.experiments.studies.Design.point_entry` allows) and the sweep's
     summary. ``spec`` is the study about to run (its page names are checked even before the page folder
     exists)."""
-    from stickslip.experiments.studies import STUDIES
+    from stickslip.experiments.studies import PAPER, STUDIES
     from stickslip.experiments.sweep import POINT_FILE, STOP_FILE, SUMMARY_NAME
     from stickslip.run.rundir import LOCK_FILES, is_temporary
 
@@ -298,7 +298,7 @@ def foreign_files(out: str | Path, spec: Study) -> list[str]:
         return points
 
     def runs(path: Path, rel: str):
-        names = [name for name in STUDIES if path.name.startswith(f"{name}-")]
+        names = [name for name in STUDIES + PAPER if path.name.startswith(f"{name}-")]
         if not (path.is_dir() and names):
             return False
         points = points_of(design(names[0]))
@@ -315,7 +315,7 @@ def foreign_files(out: str | Path, spec: Study) -> list[str]:
             return True
         if path.name == "runs" and path.is_dir():
             return runs
-        if path.name in STUDIES and path.is_dir():
+        if path.name in STUDIES + PAPER and path.is_dir():
             return page
         return False
 

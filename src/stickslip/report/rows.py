@@ -187,8 +187,8 @@ def _final_state_row(o: Outcome, a: dict[str, Any], mode: str) -> ReportRow:
         if r.beta > 1.0 and state != "steady sliding":
             t_run = float(o.settings["t_end_by_N"][str(int(r.N))])
             unsettled.append(f"{r.beta:g} (N = {r.N}, t = {_g(t_run)})")
-    if mode == "smoke":
-        agrees, reason = None, "smoke run: tiny chains"
+    if mode == "tiny":
+        agrees, reason = None, "tiny run: tiny chains"
     elif contradicts:
         agrees, reason = False, ""
     elif unsettled:
@@ -258,8 +258,8 @@ def front_speed_row(
     settled = mode == "full" and agrees is not None
     if agrees is None:
         reason = "no event reached block N"
-    elif mode == "smoke":
-        reason = "smoke run: tiny chain"
+    elif mode == "tiny":
+        reason = "tiny run: tiny chain"
     else:
         reason = "" if settled else quick_reason
     return ReportRow(
@@ -282,7 +282,7 @@ def chain_rows(o: Outcome, a: dict[str, Any], mode: str) -> list[ReportRow]:
     """Rows of section 3 and Figs. 5-8 from the chain runs (``o``) and their analysis ``a``
     (:func:`stickslip.analysis.chain_runs.chain_analysis`)."""
     rows = [_final_state_row(o, a, mode)]
-    smoke = mode == "smoke"
+    tiny = mode == "tiny"
 
     def quick_reason(events: pd.DataFrame) -> str:
         return (
@@ -303,10 +303,10 @@ def chain_rows(o: Outcome, a: dict[str, Any], mode: str) -> list[ReportRow]:
             f"snapshot of x_i at beta = 1 against steady sliding (t = {t:.3g}, N = {run.params.N})",
             "close to the steady sliding profile",
             f"max_i |x_i - x_i^ss| = {100 * dev:.2f}% of L_ss = {L_ss:.5g}",
-            None if smoke else dev <= 0.05,
+            None if tiny else dev <= 0.05,
             "max_i |x_i - x_i^ss| <= 5% of L_ss",
             chain_command(o, run.params.N, 1.0),
-            na_reason="smoke run: tiny chain" if smoke else "",
+            na_reason="tiny run: tiny chain" if tiny else "",
         )
     )
     # Fig. 5(b)
@@ -332,10 +332,10 @@ def chain_rows(o: Outcome, a: dict[str, Any], mode: str) -> list[ReportRow]:
             f"<L> against beta (N = {a['sweep_N']})",
             "continuous decrease below beta = 1",
             "<L>/L_ss = " + ", ".join(f"{r:.3f} (beta = {b:g})" for b, r in zip(below["beta"], ratio, strict=False)),
-            None if smoke else (increasing and under and meets),
+            None if tiny else (increasing and under and meets),
             "<L> increases with beta up to 1 (within 2 sigma), stays below L_ss, and is within 3% of L_ss at beta = 1",
             sweep_command(o, mode),
-            na_reason="smoke run: tiny chains" if smoke else "",
+            na_reason="tiny run: tiny chains" if tiny else "",
             note="above beta = 1: "
             + (
                 ", ".join(
@@ -385,7 +385,7 @@ def chain_rows(o: Outcome, a: dict[str, Any], mode: str) -> list[ReportRow]:
                 (abs(fit.tau - PAPER["tau_beta1"]) <= 0.1 and s1["largest_reaches_N"]) if mode == "full" else None,
                 "|tau - 1.5| <= 0.1 and the largest events span the chain",
                 chain_command(o, a["figure_N"], 1.0),
-                na_reason="" if mode == "full" else ("smoke run: tiny chain" if smoke else quick_reason(a["events1"])),
+                na_reason="" if mode == "full" else ("tiny run: tiny chain" if tiny else quick_reason(a["events1"])),
                 note="maximum likelihood for a power law truncated to the fit range; s_min by least KS distance; "
                 "error: bootstrap",
             )
@@ -419,7 +419,7 @@ def chain_rows(o: Outcome, a: dict[str, Any], mode: str) -> list[ReportRow]:
                 (abs(fit.tau - PAPER["tau_beta02"]) <= 0.15 and ex >= 2.0) if mode == "full" else None,
                 "|tau - 1.6| <= 0.15 and at least twice the power law's count of large events",
                 chain_command(o, a["figure_N"], 0.2),
-                na_reason=("" if mode == "full" else "smoke run: tiny chain" if smoke else quick_reason(a["events02"])),
+                na_reason=("" if mode == "full" else "tiny run: tiny chain" if tiny else quick_reason(a["events02"])),
                 note="large: S at least that of the smallest event that reached block N; "
                 f"the same ratio at beta = 1 is {_f(ex1, 3)}",
             )

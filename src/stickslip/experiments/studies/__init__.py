@@ -200,7 +200,7 @@ def study(name: str, mode: str = "quick", **options: Any) -> Study:
     Parameters
     ----------
     name : str
-        One of :data:`STUDIES`.
+        One of :data:`STUDIES` or :data:`PAPER`.
     mode : str
         One of :data:`MODES`.
     **options

@@ -6,7 +6,7 @@ at beta = 1 and 0.2).
   near beta = 1; beta = 1.2 runs its whole length (the paper's run of the sliding regime).
 * ``quick``: Fig. 5(b) on chains of N = 99 to t = 2e6 (a chain loads in about L_ss / V time units
   and L_ss grows like N^2), Figs. 5(a), 6, 7 and 8 on chains of N = 199 to t = 4e6: minutes.
-* ``smoke``: chains of N = 19 to t = 4e4, for the tests; its numbers mean nothing.
+* ``tiny``: chains of N = 19 to t = 4e4, for the tests; its numbers mean nothing.
 
 Chain runs at beta > 1 (beyond 1.2 in ``full``) stop once the chain slides steadily
 (``until_steady``): from then on every block moves every step and nothing changes but the position
@@ -56,7 +56,7 @@ def chain_points(
 
 
 def build(mode: str) -> Study:
-    """The chain runs of ``mode`` (``quick``, ``full`` or ``smoke``) and the settings they share."""
+    """The chain runs of ``mode`` (``quick``, ``full`` or ``tiny``) and the settings they share."""
     if mode == "full":
         sweep_N = figure_N = 399
         t_sweep = t_fig = 2e7
@@ -73,17 +73,17 @@ def build(mode: str) -> Study:
             "quick: Fig. 5(b) on N = 99 chains to t = 2e6, Figs. 5(a), 6, 7, 8 on N = 199 chains "
             "to t = 4e6 (the paper: N = 399 to t = 2e7)"
         )
-    else:  # smoke
+    else:  # tiny
         sweep_N = figure_N = 19
         t_sweep = t_fig = 4e4
         betas, steady_above = (0.2, 1.0, 1.5), 1.0
-        note = "smoke: tiny chains for tests; the numbers mean nothing"
+        note = "tiny: tiny chains for tests; the numbers mean nothing"
     common = {
         **paper_parameters("N", "beta"),
         # A chain loads in about L_ss / V: average and count events over the second half only.
         "t_end_by_N": {str(sweep_N): t_sweep, str(figure_N): t_fig},
         "average_fraction": 0.5,
-        "sample_interval": 100.0 if mode != "smoke" else 10.0,
+        "sample_interval": 100.0 if mode != "tiny" else 10.0,
         "until_steady": UNTIL_STEADY,
         "until_steady_above": steady_above,
         "profile_betas": [1.0],
@@ -168,11 +168,18 @@ def figures(spec: Study, results: Results | None, page_dir: Path) -> list[tuple]
 
 
 def describe() -> str:
-    """What ``stickslip reproduce`` computes for section 3."""
+    """The text of ``stickslip study figs5-8 --help`` (section 3 of the paper)."""
+    quick, full = build("quick"), build("full")
     return (
-        "Chain runs of eq. (4) from the paper's initial state on Dask: the final state against beta, "
-        "<L> against beta (Fig. 5b), and at beta = 1 and 0.2 the snapshot, the rupture fronts and the "
-        "slip sizes (Figs. 5a, 6, 7, 8)."
+        "Section 3 of the paper, one of the two studies of `stickslip reproduce`: chain runs of eq. (4) "
+        "from the paper's initial state, each a point on Dask: the final state and <L> against beta "
+        "(Fig. 5b), and at beta = 1 and 0.2 the snapshot, the rupture fronts and the slip sizes (Figs. "
+        f"5a, 6, 7, 8). Grid: --quick {quick.note.split(': ', 1)[1]} ({len(quick.points)} runs, one to "
+        f"two minutes on two cores); --full: the paper's chains, N = 399 to t = 2e7, at {len(full.points)} "
+        "values of beta (hours on two cores; run again to resume). "
+        "Outputs in DIR/figs5-8/: fig5a, fig5b, fig6, fig7, fig8 (PNG, PDF, "
+        "their data), table.parquet and table.csv (one row per run: final state, <L>, events), "
+        "study.json (the paper's stated numbers of section 3 against ours), index.html."
     )
 
 
