@@ -166,20 +166,45 @@ def run_rung(
     params, state, cfg: dict[str, Any], *, leave_stops: bool = False, stop_requested=None, resume=None, save=None
 ) -> dict[str, Any]:
     """One rung of the transition study: the chain of eq. (4) at ``params`` from ``state`` in
-    segments (the first ``first_segment_loads`` loading times, then doubling up to
-    ``segment_loads``) until its answer is known: :func:`assess` decides with the stuck fraction
-    at least :data:`STUCK_SLIDING` over a window of half a loading time or more (stick-slip);
-    steady sliding is reached (every block within ``UNTIL_STEADY`` of it) or every block slides
-    with the deviation falling; with ``leave_stops`` (the down ladder), a block sticks; or the cap
-    of ``cap_loads`` loading times (then ``undecided``, with the reason). Returns the row (m,
-    its error, the stuck fraction phi and its error, final state and reason, times in model time
-    and loading times) with ``state`` (the final :class:`~stickslip.run.state.ChainState`) and
-    ``samples`` (arrays t, L, n_moving).
+    segments until its answer is known.
 
-    After each segment that does not end the rung, ``save`` (if given) gets the rung's progress
-    (``state``, the next segment's length ``seg``, ``t_start``, ``devs``, the samples ``t``, ``L``,
-    ``n_moving`` and ``wall_seconds``); given back as ``resume``, the rung goes on from there with
-    the result of an uninterrupted rung (each segment is a run continued from the state before)."""
+    The first segment lasts ``first_segment_loads`` loading times, each next one twice the last,
+    up to ``segment_loads``. The rung stops when :func:`assess` decides with a stuck fraction of
+    at least :data:`STUCK_SLIDING` over a window of half a loading time or more (stick-slip); when
+    steady sliding is reached (every block within ``UNTIL_STEADY`` of it) or every block slides
+    with the deviation from it falling; with ``leave_stops`` (the down ladder), when a block
+    sticks; or at the cap of ``cap_loads`` loading times (then ``undecided``, with the reason).
+    Each segment is a run continued from the state before, so a rung resumed from its progress
+    ends as the rung without a stop does.
+
+    Parameters
+    ----------
+    params : ChainParams
+        The chain of the rung (its beta).
+    state : ChainState
+        The state it starts from (the loaded start, or the final state of the rung before).
+    cfg : dict
+        The rung's settings: ``target`` (error of m), ``cap_loads``, ``first_segment_loads``,
+        ``segment_loads``, ``samples_per_load`` and optionally ``stop_batches``.
+    leave_stops : bool
+        Stop as soon as a block sticks (the down ladder leaving steady sliding).
+    stop_requested : callable, optional
+        Passed to :func:`stickslip.run.driver.run_chain`: a stop raises
+        :class:`stickslip.run.errors.Interrupted` within the segment.
+    resume : dict, optional
+        The progress ``save`` was given after a segment: the rung goes on from there.
+    save : callable, optional
+        Called after each segment that does not end the rung with its progress: ``state``, the
+        next segment's length ``seg``, ``t_start``, ``devs`` (deviations from steady sliding),
+        the samples ``t``, ``L``, ``n_moving`` and ``wall_seconds``.
+
+    Returns
+    -------
+    dict
+        ``row`` (m and its error, the stuck fraction phi and its error, the final state and its
+        reason, times in model time and in loading times), ``state`` (the final
+        :class:`~stickslip.run.state.ChainState`) and ``samples`` (arrays t, L, n_moving).
+    """
     from stickslip.models.physics import UNTIL_STEADY, chain_steady_length, loading_time
     from stickslip.run.driver import run_chain
     from stickslip.run.state import steady_deviation

@@ -280,8 +280,23 @@ def _read(path: Path, spec: dict[str, Any], params: ChainParams) -> tuple[ChainS
 
 def located_start(params: ChainParams, transient: float, *, start: str, perturbation: float, seed: int):
     """The located integrator's start at the end of ``transient``: the engine's run of eq. (4) or
-    a relative up to there from ``start`` (:func:`loaded_state`), clock restarted; at
-    ``transient`` 0 the start itself (:func:`stickslip.run.located.start_state`)."""
+    a relative up to there from ``start`` (:func:`loaded_state`), clock restarted.
+
+    Parameters
+    ----------
+    params : ChainParams
+        The chain.
+    transient : float
+        Model time run before the start; at 0 the start itself
+        (:func:`stickslip.run.located.start_state`).
+    start, perturbation, seed
+        The initial state of :func:`stickslip.run.driver.run_chain`.
+
+    Returns
+    -------
+    LocatedState
+        The state at the end of the transient, at t = 0.
+    """
     from stickslip.run.located import start_state
 
     if transient <= 0.0:
