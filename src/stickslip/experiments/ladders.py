@@ -121,39 +121,33 @@ def _replay(rdir: Path, spec: dict[str, Any], params) -> tuple[dict[str, Any] | 
 
 def _keep_progress(path: Path, spec: dict[str, Any], progress: dict[str, Any]) -> None:
     """A rung's progress after a segment (:func:`stickslip.analysis.adaptive.run_rung`) to ``path``,
-    with its spec and checksum (:func:`stickslip.run.checkpoint.write_npz`): an interrupted rung
-    loses at most the segment it was in."""
-    from stickslip.run.checkpoint import write_npz
-    from stickslip.run.state import ChainState
+    with its spec and checksum (:func:`stickslip.run.checkpoint.write_state_npz`): an interrupted
+    rung loses at most the segment it was in."""
+    from stickslip.run.checkpoint import write_state_npz
 
-    state = progress["state"]
-    arrays = {k: getattr(state, k) for k in ChainState.ARRAYS}
-    arrays |= {k: np.asarray(progress[k]) for k in ("t", "L", "n_moving")}
+    arrays = {k: np.asarray(progress[k]) for k in ("t", "L", "n_moving")}
     arrays["devs"] = np.asarray(progress["devs"], dtype=float)
     path.parent.mkdir(parents=True, exist_ok=True)
-    write_npz(path, arrays, {"spec": spec} | {k: float(progress[k]) for k in ("seg", "t_start", "wall_seconds")})
+    header = {"spec": spec} | {k: float(progress[k]) for k in ("seg", "t_start", "wall_seconds")}
+    write_state_npz(path, progress["state"], header, arrays)
 
 
 def _progress(path: Path, spec: dict[str, Any], params) -> dict[str, Any] | None:
     """The progress kept at ``path`` by :func:`_keep_progress` if it is whole, of this rung's spec
     and its state one a run can go on from; else None (the rung starts over)."""
     from stickslip.models.params import ParameterError
-    from stickslip.run.checkpoint import read_npz
-    from stickslip.run.errors import ChainRunError
-    from stickslip.run.state import ChainState, model_of
+    from stickslip.run.checkpoint import read_state_npz
     from stickslip.run.validate import check_start_state
 
-    if not path.is_file():
+    found = read_state_npz(path, spec, params)
+    if found is None:
         return None
+    state, header, arrays = found
     try:
-        arrays, header, _ = read_npz(path)
-        if header.get("spec") != spec:
-            return None
-        state = ChainState(**{k: arrays[k].copy() for k in ChainState.ARRAYS}, model=model_of(params))
         check_start_state(state, params, where=path.name)
         out = {k: arrays[k] for k in ("t", "L", "n_moving")} | {"devs": arrays["devs"].tolist(), "state": state}
         return out | {k: float(header[k]) for k in ("seg", "t_start", "wall_seconds")}
-    except (ChainRunError, ParameterError, KeyError, TypeError, ValueError):
+    except (ParameterError, KeyError, TypeError, ValueError):
         return None
 
 

@@ -66,6 +66,37 @@ def read_npz(path: Path) -> tuple[dict[str, np.ndarray], dict[str, Any], str]:
     return arrays, header, stored
 
 
+def write_state_npz(
+    path: Path, state: ChainState, header: dict[str, Any], arrays: dict[str, np.ndarray] | None = None
+) -> None:
+    """A chain state kept with what it was made from (``header["spec"]``) and further ``arrays``
+    (a loaded state, a rung's progress), by :func:`write_npz`."""
+    write_npz(path, {k: getattr(state, k) for k in ChainState.ARRAYS} | dict(arrays or {}), header)
+
+
+def read_state_npz(
+    path: Path, spec: dict[str, Any], params
+) -> tuple[ChainState, dict[str, Any], dict[str, np.ndarray]] | None:
+    """The state, header and further arrays that :func:`write_state_npz` kept at ``path``, if the
+    file is intact, was made from ``spec`` and holds a state of the chain ``params``' size; else
+    None (the caller computes it again)."""
+    from stickslip.run.state import model_of
+
+    if not path.is_file():
+        return None
+    try:
+        arrays, header, _ = read_npz(path)
+    except ChainRunError:
+        return None
+    if header.get("spec") != spec:
+        return None
+    shapes = {k: (params.N + 2,) for k in ChainState.ARRAYS if k != "ist"} | {"ist": (layout.IST_SIZE,)}
+    if any(k not in arrays or arrays[k].shape != s for k, s in shapes.items()):
+        return None
+    state = ChainState(**{k: arrays.pop(k).copy() for k in ChainState.ARRAYS}, model=model_of(params))
+    return state, header, arrays
+
+
 def _check_layout(arrays: dict[str, np.ndarray], header: dict[str, Any]) -> None:
     """Refuse state arrays that do not fit the header's N or this version's layout."""
     try:

@@ -31,10 +31,8 @@ from typing import Any
 import numpy as np
 
 from stickslip import __version__
-from stickslip.kernels import layout
 from stickslip.models.params import ChainParams, check_number
-from stickslip.run.errors import ChainRunError
-from stickslip.run.state import ChainState, model_of
+from stickslip.run.state import ChainState
 
 __all__ = [
     "LoadedState",
@@ -250,32 +248,23 @@ def _info(tally: _Tally, state: ChainState, wall: float, cached: bool, path) -> 
 
 
 def _write(path: Path, state: ChainState, header: dict[str, Any]) -> None:
-    from stickslip.run.checkpoint import write_npz
+    from stickslip.run.checkpoint import write_state_npz
 
-    write_npz(path, {k: getattr(state, k) for k in ChainState.ARRAYS}, header)
+    write_state_npz(path, state, header)
 
 
 def _read(path: Path, spec: dict[str, Any], params: ChainParams) -> tuple[ChainState, dict[str, Any]] | None:
     """The state and header kept at ``path`` if it is intact and made from ``spec``; else None."""
-    from stickslip.run.checkpoint import read_npz
+    from stickslip.run.checkpoint import read_state_npz
 
-    if not path.is_file():
+    found = read_state_npz(path, spec, params)
+    if found is None:
         return None
-    try:
-        arrays, header, _ = read_npz(path)
-    except ChainRunError:
-        return None
-    if header.get("spec") != spec:
-        return None
-    N = params.N
-    shapes = {k: (N + 2,) for k in ChainState.ARRAYS if k != "ist"} | {"ist": (layout.IST_SIZE,)}
-    if set(arrays) != set(shapes) or any(arrays[k].shape != s for k, s in shapes.items()):
-        return None
+    state, header, extra = found
     wall = header.get("wall_seconds")
-    if not isinstance(wall, (int, float)) or not math.isfinite(wall) or not isinstance(header.get("tally"), dict):
+    if extra or not isinstance(wall, (int, float)) or not math.isfinite(wall):
         return None
-    state = ChainState(**{k: arrays[k].copy() for k in ChainState.ARRAYS}, model=model_of(params))
-    return state, header
+    return (state, header) if isinstance(header.get("tally"), dict) else None
 
 
 def located_start(params: ChainParams, transient: float, *, start: str, perturbation: float, seed: int):
