@@ -255,7 +255,7 @@ def test_second_call_reuses_every_result_and_only_redraws(tiny_run, monkeypatch)
 
     import stickslip.experiments.sweep
 
-    monkeypatch.setattr(stickslip.experiments.sweep, "_compute", boom)  # no point is sent to Dask
+    monkeypatch.setattr(stickslip.experiments.sweep, "_client", boom)  # no point is sent to Dask
     before = read_json(out / "report.json")
     result = rp.reproduce(out, "tiny", progress=False)
     assert [s["study"] for s in result["studies"]] == ["figs1-4", "figs5-8"]

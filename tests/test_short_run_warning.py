@@ -53,12 +53,12 @@ def test_cli_warns_on_stderr_and_succeeds(capsys):
 
 
 def test_sweep_warns_per_point_before_running():
-    from stickslip.experiments.sweep import _warn_short_chain_runs
+    from stickslip.experiments.sweep_points import warn_short_chain_runs
 
     points = [{"beta": 0.6}, {"beta": 1.0}]
     with pytest.warns(ShortRunWarning) as record:
-        _warn_short_chain_runs(points, {"N": 99, "t_end": 1e5, "average_from": 5e4}, ["beta=0.6", "beta=1"])
+        warn_short_chain_runs(points, {"N": 99, "t_end": 1e5, "average_from": 5e4}, ["beta=0.6", "beta=1"])
     assert [str(w.message).split(":")[0] for w in record] == ["beta=0.6", "beta=1"]
     with warnings.catch_warnings():
         warnings.simplefilter("error", ShortRunWarning)
-        _warn_short_chain_runs(points, {"N": 49, "t_end": 3e5, "average_from": 1.5e5}, ["a", "b"])
+        warn_short_chain_runs(points, {"N": 49, "t_end": 3e5, "average_from": 1.5e5}, ["a", "b"])

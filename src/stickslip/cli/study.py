@@ -147,7 +147,7 @@ def _claim(path: str, spec, *, overwrite: bool) -> Iterator[Path]:
     from stickslip.run.rundir import RunDirBusy, owned_run_dir
 
     out = check_out_dir(path)
-    foreign = foreign_files(out, spec)
+    foreign = foreign_files(out)
     if overwrite:  # other files may stay, but nothing of somebody else's where this study writes
         mine = (f"{spec.name}/", f"runs/{spec.dirname}/")
         foreign = [f for f in foreign if f.startswith(mine)]
@@ -159,7 +159,7 @@ def _claim(path: str, spec, *, overwrite: bool) -> Iterator[Path]:
         )
     try:
         with owned_run_dir(out, run_id=False, keep={MANIFEST}):  # it names the page files kept
-            if foreign_files(out, spec) and not overwrite:  # put there while the lock was taken
+            if foreign_files(out) and not overwrite:  # put there while the lock was taken
                 raise CommandError(f"--out {out} changed while the study started; run it again")
             if overwrite:
                 remove_study_files(out, spec)

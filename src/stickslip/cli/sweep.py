@@ -165,7 +165,7 @@ def parse_grid(
 
     names = list(axes)
     points = [dict(zip(names, combo, strict=False)) for combo in itertools.product(*axes.values())] if names else [{}]
-    from stickslip.experiments.sweep import point_params
+    from stickslip.experiments.sweep_points import point_params
 
     for point in points:
         settings = {**common, **point}

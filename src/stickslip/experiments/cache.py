@@ -1,21 +1,12 @@
 """How an experiment is described and cached, for ``reproduce``, sweeps and studies alike.
 
-An experiment (a :class:`~stickslip.experiments.studies.Study`, among them those of
-``reproduce``, or one point of a sweep) is a *spec*: a plain JSON
-document of everything its result depends on, the package version included.
-
-- :func:`canonical` puts a spec in one form (sorted keys, tuples as lists, whole floats as ints),
-  so ``K = 10`` and ``K = 10.0`` are the same spec;
-- :func:`spec_key` names it: the first 12 hex digits of the SHA-256 of its JSON text, the stem of
-  its run directory (``<name>-<key>``);
-- :func:`read_done` gives a stored result (``done.json`` of a sweep's point, ``rung.json`` of a
-  ladder's rung) only if it was made from the same spec: anything else is computed again;
-- a finished point of a sweep records the checksum of every file it wrote
-  (:func:`file_digests`); it is reused only if its summary is there and every file matches
-  (:func:`damage`, :func:`read_done`), otherwise it runs again and the table and the study's page
-  say why; the record itself carries its SHA-256 (:func:`sealed`), so an edited summary is
-  not reused either; :func:`spec_before` tells whether an interrupted point's checkpoint was made from the
-  same spec and may be continued.
+An experiment (a :class:`~stickslip.experiments.studies.Study`, or one point of a sweep) is a
+*spec*: a plain JSON document of everything its result depends on, the package version included,
+in one form (:func:`canonical`) and named by :func:`spec_key`. A stored result (``done.json`` of
+a sweep's point, ``rung.json`` of a ladder's rung) is reused only if it was made from the same
+spec, carries its own checksum (:func:`sealed`) and every file it wrote still matches the
+checksum it recorded (:func:`read_done`); otherwise it is computed again and the table and the
+study's page say why.
 """
 
 from __future__ import annotations
@@ -28,18 +19,7 @@ from typing import Any
 from stickslip.io import read_json
 from stickslip.jsonable import to_jsonable
 
-__all__ = [
-    "canonical",
-    "spec_key",
-    "read_done",
-    "spec_before",
-    "file_digests",
-    "damage",
-    "files_damage",
-    "sealed",
-    "record_digest",
-    "file_sha256",
-]
+__all__ = ["canonical", "spec_key", "read_done", "spec_before", "file_digests", "damage", "sealed", "file_sha256"]
 
 #: The separators of :func:`spec_key`'s JSON text: compact, as ``reproduce`` and the studies use.
 COMPACT = (",", ":")
@@ -65,8 +45,7 @@ def canonical(value: Any) -> Any:
 
 def spec_key(spec: dict[str, Any]) -> str:
     """First 12 hex digits of the SHA-256 of ``spec`` as compact JSON with sorted keys."""
-    text = json.dumps(spec, sort_keys=True, separators=COMPACT)
-    return hashlib.sha256(text.encode()).hexdigest()[:12]
+    return hashlib.sha256(json.dumps(spec, sort_keys=True, separators=COMPACT).encode()).hexdigest()[:12]
 
 
 #: Files of a point's folder that are not part of its result (the sweep's own bookkeeping).
@@ -102,12 +81,9 @@ def spec_before(point_dir: Path) -> dict[str, Any] | None:
 
 
 def file_sha256(path: Path) -> str:
-    """SHA-256 of the file at ``path``, read in blocks."""
-    h = hashlib.sha256()
+    """SHA-256 of the file at ``path``."""
     with open(path, "rb") as fh:
-        for block in iter(lambda: fh.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
+        return hashlib.file_digest(fh, "sha256").hexdigest()
 
 
 def file_digests(point_dir: str | Path) -> dict[str, str]:
@@ -150,14 +126,8 @@ def damage(point_dir: str | Path, record: dict[str, Any], field: str = "summary"
         return "it records no checksum of itself"
     if record["sha256"] != record_digest(record):
         return "its record was changed after it was written (checksum)"
-    return files_damage(point_dir, files)
-
-
-def files_damage(root: str | Path, files: dict[str, Any]) -> str | None:
-    """Why the files ``files`` (relative path -> SHA-256) under ``root`` are not as recorded, or None."""
-    root = Path(root)
     for rel, digest in sorted(files.items()):
-        path = root / rel
+        path = Path(point_dir) / rel
         if not path.is_file():
             return f"{rel} is missing"
         try:

@@ -2,21 +2,11 @@
 
 :func:`reproduce` runs each of the paper's studies (:data:`stickslip.experiments.studies.PAPER`)
 with :func:`stickslip.experiments.study_run.run_study`, the runner of every study (points on Dask,
-cache, resume), and gathers their rows of stated numbers and their figures into one report
-(:mod:`stickslip.report.writer`). Layout of the output directory::
-
-    DIR/
-      runs/<study>-<key>/points/<point>/   one folder per experiment or chain run (key: hash of
-                                            the study's shared settings and the package version);
-                                            its done.json is written last
-      <study>/<stem>.png|.pdf               the study's figures, the data drawn beside them
-      <study>/index.html, study.json, table.parquet, table.csv
-                                            the study's page, findings and table of points
-      report.json, report.html              every stated number and every figure
-
-A second call with the same mode finds every ``done.json`` and only redraws. A chain run that
-was interrupted continues from its last checkpoint (:func:`stickslip.run.driver.resume_chain`);
-adding a value of beta to a study only runs the new point.
+cache, resume; its docstring gives the layout of the runs and the pages), and gathers their rows
+of stated numbers and their figures into ``report.json`` and ``report.html`` in the same folder
+(:mod:`stickslip.report.writer`). A second call with the same mode finds every ``done.json`` and
+only redraws; an interrupted chain run continues from its last checkpoint; adding a value of beta
+to a study only runs the new point.
 """
 
 from __future__ import annotations
@@ -80,8 +70,7 @@ def reproduce(
     out = Path(out_dir)
     results = []
     for name in PAPER:
-        spec = study(name, mode)
-        r = run_study(spec, out, scheduler=scheduler, n_workers=n_workers, progress=progress)
+        r = run_study(study(name, mode), out, scheduler=scheduler, n_workers=n_workers, progress=progress)
         results.append(r)
         _log(
             progress,
@@ -96,13 +85,8 @@ def reproduce(
     figures = [_figure(r["study"], f) for r in results for f in r["figures"]]
     not_drawn = {k: v for r in results for k, v in r["figures_not_drawn"].items()}
     wall = time.perf_counter() - start
-    studies = [
-        {
-            key: r[key]
-            for key in ("study", "runs", "page", "points", "run", "reused", "damaged", "failed", "compute_seconds")
-        }
-        for r in results
-    ]
+    keys = ("study", "runs", "page", "points", "run", "reused", "damaged", "failed", "compute_seconds")
+    studies = [{key: r[key] for key in keys} for r in results]
     meta = {
         "mode": mode,
         "command": f"stickslip reproduce --{mode} --out {out}",

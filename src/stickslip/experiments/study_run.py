@@ -15,6 +15,7 @@ Layout::
 
 from __future__ import annotations
 
+import shutil
 import sys
 import time
 from pathlib import Path
@@ -28,7 +29,7 @@ from stickslip.experiments.studies import MANIFEST, Design, Study, design, study
 from stickslip.jsonable import table_records
 from stickslip.pages import image_src, write_page
 
-__all__ = ["run_study", "study_command", "foreign_files", "remove_study_files", "MANIFEST"]
+__all__ = ["run_study", "foreign_files", "remove_study_files", "MANIFEST"]
 
 
 def _log(enabled: bool, t0: float, text: str) -> None:
@@ -55,16 +56,9 @@ def run_study(
         The study, or a study's name (then ``mode`` picks its spec set).
     out_dir : str or Path
         The output folder: ``runs/<name>-<key>/`` and the page folder ``<name>/``.
-    mode : str
-        The mode when ``spec`` is a name.
-    scheduler : str, optional
-        Address of an existing Dask scheduler; else a local cluster of ``n_workers`` processes.
-    n_workers : int, optional
-        Worker processes of the local cluster (default one per core).
-    progress : bool
-        Progress on stderr when it is a terminal.
-    dashboard : bool
-        Serve the local cluster's dashboard on 127.0.0.1 (its address on stderr).
+    scheduler, n_workers, progress, dashboard
+        As for :func:`stickslip.experiments.sweep.run_sweep` (``progress`` also: the study's own
+        lines on stderr, where it is a terminal).
 
     Returns
     -------
@@ -256,14 +250,13 @@ def record_outputs(out: Path, paths: list[Path]) -> None:
     io.write_json(out / MANIFEST, {"files": sorted(files)})
 
 
-def foreign_files(out: str | Path, spec: Study) -> list[str]:
+def foreign_files(out: str | Path) -> list[str]:
     """The entries of the output folder ``out`` that no study of this package wrote (relative
     paths): at its top anything but the runs folder, the study pages and the manifest; in a page
     folder anything not in the manifest; in the runs folder anything but the folders of studies
     (``<name>-<key>``) holding their spec, their points (each with its point.json, holding what
     the study's :attr:`~stickslip.experiments.studies.Design.point_entry` allows) and the sweep's
-    summary. ``spec`` is the study about to run (its page names are checked even before the page folder
-    exists)."""
+    summary."""
     from stickslip.experiments.studies import PAPER, STUDIES
     from stickslip.experiments.sweep import POINT_FILE, STOP_FILE, SUMMARY_NAME
     from stickslip.run.rundir import LOCK_FILES, is_temporary
@@ -285,23 +278,16 @@ def foreign_files(out: str | Path, spec: Study) -> list[str]:
             elif callable(sub):
                 walk(path, sub)
 
-    def page(path: Path, rel: str):
-        return rel in own and path.is_file()
-
-    def points_of(plan):
-        def points(path: Path, rel: str):
-            summary = {f"{SUMMARY_NAME}.parquet", f"{SUMMARY_NAME}.csv", STOP_FILE}
-            if path.is_file():
-                return path.name in summary
-            return (path / POINT_FILE).is_file() and (plan.point_entry or True)
-
-        return points
-
     def runs(path: Path, rel: str):
         names = [name for name in STUDIES + PAPER if path.name.startswith(f"{name}-")]
         if not (path.is_dir() and names):
             return False
-        points = points_of(design(names[0]))
+        entry = design(names[0]).point_entry or True
+
+        def points(path: Path, rel: str):
+            if path.is_file():
+                return path.name in {f"{SUMMARY_NAME}.parquet", f"{SUMMARY_NAME}.csv", STOP_FILE}
+            return (path / POINT_FILE).is_file() and entry
 
         def study_runs(path: Path, rel: str):
             if path.name == "points" and path.is_dir():
@@ -316,7 +302,7 @@ def foreign_files(out: str | Path, spec: Study) -> list[str]:
         if path.name == "runs" and path.is_dir():
             return runs
         if path.name in STUDIES + PAPER and path.is_dir():
-            return page
+            return lambda path, rel: rel in own and path.is_file()  # a page's files
         return False
 
     walk(out, top)
@@ -326,8 +312,6 @@ def foreign_files(out: str | Path, spec: Study) -> list[str]:
 def remove_study_files(out: str | Path, spec: Study) -> None:
     """``--overwrite``: remove what this study wrote under ``out`` (its page files and its runs
     folder); every other file stays."""
-    import shutil
-
     out = Path(out)
     own = read_manifest(out)
     page_dir = out / spec.name

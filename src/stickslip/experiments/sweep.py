@@ -1,23 +1,18 @@
 """Parameter sweeps on Dask: one independent task per grid point (e.g. <L> against beta, Fig. 5b).
 
-A sweep is a task function and a list of points. Each point gets its own directory under the
-sweep's output directory, named from its parameters (``beta=0.9_N=399``); the task writes its
-outputs there and returns a summary dict. When a point finishes, ``done.json`` is written into
-its directory atomically; a later sweep over the same points finds it and skips the point, so
-an interrupted sweep resumes where it stopped. A point whose task raises gets ``error.json``
-(message and traceback), is reported in the summary table and does not stop the others; it is
-run again by the next sweep. With ``stop_wait`` > 0, an interrupted sweep (SIGINT, or SIGTERM where
-the command turns it into one) asks its running points to stop (:data:`STOP_FILE`) and waits for
-them: a task that passes :func:`stop_requested` to the chain driver (studies, reproductions)
-writes its checkpoint and stops, so the point loses nothing.
+Each point of a sweep gets its own directory under the sweep's output directory, named from its
+parameters (``beta=0.9_N=399``); the task writes its outputs there and returns a summary dict.
+A finished point gets ``done.json`` (written atomically), and a later sweep over the same points
+skips it, so an interrupted sweep resumes where it stopped. A point whose task raises gets
+``error.json`` (message and traceback), is reported in the summary table, does not stop the
+others and runs again in the next sweep. With ``stop_wait`` > 0, an interrupted sweep (SIGINT, or
+SIGTERM where the command turns it into one) asks its running points to stop (:data:`STOP_FILE`)
+and waits for them: a task that passes :func:`stop_requested` to the chain driver writes its
+checkpoint and stops, so the point loses nothing.
 
-The points run on ``dask.distributed``: a local cluster of worker processes (one per core,
-one thread each) by default, or an existing cluster given by its scheduler address. With a
-remote cluster the output directory must be on a file system the workers share.
-
-A task is a plain top-level function ``task(point: dict, point_dir: Path) -> dict`` so that it
-pickles by reference; :func:`chain_task` and :func:`block_task` run the model, :func:`demo_task`
-is a cheap stand-in for tests and for checking a cluster.
+The points run on ``dask.distributed``: a local cluster of worker processes (one per core, one
+thread each) by default, or an existing cluster given by its scheduler address (then the output
+directory must be on a file system the workers share).
 """
 
 from __future__ import annotations
@@ -41,21 +36,13 @@ import numpy as np
 import pandas as pd
 
 from stickslip import __version__, heartbeat
-from stickslip.experiments.cache import file_digests, sealed
-from stickslip.experiments.cache import read_done as _read_done
-from stickslip.experiments.cache import spec_before as _spec_before
-from stickslip.experiments.sweep_points import (  # noqa: F401 (point_params: importable here, as before)
-    BLOCK_RUN_OPTIONS,
-    CHAIN_RUN_OPTIONS,
-    point_params,
-)
-from stickslip.experiments.sweep_points import chain_run_args as _chain_run_args
-from stickslip.experiments.sweep_points import split_point as _split
-from stickslip.experiments.sweep_points import warn_short_chain_runs as _warn_short_chain_runs
+from stickslip.experiments.cache import file_digests, read_done, sealed, spec_before
+from stickslip.experiments.sweep_points import BLOCK_RUN_OPTIONS, chain_run_args, split_point, warn_short_chain_runs
 from stickslip.io import disk_full, run_metadata, write_dataset, write_json, write_table_files
 from stickslip.jsonable import to_jsonable
 from stickslip.models.params import BlockParams, ChainParams
-from stickslip.run.errors import short_runs_expected
+from stickslip.run.errors import Interrupted, short_runs_expected
+from stickslip.run.progress import SignalFlag
 
 __all__ = [
     "run_sweep",
@@ -64,14 +51,10 @@ __all__ = [
     "chain_task",
     "block_task",
     "demo_task",
-    "CHAIN_RUN_OPTIONS",
-    "BLOCK_RUN_OPTIONS",
     "DONE_FILE",
-    "ERROR_FILE",
     "POINT_FILE",
     "STOP_FILE",
     "STOP_WAIT_SECONDS",
-    "CHECKPOINT_INTERVAL",
     "run_chain_point",
     "stop_requested",
 ]
@@ -86,8 +69,6 @@ STOP_FILE = "stop-requested"
 # stop (each does within about a second); a second interrupt ends the wait at once.
 STOP_WAIT_SECONDS = 60.0
 CHECKPOINT_INTERVAL = 120.0  # wall-clock seconds between a chain point's checkpoints
-
-# Keys of a point that are options of the run rather than model parameters.
 
 # Columns of the summary table that are not parameters or task results.
 _STATUS_COLUMNS = ("point_dir", "status", "reused", "error", "wall_seconds", "note")
@@ -128,13 +109,10 @@ def _jsonable(value: Any) -> Any:
     return json.loads(json.dumps(to_jsonable(value)))
 
 
-def _task_name(task: Task) -> str:
-    return f"{task.__module__}.{task.__qualname__}"
-
-
 def _spec(task: Task, point: dict[str, Any], common: dict[str, Any]) -> dict[str, Any]:
     """What a point's result depends on; a stored result is reused only if this matches."""
-    return _jsonable({"task": _task_name(task), "point": point, "common": common, "version": __version__})
+    name = f"{task.__module__}.{task.__qualname__}"
+    return _jsonable({"task": name, "point": point, "common": common, "version": __version__})
 
 
 def stop_requested(point_dir: str | Path) -> Callable[[], bool]:
@@ -147,6 +125,17 @@ def stop_requested(point_dir: str | Path) -> Callable[[], bool]:
     return lambda: flag.exists() or signalled()  # or its worker got SIGINT/SIGTERM
 
 
+def _failed(spec: dict[str, Any], exc: BaseException, wall_seconds: float) -> dict[str, Any]:
+    """The record of a point whose task raised or whose worker died (its error.json)."""
+    return {
+        "spec": spec,
+        "status": "failed",
+        "error": f"{type(exc).__name__}: {exc}",
+        "traceback": traceback.format_exc(),
+        "wall_seconds": wall_seconds,
+    }
+
+
 def _run_point(
     task: Task, point: dict[str, Any], common: dict[str, Any], point_dir: str, spec: dict[str, Any]
 ) -> dict[str, Any]:
@@ -154,15 +143,13 @@ def _run_point(
 
     A point stopped because the sweep was interrupted gets neither file: the next sweep runs it.
     """
-    from stickslip.run.errors import Interrupted
-
     directory = Path(point_dir)
     if stop_requested(directory)():
         return {"spec": spec, "status": "interrupted", "error": None, "wall_seconds": 0.0}
     directory.mkdir(parents=True, exist_ok=True)
     for stale in (DONE_FILE, ERROR_FILE):
         (directory / stale).unlink(missing_ok=True)
-    if _spec_before(directory) != spec:
+    if spec_before(directory) != spec:
         # a checkpoint of other settings (run length, start, package version) is not continued
         from stickslip.run.checkpoint import Checkpointer
 
@@ -170,20 +157,13 @@ def _run_point(
     write_json(directory / POINT_FILE, {"spec": spec})
     start = time.perf_counter()
     try:
-        summary = task({**common, **point}, directory)
-        summary = {} if summary is None else dict(summary)
+        summary = dict(task({**common, **point}, directory) or {})
     except Interrupted as exc:
         return {"spec": spec, "status": "interrupted", "error": str(exc), "wall_seconds": time.perf_counter() - start}
     except Exception as exc:  # a failing point is data, not a reason to stop the sweep
         if disk_full(exc) is not None:  # but a full disk stops every point: the command says so
             raise
-        record = {
-            "spec": spec,
-            "status": "failed",
-            "error": f"{type(exc).__name__}: {exc}",
-            "traceback": traceback.format_exc(),
-            "wall_seconds": time.perf_counter() - start,
-        }
+        record = _failed(spec, exc, time.perf_counter() - start)
         write_json(directory / ERROR_FILE, record)
         return record
     record = {
@@ -199,12 +179,8 @@ def _run_point(
     return record
 
 
-def _row(
-    point: dict[str, Any], name: str, record: dict[str, Any], reused: bool, common: dict[str, Any] | None = None
-) -> dict[str, Any]:
-    row: dict[str, Any] = dict(point)
-    for key, value in (common or {}).items():  # the fixed settings (--set, t_end) after the grid values
-        row.setdefault(key, value)
+def _row(point: dict[str, Any], name: str, record: dict[str, Any], reused: bool, common: dict[str, Any]) -> dict:
+    row: dict[str, Any] = {**common, **point}  # the fixed settings (--set, t_end) besides the grid values
     row.update(
         point_dir=name,
         status=record.get("status", "failed"),
@@ -220,6 +196,10 @@ def _row(
     return row
 
 
+def _missing(value: Any) -> bool:
+    return value is None or (isinstance(value, float) and math.isnan(value))
+
+
 def _table(rows: list[dict[str, Any]], points: list[dict[str, Any]]) -> pd.DataFrame:
     """The summary table: parameters, status columns, results.
 
@@ -230,17 +210,9 @@ def _table(rows: list[dict[str, Any]], points: list[dict[str, Any]]) -> pd.DataF
     leading = params + [c for c in _STATUS_COLUMNS if c in table.columns]
     table = table[leading + [c for c in table.columns if c not in leading]]
     for column in table.columns:
-        if table[column].dtype != object:
-            continue
-        values = [v for v in table[column] if v is not None and not (isinstance(v, float) and math.isnan(v))]
-        kinds = {type(v) for v in values}
-        if kinds and not (kinds <= {str} or kinds <= {bool}):
-            table[column] = [
-                None
-                if v is None or (isinstance(v, float) and math.isnan(v))
-                else (v if isinstance(v, str) else json.dumps(v))
-                for v in table[column]
-            ]
+        kinds = {type(v) for v in table[column] if not _missing(v)}
+        if table[column].dtype == object and kinds and not (kinds <= {str} or kinds <= {bool}):
+            table[column] = [None if _missing(v) else v if isinstance(v, str) else json.dumps(v) for v in table[column]]
     return table
 
 
@@ -284,18 +256,17 @@ def run_sweep(
     """Run ``task`` at every point of a parameter grid, each point an independent Dask task
     (docs/sweeps.md).
 
-    Each point names its directory under ``out_dir`` (:func:`point_name`). A point whose
-    directory holds a ``done.json`` for the same task, point, common settings and package version
-    is not run again, unless its files are damaged (:mod:`stickslip.experiments.cache`: then it
-    runs again and its row's ``note`` says why). Writes ``summary.parquet`` and ``summary.csv`` in
-    ``out_dir``. The local cluster listens on 127.0.0.1 only.
+    A point whose directory under ``out_dir`` holds a ``done.json`` for the same task, point,
+    common settings and package version is not run again, unless its files are damaged
+    (:mod:`stickslip.experiments.cache`: then it runs again and its row's ``note`` says why).
+    Writes ``summary.parquet`` and ``summary.csv`` in ``out_dir``. The local cluster listens on
+    127.0.0.1 only.
 
     Parameters
     ----------
     task : callable
         ``task(point: dict, point_dir: Path) -> dict``, a top-level function (:func:`chain_task`,
-        :func:`block_task`, ...) so that it pickles by reference; it receives
-        ``{**common, **point}`` and returns the point's summary.
+        :func:`block_task`, ...); it receives ``{**common, **point}`` and returns the point's summary.
     points : iterable of dict
         The varying parameters of each point.
     out_dir : str or Path
@@ -303,27 +274,26 @@ def run_sweep(
     common : dict, optional
         Settings shared by every point (fixed parameters, run length ``t_end``).
     scheduler : str, optional
-        Address of an existing Dask scheduler; else a new local cluster.
-    n_workers : int, optional
-        Worker processes of the local cluster (default one per core, one thread each).
+        Address of an existing Dask scheduler; else a new local cluster of ``n_workers``
+        processes (default one per core, one thread each).
     progress : bool
         A bar of points done on stderr, where stderr is a terminal.
     stop_wait : float
         Interrupted (KeyboardInterrupt), how long to wait for the running points to stop on
-        request (:func:`stop_requested`) before the cluster is closed and the interrupt goes on.
+        request (:func:`stop_requested`; they checkpoint first) before the cluster is closed and
+        the interrupt goes on; a second interrupt ends the wait.
     dashboard : bool
         Serve the local cluster's dashboard on 127.0.0.1 and print its address on stderr.
     names : list of str, optional
-        The points' folder names, where the points name themselves (a study's
-        :attr:`~stickslip.experiments.studies.Design.point_name`); by default :func:`point_name`.
+        The points' folder names (a study's :attr:`~stickslip.experiments.studies.Design.point_name`);
+        by default :func:`point_name`.
 
     Returns
     -------
     SweepResult
         ``table``, one row per point with its parameters, the fixed settings of ``common``,
         ``status`` ("ok"/"failed"), ``reused``, ``error``, ``wall_seconds``, ``point_dir`` and the
-        task's summary fields; and the counts ``n_points``, ``n_run``, ``n_reused``,
-        ``n_failed``.
+        task's summary fields; and the counts ``n_points``, ``n_run``, ``n_reused``, ``n_failed``.
 
     Examples
     --------
@@ -336,6 +306,9 @@ def run_sweep(
     >>> result.table["value"].tolist()  # sum of k^2 x over k = 1..3
     [14.0, 28.0]
     """
+    from dask.distributed import as_completed, wait
+    from tqdm import tqdm
+
     start = time.perf_counter()
     points = [dict(p) for p in points]
     common = dict(common or {})
@@ -349,163 +322,111 @@ def run_sweep(
     out.mkdir(parents=True, exist_ok=True)
 
     if task is chain_task:
-        _warn_short_chain_runs(points, common, names)
+        warn_short_chain_runs(points, common, names)
     specs = [_spec(task, p, common) for p in points]
-    found = [_read_done(out / n / DONE_FILE, s) for n, s in zip(names, specs, strict=False)]
+    found = [read_done(out / n / DONE_FILE, s) for n, s in zip(names, specs, strict=False)]
     records: list[dict[str, Any] | None] = [r for r, _ in found]
     damaged = {k: why for k, (_, why) in enumerate(found) if why}
     reused = [r is not None for r in records]
     pending = [k for k, r in enumerate(records) if r is None]
 
     if pending:
-        _compute(
-            task,
-            points,
-            common,
-            out,
-            names,
-            specs,
-            pending,
-            records,
-            scheduler=scheduler,
-            n_workers=n_workers,
-            progress=progress,
-            stop_wait=stop_wait,
-            dashboard=dashboard,
+        stop_file = out / STOP_FILE
+        stop_file.unlink(missing_ok=True)  # left by a sweep that was killed while it waited
+        client, cluster = _client(scheduler, n_workers or os.cpu_count() or 1, len(pending), dashboard)
+        done = len(points) - len(pending)
+        bar = tqdm(
+            total=len(points),
+            initial=done,
+            desc="points",
+            unit=" points",
+            file=sys.stderr,
+            dynamic_ncols=True,
+            smoothing=0.1,
+            disable=not (progress and _on_terminal()),  # a bar would garble a log file
         )
+        heartbeat.note(f"{done} of {len(points)} points done in {out.parent.name}/{out.name}")
+        futures = {}
+        try:
+            for k in pending:
+                point_dir, key = str(out / names[k]), f"sweep-{names[k]}-{os.getpid()}-{time.time_ns()}"
+                future = client.submit(_run_point, task, points[k], common, point_dir, specs[k], key=key, pure=False)
+                futures[future] = k
+            for future in as_completed(futures):
+                k = futures[future]
+                try:
+                    records[k] = future.result()
+                except Exception as exc:  # the worker itself died (memory, signal): record it here
+                    if disk_full(exc) is not None:
+                        raise
+                    records[k] = _failed(specs[k], exc, math.nan)
+                    write_json(out / names[k] / ERROR_FILE, records[k])
+                done += 1
+                heartbeat.note(f"{done} of {len(points)} points done in {out.parent.name}/{out.name}")
+                bar.update(1)
+                if records[k]["status"] != "ok" and not bar.disable:
+                    bar.write(f"point {names[k]} failed: {records[k]['error']}", file=sys.stderr)
+        except KeyboardInterrupt:
+            if stop_wait > 0:  # the running points checkpoint and stop; those not yet started return at once
+                stop_file.touch()
+                try:
+                    wait(list(futures), timeout=stop_wait)
+                except (Exception, KeyboardInterrupt):  # a point that does not stop, a lost worker, a second interrupt
+                    pass
+            raise
+        finally:
+            # a second Ctrl-C while the cluster closes is raised after it: the closing is not cut short
+            with SignalFlag(True) as second:
+                bar.close()
+                client.close()
+                if cluster is not None:
+                    cluster.close()
+                stop_file.unlink(missing_ok=True)
+            if second.set:
+                raise KeyboardInterrupt
 
     for k, why in damaged.items():  # the table says why a cached point ran again
         records[k] = {**(records[k] or {"status": "failed"}), "note": f"cached result damaged ({why}): run again"}
     rows = [_row(p, n, r, u, common) for p, n, r, u in zip(points, names, records, reused, strict=False)]  # type: ignore[arg-type]
     table = _table(rows, points + [common])
     write_table_files(out / SUMMARY_NAME, table)
-    n_failed = int((table["status"] != "ok").sum()) if len(table) else 0
     return SweepResult(
         table=table,
         out_dir=out,
         n_points=len(points),
         n_run=len(pending),
         n_reused=sum(reused),
-        n_failed=n_failed,
+        n_failed=int((table["status"] != "ok").sum()) if len(table) else 0,
         wall_seconds=time.perf_counter() - start,
         n_damaged=len(damaged),
     )
 
 
-def _compute(
-    task, points, common, out, names, specs, pending, records, *, scheduler, n_workers, progress, stop_wait, dashboard
-):
-    """Submit the pending points and collect their records as they finish (fills ``records``).
+def _client(scheduler: str | None, n_workers: int, n_pending: int, dashboard: bool):
+    """A client of the cluster at ``scheduler``, else of a new local cluster (also returned, to be closed)."""
+    from dask.distributed import Client, LocalCluster
 
-    On KeyboardInterrupt the running points are asked to stop and waited for, at most
-    ``stop_wait`` seconds (:func:`_stop_points`), before the cluster is closed; the interrupt then
-    goes on to the caller.
-    """
-    from dask.distributed import Client, LocalCluster, as_completed
+    if scheduler is not None:
+        return Client(scheduler), None
+    from stickslip.experiments.worker_signals import StopOnSignal
 
-    stop_file = out / STOP_FILE
-    stop_file.unlink(missing_ok=True)  # left by a sweep that was killed while it waited
-    cluster = None
-    if scheduler is None:
-        workers = n_workers or os.cpu_count() or 1
-        cluster = LocalCluster(
-            n_workers=min(workers, len(pending)),
-            threads_per_worker=1,
-            processes=True,
-            host="127.0.0.1",  # scheduler and workers: nothing listens beyond this machine
-            # its web server on any free port (never clash with another cluster), on the loopback;
-            # the dashboard's pages only when asked
-            dashboard_address="127.0.0.1:0",
-            scheduler_kwargs={"dashboard": dashboard},
-            silence_logs=logging.CRITICAL,  # failures are in error.json; keep worker heartbeats off a Ctrl-C
-        )
-        client = Client(cluster)
-        from stickslip.experiments.worker_signals import StopOnSignal
-
-        client.register_plugin(StopOnSignal())  # a signal to the process group stops the points cleanly
-        if dashboard:
-            sys.stderr.write(f"dashboard: {cluster.dashboard_link}\n")
-            sys.stderr.flush()
-    else:
-        client = Client(scheduler)
-    bar = _progress_bar(len(points), len(points) - len(pending), progress)
-    done = len(points) - len(pending)
-    heartbeat.note(f"{done} of {len(points)} points done in {out.parent.name}/{out.name}")
-    futures = {}
-    try:
-        for k in pending:
-            future = client.submit(
-                _run_point,
-                task,
-                points[k],
-                common,
-                str(out / names[k]),
-                specs[k],
-                key=f"sweep-{names[k]}-{os.getpid()}-{time.time_ns()}",
-                pure=False,
-            )
-            futures[future] = k
-        for future in as_completed(futures):
-            k = futures[future]
-            try:
-                records[k] = future.result()
-            except Exception as exc:  # the worker itself died (memory, signal): record it here
-                if disk_full(exc) is not None:
-                    raise
-                records[k] = {
-                    "spec": specs[k],
-                    "status": "failed",
-                    "error": f"{type(exc).__name__}: {exc}",
-                    "traceback": traceback.format_exc(),
-                    "wall_seconds": math.nan,
-                }
-                write_json(out / names[k] / ERROR_FILE, records[k])
-            done += 1
-            heartbeat.note(f"{done} of {len(points)} points done in {out.parent.name}/{out.name}")
-            if bar is not None:
-                bar.update(1)
-                if records[k]["status"] != "ok":
-                    bar.write(f"point {names[k]} failed: {records[k]['error']}", file=sys.stderr)
-    except KeyboardInterrupt:
-        if stop_wait > 0:
-            _stop_points(stop_file, list(futures), stop_wait)
-        raise
-    finally:
-        from stickslip.run.progress import SignalFlag
-
-        # a second Ctrl-C while the cluster closes is raised after it: the closing is not cut short
-        with SignalFlag(True) as second:
-            if bar is not None:
-                bar.close()
-            client.close()
-            if cluster is not None:
-                cluster.close()
-            stop_file.unlink(missing_ok=True)
-        if second.set:
-            raise KeyboardInterrupt
-
-
-def _stop_points(stop_file: Path, futures: list, timeout: float) -> None:
-    """Ask the running points to stop (they checkpoint first) and wait for them, at most ``timeout``
-    seconds; points not yet started then return at once. A second interrupt ends the wait."""
-    from dask.distributed import wait
-
-    stop_file.touch()
-    try:
-        wait(futures, timeout=timeout)
-    except (Exception, KeyboardInterrupt):  # a point that does not stop, a lost worker, a second interrupt
-        pass
-
-
-def _progress_bar(total: int, done: int, enabled: bool):
-    """A bar of finished points on stderr, only when asked and stderr is a terminal (not a log)."""
-    if not (enabled and _on_terminal()):
-        return None
-    from tqdm import tqdm
-
-    return tqdm(
-        total=total, initial=done, desc="points", unit=" points", file=sys.stderr, dynamic_ncols=True, smoothing=0.1
+    cluster = LocalCluster(
+        n_workers=min(n_workers, n_pending),
+        threads_per_worker=1,
+        processes=True,
+        host="127.0.0.1",  # scheduler and workers: nothing listens beyond this machine
+        # its web server on any free port (never clash with another cluster), on the loopback;
+        # the dashboard's pages only when asked
+        dashboard_address="127.0.0.1:0",
+        scheduler_kwargs={"dashboard": dashboard},
+        silence_logs=logging.CRITICAL,  # failures are in error.json; keep worker heartbeats off a Ctrl-C
     )
+    client = Client(cluster)
+    client.register_plugin(StopOnSignal())  # a signal to the process group stops the points cleanly
+    if dashboard:
+        sys.stderr.write(f"dashboard: {cluster.dashboard_link}\n")
+        sys.stderr.flush()
+    return client, cluster
 
 
 def _on_terminal() -> bool:
@@ -536,25 +457,24 @@ def run_chain_point(params: ChainParams, t_end: float, point_dir: str | Path, **
 
 
 def chain_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
-    """Run the chain of eq. (4), or a relative, at one sweep point; its run directory is
-    ``point_dir``.
+    """Run the chain of eq. (4), or a relative, at one sweep point.
 
     Parameters
     ----------
     point : dict
         :class:`~stickslip.models.params.ChainParams` fields (``model``: a preset, default the
-        paper's chain), ``t_end`` and optionally the run options of :data:`CHAIN_RUN_OPTIONS`;
-        without ``start`` the model's own start.
+        paper's chain), ``t_end`` and optionally the run options of
+        :data:`~stickslip.experiments.sweep_points.CHAIN_RUN_OPTIONS`; without ``start``, the model's own.
     point_dir : Path
-        Where the run writes run.json, state.nc and the tables (and its checkpoint while it
-        runs: an interrupted point goes on from there).
+        Where the run writes run.json, state.nc and the tables, and its checkpoint while it runs
+        (an interrupted point goes on from there).
 
     Returns
     -------
     dict
         The run's summary (``n_events``, ``L_mean``, ``L_steady``, ``state_sha256``, ...).
     """
-    params, t_end, options = _chain_run_args(point)
+    params, t_end, options = chain_run_args(point)
     with short_runs_expected():  # said once, by run_sweep, before the points run
         run = run_chain_point(params, t_end, point_dir, **options)  # writes run.json, as every run with a directory
     return dict(run.summary)
@@ -569,7 +489,7 @@ def block_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     """
     from stickslip.run import block  # imported here: workers load the simulator only when needed
 
-    params, options = _split(point, BlockParams, BLOCK_RUN_OPTIONS)
+    params, options = split_point(point, BlockParams, BLOCK_RUN_OPTIONS)
     t_end = options.pop("t_end")
     run = block.simulate_block(params, t_end, **options)
     summary = dict(run.summary())

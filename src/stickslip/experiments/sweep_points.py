@@ -1,10 +1,7 @@
-"""What a point of a parameter sweep holds (:mod:`stickslip.experiments.sweep`): the model's
-parameters, read from the point's fields, and the run options a task takes.
-
-A chain point holds :class:`~stickslip.models.params.ChainParams` fields (with ``model``, a
-preset) and the options of :data:`CHAIN_RUN_OPTIONS`; a block point
-:class:`~stickslip.models.params.BlockParams` fields and :data:`BLOCK_RUN_OPTIONS`. Both need
-``t_end``.
+"""What a point of a parameter sweep holds (:mod:`stickslip.experiments.sweep`): a chain point
+:class:`~stickslip.models.params.ChainParams` fields (with ``model``, a preset) and the options of
+:data:`CHAIN_RUN_OPTIONS`, a block point :class:`~stickslip.models.params.BlockParams` fields and
+:data:`BLOCK_RUN_OPTIONS`; both need ``t_end``.
 """
 
 from __future__ import annotations
@@ -34,13 +31,12 @@ def point_params(kind: str, point: dict[str, Any]):
     """The parameters of one sweep point: BlockParams, or ChainParams of the point's ``model``
     preset (default the paper's chain) with the point's other fields as overrides."""
     params_cls = ChainParams if kind == "chain" else BlockParams
-    fields = {f.name for f in dataclasses.fields(params_cls)}
-    values = {k: v for k, v in point.items() if k in fields}
-    if params_cls is ChainParams:
-        from stickslip.models.presets import chain_params
+    values = {k: v for k, v in point.items() if k in {f.name for f in dataclasses.fields(params_cls)}}
+    if params_cls is BlockParams:
+        return BlockParams(**values)
+    from stickslip.models.presets import chain_params
 
-        return chain_params(values.pop("model", "sakaguchi"), **values)
-    return params_cls(**values)
+    return chain_params(values.pop("model", "sakaguchi"), **values)
 
 
 def preset_start(params: ChainParams, cfg: dict[str, Any]) -> dict[str, Any]:
@@ -57,8 +53,7 @@ def preset_start(params: ChainParams, cfg: dict[str, Any]) -> dict[str, Any]:
 
 
 def split_point(point: dict[str, Any], params_cls: type, options: tuple[str, ...]) -> tuple[Any, dict[str, Any]]:
-    fields = {f.name for f in dataclasses.fields(params_cls)}
-    unknown = sorted(set(point) - fields - set(options))
+    unknown = sorted(set(point) - {f.name for f in dataclasses.fields(params_cls)} - set(options))
     if unknown:
         raise ValueError(f"unknown keys for {params_cls.__name__}: {', '.join(unknown)}")
     params = point_params("chain" if params_cls is ChainParams else "block", point)

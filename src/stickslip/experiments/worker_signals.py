@@ -1,21 +1,19 @@
 """Signals to the worker processes of a local Dask cluster.
 
-A batch system stopping a job sends SIGTERM to every process of it, and Ctrl-C in a terminal sends
-SIGINT to the whole foreground process group: the command's driver and its Dask workers alike.
-Left to their default, the workers die at once (losing the work since the point's last
-checkpoint, printing a traceback) and the driver waits in vain for its points to stop. On a
-local cluster each worker therefore turns either signal into a stop request
-(:class:`StopOnSignal`): its running point writes its checkpoint and stops, as when the driver
-asks (:func:`stickslip.experiments.sweep.stop_requested`), and the driver, which got the signal
-too, closes the cluster.
+SIGTERM (a batch system stopping a job) and SIGINT (Ctrl-C) reach the driver and its Dask workers
+alike; left to their default, the workers would die at once, losing the work since the point's
+last checkpoint. Each worker of a local cluster therefore turns either signal into a stop request
+(:class:`StopOnSignal`): its running point writes its checkpoint and stops, as when the driver asks
+(:func:`stickslip.experiments.sweep.stop_requested`).
 """
 
 from __future__ import annotations
 
 import signal
-import threading
 
 from distributed.diagnostics.plugin import WorkerPlugin
+
+from stickslip.run.progress import in_main_thread
 
 _signalled = False
 
@@ -36,6 +34,6 @@ class StopOnSignal(WorkerPlugin):
     name = "stickslip-stop-on-signal"
 
     def setup(self, worker) -> None:
-        if threading.current_thread() is threading.main_thread():
+        if in_main_thread():
             for sig in (signal.SIGINT, signal.SIGTERM):
                 signal.signal(sig, _stop)

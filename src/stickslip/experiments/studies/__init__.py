@@ -1,4 +1,4 @@
-"""The studies the paper leaves open (``stickslip study NAME``): one module each.
+"""The studies (``stickslip study NAME``): one module each.
 
 A study's module says everything about it in one :class:`Design`: its points in each mode (a
 :class:`Study`), the task that runs one point on a Dask worker, its findings and figures from the
@@ -7,22 +7,13 @@ table of its finished points, the columns of its page and the text of ``sticksli
 the cache, resume and folder ownership of :func:`stickslip.experiments.sweep.run_sweep`) without
 naming one.
 
-* :mod:`~stickslip.experiments.studies.transition`: the stick-slip transition at beta = 1 as N
-  grows, by continuation in beta (ladders of chain runs);
-* :mod:`~stickslip.experiments.studies.phase_diagram`: final state and m over (alpha, beta) and
-  (D, beta), from two starts;
-* :mod:`~stickslip.experiments.studies.exponents`: the slip-size exponent tau against beta, and
-  Carlson-Langer;
-* :mod:`~stickslip.experiments.studies.chaos`: is the chain chaotic at the onset (the flow's
-  exponent, the decorrelation of slips, its threshold delta*)?
-
-The paper's own figures and stated numbers are studies of the same shape (:data:`PAPER`), each
-with one page; ``stickslip reproduce`` runs them with the same runner and gathers their rows and
-figures into one report (:mod:`stickslip.experiments.reproduce`):
-
-* :mod:`~stickslip.experiments.studies.figs1_4`: the single block of section 2 (Figs. 1-3, the
-  Hopf point, the inverse transition) and the Fourier modes of the chain (Fig. 4);
-* :mod:`~stickslip.experiments.studies.figs5_8`: the chain runs of section 3 (Figs. 5-8).
+:data:`STUDIES` are the questions the paper leaves open: the stick-slip transition at beta = 1 as
+N grows (``transition``), the final state and m over (alpha, beta) and (D, beta)
+(``phase-diagram``), the slip-size exponent tau (``exponents``) and whether the chain is chaotic
+at the onset (``chaos``). :data:`PAPER` are the paper's own figures and stated numbers, each with
+one page: the single block of section 2 and the Fourier modes of Fig. 4 (``figs1-4``) and the
+chain runs of section 3 (``figs5-8``); ``stickslip reproduce`` gathers them into one report
+(:mod:`stickslip.experiments.reproduce`).
 
 A :class:`Study`'s key hashes its name, the settings every point shares and the package version
 (not the point list, so a point added to a study keeps the directory and runs only the new point).
@@ -90,9 +81,7 @@ class Study:
 
     def key(self) -> str:
         """First 12 hex digits of the SHA-256 of the spec without its points."""
-        spec = self.spec()
-        spec.pop("points")
-        return spec_key(spec)
+        return spec_key({k: v for k, v in self.spec().items() if k != "points"})
 
     @property
     def dirname(self) -> str:
@@ -139,7 +128,9 @@ class Design:
     - ``task(point, point_dir)``: one point on a worker (a task of ``run_sweep``);
     - ``check(cfg)``: refuse a point's merged settings (ParameterError) before any work starts;
     - ``findings(study, table)``: what the table of finished rows says (``statements`` first);
-    - ``figures(study, table, page_dir)``: (name, Figure, caption) for each figure;
+    - ``figures(study, table, page_dir)``: (name, Figure, caption) for each figure, and may add a
+      dict of further fields of its entry (its data files, the command that draws it); (name,
+      None, reason) for a figure the results cannot give;
     - ``columns``: the leading columns of its table and page;
     - ``rows(table)``: the study's table from the sweep's (one row per point when None);
     - ``tables(findings)``: further tables of its page, as (title, columns, records);
@@ -149,13 +140,9 @@ class Design:
       entries); without it a point's folder is the point's;
     - ``load(study, table, points_dir)``: for a study whose findings and figures read its
       points' files, what they read in place of the table (loaded once);
-    - ``point_name(point)``: a point's folder name (default
-      :func:`stickslip.experiments.sweep.point_name`);
+    - ``point_name(point)``: a point's folder name (default :func:`~stickslip.experiments.sweep.point_name`);
     - ``command(mode)``: the command line that computes the study (default ``stickslip study
       NAME --MODE --out DIR``).
-
-    ``figures`` gives ``(name, None, reason)`` for a figure the results cannot give, and may add
-    a dict of further fields of the figure's entry (its data files, the command that draws it).
     """
 
     name: str
@@ -177,40 +164,16 @@ class Design:
 
 
 def design(name: str) -> Design:
-    """The :class:`Design` of study ``name`` (:data:`STUDIES`), from its module.
-
-    Parameters
-    ----------
-    name : str
-        One of :data:`STUDIES` or :data:`PAPER`.
-
-    Returns
-    -------
-    Design
-        The module's ``DESIGN``.
-    """
+    """The :class:`Design` of study ``name`` (one of :data:`STUDIES` or :data:`PAPER`): its module's ``DESIGN``."""
     if name not in STUDIES + PAPER:
         raise ValueError(f"study must be one of {', '.join(STUDIES + PAPER)} (got {name!r})")
     return importlib.import_module(f"{__name__}.{name.replace('-', '_')}").DESIGN
 
 
 def study(name: str, mode: str = "quick", **options: Any) -> Study:
-    """The spec of study ``name`` in ``mode``.
-
-    Parameters
-    ----------
-    name : str
-        One of :data:`STUDIES` or :data:`PAPER`.
-    mode : str
-        One of :data:`MODES`.
-    **options
-        The study's own options (:attr:`Design.options`), e.g. ``extra_Ns`` of the transition.
-
-    Returns
-    -------
-    Study
-        Its shared settings and points.
-    """
+    """The :class:`Study` (shared settings and points) of study ``name`` (:data:`STUDIES` or
+    :data:`PAPER`) in ``mode`` (:data:`MODES`), with the study's own ``options``
+    (:attr:`Design.options`, e.g. ``extra_Ns`` of the transition)."""
     if mode not in MODES:
         raise ValueError(f"mode must be one of {', '.join(MODES)} (got {mode!r})")
     return design(name).build(mode, **options)
