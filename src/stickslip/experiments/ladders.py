@@ -12,12 +12,9 @@ runs points ("rungs") one after the other, each starting from the final state of
   same amount, to the next smaller beta, until a rung leaves steady sliding (some block sticks);
   then bisects. Linear stability puts that lower edge at beta = 1.
 
-A rung runs in segments and stops when its answer is known (:func:`stickslip.analysis.adaptive.run_rung`):
-the error of m below the target from at least 16 batches of 10 tau_int; steady sliding reached
-(every block within :data:`UNTIL_STEADY` of it) or every block sliding with the deviation falling;
-on the down ladder, a block stuck (it left steady sliding); or the cap, then ``undecided`` with the
-reason. Each finished rung is written to ``<ladder>/rungs/<k>-beta<b>/`` (``rung.json``, the final
-state ``state.npz``, the samples ``samples.npz``), and a running rung keeps its progress after each
+A rung runs in segments until its answer is known (:func:`stickslip.analysis.adaptive.run_rung`).
+Each finished rung is written to ``<ladder>/rungs/<k>-beta<b>/`` (``rung.json``, the final state
+``state.npz``, the samples ``samples.npz``), and a running rung keeps its progress after each
 segment there (``progress.npz``); a ladder started again replays its finished rungs and continues
 the first unfinished one from its last finished segment, with the result of an uninterrupted rung.
 """
@@ -32,40 +29,28 @@ from typing import Any
 import numpy as np
 
 from stickslip import io
-from stickslip.experiments.cache import canonical
+from stickslip.analysis.adaptive import STOP_BATCHES, run_rung
+from stickslip.experiments.cache import BOOKKEEPING, canonical, file_sha256, read_done, sealed
+from stickslip.experiments.sweep_points import point_params
 from stickslip.jsonable import to_jsonable
+from stickslip.models.params import ParameterError
 from stickslip.models.presets import paper_parameters
+from stickslip.run.checkpoint import read_state_npz, write_state_npz
+from stickslip.run.rundir import read_state_file, write_state_file
+from stickslip.run.state import ChainState
+from stickslip.run.validate import check_start_state
 
 __all__ = ["ladder_task", "ladder_entry"]
 
 _PAPER = paper_parameters("N", "beta")
+#: The settings a rung is run from, recorded in its spec with the paper's parameters.
+_SETTINGS = ("target", "cap_loads", "segment_loads", "first_segment_loads", "samples_per_load")
+_SETTINGS += ("perturbation", "down_perturbation", "seed")
 
 
 def params_at(cfg: dict[str, Any], beta: float):
     """The chain of eq. (4) with the ladder's settings at ``beta``."""
-    from stickslip.experiments.sweep_points import point_params
-
     return point_params("chain", {**cfg, "N": int(cfg["N"]), "beta": float(beta)})
-
-
-def _save_npz(path: Path, arrays: dict) -> None:
-    """Arrays to ``path``, built in memory and written atomically (a full disk leaves no half file)."""
-    buf = BytesIO()
-    np.savez(buf, **arrays)
-    io.write_bytes(path, buf.getvalue())
-
-
-def _rung_settings(cfg: dict[str, Any]) -> dict[str, Any]:
-    from stickslip.analysis.adaptive import STOP_BATCHES
-
-    keys = ("target", "cap_loads", "segment_loads", "first_segment_loads", "samples_per_load")
-    keys += ("perturbation", "down_perturbation", "seed")
-    # a rung of another stop rule is not this rung: it is run again, not replayed
-    return (
-        {k: cfg[k] for k in keys}
-        | {k: cfg.get(k, v) for k, v in _PAPER.items()}
-        | {"stop_batches": int(cfg.get("stop_batches", STOP_BATCHES))}
-    )
 
 
 #: The files of a rung's folder, each recorded with its SHA-256 in rung.json.
@@ -79,7 +64,6 @@ def ladder_entry(path: Path, rel: str = ""):
     ``rungs`` folder, holding only rungs (``<k>-beta<b>``) of ``rung.json``,
     :data:`RUNG_FILES` and :data:`PROGRESS_FILE`. True or False, or for a folder the test of its entries (the walk of
     :func:`stickslip.experiments.study_run.foreign_files`)."""
-    from stickslip.experiments.cache import BOOKKEEPING
 
     def rung(p: Path, r: str) -> bool:
         return p.is_file() and p.name in ("rung.json", PROGRESS_FILE, *RUNG_FILES)
@@ -97,11 +81,6 @@ def _replay(rdir: Path, spec: dict[str, Any], params) -> tuple[dict[str, Any] | 
     whole: its record as written (its SHA-256), every file present with the checksum recorded
     when it was written, the state the one its row names and one a run can go on from. Else
     None, and why a stored rung of this spec is not reused (None when there is none)."""
-    from stickslip.experiments.cache import read_done
-    from stickslip.models.params import ParameterError
-    from stickslip.run.rundir import read_state_file
-    from stickslip.run.validate import check_start_state
-
     # another rung's record (another start or settings) is not this rung's: (None, None)
     rec, why = read_done(rdir / "rung.json", spec, "row")
     if rec is None:
@@ -123,8 +102,6 @@ def _keep_progress(path: Path, spec: dict[str, Any], progress: dict[str, Any]) -
     """A rung's progress after a segment (:func:`stickslip.analysis.adaptive.run_rung`) to ``path``,
     with its spec and checksum (:func:`stickslip.run.checkpoint.write_state_npz`): an interrupted
     rung loses at most the segment it was in."""
-    from stickslip.run.checkpoint import write_state_npz
-
     arrays = {k: np.asarray(progress[k]) for k in ("t", "L", "n_moving")}
     arrays["devs"] = np.asarray(progress["devs"], dtype=float)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -135,10 +112,6 @@ def _keep_progress(path: Path, spec: dict[str, Any], progress: dict[str, Any]) -
 def _progress(path: Path, spec: dict[str, Any], params) -> dict[str, Any] | None:
     """The progress kept at ``path`` by :func:`_keep_progress` if it is whole, of this rung's spec
     and its state one a run can go on from; else None (the rung starts over)."""
-    from stickslip.models.params import ParameterError
-    from stickslip.run.checkpoint import read_state_npz
-    from stickslip.run.validate import check_start_state
-
     found = read_state_npz(path, spec, params)
     if found is None:
         return None
@@ -157,13 +130,11 @@ def _rung(
     """Rung ``index`` at ``beta`` from ``state``: reused from its directory when it was run from the
     same state with the same settings and its files are whole (:func:`_replay`), else run and
     written; a rung run again because its stored files were damaged says so in its row's ``note``."""
-    from stickslip.analysis.adaptive import run_rung
-    from stickslip.experiments.cache import file_sha256, sealed
-    from stickslip.run.rundir import write_state_file
-
     rdir = ladder_dir / "rungs" / f"{index:02d}-beta{beta:.6g}"
     sha = state.sha256()
-    settings = _rung_settings(cfg)
+    settings = {k: cfg[k] for k in _SETTINGS} | {k: cfg.get(k, v) for k, v in _PAPER.items()}
+    # a rung of another stop rule is not this rung: it is run again, not replayed
+    settings["stop_batches"] = int(cfg.get("stop_batches", STOP_BATCHES))
     # The rung's spec: the state it starts from and its settings (the study cache's record format).
     spec = canonical({"start_sha256": sha, "settings": settings})
     params = params_at(cfg, beta)
@@ -174,13 +145,14 @@ def _rung(
     resume = _progress(progress, spec, params)
     res = run_rung(params, state, cfg, resume=resume, save=lambda p: _keep_progress(progress, spec, p), **kw)
     row = {**res["row"], "branch": cfg["direction"], "replica": int(cfg.get("replica", 0)), "seed": int(cfg["seed"])}
-    row.update(rung=index, role=role, start=start, start_sha256=sha)
-    row["final_sha256"] = res["state"].sha256()
+    row.update(rung=index, role=role, start=start, start_sha256=sha, final_sha256=res["state"].sha256())
     row = to_jsonable(row)  # as a replay reads it back (NaN and inf become None)
     rdir.mkdir(parents=True, exist_ok=True)
     (rdir / "rung.json").unlink(missing_ok=True)  # no record while its files are rewritten
     write_state_file(rdir / "state.npz", res["state"])
-    _save_npz(rdir / "samples.npz", res["samples"])
+    samples = BytesIO()  # written whole or not at all (a full disk leaves no half file)
+    np.savez(samples, **res["samples"])
+    io.write_bytes(rdir / "samples.npz", samples.getvalue())
     files = {name: file_sha256(rdir / name) for name in RUNG_FILES}
     io.write_json(rdir / "rung.json", sealed({"spec": spec, "row": row, "files": files}))
     progress.unlink(missing_ok=True)
@@ -195,7 +167,6 @@ def ladder_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     (``target``, ``cap_loads``, segments, ``samples_per_load``) and the start's ``perturbation``
     and ``seed``. Returns the rungs as rows (``rows``) and the bracket found."""
     from stickslip.experiments.sweep import stop_requested
-    from stickslip.run.state import ChainState
 
     cfg, d = dict(point), Path(point_dir)
     up = cfg["direction"] == "up"
@@ -206,13 +177,13 @@ def ladder_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     kw = {"leave_stops": not up, "stop_requested": stop_requested(d)}
     state = ChainState.steady(params_at(cfg, betas[0]), amp, seed)
     start = f"steady sliding + uniform perturbation {amp:g} (seed {seed})"
+    own = "stick-slip" if up else "sliding"
     rows: list[dict[str, Any]] = []
     inside = outside = None  # (beta, state) on the ladder's own branch / the first beta off it
     for b in betas:
         r = _rung(d, len(rows), b, state, start, cfg, **kw)
         rows.append(r["row"])
-        own = r["row"]["branch_state"] == ("stick-slip" if up else "sliding")
-        if not own:
+        if r["row"]["branch_state"] != own:
             outside = b
             break
         inside = (b, r["state"])
@@ -227,7 +198,7 @@ def ladder_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
         start = f"final state of beta = {b_in:g}" + ("" if up else " + perturbation")
         r = _rung(d, len(rows), mid, s0, start, cfg, role="bisection", **kw)
         rows.append(r["row"])
-        if r["row"]["branch_state"] == ("stick-slip" if up else "sliding"):
+        if r["row"]["branch_state"] == own:
             inside = (mid, r["state"])
         else:
             outside = mid

@@ -1,12 +1,8 @@
 """The paper's section 3 as a study of ``stickslip reproduce``: chain runs of eq. (4) from the paper's
 initial state for the final states, Fig. 5(b) (<L> against beta) and Figs. 5(a), 6, 7, 8 (the runs
-at beta = 1 and 0.2).
-
-* ``full``: the paper's chains, N = 399 to t = 2e7, at the values of beta of Fig. 5(b) with more
-  near beta = 1; beta = 1.2 runs its whole length (the paper's run of the sliding regime).
-* ``quick``: Fig. 5(b) on chains of N = 99 to t = 2e6 (a chain loads in about L_ss / V time units
-  and L_ss grows like N^2), Figs. 5(a), 6, 7 and 8 on chains of N = 199 to t = 4e6: minutes.
-* ``tiny``: chains of N = 19 to t = 4e4, for the tests; its numbers mean nothing.
+at beta = 1 and 0.2). ``full`` runs the paper's chains (N = 399 to t = 2e7) at the values of beta
+of Fig. 5(b) with more near beta = 1, ``quick`` shorter chains in minutes (a chain loads in about
+L_ss / V time units and L_ss grows like N^2), ``tiny`` chains of N = 19 for the tests (:func:`build`).
 
 Chain runs at beta > 1 (beyond 1.2 in ``full``) stop once the chain slides steadily
 (``until_steady``): from then on every block moves every step and nothing changes but the position
@@ -15,44 +11,31 @@ of the pulling point. Each run averages <L> and counts events over its second ha
 
 from __future__ import annotations
 
+import functools
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pandas as pd
 
+from stickslip.analysis.chain_runs import chain_analysis, run_summary
 from stickslip.experiments.studies import Design, Study
+from stickslip.experiments.sweep import point_name, run_chain_point
+from stickslip.jsonable import table_records
 from stickslip.models.physics import UNTIL_STEADY
 from stickslip.models.presets import paper_parameters
 from stickslip.outcome import Outcome, Results, point_settings
 from stickslip.report.commands import reproduce_command
-from stickslip.report.rows import stated_numbers
+from stickslip.report.rows import chain_rows, findings_of, stated_numbers
+from stickslip.run.driver import load_run
 
-__all__ = ["DESIGN", "chain_point_task", "chain_points"]
+__all__ = ["DESIGN", "chain_point_task"]
 
 # Just above beta = 1 (1.025 to 1.1) the chain stick-slips for a very long time: at N = 99 it
 # still does at t = 1e7, so such a point at N = 399 costs a whole run of the sliding regime
 # (an hour on one core) and ends without settling. The full set therefore jumps to 1.2.
 _FULL_BETAS = (0.2, 0.4, 0.6, 0.7, 0.8, 0.85, 0.9, 0.95, 0.975, 0.99, 1.0, 1.2, 1.5)
 _QUICK_BETAS = (0.2, 0.4, 0.6, 0.8, 0.9, 0.95, 1.0, 1.1, 1.2, 1.5)
-
-
-def chain_points(
-    sweep_N: int, betas: tuple[float, ...], figure_N: int, figure_betas: tuple[float, ...] = (1.0, 0.2)
-) -> list[dict[str, Any]]:
-    """The chain runs of a mode: ``{"N", "beta"}`` for Fig. 5(b) and for Figs. 5(a), 6, 7, 8.
-
-    The Fig. 5(b) sweep is ``betas`` at ``sweep_N``; the figure runs (beta = 1 for Figs. 5a, 6
-    and 7, beta = 0.2 for Fig. 8) are at ``figure_N``, shared with the sweep where N agrees.
-    The figure runs come first, then the sweep from the largest beta down: the longest runs
-    start first, which shortens the wall time on a few workers.
-    """
-    points = [{"N": int(figure_N), "beta": float(b)} for b in figure_betas]
-    for b in sorted(betas, reverse=True):
-        p = {"N": int(sweep_N), "beta": float(b)}
-        if p not in points:
-            points.append(p)
-    return points
 
 
 def build(mode: str) -> Study:
@@ -93,7 +76,11 @@ def build(mode: str) -> Study:
         "sweep_N": sweep_N,
         "figure_N": figure_N,
     }
-    return Study("figs5-8", mode, common, tuple(chain_points(sweep_N, betas, figure_N)), note=note)
+    # The runs of Figs. 5(a), 6, 7 (beta = 1) and 8 (beta = 0.2) first, then the Fig. 5(b) sweep from
+    # the largest beta down, sharing a run where N agrees: the longest runs start first.
+    points = [{"N": figure_N, "beta": b} for b in (1.0, 0.2)]
+    points += [p for b in sorted(betas, reverse=True) if (p := {"N": sweep_N, "beta": b}) not in points]
+    return Study("figs5-8", mode, common, tuple(points), note=note)
 
 
 def chain_point_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
@@ -102,14 +89,10 @@ def chain_point_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     ``point`` holds N and beta merged with the study's shared settings (:func:`build`). Runs at
     beta above ``until_steady_above`` stop once the chain slides steadily; the runs at N =
     ``profile_N`` and beta in ``profile_betas`` also store the displacement over windows of
-    ``profile_window`` for Fig. 6. The run checkpoints into ``point_dir``, continues from a
-    checkpoint there, and checkpoints and stops when the reproduction is interrupted
+    ``profile_window`` for Fig. 6. The run checkpoints and resumes in ``point_dir``
     (:func:`stickslip.experiments.sweep.run_chain_point`). Returns the run's summary with <L> and
     its batch-means error (Fig. 5b) and the final state ("steady sliding" or "stick-slip", section 3).
     """
-    from stickslip.analysis.chain_runs import run_summary
-    from stickslip.experiments.sweep import run_chain_point
-
     params, t_end, options = point_settings(point)
     run = run_chain_point(params, t_end, point_dir, **options)
     return {**run_summary(run, params, options["average_from"], UNTIL_STEADY), "t_end_requested": t_end}
@@ -123,24 +106,16 @@ def check(cfg: dict[str, Any]) -> None:
 def load(spec: Study, table: pd.DataFrame, points_dir: Path) -> Results | None:
     """The chain runs (each read from its folder when first asked for) and their analysis
     (:func:`stickslip.analysis.chain_runs.chain_analysis`); None unless every run finished."""
-    from stickslip.analysis.chain_runs import chain_analysis
-    from stickslip.experiments.sweep import point_name
-    from stickslip.jsonable import table_records
-    from stickslip.run.driver import load_run
-
     if len(table) < len(spec.points):
         return None
     # as the table reads back from JSON; the final state of each run is its task's
     summary = {"points": table_records(table)}
     table = pd.DataFrame(summary["points"])
-    cache: dict[tuple[int, float], Any] = {}
 
+    @functools.cache
     def get(N: int, beta: float):
         """The full run at (N, beta), read from its folder when first asked for."""
-        key = (int(N), float(beta))
-        if key not in cache:
-            cache[key] = load_run(points_dir / point_name({"N": int(N), "beta": float(beta)}))
-        return cache[key]
+        return load_run(points_dir / point_name({"N": int(N), "beta": float(beta)}))
 
     wall = float(np.nansum(table["wall_seconds"].to_numpy(dtype=float)))
     data = {"table": table, "run": get}
@@ -151,20 +126,14 @@ def load(spec: Study, table: pd.DataFrame, points_dir: Path) -> Results | None:
 def findings(spec: Study, results: Results | None) -> dict[str, Any]:
     """The rows of section 3 and Figs. 5-8 (:func:`stickslip.report.rows.chain_rows`), and one
     statement per row."""
-    from stickslip.report.rows import chain_rows, findings_of
-
-    if results is None:
-        return findings_of(None)
-    return findings_of(chain_rows(results.outcomes["chain-runs"], results.analysis, results.mode))
+    return findings_of(chain_rows(results.outcomes["chain-runs"], results.analysis, results.mode) if results else None)
 
 
 def figures(spec: Study, results: Results | None, page_dir: Path) -> list[tuple]:
     """Figs. 5-8, with their data beside them (:func:`stickslip.plotting.figures.chain_figures`)."""
     from stickslip.plotting.figures import chain_figures
 
-    if results is None:
-        return []
-    return chain_figures(results.outcomes["chain-runs"], results.analysis, page_dir, results.mode)
+    return chain_figures(results.outcomes["chain-runs"], results.analysis, page_dir, results.mode) if results else []
 
 
 def describe() -> str:

@@ -1,18 +1,13 @@
 """``stickslip study transition``: the stick-slip transition of eq. (4) at beta = 1 as N grows, by
 continuation in beta (:mod:`stickslip.experiments.ladders`).
 
-For each N an ``up`` and a ``down`` ladder run as independent Dask tasks
+For each N ``up`` ladders and a ``down`` ladder run as independent Dask tasks
 (:func:`stickslip.experiments.sweep.run_sweep`: a finished ladder is reused, a failed one recorded
 and retried, an interrupted one continues its running rung from its last finished segment). From
-the rungs:
-
-* ``beta_t`` (last beta where the up ladder stick-slips) and ``beta_t_err`` (half the bracket to the
-  first sliding beta, after bisection);
-* ``lower_edge`` (middle of the bracket where the down ladder first leaves steady sliding) and
-  ``lower_edge_err``; linear stability of steady sliding puts it at beta = 1;
-* ``step`` of the order parameter m at beta_t (the up ladder's m there minus steady sliding's 0)
-  with ``step_err``, and ``step_phi`` of the stuck fraction;
-* power laws beta_t - 1 ~ N^b and (size of the step) ~ N^b (:func:`stickslip.analysis.order.power_law_fit`).
+the rungs, per N (:func:`per_n_summary`): the loop's upper edge ``beta_t``, its lower edge (linear
+stability of steady sliding puts it at beta = 1) and the step of the order parameter m at beta_t
+(from steady sliding's 0); and the power laws beta_t - 1 ~ N^b and (size of the step) ~ N^b
+(:func:`stickslip.analysis.order.power_law_fit`).
 
 Layout: ``OUT/runs/transition-<key>/points/<ladder>/rungs/...`` and ``OUT/transition/`` (table,
 figures, ``study.json``, ``index.html``).
@@ -30,6 +25,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from stickslip.analysis.adaptive import STOP_BATCHES
+from stickslip.analysis.order import power_law_fit
 from stickslip.experiments.ladders import ladder_entry, ladder_task, params_at
 from stickslip.experiments.studies import Design, Option, Study
 from stickslip.jsonable import table_records
@@ -60,22 +57,13 @@ def _cap_loads(N: int) -> float:
     loading time costs seconds (the largest events of a short chain come once per loading time,
     so its m needs several), shorter where a loading time costs minutes (there tau_int is a few
     thousandths of a loading time)."""
-    if N <= 99:
-        return 16.0
-    if N <= 199:
-        return 8.0
-    if N <= 399:
-        return 3.0
-    if N <= 799:
-        return 1.5
-    return 0.8
+    return next((cap for n, cap in ((99, 16.0), (199, 8.0), (399, 3.0), (799, 1.5)) if N <= n), 0.8)
 
 
 def _grids(N: int, mode: str) -> tuple[list[float], list[float]]:
     """Coarse grids in beta of the up and down ladders: steps in 1 + k / N, where beta_t(N) lies
     for small N (about 1 + 15 / N), and a few points below 1."""
-    ks = (5, 10, 20, 40, 80)
-    above = [round(1.0 + k / N, 6) for k in ks]
+    above = [round(1.0 + k / N, 6) for k in (5, 10, 20, 40, 80)]
     if mode == "tiny":
         return [0.8, 2.0, 4.0], [2.0, 1.2, 0.8]
     below_up = [0.8, 0.9, 1.0] if N <= 199 else [0.95, 1.0]
@@ -86,9 +74,6 @@ def _grids(N: int, mode: str) -> tuple[list[float], list[float]]:
 def ladder_points(mode: str, extra_Ns: tuple[int, ...] = ()) -> tuple[dict[str, Any], list[dict[str, Any]]]:
     """The shared settings and the ladders (one per N and direction) of a mode; large N first (the
     up ladder of the largest chain is the longest task: it sets the wall time on a few workers)."""
-    from stickslip.analysis.adaptive import STOP_BATCHES
-
-    Ns = tuple(sorted(set(LADDER_NS[mode]) | set(int(n) for n in extra_Ns)))
     common = {
         **paper_parameters("N", "beta"),
         "model": "sakaguchi",
@@ -104,14 +89,12 @@ def ladder_points(mode: str, extra_Ns: tuple[int, ...] = ()) -> tuple[dict[str, 
         "stop_batches": STOP_BATCHES,
     }
     points = []
-    for N in sorted(Ns, reverse=True):
+    for N in sorted(set(LADDER_NS[mode]) | {int(n) for n in extra_Ns}, reverse=True):
         up, down = _grids(N, mode)
         cap = _cap_loads(N) if mode != "tiny" else 1.0
         for r in range(REPLICAS[mode]):
             points.append({"N": N, "direction": "up", "betas": up, "cap_loads": cap, "seed": r, "replica": r})
         points.append({"N": N, "direction": "down", "betas": down, "cap_loads": cap, "seed": 0, "replica": 0})
-        for beta in (*up, *down):  # every rung's parameters, refused before any ladder runs
-            params_at({**common, "N": N}, beta)
     return common, points
 
 
@@ -134,22 +117,27 @@ def check(cfg: dict[str, Any]) -> None:
         params_at(cfg, float(beta))
 
 
+def _bracket(ladder: pd.DataFrame) -> tuple[float, float]:
+    """A ladder's last stick-slip beta and the first sliding beta above it (NaN where none)."""
+    lo = float(ladder.loc[ladder["branch_state"] == "stick-slip", "beta"].max())
+    return lo, float(ladder.loc[(ladder["branch_state"] == "sliding") & (ladder["beta"] > lo), "beta"].min())
+
+
 def _replica_edge(up: pd.DataFrame) -> dict[str, Any] | None:
-    """One up ladder's upper edge: the last stick-slip beta, half the bracket to the first sliding
-    beta above it, and m and phi there (None when the ladder never stick-slipped)."""
-    stick = up[up["branch_state"] == "stick-slip"]
-    if not len(stick):
+    """One up ladder's upper edge: the last stick-slip beta with half the bracket to the first
+    sliding beta above it as its error, and m (``step``) and phi (``step_phi``) there (None when
+    the ladder never stick-slipped)."""
+    bt, above = _bracket(up)
+    if math.isnan(bt):
         return None
-    bt = float(stick["beta"].max())
-    above = up[(up["branch_state"] == "sliding") & (up["beta"] > bt)]
-    at = stick[stick["beta"] == bt].iloc[-1]
+    at = up[(up["branch_state"] == "stick-slip") & (up["beta"] == bt)].iloc[-1]
     return {
         "beta_t": bt,
-        "half_bracket": 0.5 * (float(above["beta"].min()) - bt) if len(above) else math.nan,
-        "m": float(at["order_parameter"]),
-        "m_err": float(at["order_parameter_err"]),
-        "phi": float(at["stuck_fraction"]),
-        "phi_err": float(at["stuck_fraction_err"]),
+        "beta_t_err": 0.5 * (above - bt),
+        "step": float(at["order_parameter"]),
+        "step_err": float(at["order_parameter_err"]),
+        "step_phi": float(at["stuck_fraction"]),
+        "step_phi_err": float(at["stuck_fraction_err"]),
         "reliable": bool(at["err_reliable"]),
         "tau": float(at["tau_int_loads"]) if at["tau_int_loads"] is not None else math.nan,
     }
@@ -190,23 +178,15 @@ def per_n_summary(rows: pd.DataFrame) -> pd.DataFrame:
         rec: dict[str, Any] = {"N": int(N), **{k: math.nan for k in PER_N_COLUMNS[1:]}}
         edges = [e for _, u in up.groupby("replica") if (e := _replica_edge(u)) is not None]
         if edges:
-            rec["beta_t"], rec["beta_t_err"] = _mean_err(
-                [e["beta_t"] for e in edges], [e["half_bracket"] for e in edges]
-            )
-            rec["beta_t_spread"] = float(np.std([e["beta_t"] for e in edges], ddof=1)) if len(edges) > 1 else math.nan
+            for k in ("beta_t", "step", "step_phi"):
+                rec[k], rec[f"{k}_err"] = _mean_err([e[k] for e in edges], [e[f"{k}_err"] for e in edges])
             rec["beta_t_replicas"] = [e["beta_t"] for e in edges]
-            rec["step"], rec["step_err"] = _mean_err([e["m"] for e in edges], [e["m_err"] for e in edges])
-            rec["step_phi"], rec["step_phi_err"] = _mean_err([e["phi"] for e in edges], [e["phi_err"] for e in edges])
+            rec["beta_t_spread"] = float(np.std(rec["beta_t_replicas"], ddof=1)) if len(edges) > 1 else math.nan
             rec["m_at_beta_t_reliable"] = all(e["reliable"] for e in edges)
             rec["tau_int_loads_at_beta_t"] = float(np.nanmean([e["tau"] for e in edges]))
             rec["replicas"] = len(edges)
-        left = down[down["branch_state"] == "stick-slip"]
-        if len(left):
-            lo = float(left["beta"].max())
-            above = down[(down["branch_state"] == "sliding") & (down["beta"] > lo)]
-            if len(above):
-                hi = float(above["beta"].min())
-                rec["lower_edge"], rec["lower_edge_err"] = 0.5 * (lo + hi), 0.5 * (hi - lo)
+        lo, hi = _bracket(down)  # NaN unless the down ladder left steady sliding below a sliding rung
+        rec["lower_edge"], rec["lower_edge_err"] = 0.5 * (lo + hi), 0.5 * (hi - lo)
         rec["undecided"] = int((g["final_state"] == "undecided").sum())
         rec["rungs"] = len(g)
         out.append(rec)
@@ -214,51 +194,43 @@ def per_n_summary(rows: pd.DataFrame) -> pd.DataFrame:
 
 
 def _fits(per_n: pd.DataFrame) -> dict[str, Any]:
-    from stickslip.analysis.order import power_law_fit
-
-    fits = {}
-    ok = per_n.dropna(subset=["beta_t"])
-    fits["beta_t_minus_1"] = power_law_fit(ok["N"], ok["beta_t"] - 1.0, ok["beta_t_err"].fillna(ok["beta_t"] - 1.0))
-    ok = per_n.dropna(subset=["step"])
-    fits["step"] = power_law_fit(ok["N"], ok["step"].abs(), ok["step_err"])
-    return fits
-
-
-def _statements(per_n: pd.DataFrame, fits: dict[str, Any], rows: pd.DataFrame) -> list[str]:
-    say = []
-    for r in per_n.itertuples():
-        say.append(
-            f"N = {r.N}: beta_t = {r.beta_t:.4g} +- {r.beta_t_err:.2g}, lower edge {r.lower_edge:.4g} "
-            f"+- {r.lower_edge_err:.2g}, step of m at beta_t {r.step:.3g} +- {r.step_err:.2g}, "
-            f"stuck fraction there {r.step_phi:.3g}"
-        )
-    for name, label in (("beta_t_minus_1", "beta_t - 1"), ("step", "|step of m|")):
-        f = fits[name]
-        if math.isfinite(f["b"]):
-            say.append(f"{label} ~ N^b with b = {f['b']:.2f} +- {f['b_err']:.2f} ({f['n']} values of N)")
-    n_und = int((rows["final_state"] == "undecided").sum())
-    say.append(f"{n_und} of {len(rows)} rungs undecided at their cap (reasons in the table)")
-    return say
+    bt, step = per_n.dropna(subset=["beta_t"]), per_n.dropna(subset=["step"])
+    return {
+        "beta_t_minus_1": power_law_fit(bt["N"], bt["beta_t"] - 1.0, bt["beta_t_err"].fillna(bt["beta_t"] - 1.0)),
+        "step": power_law_fit(step["N"], step["step"].abs(), step["step_err"]),
+    }
 
 
 def rungs(sweep: pd.DataFrame) -> pd.DataFrame:
     """The study's table, one row per rung, from the sweep's (one row per ladder)."""
-    ok = sweep[sweep["status"] == "ok"] if "status" in sweep else sweep.iloc[:0]
-    rows = [r for text in ok.get("rows", []) for r in (json.loads(text) if isinstance(text, str) else text)]
-    return _rows_table(rows)
+    ok = sweep[sweep["status"] == "ok"]  # the rows of each ladder as JSON text (the sweep's table)
+    return _rows_table([r for text in ok.get("rows", []) for r in json.loads(text)])
 
 
 def findings(spec: Study, table: pd.DataFrame) -> dict[str, Any]:
     """beta_t, the lower edge and the step at beta_t per N (:func:`per_n_summary`), their power
-    laws in N and the statements of the page."""
-    per_n = per_n_summary(table) if len(table) else pd.DataFrame(columns=PER_N_COLUMNS)
-    fits = _fits(per_n) if len(per_n) else {}
+    laws in N and the statements of the page, from the rungs of the finished ladders (never none:
+    :func:`stickslip.experiments.study_run.run_study` asks only then)."""
+    per_n = per_n_summary(table)
+    fits = _fits(per_n)
+    undecided = int((table["final_state"] == "undecided").sum())
+    say = [
+        f"N = {r.N}: beta_t = {r.beta_t:.4g} +- {r.beta_t_err:.2g}, lower edge {r.lower_edge:.4g} "
+        f"+- {r.lower_edge_err:.2g}, step of m at beta_t {r.step:.3g} +- {r.step_err:.2g}, "
+        f"stuck fraction there {r.step_phi:.3g}"
+        for r in per_n.itertuples()
+    ]
+    for name, label in (("beta_t_minus_1", "beta_t - 1"), ("step", "|step of m|")):
+        f = fits[name]
+        if math.isfinite(f["b"]):
+            say.append(f"{label} ~ N^b with b = {f['b']:.2f} +- {f['b_err']:.2f} ({f['n']} values of N)")
+    say.append(f"{undecided} of {len(table)} rungs undecided at their cap (reasons in the table)")
     return {
-        "statements": _statements(per_n, fits, table) if len(table) else [],
+        "statements": say,
         "fits": fits,
         "per_N": table_records(per_n),
         "rungs": len(table),
-        "undecided": int((table["final_state"] == "undecided").sum()) if len(table) else 0,
+        "undecided": undecided,
         "rungs_damaged": int(table["note"].notna().sum()) if "note" in table else 0,
     }
 
@@ -273,10 +245,6 @@ def figures(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[tuple[str,
         ("loops", loops_figure(table), "m and the stuck fraction against beta: up ladders and the down ladder, per N."),
         ("scaling", scaling_figure(per_n, _fits(per_n)), "beta_t - 1 and the step of m at beta_t against N."),
     ]
-
-
-def _per_n_table(found: dict[str, Any]) -> list[tuple[str, list[str], list[dict[str, Any]]]]:
-    return [("Per N", PER_N_COLUMNS + ["undecided", "rungs"], found.get("per_N", []))]
 
 
 def _rows_table(rows: list[dict[str, Any]]) -> pd.DataFrame:
@@ -302,12 +270,8 @@ def transition_loop(
     beta: the up and down ladders of ``stickslip study transition`` (docs/studies/transition.md),
     run one after the other in this process.
 
-    The up ladder starts in stick-slip below beta = 1 and hands each rung's final state to the next
-    larger beta until the chain slides steadily; the down ladder starts from steady sliding above
-    the loop and goes down until a block sticks; each then bisects the bracket it found. Every rung
-    stops when its answer is known (:mod:`stickslip.experiments.ladders`). The rungs are those of
-    the study with the same settings, bit for bit: at N = 49 (about 15 s) replica 0 of
-    ``--quick``.
+    The rungs (:mod:`stickslip.experiments.ladders`) are those of the study with the same
+    settings, bit for bit: at N = 49 (about 15 s) replica 0 of ``--quick``.
 
     Parameters
     ----------
@@ -355,8 +319,7 @@ def transition_loop(
     ladders.append({"direction": "down", "betas": list(down or grid_down), "seed": 0, "replica": 0})
     points = [{**common, "N": N, "cap_loads": cap, "bisections": bisections, **lad} for lad in ladders]
     for point in points:  # every rung's parameters refused before any ladder runs
-        for beta in point["betas"]:
-            params_at(point, float(beta))
+        check(point)
     folder = Path(out_dir) if out_dir is not None else Path(tempfile.mkdtemp(prefix="stickslip-transition-"))
     rows: list[dict[str, Any]] = []
     for point in points:
@@ -394,7 +357,7 @@ DESIGN = Design(
     figures=figures,
     columns=tuple(ROW_COLUMNS),
     rows=rungs,
-    tables=_per_n_table,
+    tables=lambda found: [("Per N", PER_N_COLUMNS + ["undecided", "rungs"], found.get("per_N", []))],
     point_entry=ladder_entry,
     options=(Option("--extra-n", "extra_Ns", "N", "add a chain of N blocks (both ladders), e.g. 1599; repeatable"),),
 )
