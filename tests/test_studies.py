@@ -537,7 +537,7 @@ def test_tiny_exponents_study_draws_the_family_beside_fig8(tmp_path, cluster):
     cl, fig8 = rows[("carlson-langer", None)], rows[("sakaguchi", 0.2)]
     assert cl["spanning"] == "n_blocks" and fig8["spanning"] == "max_block"
     table = pd.read_parquet(tmp_path / "exponents" / "table.parquet")
-    panels = _family_panels(spec, table, tmp_path / "runs" / spec.dirname / "points")
+    panels = _family_panels(table, tmp_path / "runs" / spec.dirname / "points")
     titles = [title for title, _, _ in panels]
     assert titles[0].startswith("Carlson-Langer") and titles[1].startswith("eq. (4), beta = 0.2")
     for (_, events, stats), row in zip(panels, (cl, fig8), strict=True):

@@ -87,7 +87,7 @@ def figures(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[tuple[str,
         "bootstrap errors) and great-event excess against beta; Carlson-Langer as a band."
     )
     out = [("tau_beta", exponents_figure(table), caption)]
-    panels = _family_panels(spec, table, spec.runs_dir(Path(page_dir).parent) / "points")
+    panels = _family_panels(table, spec.runs_dir(Path(page_dir).parent) / "points")
     if len(panels) == 2:
         caption = (
             "Slip-size density p(S) on logarithmic bins, log-log, of the events after each run's transient. "
@@ -99,7 +99,7 @@ def figures(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[tuple[str,
     return out
 
 
-def _family_panels(spec: Study, table: pd.DataFrame, points: Path) -> list[tuple[str, pd.DataFrame, dict[str, Any]]]:
+def _family_panels(table: pd.DataFrame, points: Path) -> list[tuple[str, pd.DataFrame, dict[str, Any]]]:
     """(title, events, statistics) of the relative's run and of eq. (4) at its smallest beta, each
     fitted as its point was (:func:`stickslip.analysis.chain_runs.size_statistics`); none without a fit."""
     from stickslip import io
