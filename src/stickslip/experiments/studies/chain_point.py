@@ -29,10 +29,6 @@ def t_end_of(N: int, loads: float) -> float:
     return math.ceil(t / scale) * scale
 
 
-# ---------------------------------------------------------------------------------------------
-# One point: a chain run and its analysis, on a worker
-
-
 def point_run_options(cfg: dict[str, Any], params) -> tuple[float, dict[str, Any]]:
     """Run length and :func:`~stickslip.run.driver.run_chain` options of a point."""
     t_end = float(cfg["t_end"])

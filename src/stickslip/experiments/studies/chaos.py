@@ -1,31 +1,30 @@
 """``stickslip study chaos``: is the chain of eq. (4) chaotic at the onset (section 3, "chaotic
-motion")? Its points, the measurement of one point, its findings (delta* against N) and its
-figures (docs/studies/chaos.md).
+motion")? Its points, the measurement of one point, its findings and figures
+(docs/studies/chaos.md).
 
-At several N and beta = 0.5, 0.9, 1, and for two blocks and Carlson-Langer as known answers, a
-point (:func:`chaos_point`) measures from the engine's state at the end of its transient
+A point (:func:`chaos_point`: the paper's chain at several N and beta = 0.5, 0.9, 1, or two blocks
+or Carlson-Langer as known answers) measures from the engine's state at the end of its transient
 (:func:`stickslip.run.loaded.loaded_state`, kept in the point's folder with its loading check):
 
 - the flow's largest exponent by two trajectories with located switches
-  (:func:`stickslip.analysis.lyapunov_flow.flow_lyapunov`) at dt, dt/2, dt/4 over ``flow_t``, each
-  rung counting some 300 slips or more in the chain's points, extrapolated to dt -> 0
-  (:func:`stickslip.analysis.lyapunov_flow.extrapolate`);
-- n(delta) on the engine's map over windows of ``events`` slips (1000 in the chain's points), for
-  each kind of perturbation (state, Fs, V), each delta and ``seeds`` consecutive windows
-  (:func:`stickslip.analysis.decorrelation.sequence_decorrelation`, the measurement of
-  ``stickslip lyapunov --decorrelation``), and delta* per kind
+  (:func:`stickslip.analysis.lyapunov_flow.flow_lyapunov`) at dt, dt/2, dt/4 over ``flow_t``
+  (some :data:`MIN_FLOW_SLIPS` slips or more per rung in the chain's points), extrapolated to
+  dt -> 0 (:func:`stickslip.analysis.lyapunov_flow.extrapolate`);
+- n(delta) on the engine's map (:func:`stickslip.analysis.decorrelation.sequence_decorrelation`,
+  as ``stickslip lyapunov --decorrelation``) for each kind of perturbation (state, Fs, V) and each
+  delta over ``seeds`` consecutive windows of ``events`` slips, and delta* per kind
   (:func:`stickslip.analysis.threshold.delta_star`);
 - the verdict (:func:`stickslip.analysis.decorrelation.verdict`) from the exponent and the
   state's n(delta).
 
-Every part (each rung, each kind) is written to ``parts/`` in the point's folder as it finishes
-and read back, not run again, when the point runs again with the same settings, and the transient
-keeps its finished chunks: an interrupted point loses at most the part it was in. A study that is
-interrupted asks its points to stop (:func:`stickslip.experiments.sweep.stop_requested`); a point
-stops within a chunk of the transient, 64 renormalisations of a rung or one twin.
+Each part (rung, kind) is written to ``parts/`` as it finishes and read back, not run again, when
+the point runs again with the same settings, as are the transient's finished chunks: an
+interrupted point loses at most the part it was in. Asked to stop
+(:func:`stickslip.experiments.sweep.stop_requested`), a point stops within a chunk of the
+transient, 64 renormalisations of a rung or one twin.
 
-From the table (one row per point): each point's verdict with the window it holds for, the flow's
-exponent and the slips its rungs counted, the loading check; delta* of each kind per point
+The findings (:func:`conclusions`, from the table): each point's verdict with its window, the
+flow's exponent and the slips its rungs counted, the loading check; delta* per point and kind
 (geometric mean over the windows, its error in decades, the range) and, for each beta and kind,
 the least-squares slope of log10 delta* (one point per window) on log10 N
 (:func:`stickslip.analysis.threshold.threshold_fit`). The figures (:mod:`stickslip.plotting.chaos`)
@@ -297,9 +296,12 @@ def _value(x) -> float | None:
     return float(x) if finite(x) else None
 
 
-def thresholds(table: pd.DataFrame) -> list[dict[str, Any]]:
-    """delta* of every chain point and kind: ``N``, ``beta``, ``kind``, ``per_seed``,
-    ``geometric_mean``, ``log10_err``, ``low``, ``high``, ``censored``."""
+def thresholds(table: pd.DataFrame) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
+    """delta* of every chain point and kind (``N``, ``beta``, ``kind``, ``per_seed``,
+    ``geometric_mean``, ``log10_err``, ``low``, ``high``, ``censored``) and, for each beta and
+    kind, :func:`~stickslip.analysis.threshold.threshold_fit` of its points."""
+    from stickslip.analysis.threshold import threshold_fit
+
     out = []
     chain = table[table["model"].map(is_paper)].sort_values(["N", "beta"])
     for _, row in chain.iterrows():
@@ -320,20 +322,12 @@ def thresholds(table: pd.DataFrame) -> list[dict[str, Any]]:
                     "censored": int(row[censored]),
                 }
             )
-    return out
-
-
-def fits(points: list[dict[str, Any]]) -> list[dict[str, Any]]:
-    """For each beta and kind, :func:`~stickslip.analysis.threshold.threshold_fit` of its points."""
-    from stickslip.analysis.threshold import threshold_fit
-
-    out = []
-    keys = sorted({(p["beta"], p["kind"]) for p in points}, key=lambda k: (KINDS.index(k[1]), k[0]))
-    for beta, kind in keys:
-        mine = sorted((p for p in points if p["beta"] == beta and p["kind"] == kind), key=lambda p: p["N"])
+    fits = []
+    for beta, kind in sorted({(p["beta"], p["kind"]) for p in out}, key=lambda k: (KINDS.index(k[1]), k[0])):
+        mine = sorted((p for p in out if p["beta"] == beta and p["kind"] == kind), key=lambda p: p["N"])
         fit = threshold_fit([p["N"] for p in mine], [p["per_seed"] for p in mine])
-        out.append({"beta": beta, "kind": kind, **fit})
-    return out
+        fits.append({"beta": beta, "kind": kind, **fit})
+    return out, fits
 
 
 def conclusions(spec: Study | None, table: pd.DataFrame) -> dict[str, Any]:
@@ -375,9 +369,7 @@ def conclusions(spec: Study | None, table: pd.DataFrame) -> dict[str, Any]:
             if not not_loaded
             else f"Loading: NOT loaded by that rule: {', '.join(not_loaded)}."
         )
-    points = thresholds(table)
-    out["thresholds"] = points
-    out["fits"] = fits(points)
+    out["thresholds"], out["fits"] = thresholds(table)
     for kind in KINDS:
         mine = [f for f in out["fits"] if f["kind"] == kind and math.isfinite(f["slope"])]
         if not mine:
@@ -400,24 +392,29 @@ def curves(table: pd.DataFrame, points_dir: Path) -> list[dict[str, Any]]:
     for the relatives); chain points by N then beta, the relatives last."""
     from stickslip import io
 
-    found = []
     if "point_dir" not in table.columns:
-        return found
-    for r in table.itertuples():
+        return []
+    found = []
+    for r in sorted(table.itertuples(), key=lambda r: (0, r.N, r.beta) if is_paper(r.model) else (1, 0, 0.0)):
         path = Path(points_dir) / str(r.point_dir) / "flow.json"
         if not path.is_file():
             continue
         chain = is_paper(r.model)
         label = f"eq. (4), N = {int(r.N)}, beta = {r.beta:g}" if chain else f"{r.model}, N = {int(r.N)}"
-        key = (0, int(r.N), float(r.beta)) if chain else (1, 0, 0.0)
-        data = io.read_json(path)
-        found.append((key, {**data, "label": label, "N": int(r.N), "beta": float(r.beta) if chain else None}))
-    return [c for _, c in sorted(found, key=lambda x: x[0])]
+        found.append({**io.read_json(path), "label": label, "N": int(r.N), "beta": float(r.beta) if chain else None})
+    return found
 
 
-def decorrelation_table(found: list[dict[str, Any]]) -> pd.DataFrame:
-    """Every n(delta) row of the points: model label, N, beta, kind, delta, seed, events,
-    decorrelated, t_decorrelated."""
+def figures(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[tuple[str, Any, str]]:
+    """The study's figures (name, Figure, caption), from each point's ``flow.json`` in its runs
+    folder beside ``page_dir``, and ``decorrelation.csv``/``.parquet`` in ``page_dir``: every
+    n(delta) row (point, N, beta, kind, delta, seed, events, decorrelated, t_decorrelated)."""
+    from stickslip import io
+    from stickslip.plotting import chaos as pc
+
+    found = curves(table, spec.runs_dir(Path(page_dir).parent) / "points")
+    if not found:
+        return []
     keys = ("delta", "seed", "events", "decorrelated", "t_decorrelated")
     rows = [
         {"point": c["label"], "N": c["N"], "beta": c["beta"], "kind": kind, **{k: r.get(k) for k in keys}}
@@ -425,20 +422,7 @@ def decorrelation_table(found: list[dict[str, Any]]) -> pd.DataFrame:
         for kind, d in (c.get("decorrelation") or {}).items()
         for r in d.get("decorrelation", [])
     ]
-    return pd.DataFrame(rows)
-
-
-def figures(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[tuple[str, Any, str]]:
-    """The study's figures (name, Figure, caption), from each point's ``flow.json`` in its runs
-    folder beside ``page_dir``, and ``decorrelation.csv``/``.parquet`` in ``page_dir`` (every
-    n(delta) row)."""
-    from stickslip import io
-    from stickslip.plotting import chaos as pc
-
-    found = curves(table, spec.runs_dir(Path(page_dir).parent) / "points")
-    if not found:
-        return []
-    io.write_table_files(Path(page_dir) / "decorrelation", decorrelation_table(found))
+    io.write_table_files(Path(page_dir) / "decorrelation", pd.DataFrame(rows))
     out = [
         (
             "decorrelation",
@@ -454,12 +438,12 @@ def figures(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[tuple[str,
             "dt/4, with the fit lambda_0 + c dt^2 and lambda_0 (square) at dt = 0.",
         ),
     ]
-    points = thresholds(table)
+    points, fits = thresholds(table)
     if points:
         out.append(
             (
                 "threshold",
-                pc.threshold_figure(points, fits(points)),
+                pc.threshold_figure(points, fits),
                 "delta*, the smallest delta that decorrelated within the window, against N: each "
                 "window (dots), the geometric mean with its standard error, and the least-squares "
                 "line of log10 delta* on log10 N for each beta (dashed, slope in the legend).",
@@ -485,13 +469,6 @@ def describe() -> str:
     )
 
 
-_COLUMNS = (
-    *"model N beta verdict verdict_text lyapunov_dt0 lyapunov_dt0_err flow_slips window".split(),
-    *(column for kind in KINDS for column in threshold_columns(kind)),
-    *"threshold_below threshold_low windows_decorrelated windows transient loaded".split(),
-    *"first_slip_reaching_block_N flow_t seeds n_deltas".split(),
-)
-
 DESIGN = Design(
     name="chaos",
     summary="the flow's exponent, slip decorrelation and its threshold delta* against N; the verdict",
@@ -501,5 +478,10 @@ DESIGN = Design(
     check=check_point,
     findings=conclusions,
     figures=figures,
-    columns=_COLUMNS,
+    columns=(
+        *"model N beta verdict verdict_text lyapunov_dt0 lyapunov_dt0_err flow_slips window".split(),
+        *(column for kind in KINDS for column in threshold_columns(kind)),
+        *"threshold_below threshold_low windows_decorrelated windows transient loaded".split(),
+        *"first_slip_reaching_block_N flow_t seeds n_deltas".split(),
+    ),
 )

@@ -1,10 +1,8 @@
 """``stickslip study phase-diagram``: the final state and m = 1 - <L>/L_ss of eq. (4) over
 (alpha, beta) at D = 5 and over (D, beta) at alpha = 1, at N = 99, each cell from the paper's
 start and from steady sliding perturbed by 0.01 (hysteresis), against the linear-stability
-line beta_c = alpha (docs/studies/phase-diagram.md).
-
-Each point is one chain run and its order parameter
-(:func:`stickslip.experiments.studies.chain_point.order_task`).
+line beta_c = alpha (docs/studies/phase-diagram.md). Each point is one chain run and its order
+parameter (:func:`stickslip.experiments.studies.chain_point.order_task`).
 """
 
 from __future__ import annotations
@@ -20,6 +18,9 @@ from stickslip.models.physics import UNTIL_STEADY
 from stickslip.models.presets import paper_parameters
 
 __all__ = ["DESIGN"]
+
+#: The two slices of the diagram: the parameter that varies beside beta, the one held and its value.
+_SLICES = (("alpha", "D", 5.0, "D = 5"), ("D", "alpha", 1.0, "alpha = 1"))
 
 
 def build(mode: str) -> Study:
@@ -90,7 +91,7 @@ def findings(spec: Study, table: pd.DataFrame) -> dict[str, Any]:
         f"From the paper's start, {agree_lin} of {n_lin} settled cells are on the side of beta_c = alpha that "
         f"linear stability predicts (steady for beta > alpha, stick-slip below)."
     )
-    for name, fixed, value, where in (("alpha", "D", 5.0, "D = 5"), ("D", "alpha", 1.0, "alpha = 1")):
+    for name, fixed, value, where in _SLICES:
         for x, g in table[(table[fixed] == value) & (table["start"] == "paper")].groupby(name):
             br = transition_bracket(g["beta"], g["final_state"])
             line = (
@@ -107,15 +108,11 @@ def figures(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[tuple[str,
 
     return [
         (
-            "phase_alpha_beta",
-            phase_map_figure(table[table["D"] == 5.0], "alpha", "D = 5"),
-            "Final state and m over (alpha, beta) at D = 5; dashed: beta_c = alpha.",
-        ),
-        (
-            "phase_D_beta",
-            phase_map_figure(table[table["alpha"] == 1.0], "D", "alpha = 1"),
-            "Final state and m over (D, beta) at alpha = 1; dashed: beta_c = alpha = 1.",
-        ),
+            f"phase_{name}_beta",
+            phase_map_figure(table[table[fixed] == value], name, where),
+            f"Final state and m over ({name}, beta) at {where}; dashed: beta_c = alpha{' = 1' if name == 'D' else ''}.",
+        )
+        for name, fixed, value, where in _SLICES
     ]
 
 
