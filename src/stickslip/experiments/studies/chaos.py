@@ -387,32 +387,25 @@ def conclusions(spec: Study | None, table: pd.DataFrame) -> dict[str, Any]:
     return out
 
 
-def curves(table: pd.DataFrame, points_dir: Path) -> list[dict[str, Any]]:
-    """The ``flow.json`` of every point that has one, with ``label``, ``N`` and ``beta`` (None
-    for the relatives); chain points by N then beta, the relatives last."""
+def figures(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[tuple[str, Any, str]]:
+    """The study's figures (name, Figure, caption), from each point's ``flow.json`` in its runs
+    folder beside ``page_dir`` (the curves of :mod:`stickslip.plotting.chaos`: chain points by N
+    then beta, the relatives last), and ``decorrelation.csv``/``.parquet`` in ``page_dir``: every
+    n(delta) row (point, N, beta, kind, delta, seed, events, decorrelated, t_decorrelated)."""
     from stickslip import io
+    from stickslip.plotting import chaos as pc
 
     if "point_dir" not in table.columns:
         return []
+    points_dir = spec.runs_dir(Path(page_dir).parent) / "points"
     found = []
     for r in sorted(table.itertuples(), key=lambda r: (0, r.N, r.beta) if is_paper(r.model) else (1, 0, 0.0)):
-        path = Path(points_dir) / str(r.point_dir) / "flow.json"
+        path = points_dir / str(r.point_dir) / "flow.json"
         if not path.is_file():
             continue
         chain = is_paper(r.model)
         label = f"eq. (4), N = {int(r.N)}, beta = {r.beta:g}" if chain else f"{r.model}, N = {int(r.N)}"
         found.append({**io.read_json(path), "label": label, "N": int(r.N), "beta": float(r.beta) if chain else None})
-    return found
-
-
-def figures(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[tuple[str, Any, str]]:
-    """The study's figures (name, Figure, caption), from each point's ``flow.json`` in its runs
-    folder beside ``page_dir``, and ``decorrelation.csv``/``.parquet`` in ``page_dir``: every
-    n(delta) row (point, N, beta, kind, delta, seed, events, decorrelated, t_decorrelated)."""
-    from stickslip import io
-    from stickslip.plotting import chaos as pc
-
-    found = curves(table, spec.runs_dir(Path(page_dir).parent) / "points")
     if not found:
         return []
     keys = ("delta", "seed", "events", "decorrelated", "t_decorrelated")
@@ -440,15 +433,12 @@ def figures(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[tuple[str,
     ]
     points, fits = thresholds(table)
     if points:
-        out.append(
-            (
-                "threshold",
-                pc.threshold_figure(points, fits),
-                "delta*, the smallest delta that decorrelated within the window, against N: each "
-                "window (dots), the geometric mean with its standard error, and the least-squares "
-                "line of log10 delta* on log10 N for each beta (dashed, slope in the legend).",
-            )
+        caption = (
+            "delta*, the smallest delta that decorrelated within the window, against N: each "
+            "window (dots), the geometric mean with its standard error, and the least-squares "
+            "line of log10 delta* on log10 N for each beta (dashed, slope in the legend)."
         )
+        out.append(("threshold", pc.threshold_figure(points, fits), caption))
     return out
 
 
