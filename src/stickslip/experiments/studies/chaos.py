@@ -261,9 +261,7 @@ def chaos_point(cfg: dict[str, Any], params, point_dir: Path) -> dict[str, Any]:
     out: dict[str, Any] = {
         "loaded": bool(loaded.info["loaded"]),
         "first_slip_reaching_block_N": loaded.info["first_slip_reaching_block_N"],
-        "lyapunov_dt0": lam0,
-        "lyapunov_dt0_err": err0,
-        "flow_slips": flow_slips,
+        **{k: info[k] for k in ("lyapunov_dt0", "lyapunov_dt0_err", "flow_slips")},
         "window": window,
         "n_deltas": len(cfg["deltas"]),
         **v.to_dict(),
@@ -303,8 +301,7 @@ def thresholds(table: pd.DataFrame) -> tuple[list[dict[str, Any]], list[dict[str
     from stickslip.analysis.threshold import threshold_fit
 
     out = []
-    chain = table[table["model"].map(is_paper)].sort_values(["N", "beta"])
-    for _, row in chain.iterrows():
+    for _, row in table[table["model"].map(is_paper)].sort_values(["N", "beta"]).iterrows():
         for kind in KINDS:
             mean, err, low, high, censored = threshold_columns(kind)
             if mean not in row.index or not finite(row.get(censored)):

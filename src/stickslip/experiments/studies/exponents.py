@@ -64,8 +64,7 @@ def findings(spec: Study, table: pd.DataFrame) -> dict[str, Any]:
             f"{short(getattr(r, 'excess', math.nan))} ({getattr(r, 'observed', 'n/a')} observed / "
             f"{short(getattr(r, 'expected', math.nan))} expected)."
         )
-    chain = table[table["model"].map(is_paper)].sort_values("beta")
-    ok = chain[np.isfinite(chain["tau"].astype(float))]
+    ok = table[table["model"].map(is_paper) & np.isfinite(table["tau"].astype(float))].sort_values("beta")
     if len(ok) > 1:
         slope = np.polyfit(ok["beta"].astype(float), ok["tau"].astype(float), 1)[0]
         say(
