@@ -439,8 +439,8 @@ def test_a_quick_chain_point_counts_its_slips():
     the windows 1000, and the row has the study's columns (about a minute)."""
     import tempfile
 
+    from stickslip.experiments.studies import design
     from stickslip.experiments.studies.chaos import MIN_FLOW_SLIPS, chaos_point
-    from stickslip.experiments.study_run import TABLE_COLUMNS
 
     spec = study("chaos", "quick")
     cfg = {**spec.common, **next(p for p in spec.points if p.get("N") == 49 and p.get("beta") == 1.0)}
@@ -448,7 +448,7 @@ def test_a_quick_chain_point_counts_its_slips():
         row = chaos_point(cfg, point_params("chain", cfg), Path(d))
     assert row["flow_slips"] >= MIN_FLOW_SLIPS and row["window"] == 1000 and row["loaded"] is True
     point_keys = set(cfg) | {"model", "N", "beta"}
-    assert set(TABLE_COLUMNS["chaos"]) <= set(row) | point_keys
+    assert set(design("chaos").columns) <= set(row) | point_keys
     assert row["verdict_text"].startswith(row["verdict"])
 
 
@@ -537,7 +537,7 @@ def test_tiny_exponents_study_draws_the_family_beside_fig8(tmp_path, cluster):
     cl, fig8 = rows[("carlson-langer", None)], rows[("sakaguchi", 0.2)]
     assert cl["spanning"] == "n_blocks" and fig8["spanning"] == "max_block"
     table = pd.read_parquet(tmp_path / "exponents" / "table.parquet")
-    panels = _family_panels(spec, table, tmp_path / "runs" / spec.dirname / "points")
+    panels = _family_panels(table, tmp_path / "runs" / spec.dirname / "points")
     titles = [title for title, _, _ in panels]
     assert titles[0].startswith("Carlson-Langer") and titles[1].startswith("eq. (4), beta = 0.2")
     for (_, events, stats), row in zip(panels, (cl, fig8), strict=True):

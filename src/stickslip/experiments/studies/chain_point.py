@@ -1,12 +1,7 @@
-"""One point of a study that is one chain run and its analysis (the phase diagram, the exponents).
-
-Each point is one chain run of eq. (4) (or of a relative of it, :mod:`stickslip.models.presets`)
-plus the analysis of that run, carried out on a Dask worker through
-:func:`stickslip.experiments.sweep.run_sweep`: finished points are reused, failed ones are
-recorded and retried by the next call, interrupted runs continue from their checkpoints.
-:func:`order_task` gives the order parameter and the final state
-(:func:`stickslip.analysis.order.order_summary`), :func:`sizes_task` the slip-size exponent
-(:func:`stickslip.analysis.chain_runs.sizes_summary`).
+"""One point of a study that is one chain run of eq. (4) (or of a relative,
+:mod:`stickslip.models.presets`) and its analysis, a task of
+:func:`stickslip.experiments.sweep.run_sweep`: :func:`order_task` gives the order parameter and
+the final state (the phase diagram), :func:`sizes_task` the slip-size exponent (the exponents).
 """
 
 from __future__ import annotations
@@ -34,10 +29,6 @@ def t_end_of(N: int, loads: float) -> float:
     return math.ceil(t / scale) * scale
 
 
-# ---------------------------------------------------------------------------------------------
-# One point: a chain run and its analysis, on a worker
-
-
 def point_run_options(cfg: dict[str, Any], params) -> tuple[float, dict[str, Any]]:
     """Run length and :func:`~stickslip.run.driver.run_chain` options of a point."""
     t_end = float(cfg["t_end"])
@@ -57,44 +48,40 @@ def check_point(cfg: dict[str, Any]) -> None:
     point_run_options(cfg, point_params("chain", cfg))
 
 
-def _run(point: dict[str, Any], point_dir: Path):
-    """The point's chain run (continued from its checkpoint), its parameters, options and the
-    summary fields every point stores."""
+def _run(point: dict[str, Any], point_dir: Path, analyse) -> dict[str, Any]:
+    """The point's chain run (continued from its checkpoint): the summary fields every point
+    stores and ``analyse(run, params, options)``, the summary of its ``done.json``."""
     from stickslip.experiments.sweep import run_chain_point
 
     params = point_params("chain", point)
     t_end, options = point_run_options(point, params)
     run = run_chain_point(params, t_end, Path(point_dir), **options)
-    base = {
+    return {
         "model": params.model,
         "t_end": t_end,
         "t_reached": float(run.summary["t_reached"]),
         "n_events_total": int(run.summary["n_events"]),
         "run_wall_seconds": float(run.summary["wall_seconds"]),
         "block_updates": int(run.summary["block_updates"]),
+        **analyse(run, params, options),
     }
-    return run, params, options, base
 
 
 def order_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
-    """One chain run and its order parameter and final state, a task of ``run_sweep``; returns
-    the summary stored in the point's ``done.json``."""
+    """One chain run and its order parameter and final state, a task of ``run_sweep``."""
     from stickslip.analysis.order import order_summary
 
-    run, params, options, base = _run(point, point_dir)
-    return {**base, **order_summary(run, params, options["average_from"])}
+    return _run(point, point_dir, lambda run, params, options: order_summary(run, params, options["average_from"]))
 
 
 def sizes_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     """One chain run and its slip-size exponent over the events after its transient, a task of
-    ``run_sweep``; returns the summary stored in the point's ``done.json``."""
+    ``run_sweep``."""
     from stickslip.analysis.chain_runs import sizes_summary
 
-    run, _, _, base = _run(point, point_dir)
-    t_from = float(point.get("transient", point.get("average_fraction", 0.5))) * float(run.options.t_end)
-    spanning, seed, bootstrap = (
-        point.get("spanning", "max_block"),
-        int(point.get("seed", 0)),
-        int(point.get("bootstrap", 200)),
-    )
-    return {**base, **sizes_summary(run, t_from, spanning=spanning, seed=seed, bootstrap=bootstrap)}
+    def sizes(run, params, options) -> dict[str, Any]:
+        t_from = float(point.get("transient", point.get("average_fraction", 0.5))) * float(run.options.t_end)
+        spanning, seed = point.get("spanning", "max_block"), int(point.get("seed", 0))
+        return sizes_summary(run, t_from, spanning=spanning, seed=seed, bootstrap=int(point.get("bootstrap", 200)))
+
+    return _run(point, point_dir, sizes)

@@ -1,31 +1,30 @@
 """``stickslip study chaos``: is the chain of eq. (4) chaotic at the onset (section 3, "chaotic
-motion")? Its points, the measurement of one point, its findings (delta* against N) and its
-figures (docs/studies/chaos.md).
+motion")? Its points, the measurement of one point, its findings and figures
+(docs/studies/chaos.md).
 
-At several N and beta = 0.5, 0.9, 1, and for two blocks and Carlson-Langer as known answers, a
-point (:func:`chaos_point`) measures from the engine's state at the end of its transient
+A point (:func:`chaos_point`: the paper's chain at several N and beta = 0.5, 0.9, 1, or two blocks
+or Carlson-Langer as known answers) measures from the engine's state at the end of its transient
 (:func:`stickslip.run.loaded.loaded_state`, kept in the point's folder with its loading check):
 
 - the flow's largest exponent by two trajectories with located switches
-  (:func:`stickslip.analysis.lyapunov_flow.flow_lyapunov`) at dt, dt/2, dt/4 over ``flow_t``, each
-  rung counting some 300 slips or more in the chain's points, extrapolated to dt -> 0
-  (:func:`stickslip.analysis.lyapunov_flow.extrapolate`);
-- n(delta) on the engine's map over windows of ``events`` slips (1000 in the chain's points), for
-  each kind of perturbation (state, Fs, V), each delta and ``seeds`` consecutive windows
-  (:func:`stickslip.analysis.decorrelation.sequence_decorrelation`, the measurement of
-  ``stickslip lyapunov --decorrelation``), and delta* per kind
+  (:func:`stickslip.analysis.lyapunov_flow.flow_lyapunov`) at dt, dt/2, dt/4 over ``flow_t``
+  (some :data:`MIN_FLOW_SLIPS` slips or more per rung in the chain's points), extrapolated to
+  dt -> 0 (:func:`stickslip.analysis.lyapunov_flow.extrapolate`);
+- n(delta) on the engine's map (:func:`stickslip.analysis.decorrelation.sequence_decorrelation`,
+  as ``stickslip lyapunov --decorrelation``) for each kind of perturbation (state, Fs, V) and each
+  delta over ``seeds`` consecutive windows of ``events`` slips, and delta* per kind
   (:func:`stickslip.analysis.threshold.delta_star`);
 - the verdict (:func:`stickslip.analysis.decorrelation.verdict`) from the exponent and the
   state's n(delta).
 
-Every part (each rung, each kind) is written to ``parts/`` in the point's folder as it finishes
-and read back, not run again, when the point runs again with the same settings, and the transient
-keeps its finished chunks: an interrupted point loses at most the part it was in. A study that is
-interrupted asks its points to stop (:func:`stickslip.experiments.sweep.stop_requested`); a point
-stops within a chunk of the transient, 64 renormalisations of a rung or one twin.
+Each part (rung, kind) is written to ``parts/`` as it finishes and read back, not run again, when
+the point runs again with the same settings, as are the transient's finished chunks: an
+interrupted point loses at most the part it was in. Asked to stop
+(:func:`stickslip.experiments.sweep.stop_requested`), a point stops within a chunk of the
+transient, 64 renormalisations of a rung or one twin.
 
-From the table (one row per point): each point's verdict with the window it holds for, the flow's
-exponent and the slips its rungs counted, the loading check; delta* of each kind per point
+The findings (:func:`conclusions`, from the table): each point's verdict with its window, the
+flow's exponent and the slips its rungs counted, the loading check; delta* per point and kind
 (geometric mean over the windows, its error in decades, the range) and, for each beta and kind,
 the least-squares slope of log10 delta* (one point per window) on log10 N
 (:func:`stickslip.analysis.threshold.threshold_fit`). The figures (:mod:`stickslip.plotting.chaos`)
@@ -45,20 +44,7 @@ from stickslip.experiments.studies import Design, Study, finite, short
 from stickslip.experiments.sweep_points import point_params
 from stickslip.models.presets import PRESETS, is_paper
 
-__all__ = [
-    "DESIGN",
-    "chaos_points",
-    "chaos_point",
-    "check_point",
-    "conclusions",
-    "curves",
-    "figures",
-    "decorrelation_table",
-    "DELTAS_FULL",
-    "DELTAS_QUICK",
-    "TRANSIENTS",
-    "MIN_FLOW_SLIPS",
-]
+__all__ = ["DESIGN", "chaos_point", "conclusions", "MIN_FLOW_SLIPS"]
 
 KINDS = ("state", "Fs", "V")
 #: The deltas of ``--full`` (and of docs/studies/decorrelation-grid.json): 1e-12, 1e-11, ..., 1e-1.
@@ -70,35 +56,29 @@ DELTAS_QUICK = (1e-10, 1e-8, 1e-6, 1e-5, 1e-4, 1e-3, 1e-2, 1e-1)
 TRANSIENTS = {49: 5e5, 99: 1.5e6, 199: 5e6, 399: 2e7, 799: 8e7}
 #: Slips each rung of a chain point's ladder should count (the page reports what they did).
 MIN_FLOW_SLIPS = 300
-_KEYS = ("transient", "kinds", "deltas", "seeds", "events", "flow_t")
 
 
-def chaos_points(mode: str) -> tuple[list[dict[str, Any]], dict[str, Any]]:
-    """The points of ``stickslip study chaos`` in ``mode`` and the settings they share: the
-    paper's chain (eq. 4) at several N and beta = 0.5, 0.9, 1, and two blocks and Carlson-Langer at
-    their standard parameters (the verdict's known answers: chaotic), dearest first. A point's
-    own keys override the shared ones (the relatives' interval, kinds and ladder length)."""
-    betas = (0.5, 0.9, 1.0)
+def build(mode: str) -> Study:
+    """The study of ``mode``: the paper's chain (eq. 4) at several N and beta = 0.5, 0.9, 1, and two
+    blocks and Carlson-Langer at their standard parameters (the verdict's known answers: chaotic),
+    dearest first, and the settings they share. A point's own keys override the shared ones (the
+    relatives' interval, kinds and ladder length)."""
     # a rung of 1.2e5 time units counts 0.9 of it: some 360 slips of the chain at every N (1000 slips
     # take 2.9e5 to 3.0e5, docs/studies/chaos.md); --full counts five times as many (at N = 799 the
     # growth of a separation comes in rare large slips, and 360 slips hold only a few of them)
+    betas = (0.5, 0.9, 1.0)
     if mode == "tiny":
         Ns, deltas, seeds, events, flow_t, levels = (5, 9), (1e-8, 1e-4, 1e-1), 2, 40, 2000.0, 2
         transients = {5: 1e4, 9: 2e4}
         family = [{"model": "two-blocks", "transient": 100.0, "flow_t": 200.0, "events": 30, "seeds": 1}]
-    elif mode == "quick":
-        Ns, deltas, seeds, events, flow_t, levels = (49, 99, 199), DELTAS_QUICK, 2, 1000, 1.2e5, 3
-        transients = TRANSIENTS
+    else:  # --quick: three N, fewer deltas and windows, one window of the relatives
+        quick = mode == "quick"
+        Ns, deltas, seeds = ((49, 99, 199), DELTAS_QUICK, 2) if quick else ((49, 99, 199, 399, 799), DELTAS_FULL, 3)
+        events, flow_t, levels, transients = 1000, 1.2e5 if quick else 6e5, 3, TRANSIENTS
+        once = {"seeds": 1} if quick else {}
         family = [
-            {"model": "two-blocks", "transient": 2e3, "flow_t": 1.2e4, "seeds": 1},
-            {"model": "carlson-langer", "transient": 2e3, "flow_t": 1e3, "seeds": 1},
-        ]
-    else:
-        Ns, deltas, seeds, events, flow_t, levels = (49, 99, 199, 399, 799), DELTAS_FULL, 3, 1000, 6e5, 3
-        transients = TRANSIENTS
-        family = [
-            {"model": "two-blocks", "transient": 2e3, "flow_t": 1.2e4},
-            {"model": "carlson-langer", "transient": 2e3, "flow_t": 1e3},
+            {"model": "two-blocks", "transient": 2e3, "flow_t": 1.2e4, **once},
+            {"model": "carlson-langer", "transient": 2e3, "flow_t": 1e3, **once},
         ]
     shared = {
         "kinds": list(KINDS),
@@ -122,25 +102,14 @@ def chaos_points(mode: str) -> tuple[list[dict[str, Any]], dict[str, Any]]:
         {**f, "start": "rest", "perturbation": 0.01, "seed": 0, "kinds": "state", "interval": 1.0} for f in family
     ]
     points.sort(key=lambda p: -(p.get("N", 100) ** 2) * p["transient"] ** 0.5)
-    return points, shared
-
-
-def build(mode: str) -> Study:
-    """The study of ``mode``: :func:`chaos_points` and the settings they share."""
-    points, shared = chaos_points(mode)
-    chain = [{**shared, **p} for p in points if is_paper(p["model"])]
-    Ns = sorted({p["N"] for p in chain})
-    betas = sorted({p["beta"] for p in chain})
-    first = chain[0]
-    transients = ", ".join(f"{p['transient']:g}" for p in sorted(chain, key=lambda p: p["N"]) if p["beta"] == betas[0])
-    family = " and ".join(PRESETS[p["model"]].label or p["model"] for p in points if not is_paper(p["model"]))
     common = {"analysis": "chaos", "segments": 10, "direction_seed": 0, **shared}
     note = (
         f"{mode}: eq. (4) at N = {', '.join(map(str, Ns))}, beta = {', '.join(f'{b:g}' for b in betas)}, "
-        f"from loaded states (transients {transients}); "
-        f"flow ladders of {first['flow_t']:g} time units; n(delta) for {len(first['deltas'])} deltas "
-        f"({first['deltas'][0]:g} .. {first['deltas'][-1]:g}), perturbations of the state, Fs and V, "
-        f"{first['seeds']} windows of {first['events']} slips; {family} at standard parameters"
+        f"from loaded states (transients {', '.join(f'{transients[N]:g}' for N in Ns)}); "
+        f"flow ladders of {flow_t:g} time units; n(delta) for {len(deltas)} deltas "
+        f"({deltas[0]:g} .. {deltas[-1]:g}), perturbations of the state, Fs and V, {seeds} windows of "
+        f"{events} slips; {' and '.join(PRESETS[f['model']].label or f['model'] for f in family)} at standard "
+        "parameters"
     )
     return Study("chaos", mode, common, tuple(points), note=note)
 
@@ -161,13 +130,16 @@ def threshold_columns(kind: str) -> tuple[str, ...]:
     return (base, f"{base}_err_log10", f"{base}_low", f"{base}_high", f"{base}_censored")
 
 
-def check_point(cfg: dict[str, Any], params) -> None:
-    """Raise ParameterError (one line) unless a chaos point's settings make a valid measurement."""
+def check_point(cfg: dict[str, Any], params=None) -> None:
+    """Raise ParameterError (one line) unless a chaos point's merged settings and its model
+    ``params`` (by default :func:`~stickslip.experiments.sweep_points.point_params` of them) make
+    a valid measurement."""
     from stickslip.analysis.benettin import check_run
     from stickslip.analysis.decorrelation import PERTURBATIONS
     from stickslip.models.params import ParameterError, check_number
 
-    missing = [k for k in _KEYS if k not in cfg]
+    params = point_params("chain", cfg) if params is None else params
+    missing = [k for k in ("transient", "kinds", "deltas", "seeds", "events", "flow_t") if k not in cfg]
     if missing:
         raise ParameterError(f"a chaos point needs {', '.join(missing)}")
     check_number("transient", cfg["transient"], low=0.0, low_open=True)
@@ -187,28 +159,22 @@ def check_point(cfg: dict[str, Any], params) -> None:
     )
 
 
-class _Parts:
-    """The finished parts of a point (``parts/NAME.json``), each with the settings it was made with
-    and its own checksum (:func:`stickslip.experiments.cache.sealed`): an edited or foreign part is
-    computed again."""
+def _part(folder: Path, spec: dict[str, Any], name: str, compute) -> dict[str, Any]:
+    """The finished part ``folder/NAME.json`` of a point if it was made with ``spec`` and its own
+    checksum (:func:`stickslip.experiments.cache.sealed`) holds, else ``compute()``, written so: an
+    edited or foreign part is computed again."""
+    from stickslip import io
+    from stickslip.experiments.cache import canonical, read_done, sealed
+    from stickslip.jsonable import to_jsonable
 
-    def __init__(self, folder: Path, spec: dict[str, Any]):
-        self.folder = folder
-        self.spec = spec
-
-    def get(self, name: str, compute) -> dict[str, Any]:
-        from stickslip import io
-        from stickslip.experiments.cache import canonical, read_done, sealed
-
-        path = self.folder / f"{name}.json"
-        want = canonical({**self.spec, "part": name})
-        kept, _ = read_done(path, want, "result")
-        if kept is not None:
-            return kept["result"]
-        io.write_json(path, {"spec": want, "result": compute(), "files": {}})
-        record = io.read_json(path)  # as a reused part reads it (NaN as null), then sealed
-        io.write_json(path, sealed(record))
-        return record["result"]
+    path = folder / f"{name}.json"
+    want = canonical({**spec, "part": name})
+    kept, _ = read_done(path, want, "result")
+    if kept is not None:
+        return kept["result"]
+    record = to_jsonable({"spec": want, "result": compute(), "files": {}})  # as a reused part reads it
+    io.write_json(path, sealed(record))
+    return record["result"]
 
 
 def chaos_point(cfg: dict[str, Any], params, point_dir: Path) -> dict[str, Any]:
@@ -218,10 +184,11 @@ def chaos_point(cfg: dict[str, Any], params, point_dir: Path) -> dict[str, Any]:
     ``point_dir`` and returns the table's columns."""
     from stickslip import __version__, io
     from stickslip.analysis.decorrelation import GridSequences, sequence_decorrelation, verdict
-    from stickslip.analysis.lyapunov_flow import extrapolate, flow_lyapunov
+    from stickslip.analysis.lyapunov_flow import LADDER_COLUMNS, extrapolate, flow_lyapunov
     from stickslip.analysis.threshold import delta_star
     from stickslip.experiments.sweep import stop_requested
     from stickslip.experiments.sweep_points import preset_start
+    from stickslip.run.errors import Interrupted
     from stickslip.run.loaded import loaded_state
 
     wall0 = time.perf_counter()
@@ -230,17 +197,15 @@ def chaos_point(cfg: dict[str, Any], params, point_dir: Path) -> dict[str, Any]:
     stop = stop_requested(point_dir)
     start = preset_start(params, cfg)
     loaded = loaded_state(params, float(cfg["transient"]), **start, cache=point_dir / "state", stop_requested=stop)
-    spec = {k: v for k, v in cfg.items()} | {"version": __version__}
-    parts = _Parts(point_dir / "parts", spec)
+    spec, parts = {**cfg, "version": __version__}, point_dir / "parts"
     direction_seed = int(cfg.get("direction_seed", 0))
     interval, d0 = float(cfg.get("interval", 10.0)), float(cfg.get("d0", 1e-10))
     flow_t, levels = float(cfg["flow_t"]), int(cfg.get("levels", 3))
     located = loaded.located(params)
 
-    def rung(k: int):
-        p = params.replace(dt=params.dt / 2**k)
-        res = flow_lyapunov(
-            p,
+    def rung(k: int) -> dict[str, Any]:
+        return flow_lyapunov(
+            params.replace(dt=params.dt / 2**k),
             flow_t,
             start=located,
             interval=interval,
@@ -248,10 +213,13 @@ def chaos_point(cfg: dict[str, Any], params, point_dir: Path) -> dict[str, Any]:
             direction_seed=direction_seed,
             segments=int(cfg.get("segments", 10)),
             stop_requested=stop,
-        )
-        return res.to_dict()
+        ).to_dict()
 
-    rungs = [parts.get(f"flow-rung-{k}", lambda k=k: rung(k)) for k in range(levels)]
+    def stop_now(_line: str) -> None:  # n(delta)'s progress, after each twin: stop if the study asks
+        if stop():
+            raise Interrupted(None, math.nan)
+
+    rungs = [_part(parts, spec, f"flow-rung-{k}", lambda k=k: rung(k)) for k in range(levels)]
     lam0, err0, slope = extrapolate(
         [r["dt"] for r in rungs], [_num(r["lyapunov"]) for r in rungs], [_num(r["lyapunov_err"]) for r in rungs]
     )
@@ -259,7 +227,7 @@ def chaos_point(cfg: dict[str, Any], params, point_dir: Path) -> dict[str, Any]:
     for kind in kinds_of(cfg):
 
         def measure(kind=kind):
-            res = sequence_decorrelation(
+            return sequence_decorrelation(
                 GridSequences(params),
                 loaded.state,
                 [float(d) for d in cfg["deltas"]],
@@ -267,23 +235,17 @@ def chaos_point(cfg: dict[str, Any], params, point_dir: Path) -> dict[str, Any]:
                 events=int(cfg["events"]),
                 seeds=int(cfg["seeds"]),
                 direction_seed=direction_seed,
-                progress=lambda _line: _stop_now(stop),
-            )
-            return res.to_dict()
+                progress=stop_now,
+            ).to_dict()
 
-        decorrelation[kind] = parts.get(f"decorrelation-{kind}", measure)
+        decorrelation[kind] = _part(parts, spec, f"decorrelation-{kind}", measure)
         thresholds[kind] = delta_star(decorrelation[kind]["decorrelation"])
-    windows = decorrelation["state"]["decorrelation_windows"]
-    window = min(int(w["reference_events"]) for w in windows)
+    window = min(int(w["reference_events"]) for w in decorrelation["state"]["decorrelation_windows"])
     v = verdict(lam0, err0, decorrelation["state"]["decorrelation"], window=window)
-    ladder = [
-        {k: r[k] for k in ("dt", "lyapunov", "lyapunov_err", "renormalisations", "events", "waits", "wall_seconds")}
-        for r in rungs
-    ]
     flow_slips = min(int(r["events"]) for r in rungs)
     info = {
         "loading": loaded.info,
-        "ladder": ladder,
+        "ladder": [{k: r[k] for k in LADDER_COLUMNS} for r in rungs],
         "lyapunov_dt0": lam0,
         "lyapunov_dt0_err": err0,
         "dt2_slope": slope,
@@ -295,14 +257,11 @@ def chaos_point(cfg: dict[str, Any], params, point_dir: Path) -> dict[str, Any]:
         "thresholds": thresholds,
         **v.to_dict(),
     }
-    point_dir.mkdir(parents=True, exist_ok=True)
     io.write_json(point_dir / "flow.json", info)
     out: dict[str, Any] = {
         "loaded": bool(loaded.info["loaded"]),
         "first_slip_reaching_block_N": loaded.info["first_slip_reaching_block_N"],
-        "lyapunov_dt0": lam0,
-        "lyapunov_dt0_err": err0,
-        "flow_slips": flow_slips,
+        **{k: info[k] for k in ("lyapunov_dt0", "lyapunov_dt0_err", "flow_slips")},
         "window": window,
         "n_deltas": len(cfg["deltas"]),
         **v.to_dict(),
@@ -310,26 +269,11 @@ def chaos_point(cfg: dict[str, Any], params, point_dir: Path) -> dict[str, Any]:
     }
     for kind, th in thresholds.items():
         mean, err, low, high, censored = threshold_columns(kind)
-        out.update(
-            {
-                mean: _num(th["geometric_mean"]),
-                err: _num(th["log10_err"]),
-                low: _num(th["low"]),
-                high: _num(th["high"]),
-                censored: int(th["censored"]),
-            }
-        )
-        for s, value in zip(th["seeds"], th["per_seed"], strict=True):
-            out[f"{mean}_seed{s}"] = _num(value)
+        fields = {mean: "geometric_mean", err: "log10_err", low: "low", high: "high"}
+        out.update({column: _num(th[field]) for column, field in fields.items()})
+        out[censored] = int(th["censored"])
+        out.update({f"{mean}_seed{s}": _num(value) for s, value in zip(th["seeds"], th["per_seed"], strict=True)})
     return out
-
-
-def _stop_now(stop) -> None:
-    """Raise :class:`stickslip.run.errors.Interrupted` if the study asked its points to stop."""
-    if stop():
-        from stickslip.run.errors import Interrupted
-
-        raise Interrupted(None, math.nan)
 
 
 def _num(x) -> float:
@@ -341,28 +285,23 @@ def task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     return chaos_point(point, point_params("chain", point), Path(point_dir))
 
 
-def check(cfg: dict[str, Any]) -> None:
-    """Refuse a point's merged settings (:func:`check_point`)."""
-    check_point(cfg, point_params("chain", cfg))
-
-
 # ---------------------------------------------------------------------------------------------
 # Findings and figures, from the table of finished points
 
 
-def _per_seed(row: pd.Series, kind: str) -> list[float | None]:
-    """The per-window delta* of ``kind`` in a row (``delta_star_<kind>_seed<k>``; None: censored)."""
-    base = f"{threshold_columns(kind)[0]}_seed"
-    cols = [f"{base}{k}" for k in range(int(row["seeds"]))]
-    return [float(row[c]) if c in row.index and finite(row[c]) else None for c in cols]
+def _value(x) -> float | None:
+    """A number of the table, None where it is missing or not finite (a censored window)."""
+    return float(x) if finite(x) else None
 
 
-def thresholds(table: pd.DataFrame) -> list[dict[str, Any]]:
-    """delta* of every chain point and kind: ``N``, ``beta``, ``kind``, ``per_seed``,
-    ``geometric_mean``, ``log10_err``, ``low``, ``high``, ``censored``."""
+def thresholds(table: pd.DataFrame) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
+    """delta* of every chain point and kind (``N``, ``beta``, ``kind``, ``per_seed``,
+    ``geometric_mean``, ``log10_err``, ``low``, ``high``, ``censored``) and, for each beta and
+    kind, :func:`~stickslip.analysis.threshold.threshold_fit` of its points."""
+    from stickslip.analysis.threshold import threshold_fit
+
     out = []
-    chain = table[table["model"].map(is_paper)].sort_values(["N", "beta"])
-    for _, row in chain.iterrows():
+    for _, row in table[table["model"].map(is_paper)].sort_values(["N", "beta"]).iterrows():
         for kind in KINDS:
             mean, err, low, high, censored = threshold_columns(kind)
             if mean not in row.index or not finite(row.get(censored)):
@@ -372,54 +311,44 @@ def thresholds(table: pd.DataFrame) -> list[dict[str, Any]]:
                     "N": int(row["N"]),
                     "beta": float(row["beta"]),
                     "kind": kind,
-                    "per_seed": _per_seed(row, kind),
-                    "geometric_mean": float(row[mean]) if finite(row[mean]) else None,
+                    "per_seed": [_value(row.get(f"{mean}_seed{k}")) for k in range(int(row["seeds"]))],
+                    "geometric_mean": _value(row[mean]),
                     "log10_err": float(row[err]) if finite(row[err]) else math.nan,
-                    "low": float(row[low]) if finite(row[low]) else None,
-                    "high": float(row[high]) if finite(row[high]) else None,
+                    "low": _value(row[low]),
+                    "high": _value(row[high]),
                     "censored": int(row[censored]),
                 }
             )
-    return out
-
-
-def fits(points: list[dict[str, Any]]) -> list[dict[str, Any]]:
-    """For each beta and kind, :func:`~stickslip.analysis.threshold.threshold_fit` of its points."""
-    from stickslip.analysis.threshold import threshold_fit
-
-    out = []
-    keys = sorted({(p["beta"], p["kind"]) for p in points}, key=lambda k: (KINDS.index(k[1]), k[0]))
-    for beta, kind in keys:
-        mine = sorted((p for p in points if p["beta"] == beta and p["kind"] == kind), key=lambda p: p["N"])
+    fits = []
+    for beta, kind in sorted({(p["beta"], p["kind"]) for p in out}, key=lambda k: (KINDS.index(k[1]), k[0])):
+        mine = sorted((p for p in out if p["beta"] == beta and p["kind"] == kind), key=lambda p: p["N"])
         fit = threshold_fit([p["N"] for p in mine], [p["per_seed"] for p in mine])
-        out.append({"beta": beta, "kind": kind, **fit})
-    return out
+        fits.append({"beta": beta, "kind": kind, **fit})
+    return out, fits
 
 
 def conclusions(spec: Study | None, table: pd.DataFrame) -> dict[str, Any]:
     """Statements, verdicts, delta* and its fits of a chaos study's rows (module docstring)."""
     out: dict[str, Any] = {"statements": [], "verdicts": {}, "points": []}
     say = out["statements"].append
-    rows = table.copy()
-    rows["_chain"] = rows["model"].map(is_paper)
+    rows = table.assign(_chain=table["model"].map(is_paper))
     rows = rows.sort_values(["_chain", "N", "beta"], ascending=[False, True, True])
     for _, r in rows.iterrows():
         name = PRESETS[r["model"]].point_label(r["beta"], r["N"])
         lam, err = r.get("lyapunov_dt0"), r.get("lyapunov_dt0_err")
         slips = int(r["flow_slips"]) if finite(r.get("flow_slips")) else None
-        loaded = bool(r.get("loaded")) if r.get("loaded") is not None else None
         out["points"].append(
             {
                 "point": name,
                 "model": r["model"],
                 "N": int(r["N"]),
-                "beta": float(r["beta"]) if finite(r.get("beta")) else None,
+                "beta": _value(r.get("beta")),
                 "verdict": r.get("verdict"),
                 "verdict_text": r.get("verdict_text"),
-                "lyapunov_dt0": float(lam) if finite(lam) else None,
-                "lyapunov_dt0_err": float(err) if finite(err) else None,
+                "lyapunov_dt0": _value(lam),
+                "lyapunov_dt0_err": _value(err),
                 "flow_slips": slips,
-                "loaded": loaded,
+                "loaded": bool(r.get("loaded")) if r.get("loaded") is not None else None,
             }
         )
         out["verdicts"].setdefault(r.get("verdict"), []).append(name)
@@ -437,9 +366,7 @@ def conclusions(spec: Study | None, table: pd.DataFrame) -> dict[str, Any]:
             if not not_loaded
             else f"Loading: NOT loaded by that rule: {', '.join(not_loaded)}."
         )
-    points = thresholds(table)
-    out["thresholds"] = points
-    out["fits"] = fits(points)
+    out["thresholds"], out["fits"] = thresholds(table)
     for kind in KINDS:
         mine = [f for f in out["fits"] if f["kind"] == kind and math.isfinite(f["slope"])]
         if not mine:
@@ -457,56 +384,35 @@ def conclusions(spec: Study | None, table: pd.DataFrame) -> dict[str, Any]:
     return out
 
 
-def curves(table: pd.DataFrame, points_dir: Path) -> list[dict[str, Any]]:
-    """The ``flow.json`` of every point that has one, with ``label``, ``N`` and ``beta`` (None
-    for the relatives); chain points by N then beta, the relatives last."""
+def figures(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[tuple[str, Any, str]]:
+    """The study's figures (name, Figure, caption), from each point's ``flow.json`` in its runs
+    folder beside ``page_dir`` (the curves of :mod:`stickslip.plotting.chaos`: chain points by N
+    then beta, the relatives last), and ``decorrelation.csv``/``.parquet`` in ``page_dir``: every
+    n(delta) row (point, N, beta, kind, delta, seed, events, decorrelated, t_decorrelated)."""
     from stickslip import io
+    from stickslip.plotting import chaos as pc
 
-    found = []
     if "point_dir" not in table.columns:
-        return found
-    for r in table.itertuples():
-        path = Path(points_dir) / str(r.point_dir) / "flow.json"
+        return []
+    points_dir = spec.runs_dir(Path(page_dir).parent) / "points"
+    found = []
+    for r in sorted(table.itertuples(), key=lambda r: (0, r.N, r.beta) if is_paper(r.model) else (1, 0, 0.0)):
+        path = points_dir / str(r.point_dir) / "flow.json"
         if not path.is_file():
             continue
         chain = is_paper(r.model)
         label = f"eq. (4), N = {int(r.N)}, beta = {r.beta:g}" if chain else f"{r.model}, N = {int(r.N)}"
-        key = (0, int(r.N), float(r.beta)) if chain else (1, 0, 0.0)
-        data = io.read_json(path)
-        found.append((key, {**data, "label": label, "N": int(r.N), "beta": float(r.beta) if chain else None}))
-    return [c for _, c in sorted(found, key=lambda x: x[0])]
-
-
-def decorrelation_table(found: list[dict[str, Any]]) -> pd.DataFrame:
-    """Every n(delta) row of the points: model label, N, beta, kind, delta, seed, events,
-    decorrelated, t_decorrelated."""
-    rows = []
-    for c in found:
-        for kind, d in (c.get("decorrelation") or {}).items():
-            for r in d.get("decorrelation", []):
-                rows.append(
-                    {
-                        "point": c["label"],
-                        "N": c["N"],
-                        "beta": c["beta"],
-                        "kind": kind,
-                        **{k: r.get(k) for k in ("delta", "seed", "events", "decorrelated", "t_decorrelated")},
-                    }
-                )
-    return pd.DataFrame(rows)
-
-
-def figures(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[tuple[str, Any, str]]:
-    """The study's figures (name, Figure, caption), from each point's ``flow.json`` in its runs
-    folder beside ``page_dir``, and ``decorrelation.csv``/``.parquet`` in ``page_dir`` (every
-    n(delta) row)."""
-    from stickslip import io
-    from stickslip.plotting import chaos as pc
-
-    found = curves(table, spec.runs_dir(Path(page_dir).parent) / "points")
+        found.append({**io.read_json(path), "label": label, "N": int(r.N), "beta": float(r.beta) if chain else None})
     if not found:
         return []
-    io.write_table_files(Path(page_dir) / "decorrelation", decorrelation_table(found))
+    keys = ("delta", "seed", "events", "decorrelated", "t_decorrelated")
+    rows = [
+        {"point": c["label"], "N": c["N"], "beta": c["beta"], "kind": kind, **{k: r.get(k) for k in keys}}
+        for c in found
+        for kind, d in (c.get("decorrelation") or {}).items()
+        for r in d.get("decorrelation", [])
+    ]
+    io.write_table_files(Path(page_dir) / "decorrelation", pd.DataFrame(rows))
     out = [
         (
             "decorrelation",
@@ -522,17 +428,14 @@ def figures(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[tuple[str,
             "dt/4, with the fit lambda_0 + c dt^2 and lambda_0 (square) at dt = 0.",
         ),
     ]
-    points = thresholds(table)
+    points, fits = thresholds(table)
     if points:
-        out.append(
-            (
-                "threshold",
-                pc.threshold_figure(points, fits(points)),
-                "delta*, the smallest delta that decorrelated within the window, against N: each "
-                "window (dots), the geometric mean with its standard error, and the least-squares "
-                "line of log10 delta* on log10 N for each beta (dashed, slope in the legend).",
-            )
+        caption = (
+            "delta*, the smallest delta that decorrelated within the window, against N: each "
+            "window (dots), the geometric mean with its standard error, and the least-squares "
+            "line of log10 delta* on log10 N for each beta (dashed, slope in the legend)."
         )
+        out.append(("threshold", pc.threshold_figure(points, fits), caption))
     return out
 
 
@@ -553,21 +456,19 @@ def describe() -> str:
     )
 
 
-_COLUMNS = "model N beta verdict verdict_text lyapunov_dt0 lyapunov_dt0_err flow_slips window"
-for _kind in KINDS:
-    _COLUMNS += f" delta_star_{_kind} delta_star_{_kind}_err_log10 delta_star_{_kind}_low"
-    _COLUMNS += f" delta_star_{_kind}_high delta_star_{_kind}_censored"
-_COLUMNS += " threshold_below threshold_low windows_decorrelated windows transient loaded"
-_COLUMNS += " first_slip_reaching_block_N flow_t seeds n_deltas"
-
 DESIGN = Design(
     name="chaos",
     summary="the flow's exponent, slip decorrelation and its threshold delta* against N; the verdict",
     describe=describe,
     build=build,
     task=task,
-    check=check,
+    check=check_point,
     findings=conclusions,
     figures=figures,
-    columns=tuple(_COLUMNS.split()),
+    columns=(
+        *"model N beta verdict verdict_text lyapunov_dt0 lyapunov_dt0_err flow_slips window".split(),
+        *(column for kind in KINDS for column in threshold_columns(kind)),
+        *"threshold_below threshold_low windows_decorrelated windows transient loaded".split(),
+        *"first_slip_reaching_block_N flow_t seeds n_deltas".split(),
+    ),
 )

@@ -64,8 +64,7 @@ def findings(spec: Study, table: pd.DataFrame) -> dict[str, Any]:
             f"{short(getattr(r, 'excess', math.nan))} ({getattr(r, 'observed', 'n/a')} observed / "
             f"{short(getattr(r, 'expected', math.nan))} expected)."
         )
-    chain = table[table["model"].map(is_paper)].sort_values("beta")
-    ok = chain[np.isfinite(chain["tau"].astype(float))]
+    ok = table[table["model"].map(is_paper) & np.isfinite(table["tau"].astype(float))].sort_values("beta")
     if len(ok) > 1:
         slope = np.polyfit(ok["beta"].astype(float), ok["tau"].astype(float), 1)[0]
         say(
@@ -87,7 +86,7 @@ def figures(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[tuple[str,
         "bootstrap errors) and great-event excess against beta; Carlson-Langer as a band."
     )
     out = [("tau_beta", exponents_figure(table), caption)]
-    panels = _family_panels(spec, table, spec.runs_dir(Path(page_dir).parent) / "points")
+    panels = _family_panels(table, spec.runs_dir(Path(page_dir).parent) / "points")
     if len(panels) == 2:
         caption = (
             "Slip-size density p(S) on logarithmic bins, log-log, of the events after each run's transient. "
@@ -99,7 +98,7 @@ def figures(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[tuple[str,
     return out
 
 
-def _family_panels(spec: Study, table: pd.DataFrame, points: Path) -> list[tuple[str, pd.DataFrame, dict[str, Any]]]:
+def _family_panels(table: pd.DataFrame, points: Path) -> list[tuple[str, pd.DataFrame, dict[str, Any]]]:
     """(title, events, statistics) of the relative's run and of eq. (4) at its smallest beta, each
     fitted as its point was (:func:`stickslip.analysis.chain_runs.size_statistics`); none without a fit."""
     from stickslip import io

@@ -1,10 +1,8 @@
 """``stickslip study phase-diagram``: the final state and m = 1 - <L>/L_ss of eq. (4) over
 (alpha, beta) at D = 5 and over (D, beta) at alpha = 1, at N = 99, each cell from the paper's
 start and from steady sliding perturbed by 0.01 (hysteresis), against the linear-stability
-line beta_c = alpha (docs/studies/phase-diagram.md).
-
-Each point is one chain run and its order parameter
-(:func:`stickslip.experiments.studies.chain_point.order_task`).
+line beta_c = alpha (docs/studies/phase-diagram.md). Each point is one chain run and its order
+parameter (:func:`stickslip.experiments.studies.chain_point.order_task`).
 """
 
 from __future__ import annotations
@@ -21,30 +19,30 @@ from stickslip.models.presets import paper_parameters
 
 __all__ = ["DESIGN"]
 
+#: The two slices of the diagram: the parameter that varies beside beta, the one held and its value.
+_SLICES = (("alpha", "D", 5.0, "D = 5"), ("D", "alpha", 1.0, "alpha = 1"))
+
 
 def build(mode: str) -> Study:
     """The cells of ``mode``, deep on the sliding side first (there the paper's start slides
     longest before it settles), each from two starts."""
     if mode == "tiny":
-        N, alphas, Ds, betas = 9, (1.0,), (5.0,), (0.8, 1.2)
-        D_betas = betas
+        N, alphas, Ds, betas, D_betas = 9, (1.0,), (5.0,), (0.8, 1.2), (0.8, 1.2)
     elif mode == "quick":
         N, alphas, Ds = 99, (0.5, 1.0, 1.5), (0.5, 5.0, 50.0)
-        betas = (0.25, 0.5, 0.75, 1.0, 1.25, 1.5, 1.75)
-        D_betas = (0.7, 0.9, 1.0, 1.1, 1.3)
+        betas, D_betas = (0.25, 0.5, 0.75, 1.0, 1.25, 1.5, 1.75), (0.7, 0.9, 1.0, 1.1, 1.3)
     else:
         N, alphas, Ds = 99, (0.25, 0.5, 0.75, 1.0, 1.25, 1.5, 1.75, 2.0), (0.1, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0)
         betas = tuple(round(0.125 * k, 3) for k in range(1, 19))
         D_betas = (0.6, 0.7, 0.8, 0.85, 0.9, 0.95, 1.0, 1.05, 1.1, 1.15, 1.2, 1.3, 1.4)
     loads = 2.5
-    cells = [{"alpha": a, "D": 5.0, "beta": b} for a in alphas for b in betas]
-    cells += [{"alpha": 1.0, "D": d, "beta": b} for d in Ds for b in D_betas]
-    unique: list[dict[str, Any]] = []
-    for c in cells:
-        if c not in unique:
-            unique.append(c)
-    unique.sort(key=lambda c: -(c["beta"] - c["alpha"]))
-    points = [{**c, "N": N, "t_end": t_end_of(N, loads), "start": s} for c in unique for s in ("paper", "steady")]
+    cells = [(a, 5.0, b) for a in alphas for b in betas] + [(1.0, d, b) for d in Ds for b in D_betas]
+    unique = sorted(dict.fromkeys(cells), key=lambda c: -(c[2] - c[0]))  # (alpha, D, beta), each once
+    points = [
+        {"alpha": a, "D": d, "beta": b, "N": N, "t_end": t_end_of(N, loads), "start": s}
+        for a, d, b in unique
+        for s in ("paper", "steady")
+    ]
     common = {
         **paper_parameters("N", "beta", "alpha", "D"),
         "model": "sakaguchi",
@@ -92,18 +90,14 @@ def findings(spec: Study, table: pd.DataFrame) -> dict[str, Any]:
         f"From the paper's start, {agree_lin} of {n_lin} settled cells are on the side of beta_c = alpha that "
         f"linear stability predicts (steady for beta > alpha, stick-slip below)."
     )
-    for a, g in table[(table["D"] == 5.0) & (table["start"] == "paper")].groupby("alpha"):
-        br = transition_bracket(g["beta"], g["final_state"])
-        say(
-            f"alpha = {a:g} (D = 5, paper's start): last stick-slip beta = {short(br['lo'])}, first steady above it "
-            f"= {short(br['hi'])} (beta_c = alpha = {a:g})."
-        )
-    for d, g in table[(table["alpha"] == 1.0) & (table["start"] == "paper")].groupby("D"):
-        br = transition_bracket(g["beta"], g["final_state"])
-        say(
-            f"D = {d:g} (alpha = 1, paper's start): last stick-slip beta = {short(br['lo'])}, first steady above it "
-            f"= {short(br['hi'])}."
-        )
+    for name, fixed, value, where in _SLICES:
+        for x, g in table[(table[fixed] == value) & (table["start"] == "paper")].groupby(name):
+            br = transition_bracket(g["beta"], g["final_state"])
+            line = (
+                f"{name} = {x:g} ({where}, paper's start): last stick-slip beta = {short(br['lo'])}, "
+                f"first steady above it = {short(br['hi'])}"
+            )
+            say(line + (f" (beta_c = alpha = {x:g})." if name == "alpha" else "."))
     return out
 
 
@@ -113,15 +107,11 @@ def figures(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[tuple[str,
 
     return [
         (
-            "phase_alpha_beta",
-            phase_map_figure(table[table["D"] == 5.0], "alpha", "D = 5"),
-            "Final state and m over (alpha, beta) at D = 5; dashed: beta_c = alpha.",
-        ),
-        (
-            "phase_D_beta",
-            phase_map_figure(table[table["alpha"] == 1.0], "D", "alpha = 1"),
-            "Final state and m over (D, beta) at alpha = 1; dashed: beta_c = alpha = 1.",
-        ),
+            f"phase_{name}_beta",
+            phase_map_figure(table[table[fixed] == value], name, where),
+            f"Final state and m over ({name}, beta) at {where}; dashed: beta_c = alpha{' = 1' if name == 'D' else ''}.",
+        )
+        for name, fixed, value, where in _SLICES
     ]
 
 
