@@ -262,9 +262,8 @@ def _read(path: Path, spec: dict[str, Any], params: ChainParams) -> tuple[ChainS
         return None
     state, header, extra = found
     wall = header.get("wall_seconds")
-    if extra or not isinstance(wall, (int, float)) or not math.isfinite(wall):
-        return None
-    return (state, header) if isinstance(header.get("tally"), dict) else None
+    whole = isinstance(wall, (int, float)) and math.isfinite(wall) and isinstance(header.get("tally"), dict)
+    return (state, header) if whole and not extra else None
 
 
 def located_start(params: ChainParams, transient: float, *, start: str, perturbation: float, seed: int):
