@@ -70,12 +70,10 @@ from stickslip.kernels.layout import (
 from stickslip.kernels.stages import (
     _longest_run,
     _stage1,
-    _stage1_all,
     _stage1_run,
     _stage1_theta,
     _stage1_theta_only,
     _stage2,
-    _stage2_all,
     _stage2_run,
     _stage2_theta,
 )
@@ -191,10 +189,10 @@ def run_exact(args, drive, friction, threshold, ends):
                 # Every block slides: no start, no first move, nothing to track but stops.
                 p1 = _pull(V, n, dt)
                 _set_ghosts(x, th, N, p1, drive, ends)
-                _stage1_all(x, v, th, xs, vs, ths, a1, b1, N, p1, mp, dt, drive, friction)
+                _stage1_run(x, v, th, xs, vs, ths, a1, b1, 1, N, p1, mp, dt, drive, friction)
                 p2 = _pull(V, n + 1, dt)
                 _set_ghosts(xs, ths, N, p2, drive, ends)
-                stops = _stage2_all(x, v, th, xs, vs, ths, a1, b1, N, p2, mp, h2, drive, friction)
+                stops = _stage2_run(x, v, th, xs, vs, ths, a1, b1, 1, N, p2, mp, h2, drive, friction)
                 ist[BLOCK_UPDATES] += N
                 ist[FULL_UPDATES] += N
                 ist[STEPS_COMPUTED] += 1
@@ -208,8 +206,11 @@ def run_exact(args, drive, friction, threshold, ends):
                 if stops:
                     n_moving = 0
                     for i in range(1, N + 1):
-                        mov[i] = 1.0 if v[i] > 0.0 else 0.0
-                        n_moving += 1 if v[i] > 0.0 else 0
+                        # The stop rule (_stage2_run stored v as computed).
+                        keep = v[i] > 0.0
+                        v[i] = v[i] if keep else 0.0
+                        mov[i] = 1.0 if keep else 0.0
+                        n_moving += 1 if keep else 0
                     ist[N_MOVING] = n_moving
                     ra, rb = _longest_run(mov, 1, N)
                     if has(drive, "leaf_spring"):
