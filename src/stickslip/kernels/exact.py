@@ -32,7 +32,7 @@ once per run. The driver hands over arrays whose block 1 starts a 64-byte line
 aligned arrays").
 
 Three more savings keep every bit (docs/performance.md, "Fewer scalar blocks in the partly stuck
-step"): stage 1 of the run covers whole vectors of blocks, the up to three blocks past it
+step"): stage 1 of the run covers whole groups of 8 blocks, the up to seven blocks past it
 getting a moving block's values that the general stages then overwrite; the one block past the
 run that the start rule leaves stopped gets the stopped blocks' stage 1; and a stopped block of
 the interval gets its stage-1 predictors of x and v and its mask only next to the blocks that may
@@ -248,10 +248,10 @@ def run_exact(args, drive, friction, threshold, ends):
                         )
                         if f_ <= l_:
                             first = f_
-                    # Over whole vectors of 4 blocks, not one at a time at the end: the up to 3
+                    # Over whole groups of 8 blocks, with no masked or scalar rest: the up to 7
                     # blocks past the run get a moving block's values, which the stages below
-                    # overwrite wherever stage 2 and the bookkeeping read them (measured: 1-2%).
-                    rp = rb0 + (ra0 - rb0 - 1) % 4
+                    # overwrite wherever stage 2 and the bookkeeping read them (measured: 2%).
+                    rp = rb0 + (ra0 - rb0 - 1) % 8
                     if rp > N:
                         rp = rb0
                     _stage1_run(x, v, th, xs, vs, ths, a1, b1, ra0, rp, p1, mp, dt, drive, friction)
@@ -312,12 +312,22 @@ def run_exact(args, drive, friction, threshold, ends):
             stops_run = False
             whole = False  # the whole run went through _stage2_run
             if sl <= sh:
+                if has(friction, "has_state"):
+                    # The state variable of the stopped blocks on either side first: it reads
+                    # nothing the full stages write, and its short chain of dependent operations
+                    # then overlaps their loops instead of holding up the bookkeeping (measured).
+                    if lo < sl:
+                        c_lo, c_hi = _stage2_theta(th, ths, v, b1, lo, sl - 1, mp, h2, friction)
+                    if sh < hi:
+                        t_lo, t_hi = _stage2_theta(th, ths, v, b1, sh + 1, hi, mp, h2, friction)
+                        c_lo, c_hi = _merge(c_lo, c_hi, t_lo, t_hi)
                 whole = run_in
                 if run_in:
                     if sl < ra0:
-                        c_lo, c_hi, moved_before, moved_after = _stage2(
+                        t_lo, t_hi, moved_before, moved_after = _stage2(
                             x, v, th, mov, xs, vs, ths, mm, a1, b1, sl, ra0 - 1, p2, mp, h2, drive, friction
                         )
+                        c_lo, c_hi = _merge(c_lo, c_hi, t_lo, t_hi)
                     stops_run = _stage2_run(x, v, th, xs, vs, ths, a1, b1, ra0, rb0, p2, mp, h2, drive, friction)
                     # Every block of the run moved: count it as changed.
                     c_lo, c_hi = _merge(c_lo, c_hi, ra0, rb0)
@@ -339,17 +349,11 @@ def run_exact(args, drive, friction, threshold, ends):
                         moved_before += mb
                         moved_after += ma
                 else:
-                    c_lo, c_hi, moved_before, moved_after = _stage2(
+                    t_lo, t_hi, moved_before, moved_after = _stage2(
                         x, v, th, mov, xs, vs, ths, mm, a1, b1, sl, sh, p2, mp, h2, drive, friction
                     )
+                    c_lo, c_hi = _merge(c_lo, c_hi, t_lo, t_hi)
                 ist[FULL_UPDATES] += sh - sl + 1
-                if has(friction, "has_state"):
-                    if lo < sl:
-                        t_lo, t_hi = _stage2_theta(th, ths, v, b1, lo, sl - 1, mp, h2, friction)
-                        c_lo, c_hi = _merge(c_lo, c_hi, t_lo, t_hi)
-                    if sh < hi:
-                        t_lo, t_hi = _stage2_theta(th, ths, v, b1, sh + 1, hi, mp, h2, friction)
-                        c_lo, c_hi = _merge(c_lo, c_hi, t_lo, t_hi)
             elif has(friction, "has_state"):
                 c_lo, c_hi = _stage2_theta(th, ths, v, b1, lo, hi, mp, h2, friction)
             # Next step's movers: a stopped block starts only if its force or threshold changed;

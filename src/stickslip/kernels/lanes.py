@@ -107,7 +107,8 @@ def _first(builder, n):
 
 def _address(context, builder, sig, args):
     """Pointer to element i of the float64 array at address ``base`` (both uint64)."""
-    base, i = (context.cast(builder, a, t, types.uint64) for a, t in zip(args[:2], sig.args[:2]))
+    base = context.cast(builder, args[0], sig.args[0], types.uint64)
+    i = context.cast(builder, args[1], sig.args[1], types.uint64)
     return builder.inttoptr(builder.add(base, builder.mul(i, ir.Constant(_I64, 8))), _VT.as_pointer())
 
 

@@ -1,6 +1,7 @@
 """The Heun stages of the fast interval path (:mod:`stickslip.kernels.exact`) over a contiguous
-interval of blocks: the general stages with the start and stop rules, the all-sliding stages,
-and the stages of blocks known to stay stopped, which change their state variable alone
+interval of blocks: the general stages with the start and stop rules, the stages of a run of
+blocks that all slide (the whole chain when it slides throughout), and the stages of blocks known
+to stay stopped, which change their state variable alone
 (eq. 4, docs/model.md; the step is in :mod:`stickslip.kernels.laws`).
 
 Each evaluates every quantity with the expressions of :mod:`stickslip.kernels.laws`, in the
@@ -16,6 +17,13 @@ cheap, many short ones are not: the exact path runs the blocks that move through
 run (:func:`_stage1_run`, :func:`_stage2_run`, which skip the start rule and the bookkeeping
 of changes), with the run's bounds fixed over the steps of one run so that the compiler makes
 these checks once per run.
+
+Where the drive and the friction law run as lanes (their ``PIECE.lanes``), the run stages and the
+stopped blocks' state-variable stages take 8 blocks at a time instead
+(:mod:`stickslip.kernels.lanes`): each group loads its blocks and their neighbours, calls the
+pieces' functions on the 8 lanes and stores the results, the last group under a mask, with no
+overlap checks and no scalar remainder (``*_lanes``; the loops are ``*_loop``). Which of the two a
+kernel runs is resolved when it is compiled (numba's ``overload`` on the pieces' literals).
 """
 
 from __future__ import annotations
@@ -59,47 +67,6 @@ def _stage1(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, p, mp, dt, drive, fr
         vs[i] = v[i] + dt * a
         ths[i] = th[i] + dt * b
     return first + lo, last + lo, starts
-
-
-@njit(cache=True, inline="always")
-def _stage1_all(x, v, th, xs, vs, ths, a1, b1, N, p, mp, dt, drive, friction):
-    """Stage 1 over the whole chain when every block moves (no start can happen).
-
-    The mid-step mask is 1 everywhere and is not stored: no later use reads it.
-    """
-    K, dp = mp[0], mp[1]
-    for i in range(1, N + 1):
-        f = _force(x[i - 1], x[i], x[i + 1], K, dp, p, drive)
-        a = _accel(f, th[i], v[i], 1.0, mp, friction)
-        b = _dtheta(th[i - 1], th[i], th[i + 1], v[i], mp, friction)
-        a1[i] = a
-        b1[i] = b
-        xs[i] = x[i] + dt * v[i]
-        vs[i] = v[i] + dt * a
-        ths[i] = th[i] + dt * b
-
-
-@njit(cache=True, inline="always")
-def _stage2_all(x, v, th, xs, vs, ths, a1, b1, N, p, mp, h2, drive, friction):
-    """Stage 2, corrector and stop rule over the whole chain when every block moves.
-
-    Skips the bookkeeping of changes (every block is kept active) and returns only whether
-    some block stopped. The moving flags are not written: after the step a block moves
-    exactly when its v > 0, and the caller rebuilds them from v when a block stopped.
-    """
-    K, dp = mp[0], mp[1]
-    stops = False
-    for i in range(1, N + 1):
-        f2 = _force(xs[i - 1], xs[i], xs[i + 1], K, dp, p, drive)
-        a2 = _accel(f2, ths[i], vs[i], 1.0, mp, friction)
-        b2 = _dtheta(ths[i - 1], ths[i], ths[i + 1], vs[i], mp, friction)
-        x[i] = x[i] + h2 * (v[i] + vs[i])
-        vn = v[i] + h2 * (a1[i] + a2)
-        th[i] = th[i] + h2 * (b1[i] + b2)
-        keep = vn > 0.0
-        v[i] = vn if keep else 0.0
-        stops |= not keep
-    return stops
 
 
 @njit(cache=True, _nrt=False, inline="always")
@@ -234,9 +201,10 @@ def _stage1_run_loop(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, dt, drive, fr
 def _stage2_run_loop(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, h2, drive, friction):
     """Stage 2, corrector and stop rule for a run lo..hi of blocks moving in this step.
 
-    As :func:`_stage2_all` on the run: the moving flags are not written and the changes not
-    tracked (the caller counts the run as changed); returns whether some block stopped. The
-    velocity is stored as computed: where a block stopped (rare), the caller sets it to 0.
+    The moving flags are not written and the changes not tracked (the caller counts the run as
+    changed); returns whether some block stopped. The velocity is stored as computed: where a
+    block stopped (rare), the caller sets it to 0. With lo..hi = 1..N it is the step of a chain
+    that slides throughout.
     """
     K, dp = mp[0], mp[1]
     one = np.uint64(1)
@@ -259,10 +227,11 @@ def _stage2_run_loop(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, h2, drive, fr
     return stops
 
 
-@njit(cache=True, _nrt=False, inline="always")
+@njit(cache=True, _nrt=False)
 def _stage1_group(x, v, th, xs, vs, ths, a1, b1, i, n, p, mp, dt, drive, friction):
     """Stage 1 of a run for blocks i..i+n-1 (n <= 8) as lanes: :func:`_stage1_run_loop`'s
-    expressions on 8 blocks at once (:mod:`stickslip.kernels.lanes`)."""
+    expressions on 8 blocks at once (:mod:`stickslip.kernels.lanes`). The arrays are given by the
+    addresses of their data (``a.ctypes.data``), as in every ``*_group``."""
     K, dp = mp[0], mp[1]
     one = np.uint64(1)
     xi = lanes.load(x, i, n)
@@ -278,7 +247,7 @@ def _stage1_group(x, v, th, xs, vs, ths, a1, b1, i, n, p, mp, dt, drive, frictio
     lanes.store(b1, i, n, b)
 
 
-@njit(cache=True, _nrt=False, inline="always")
+@njit(cache=True, _nrt=False)
 def _stage2_group(x, v, th, xs, vs, ths, a1, b1, i, n, p, mp, h2, drive, friction):
     """Stage 2 of a run for blocks i..i+n-1 (n <= 8) as lanes (:func:`_stage2_run_loop`'s
     expressions); returns whether one of them stopped."""
@@ -329,7 +298,7 @@ def _stage2_run_lanes(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, h2, drive, f
     return stops
 
 
-@njit(cache=True, _nrt=False, inline="always")
+@njit(cache=True, _nrt=False)
 def _theta1_group(x, v, th, xs, vs, ths, mm, b1, i, n, mp, dt, friction, full):
     """Stage 1 of the state variable for stopped blocks i..i+n-1 as lanes, and with ``full``
     their predictors of x and v and their mask (:func:`_stage1_theta_loop`)."""
@@ -371,19 +340,20 @@ def _stage1_theta_only_lanes(v, th, ths, b1, lo, hi, mp, dt, friction):
     _theta1_lanes(v, v, th, ths, ths, ths, b1, b1, lo, hi, mp, dt, friction, False)
 
 
-@njit(cache=True, _nrt=False, inline="always")
+@njit(cache=True, _nrt=False)
 def _theta2_group(th, ths, v, b1, i, n, mp, h2, friction):
     """:func:`_stage2_theta_loop` for blocks i..i+n-1 as lanes; returns the mask of the lanes
     whose state variable changed (:func:`stickslip.kernels.lanes.changed`)."""
     one = np.uint64(1)
-    b2 = _dtheta(lanes.load(ths, i - one, n), lanes.load(ths, i, n), lanes.load(ths, i + one, n), lanes.load(v, i, n), mp, friction)
+    tsl, tsi, tsr = lanes.load(ths, i - one, n), lanes.load(ths, i, n), lanes.load(ths, i + one, n)
+    b2 = _dtheta(tsl, tsi, tsr, lanes.load(v, i, n), mp, friction)
     tho = lanes.load(th, i, n)
     thn = tho + h2 * (lanes.load(b1, i, n) + b2)
     lanes.store(th, i, n, thn)
     return lanes.changed(thn, tho, n)
 
 
-@njit(cache=True, _nrt=False, inline="always")
+@njit(cache=True, _nrt=False)
 def _theta2_changes(T, TS, V, B1, i, n, mp, h2, friction, c_lo, c_hi):
     """:func:`_theta2_group`, and the first and last changed block so far (branch-free)."""
     m = _theta2_group(T, TS, V, B1, i, n, mp, h2, friction)
