@@ -22,7 +22,7 @@ import operator
 
 from llvmlite import ir
 from numba import types
-from numba.extending import intrinsic, models, overload, register_model
+from numba.extending import intrinsic, lower_builtin, models, register_model, type_callable
 
 #: lanes per value
 WIDTH = 8
@@ -66,28 +66,24 @@ def _arithmetic(a, b) -> bool:
     )
 
 
-def _binary(instruction):
-    @intrinsic
-    def apply(typingctx, a, b):
-        if not _arithmetic(a, b):
-            return None
+def _register(op, instruction):
+    """Type and lower ``op`` on lanes (with lanes or a float64) as the LLVM ``instruction`` on
+    <8 x double>: no function of its own to compile per operator and operand types."""
 
-        def codegen(context, builder, sig, args):
-            x = _operand(builder, sig.args[0], args[0])
-            y = _operand(builder, sig.args[1], args[1])
-            return getattr(builder, instruction)(x, y)
+    @type_callable(op)
+    def _typing(context):
+        def typer(a, b):
+            return f64x8 if _arithmetic(a, b) else None
 
-        return f64x8(a, b), codegen
+        return typer
 
-    return apply
+    def _lower(context, builder, sig, args):
+        x = _operand(builder, sig.args[0], args[0])
+        y = _operand(builder, sig.args[1], args[1])
+        return getattr(builder, instruction)(x, y)
 
-
-def _register(op, apply):
-    @overload(op)
-    def _lanes(a, b):
-        if _arithmetic(a, b):
-            return lambda a, b: apply(a, b)
-        return None
+    for a, b in ((F64x8, F64x8), (F64x8, types.float64), (types.float64, F64x8)):
+        lower_builtin(op, a, b)(_lower)
 
 
 for _op, _instruction in (
@@ -96,7 +92,7 @@ for _op, _instruction in (
     (operator.mul, "fmul"),
     (operator.truediv, "fdiv"),
 ):
-    _register(_op, _binary(_instruction))
+    _register(_op, _instruction)
 
 
 def _first(builder, n):
