@@ -44,6 +44,7 @@ from __future__ import annotations
 
 from numba import njit
 
+from stickslip.kernels import lanes
 from stickslip.kernels.events import _end_event, _overflow, _service, _start_and_first_moves
 from stickslip.kernels.laws import _force, _pull, _right_of_first, _set_ghosts, _threshold, has
 from stickslip.kernels.layout import (
@@ -71,10 +72,12 @@ from stickslip.kernels.stages import (
     _longest_run,
     _stage1,
     _stage1_run,
+    _stage1_run_loop,
     _stage1_theta,
     _stage1_theta_only,
     _stage2,
     _stage2_run,
+    _stage2_run_loop,
     _stage2_theta,
 )
 from stickslip.kernels.triggers import leaf_triggers, pull_trigger
@@ -189,10 +192,18 @@ def run_exact(args, drive, friction, threshold, ends):
                 # Every block slides: no start, no first move, nothing to track but stops.
                 p1 = _pull(V, n, dt)
                 _set_ghosts(x, th, N, p1, drive, ends)
-                _stage1_run(x, v, th, xs, vs, ths, a1, b1, 1, N, p1, mp, dt, drive, friction)
                 p2 = _pull(V, n + 1, dt)
-                _set_ghosts(xs, ths, N, p2, drive, ends)
-                stops = _stage2_run(x, v, th, xs, vs, ths, a1, b1, 1, N, p2, mp, h2, drive, friction)
+                if N < lanes.WIDTH:
+                    # A chain shorter than a group of lanes: its one masked group per stage would
+                    # be read again at once by the next stage, and a masked store cannot be
+                    # forwarded to a load (measured: 2.5 times slower for N = 1).
+                    _stage1_run_loop(x, v, th, xs, vs, ths, a1, b1, 1, N, p1, mp, dt, drive, friction)
+                    _set_ghosts(xs, ths, N, p2, drive, ends)
+                    stops = _stage2_run_loop(x, v, th, xs, vs, ths, a1, b1, 1, N, p2, mp, h2, drive, friction)
+                else:
+                    _stage1_run(x, v, th, xs, vs, ths, a1, b1, 1, N, p1, mp, dt, drive, friction)
+                    _set_ghosts(xs, ths, N, p2, drive, ends)
+                    stops = _stage2_run(x, v, th, xs, vs, ths, a1, b1, 1, N, p2, mp, h2, drive, friction)
                 ist[BLOCK_UPDATES] += N
                 ist[FULL_UPDATES] += N
                 ist[STEPS_COMPUTED] += 1
