@@ -72,12 +72,10 @@ from stickslip.kernels.stages import (
     _longest_run,
     _stage1,
     _stage1_run,
-    _stage1_run_loop,
     _stage1_theta,
     _stage1_theta_only,
     _stage2,
     _stage2_run,
-    _stage2_run_loop,
     _stage2_theta,
 )
 from stickslip.kernels.triggers import leaf_triggers, pull_trigger
@@ -188,22 +186,18 @@ def run_exact(args, drive, friction, threshold, ends):
                     ist[STEP] = t_next if t_next < target else target
                 continue
 
-            if ist[N_MOVING] == N and lo == 1 and hi == N:
+            # A chain shorter than a group of lanes takes the general stages: the run stages would
+            # make it one masked group per stage, which the next stage reads again at once, and a
+            # masked store is not forwarded to a load (measured for N = 1: 1.65 s against 1.35 s;
+            # docs/performance.md, "Eight blocks at once").
+            if ist[N_MOVING] == N and lo == 1 and hi == N and N >= lanes.WIDTH:
                 # Every block slides: no start, no first move, nothing to track but stops.
                 p1 = _pull(V, n, dt)
                 _set_ghosts(x, th, N, p1, drive, ends)
+                _stage1_run(x, v, th, xs, vs, ths, a1, b1, 1, N, p1, mp, dt, drive, friction)
                 p2 = _pull(V, n + 1, dt)
-                if N < lanes.WIDTH:
-                    # A chain shorter than a group of lanes: its one masked group per stage would
-                    # be read again at once by the next stage, and a masked store cannot be
-                    # forwarded to a load (measured: 2.5 times slower for N = 1).
-                    _stage1_run_loop(x, v, th, xs, vs, ths, a1, b1, 1, N, p1, mp, dt, drive, friction)
-                    _set_ghosts(xs, ths, N, p2, drive, ends)
-                    stops = _stage2_run_loop(x, v, th, xs, vs, ths, a1, b1, 1, N, p2, mp, h2, drive, friction)
-                else:
-                    _stage1_run(x, v, th, xs, vs, ths, a1, b1, 1, N, p1, mp, dt, drive, friction)
-                    _set_ghosts(xs, ths, N, p2, drive, ends)
-                    stops = _stage2_run(x, v, th, xs, vs, ths, a1, b1, 1, N, p2, mp, h2, drive, friction)
+                _set_ghosts(xs, ths, N, p2, drive, ends)
+                stops = _stage2_run(x, v, th, xs, vs, ths, a1, b1, 1, N, p2, mp, h2, drive, friction)
                 ist[BLOCK_UPDATES] += N
                 ist[FULL_UPDATES] += N
                 ist[STEPS_COMPUTED] += 1
@@ -246,7 +240,7 @@ def run_exact(args, drive, friction, threshold, ends):
             starts = False
             # The run, when it lies within [fl, fh] and [lo, hi] (as it should: its blocks moved in
             # the last step): no start rule there; the general stages on either side of it.
-            run_in = ra0 <= rb0 and fl <= ra0 and rb0 <= fh and lo <= ra0 and rb0 <= hi
+            run_in = N >= lanes.WIDTH and ra0 <= rb0 and fl <= ra0 and rb0 <= fh and lo <= ra0 and rb0 <= hi
             if not run_in:
                 mm_run = False
             if fl <= fh:
