@@ -2,7 +2,8 @@
 
 Reads the LLVM IR numba generates for the kernel and looks for vector arithmetic on doubles;
 a per-block branch or a negative-index check inside the loops would make LLVM give up on
-vectorising them and this test would fail.
+vectorising them and this test would fail. The stages written as eight-block lanes
+(kernels/lanes.py) must compile to arithmetic on 8 doubles with masked loads and stores.
 """
 
 from __future__ import annotations
@@ -21,7 +22,23 @@ from stickslip.models.threshold import constant as constant_threshold
 from stickslip.run.driver import run_chain
 
 # The block loops: separate compiled functions, and the all-moving ones inlined in run_exact.
-STAGES = ("_stage1", "_stage2", "_stage1_theta", "_stage1_theta_only", "_stage2_theta", "_stage1_run", "_stage2_run")
+STAGES = (
+    "_stage1",
+    "_stage2",
+    "_stage1_theta_loop",
+    "_stage1_theta_only_loop",
+    "_stage2_theta_loop",
+    "_stage1_run_loop",
+    "_stage2_run_loop",
+)
+# The same stages as lanes of 8 blocks (what the pieces with PIECE.lanes get).
+LANES = (
+    "_stage1_theta_lanes",
+    "_stage1_theta_only_lanes",
+    "_stage2_theta_lanes",
+    "_stage1_run_lanes",
+    "_stage2_run_lanes",
+)
 
 
 def _fresh_ir(kernel, args=None) -> str:
@@ -41,6 +58,7 @@ def _fresh_ir(kernel, args=None) -> str:
 
 
 def _example_args(name: str) -> tuple:
+    name = name.removesuffix("_loop").removesuffix("_lanes")
     a = [np.linspace(0.5, 1.5, 12) for _ in range(10)]
     lo, hi = 1, 10
     dt, p = 0.005, 0.0
@@ -63,7 +81,7 @@ def _example_args(name: str) -> tuple:
 def irs() -> dict[str, str]:
     run_chain(ChainParams(N=8), 1.0, integrator="exact")
     run_chain(ChainParams(N=8), 1.0, integrator="dense")
-    out = {name: _fresh_ir(getattr(stages, name), _example_args(name)) for name in STAGES}
+    out = {name: _fresh_ir(getattr(stages, name), _example_args(name)) for name in STAGES + LANES}
     out["run_exact"] = _fresh_ir(exact.run_exact)
     out["run_dense"] = _fresh_ir(dense.run_dense)
     return out
@@ -91,7 +109,21 @@ def test_start_and_stop_rules_are_vector_selects(irs, name):
     assert re.search(r"select <\d+ x i1>", ir)
 
 
-@pytest.mark.parametrize("name", STAGES + ("run_exact", "run_dense"))
+@pytest.mark.parametrize("name", LANES)
+def test_lanes_are_arithmetic_on_eight_doubles_with_masked_loads_and_stores(irs, name):
+    ir = irs[name]
+    ops = _vector_ops(ir)
+    eight = [op for op, w in ops if w == 8]
+    # Each stage evaluates the state law's rate, a*(1 - b) - ... (and the runs the force and accel).
+    assert sum(1 for op in eight if op == "fsub") >= 3, ops
+    assert sum(1 for op in eight if op == "fmul") >= 3, ops
+    assert "fadd" in eight, ops
+    # The last group of an interval is masked (a group of 8 may compile to plain vector loads).
+    assert re.search(r"call <8 x double> @llvm\.masked\.load\.v8f64", ir)
+    assert re.search(r"call void @llvm\.masked\.store\.v8f64", ir)
+
+
+@pytest.mark.parametrize("name", STAGES + LANES + ("run_exact", "run_dense"))
 def test_no_fast_math_flags(irs, name):
     ir = irs[name]
     for flag in ("fast ", "reassoc", "contract", "nnan", "ninf"):

@@ -32,7 +32,7 @@ once per run. The driver hands over arrays whose block 1 starts a 64-byte line
 aligned arrays").
 
 Three more savings keep every bit (docs/performance.md, "Fewer scalar blocks in the partly stuck
-step"): stage 1 of the run covers whole vectors of blocks, the up to three blocks past it
+step"): stage 1 of the run covers whole groups of 8 blocks, the up to seven blocks past it
 getting a moving block's values that the general stages then overwrite; the one block past the
 run that the start rule leaves stopped gets the stopped blocks' stage 1; and a stopped block of
 the interval gets its stage-1 predictors of x and v and its mask only next to the blocks that may
@@ -44,6 +44,7 @@ from __future__ import annotations
 
 from numba import njit
 
+from stickslip.kernels import lanes
 from stickslip.kernels.events import _end_event, _overflow, _service, _start_and_first_moves
 from stickslip.kernels.laws import _force, _pull, _right_of_first, _set_ghosts, _threshold, has
 from stickslip.kernels.layout import (
@@ -70,12 +71,10 @@ from stickslip.kernels.layout import (
 from stickslip.kernels.stages import (
     _longest_run,
     _stage1,
-    _stage1_all,
     _stage1_run,
     _stage1_theta,
     _stage1_theta_only,
     _stage2,
-    _stage2_all,
     _stage2_run,
     _stage2_theta,
 )
@@ -187,14 +186,18 @@ def run_exact(args, drive, friction, threshold, ends):
                     ist[STEP] = t_next if t_next < target else target
                 continue
 
-            if ist[N_MOVING] == N and lo == 1 and hi == N:
+            # A chain shorter than a group of lanes takes the general stages: the run stages would
+            # make it one masked group per stage, which the next stage reads again at once, and a
+            # masked store is not forwarded to a load (measured for N = 1: 1.65 s against 1.35 s;
+            # docs/performance.md, "Eight blocks at once").
+            if ist[N_MOVING] == N and lo == 1 and hi == N and N >= lanes.WIDTH:
                 # Every block slides: no start, no first move, nothing to track but stops.
                 p1 = _pull(V, n, dt)
                 _set_ghosts(x, th, N, p1, drive, ends)
-                _stage1_all(x, v, th, xs, vs, ths, a1, b1, N, p1, mp, dt, drive, friction)
+                _stage1_run(x, v, th, xs, vs, ths, a1, b1, 1, N, p1, mp, dt, drive, friction)
                 p2 = _pull(V, n + 1, dt)
                 _set_ghosts(xs, ths, N, p2, drive, ends)
-                stops = _stage2_all(x, v, th, xs, vs, ths, a1, b1, N, p2, mp, h2, drive, friction)
+                stops = _stage2_run(x, v, th, xs, vs, ths, a1, b1, 1, N, p2, mp, h2, drive, friction)
                 ist[BLOCK_UPDATES] += N
                 ist[FULL_UPDATES] += N
                 ist[STEPS_COMPUTED] += 1
@@ -208,8 +211,11 @@ def run_exact(args, drive, friction, threshold, ends):
                 if stops:
                     n_moving = 0
                     for i in range(1, N + 1):
-                        mov[i] = 1.0 if v[i] > 0.0 else 0.0
-                        n_moving += 1 if v[i] > 0.0 else 0
+                        # The stop rule (_stage2_run stored v as computed).
+                        keep = v[i] > 0.0
+                        v[i] = v[i] if keep else 0.0
+                        mov[i] = 1.0 if keep else 0.0
+                        n_moving += 1 if keep else 0
                     ist[N_MOVING] = n_moving
                     ra, rb = _longest_run(mov, 1, N)
                     if has(drive, "leaf_spring"):
@@ -234,7 +240,7 @@ def run_exact(args, drive, friction, threshold, ends):
             starts = False
             # The run, when it lies within [fl, fh] and [lo, hi] (as it should: its blocks moved in
             # the last step): no start rule there; the general stages on either side of it.
-            run_in = ra0 <= rb0 and fl <= ra0 and rb0 <= fh and lo <= ra0 and rb0 <= hi
+            run_in = N >= lanes.WIDTH and ra0 <= rb0 and fl <= ra0 and rb0 <= fh and lo <= ra0 and rb0 <= hi
             if not run_in:
                 mm_run = False
             if fl <= fh:
@@ -247,10 +253,10 @@ def run_exact(args, drive, friction, threshold, ends):
                         )
                         if f_ <= l_:
                             first = f_
-                    # Over whole vectors of 4 blocks, not one at a time at the end: the up to 3
+                    # Over whole groups of 8 blocks, with no masked or scalar rest: the up to 7
                     # blocks past the run get a moving block's values, which the stages below
-                    # overwrite wherever stage 2 and the bookkeeping read them (measured: 1-2%).
-                    rp = rb0 + (ra0 - rb0 - 1) % 4
+                    # overwrite wherever stage 2 and the bookkeeping read them (measured: 2%).
+                    rp = rb0 + (ra0 - rb0 - 1) % 8
                     if rp > N:
                         rp = rb0
                     _stage1_run(x, v, th, xs, vs, ths, a1, b1, ra0, rp, p1, mp, dt, drive, friction)
@@ -311,12 +317,22 @@ def run_exact(args, drive, friction, threshold, ends):
             stops_run = False
             whole = False  # the whole run went through _stage2_run
             if sl <= sh:
+                if has(friction, "has_state"):
+                    # The state variable of the stopped blocks on either side first: it reads
+                    # nothing the full stages write, and its short chain of dependent operations
+                    # then overlaps their loops instead of holding up the bookkeeping (measured).
+                    if lo < sl:
+                        c_lo, c_hi = _stage2_theta(th, ths, v, b1, lo, sl - 1, mp, h2, friction)
+                    if sh < hi:
+                        t_lo, t_hi = _stage2_theta(th, ths, v, b1, sh + 1, hi, mp, h2, friction)
+                        c_lo, c_hi = _merge(c_lo, c_hi, t_lo, t_hi)
                 whole = run_in
                 if run_in:
                     if sl < ra0:
-                        c_lo, c_hi, moved_before, moved_after = _stage2(
+                        t_lo, t_hi, moved_before, moved_after = _stage2(
                             x, v, th, mov, xs, vs, ths, mm, a1, b1, sl, ra0 - 1, p2, mp, h2, drive, friction
                         )
+                        c_lo, c_hi = _merge(c_lo, c_hi, t_lo, t_hi)
                     stops_run = _stage2_run(x, v, th, xs, vs, ths, a1, b1, ra0, rb0, p2, mp, h2, drive, friction)
                     # Every block of the run moved: count it as changed.
                     c_lo, c_hi = _merge(c_lo, c_hi, ra0, rb0)
@@ -338,17 +354,11 @@ def run_exact(args, drive, friction, threshold, ends):
                         moved_before += mb
                         moved_after += ma
                 else:
-                    c_lo, c_hi, moved_before, moved_after = _stage2(
+                    t_lo, t_hi, moved_before, moved_after = _stage2(
                         x, v, th, mov, xs, vs, ths, mm, a1, b1, sl, sh, p2, mp, h2, drive, friction
                     )
+                    c_lo, c_hi = _merge(c_lo, c_hi, t_lo, t_hi)
                 ist[FULL_UPDATES] += sh - sl + 1
-                if has(friction, "has_state"):
-                    if lo < sl:
-                        t_lo, t_hi = _stage2_theta(th, ths, v, b1, lo, sl - 1, mp, h2, friction)
-                        c_lo, c_hi = _merge(c_lo, c_hi, t_lo, t_hi)
-                    if sh < hi:
-                        t_lo, t_hi = _stage2_theta(th, ths, v, b1, sh + 1, hi, mp, h2, friction)
-                        c_lo, c_hi = _merge(c_lo, c_hi, t_lo, t_hi)
             elif has(friction, "has_state"):
                 c_lo, c_hi = _stage2_theta(th, ths, v, b1, lo, hi, mp, h2, friction)
             # Next step's movers: a stopped block starts only if its force or threshold changed;

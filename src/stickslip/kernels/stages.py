@@ -1,6 +1,7 @@
 """The Heun stages of the fast interval path (:mod:`stickslip.kernels.exact`) over a contiguous
-interval of blocks: the general stages with the start and stop rules, the all-sliding stages,
-and the stages of blocks known to stay stopped, which change their state variable alone
+interval of blocks: the general stages with the start and stop rules, the stages of a run of
+blocks that all slide (the whole chain when it slides throughout), and the stages of blocks known
+to stay stopped, which change their state variable alone
 (eq. 4, docs/model.md; the step is in :mod:`stickslip.kernels.laws`).
 
 Each evaluates every quantity with the expressions of :mod:`stickslip.kernels.laws`, in the
@@ -16,14 +17,23 @@ cheap, many short ones are not: the exact path runs the blocks that move through
 run (:func:`_stage1_run`, :func:`_stage2_run`, which skip the start rule and the bookkeeping
 of changes), with the run's bounds fixed over the steps of one run so that the compiler makes
 these checks once per run.
+
+Where the drive and the friction law run as lanes (their ``PIECE.lanes``), the run stages and the
+stopped blocks' state-variable stages take 8 blocks at a time instead
+(:mod:`stickslip.kernels.lanes`): each group loads its blocks and their neighbours, calls the
+pieces' functions on the 8 lanes and stores the results, the last group under a mask, with no
+overlap checks and no scalar remainder (``*_lanes``; the loops are ``*_loop``). Which of the two a
+kernel runs is resolved when it is compiled (numba's ``overload`` on the pieces' literals).
 """
 
 from __future__ import annotations
 
 import numpy as np
 from numba import njit
+from numba.extending import overload
 
-from stickslip.kernels.laws import _accel, _dtheta, _force, _threshold
+from stickslip.kernels import lanes
+from stickslip.kernels.laws import _accel, _dtheta, _force, _threshold, piece_attr
 
 
 @njit(cache=True, _nrt=False, inline="always")
@@ -59,49 +69,8 @@ def _stage1(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, p, mp, dt, drive, fr
     return first + lo, last + lo, starts
 
 
-@njit(cache=True, inline="always")
-def _stage1_all(x, v, th, xs, vs, ths, a1, b1, N, p, mp, dt, drive, friction):
-    """Stage 1 over the whole chain when every block moves (no start can happen).
-
-    The mid-step mask is 1 everywhere and is not stored: no later use reads it.
-    """
-    K, dp = mp[0], mp[1]
-    for i in range(1, N + 1):
-        f = _force(x[i - 1], x[i], x[i + 1], K, dp, p, drive)
-        a = _accel(f, th[i], v[i], 1.0, mp, friction)
-        b = _dtheta(th[i - 1], th[i], th[i + 1], v[i], mp, friction)
-        a1[i] = a
-        b1[i] = b
-        xs[i] = x[i] + dt * v[i]
-        vs[i] = v[i] + dt * a
-        ths[i] = th[i] + dt * b
-
-
-@njit(cache=True, inline="always")
-def _stage2_all(x, v, th, xs, vs, ths, a1, b1, N, p, mp, h2, drive, friction):
-    """Stage 2, corrector and stop rule over the whole chain when every block moves.
-
-    Skips the bookkeeping of changes (every block is kept active) and returns only whether
-    some block stopped. The moving flags are not written: after the step a block moves
-    exactly when its v > 0, and the caller rebuilds them from v when a block stopped.
-    """
-    K, dp = mp[0], mp[1]
-    stops = False
-    for i in range(1, N + 1):
-        f2 = _force(xs[i - 1], xs[i], xs[i + 1], K, dp, p, drive)
-        a2 = _accel(f2, ths[i], vs[i], 1.0, mp, friction)
-        b2 = _dtheta(ths[i - 1], ths[i], ths[i + 1], vs[i], mp, friction)
-        x[i] = x[i] + h2 * (v[i] + vs[i])
-        vn = v[i] + h2 * (a1[i] + a2)
-        th[i] = th[i] + h2 * (b1[i] + b2)
-        keep = vn > 0.0
-        v[i] = vn if keep else 0.0
-        stops |= not keep
-    return stops
-
-
 @njit(cache=True, _nrt=False, inline="always")
-def _stage1_theta(x, v, th, xs, vs, ths, mm, b1, lo, hi, mp, dt, friction):
+def _stage1_theta_loop(x, v, th, xs, vs, ths, mm, b1, lo, hi, mp, dt, friction):
     """Stage 1 for blocks lo..hi known to stay stopped in this step (mid-step mask 0).
 
     For such a block v = 0 and the acceleration is 0 * (...), so the full stage gives
@@ -118,12 +87,12 @@ def _stage1_theta(x, v, th, xs, vs, ths, mm, b1, lo, hi, mp, dt, friction):
 
 
 @njit(cache=True, _nrt=False)
-def _stage1_theta_only(v, th, ths, b1, lo, hi, mp, dt, friction):
+def _stage1_theta_only_loop(v, th, ths, b1, lo, hi, mp, dt, friction):
     """Stage 1 for stopped blocks lo..hi whose predictors of x and v and mask nothing reads: in a
     step in which no block moves, or not next to a block that may move (stage 2 reads those of
     its movers' neighbours only).
 
-    So only the state variable's derivative and predictor are written (see _stage1_theta for why
+    So only the state variable's derivative and predictor are written (see _stage1_theta_loop for why
     this is exact).
     """
     one = np.uint64(1)
@@ -134,10 +103,10 @@ def _stage1_theta_only(v, th, ths, b1, lo, hi, mp, dt, friction):
 
 
 @njit(cache=True, _nrt=False, inline="always")
-def _stage2_theta(th, ths, v, b1, lo, hi, mp, h2, friction):
+def _stage2_theta_loop(th, ths, v, b1, lo, hi, mp, h2, friction):
     """Stage 2 and corrector of the state variable alone, for blocks lo..hi that stay stopped.
 
-    Their x, v and stopped flag provably keep every bit (see _stage1_theta), and their
+    Their x, v and stopped flag provably keep every bit (see _stage1_theta_loop), and their
     predicted velocity equals v = 0, which is read instead. Returns the first and last block
     whose state variable changed (lo > hi if none).
     """
@@ -202,7 +171,7 @@ def _stage2(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, p, mp, h2, drive, fr
 
 
 @njit(cache=True, _nrt=False, inline="always")
-def _stage1_run(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, dt, drive, friction):
+def _stage1_run_loop(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, dt, drive, friction):
     """Stage 1 for blocks lo..hi that all move at t_n (a run of sliding blocks).
 
     A moving block moves in this step whatever its force (start rule), so the mask is 1 and
@@ -229,18 +198,19 @@ def _stage1_run(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, dt, drive, frictio
 
 
 @njit(cache=True, _nrt=False, inline="always")
-def _stage2_run(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, h2, drive, friction):
+def _stage2_run_loop(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, h2, drive, friction):
     """Stage 2, corrector and stop rule for a run lo..hi of blocks moving in this step.
 
-    As :func:`_stage2_all` on the run: the moving flags are not written and the changes not
-    tracked (the caller counts the run as changed); returns whether some block stopped. The
-    velocity is stored as computed: where a block stopped (rare), the caller sets it to 0.
+    The moving flags are not written and the changes not tracked (the caller counts the run as
+    changed); returns whether some block stopped. The velocity is stored as computed: where a
+    block stopped (rare), the caller sets it to 0. With lo..hi = 1..N it is the step of a chain
+    that slides throughout.
     """
     K, dp = mp[0], mp[1]
     one = np.uint64(1)
     stops = False
     for i in range(np.uint64(lo), np.uint64(hi) + one):
-        # Read once, stored last (as in _stage1_run).
+        # Read once, stored last (as in _stage1_run_loop).
         vi = v[i]
         vsi = vs[i]
         tsi = ths[i]
@@ -255,6 +225,241 @@ def _stage2_run(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, h2, drive, frictio
         th[i] = thn
         stops |= not vn > 0.0
     return stops
+
+
+@njit(cache=True, _nrt=False)
+def _stage1_group(x, v, th, xs, vs, ths, a1, b1, i, n, p, mp, dt, drive, friction):
+    """Stage 1 of a run for blocks i..i+n-1 (n <= 8) as lanes: :func:`_stage1_run_loop`'s
+    expressions on 8 blocks at once (:mod:`stickslip.kernels.lanes`). The arrays are given by the
+    addresses of their data (``a.ctypes.data``), as in every ``*_group``."""
+    K, dp = mp[0], mp[1]
+    one = np.uint64(1)
+    xi = lanes.load(x, i, n)
+    vi = lanes.load(v, i, n)
+    ti = lanes.load(th, i, n)
+    f = _force(lanes.load(x, i - one, n), xi, lanes.load(x, i + one, n), K, dp, p, drive)
+    a = _accel(f, ti, vi, 1.0, mp, friction)
+    b = _dtheta(lanes.load(th, i - one, n), ti, lanes.load(th, i + one, n), vi, mp, friction)
+    lanes.store(xs, i, n, xi + dt * vi)
+    lanes.store(vs, i, n, vi + dt * a)
+    lanes.store(ths, i, n, ti + dt * b)
+    lanes.store(a1, i, n, a)
+    lanes.store(b1, i, n, b)
+
+
+@njit(cache=True, _nrt=False)
+def _stage2_group(x, v, th, xs, vs, ths, a1, b1, i, n, p, mp, h2, drive, friction):
+    """Stage 2 of a run for blocks i..i+n-1 (n <= 8) as lanes (:func:`_stage2_run_loop`'s
+    expressions); returns whether one of them stopped."""
+    K, dp = mp[0], mp[1]
+    one = np.uint64(1)
+    vi = lanes.load(v, i, n)
+    vsi = lanes.load(vs, i, n)
+    tsi = lanes.load(ths, i, n)
+    f2 = _force(lanes.load(xs, i - one, n), lanes.load(xs, i, n), lanes.load(xs, i + one, n), K, dp, p, drive)
+    a2 = _accel(f2, tsi, vsi, 1.0, mp, friction)
+    b2 = _dtheta(lanes.load(ths, i - one, n), tsi, lanes.load(ths, i + one, n), vsi, mp, friction)
+    vn = vi + h2 * (lanes.load(a1, i, n) + a2)
+    lanes.store(x, i, n, lanes.load(x, i, n) + h2 * (vi + vsi))
+    lanes.store(v, i, n, vn)
+    lanes.store(th, i, n, lanes.load(th, i, n) + h2 * (lanes.load(b1, i, n) + b2))
+    return lanes.any_not_positive(vn, n)
+
+
+@njit(cache=True, _nrt=False, inline="always")
+def _stage1_run_lanes(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, dt, drive, friction):
+    """:func:`_stage1_run_loop` in groups of 8 blocks, the last group masked."""
+    X, V, T = x.ctypes.data, v.ctypes.data, th.ctypes.data
+    XS, VS, TS, A1, B1 = xs.ctypes.data, vs.ctypes.data, ths.ctypes.data, a1.ctypes.data, b1.ctypes.data
+    w = np.uint64(lanes.WIDTH)
+    i = np.uint64(lo)
+    end = np.uint64(hi) + np.uint64(1)
+    while i + w <= end:
+        _stage1_group(X, V, T, XS, VS, TS, A1, B1, i, w, p, mp, dt, drive, friction)
+        i += w
+    if i < end:
+        _stage1_group(X, V, T, XS, VS, TS, A1, B1, i, end - i, p, mp, dt, drive, friction)
+
+
+@njit(cache=True, _nrt=False, inline="always")
+def _stage2_run_lanes(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, h2, drive, friction):
+    """:func:`_stage2_run_loop` in groups of 8 blocks, the last group masked."""
+    X, V, T = x.ctypes.data, v.ctypes.data, th.ctypes.data
+    XS, VS, TS, A1, B1 = xs.ctypes.data, vs.ctypes.data, ths.ctypes.data, a1.ctypes.data, b1.ctypes.data
+    w = np.uint64(lanes.WIDTH)
+    i = np.uint64(lo)
+    end = np.uint64(hi) + np.uint64(1)
+    stops = False
+    while i + w <= end:
+        stops |= _stage2_group(X, V, T, XS, VS, TS, A1, B1, i, w, p, mp, h2, drive, friction)
+        i += w
+    if i < end:
+        stops |= _stage2_group(X, V, T, XS, VS, TS, A1, B1, i, end - i, p, mp, h2, drive, friction)
+    return stops
+
+
+@njit(cache=True, _nrt=False)
+def _theta1_group(x, v, th, xs, vs, ths, mm, b1, i, n, mp, dt, friction, full):
+    """Stage 1 of the state variable for stopped blocks i..i+n-1 as lanes, and with ``full``
+    their predictors of x and v and their mask (:func:`_stage1_theta_loop`)."""
+    one = np.uint64(1)
+    vi = lanes.load(v, i, n)
+    ti = lanes.load(th, i, n)
+    b = _dtheta(lanes.load(th, i - one, n), ti, lanes.load(th, i + one, n), vi, mp, friction)
+    lanes.store(b1, i, n, b)
+    lanes.store(ths, i, n, ti + dt * b)
+    if full:
+        lanes.store(xs, i, n, lanes.load(x, i, n) + dt * vi)
+        lanes.store(vs, i, n, vi)
+        lanes.store(mm, i, n, 0.0)
+
+
+@njit(cache=True, _nrt=False, inline="always")
+def _theta1_lanes(x, v, th, xs, vs, ths, mm, b1, lo, hi, mp, dt, friction, full):
+    X, V, T = x.ctypes.data, v.ctypes.data, th.ctypes.data
+    XS, VS, TS, MM, B1 = xs.ctypes.data, vs.ctypes.data, ths.ctypes.data, mm.ctypes.data, b1.ctypes.data
+    w = np.uint64(lanes.WIDTH)
+    i = np.uint64(lo)
+    end = np.uint64(hi) + np.uint64(1)
+    while i + w <= end:
+        _theta1_group(X, V, T, XS, VS, TS, MM, B1, i, w, mp, dt, friction, full)
+        i += w
+    if i < end:
+        _theta1_group(X, V, T, XS, VS, TS, MM, B1, i, end - i, mp, dt, friction, full)
+
+
+@njit(cache=True, _nrt=False, inline="always")
+def _stage1_theta_lanes(x, v, th, xs, vs, ths, mm, b1, lo, hi, mp, dt, friction):
+    """:func:`_stage1_theta_loop` as lanes."""
+    _theta1_lanes(x, v, th, xs, vs, ths, mm, b1, lo, hi, mp, dt, friction, True)
+
+
+@njit(cache=True, _nrt=False)
+def _stage1_theta_only_lanes(v, th, ths, b1, lo, hi, mp, dt, friction):
+    """:func:`_stage1_theta_only_loop` as lanes."""
+    _theta1_lanes(v, v, th, ths, ths, ths, b1, b1, lo, hi, mp, dt, friction, False)
+
+
+@njit(cache=True, _nrt=False)
+def _theta2_group(th, ths, v, b1, i, n, mp, h2, friction):
+    """:func:`_stage2_theta_loop` for blocks i..i+n-1 as lanes; returns the mask of the lanes
+    whose state variable changed (:func:`stickslip.kernels.lanes.changed`)."""
+    one = np.uint64(1)
+    tsl, tsi, tsr = lanes.load(ths, i - one, n), lanes.load(ths, i, n), lanes.load(ths, i + one, n)
+    b2 = _dtheta(tsl, tsi, tsr, lanes.load(v, i, n), mp, friction)
+    tho = lanes.load(th, i, n)
+    thn = tho + h2 * (lanes.load(b1, i, n) + b2)
+    lanes.store(th, i, n, thn)
+    return lanes.changed(thn, tho, n)
+
+
+@njit(cache=True, _nrt=False)
+def _theta2_changes(T, TS, V, B1, i, n, mp, h2, friction, c_lo, c_hi):
+    """:func:`_theta2_group`, and the first and last changed block so far (branch-free)."""
+    m = _theta2_group(T, TS, V, B1, i, n, mp, h2, friction)
+    first = np.int64(i) + lanes.lowest(m)
+    last = np.int64(i) + 63 - lanes.leading_zeros(m)
+    c_lo = first if m != 0 and c_lo > first else c_lo
+    c_hi = last if m != 0 else c_hi
+    return c_lo, c_hi
+
+
+@njit(cache=True, _nrt=False, inline="always")
+def _stage2_theta_lanes(th, ths, v, b1, lo, hi, mp, h2, friction):
+    """:func:`_stage2_theta_loop` as lanes."""
+    T, TS, V, B1 = th.ctypes.data, ths.ctypes.data, v.ctypes.data, b1.ctypes.data
+    w = np.uint64(lanes.WIDTH)
+    i = np.uint64(lo)
+    end = np.uint64(hi) + np.uint64(1)
+    c_lo = hi + 1
+    c_hi = lo - 1
+    while i + w <= end:
+        c_lo, c_hi = _theta2_changes(T, TS, V, B1, i, w, mp, h2, friction, c_lo, c_hi)
+        i += w
+    if i < end:
+        c_lo, c_hi = _theta2_changes(T, TS, V, B1, i, end - i, mp, h2, friction, c_lo, c_hi)
+    return c_lo, c_hi
+
+
+def _choose(by_lanes, by_loop, *pieces):
+    """``by_lanes`` where the pieces (literal module paths) all run as lanes (their
+    ``PIECE.lanes``), else ``by_loop``; None while they are not literals."""
+    flags = [piece_attr(piece, "lanes") for piece in pieces]
+    if None in flags:
+        return None
+    return by_lanes if all(flags) else by_loop
+
+
+def _stage1_run(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, dt, drive, friction):
+    """Stage 1 for blocks lo..hi that all move at t_n (a run of sliding blocks):
+    :func:`_stage1_run_lanes` where the drive and the law run as lanes, else
+    :func:`_stage1_run_loop` (resolved when the kernel is compiled)."""
+
+
+def _stage2_run(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, h2, drive, friction):
+    """Stage 2, corrector and stop rule for a run lo..hi (:func:`_stage2_run_lanes` or
+    :func:`_stage2_run_loop`). Returns whether some block stopped (v is stored as computed)."""
+
+
+def _stage1_theta(x, v, th, xs, vs, ths, mm, b1, lo, hi, mp, dt, friction):
+    """Stage 1 for blocks lo..hi known to stay stopped (:func:`_stage1_theta_loop`, as lanes
+    where the law allows)."""
+
+
+def _stage1_theta_only(v, th, ths, b1, lo, hi, mp, dt, friction):
+    """The state variable's stage 1 alone for stopped blocks lo..hi
+    (:func:`_stage1_theta_only_loop`, as lanes where the law allows)."""
+
+
+def _stage2_theta(th, ths, v, b1, lo, hi, mp, h2, friction):
+    """Stage 2 of the state variable alone for stopped blocks lo..hi; the first and last block
+    whose state variable changed (:func:`_stage2_theta_loop`, as lanes where the law allows)."""
+
+
+@overload(_stage1_run, prefer_literal=True)
+def _stage1_run_choice(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, dt, drive, friction):
+    fn = _choose(_stage1_run_lanes, _stage1_run_loop, drive, friction)
+    if fn is None:
+        return None
+    return lambda x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, dt, drive, friction: fn(
+        x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, dt, drive, friction
+    )
+
+
+@overload(_stage2_run, prefer_literal=True)
+def _stage2_run_choice(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, h2, drive, friction):
+    fn = _choose(_stage2_run_lanes, _stage2_run_loop, drive, friction)
+    if fn is None:
+        return None
+    return lambda x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, h2, drive, friction: fn(
+        x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, h2, drive, friction
+    )
+
+
+@overload(_stage1_theta, prefer_literal=True)
+def _stage1_theta_choice(x, v, th, xs, vs, ths, mm, b1, lo, hi, mp, dt, friction):
+    fn = _choose(_stage1_theta_lanes, _stage1_theta_loop, friction)
+    if fn is None:
+        return None
+    return lambda x, v, th, xs, vs, ths, mm, b1, lo, hi, mp, dt, friction: fn(
+        x, v, th, xs, vs, ths, mm, b1, lo, hi, mp, dt, friction
+    )
+
+
+@overload(_stage1_theta_only, prefer_literal=True)
+def _stage1_theta_only_choice(v, th, ths, b1, lo, hi, mp, dt, friction):
+    fn = _choose(_stage1_theta_only_lanes, _stage1_theta_only_loop, friction)
+    if fn is None:
+        return None
+    return lambda v, th, ths, b1, lo, hi, mp, dt, friction: fn(v, th, ths, b1, lo, hi, mp, dt, friction)
+
+
+@overload(_stage2_theta, prefer_literal=True)
+def _stage2_theta_choice(th, ths, v, b1, lo, hi, mp, h2, friction):
+    fn = _choose(_stage2_theta_lanes, _stage2_theta_loop, friction)
+    if fn is None:
+        return None
+    return lambda th, ths, v, b1, lo, hi, mp, h2, friction: fn(th, ths, v, b1, lo, hi, mp, h2, friction)
 
 
 @njit(cache=True, _nrt=False)

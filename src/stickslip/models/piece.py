@@ -122,6 +122,10 @@ class Piece:
     label: str = ""
     #: friction: extra numbers the stability report shows for this law (closed forms to compare)
     stability_extras: Callable[[Any], dict[str, float]] | None = None
+    #: friction and drive: the compiled functions the run stages call (``accel``, ``rate``;
+    #: ``force``) use only + - * / on their arguments and float parameters, so they run on 8
+    #: blocks at once (:mod:`stickslip.kernels.lanes`)
+    lanes: bool = False
     #: ends: steady sliding exists (a spring to a fixed wall stretches without bound)
     steady_sliding: bool = True
     #: ends: the chain closes into a ring (x_0 = x_N, x_{N+1} = x_1)

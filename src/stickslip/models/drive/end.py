@@ -29,5 +29,10 @@ def left(p, ghost):
 
 
 PIECE = Piece(
-    "drive", "end", "pulling point x_0 = V t joined to block 1 by the spring K (eq. 4)", READS, module=__name__
+    "drive",
+    "end",
+    "pulling point x_0 = V t joined to block 1 by the spring K (eq. 4)",
+    READS,
+    module=__name__,
+    lanes=True,
 )

@@ -36,4 +36,5 @@ PIECE = Piece(
     READS,
     leaf_spring=True,
     module=__name__,
+    lanes=True,
 )

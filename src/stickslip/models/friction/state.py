@@ -71,5 +71,6 @@ PIECE = Piece(
     linear=_linear,
     eq5=True,
     module=__name__,
+    lanes=True,
     label=r"$\theta + \beta v$",
 )

@@ -46,5 +46,6 @@ PIECE = Piece(
     steady=_steady,
     slope=_slope,
     module=__name__,
+    lanes=True,
     label=r"$F_0 + \beta v$",
 )
