@@ -316,6 +316,8 @@ def _theta1_group(x, v, th, xs, vs, ths, mm, b1, i, n, mp, dt, friction, full):
 
 @njit(cache=True, _nrt=False, inline="always")
 def _theta1_lanes(x, v, th, xs, vs, ths, mm, b1, lo, hi, mp, dt, friction, full):
+    """The state variable's stage 1 for stopped blocks lo..hi in groups of 8, the last masked
+    (with ``full``, their predictors of x and v and their mask too: :func:`_theta1_group`)."""
     X, V, T = x.ctypes.data, v.ctypes.data, th.ctypes.data
     XS, VS, TS, MM, B1 = xs.ctypes.data, vs.ctypes.data, ths.ctypes.data, mm.ctypes.data, b1.ctypes.data
     w = np.uint64(lanes.WIDTH)
@@ -337,6 +339,7 @@ def _stage1_theta_lanes(x, v, th, xs, vs, ths, mm, b1, lo, hi, mp, dt, friction)
 @njit(cache=True, _nrt=False)
 def _stage1_theta_only_lanes(v, th, ths, b1, lo, hi, mp, dt, friction):
     """:func:`_stage1_theta_only_loop` as lanes."""
+    # Without ``full`` the arrays in the places of x, xs, vs and mm are not touched.
     _theta1_lanes(v, v, th, ths, ths, ths, b1, b1, lo, hi, mp, dt, friction, False)
 
 
