@@ -288,16 +288,24 @@ def run_exact(args, drive, friction, threshold, ends):
                 # Blocks that stay stopped: stage 2 reads the predictors and the mask only next to
                 # [fl, fh] (the neighbours of its movers), so farther blocks need their theta alone
                 # (on a ring, blocks 1 and N are neighbours: all of them).
-                if l1 < fl:
-                    a_ = l1 if has(ends, "ring") else fl - 1
-                    if l1 < a_:
-                        _stage1_theta_only(v, th, ths, b1, l1, a_ - 1, mp, dt, friction)
-                    _stage1_theta(x, v, th, xs, vs, ths, mm, b1, a_, fl - 1, mp, dt, friction)
-                if fh < h1:
-                    b_ = h1 if has(ends, "ring") else fh + 1
-                    _stage1_theta(x, v, th, xs, vs, ths, mm, b1, fh + 1, b_, mp, dt, friction)
-                    if b_ < h1:
-                        _stage1_theta_only(v, th, ths, b1, b_ + 1, h1, mp, dt, friction)
+                if has(friction, "lanes"):
+                    # As lanes one pass is cheaper than two, and the full stopped stage 1 is exact
+                    # for every one of these blocks (see stages._stage1_theta_loop).
+                    if l1 < fl:
+                        _stage1_theta(x, v, th, xs, vs, ths, mm, b1, l1, fl - 1, mp, dt, friction)
+                    if fh < h1:
+                        _stage1_theta(x, v, th, xs, vs, ths, mm, b1, fh + 1, h1, mp, dt, friction)
+                else:
+                    if l1 < fl:
+                        a_ = l1 if has(ends, "ring") else fl - 1
+                        if l1 < a_:
+                            _stage1_theta_only(v, th, ths, b1, l1, a_ - 1, mp, dt, friction)
+                        _stage1_theta(x, v, th, xs, vs, ths, mm, b1, a_, fl - 1, mp, dt, friction)
+                    if fh < h1:
+                        b_ = h1 if has(ends, "ring") else fh + 1
+                        _stage1_theta(x, v, th, xs, vs, ths, mm, b1, fh + 1, b_, mp, dt, friction)
+                        if b_ < h1:
+                            _stage1_theta_only(v, th, ths, b1, b_ + 1, h1, mp, dt, friction)
             elif has(friction, "has_state"):
                 _stage1_theta_only(v, th, ths, b1, l1, h1, mp, dt, friction)
             p2 = _pull(V, n + 1, dt)
