@@ -385,12 +385,13 @@ def _stage2_theta_lanes(th, ths, v, b1, lo, hi, mp, h2, friction):
 
 
 def _choose(by_lanes, by_loop, *pieces):
-    """``by_lanes`` where the pieces (literal module paths) all run as lanes (their
-    ``PIECE.lanes``), else ``by_loop``; None while they are not literals."""
+    """The implementation of a stage stub: the Python function of ``by_lanes`` where the pieces
+    (literal module paths) all run as lanes (their ``PIECE.lanes``), else of ``by_loop``; both
+    take the stub's arguments. None while the pieces are not literals."""
     flags = [piece_attr(piece, "lanes") for piece in pieces]
     if None in flags:
         return None
-    return by_lanes if all(flags) else by_loop
+    return (by_lanes if all(flags) else by_loop).py_func
 
 
 def _stage1_run(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, dt, drive, friction):
@@ -421,48 +422,27 @@ def _stage2_theta(th, ths, v, b1, lo, hi, mp, h2, friction):
 
 @overload(_stage1_run, prefer_literal=True)
 def _stage1_run_choice(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, dt, drive, friction):
-    fn = _choose(_stage1_run_lanes, _stage1_run_loop, drive, friction)
-    if fn is None:
-        return None
-    return lambda x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, dt, drive, friction: fn(
-        x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, dt, drive, friction
-    )
+    return _choose(_stage1_run_lanes, _stage1_run_loop, drive, friction)
 
 
 @overload(_stage2_run, prefer_literal=True)
 def _stage2_run_choice(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, h2, drive, friction):
-    fn = _choose(_stage2_run_lanes, _stage2_run_loop, drive, friction)
-    if fn is None:
-        return None
-    return lambda x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, h2, drive, friction: fn(
-        x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, h2, drive, friction
-    )
+    return _choose(_stage2_run_lanes, _stage2_run_loop, drive, friction)
 
 
 @overload(_stage1_theta, prefer_literal=True)
 def _stage1_theta_choice(x, v, th, xs, vs, ths, mm, b1, lo, hi, mp, dt, friction):
-    fn = _choose(_stage1_theta_lanes, _stage1_theta_loop, friction)
-    if fn is None:
-        return None
-    return lambda x, v, th, xs, vs, ths, mm, b1, lo, hi, mp, dt, friction: fn(
-        x, v, th, xs, vs, ths, mm, b1, lo, hi, mp, dt, friction
-    )
+    return _choose(_stage1_theta_lanes, _stage1_theta_loop, friction)
 
 
 @overload(_stage1_theta_only, prefer_literal=True)
 def _stage1_theta_only_choice(v, th, ths, b1, lo, hi, mp, dt, friction):
-    fn = _choose(_stage1_theta_only_lanes, _stage1_theta_only_loop, friction)
-    if fn is None:
-        return None
-    return lambda v, th, ths, b1, lo, hi, mp, dt, friction: fn(v, th, ths, b1, lo, hi, mp, dt, friction)
+    return _choose(_stage1_theta_only_lanes, _stage1_theta_only_loop, friction)
 
 
 @overload(_stage2_theta, prefer_literal=True)
 def _stage2_theta_choice(th, ths, v, b1, lo, hi, mp, h2, friction):
-    fn = _choose(_stage2_theta_lanes, _stage2_theta_loop, friction)
-    if fn is None:
-        return None
-    return lambda th, ths, v, b1, lo, hi, mp, h2, friction: fn(th, ths, v, b1, lo, hi, mp, h2, friction)
+    return _choose(_stage2_theta_lanes, _stage2_theta_loop, friction)
 
 
 @njit(cache=True, _nrt=False)
