@@ -16,6 +16,7 @@ from hypothesis import strategies as st
 from chain_helpers import assert_same_run, oracle_run
 from stickslip.kernels import layout
 from stickslip.models.params import ChainParams
+from stickslip.models.presets import chain_params
 from stickslip.run.driver import ChainRunError, ChainState, run_chain
 
 BETAS = [0.2, 0.5, 1.0, 1.2]
@@ -137,6 +138,21 @@ def test_dense_equals_exact_benchmark_length(beta):
     dense, exact = _both(p, 2e4, profile_window=20.0, profile_min_blocks=5)
     assert_same_run(dense, exact)
     assert dense.summary["n_events"] > 20
+
+
+def test_a_partly_stuck_slide_equals_dense():
+    """The paper's chain loading at beta = 1.3 (`stickslip bench --workload partly-stuck`):
+    blocks 1..83 slide for thousands of steps while the rest stick, then block 84 starts and
+    blocks stop. The exact path takes the sliding steps in its tight loop (kernels/exact.py,
+    _slide_steps) and leaves it for the start and the stops; every bit is the reference's."""
+    p = chain_params("sakaguchi", N=199, beta=1.3)
+    prep = run_chain(p, 4.162e5, start="paper")
+    assert (np.flatnonzero(prep.state.mov[1:-1]) + 1).tolist() == list(range(1, 84))
+    dense, exact = _both(p, 4.164e5, start=prep.state, sample_interval=0.5, sample_moving=True)
+    assert_same_run(dense, exact)
+    n_moving = dense.samples["n_moving"].values
+    assert n_moving.max() == 84 and n_moving[-1] == 80  # a start, then stops, in the window
+    assert (exact.samples["n_moving"].values == n_moving).all()
 
 
 @pytest.mark.parametrize("V", [0.0, 2e-3])

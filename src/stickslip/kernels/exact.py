@@ -31,6 +31,12 @@ once per run. The driver hands over arrays whose block 1 starts a 64-byte line
 (:func:`stickslip.run.state.line_aligned`; docs/performance.md, "The run's bounds per run, and
 aligned arrays").
 
+Steps that repeat with nothing changing but the sliding (a run from block 1 with stopped blocks
+past it, or the whole chain sliding) are taken in a tight loop in a function of their own,
+:func:`_slide_steps`, whose loops compile to fewer instructions than inside run_exact; it returns
+at the first step that needs the general step (docs/performance.md, "The sliding steps in a
+function of their own").
+
 Three more savings keep every bit (docs/performance.md, "Fewer scalar blocks in the partly stuck
 step"): stage 1 of the run covers whole groups of 8 blocks, the up to seven blocks past it
 getting a moving block's values that the general stages then overwrite; the one block past the
@@ -79,6 +85,94 @@ from stickslip.kernels.stages import (
     _stage2_theta,
 )
 from stickslip.kernels.triggers import leaf_triggers, pull_trigger
+
+
+@njit(cache=True, _nrt=False)
+def _slide_steps(args, ra0, rb0, hi, mp, V, dt, drive, friction, threshold, ends):
+    """Steps of :func:`run_exact` in which the run ra0 = 1..rb0 slides and blocks rb0+1..hi stay
+    stopped, or (rb0 = hi = N) every block slides: the steps that run_exact would take, in a tight
+    loop, until block rb0+1 starts, a block of the run stops, the interval changes, or an output,
+    the end or a full buffer is due (then run_exact goes on from that step).
+
+    The stages' loops compile to fewer instructions in this small function than inside run_exact
+    (docs/performance.md, "The sliding steps in a function of their own"). Returns the run of the
+    next step, (ra0, rb0) unless a block of the run stopped, and with a plate the first start
+    step of the blocks that stopped (``_NEVER`` if none).
+    """
+    x, v, th, mov, xs = args.x, args.v, args.th, args.mov, args.xs
+    vs, ths, mm, a1, b1, ist = args.vs, args.ths, args.mm, args.a1, args.b1, args.ist
+    n_end, profile_every = args.n_end, args.profile_every
+    cap_ev, cap_fm, cap_p = args.ev_int.shape[0], args.fm.shape[0], args.prof_x.shape[0]
+    N = x.shape[0] - 2
+    K, dp, tp = mp[0], mp[1], mp[2]
+    h2 = 0.5 * dt
+    every = rb0 == N  # the whole chain slides: no stopped blocks, no start rule
+    fh = rb0 + 1
+    h1 = hi + 1
+    # Stage 1 of the run over whole groups of 8 blocks, as in run_exact.
+    rp = rb0 + (ra0 - rb0 - 1) % 8
+    if rp > N:
+        rp = rb0
+    while True:
+        n = ist[STEP]
+        if (
+            n == ist[NEXT_SAMPLE]
+            or (profile_every > 0 and ist[EV_ACTIVE] == 1 and n == ist[NEXT_PROFILE])
+            or n >= n_end
+            or ist[EV_COUNT] >= cap_ev
+            or ist[FM_COUNT] + N > cap_fm
+            or (profile_every > 0 and ist[P_COUNT] + 2 > cap_p)
+        ):
+            return ra0, rb0, _NEVER
+        p1 = _pull(V, n, dt)
+        _set_ghosts(x, th, N, p1, drive, ends)
+        if not every and _force(x[fh - 1], x[fh], x[fh + 1], K, dp, p1, drive) > _threshold(th[fh], tp, threshold):
+            return ra0, rb0, _NEVER  # block rb0+1 starts: run_exact's general step
+        _stage1_run(x, v, th, xs, vs, ths, a1, b1, ra0, rp, p1, mp, dt, drive, friction)
+        if not every:
+            _stage1_theta(x, v, th, xs, vs, ths, mm, b1, fh, h1, mp, dt, friction)
+        p2 = _pull(V, n + 1, dt)
+        _set_ghosts(xs, ths, N, p2, drive, ends)
+        c_hi = rb0
+        if has(friction, "has_state") and not every:
+            t_lo, t_hi = _stage2_theta(th, ths, v, b1, fh, hi, mp, h2, friction)
+            c_hi = t_hi if t_hi > rb0 else rb0
+        stops = _stage2_run(x, v, th, xs, vs, ths, a1, b1, ra0, rb0, p2, mp, h2, drive, friction)
+        ist[FULL_UPDATES] += rb0
+        ist[BLOCK_UPDATES] += hi
+        ist[STEPS_COMPUTED] += 1
+        ist[STEP] = n + 1
+        # The next step's candidates, as run_exact's: the changes dilated by two (block 1 is the
+        # lowest), and the movers and their neighbours.
+        c_hi = c_hi + 2 if c_hi < N - 2 else N
+        a_hi = c_hi if c_hi > fh or every else fh
+        ist[ACT_LO], ist[ACT_HI] = 1, a_hi
+        ist[MECH_LO], ist[MECH_HI] = 1, N if every else fh
+        if stops:
+            # The stop rule on the run (_stage2_run stored v as computed).
+            n_moving = ist[N_MOVING]
+            for i in range(ra0, rb0 + 1):
+                keep = v[i] > 0.0
+                v[i] = v[i] if keep else 0.0
+                mov[i] = 1.0 if keep else 0.0
+                n_moving -= 0 if keep else 1
+            ist[N_MOVING] = n_moving
+            ra, rb = _longest_run(mov, ra0, rb0)
+            t = _NEVER
+            if has(drive, "leaf_spring"):
+                # The blocks that stopped need their first start step under the plate (only the
+                # whole chain sliding comes here with a plate).
+                _set_ghosts(x, th, N, 0.0, drive, ends)
+                t = leaf_triggers(x, th, mov, mm, args.trig, 1, N, True, n + 1, n_end, mp, V, dt, drive, threshold)
+            if ist[EV_ACTIVE] == 1 and n_moving == 0:
+                _end_event(n, args)
+            return ra, rb, t
+        if a_hi != hi:
+            # Stopped blocks whose theta changes, and two past them: a wider interval.
+            if a_hi >= N:
+                return ra0, rb0, _NEVER
+            hi = a_hi
+            h1 = hi + 1
 
 
 @njit(cache=True)
@@ -191,41 +285,11 @@ def run_exact(args, drive, friction, threshold, ends):
             # masked store is not forwarded to a load (measured for N = 1: 1.65 s against 1.35 s;
             # docs/performance.md, "Eight blocks at once").
             if ist[N_MOVING] == N and lo == 1 and hi == N and N >= lanes.WIDTH:
-                # Every block slides: no start, no first move, nothing to track but stops.
-                p1 = _pull(V, n, dt)
-                _set_ghosts(x, th, N, p1, drive, ends)
-                _stage1_run(x, v, th, xs, vs, ths, a1, b1, 1, N, p1, mp, dt, drive, friction)
-                p2 = _pull(V, n + 1, dt)
-                _set_ghosts(xs, ths, N, p2, drive, ends)
-                stops = _stage2_run(x, v, th, xs, vs, ths, a1, b1, 1, N, p2, mp, h2, drive, friction)
-                ist[BLOCK_UPDATES] += N
-                ist[FULL_UPDATES] += N
-                ist[STEPS_COMPUTED] += 1
-                ist[STEP] = n + 1
-                # Every block changed: all stay candidates for the next step.
-                ist[ACT_LO] = 1
-                ist[ACT_HI] = N
-                ist[MECH_LO] = 1
-                ist[MECH_HI] = N
-                ra, rb = 1, N
-                if stops:
-                    n_moving = 0
-                    for i in range(1, N + 1):
-                        # The stop rule (_stage2_run stored v as computed).
-                        keep = v[i] > 0.0
-                        v[i] = v[i] if keep else 0.0
-                        mov[i] = 1.0 if keep else 0.0
-                        n_moving += 1 if keep else 0
-                    ist[N_MOVING] = n_moving
-                    ra, rb = _longest_run(mov, 1, N)
-                    if has(drive, "leaf_spring"):
-                        # The blocks that stopped need their first start step under the plate.
-                        _set_ghosts(x, th, N, 0.0, drive, ends)
-                        t = leaf_triggers(x, th, mov, mm, trig, 1, N, True, n + 1, n_end, mp, V, dt, drive, threshold)
-                        if t < t_next:
-                            t_next = t
-                    if ist[EV_ACTIVE] == 1 and n_moving == 0:
-                        _end_event(n, args)
+                # Every block slides: no start, no first move, nothing to track but stops; steps
+                # in the tight loop of _slide_steps until a block stops or an output is due.
+                ra, rb, t = _slide_steps(args, lo, hi, hi, mp, V, dt, drive, friction, threshold, ends)
+                if t < t_next:
+                    t_next = t
                 continue
 
             p1 = _pull(V, n, dt)
@@ -426,3 +490,24 @@ def run_exact(args, drive, friction, threshold, ends):
                         t_next = t
             if ist[EV_ACTIVE] == 1 and n_moving == 0:
                 _end_event(n, args)
+            if (
+                not has(drive, "leaf_spring")
+                and not has(ends, "ring")
+                and not has(threshold, "has_state")
+                and whole
+                and ra0 == 1
+                and first == 1
+                and last == rb0
+                and rb0 < hi
+                and hi < N
+                and not (starts or stops_run)
+                and ra == ra0
+                and rb == rb0
+                and ist[ACT_LO] == 1
+                and ist[ACT_HI] == hi
+                and ist[MECH_LO] == 1
+                and ist[MECH_HI] == rb0 + 1
+            ):
+                # The same step again and again while nothing changes but the run's sliding (a
+                # chain loading towards steady sliding): the tight loop of _slide_steps.
+                ra, rb, t = _slide_steps(args, ra0, rb0, hi, mp, V, dt, drive, friction, threshold, ends)
