@@ -76,6 +76,7 @@ from stickslip.kernels.layout import (
 )
 from stickslip.kernels.stages import (
     _longest_run,
+    _run_padded,
     _stage1,
     _stage1_run,
     _stage1_theta,
@@ -83,6 +84,7 @@ from stickslip.kernels.stages import (
     _stage2,
     _stage2_run,
     _stage2_theta,
+    _stop_run,
 )
 from stickslip.kernels.triggers import leaf_triggers, pull_trigger
 
@@ -109,10 +111,7 @@ def _slide_steps(args, ra0, rb0, hi, mp, V, dt, drive, friction, threshold, ends
     every = rb0 == N  # the whole chain slides: no stopped blocks, no start rule
     fh = rb0 + 1
     h1 = hi + 1
-    # Stage 1 of the run over whole groups of 8 blocks, as in run_exact.
-    rp = rb0 + (ra0 - rb0 - 1) % 8
-    if rp > N:
-        rp = rb0
+    rp = _run_padded(ra0, rb0, N)
     while True:
         n = ist[STEP]
         if (
@@ -135,7 +134,7 @@ def _slide_steps(args, ra0, rb0, hi, mp, V, dt, drive, friction, threshold, ends
         _set_ghosts(xs, ths, N, p2, drive, ends)
         c_hi = rb0
         if has(friction, "has_state") and not every:
-            t_lo, t_hi = _stage2_theta(th, ths, v, b1, fh, hi, mp, h2, friction)
+            _, t_hi = _stage2_theta(th, ths, v, b1, fh, hi, mp, h2, friction)
             c_hi = t_hi if t_hi > rb0 else rb0
         stops = _stage2_run(x, v, th, xs, vs, ths, a1, b1, ra0, rb0, p2, mp, h2, drive, friction)
         ist[FULL_UPDATES] += rb0
@@ -149,13 +148,7 @@ def _slide_steps(args, ra0, rb0, hi, mp, V, dt, drive, friction, threshold, ends
         ist[ACT_LO], ist[ACT_HI] = 1, a_hi
         ist[MECH_LO], ist[MECH_HI] = 1, N if every else fh
         if stops:
-            # The stop rule on the run (_stage2_run stored v as computed).
-            n_moving = ist[N_MOVING]
-            for i in range(ra0, rb0 + 1):
-                keep = v[i] > 0.0
-                v[i] = v[i] if keep else 0.0
-                mov[i] = 1.0 if keep else 0.0
-                n_moving -= 0 if keep else 1
+            n_moving = ist[N_MOVING] - (rb0 - ra0 + 1) + _stop_run(v, mov, ra0, rb0)
             ist[N_MOVING] = n_moving
             ra, rb = _longest_run(mov, ra0, rb0)
             t = _NEVER
@@ -320,9 +313,7 @@ def run_exact(args, drive, friction, threshold, ends):
                     # Over whole groups of 8 blocks, with no masked or scalar rest: the up to 7
                     # blocks past the run get a moving block's values, which the stages below
                     # overwrite wherever stage 2 and the bookkeeping read them (measured: 2%).
-                    rp = rb0 + (ra0 - rb0 - 1) % 8
-                    if rp > N:
-                        rp = rb0
+                    rp = _run_padded(ra0, rb0, N)
                     _stage1_run(x, v, th, xs, vs, ths, a1, b1, ra0, rp, p1, mp, dt, drive, friction)
                     if not mm_run:
                         for i in range(ra0, rb0 + 1):
@@ -410,12 +401,7 @@ def run_exact(args, drive, friction, threshold, ends):
                     c_lo, c_hi = _merge(c_lo, c_hi, ra0, rb0)
                     moved_before += rb0 - ra0 + 1
                     if stops_run:
-                        # The stop rule on the run (_stage2_run stored v as computed).
-                        for i in range(ra0, rb0 + 1):
-                            keep = v[i] > 0.0
-                            v[i] = v[i] if keep else 0.0
-                            mov[i] = 1.0 if keep else 0.0
-                            moved_after += 1 if keep else 0
+                        moved_after += _stop_run(v, mov, ra0, rb0)
                     else:
                         moved_after += rb0 - ra0 + 1
                     if rb0 < sh:
@@ -510,4 +496,4 @@ def run_exact(args, drive, friction, threshold, ends):
             ):
                 # The same step again and again while nothing changes but the run's sliding (a
                 # chain loading towards steady sliding): the tight loop of _slide_steps.
-                ra, rb, t = _slide_steps(args, ra0, rb0, hi, mp, V, dt, drive, friction, threshold, ends)
+                ra, rb, _ = _slide_steps(args, ra0, rb0, hi, mp, V, dt, drive, friction, threshold, ends)

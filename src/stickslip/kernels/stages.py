@@ -445,6 +445,28 @@ def _stage2_theta_choice(th, ths, v, b1, lo, hi, mp, h2, friction):
     return _choose(_stage2_theta_lanes, _stage2_theta_loop, friction)
 
 
+@njit(cache=True, _nrt=False, inline="always")
+def _stop_run(v, mov, lo, hi):
+    """The stop rule on a run lo..hi whose stage 2 stored v as computed (:func:`_stage2_run`): a
+    block with v <= 0 gets v = 0 and stops. Returns how many of the run still move."""
+    kept = 0
+    for i in range(lo, hi + 1):
+        keep = v[i] > 0.0
+        v[i] = v[i] if keep else 0.0
+        mov[i] = 1.0 if keep else 0.0
+        kept += 1 if keep else 0
+    return kept
+
+
+@njit(cache=True, _nrt=False, inline="always")
+def _run_padded(lo, hi, N):
+    """The last block of stage 1 of a run lo..hi over whole groups of 8 (the blocks past hi get a
+    moving block's values, which the stages after it overwrite where they are read), or hi where
+    the groups would pass block N."""
+    end = hi + (lo - hi - 1) % lanes.WIDTH
+    return end if end <= N else hi
+
+
 @njit(cache=True, _nrt=False)
 def _longest_run(mov, lo, hi):
     """The longest run of moving blocks within lo..hi (lo > hi if none)."""
