@@ -235,6 +235,17 @@ class LoadHistory:
         """V_i = (p_i+1 - p_i) / (t_i+1 - t_i), the load-point velocity on each interval."""
         return np.diff(self.positions) / np.diff(self.times)
 
+    def merged(self, rtol: float = 1e-9) -> LoadHistory:
+        """The same history without the breakpoints where the velocity does not change (to
+        ``rtol`` of the largest velocity): a record sampled at a steady rate becomes one interval,
+        so an integrator restarts only where the load point's velocity really steps."""
+        v = self.velocities
+        tol = rtol * max(float(np.max(np.abs(v))), 1e-300)
+        keep = np.concatenate([[True], np.abs(np.diff(v)) > tol, [True]])
+        if keep.all():
+            return self
+        return LoadHistory(self.times[keep], self.positions[keep])
+
     def segment(self, t) -> np.ndarray:
         """The index i of the interval [t_i, t_i+1) holding each t (the last interval holds t_end)."""
         i = np.searchsorted(self.times, np.asarray(t, dtype=float), side="right") - 1

@@ -262,6 +262,7 @@ def integrate(model, history, y0, t_out, *, rtol=1e-10, atol=1e-12, method="dop8
         The integrator failed (too many steps, step size at round-off, a non-finite state).
     """
     args = model.arrays()
+    history = history.merged()
     seg_t = np.ascontiguousarray(history.times, dtype=float)
     seg_v = np.ascontiguousarray(history.velocities, dtype=float)
     t_out = np.ascontiguousarray(t_out, dtype=float)
