@@ -28,7 +28,7 @@ from scipy.optimize import least_squares
 
 from stickslip.lab.integrate import IntegrationError
 from stickslip.lab.laws import RateState
-from stickslip.lab.quasi_static import quasi_static
+from stickslip.lab.quasi_static import solve
 from stickslip.lab.records import Record
 from stickslip.models.params import ParameterError
 
@@ -69,8 +69,7 @@ def _value(model: RateState, name: str, trend: float) -> float:
 def model_friction(model: RateState, record: Record, *, trend: float = 0.0, rtol: float = 1e-10) -> np.ndarray:
     """The spring-slider's friction at the record's samples, plus ``trend`` times the load-point
     displacement since the first sample."""
-    ds = quasi_static(model, record.history, t=record.t, v_init=record.v_init, rtol=rtol)
-    mu = ds.mu.values
+    mu = solve(model, record.history, record.t, v_init=record.v_init, rtol=rtol)["mu"]
     if trend != 0.0:
         p = record.history.position(record.t)
         mu = mu + trend * (p - p[0])

@@ -21,7 +21,7 @@ from stickslip.lab.integrate import METHODS, integrate
 from stickslip.lab.laws import RateState, friction_of, steady_theta
 from stickslip.models.params import ParameterError, check_number
 
-__all__ = ["quasi_static", "initial_state"]
+__all__ = ["initial_state", "quasi_static", "solve"]
 
 
 def initial_state(
@@ -74,6 +74,33 @@ def output_times(history: LoadHistory, t=None, n: int = 2001) -> np.ndarray:
     return t
 
 
+def solve(
+    model: RateState,
+    history: LoadHistory,
+    t,
+    *,
+    v_init: float | None = None,
+    theta_init=None,
+    rtol: float = 1e-10,
+    atol: float = 1e-12,
+    method: str = "dop853",
+) -> dict:
+    """The arrays of :func:`quasi_static` without the Dataset around them (what a fit evaluates
+    many times): ``t``, ``mu``, ``v``, ``theta`` (t, m), ``y0`` and the integrator's ``info``."""
+    k = model.require_k()
+    if method not in METHODS:
+        raise ParameterError(f"method must be one of {', '.join(METHODS)} (got {method!r})")
+    rtol = check_number("rtol", rtol, low=1e-14, high=1.0)
+    atol = check_number("atol", atol, low=0.0, low_open=True)
+    y0 = initial_state(model, history, v_init=v_init, theta_init=theta_init)
+    Y, v, info = integrate(model, history, y0, t, rtol=rtol, atol=atol, method=method)
+    tau = Y[:, 0]
+    if k == np.inf:
+        # A rigid machine: the friction of the imposed slip rate and the state reached.
+        tau = np.array([friction_of(model, vi, yi[1:]) for vi, yi in zip(v, Y, strict=True)])
+    return {"t": t, "mu": tau, "v": v, "theta": Y[:, 1:], "y0": y0, "info": info}
+
+
 def quasi_static(
     model: RateState,
     history: LoadHistory,
@@ -121,22 +148,14 @@ def quasi_static(
     0.5885
     """
     k = model.require_k()
-    if method not in METHODS:
-        raise ParameterError(f"method must be one of {', '.join(METHODS)} (got {method!r})")
-    rtol = check_number("rtol", rtol, low=1e-14, high=1.0)
-    atol = check_number("atol", atol, low=0.0, low_open=True)
     t_out = output_times(history, t, n)
-    y0 = initial_state(model, history, v_init=v_init, theta_init=theta_init)
-    Y, v, info = integrate(model, history, y0, t_out, rtol=rtol, atol=atol, method=method)
-    tau = Y[:, 0]
+    r = solve(model, history, t_out, v_init=v_init, theta_init=theta_init, rtol=rtol, atol=atol, method=method)
+    tau, v, y0, info, Y = r["mu"], r["v"], r["y0"], r["info"], r["theta"]
     p = history.position(t_out)
     p0 = float(history.position(history.times[0]))
-    if k == np.inf:
-        # A rigid machine: the friction of the imposed slip rate and the state reached.
-        tau = np.array([friction_of(model, vi, yi[1:]) for vi, yi in zip(v, Y, strict=True)])
     slip = (p - p0) if k == np.inf else (p - p0) - (tau - y0[0]) / k
     m = model.n_states
-    theta = (("t", "state"), Y[:, 1:]) if m > 1 else ("t", Y[:, 1])
+    theta = (("t", "state"), Y) if m > 1 else ("t", Y[:, 0])
     ds = xr.Dataset(
         {
             "mu": ("t", tau, {"long_name": "friction k (p - x)", "units": "1"}),
@@ -163,8 +182,8 @@ def quasi_static(
             "k": k,
             "eta": model.eta,
             "integrator": info["method"],
-            "rtol": rtol,
-            "atol": atol,
+            "rtol": float(rtol),
+            "atol": float(atol),
             "steps": info["steps"],
             "evaluations": info["evaluations"],
         }
