@@ -221,7 +221,12 @@ def run_shs(args) -> Result:
         lines.append(
             f"healing rate d(Delta mu)/d log10 t_hold = {data['healing_rate']:.5g}"
             + (f" +- {se:.2g}" if se is not None else "")
-            + f" per decade (aging law, stiff machine, long holds: b ln 10 = {data['aging_long_hold_rate']:.5g})"
+            + " per decade"
+            + (
+                f" (aging law, stiff machine, long holds: b ln 10 = {data['aging_long_hold_rate']:.5g})"
+                if data["aging_long_hold_rate"]
+                else ""
+            )
         )
     lines += [f"wrote {p}" for p in data.get("outputs", [])]
     return Result(data=data, text="\n".join(lines))

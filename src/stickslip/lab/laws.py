@@ -233,20 +233,54 @@ PARAM_TEXT = {
 
 
 def steady_theta(m: RateState, V: float) -> np.ndarray:
-    """theta_k = s_k D_c,k / V of steady sliding at V > 0 (x_k = 1 for every law)."""
+    """theta_k = s_k D_c,k / V of steady sliding at V > 0 (x_k = 1 for every law; module docstring).
+
+    Parameters
+    ----------
+    m : RateState
+    V : float
+
+    Returns
+    -------
+    numpy.ndarray
+        One theta per state variable.
+    """
     V = check_number("V", V, low=0.0, low_open=True)
     return np.array([LAWS[n].scale * dc / V for n, dc in zip(m.law, m.Dc, strict=True)])
 
 
 def friction_of(m: RateState, v: float, theta) -> float:
-    """mu(v, theta) of the model ``m`` (:func:`friction`; -inf at v = 0 in the log form)."""
+    """mu(v, theta) of the model ``m`` (module docstring; -inf at v = 0 in the log form).
+
+    Parameters
+    ----------
+    m : RateState
+    v : float
+        Slip rate.
+    theta : float or array
+        One state per state variable.
+
+    Returns
+    -------
+    float
+    """
     a, mu0, V0, _, _, form, b, sdc, _, _ = m.arrays()
     return float(friction(float(v), np.asarray(theta, dtype=float).reshape(-1), a, mu0, V0, form, b, sdc))
 
 
 def steady_friction(m: RateState, V: float) -> float:
-    """mu_ss(V) of the law as evaluated by :func:`friction` at steady state (= mu0 + (a - sum b) ln(V / V0)
-    in the log form)."""
+    """mu_ss(V) = mu0 + (a - sum b) ln(V / V0) (log form; the asinh form differs by terms of
+    relative size exp(-2 mu_ss / a)), as :func:`friction` evaluates it at steady state.
+
+    Parameters
+    ----------
+    m : RateState
+    V : float
+
+    Returns
+    -------
+    float
+    """
     return friction_of(m, V, steady_theta(m, V))
 
 

@@ -30,6 +30,18 @@ def initial_state(
     """y0 = (tau, theta_1 .. theta_m) at the history's start: steady sliding at ``v_init`` (default
     the load point's first velocity) unless ``theta_init`` is given, and tau = mu(v_init, theta) + eta v_init.
 
+    Parameters
+    ----------
+    model : RateState
+    history : LoadHistory
+    v_init : float, optional
+    theta_init : float or array, optional
+
+    Returns
+    -------
+    numpy.ndarray
+        (tau, theta_1 .. theta_m).
+
     Raises
     ------
     ParameterError
@@ -57,7 +69,18 @@ def initial_state(
 
 def output_times(history: LoadHistory, t=None, n: int = 2001) -> np.ndarray:
     """The sorted, distinct output times: ``t`` as given (within the history), else ``n`` even
-    points and every breakpoint."""
+    points and every breakpoint.
+
+    Parameters
+    ----------
+    history : LoadHistory
+    t : array, optional
+    n : int
+
+    Returns
+    -------
+    numpy.ndarray
+    """
     if t is None:
         n = int(check_number("n", n, low=2, integer=True))
         t = np.union1d(np.linspace(history.times[0], history.t_end, n), history.times)
@@ -86,7 +109,20 @@ def solve(
     method: str = "dop853",
 ) -> dict:
     """The arrays of :func:`quasi_static` without the Dataset around them (what a fit evaluates
-    many times): ``t``, ``mu``, ``v``, ``theta`` (t, m), ``y0`` and the integrator's ``info``."""
+    many times).
+
+    Parameters
+    ----------
+    model, history, v_init, theta_init, rtol, atol, method
+        As for :func:`quasi_static`.
+    t : array
+        Output times, increasing, within the history.
+
+    Returns
+    -------
+    dict
+        ``t``, ``mu``, ``v``, ``theta`` (t, m), ``y0`` and the integrator's ``info``.
+    """
     k = model.require_k()
     if method not in METHODS:
         raise ParameterError(f"method must be one of {', '.join(METHODS)} (got {method!r})")

@@ -172,8 +172,25 @@ def detrend(record: Record, *, window: tuple[float, float] | None = None, slope:
 
 def synthetic(model, history: LoadHistory, *, n: int = 500, noise: float = 0.0, rng=None, name: str = "") -> Record:
     """A record of the quasi-static spring-slider with known parameters, sampled at ``n`` even times,
-    with Gaussian noise of standard deviation ``noise`` added to the friction (``rng``: a numpy
-    Generator or a seed)."""
+    with Gaussian noise of standard deviation ``noise`` added to the friction.
+
+    Parameters
+    ----------
+    model : RateState
+        The true parameters (k required).
+    history : LoadHistory
+    n : int
+        Samples, evenly spaced over the history.
+    noise : float
+        Standard deviation of the noise; the record's weights are 1 / noise where it is > 0.
+    rng : numpy.random.Generator or int, optional
+        The random numbers (a seed makes the record reproducible).
+    name : str
+
+    Returns
+    -------
+    Record
+    """
     from stickslip.lab.quasi_static import quasi_static
 
     t = np.linspace(history.times[0], history.t_end, int(check_number("n", n, low=2, integer=True)))

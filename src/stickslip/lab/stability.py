@@ -99,7 +99,21 @@ def _jacobian(model: RateState, k: float, V: float) -> np.ndarray:
 
 
 def growth_rate(model: RateState, k: float, V: float | None = None) -> float:
-    """The largest real part of the eigenvalues of the linearised spring-slider at stiffness k."""
+    """The largest real part of the eigenvalues of the linearised spring-slider at stiffness k
+    (module docstring; > 0: steady sliding at V is unstable).
+
+    Parameters
+    ----------
+    model : RateState
+    k : float
+        Stiffness in friction per unit displacement.
+    V : float, optional
+        Sliding velocity (default V0).
+
+    Returns
+    -------
+    float
+    """
     V = model.V0 if V is None else V
     return float(np.max(np.linalg.eigvals(_jacobian(model, k, V)).real))
 
@@ -107,7 +121,20 @@ def growth_rate(model: RateState, k: float, V: float | None = None) -> float:
 def critical_stiffness_numeric(model: RateState, V: float | None = None, *, k_max: float | None = None) -> float:
     """k_c as the largest stiffness at which the linearised system has a growing mode: a scan
     over k on a log grid up to ``k_max`` (default 10 sum |b_k| / D_c,k), refined by Brent's
-    method. Returns 0 where no stiffness in the range is unstable.
+    method (module docstring).
+
+    Parameters
+    ----------
+    model : RateState
+    V : float, optional
+        Sliding velocity (default V0).
+    k_max : float, optional
+        Top of the scan.
+
+    Returns
+    -------
+    float
+        k_c; 0 where no stiffness in the range is unstable.
     """
     V = model.V0 if V is None else check_number("V", V, low=0.0, low_open=True)
     scale = sum(abs(b) / dc for b, dc in zip(model.b, model.Dc, strict=True)) + sum(abs(c) for c in model.c) / min(

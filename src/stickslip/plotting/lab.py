@@ -12,7 +12,19 @@ from stickslip.plotting.style import SIM, THEORY, new_figure
 
 def plot_step(ds: xr.Dataset, summary: dict | None = None) -> Figure:
     """Friction and slip rate against load-point displacement through velocity steps
-    (:func:`stickslip.lab.protocols.velocity_step`), the closed-form steady states dashed."""
+    (:func:`stickslip.lab.protocols.velocity_step`), the closed-form steady states dashed.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        The run of the spring-slider.
+    summary : dict, optional
+        The protocol's summary (its ``steps`` give the steady states drawn).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     fig, (ax, axv) = new_figure(2, 1, width=6.0, height=2.6, sharex=True)
     x = ds.load_point.values - float(ds.load_point[0])
     ax.plot(x, ds.mu, **SIM, label="spring-slider")
@@ -34,7 +46,19 @@ def plot_step(ds: xr.Dataset, summary: dict | None = None) -> Figure:
 
 def plot_shs(ds: xr.Dataset, summary: dict) -> Figure:
     """A slide-hold-slide test (:func:`stickslip.lab.protocols.slide_hold_slide`): friction against
-    time, and the healing Delta mu against log10 t_hold with the fitted healing rate."""
+    time, and the healing Delta mu against log10 t_hold with the fitted healing rate.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        The run of the spring-slider.
+    summary : dict
+        The protocol's summary (``holds``, ``healing_rate``).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     fig, (ax, axh) = new_figure(1, 2, width=4.6, height=3.4)
     ax.plot(ds.t, ds.mu, **SIM)
     ax.set_xlabel("time")
@@ -54,7 +78,17 @@ def plot_shs(ds: xr.Dataset, summary: dict) -> Figure:
 
 def plot_fit(result) -> Figure:
     """A fit (:class:`stickslip.lab.fit.FitResult`): data and model of each record against time, and
-    the residuals below; samples outside the fit's window in grey."""
+    the residuals below; samples outside the fit's window in grey.
+
+    Parameters
+    ----------
+    result : FitResult
+        What :func:`stickslip.lab.fit.fit` returned.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     fig, (ax, axr) = new_figure(2, 1, width=6.0, height=2.6, sharex=True, gridspec_kw={"height_ratios": [2, 1]})
     for i, (rec, pred) in enumerate(zip(result.records, result.predictions, strict=True)):
         m = rec.mask
