@@ -166,3 +166,27 @@ def test_missing_and_bad_parameters():
         RateState(a=0.005, b=(0.01, 0.01), Dc=(1.0,), mu0=0.6, V0=1.0)
     with pytest.raises(ParameterError, match="singular"):
         quasi_static(RateState(**LAB, k=1e-3), LoadHistory.steps([0.0, 1.0], [1.0, 1.0]))
+
+
+def test_two_state_variables_and_damping_agree_with_plain_python_odeint():
+    """Two state variables of different laws, with radiation damping (v by Newton's method here,
+    by Brent's method in the reference)."""
+    kw = dict(a=0.008, b=(0.006, 0.004), Dc=(5.0, 50.0), mu0=0.6, V0=1.0, k=2e-3, law=("aging", "slip"))
+    h = LoadHistory.steps([1.0, 10.0, 0.0, 10.0], [10.0, 40.0, 30.0, 40.0])
+    for eta in (0.0, 2e-4):
+        ds = quasi_static(RateState(**kw, eta=eta), h, n=241)
+        mu, th, v = odeint_spring_slider(
+            0.008, (0.006, 0.004), (5.0, 50.0), 0.6, 1.0, 2e-3, ("aging", "slip"), h, ds.t.values, eta=eta,
+            rtol=1e-11,
+        )  # fmt: skip
+        np.testing.assert_allclose(ds.mu, mu, rtol=0, atol=1e-9)
+        np.testing.assert_allclose(ds.theta, th, rtol=1e-7)
+        np.testing.assert_allclose(ds.v, v, rtol=1e-6)
+
+
+def test_asinh_form_matches_the_log_form_away_from_v_0():
+    h = LoadHistory.steps([1.0, 10.0], [10.0, 40.0])
+    a = quasi_static(RateState(**LAB, k=1e-3), h, n=101)
+    b = quasi_static(RateState(**LAB, k=1e-3, form="asinh"), h, n=101)
+    # the forms differ by terms of relative size exp(-2 mu / a) ~ 1e-104
+    np.testing.assert_allclose(a.mu, b.mu, atol=1e-10)

@@ -19,7 +19,7 @@ from stickslip.lab.history import LoadHistory
 from stickslip.lab.laws import RateState
 from stickslip.lab.quasi_static import quasi_static, solve
 from stickslip.lab.records import synthetic
-from stickslip.lab.reference import odeint_spring_slider
+from stickslip.lab.reference import odeint_one_state
 
 __all__ = ["bench"]
 
@@ -51,8 +51,8 @@ def bench(repeats: int = 5) -> dict:
     history = LoadHistory.steps([1.0, 10.0], [10.0, 90.0])
     t = np.linspace(0.0, 100.0, 1001)
     qs = lambda: quasi_static(model, history, t=t, rtol=1e-10)
-    ref = lambda: odeint_spring_slider(
-        CASE["a"], CASE["b"], CASE["Dc"], CASE["mu0"], CASE["V0"], CASE["k"], "aging", history, t, rtol=1e-10
+    ref = lambda: odeint_one_state(
+        CASE["a"], CASE["b"], CASE["Dc"], CASE["mu0"], CASE["V0"], CASE["k"], history, t, rtol=1e-10
     )
     arrays = lambda: solve(model, history, t, rtol=1e-10)
     ds = qs()
