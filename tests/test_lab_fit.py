@@ -96,3 +96,19 @@ def test_record_from_csv_and_bad_fits(tmp_path):
         fit(rec, START, ("a",), per_record=("mu0",))
     with pytest.raises(ParameterError, match="k is required"):
         fit(rec, RateState(a=0.005, b=0.008, Dc=20.0, mu0=0.6, V0=1.0), ("a",))
+
+
+def test_posterior_agrees_with_the_least_squares_errors():
+    pytest.importorskip("emcee")
+    from stickslip.lab.posterior import posterior
+
+    res = fit(synthetic(TRUE, STEP, n=300, noise=2e-4, rng=5), START, FREE)
+    post = posterior(res, walkers=16, steps=240, rng=1)
+    assert post.samples.shape == (16 * 180, 4)
+    # a Gaussian likelihood about a well-determined minimum: mean at the fit, spread its errors
+    assert np.all(np.abs(post.mean - res.values) < 0.5 * res.errors)
+    assert np.all((post.std > 0.7 * res.errors) & (post.std < 1.4 * res.errors))
+    assert 0.2 < post.acceptance < 0.9
+    # the seed makes the chain reproducible
+    one, two = (posterior(res, walkers=8, steps=12, burn=0, rng=3) for _ in range(2))
+    np.testing.assert_array_equal(one.samples, two.samples)

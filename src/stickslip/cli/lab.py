@@ -123,6 +123,9 @@ def register(sub) -> None:
     f.add_argument("--window", type=_floats("window"), default=None, help="fit only t0 <= t <= t1 (T0,T1)")
     f.add_argument("--detrend", type=_floats("detrend"), default=None,
                    help="remove a linear trend of mu with load-point displacement fitted over T0,T1")  # fmt: skip
+    f.add_argument("--posterior", type=int_arg("posterior"), default=None, metavar="STEPS",
+                   help="also sample the posterior by MCMC (emcee) for STEPS steps of each walker")  # fmt: skip
+    f.add_argument("--seed", type=int_arg("seed"), default=0, help="seed of the posterior's chain (default 0)")
     f.add_argument("--time", default="time", help="time column (default time)")
     f.add_argument("--friction", default=None, help="friction column (default mu or friction)")
     f.add_argument("--displacement", default=None, help="load-point displacement column")
@@ -259,19 +262,33 @@ def run_fit(args) -> Result:
     with owned_out_dir(args.out, own, "stickslip lab fit", overwrite=args.overwrite) as out:
         res = fit(records, model, args.free, per_record=args.per_record, rtol=args.rtol)
         data = res.summary()
+        post = None
+        if args.posterior is not None:
+            from stickslip.lab.posterior import posterior
+
+            post = posterior(res, steps=args.posterior, rng=args.seed)
+            data["posterior"] = post.summary()
         if out is not None:
             from stickslip import io
-            from stickslip.plotting.lab import plot_fit
+            from stickslip.plotting.lab import plot_fit, plot_posterior
             from stickslip.plotting.style import save_figure
 
             written = [io.write_dataset(out / "fit.nc", res.to_dataset())]
             written += save_figure(plot_fit(res), out / "fit")
+            if post is not None:
+                written.append(io.write_dataset(out / "posterior.nc", post.to_dataset()))
+                written += save_figure(plot_posterior(post, res), out / "posterior")
             written.append(io.write_json(out / "fit.json", data))
             data["outputs"] = [str(p) for p in written]
     lines = [f"fit of {len(records)} record(s), {res.n} samples, rms residual {res.rms:.3g}: {res.message}"]
     for name, v in data["parameters"].items():
         lines.append(f"  {name:>8} = {v['value']:.6g} +- {v['stderr']:.2g}")
     lines.append(f"CPU {res.cpu_seconds:.3g} s, {res.evaluations} model evaluations")
+    if "posterior" in data:
+        lines.append(f"posterior ({data['posterior']['samples']} samples): mean +- std, 95% interval")
+        for name, v in data["posterior"]["parameters"].items():
+            lo, hi = v["interval_95"]
+            lines.append(f"  {name:>8} = {v['mean']:.6g} +- {v['std']:.2g}  [{lo:.6g}, {hi:.6g}]")
     lines += [f"wrote {p}" for p in data.get("outputs", [])]
     return Result(data=data, text="\n".join(lines))
 

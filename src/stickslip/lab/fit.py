@@ -192,6 +192,78 @@ class FitResult:
         return f"FitResult({len(self.records)} record(s), {self.n} samples: {body})"
 
 
+class Problem:
+    """The least-squares problem of :func:`fit`: the free numbers (``slots``: name shown, parameter,
+    record index or None), their scales, bounds and starting point, and the weighted residuals of
+    all records at a point x of scaled parameters (each parameter over its starting value).
+
+    Parameters
+    ----------
+    records, model, free, per_record, trend, rtol
+        As for :func:`fit`.
+    """
+
+    def __init__(self, records, model, free, *, per_record=(), trend=0.0, rtol=1e-10):
+        records = [records] if isinstance(records, Record) else list(records)
+        if not records:
+            raise ParameterError("fit needs at least one record")
+        model.require_k()
+        free = list(free)
+        if len(set(free)) != len(free) or not free:
+            raise ParameterError(f"free must name each parameter once, at least one (got {free})")
+        for name in per_record:
+            if name not in free:
+                raise ParameterError(f"per_record names {name!r}, which is not free")
+        slots = []
+        for name in free:
+            _value(model, name, trend)
+            if name in per_record:
+                slots += [(f"{name}[{r}]", name, r) for r in range(len(records))]
+            else:
+                slots.append((name, name, None))
+        start = np.array([_value(model, name, trend) for _, name, _ in slots])
+        is_trend = np.array([s[1] == "trend" for s in slots])
+        self.scale = np.where(start != 0.0, np.abs(start), np.where(is_trend, 1e-4, 1e-2))
+        self.lower = np.array([_LOWER.get(_base(s[1]), -np.inf) for s in slots]) / self.scale
+        self.x0 = start / self.scale
+        self.records, self.model, self.slots, self.trend, self.rtol = records, model, slots, trend, rtol
+        self.masks = [r.mask for r in records]
+        self.n = int(sum(m.sum() for m in self.masks))
+        if self.n <= len(slots):
+            raise ParameterError(f"fit needs more samples ({self.n}) than free parameters ({len(slots)})")
+        self.calls = [0]
+
+    def models_at(self, x) -> list[tuple[RateState, float]]:
+        """The model and trend of each record at the scaled parameters x."""
+        vals = np.asarray(x) * self.scale
+        out = []
+        for r in range(len(self.records)):
+            kw, tr = {}, self.trend
+            for (_, name, rr), v in zip(self.slots, vals, strict=True):
+                if rr is not None and rr != r:
+                    continue
+                if name == "trend":
+                    tr = v
+                else:
+                    kw[name] = v
+            out.append((self.model.with_values(**kw) if kw else self.model, tr))
+        return out
+
+    def residuals(self, x) -> np.ndarray:
+        """w_i (mu_model(t_i) - mu_i) of every fitted sample of every record."""
+        self.calls[0] += 1
+        res = []
+        for (m, tr), rec, mask in zip(self.models_at(x), self.records, self.masks, strict=True):
+            try:
+                pred = model_friction(m, rec, trend=tr, rtol=self.rtol)
+            except (IntegrationError, ParameterError):
+                # A trial point where the slider runs away (or leaves the laws' range): a large,
+                # finite residual steers the trust region back.
+                pred = np.full(rec.t.size, 1e3)
+            res.append((rec.weights * (pred - rec.mu))[mask])
+        return np.concatenate(res)
+
+
 def fit(
     records: Record | Sequence[Record],
     model: RateState,
@@ -242,62 +314,11 @@ def fit(
     >>> [round(float(v), 4) for v in res.values]
     [0.005, 0.008, 20.0]
     """
-    records = [records] if isinstance(records, Record) else list(records)
-    if not records:
-        raise ParameterError("fit needs at least one record")
-    model.require_k()
-    free = list(free)
-    if len(set(free)) != len(free) or not free:
-        raise ParameterError(f"free must name each parameter once, at least one (got {free})")
-    for name in per_record:
-        if name not in free:
-            raise ParameterError(f"per_record names {name!r}, which is not free")
-    # One entry per fitted number: (name shown, parameter, record index or None).
-    slots = []
-    for name in free:
-        _value(model, name, trend)
-        if name in per_record:
-            slots += [(f"{name}[{r}]", name, r) for r in range(len(records))]
-        else:
-            slots.append((name, name, None))
-    start = np.array([_value(model, name, trend) for _, name, _ in slots])
-    scale = np.where(start != 0.0, np.abs(start), np.where([s[1] == "trend" for s in slots], 1e-4, 1e-2))
-    lower = np.array([_LOWER.get(_base(name), -np.inf) / s for (_, name, _), s in zip(slots, scale, strict=True)])
-    x0 = start / scale
-    masks = [r.mask for r in records]
-    n = int(sum(m.sum() for m in masks))
-    if n <= len(slots):
-        raise ParameterError(f"fit needs more samples ({n}) than free parameters ({len(slots)})")
-
-    def models_at(x):
-        vals = x * scale
-        out = []
-        for r in range(len(records)):
-            kw, tr = {}, trend
-            for (_, name, rr), v in zip(slots, vals, strict=True):
-                if rr is not None and rr != r:
-                    continue
-                if name == "trend":
-                    tr = v
-                else:
-                    kw[name] = v
-            out.append((model.with_values(**kw) if kw else model, tr))
-        return out
-
-    calls = [0]
-
-    def residuals(x):
-        calls[0] += 1
-        res = []
-        for (m, tr), rec, mask in zip(models_at(x), records, masks, strict=True):
-            try:
-                pred = model_friction(m, rec, trend=tr, rtol=rtol)
-            except (IntegrationError, ParameterError):
-                # A trial point where the slider runs away (or leaves the laws' range): a large,
-                # finite residual steers the trust region back.
-                pred = np.full(rec.t.size, 1e3)
-            res.append((rec.weights * (pred - rec.mu))[mask])
-        return np.concatenate(res)
+    problem = Problem(records, model, free, per_record=per_record, trend=trend, rtol=rtol)
+    records, slots, scale = problem.records, problem.slots, problem.scale
+    x0, lower, n = problem.x0, problem.lower, problem.n
+    models_at, residuals = problem.models_at, problem.residuals
+    calls = problem.calls
 
     cpu0 = time.process_time()
     sol = least_squares(
@@ -342,4 +363,5 @@ def fit(
         message=str(sol.message),
         evaluations=calls[0],
         cpu_seconds=cpu,
+        extra={"problem": problem, "sigma": math.sqrt(s2)},
     )

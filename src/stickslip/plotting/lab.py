@@ -108,3 +108,54 @@ def plot_fit(result) -> Figure:
     axr.set_xlabel("time")
     axr.set_ylabel("residual")
     return fig
+
+
+def plot_posterior(post, result=None) -> Figure:
+    """A corner figure of a posterior (:func:`stickslip.lab.posterior.posterior`): the histogram of
+    each parameter on the diagonal, the samples of each pair below it, the least-squares value and
+    its two-standard-error interval in red where ``result`` (the FitResult) is given.
+
+    Parameters
+    ----------
+    post : Posterior
+    result : FitResult, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    p = len(post.names)
+    fig, axes = new_figure(p, p, width=1.9, height=1.9)
+    axes = np.asarray(axes).reshape(p, p)
+    x = post.samples
+    for i in range(p):
+        for j in range(p):
+            ax = axes[i, j]
+            if j > i:
+                ax.set_visible(False)
+                continue
+            ax.locator_params(nbins=3)
+            ax.ticklabel_format(useOffset=False)
+            if i == j:
+                ax.hist(x[:, i], bins=40, color="C0", histtype="step")
+                if result is not None:
+                    v, e = result.values[i], result.errors[i]
+                    ax.axvline(v, **THEORY)
+                    ax.axvspan(v - 2 * e, v + 2 * e, color="C3", alpha=0.1)
+                ax.set_yticks([])
+            else:
+                ax.plot(x[:, j], x[:, i], ",", color="C0", alpha=0.3)
+                if result is not None:
+                    ax.plot(result.values[j], result.values[i], "+", color="C3", ms=8)
+            if i == p - 1:
+                ax.set_xlabel(post.names[j])
+            else:
+                ax.set_xticklabels([])
+            if j == 0 and i > 0:
+                ax.set_ylabel(post.names[i])
+            elif j > 0:
+                ax.set_yticklabels([])
+            ax.tick_params(labelsize=6)
+            for label in ax.get_xticklabels():
+                label.set_rotation(30)
+    return fig
