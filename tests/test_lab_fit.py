@@ -112,3 +112,12 @@ def test_posterior_agrees_with_the_least_squares_errors():
     # the seed makes the chain reproducible
     one, two = (posterior(res, walkers=8, steps=12, burn=0, rng=3) for _ in range(2))
     np.testing.assert_array_equal(one.samples, two.samples)
+
+
+def test_a_slide_hold_slide_and_a_step_fitted_together():
+    """Holds at V = 0 in a record, fitted with a velocity step: shared a, b, D_c, own mu0."""
+    shs = LoadHistory.slide_hold_slide(10.0, 20.0, [10.0, 100.0], t_reslide=20.0)
+    a = synthetic(TRUE, shs, n=400, name="shs")
+    b = synthetic(TRUE.with_values(mu0=0.61), STEP, n=200, name="step")
+    res = fit([a, b], START, FREE, per_record=("mu0",))
+    np.testing.assert_allclose(res.values, [0.005, 0.008, 20.0, 0.6, 0.61], rtol=1e-6)

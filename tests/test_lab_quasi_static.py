@@ -190,3 +190,19 @@ def test_asinh_form_matches_the_log_form_away_from_v_0():
     b = quasi_static(RateState(**LAB, k=1e-3, form="asinh"), h, n=101)
     # the forms differ by terms of relative size exp(-2 mu / a) ~ 1e-104
     np.testing.assert_allclose(a.mu, b.mu, atol=1e-10)
+
+
+def test_same_physics_as_the_inertial_models_rate_state_pieces():
+    """The lab's aging and slip laws and its asinh friction are those of the package's inertial
+    friction pieces (models/friction/rate_state.py, rate_state_slip.py) at the same parameters."""
+    from stickslip.lab.laws import friction_of, rhs
+    from stickslip.models.friction import rate_state, rate_state_slip
+
+    lp = rate_state.Params(rs_a=0.005, rs_b=0.01, Dc=10.0, v0=1.0, mu0=0.6, sigma_n=1.0)
+    for law, piece in (("aging", rate_state), ("slip", rate_state_slip)):
+        m = RateState(**LAB, k=math.inf, law=law, form="asinh")
+        out = np.empty(2)
+        for v, th in ((2.0, 30.0), (0.3, 4.0), (50.0, 0.1)):
+            rhs(0.0, np.array([0.0, th]), out, v, *m.arrays())
+            assert out[1] == pytest.approx(piece.rate(0.0, th, 0.0, v, lp), rel=1e-14)
+            assert friction_of(m, v, th) == pytest.approx(rate_state.mu_lp(v, th, lp), rel=1e-14)
