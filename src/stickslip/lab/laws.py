@@ -21,7 +21,8 @@ mu_ss = mu0 + (a - sum_k b_k) ln(V / V0).
 The parameters are the lab's: friction mu (shear over normal stress), a, b_k, D_c,k (a length, e.g.
 um), mu0 at the reference velocity V0, and, for the spring-slider of :mod:`stickslip.lab.quasi_static`,
 the stiffness k in friction per unit displacement and an optional radiation damping eta (friction
-per unit slip rate). The compiled right-hand side :func:`rhs` is what the integrators evaluate.
+per unit slip rate). The compiled friction and right-hand side (:func:`stickslip.lab.compiled.rhs`)
+are what the integrators evaluate.
 """
 
 from __future__ import annotations
@@ -31,11 +32,11 @@ from collections.abc import Sequence
 from dataclasses import dataclass, fields
 
 import numpy as np
-from numba import njit
 
+from stickslip.lab.compiled import friction, rhs
 from stickslip.models.params import ParameterError, check_number
 
-__all__ = ["LAWS", "RateState", "steady_friction", "steady_theta"]
+__all__ = ["LAWS", "RateState", "friction_of", "rhs", "steady_friction", "steady_theta"]
 
 
 @dataclass(frozen=True)
@@ -282,89 +283,3 @@ def steady_friction(m: RateState, V: float) -> float:
     float
     """
     return friction_of(m, V, steady_theta(m, V))
-
-
-@njit(cache=True)
-def psi_of(th, mu0, V0, b, sdc):
-    """psi = mu0 + sum_k b_k ln(V0 theta_k / (s_k D_c,k)) (``sdc`` holds s_k D_c,k)."""
-    psi = mu0
-    for i in range(th.size):
-        psi += b[i] * math.log(V0 * th[i] / sdc[i])
-    return psi
-
-
-@njit(cache=True)
-def friction(v, th, a, mu0, V0, form, b, sdc):
-    """mu(v, theta) in the log form (form 0) or the asinh form (form 1); module docstring."""
-    psi = psi_of(th, mu0, V0, b, sdc)
-    if form == 0:
-        return psi + a * math.log(v / V0)
-    return a * math.asinh(v / (2.0 * V0) * math.exp(psi / a))
-
-
-@njit(cache=True)
-def slip_rate(tau, psi, a, V0, eta, form):
-    """The slip rate v at which mu(v, theta) + eta v = tau, for the state's psi.
-
-    Without damping it is explicit: v = V0 exp((tau - psi) / a) (log form) or
-    v = 2 V0 exp(-psi / a) sinh(tau / a) (asinh form). With eta > 0, Newton's method on
-    u = ln v: g(u) = mu(e^u) + eta e^u - tau is increasing and convex in u for both forms, and the
-    undamped root lies to its right, so the iterates fall monotonically onto the root.
-    """
-    if form == 0:
-        u = (tau - psi) / a + math.log(V0)
-    else:
-        if tau <= 0.0:
-            return 2.0 * V0 * math.exp(-psi / a) * math.sinh(tau / a)
-        u = (tau - psi) / a + math.log(V0) + math.log1p(-math.exp(-2.0 * tau / a))
-    if eta == 0.0:
-        return math.exp(u)
-    for _ in range(100):
-        v = math.exp(u)
-        if form == 0:
-            g = psi + a * (u - math.log(V0)) + eta * v - tau
-            dg = a + eta * v
-        else:
-            z = v / (2.0 * V0) * math.exp(psi / a)
-            g = a * math.asinh(z) + eta * v - tau
-            dg = a * z / math.sqrt(1.0 + z * z) + eta * v
-        du = g / dg
-        u -= du
-        if abs(du) <= 1e-15 * max(1.0, abs(u)):
-            break
-    return math.exp(u)
-
-
-@njit(cache=True)
-def rhs(t, y, out, vlp, a, mu0, V0, k, eta, form, b, sdc, cb, codes):
-    """The quasi-static spring-slider k (p(t) - x) = tau = mu(v, theta) + eta v
-    (:mod:`stickslip.lab.quasi_static`) as d/dt of y = (tau, theta_1 .. theta_m):
-
-        dtau/dt = k (V(t) - v),   dtheta_k/dt by law k (module docstring),
-
-    with v from :func:`slip_rate` and V(t) = ``vlp``, the load point's velocity on this
-    interval of the history; with k = inf (a rigid machine) v = V(t) and tau is left alone.
-    Writes ``out`` and returns v.
-    """
-    m = b.size
-    th = y[1 : m + 1]
-    if k == np.inf:
-        v = vlp
-        dtau = 0.0
-    else:
-        psi = psi_of(th, mu0, V0, b, sdc)
-        v = slip_rate(y[0], psi, a, V0, eta, form)
-        dtau = k * (vlp - v)
-    out[0] = dtau
-    for i in range(m):
-        x = v * th[i] / sdc[i]
-        c = codes[i]
-        if c == 0:
-            out[i + 1] = 1.0 - x
-        elif c == 1:
-            out[i + 1] = -x * math.log(x) if x > 0.0 else 0.0
-        elif c == 2:
-            out[i + 1] = 1.0 - x * x
-        else:
-            out[i + 1] = 1.0 - x - cb[i] * th[i] * dtau
-    return v
