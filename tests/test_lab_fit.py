@@ -121,3 +121,12 @@ def test_a_slide_hold_slide_and_a_step_fitted_together():
     b = synthetic(TRUE.with_values(mu0=0.61), STEP, n=200, name="step")
     res = fit([a, b], START, FREE, per_record=("mu0",))
     np.testing.assert_allclose(res.values, [0.005, 0.008, 20.0, 0.6, 0.61], rtol=1e-6)
+
+
+def test_stiffness_and_a_second_state_variable_fitted():
+    two = RateState(a=0.005, b=(0.006, 0.003), Dc=(5.0, 60.0), mu0=0.6, V0=1.0, k=2e-3)
+    h = LoadHistory.steps([1.0, 10.0, 1.0], [60.0, 60.0, 300.0])
+    rec = synthetic(two, h, n=600)
+    start = two.with_values(a=0.006, b1=0.005, Dc1=8.0, b2=0.002, Dc2=40.0, k=1.5e-3)
+    res = fit(rec, start, ("a", "b1", "Dc1", "b2", "Dc2", "k"))
+    np.testing.assert_allclose(res.values, [0.005, 0.006, 5.0, 0.003, 60.0, 2e-3], rtol=1e-5)

@@ -107,3 +107,20 @@ def test_bench_measures_both_routes_and_they_agree(capsys):
     for name in ("a", "b", "Dc", "mu0"):
         v, e = d["fit"][name]["value"], d["fit"][name]["stderr"]
         assert abs(v - d["fit_truth"][name]) < 5.0 * e
+
+
+def test_cli_fit_with_window_and_detrend(capsys, tmp_path):
+    true = RateState(**LAB, k=1e-3)
+    h = LoadHistory.steps([1.0, 10.0], [50.0, 100.0])
+    rec = synthetic(true, h, n=301)
+    p = h.position(rec.t)
+    mu = rec.mu + 3e-5 * p  # a slip-hardening trend
+    mu[rec.t > 140.0] -= 0.02  # a spoilt end the window leaves out
+    path = tmp_path / "trend.csv"
+    rows = [f"{float(t)!r},{float(m)!r},{float(x)!r}" for t, m, x in zip(rec.t, mu, p, strict=True)]
+    path.write_text("time,friction,lp_disp\n" + "\n".join(rows) + "\n")
+    start = ["--a", "0.007", "--b", "0.008", "--Dc", "5", "--mu0", "0.6", "--V0", "1", "--k", "1e-3"]
+    d = _json(capsys, "lab", "fit", str(path), *start, "--detrend", "0,49", "--window", "0,140")
+    assert d["parameters"]["b"]["value"] == pytest.approx(0.01, rel=5e-3)
+    assert main(["lab", "fit", str(path), *start, "--window", "5,1"]) == 2
+    assert "--window must be two times T0,T1 with T0 < T1" in capsys.readouterr().err
