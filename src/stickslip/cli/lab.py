@@ -187,7 +187,9 @@ def run_step(args) -> Result:
     model.require_k()
     own = OUT_FILES["lab step"]
     with owned_out_dir(args.out, own, "stickslip lab step", overwrite=args.overwrite) as out:
-        ds, data = _integration(velocity_step, model, args.V, displacement=args.displacement, rtol=args.rtol)
+        ds, data = _integration(
+            velocity_step, model, args.V, displacement=args.displacement, rtol=args.rtol, method=args.method
+        )
         if out is not None:
             from stickslip.plotting.lab import plot_step
 
@@ -211,7 +213,9 @@ def run_shs(args) -> Result:
     model.require_k()
     own = OUT_FILES["lab shs"]
     with owned_out_dir(args.out, own, "stickslip lab shs", overwrite=args.overwrite) as out:
-        ds, data = _integration(slide_hold_slide, model, args.V, args.holds, slide=args.slide, rtol=args.rtol)
+        ds, data = _integration(
+            slide_hold_slide, model, args.V, args.holds, slide=args.slide, rtol=args.rtol, method=args.method
+        )
         if out is not None:
             from stickslip.plotting.lab import plot_shs
 
@@ -260,7 +264,7 @@ def run_fit(args) -> Result:
         records.append(rec)
     own = OUT_FILES["lab fit"]
     with owned_out_dir(args.out, own, "stickslip lab fit", overwrite=args.overwrite) as out:
-        res = fit(records, model, args.free, per_record=args.per_record, rtol=args.rtol)
+        res = fit(records, model, args.free, per_record=args.per_record, rtol=args.rtol, method=args.method)
         data = res.summary()
         post = None
         if args.posterior is not None:

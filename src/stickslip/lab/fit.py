@@ -66,7 +66,9 @@ def _value(model: RateState, name: str, trend: float) -> float:
     return float(value)
 
 
-def model_friction(model: RateState, record: Record, *, trend: float = 0.0, rtol: float = 1e-10) -> np.ndarray:
+def model_friction(
+    model: RateState, record: Record, *, trend: float = 0.0, rtol: float = 1e-10, method: str = "dop853"
+) -> np.ndarray:
     """The spring-slider's friction at the record's samples, plus ``trend`` times the load-point
     displacement since the first sample (the model of the module docstring).
 
@@ -77,13 +79,15 @@ def model_friction(model: RateState, record: Record, *, trend: float = 0.0, rtol
     trend : float
     rtol : float
         Tolerance of the integration.
+    method : str
+        The integrator (:func:`stickslip.lab.quasi_static.quasi_static`).
 
     Returns
     -------
     numpy.ndarray
         mu at ``record.t``.
     """
-    mu = solve(model, record.history, record.t, v_init=record.v_init, rtol=rtol)["mu"]
+    mu = solve(model, record.history, record.t, v_init=record.v_init, rtol=rtol, method=method)["mu"]
     if trend != 0.0:
         p = record.history.position(record.t)
         mu = mu + trend * (p - p[0])
@@ -199,11 +203,11 @@ class Problem:
 
     Parameters
     ----------
-    records, model, free, per_record, trend, rtol
+    records, model, free, per_record, trend, rtol, method
         As for :func:`fit`.
     """
 
-    def __init__(self, records, model, free, *, per_record=(), trend=0.0, rtol=1e-10):
+    def __init__(self, records, model, free, *, per_record=(), trend=0.0, rtol=1e-10, method="dop853"):
         records = [records] if isinstance(records, Record) else list(records)
         if not records:
             raise ParameterError("fit needs at least one record")
@@ -227,6 +231,7 @@ class Problem:
         self.lower = np.array([_LOWER.get(_base(s[1]), -np.inf) for s in slots]) / self.scale
         self.x0 = start / self.scale
         self.records, self.model, self.slots, self.trend, self.rtol = records, model, slots, trend, rtol
+        self.method = method
         self.masks = [r.mask for r in records]
         self.n = int(sum(m.sum() for m in self.masks))
         if self.n <= len(slots):
@@ -255,7 +260,7 @@ class Problem:
         res = []
         for (m, tr), rec, mask in zip(self.models_at(x), self.records, self.masks, strict=True):
             try:
-                pred = model_friction(m, rec, trend=tr, rtol=self.rtol)
+                pred = model_friction(m, rec, trend=tr, rtol=self.rtol, method=self.method)
             except (IntegrationError, ParameterError):
                 # A trial point where the slider runs away (or leaves the laws' range): a large,
                 # finite residual steers the trust region back.
@@ -272,6 +277,7 @@ def fit(
     per_record: Sequence[str] = (),
     trend: float = 0.0,
     rtol: float = 1e-10,
+    method: str = "dop853",
     diff_step: float = 1e-6,
     max_evaluations: int | None = None,
 ) -> FitResult:
@@ -291,6 +297,8 @@ def fit(
         Starting (or fixed) slope of a linear friction trend in load-point displacement.
     rtol : float
         Tolerance of the spring-slider's integration.
+    method : str
+        Its integrator (:func:`stickslip.lab.quasi_static.quasi_static`).
     diff_step : float
         Relative step of the finite-difference Jacobian.
 
@@ -314,7 +322,7 @@ def fit(
     >>> [round(float(v), 4) for v in res.values]
     [0.005, 0.008, 20.0]
     """
-    problem = Problem(records, model, free, per_record=per_record, trend=trend, rtol=rtol)
+    problem = Problem(records, model, free, per_record=per_record, trend=trend, rtol=rtol, method=method)
     records, slots, scale = problem.records, problem.slots, problem.scale
     x0, lower, n = problem.x0, problem.lower, problem.n
     models_at, residuals = problem.models_at, problem.residuals
@@ -345,7 +353,9 @@ def fit(
     with np.errstate(invalid="ignore", divide="ignore"):
         corr = cov / np.outer(err, err)
     fitted = models_at(sol.x)
-    preds = [model_friction(m, rec, trend=tr, rtol=rtol) for (m, tr), rec in zip(fitted, records, strict=True)]
+    preds = [
+        model_friction(m, rec, trend=tr, rtol=rtol, method=method) for (m, tr), rec in zip(fitted, records, strict=True)
+    ]
     return FitResult(
         names=[s[0] for s in slots],
         values=values,

@@ -59,9 +59,24 @@ def velocity_step(
     displacement: float | None = None,
     n: int = 400,
     rtol: float = 1e-10,
+    method: str = "dop853",
 ) -> tuple[xr.Dataset, dict]:
     """Steps of the load-point velocity through ``velocities`` (the first is the steady start), each
     held for a load-point ``displacement`` (default 20 times the largest D_c).
+
+    Parameters
+    ----------
+    model : RateState
+        The friction law and the stiffness k.
+    velocities : sequence of float
+        Load-point velocities in turn, each > 0.
+    displacement : float, optional
+        Load-point displacement at each velocity.
+    n : int
+        Output points per interval (and as many clustered after each step).
+    rtol : float
+    method : str
+        The integrator (:func:`stickslip.lab.quasi_static.quasi_static`).
 
     Returns
     -------
@@ -82,7 +97,7 @@ def velocity_step(
         else check_number("displacement", displacement, low=0.0, low_open=True)
     )
     history = LoadHistory.steps(v, [disp / x for x in v])
-    ds = quasi_static(model, history, t=_grid(history, n), rtol=rtol)
+    ds = quasi_static(model, history, t=_grid(history, n), rtol=rtol, method=method)
     steps = []
     for i in range(1, len(v)):
         t0, t1 = history.times[i], history.times[i + 1]
@@ -123,9 +138,26 @@ def slide_hold_slide(
     slide: float | None = None,
     n: int = 200,
     rtol: float = 1e-10,
+    method: str = "dop853",
 ) -> tuple[xr.Dataset, dict]:
     """A slide-hold-slide test (module docstring): slides at V of load-point displacement ``slide``
     (default 20 times the largest D_c) around holds of the given lengths.
+
+    Parameters
+    ----------
+    model : RateState
+        The friction law and a finite stiffness k.
+    V : float
+        Load-point velocity of the slides.
+    holds : sequence of float
+        Hold times, each > 0.
+    slide : float, optional
+        Load-point displacement of each slide.
+    n : int
+        Output points per interval (and as many clustered after each breakpoint).
+    rtol : float
+    method : str
+        The integrator (:func:`stickslip.lab.quasi_static.quasi_static`).
 
     Returns
     -------
@@ -145,7 +177,7 @@ def slide_hold_slide(
         raise ParameterError("slide_hold_slide needs a finite k (in a rigid machine the log form is -inf at V = 0)")
     slide = 20.0 * max(model.Dc) if slide is None else check_number("slide", slide, low=0.0, low_open=True)
     history = LoadHistory.slide_hold_slide(V, slide / V, holds)
-    ds = quasi_static(model, history, t=_grid(history, n), rtol=rtol)
+    ds = quasi_static(model, history, t=_grid(history, n), rtol=rtol, method=method)
     rows = []
     for i, th in enumerate(holds):
         t_hold0 = history.times[1 + 2 * i]
