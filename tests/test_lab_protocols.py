@@ -124,3 +124,14 @@ def test_cli_fit_with_window_and_detrend(capsys, tmp_path):
     assert d["parameters"]["b"]["value"] == pytest.approx(0.01, rel=5e-3)
     assert main(["lab", "fit", str(path), *start, "--window", "5,1"]) == 2
     assert "--window must be two times T0,T1 with T0 < T1" in capsys.readouterr().err
+
+
+def test_velocity_step_with_damping_and_two_state_variables():
+    model = RateState(
+        a=0.008, b=(0.006, 0.004), Dc=(5.0, 50.0), law=("aging", "slip"), mu0=0.6, V0=1.0, k=2e-3, eta=1e-4
+    )
+    _, s = velocity_step(model, (1.0, 10.0), displacement=2000.0)
+    st = s["steps"][0]
+    assert st["mu_before"] == pytest.approx(0.6 + 1e-4, abs=1e-12)  # the spring carries mu + eta V
+    assert st["mu_end"] == pytest.approx(st["mu_ss_closed_form"], abs=1e-9)
+    assert st["a_minus_b_from_run"] == pytest.approx(0.008 - 0.010, rel=1e-6)

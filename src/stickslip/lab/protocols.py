@@ -84,7 +84,8 @@ def velocity_step(
         The run (:func:`stickslip.lab.quasi_static.quasi_static`).
     summary : dict
         ``steps``: per step V_before, V_after, mu before, mu_peak (the extreme after the step),
-        its time, mu at the end, the closed-form mu_ss and (a - b) read off the run; and k_c.
+        its time, mu at the end, the closed-form steady friction of the spring mu_ss + eta V and
+        (a - b) read off the run (the damping's eta (V_after - V_before) taken out); and k_c.
     """
     from stickslip.lab.stability import critical_stiffness
 
@@ -114,8 +115,9 @@ def velocity_step(
                 "mu_peak": mp,
                 "t_peak": tp,
                 "mu_end": end,
-                "mu_ss_closed_form": steady_friction(model, v[i]),
-                "a_minus_b_from_run": (end - before) / math.log(v[i] / v[i - 1]),
+                # the spring carries mu + eta V in steady sliding
+                "mu_ss_closed_form": steady_friction(model, v[i]) + model.eta * v[i],
+                "a_minus_b_from_run": (end - before - model.eta * (v[i] - v[i - 1])) / math.log(v[i] / v[i - 1]),
             }
         )
     summary = {
