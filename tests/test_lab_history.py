@@ -2,6 +2,8 @@
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from stickslip.lab import LoadHistory
 from stickslip.models.params import ParameterError
@@ -75,3 +77,18 @@ def test_bad_steps_refused():
         LoadHistory.table([0.0, 2.0, 1.0], [0.0, 1.0, 2.0])
     with pytest.raises(ParameterError, match="finite"):
         LoadHistory.table([0.0, np.nan], [0.0, 1.0])
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.tuples(st.floats(0.0, 1e3), st.floats(1e-3, 1e3)), min_size=1, max_size=12))
+def test_any_steps_are_continuous_and_their_slope_is_the_velocity(segments):
+    v, d = zip(*segments, strict=True)
+    h = LoadHistory.steps(v, d)
+    assert h.breakpoints.size == len(v) + 1
+    np.testing.assert_allclose(h.velocities, v, rtol=1e-9, atol=1e-9)
+    mid = 0.5 * (h.times[:-1] + h.times[1:])
+    np.testing.assert_array_equal(h.velocity(mid), h.velocities)
+    # p(t) at each breakpoint is the sum of the displacements before it, from either side
+    np.testing.assert_allclose(h.position(h.times), np.concatenate([[0.0], np.cumsum(np.multiply(v, d))]), rtol=1e-12)
+    merged = h.merged()
+    np.testing.assert_allclose(merged.position(mid), h.position(mid), rtol=1e-9, atol=1e-9)
