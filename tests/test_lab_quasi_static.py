@@ -206,3 +206,12 @@ def test_same_physics_as_the_inertial_models_rate_state_pieces():
             rhs(0.0, np.array([0.0, th]), out, v, *m.arrays())
             assert out[1] == pytest.approx(piece.rate(0.0, th, 0.0, v, lp), rel=1e-14)
             assert friction_of(m, v, th) == pytest.approx(rate_state.mu_lp(v, th, lp), rel=1e-14)
+
+
+def test_auto_takes_lsoda_for_a_very_stiff_spring():
+    h = LoadHistory.steps([1.0, 10.0], [10.0, 30.0])
+    stiff = RateState(**LAB, k=1.0)  # k V Dc / a = 20000
+    ds = quasi_static(stiff, h, n=61)
+    assert ds.attrs["integrator"] == "LSODA"
+    np.testing.assert_allclose(ds.mu, quasi_static(stiff, h, n=61, method="Radau").mu, atol=1e-9)
+    assert quasi_static(RateState(**LAB, k=1e-3), h, n=61).attrs["integrator"] == "dop853"

@@ -56,8 +56,8 @@ def _add_law_options(p: argparse.ArgumentParser, *, k_help: str) -> None:
     g.add_argument("--c", type=_floats("c"), default=[0.0], help="Nagata's c of each state variable (default 0)")
     g.add_argument("--eta", type=float_arg("eta"), default=0.0, help="radiation damping eta (default 0)")
     g.add_argument("--form", choices=("log", "asinh"), default="log", help="friction form (default log)")
-    g.add_argument("--method", choices=("dop853", "LSODA", "Radau", "BDF"), default="dop853",
-                   help="integrator (default dop853, compiled)")  # fmt: skip
+    g.add_argument("--method", choices=("auto", "dop853", "LSODA", "Radau", "BDF"), default="auto",
+                   help="integrator (default auto: the compiled dop853, LSODA for a very stiff spring)")  # fmt: skip
     g.add_argument("--rtol", type=float_arg("rtol"), default=1e-10, help="relative tolerance (default 1e-10)")
 
 

@@ -67,7 +67,7 @@ def _value(model: RateState, name: str, trend: float) -> float:
 
 
 def model_friction(
-    model: RateState, record: Record, *, trend: float = 0.0, rtol: float = 1e-10, method: str = "dop853"
+    model: RateState, record: Record, *, trend: float = 0.0, rtol: float = 1e-10, method: str = "auto"
 ) -> np.ndarray:
     """The spring-slider's friction at the record's samples, plus ``trend`` times the load-point
     displacement since the first sample (the model of the module docstring).
@@ -207,7 +207,7 @@ class Problem:
         As for :func:`fit`.
     """
 
-    def __init__(self, records, model, free, *, per_record=(), trend=0.0, rtol=1e-10, method="dop853"):
+    def __init__(self, records, model, free, *, per_record=(), trend=0.0, rtol=1e-10, method="auto"):
         records = [records] if isinstance(records, Record) else list(records)
         if not records:
             raise ParameterError("fit needs at least one record")
@@ -277,7 +277,7 @@ def fit(
     per_record: Sequence[str] = (),
     trend: float = 0.0,
     rtol: float = 1e-10,
-    method: str = "dop853",
+    method: str = "auto",
     diff_step: float = 1e-6,
     max_evaluations: int | None = None,
 ) -> FitResult:

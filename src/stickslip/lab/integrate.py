@@ -11,6 +11,10 @@ Two routes over the same compiled right-hand side (:func:`stickslip.lab.laws.rhs
 - ``LSODA``, ``Radau``, ``BDF``: :func:`scipy.integrate.solve_ivp`, one call per interval of
   the history, for stiff settings (a spring far stiffer than k_c, or very fast slip) where an
   explicit method needs many small steps.
+- ``auto`` (the default of the callers): ``dop853`` unless the stiffness ratio
+  S = k V_max min(D_c) / a exceeds 3000, then ``LSODA``. On the standard step (S = 20) DOP853 takes
+  112 steps where LSODA through solve_ivp costs 5-10 times as much time; at S = 2000 DOP853 takes
+  3078 steps and is still the faster; at S = 20000 it takes 28360 steps against LSODA's 202.
 """
 
 from __future__ import annotations
@@ -33,7 +37,28 @@ _C_FULL = np.ascontiguousarray(_dop.C)
 _D = np.ascontiguousarray(_dop.D)
 
 #: Methods of :func:`integrate`.
-METHODS = ("dop853", "LSODA", "Radau", "BDF")
+METHODS = ("auto", "dop853", "LSODA", "Radau", "BDF")
+
+#: Above this stiffness ratio ``auto`` takes LSODA (module docstring).
+STIFF_RATIO = 3000.0
+
+
+def stiffness_ratio(model, history, v_init: float | None = None) -> float:
+    """S = k V_max min(D_c) / a: the rate k V / a at which the spring relaxes the friction against
+    the rate V / D_c of the state, at the fastest load-point velocity (0 for a rigid machine,
+    where no spring relaxes)."""
+    if model.k is None or model.k == np.inf:
+        return 0.0
+    v_max = max(float(np.max(history.velocities)), v_init or 0.0)
+    return model.k * v_max * min(model.Dc) / model.a
+
+
+def choose(method: str, model, history, v_init: float | None = None) -> str:
+    """The integrator ``auto`` stands for: ``dop853`` up to :data:`STIFF_RATIO`, ``LSODA`` above."""
+    if method != "auto":
+        return method
+    return "LSODA" if stiffness_ratio(model, history, v_init) > STIFF_RATIO else "dop853"
+
 
 #: Status codes of the compiled route.
 STATUS_TEXT = {
@@ -75,6 +100,7 @@ def integrate(model, history, y0, t_out, *, rtol=1e-10, atol=1e-12, method="dop8
         The integrator failed (too many steps, step size at round-off, a non-finite state).
     """
     args = model.arrays()
+    method = choose(method, model, history)
     history = history.merged()
     seg_t = np.ascontiguousarray(history.times, dtype=float)
     seg_v = np.ascontiguousarray(history.velocities, dtype=float)

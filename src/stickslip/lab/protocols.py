@@ -59,7 +59,7 @@ def velocity_step(
     displacement: float | None = None,
     n: int = 400,
     rtol: float = 1e-10,
-    method: str = "dop853",
+    method: str = "auto",
 ) -> tuple[xr.Dataset, dict]:
     """Steps of the load-point velocity through ``velocities`` (the first is the steady start), each
     held for a load-point ``displacement`` (default 20 times the largest D_c).
@@ -140,7 +140,7 @@ def slide_hold_slide(
     slide: float | None = None,
     n: int = 200,
     rtol: float = 1e-10,
-    method: str = "dop853",
+    method: str = "auto",
 ) -> tuple[xr.Dataset, dict]:
     """A slide-hold-slide test (module docstring): slides at V of load-point displacement ``slide``
     (default 20 times the largest D_c) around holds of the given lengths.

@@ -106,7 +106,7 @@ def solve(
     theta_init=None,
     rtol: float = 1e-10,
     atol: float = 1e-12,
-    method: str = "dop853",
+    method: str = "auto",
 ) -> dict:
     """The arrays of :func:`quasi_static` without the Dataset around them (what a fit evaluates
     many times).
@@ -147,7 +147,7 @@ def quasi_static(
     theta_init=None,
     rtol: float = 1e-10,
     atol: float = 1e-12,
-    method: str = "dop853",
+    method: str = "auto",
 ) -> xr.Dataset:
     """Integrate the quasi-static spring-slider (module docstring) over a load history.
 
@@ -165,8 +165,8 @@ def quasi_static(
     rtol, atol : float
         Tolerances (down to rtol = 1e-13 or so).
     method : str
-        ``dop853`` (compiled, default) or ``LSODA``, ``Radau``, ``BDF`` through solve_ivp
-        (:mod:`stickslip.lab.integrate`).
+        ``auto`` (default: the compiled ``dop853``, or ``LSODA`` for a very stiff spring),
+        ``dop853``, or ``LSODA``, ``Radau``, ``BDF`` through solve_ivp (:mod:`stickslip.lab.integrate`).
 
     Returns
     -------
