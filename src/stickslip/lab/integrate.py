@@ -12,9 +12,8 @@ Two routes over the same compiled right-hand side (:func:`stickslip.lab.laws.rhs
   the history, for stiff settings (a spring far stiffer than k_c, or very fast slip) where an
   explicit method needs many small steps.
 - ``auto`` (the default of the callers): ``dop853`` unless the stiffness ratio
-  S = k V_max min(D_c) / a exceeds 3000, then ``LSODA``. On the standard step (S = 20) DOP853 takes
-  112 steps where LSODA through solve_ivp costs 5-10 times as much time; at S = 2000 DOP853 takes
-  3078 steps and is still the faster; at S = 20000 it takes 28360 steps against LSODA's 202.
+  S = k V_max min(D_c) / a exceeds 3000, then ``LSODA`` (the threshold's measurements are in
+  docs/performance.md).
 """
 
 from __future__ import annotations
