@@ -298,16 +298,20 @@ def held(tmp_path_factory):
 
 
 @pytest.mark.parametrize("command", WRITERS, ids=[c.split(" --out")[0] for c in WRITERS])
-def test_second_writer_refused_at_once_naming_the_holder(command, held, small_run, capsys):
+def test_second_writer_refused_at_once_naming_the_holder(command, held, small_run, capsys, monkeypatch):
+    import filelock
+
+    tries = []
+    acquire = filelock.FileLock.acquire
+    monkeypatch.setattr(filelock.FileLock, "acquire", lambda self, *a, **k: tries.append(k.get("timeout")) or acquire(self, *a, **k))
     out, pid = held
     before = _tree(out)
     capsys.readouterr()
-    start = time.monotonic()
     status = main(shlex.split(command.format(out=out, run=small_run)))
     stdout, err = capsys.readouterr()
     assert status == 2 and stdout == "", err
     assert err.count("\n") == 1 and "in use by another run" in err and f"pid {pid}" in err, err
-    assert time.monotonic() - start < 30, "refused at once, not after waiting"
+    assert tries and set(tries) == {0}, "refused at once: the lock is tried, never waited for"
     assert _tree(out) == before
 
 
