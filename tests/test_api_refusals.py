@@ -148,11 +148,9 @@ def _hold(d):
 def test_run_chain_locks_its_folder(tmp_path, monkeypatch):
     """A folder another process holds is refused at once (the lock is tried, never waited for),
     naming the holder; a free one gets a run id and no lock is left behind."""
-    import filelock
+    from chain_helpers import record_lock_tries
 
-    tries = []
-    acquire = filelock.FileLock.acquire
-    monkeypatch.setattr(filelock.FileLock, "acquire", lambda self, *a, **k: tries.append(k.get("timeout")) or acquire(self, *a, **k))
+    tries = record_lock_tries(monkeypatch)
     d = tmp_path / "held"
     holder = _hold(d)
     try:

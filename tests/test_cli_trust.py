@@ -299,11 +299,9 @@ def held(tmp_path_factory):
 
 @pytest.mark.parametrize("command", WRITERS, ids=[c.split(" --out")[0] for c in WRITERS])
 def test_second_writer_refused_at_once_naming_the_holder(command, held, small_run, capsys, monkeypatch):
-    import filelock
+    from chain_helpers import record_lock_tries
 
-    tries = []
-    acquire = filelock.FileLock.acquire
-    monkeypatch.setattr(filelock.FileLock, "acquire", lambda self, *a, **k: tries.append(k.get("timeout")) or acquire(self, *a, **k))
+    tries = record_lock_tries(monkeypatch)
     out, pid = held
     before = _tree(out)
     capsys.readouterr()
