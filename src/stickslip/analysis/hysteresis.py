@@ -116,9 +116,9 @@ class HysteresisResult:
         }
 
 
-def _no_series(p: BlockParams, t: float) -> int:
+def _no_series(p: BlockParams, t: float, name: str) -> int:
     """An ``every`` that keeps only the first and last state (the statistics see every step)."""
-    return max(1, steps_for(t, p.dt))
+    return max(1, steps_for(t, p.dt, name))
 
 
 def _hold(params: BlockParams, V: float, settings: SweepSettings, state: BlockState) -> tuple[dict, BlockState]:
@@ -127,9 +127,9 @@ def _hold(params: BlockParams, V: float, settings: SweepSettings, state: BlockSt
     t_transient = settings.transient * settings.time_per_step
     t_measure = settings.time_per_step - t_transient
     if t_transient > 0.0:
-        transient = simulate_block(p, t_transient, initial=state, every=_no_series(p, t_transient))
+        transient = simulate_block(p, t_transient, initial=state, every=_no_series(p, t_transient, "t_transient"))
         state = transient.restart_state()
-    run = simulate_block(p, t_measure, initial=state, every=_no_series(p, t_measure))
+    run = simulate_block(p, t_measure, initial=state, every=_no_series(p, t_measure, "t_measure"))
     starts = run.slips["t_c"].to_numpy()
     period = float(np.mean(np.diff(starts))) if starts.size >= 2 else math.nan
     row = {

@@ -507,7 +507,8 @@ def chain_params_from_args(args: argparse.Namespace, **overrides: Any):
     """Validated ChainParams from ``--model``, the pieces and the parameter options.
 
     An option the composition does not read (``--D`` with weakening friction, say) is refused
-    rather than silently ignored.
+    rather than silently ignored. ``overrides`` are the command's own defaults (a workload's N and
+    beta), not the user's: those the composition does not read are left out, never refused.
     """
     from stickslip.models.params import ChainParams
     from stickslip.models.presets import build_chain_params, refuse_unread
@@ -523,9 +524,12 @@ def chain_params_from_args(args: argparse.Namespace, **overrides: Any):
     for name in ("l", "nu"):
         if getattr(args, f"param_{name}", None) is not None:
             values[name] = getattr(args, f"param_{name}")
-    values.update(overrides)
-    params = build_chain_params(args.model or "sakaguchi", **values)
-    refuse_unread(params, values, prefix="--", spell=option_name)
+    model = args.model or "sakaguchi"
+    if overrides:
+        reads = set(build_chain_params(model, **values).used())
+        values.update({k: v for k, v in overrides.items() if k in reads})
+    params = build_chain_params(model, **values)
+    refuse_unread(params, {k: v for k, v in values.items() if k not in overrides}, prefix="--", spell=option_name)
     return params
 
 

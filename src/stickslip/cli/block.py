@@ -141,7 +141,7 @@ def run_block(args: argparse.Namespace) -> Result:
         raise CommandError("--fig3 writes figures and needs --out DIR")
     law = _law_or_none(p)
     t_end = float(args.t_end) if args.t_end is not None else default_t_end(p, law)
-    steps = steps_for(t_end, p.dt)
+    steps = steps_for(t_end, p.dt, "t_end")
     if steps > MAX_BLOCK_STEPS:
         raise CommandError(
             f"t_end must be <= {MAX_BLOCK_STEPS * p.dt:g} for the single block (at most "
@@ -216,7 +216,7 @@ def _fig2_source(run: BlockRun) -> tuple[BlockRun, int] | None:
     # Re-run to just before the slip without storing, then store every step through it.
     p = run.params
     lead = max(0.0, float(run.slips["t_c"].iloc[index]) - 10 * p.dt)
-    before = simulate_block(p, lead, initial=run.initial, every=max(1, steps_for(lead, p.dt)))
+    before = simulate_block(p, lead, initial=run.initial, every=max(1, steps_for(lead, p.dt, "t_end")))
     span = 2.0 * float(run.slips["duration"].iloc[index]) + 20 * p.dt
     fine = simulate_block(p, span, initial=before.restart_state())
     return (fine, 0) if len(fine.slips) else None

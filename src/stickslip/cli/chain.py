@@ -439,9 +439,11 @@ def _partly_stuck(args: argparse.Namespace) -> Result:
 
 
 def _workload(args: argparse.Namespace, w: dict):
-    """The parameters, preparation time and timed span of a bench workload ``w`` (its N and beta
-    unless given), the preparation scaled with the loading time L_ss / V ~ N^2."""
-    overrides = {k: w[k] for k in ("N", "beta") if getattr(args, f"param_{k}", None) is None}
+    """The parameters, preparation time and timed span of a bench workload ``w``, the preparation
+    scaled with the loading time L_ss / V ~ N^2. The workload's N and beta are the paper's chain's
+    (unless given); another model keeps its own, and a parameter it does not read is not set."""
+    paper = (args.model or "sakaguchi") == "sakaguchi"
+    overrides = {k: w[k] for k in ("N", "beta") if paper and getattr(args, f"param_{k}", None) is None}
     params = chain_params_from_args(args, **overrides)
     t_timed = args.t_end if args.t_end is not None else w["t_timed"]
     check_number("t-end", t_timed, low=0.0, low_open=True)

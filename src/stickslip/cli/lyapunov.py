@@ -346,7 +346,7 @@ def _finite_size(params, args) -> Result:
     # A check further apart than the longest cycle (--t-end) would never look at the distance.
     check = max(1, int(round(check_number("check", args.check, low=params.dt, high=args.t_end) / params.dt)))
     ref = start_state(params, args.start, perturbation=args.perturbation, seed=args.seed)
-    ref, _ = LocatedStepper(params).advance(ref, steps_for(args.transient, params.dt))
+    ref, _ = LocatedStepper(params).advance(ref, steps_for(args.transient, params.dt, "transient"))
     pair = LocatedPair(params, ref, neutral=args.neutral, direction_seed=args.direction_seed)
     res = finite_size_exponents(
         pair, deltas, cycles=args.cycles, check_steps=check, max_cycle_time=args.t_end, pooled_below=1e-6

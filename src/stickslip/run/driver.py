@@ -261,7 +261,7 @@ def resume_chain(
         )
     if t_end is not None:
         t_end = float(check_number("t_end", t_end, low=0.0))
-        if steps_for(t_end, params.dt) < state.step:
+        if steps_for(t_end, params.dt, "t_end") < state.step:
             raise ParameterError(f"t_end must be >= the checkpoint's time {state.step * params.dt:g} (got {t_end:g})")
         options = dataclasses.replace(options, t_end=t_end)
     if keep_checkpoint is None:
@@ -330,7 +330,7 @@ def continue_or_run(
 def _drive(params, options, start_info, state, outputs, *, checkpointer, wall_before) -> ChainRun:
     """The run loop (:func:`stickslip.run.loop.run_loop`) with the hooks ``options`` asks for and
     the caller's own, then the results, written into ``options.out_dir`` if given."""
-    n_end = steps_for(options.t_end, params.dt)
+    n_end = steps_for(options.t_end, params.dt, "t_end")
     sample_every = int(round(options.sample_interval / params.dt))
     profile_every = int(round(options.profile_window / params.dt)) if options.profile_window else 0
     last_moving = max((int(a[-1, 0]) for a in outputs.parts["moving"] if len(a)), default=-1)
@@ -358,7 +358,8 @@ def _drive(params, options, start_info, state, outputs, *, checkpointer, wall_be
     hooks: list[Hook] = []
     if options.snapshot_times:
         done = set(int(s) for a in outputs.parts["snap_step"] for s in a)
-        hooks.append(Snapshots([steps_for(t, params.dt) for t in options.snapshot_times], done, n_end))
+        steps = [steps_for(t, params.dt, "snapshot_times") for t in options.snapshot_times]
+        hooks.append(Snapshots(steps, done, n_end))
     if options.sample_moving and not outputs.moving_from_kernel:
         hooks.append(MovingCounts(sample_every, last_moving))
     if options.until_steady is not None:

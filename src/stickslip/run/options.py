@@ -173,7 +173,7 @@ class RunOptions:
         """Check every option against the time step (ranges in docs/limits.md); returns self."""
         if self.t_end is None:
             raise ParameterError("t_end must be given (run_chain's own argument)")
-        steps_for(self.t_end, dt)
+        steps_for(self.t_end, dt, "t_end")
         longest = MAX_STEPS * dt
         check_number("sample_interval", self.sample_interval, low=0.0, low_open=True, high=longest)
         if round(self.sample_interval / dt) < 1:

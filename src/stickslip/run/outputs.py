@@ -355,7 +355,7 @@ def _assemble(params, options, integrator, start_info, state, outputs, wall, ste
         # From the stop on, the chain is taken to slide steadily: L = L_ss at the remaining samples.
         L_ss = physics.chain_steady_length(params)
         sample_every = int(round(options.sample_interval / dt))
-        n_end = steps_for(options.t_end, dt)
+        n_end = steps_for(options.t_end, dt, "t_end")
         later = np.arange((state.step // sample_every + 1) * sample_every, n_end + 1, sample_every) * dt
         n_virtual = int(np.count_nonzero(later >= avg_from - 0.5 * dt))
         L_values = np.concatenate([L_values, np.full(n_virtual, L_ss)])
