@@ -295,6 +295,16 @@ def run_option_dests(control: bool | None = False) -> tuple[str, ...]:
     return tuple(_run_option_dest(cli) for _, cli in _run_option_fields(control))
 
 
+def run_option_spelling(field_name: str) -> str:
+    """The command-line spelling of a field of :class:`~stickslip.run.options.RunOptions`
+    (``out_dir`` is ``--out``, ``snapshot_times`` ``--snapshot``), for the refusals of
+    :meth:`~stickslip.run.options.RunOptions.validated`, which the command and the API share."""
+    for f, cli in _run_option_fields():
+        if f.name == field_name:
+            return "--" + cli["option"]
+    return option_name(field_name)
+
+
 def run_options_from_args(args: argparse.Namespace, t_end: float):
     """The :class:`~stickslip.run.options.RunOptions` of the options :func:`add_run_options`
     added (the field's default where one is not given), with ``t_end``; not yet validated."""

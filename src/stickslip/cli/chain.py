@@ -20,6 +20,7 @@ from stickslip.cli._common import (
     int_arg,
     owned_out_dir,
     run_option_dests,
+    run_option_spelling,
     run_options_from_args,
 )
 from stickslip.models.params import MAX_PERTURBATION, check_number, steps_for
@@ -262,20 +263,12 @@ def run_chain_command(args: argparse.Namespace) -> Result:
             setattr(args, name, default)
     check_number("t-end", t_end, low=0.0, low_open=True)
     steps_for(t_end, params.dt, "t-end")
-    if args.out is None:
-        for flag, value in (
-            ("--checkpoint-interval", args.checkpoint_interval),
-            ("--overwrite", args.overwrite or None),
-            ("--keep-checkpoint", args.keep_checkpoint),
-        ):
-            if value is not None:
-                raise CommandError(f"{flag} needs --out (a run without a run directory writes no checkpoints)")
+    if args.out is None and args.overwrite:
+        raise CommandError("--overwrite needs --out (a run without a run directory writes nothing to replace)")
     interval = 300.0 if args.checkpoint_interval is None else args.checkpoint_interval
-    check_number("checkpoint-interval", interval, low=0.0, low_open=True)
     options = run_options_from_args(args, t_end)
-    check_number("profile-min-blocks", options.profile_min_blocks, low=0, integer=True)
-    # Validate every option before anything is written.
-    options.validated(params.dt)
+    # Validate every option before anything is written, where run_chain does (one place).
+    options.validated(params.dt, spell=run_option_spelling)
     check_number("perturbation", args.perturbation, low=0.0, high=MAX_PERTURBATION)
     own = _own_files(args.out)
     out = check_out_owned(args.out, own, "stickslip chain", overwrite=args.overwrite)
@@ -377,10 +370,9 @@ def _start_of(params, args) -> tuple[str, float, int]:
 
     preset = PRESETS[params.model]
     start = args.start or preset.start
-    if args.perturbation is not None and start == "paper":
-        raise CommandError("--perturbation goes with --start steady or --start rest (the paper's start has none)")
-    if args.seed is not None and start == "paper":
-        raise CommandError("--seed goes with --start steady or --start rest (the paper's start draws no numbers)")
+    from stickslip.run.state import check_start_draw
+
+    check_start_draw(start, args.perturbation, args.seed, cli=True)  # None: not given
     if start == "rest":
         amplitude = args.perturbation if args.perturbation is not None else preset.start_options.get("amplitude", 0.0)
         check_number("perturbation", amplitude, low=0.0, high=MAX_PERTURBATION)

@@ -63,7 +63,14 @@ from stickslip.run.options import INTEGRATORS, RunOptions
 from stickslip.run.outputs import EVENT_COLUMNS, ChainRun, _assemble, _Outputs
 from stickslip.run.progress import Progress, SignalFlag, show_progress
 from stickslip.run.rundir import load_run, read_run_id, write_run
-from stickslip.run.state import STARTS, ChainState, initial_state, loading_warnings, steady_deviation
+from stickslip.run.state import (
+    STARTS,
+    ChainState,
+    check_start_draw,
+    initial_state,
+    loading_warnings,
+    steady_deviation,
+)
 from stickslip.run.validate import check_chain_params, check_checkpoint_state, check_start_state
 
 __all__ = [
@@ -156,6 +163,8 @@ def run_chain(
         state = start.copy()
         start_info: dict[str, Any] = {"kind": "state", "sha256": start.sha256()}
     else:
+        # the defaults (0.0, 0) draw nothing: only another value is a draw the paper's start lacks
+        check_start_draw(start, perturbation if perturbation != 0.0 else None, seed if seed != 0 else None)
         state = initial_state(params, start, amplitude=perturbation, seed=seed)
         start_info = {"kind": start, "perturbation": perturbation, "seed": seed}
         for message in loading_warnings(params, options.t_end, options.average_from, start):
@@ -175,6 +184,11 @@ def _options(options: RunOptions | None, overrides: dict[str, Any], t_end: float
     unknown = sorted(set(overrides) - set(_FIELDS))
     if unknown:
         raise TypeError(f"run_chain() got an unexpected keyword argument {unknown[0]!r}")
+    if options is not None and not isinstance(options, RunOptions):
+        raise ParameterError(
+            f"options must be a RunOptions (stickslip.RunOptions(...)), or give its fields as keywords "
+            f"of run_chain (got {type(options).__name__})"
+        )
     options = RunOptions() if options is None else options
     if options.t_end is not None and options.t_end != t_end:
         raise ParameterError(f"options.t_end {options.t_end:g} differs from t_end {t_end:g}; give one")
@@ -183,14 +197,13 @@ def _options(options: RunOptions | None, overrides: dict[str, Any], t_end: float
     for hook in hooks:
         if not isinstance(hook, Hook):
             raise ParameterError(f"hooks must be Hook instances (stickslip.run.Hook; got {type(hook).__name__})")
+    options = dataclasses.replace(options, t_end=t_end, hooks=hooks).validated(dt)  # as given, then as used
     return dataclasses.replace(
         options,
-        t_end=t_end,
         snapshot_times=tuple(float(t) for t in options.snapshot_times),
         profile_min_blocks=int(options.profile_min_blocks),
         sample_moving=bool(options.sample_moving),
-        hooks=hooks,
-    ).validated(dt)
+    )
 
 
 def resume_chain(

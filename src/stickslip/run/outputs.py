@@ -140,7 +140,7 @@ class ChainRun:
             f"         state sha256 {s['state_sha256'][:16]}...)"
         )
 
-    def save(self, out_dir: str | Path) -> Path:
+    def save(self, out_dir: str | Path, *, overwrite: bool = False) -> Path:
         """Write the run directory ``stickslip chain --out DIR`` writes (run.json, state.nc,
         events and first_move as Parquet and CSV), for :func:`~stickslip.run.rundir.load_run`
         and ``stickslip plot`` to read.
@@ -152,6 +152,9 @@ class ChainRun:
         ----------
         out_dir : str or Path
             The run directory; created if missing.
+        overwrite : bool
+            Replace a run already there (as ``stickslip chain --overwrite``): its files are
+            removed first; other files in the folder stay.
 
         Returns
         -------
@@ -169,7 +172,7 @@ class ChainRun:
         from stickslip.run.ownership import run_dir_for_run
         from stickslip.run.runfiles import write_run
 
-        with run_dir_for_run(out_dir):
+        with run_dir_for_run(out_dir, overwrite=overwrite):
             return write_run(self, out_dir)
 
     def plot_length(self, *, ax=None):

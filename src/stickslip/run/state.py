@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import hashlib
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -173,6 +174,22 @@ def model_of(p: ChainParams) -> dict[str, str]:
     """The model a state of the parameters ``p`` belongs to: the preset's name and the four pieces
     (docs/model.md), which decide what x, v and theta mean."""
     return {"model": p.model, **p.pieces}
+
+
+def check_start_draw(start: str, perturbation: Any, seed: Any, *, cli: bool = False) -> None:
+    """Refuse a perturbation or a seed (None: not given) with a start that draws no numbers (the
+    paper's, section 3): the one check that ``run_chain`` and ``stickslip chain`` share. ``cli``
+    spells the options (``--perturbation``, ``--start steady``) instead of the arguments."""
+    if start != "paper":
+        return
+    if cli:
+        steady, rest, amplitude, seed_name = "--start steady", "--start rest", "--perturbation", "--seed"
+    else:
+        steady, rest, amplitude, seed_name = "start='steady'", "start='rest'", "perturbation", "seed"
+    if perturbation is not None:
+        raise ParameterError(f"{amplitude} goes with {steady} or {rest} (the paper's start has none)")
+    if seed is not None:
+        raise ParameterError(f"{seed_name} goes with {steady} or {rest} (the paper's start draws no numbers)")
 
 
 def initial_state(p: ChainParams, start: str = "paper", *, amplitude: float = 0.0, seed: int = 0) -> ChainState:
