@@ -415,8 +415,15 @@ def run_bench_command(args: argparse.Namespace) -> Result:
     if args.profile:
         result = bench.profile(params, t_end, start=start, perturbation=amplitude, seed=seed)
         return Result(result, bench.format_profile(result))
-    result = bench.compare(params, t_end, start=start, repeat=args.repeat, perturbation=amplitude, seed=seed)
+    _say(bench.expected_cost(params, t_end, args.repeat))  # up front: the default runs for a minute or more
+    result = bench.compare(params, t_end, start=start, repeat=args.repeat, perturbation=amplitude, seed=seed, say=_say)
     return Result(result, bench.format_result(result))
+
+
+def _say(line: str) -> None:
+    """A line of `stickslip bench` on stderr (stdout keeps the result, and --json its document)."""
+    sys.stderr.write(f"stickslip bench: {line}\n")
+    sys.stderr.flush()
 
 
 def _partly_stuck(args: argparse.Namespace) -> Result:

@@ -175,30 +175,41 @@ class ChainRun:
         with run_dir_for_run(out_dir, overwrite=overwrite):
             return write_run(self, out_dir)
 
+    # The plot_* methods draw into a new Figure and return it, or, given ``ax``, draw there and
+    # return that Axes, as pandas' and seaborn's plots on an ``ax`` do.
+
     def plot_length(self, *, ax=None):
-        """L(t) against steady sliding: :func:`stickslip.plotting.length`; returns the Figure."""
+        """L(t) against steady sliding: :func:`stickslip.plotting.length`; returns the Figure
+        (the Axes ``ax`` when given)."""
         from stickslip.plotting.run import length
 
-        return length(self, ax=ax)
+        return _drawn(length(self, ax=ax), ax)
 
     def plot_snapshot(self, t: float | None = None, *, ax=None):
         """The final state (or the snapshot at ``t``) against steady sliding:
-        :func:`stickslip.plotting.snapshot`; returns the Figure."""
+        :func:`stickslip.plotting.snapshot`; returns the Figure (the Axes ``ax`` when given)."""
         from stickslip.plotting.run import snapshot
 
-        return snapshot(self, t, ax=ax)
+        return _drawn(snapshot(self, t, ax=ax), ax)
 
     def plot_sizes(self, *, ax=None, bins: int = 30):
-        """The slip-size distribution with its fit: :func:`stickslip.plotting.sizes`; returns the Figure."""
+        """The slip-size distribution with its fit: :func:`stickslip.plotting.sizes`; returns the
+        Figure (the Axes ``ax`` when given)."""
         from stickslip.plotting.run import sizes
 
-        return sizes(self, ax=ax, bins=bins)
+        return _drawn(sizes(self, ax=ax, bins=bins), ax)
 
     def plot_fronts(self, *, ax=None):
-        """The rupture fronts of the largest events: :func:`stickslip.plotting.fronts`; returns the Figure."""
+        """The rupture fronts of the largest events: :func:`stickslip.plotting.fronts`; returns the
+        Figure (the Axes ``ax`` when given)."""
         from stickslip.plotting.run import fronts
 
-        return fronts(self, ax=ax)
+        return _drawn(fronts(self, ax=ax), ax)
+
+
+def _drawn(fig, ax):
+    """What a ``plot_*`` method returns: the Axes it was given, else the new Figure."""
+    return fig if ax is None else ax
 
 
 class _Outputs:
