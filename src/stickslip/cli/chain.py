@@ -24,8 +24,6 @@ from stickslip.cli._common import (
     run_options_from_args,
 )
 from stickslip.models.params import MAX_PERTURBATION, check_number, steps_for
-from stickslip.run.ownership import PLOT_FOLDER, only_plot_files
-from stickslip.run.rundir import OWN_FILES, RunDirBusy, owned_run_dir, read_run_id
 
 
 def register(sub) -> None:
@@ -199,10 +197,11 @@ _FIXED_BY_CHECKPOINT = ("from_dir", "start", "perturbation", "seed", *run_option
 
 def run_chain_command(args: argparse.Namespace) -> Result:
     """Handler of `stickslip chain`."""
-    from stickslip.run import driver as chain
-
     progress = not args.no_progress
     if args.resume is not None:
+        from stickslip.run import driver as chain
+        from stickslip.run.rundir import RunDirBusy, owned_run_dir
+
         if not args.resume.strip():
             raise CommandError("--resume must name a run directory (got '')")
         if not Path(args.resume).is_dir():
@@ -248,7 +247,10 @@ def run_chain_command(args: argparse.Namespace) -> Result:
             _json_summary(run.summary, Path(args.resume)), _summary_text(run.summary, Path(args.resume), run.params.N)
         )
 
-    params = chain_params_from_args(args)
+    params = chain_params_from_args(args)  # a bad parameter is refused before the engine loads
+    from stickslip.run import driver as chain
+    from stickslip.run.rundir import RunDirBusy, read_run_id
+
     from_state = _from_state(params, args)
     start, amplitude, seed = _start_of(params, args)
     params, t_end = _first_look(params, args, start) if args.t_end is None else (params, args.t_end)
@@ -313,6 +315,9 @@ def run_chain_command(args: argparse.Namespace) -> Result:
 def _own_files(out: str | None):
     """What `chain` treats as its own in ``--out``: a run's files, and the figures `stickslip plot`
     drew from that run into RUN_DIR/figures (``--overwrite`` replaces them with the run)."""
+    from stickslip.run.ownership import PLOT_FOLDER, only_plot_files
+    from stickslip.run.rundir import OWN_FILES
+
     if out is None:
         return OWN_FILES
     folder = Path(out) / PLOT_FOLDER

@@ -9,14 +9,16 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
 
 from stickslip.experiments.studies import Design, Study, finite, short
 from stickslip.experiments.studies.chain_point import check_point, sizes_task, t_end_of
 from stickslip.models.presets import PRESETS, is_paper
+
+if TYPE_CHECKING:  # loaded where used, so that listing the studies loads no heavy module
+    import pandas as pd
 
 __all__ = ["DESIGN"]
 

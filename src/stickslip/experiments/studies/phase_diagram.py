@@ -8,14 +8,15 @@ parameter (:func:`stickslip.experiments.studies.chain_point.order_task`).
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
-
-import pandas as pd
+from typing import TYPE_CHECKING, Any
 
 from stickslip.experiments.studies import Design, Study, short
 from stickslip.experiments.studies.chain_point import check_point, order_task, t_end_of
 from stickslip.models.physics import UNTIL_STEADY
 from stickslip.models.presets import paper_parameters
+
+if TYPE_CHECKING:  # loaded where used, so that listing the studies loads no heavy module
+    import pandas as pd
 
 __all__ = ["DESIGN"]
 
