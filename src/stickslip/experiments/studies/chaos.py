@@ -444,6 +444,10 @@ def figures(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[tuple[str,
     return out
 
 
+#: The wall time of each mode (``stickslip study --help``, the README).
+COST = {"quick": "about 8 minutes on two cores", "full": "about an hour on two cores"}
+
+
 def describe() -> str:
     """The text of ``stickslip study chaos --help``."""
     quick, full = build("quick"), build("full")
@@ -453,15 +457,16 @@ def describe() -> str:
         "dt/4, extrapolated to dt -> 0), the number of slips n(delta) that agree between a run and a "
         "twin perturbed by delta (the state, Fs or V), the threshold delta* and the verdict "
         "(chaotic, stable chaos, regular or undetermined); two blocks and Carlson-Langer as known answers. "
-        f"Grid: --quick {quick.note.split(': ', 1)[1]} ({len(quick.points)} points, about 8 minutes "
-        f"on two cores); --full {full.note.split(': ', 1)[1]} ({len(full.points)} points, about an "
-        "hour on two cores). Outputs in DIR/chaos/: table.parquet and table.csv (one row per point: "
+        f"Grid: --quick {quick.note.split(': ', 1)[1]} ({len(quick.points)} points, {COST['quick']}"
+        f"); --full {full.note.split(': ', 1)[1]} ({len(full.points)} points, {COST['full']})."
+        " Outputs in DIR/chaos/: table.parquet and table.csv (one row per point: "
         "verdict, exponent, delta* per kind), decorrelation.csv, decorrelation, flow_ladder and "
         "threshold (PNG, PDF), study.json, index.html."
     )
 
 
 DESIGN = Design(
+    cost=COST,
     name="chaos",
     summary="the flow's exponent, slip decorrelation and its threshold delta* against N; the verdict",
     describe=describe,

@@ -336,6 +336,10 @@ def transition_loop(
     return _rows_table(rows)
 
 
+#: The wall time of each mode (``stickslip study --help``, the README).
+COST = {"quick": "5 to 11 minutes on two cores", "full": "about 45 minutes on two free cores"}
+
+
 def describe() -> str:
     """The text of ``stickslip study transition --help``."""
     quick, full = build("quick"), build("full")
@@ -346,9 +350,10 @@ def describe() -> str:
         "ladder starts from steady sliding and goes down until a block sticks; each bisects the "
         "bracket it finds. Each rung stops when its answer is known (error of m, steady sliding "
         "reached, or its cap). "
-        f"Grid: --quick {quick.note.split(': ', 1)[1]} ({len(quick.points)} ladders, 5 to 11 minutes "
-        f"on two cores); --full {full.note.split(': ', 1)[1]} ({len(full.points)} ladders, about 45 "
-        "minutes on two free cores); --extra-n adds a chain (1599: hours). Outputs in "
+        f"Grid: --quick {quick.note.split(': ', 1)[1]} ({len(quick.points)} ladders, {COST['quick']}"
+        f"); --full {full.note.split(': ', 1)[1]} ({len(full.points)} ladders, {COST['full']}); "
+        "--extra-n adds a chain (1599: hours)."
+        " Outputs in "
         "DIR/transition/: table.parquet and table.csv (one row per rung: m, the stuck fraction, "
         "their errors, the final state), loops and scaling (PNG, PDF), study.json (with beta_t, "
         "the lower edge and the step per N and their power laws in N), index.html."
@@ -375,6 +380,7 @@ def _ladder_entry(*args: Any, **kwargs: Any) -> Any:
 
 
 DESIGN = Design(
+    cost=COST,
     name="transition",
     summary="the edges of the stick-slip loop at beta = 1 against N, by continuation in beta",
     describe=describe,
