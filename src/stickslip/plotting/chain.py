@@ -26,7 +26,7 @@ from stickslip.analysis.statistics import EdgeSpeed, FrontSpeed, PowerLawFit, ce
 from stickslip.models.params import ChainParams
 from stickslip.models.physics import chain_steady_length, chain_steady_profile_paper, chain_steady_state
 from stickslip.models.presets import is_paper_model, is_paper_run, model_title
-from stickslip.plotting.style import PAPER, SIM, THEORY, new_figure
+from stickslip.plotting.style import PAPER, SIM, THEORY, new_figure, ordinal
 
 __all__ = [
     "snapshot_figure",
@@ -283,7 +283,7 @@ def _waterfall(ax, sub: xr.Dataset, window: float | None, edge: EdgeSpeed | None
     ax.set_xlabel("block $i$")
     ax.set_xlim(blocks.min(), blocks.max())
     w = f"{window:g}" if window else "W"
-    every_text = f", every {every}th window" if every > 1 else ""
+    every_text = f", every {ordinal(every)} window" if every > 1 else ""
     ax.text(
         0.99,
         0.01,

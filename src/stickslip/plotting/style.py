@@ -35,6 +35,14 @@ THEORY = {"color": "C3", "lw": 1.2, "ls": "--"}  # analytic/limit curves: dashed
 PAPER = {"color": "0.4", "lw": 1.0, "ls": ":"}  # the paper's own formula where it differs
 
 
+def ordinal(n: int) -> str:
+    """``n`` as an English ordinal (1st, 2nd, 3rd, 4th, 11th, 12th, 13th, 21st, 112th), for a
+    figure's words (Fig. 6: "every 2nd window")."""
+    n = int(n)
+    suffix = "th" if n % 100 in (11, 12, 13) else {1: "st", 2: "nd", 3: "rd"}.get(n % 10, "th")
+    return f"{n}{suffix}"
+
+
 def new_figure(nrows: int = 1, ncols: int = 1, *, width: float = 5.0, height: float = 3.6, **kw):
     """A Figure and its axes in the project's style; no pyplot state is kept.
 

@@ -1,0 +1,58 @@
+"""Text shown to a reader is wrapped or abbreviated at word boundaries, never cut mid-word: the
+reproduce summary's agreement column; and ordinals read as English ("every 2nd window")."""
+
+from __future__ import annotations
+
+import re
+
+import pytest
+
+from stickslip.cli.reproduce import AGREEMENT_WIDTH, _text
+
+LONG = (
+    "agrees within the stated tolerance of two percent once the chain has loaded, as the paper "
+    "states for Fig. 5(b) at beta = 0.2 and N = 399"
+)
+
+
+def _result(agreement: str) -> dict:
+    return {
+        "mode": "quick",
+        "wall_seconds": 1.0,
+        "rows": [{"where": "Fig. 5b", "agreement": agreement, "quantity": "<L>"}],
+        "studies": [],
+        "figures": [],
+        "figures_not_drawn": {},
+        "report_html": "report.html",
+    }
+
+
+def test_the_agreement_column_keeps_every_word_whole():
+    text = _text(_result(LONG))
+    shown = re.findall(r"[\w().=<>-]+", text)
+    for word in LONG.split():
+        assert word in text.split(), f"{word!r} cut: {shown}"
+    lines = text.splitlines()
+    assert lines[1].rstrip().endswith("<L>") and len(lines) > 3
+    assert all(len(line) <= 2 + len("Fig. 5b") + 2 + AGREEMENT_WIDTH + 2 + 3 for line in lines[1:-2])
+
+
+@pytest.mark.parametrize(
+    "n, text",
+    [(1, "1st"), (2, "2nd"), (3, "3rd"), (4, "4th"), (11, "11th"), (12, "12th"), (13, "13th"), (21, "21st"),
+     (22, "22nd"), (23, "23rd"), (101, "101st"), (111, "111th"), (112, "112th")],
+)  # fmt: skip
+def test_ordinals(n, text):
+    from stickslip.plotting.style import ordinal
+
+    assert ordinal(n) == text
+
+
+def test_no_figure_writes_an_ordinal_by_hand():
+    """The class, not the one case: no f-string in the plotting code appends "th" to a number."""
+    from pathlib import Path
+
+    import stickslip.plotting
+
+    for path in Path(stickslip.plotting.__file__).parent.glob("*.py"):
+        assert not re.search(r"\}th\b", path.read_text()), path.name
