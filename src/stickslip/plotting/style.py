@@ -65,6 +65,18 @@ def new_figure(nrows: int = 1, ncols: int = 1, *, width: float = 5.0, height: fl
     return fig, axes
 
 
+def fit_titles(fig: Figure) -> Figure:
+    """Let the titles of ``fig`` (its suptitle, each Axes' titles) wrap at the figure's edges, as
+    matplotlib wraps a text with ``wrap=True`` when it draws it, instead of running past them (a
+    model's parameters make long titles: Fig. 5(a)'s was cut at both edges). Returns ``fig``."""
+    texts = list(fig.texts)
+    for ax in fig.axes:
+        texts += [t for t in (ax.title, getattr(ax, "_left_title", None), getattr(ax, "_right_title", None)) if t]
+    for text in texts:
+        text.set_wrap(True)
+    return fig
+
+
 #: Every figure is saved in these formats: PNG to look at, PDF to print or put in a paper.
 FIGURE_FORMATS = ("png", "pdf")
 
@@ -95,6 +107,7 @@ def save_figure(fig: Figure, path: str | Path, *, formats: tuple[str, ...] = FIG
 
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
+    fit_titles(fig)
     written = []
     with matplotlib.rc_context(RC):
         for fmt in formats:
@@ -106,4 +119,15 @@ def save_figure(fig: Figure, path: str | Path, *, formats: tuple[str, ...] = FIG
     return written
 
 
-__all__ = ["new_figure", "save_figure", "FIGURE_FORMATS", "plt", "SIM", "THEORY", "PAPER", "RC"]
+__all__ = [
+    "new_figure",
+    "save_figure",
+    "fit_titles",
+    "ordinal",
+    "FIGURE_FORMATS",
+    "plt",
+    "SIM",
+    "THEORY",
+    "PAPER",
+    "RC",
+]
