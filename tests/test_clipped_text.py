@@ -56,3 +56,27 @@ def test_no_figure_writes_an_ordinal_by_hand():
 
     for path in Path(stickslip.plotting.__file__).parent.glob("*.py"):
         assert not re.search(r"\}th\b", path.read_text()), path.name
+
+
+def _catalog_summary(paper_beta):
+    fit = {"tau": 1.5, "tau_err": 0.05, "s_min": 0.1, "s_max": 10.0, "n": 500}
+    return {
+        "paper_beta": paper_beta,
+        "sizes": {"whole_range": fit, "below_spanning": {**fit, "excess": 3.0}},
+        "frequency_magnitude": {},
+        "distributions": {},
+        "goodness_of_fit": {},
+        "recurrence": {},
+    }
+
+
+@pytest.mark.parametrize("paper_beta", [1.0, 0.2, 0.5, None])
+def test_a_catalogue_cites_only_what_the_paper_says_of_its_own_run(paper_beta):
+    """A catalogue of the paper's chain at beta = 1 cites the paper's tau at beta = 1, not its
+    beta = 0.2 result; a run the paper did not make cites nothing of it."""
+    from stickslip.report.catalog_page import catalog_statements
+
+    text = " ".join(catalog_statements(_catalog_summary(paper_beta)))
+    assert ("at beta = 1)" in text) == (paper_beta == 1.0)
+    assert ("at beta = 0.2" in text) == (paper_beta == 0.2)
+    assert ("the paper" in text) == (paper_beta in (1.0, 0.2))

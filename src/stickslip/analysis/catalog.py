@@ -304,10 +304,14 @@ def catalog_analysis(
         )
     p = run.params
     start = (run.start or {}).get("kind", "paper") if isinstance(run.start, dict) else "paper"
+    from stickslip.models.presets import is_paper_run
+
     summary: dict[str, Any] = {
         "model": p.model,
         "pieces": p.pieces,
         "N": p.N,
+        # the paper's chain at the paper's parameters: its beta picks the paper's numbers to cite
+        "paper_beta": float(p.beta) if is_paper_run(p) else None,
         "t_end": float(run.summary.get("t_end", run.options.t_end)),
         "window": {
             "t_from": t_from,
