@@ -84,3 +84,10 @@ def test_catalog_analysis_refuses_before_reading(given, said, tmp_path):
     """Refused before the run is read: the folder named does not even exist."""
     with pytest.raises(ParameterError, match=said):
         catalog_analysis(tmp_path / "no-such-run", **given)
+
+
+@pytest.mark.parametrize("argv", [["--seed", "3"], ["--perturbation", "0.1"]])
+def test_lyapunov_refuses_a_draw_with_the_papers_start_through_the_same_check(argv, capsys):
+    assert main(["lyapunov", "--N", "3", *argv]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "goes with --start steady or --start rest" in err, err

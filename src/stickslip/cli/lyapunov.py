@@ -208,10 +208,11 @@ def run_lyapunov_command(args: argparse.Namespace) -> Result:
     preset = PRESETS[params.model]
     if args.start is None:
         args.start = preset.start
+    from stickslip.run.state import check_start_draw
+
+    check_start_draw(args.start, args.perturbation, args.seed, cli=True)  # as `chain` and run_chain check it
     if args.perturbation is None:
         args.perturbation = preset.start_options.get("amplitude", 0.0) if args.start == "rest" else 0.0
-    if args.seed is not None and args.start == "paper":
-        raise CommandError("--seed goes with --start steady or --start rest (the paper's start draws no numbers)")
     if args.seed is None:
         args.seed = preset.start_options.get("seed", 0)
     check_number("perturbation", args.perturbation, low=0.0, high=MAX_PERTURBATION)
