@@ -29,7 +29,7 @@ from stickslip.analysis import magnitudes as mg
 from stickslip.analysis.chain_runs import run_size_statistics, spanning_column, stationary_events, stationary_from
 from stickslip.analysis.model_comparison import compare_distributions, power_law_gof
 from stickslip.analysis.recurrence import recurrence
-from stickslip.models.params import ParameterError
+from stickslip.models.params import ParameterError, check_number
 
 __all__ = [
     "CATALOG_COLUMNS",
@@ -240,6 +240,18 @@ class Catalog:
     intervals: dict[str, np.ndarray] = field(default_factory=dict)
 
 
+def check_catalog_options(dm: Any, bootstrap: Any, gof_sims: Any, seed: Any, spell=None) -> None:
+    """The one check of a catalogue's options, for :func:`catalog_analysis` and ``stickslip
+    catalog`` alike: ``dm`` (the magnitude bin of the b-value) in [0, 1], the counts of
+    resamples and synthetic catalogues and the seed whole numbers >= 0. ``spell`` names an
+    argument as the user gave it (``gof-sims`` on the command line)."""
+    name = spell if spell is not None else (lambda n: n)
+    check_number(name("dm"), dm, low=0.0, high=1.0)
+    check_number(name("bootstrap"), bootstrap, low=0, integer=True)
+    check_number(name("gof_sims"), gof_sims, low=0, integer=True)
+    check_number(name("seed"), seed, low=0, integer=True)
+
+
 def catalog_analysis(
     run,
     *,
@@ -277,6 +289,7 @@ def catalog_analysis(
     ParameterError
         For a run with fewer than ``min_events`` slips (one line).
     """
+    check_catalog_options(dm, bootstrap, gof_sims, seed)
     if isinstance(run, (str, Path)):
         run = load_catalog_run(run)
     from stickslip.run.state import loading_warnings
@@ -291,10 +304,14 @@ def catalog_analysis(
         )
     p = run.params
     start = (run.start or {}).get("kind", "paper") if isinstance(run.start, dict) else "paper"
+    from stickslip.models.presets import is_paper_run
+
     summary: dict[str, Any] = {
         "model": p.model,
         "pieces": p.pieces,
         "N": p.N,
+        # the paper's chain at the paper's parameters: its beta picks the paper's numbers to cite
+        "paper_beta": float(p.beta) if is_paper_run(p) else None,
         "t_end": float(run.summary.get("t_end", run.options.t_end)),
         "window": {
             "t_from": t_from,

@@ -15,7 +15,6 @@ from stickslip.cli._common import (
     int_arg,
     owned_out_dir,
 )
-from stickslip.models.params import check_number
 
 
 def register(sub) -> None:
@@ -60,13 +59,10 @@ def register(sub) -> None:
 
 def run_catalog_command(args: argparse.Namespace) -> Result:
     """Handler of `stickslip catalog`."""
-    from stickslip.analysis.catalog import catalog_analysis, load_catalog_run
+    from stickslip.analysis.catalog import catalog_analysis, check_catalog_options, load_catalog_run
     from stickslip.report.catalog_page import CATALOG_FILES, write_catalog
 
-    check_number("dm", args.dm, low=0.0, high=1.0)
-    check_number("bootstrap", args.bootstrap, low=0, integer=True)
-    check_number("gof-sims", args.gof_sims, low=0, integer=True)
-    check_number("seed", args.seed, low=0, integer=True)
+    check_catalog_options(args.dm, args.bootstrap, args.gof_sims, args.seed, spell=lambda n: n.replace("_", "-"))
     run_dir = Path(args.run_dir)
     out = Path(args.out) if args.out else run_dir / "catalog"
     if out.resolve() == run_dir.resolve():

@@ -8,8 +8,6 @@ from pathlib import Path
 from stickslip.cli._common import CommandError, Result, add_json_option, add_overwrite_option, owned_out_dir
 
 # The figures `plot` draws (stickslip.plotting.run.run_figures); its --out may hold only these.
-from stickslip.run.ownership import PLOT_FILE as _FIGURE
-from stickslip.run.ownership import PLOT_FOLDER
 
 
 def register(sub) -> None:
@@ -38,6 +36,8 @@ def register(sub) -> None:
 def run_plot_command(args: argparse.Namespace) -> Result:
     """Handler of `stickslip plot`."""
     from stickslip.plotting.run import draw_run_figures
+    from stickslip.run.ownership import PLOT_FILE as _FIGURE
+    from stickslip.run.ownership import PLOT_FOLDER
     from stickslip.run.rundir import RunDirDamaged, load_run
 
     run_dir = Path(args.run_dir)

@@ -63,7 +63,14 @@ from stickslip.run.options import INTEGRATORS, RunOptions
 from stickslip.run.outputs import EVENT_COLUMNS, ChainRun, _assemble, _Outputs
 from stickslip.run.progress import Progress, SignalFlag, show_progress
 from stickslip.run.rundir import load_run, read_run_id, write_run
-from stickslip.run.state import STARTS, ChainState, initial_state, loading_warnings, steady_deviation
+from stickslip.run.state import (
+    STARTS,
+    ChainState,
+    check_start_draw,
+    initial_state,
+    loading_warnings,
+    steady_deviation,
+)
 from stickslip.run.validate import check_chain_params, check_checkpoint_state, check_start_state
 
 __all__ = [
@@ -156,6 +163,8 @@ def run_chain(
         state = start.copy()
         start_info: dict[str, Any] = {"kind": "state", "sha256": start.sha256()}
     else:
+        # the defaults (0.0, 0) draw nothing: only another value is a draw the paper's start lacks
+        check_start_draw(start, perturbation if perturbation != 0.0 else None, seed if seed != 0 else None)
         state = initial_state(params, start, amplitude=perturbation, seed=seed)
         start_info = {"kind": start, "perturbation": perturbation, "seed": seed}
         for message in loading_warnings(params, options.t_end, options.average_from, start):
@@ -175,6 +184,11 @@ def _options(options: RunOptions | None, overrides: dict[str, Any], t_end: float
     unknown = sorted(set(overrides) - set(_FIELDS))
     if unknown:
         raise TypeError(f"run_chain() got an unexpected keyword argument {unknown[0]!r}")
+    if options is not None and not isinstance(options, RunOptions):
+        raise ParameterError(
+            f"options must be a RunOptions (stickslip.RunOptions(...)), or give its fields as keywords "
+            f"of run_chain (got {type(options).__name__})"
+        )
     options = RunOptions() if options is None else options
     if options.t_end is not None and options.t_end != t_end:
         raise ParameterError(f"options.t_end {options.t_end:g} differs from t_end {t_end:g}; give one")
@@ -183,14 +197,13 @@ def _options(options: RunOptions | None, overrides: dict[str, Any], t_end: float
     for hook in hooks:
         if not isinstance(hook, Hook):
             raise ParameterError(f"hooks must be Hook instances (stickslip.run.Hook; got {type(hook).__name__})")
+    options = dataclasses.replace(options, t_end=t_end, hooks=hooks).validated(dt)  # as given, then as used
     return dataclasses.replace(
         options,
-        t_end=t_end,
         snapshot_times=tuple(float(t) for t in options.snapshot_times),
         profile_min_blocks=int(options.profile_min_blocks),
         sample_moving=bool(options.sample_moving),
-        hooks=hooks,
-    ).validated(dt)
+    )
 
 
 def resume_chain(
@@ -261,7 +274,7 @@ def resume_chain(
         )
     if t_end is not None:
         t_end = float(check_number("t_end", t_end, low=0.0))
-        if steps_for(t_end, params.dt) < state.step:
+        if steps_for(t_end, params.dt, "t_end") < state.step:
             raise ParameterError(f"t_end must be >= the checkpoint's time {state.step * params.dt:g} (got {t_end:g})")
         options = dataclasses.replace(options, t_end=t_end)
     if keep_checkpoint is None:
@@ -330,7 +343,7 @@ def continue_or_run(
 def _drive(params, options, start_info, state, outputs, *, checkpointer, wall_before) -> ChainRun:
     """The run loop (:func:`stickslip.run.loop.run_loop`) with the hooks ``options`` asks for and
     the caller's own, then the results, written into ``options.out_dir`` if given."""
-    n_end = steps_for(options.t_end, params.dt)
+    n_end = steps_for(options.t_end, params.dt, "t_end")
     sample_every = int(round(options.sample_interval / params.dt))
     profile_every = int(round(options.profile_window / params.dt)) if options.profile_window else 0
     last_moving = max((int(a[-1, 0]) for a in outputs.parts["moving"] if len(a)), default=-1)
@@ -358,7 +371,8 @@ def _drive(params, options, start_info, state, outputs, *, checkpointer, wall_be
     hooks: list[Hook] = []
     if options.snapshot_times:
         done = set(int(s) for a in outputs.parts["snap_step"] for s in a)
-        hooks.append(Snapshots([steps_for(t, params.dt) for t in options.snapshot_times], done, n_end))
+        steps = [steps_for(t, params.dt, "snapshot_times") for t in options.snapshot_times]
+        hooks.append(Snapshots(steps, done, n_end))
     if options.sample_moving and not outputs.moving_from_kernel:
         hooks.append(MovingCounts(sample_every, last_moving))
     if options.until_steady is not None:

@@ -12,8 +12,9 @@ class ChainRunError(RuntimeError):
     """A chain run cannot go on (non-finite state, bad checkpoint)."""
 
 
-class NonFiniteState(ChainRunError):
-    """The state of the chain became non-finite; the message names the time and the block."""
+class NonFiniteState(ChainRunError, ArithmeticError):
+    """The state of the chain became non-finite; the message names the time and the block (an
+    :class:`ArithmeticError`, as the single block's :class:`NonFiniteBlock` is)."""
 
 
 class Interrupted(Exception):

@@ -53,12 +53,24 @@ class RunDirDamaged(ValueError):
     """A file of a run directory is missing, truncated or not what :func:`write_run` writes."""
 
 
+class RunDirMissing(RunDirDamaged, FileNotFoundError):
+    """A run directory, or a file it must hold, is not there: a :class:`FileNotFoundError` as
+    Python code expects of a missing path (and a :class:`RunDirDamaged` as before)."""
+
+    def __init__(self, message: str, path: Path):
+        super().__init__(message)
+        self.filename = str(path)
+
+    def __str__(self) -> str:  # the message, not OSError's "[Errno None] None: path"
+        return str(self.args[0])
+
+
 def _read(path: Path, reader):
     """``reader(path)``, any failure of it a :class:`RunDirDamaged` naming the file."""
     try:
         return reader(path)
     except FileNotFoundError:
-        raise RunDirDamaged(f"{path} is missing") from None
+        raise RunDirMissing(f"{path} is missing", path) from None
     except Exception as exc:  # truncated, overwritten, another format: all the same to a reader
         why = str(exc).strip().splitlines()[0][:120] if str(exc).strip() else type(exc).__name__
         raise RunDirDamaged(f"{path} is damaged or not a file of this package ({why})") from None
@@ -66,7 +78,8 @@ def _read(path: Path, reader):
 
 def load_run(run_dir: str | Path) -> ChainRun:
     """Read a run directory written by :func:`write_run` back into a :class:`ChainRun`; a
-    missing or damaged file raises :class:`RunDirDamaged` naming it.
+    missing or damaged file raises :class:`RunDirDamaged` naming it (a missing folder or file
+    :class:`RunDirMissing`, which is also a :class:`FileNotFoundError`).
 
     Parameters
     ----------
@@ -89,6 +102,10 @@ def load_run(run_dir: str | Path) -> ChainRun:
     (True, True)
     """
     run_dir = Path(run_dir)
+    if run_dir.exists() and not run_dir.is_dir():
+        raise RunDirDamaged(f"{run_dir} is not a directory (a run directory holds run.json, state.nc, ...)")
+    if not run_dir.exists():
+        raise RunDirMissing(f"{run_dir}: no such run directory", run_dir)
     try:
         return _load_run(run_dir)
     except RunDirDamaged:
