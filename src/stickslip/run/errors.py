@@ -16,6 +16,11 @@ class NonFiniteState(ChainRunError):
     """The state of the chain became non-finite; the message names the time and the block."""
 
 
+class HookError(ChainRunError):
+    """A hook of the run loop broke its contract (:class:`~stickslip.run.loop.Hook`); the message
+    names the hook, the method and what it returned."""
+
+
 class Interrupted(Exception):
     """A run was stopped by a signal after writing its checkpoint."""
 
