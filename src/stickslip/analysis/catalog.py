@@ -344,7 +344,10 @@ def catalog_analysis(
         cat.candidates = comparison.pop("objects")
         summary["distributions"] = comparison
         if gof_sims > 0:
-            summary["goodness_of_fit"] = power_law_gof(S, fit.s_max, sims=gof_sims, seed=seed)
+            try:
+                summary["goodness_of_fit"] = power_law_gof(S, fit.s_max, sims=gof_sims, seed=seed)
+            except ValueError as exc:
+                summary["goodness_of_fit"] = {"reason": f"no fit: {exc}"}
         else:
             summary["goodness_of_fit"] = {"reason": "not computed (gof_sims = 0)"}
     else:

@@ -215,8 +215,17 @@ def run_figures(run, *, max_snapshots: int = 4) -> list[RunFigure]:
     # The stationary window shared with `reproduce` and `catalog` (analysis.chain_runs.stationary_from).
     window = stationary_events(run)
     n_pos = int(np.count_nonzero(window["S"].to_numpy(dtype=float) > 0)) if len(window) else 0
+    stats = None
+    why = (
+        f"{n_pos} events with S > 0 at t >= {stationary_from(run):g}, the stationary window "
+        f"(a distribution needs {MIN_EVENTS_FOR_SIZES})"
+    )
     if n_pos >= MIN_EVENTS_FOR_SIZES:
-        stats = run_size_statistics(run, small_only=False)
+        try:
+            stats = run_size_statistics(run, small_only=False)
+        except ValueError as exc:  # no power law on the sizes: the figure says why
+            why = f"no power-law fit: {exc}"
+    if stats is not None:
         out.append(
             RunFigure(
                 "sizes",
@@ -231,8 +240,7 @@ def run_figures(run, *, max_snapshots: int = 4) -> list[RunFigure]:
                 "sizes",
                 "slip-size distribution",
                 None,
-                f"{n_pos} events with S > 0 at t >= {stationary_from(run):g}, the stationary window "
-                f"(a distribution needs {MIN_EVENTS_FOR_SIZES})",
+                why,
             )
         )
     if run.profiles.sizes.get("profile_row", 0) and len(events):
