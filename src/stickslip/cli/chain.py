@@ -23,7 +23,15 @@ from stickslip.cli._common import (
     run_options_from_args,
 )
 from stickslip.models.params import MAX_PERTURBATION, check_number, steps_for
-from stickslip.run.ownership import PLOT_FOLDER, only_plot_files
+from stickslip.run.ownership import (
+    CATALOG_FILES,
+    CATALOG_FOLDER,
+    PLOT_FILE,
+    PLOT_FOLDER,
+    only_catalog_files,
+    only_plot_files,
+    remove_own_files,
+)
 from stickslip.run.rundir import OWN_FILES, RunDirBusy, owned_run_dir, read_run_id
 
 
@@ -288,6 +296,8 @@ def run_chain_command(args: argparse.Namespace) -> Result:
             raise CommandError(f"{out} already holds a finished run; choose another --out or give --overwrite")
     try:
         with owned_out_dir(out, own, "stickslip chain", overwrite=args.overwrite, run_id=True) as out:
+            if args.overwrite:
+                _remove_derived(out)
             # The command's own defaults: a progress bar on any terminal, checkpoints every
             # `interval` and on signals where it writes, into the folder it owns.
             options = dataclasses.replace(
@@ -318,12 +328,26 @@ def run_chain_command(args: argparse.Namespace) -> Result:
 
 
 def _own_files(out: str | None):
-    """What `chain` treats as its own in ``--out``: a run's files, and the figures `stickslip plot`
-    drew from that run into RUN_DIR/figures (``--overwrite`` replaces them with the run)."""
+    """What `chain` treats as its own in ``--out``: a run's files, the figures `stickslip plot`
+    drew from that run into RUN_DIR/figures and the catalogue `stickslip catalog` wrote into
+    RUN_DIR/catalog (``--overwrite`` removes them with the run they were read from; either folder
+    holding other files too is left alone)."""
     if out is None:
         return OWN_FILES
-    folder = Path(out) / PLOT_FOLDER
-    return lambda name: name in OWN_FILES or (name == PLOT_FOLDER and only_plot_files(folder))
+    figures, catalog = Path(out) / PLOT_FOLDER, Path(out) / CATALOG_FOLDER
+    return lambda name: (
+        name in OWN_FILES
+        or (name == PLOT_FOLDER and only_plot_files(figures))
+        or (name == CATALOG_FOLDER and only_catalog_files(catalog))
+    )
+
+
+def _remove_derived(out: Path) -> None:
+    """With ``--overwrite``: the figures and catalogue of the replaced run that a folder of them
+    holding other files too still had (those other files stay)."""
+    for folder, own in ((PLOT_FOLDER, PLOT_FILE.fullmatch), (CATALOG_FOLDER, CATALOG_FILES.__contains__)):
+        if (out / folder).is_dir():
+            remove_own_files(out / folder, own)
 
 
 def _first_look(params, args, start: str):
