@@ -14,9 +14,8 @@ from stickslip.cli._common import (
     float_arg,
     int_arg,
     owned_out_dir,
-    reading_run_dir,
-    staged_writes,
 )
+from stickslip.cli._reading import reading_run_dir, staged_writes
 from stickslip.models.params import check_number
 
 

@@ -11,8 +11,8 @@ from stickslip.cli._common import (
     add_json_option,
     add_overwrite_option,
     owned_out_dir,
-    reading_run_dir,
 )
+from stickslip.cli._reading import reading_run_dir
 
 # The figures `plot` draws (stickslip.plotting.run.run_figures); its --out may hold only these.
 from stickslip.run.ownership import PLOT_FILE as _FIGURE
