@@ -262,6 +262,9 @@ def b_value(M: Any, mc: float, *, dm: float = DM, bootstrap: int = 200, seed: in
             lambda x, axis=-1: _aki_utsu(x, mc, dm, axis),
             n_resamples=bootstrap,
             vectorized=True,
+            # resamples in batches of at most 2**24 magnitudes: the memory of a large catalogue
+            # times many resamples stays bounded (one batch, as before, where it fits)
+            batch=None if bootstrap * n <= 2**24 else max(1, 2**24 // n),
             method="percentile",
             rng=np.random.default_rng(seed),
         )

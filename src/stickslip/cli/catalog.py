@@ -65,6 +65,9 @@ def run_catalog_command(args: argparse.Namespace) -> Result:
     check_number("bootstrap", args.bootstrap, low=0, integer=True)
     check_number("gof-sims", args.gof_sims, low=0, integer=True)
     check_number("seed", args.seed, low=0, integer=True)
+    from stickslip.analysis.catalog import check_counts
+
+    check_counts(args.bootstrap, args.gof_sims, ("bootstrap", "gof-sims"))  # before the run is read: refused at once
     run_dir = Path(args.run_dir)
     out = Path(args.out) if args.out else run_dir / "catalog"
     if out.resolve() == run_dir.resolve():

@@ -23,6 +23,7 @@ from stickslip.cli._common import (
     run_options_from_args,
 )
 from stickslip.models.params import MAX_PERTURBATION, check_number, steps_for
+from stickslip.run.budget import check_run_outputs
 from stickslip.run.ownership import (
     CATALOG_FILES,
     CATALOG_FOLDER,
@@ -284,6 +285,7 @@ def run_chain_command(args: argparse.Namespace) -> Result:
     check_number("profile-min-blocks", options.profile_min_blocks, low=0, integer=True)
     # Validate every option before anything is written.
     options.validated(params.dt)
+    check_run_outputs(params.N, params.dt, options)
     check_number("perturbation", args.perturbation, low=0.0, high=MAX_PERTURBATION)
     own = _own_files(args.out)
     out = check_out_owned(args.out, own, "stickslip chain", overwrite=args.overwrite)

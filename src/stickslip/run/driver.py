@@ -41,6 +41,7 @@ from stickslip.models.params import ChainParams, ParameterError, check_number, s
 from stickslip.run import rundir
 
 # The checkpoint file helpers (read_npz, write_npz) are named here too, for checks of the files.
+from stickslip.run.budget import check_run_outputs
 from stickslip.run.checkpoint import (  # noqa: F401
     CHECKPOINT_FORMAT,
     Checkpointer,
@@ -156,6 +157,7 @@ def run_chain(
     """
     check_chain_params(params)
     options = _options(options, overrides, float(check_number("t_end", t_end, low=0.0, low_open=True)), params.dt)
+    check_run_outputs(params.N, params.dt, options)
     check_number("perturbation", perturbation, low=0.0)
     if isinstance(start, ChainState):
         check_start_state(start, params, t_end=options.t_end)
@@ -287,6 +289,7 @@ def resume_chain(
         options.t_end,
         params.dt,
     )
+    check_run_outputs(params.N, params.dt, options)
     outputs = _Outputs(params.N, options.profile_window is not None)
     outputs.parts = parts
     ckpt.since = {k: len(v) for k, v in parts.items()}
