@@ -397,7 +397,7 @@ def choose_s_min(S: Any, s_max: float | None = None, **candidates: Any) -> float
         s_min; the smallest S where there is no candidate (too few events).
     """
     scan = s_min_scan(S, s_max, **candidates)
-    scan = scan[np.isfinite(scan["ks_distance"])]
+    scan = scan[np.isfinite(scan["ks_distance"].to_numpy(dtype=np.float64))]  # an empty scan's column is object
     if scan.empty:
         values, _ = _positive_finite(S)
         return float(values.min())

@@ -172,30 +172,30 @@ class ChainRun:
         with run_dir_for_run(out_dir):
             return write_run(self, out_dir)
 
+    @property
+    def plot(self):
+        """This run's figures (:class:`stickslip.plotting.run.RunPlots`): ``run.plot.length()``,
+        ``.snapshot(t)``, ``.sizes()``, ``.fronts()``, each returning the Figure drawn in."""
+        from stickslip import accessors
+
+        return accessors.accessor("plot", self)
+
     def plot_length(self, *, ax=None):
         """L(t) against steady sliding: :func:`stickslip.plotting.length`; returns the Figure."""
-        from stickslip.plotting.run import length
-
-        return length(self, ax=ax)
+        return self.plot.length(ax=ax)
 
     def plot_snapshot(self, t: float | None = None, *, ax=None):
         """The final state (or the snapshot at ``t``) against steady sliding:
         :func:`stickslip.plotting.snapshot`; returns the Figure."""
-        from stickslip.plotting.run import snapshot
-
-        return snapshot(self, t, ax=ax)
+        return self.plot.snapshot(t, ax=ax)
 
     def plot_sizes(self, *, ax=None, bins: int = 30):
         """The slip-size distribution with its fit: :func:`stickslip.plotting.sizes`; returns the Figure."""
-        from stickslip.plotting.run import sizes
-
-        return sizes(self, ax=ax, bins=bins)
+        return self.plot.sizes(ax=ax, bins=bins)
 
     def plot_fronts(self, *, ax=None):
         """The rupture fronts of the largest events: :func:`stickslip.plotting.fronts`; returns the Figure."""
-        from stickslip.plotting.run import fronts
-
-        return fronts(self, ax=ax)
+        return self.plot.fronts(ax=ax)
 
 
 class _Outputs:
