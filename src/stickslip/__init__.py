@@ -43,5 +43,11 @@ _LAZY = {
 
 __all__ = ["BlockParams", "ChainParams", "ParameterError", "__version__", *_LAZY]
 
+# A run's figures, lent by the plotting to the runs (``run.plot.sizes()``, ``run.plot_sizes()``)
+# from above the layers: stickslip.run never imports stickslip.plotting.
+from stickslip import accessors as _accessors  # noqa: E402
+
+_accessors.register("plot", "stickslip.plotting.run:RunPlots")
+
 
 __getattr__, __dir__ = lazy_names(__name__, _LAZY)

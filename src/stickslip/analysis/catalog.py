@@ -44,6 +44,38 @@ __all__ = [
 
 #: Fewest slips with S > 0 in the stationary window for a catalogue's fits.
 MIN_EVENTS = 50
+#: The most resamples of the bootstrap errors: with 1e5 the error of an error is 0.2%.
+MAX_BOOTSTRAP = 100_000
+#: The most synthetic catalogues of the goodness of fit: with 1e4, p is known to +-0.005.
+MAX_GOF_SIMS = 10_000
+#: The most magnitude bins of width dm over the catalogue's magnitudes: the completeness scan
+#: fits a b-value at each bin (work growing as the square of their number).
+MAX_MAGNITUDE_BINS = 10_000
+
+
+def check_counts(bootstrap: int, gof_sims: int, names: tuple[str, str] = ("bootstrap", "gof_sims")) -> None:
+    """Refuse counts of work that do not end in reasonable time (:data:`MAX_BOOTSTRAP`,
+    :data:`MAX_GOF_SIMS`; ParameterError in one line naming them as ``names`` says)."""
+    from stickslip.run.budget import check_count
+
+    check_count(names[0], bootstrap, MAX_BOOTSTRAP, "the errors' own errors are then 0.2%; more changes nothing")
+    check_count(names[1], gof_sims, MAX_GOF_SIMS, "p is then known to +-0.005; more changes nothing")
+
+
+def check_magnitude_bins(M: np.ndarray, dm: float) -> None:
+    """Refuse a bin ``dm`` that cuts the catalogue's magnitudes into more than
+    :data:`MAX_MAGNITUDE_BINS` bins, saying how many and what they would cost."""
+    if dm <= 0 or M.size == 0:
+        return
+    span = float(np.nanmax(M) - np.nanmin(M))
+    bins = span / dm + 1
+    if bins > MAX_MAGNITUDE_BINS:
+        raise ParameterError(
+            f"dm = {dm:g} cuts the magnitudes (from {float(np.nanmin(M)):.3g} to {float(np.nanmax(M)):.3g}) into "
+            f"{bins:.3g} bins, about {8 * bins / 2**30:.3g} GiB per scan of them and {bins:.3g} scans; "
+            f"at most {MAX_MAGNITUDE_BINS} bins: dm >= {span / (MAX_MAGNITUDE_BINS - 1):.2g} here"
+        )
+
 
 CATALOG_COLUMNS = ["event", "t_start", "duration", "S", "magnitude", "epicentre", "extent", "reach", "spans"]
 CATALOG_DOCS = {
@@ -287,9 +319,11 @@ def catalog_analysis(
     Raises
     ------
     ParameterError
-        For a run with fewer than ``min_events`` slips (one line).
+        For a run with fewer than ``min_events`` slips, or counts or a bin whose work cannot
+        finish (:data:`MAX_BOOTSTRAP`, :data:`MAX_GOF_SIMS`, :data:`MAX_MAGNITUDE_BINS`; one line).
     """
     check_catalog_options(dm, bootstrap, gof_sims, seed)
+    check_counts(bootstrap, gof_sims)
     if isinstance(run, (str, Path)):
         run = load_catalog_run(run)
     from stickslip.run.state import loading_warnings
@@ -302,6 +336,7 @@ def catalog_analysis(
             f"{len(positive)} slips with S > 0 at t >= {t_from:g} (the run's stationary window, "
             f"{len(run.events)} in all); a catalogue's fits need at least {min_events}: run longer"
         )
+    check_magnitude_bins(positive["magnitude"].to_numpy(dtype=np.float64), dm)
     p = run.params
     start = (run.start or {}).get("kind", "paper") if isinstance(run.start, dict) else "paper"
     from stickslip.models.presets import is_paper_run
@@ -361,7 +396,10 @@ def catalog_analysis(
         cat.candidates = comparison.pop("objects")
         summary["distributions"] = comparison
         if gof_sims > 0:
-            summary["goodness_of_fit"] = power_law_gof(S, fit.s_max, sims=gof_sims, seed=seed)
+            try:
+                summary["goodness_of_fit"] = power_law_gof(S, fit.s_max, sims=gof_sims, seed=seed)
+            except ValueError as exc:
+                summary["goodness_of_fit"] = {"reason": f"no fit: {exc}"}
         else:
             summary["goodness_of_fit"] = {"reason": "not computed (gof_sims = 0)"}
     else:

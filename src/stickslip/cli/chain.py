@@ -269,8 +269,12 @@ def run_chain_command(args: argparse.Namespace) -> Result:
         raise CommandError("--overwrite needs --out (a run without a run directory writes nothing to replace)")
     interval = 300.0 if args.checkpoint_interval is None else args.checkpoint_interval
     options = run_options_from_args(args, t_end)
-    # Validate every option before anything is written, where run_chain does (one place).
+    # Validate every option before anything is written, where run_chain does (one place), and
+    # refuse outputs no machine can hold.
     options.validated(params.dt, spell=run_option_spelling)
+    from stickslip.run.budget import check_run_outputs
+
+    check_run_outputs(params.N, params.dt, options)
     check_number("perturbation", args.perturbation, low=0.0, high=MAX_PERTURBATION)
     own = _own_files(args.out)
     out = check_out_owned(args.out, own, "stickslip chain", overwrite=args.overwrite)
@@ -283,6 +287,8 @@ def run_chain_command(args: argparse.Namespace) -> Result:
             raise CommandError(f"{out} already holds a finished run; choose another --out or give --overwrite")
     try:
         with owned_out_dir(out, own, "stickslip chain", overwrite=args.overwrite, run_id=True) as out:
+            if args.overwrite:
+                _remove_derived(out)
             # The command's own defaults: a progress bar on any terminal, checkpoints every
             # `interval` and on signals where it writes, into the folder it owns.
             options = dataclasses.replace(
@@ -313,15 +319,31 @@ def run_chain_command(args: argparse.Namespace) -> Result:
 
 
 def _own_files(out: str | None):
-    """What `chain` treats as its own in ``--out``: a run's files, and the figures `stickslip plot`
-    drew from that run into RUN_DIR/figures (``--overwrite`` replaces them with the run)."""
-    from stickslip.run.ownership import PLOT_FOLDER, only_plot_files
+    """What `chain` treats as its own in ``--out``: a run's files, the figures `stickslip plot`
+    drew from that run into RUN_DIR/figures and the catalogue `stickslip catalog` wrote into
+    RUN_DIR/catalog (``--overwrite`` removes them with the run they were read from; either folder
+    holding other files too is left alone)."""
+    from stickslip.run.ownership import CATALOG_FOLDER, PLOT_FOLDER, only_catalog_files, only_plot_files
     from stickslip.run.rundir import OWN_FILES
 
     if out is None:
         return OWN_FILES
-    folder = Path(out) / PLOT_FOLDER
-    return lambda name: name in OWN_FILES or (name == PLOT_FOLDER and only_plot_files(folder))
+    figures, catalog = Path(out) / PLOT_FOLDER, Path(out) / CATALOG_FOLDER
+    return lambda name: (
+        name in OWN_FILES
+        or (name == PLOT_FOLDER and only_plot_files(figures))
+        or (name == CATALOG_FOLDER and only_catalog_files(catalog))
+    )
+
+
+def _remove_derived(out: Path) -> None:
+    """With ``--overwrite``: the figures and catalogue of the replaced run that a folder of them
+    holding other files too still had (those other files stay)."""
+    from stickslip.run.ownership import CATALOG_FILES, CATALOG_FOLDER, PLOT_FILE, PLOT_FOLDER, remove_own_files
+
+    for folder, own in ((PLOT_FOLDER, PLOT_FILE.fullmatch), (CATALOG_FOLDER, CATALOG_FILES.__contains__)):
+        if (out / folder).is_dir():
+            remove_own_files(out / folder, own)
 
 
 def _first_look(params, args, start: str):

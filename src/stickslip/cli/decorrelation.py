@@ -95,6 +95,7 @@ def run(params, args: argparse.Namespace) -> Result:
         SIZE_RTOL,
         GridSequences,
         LocatedSequences,
+        check_slips,
         sequence_decorrelation,
     )
 
@@ -102,6 +103,7 @@ def run(params, args: argparse.Namespace) -> Result:
     events = int(check_number("events", args.events if args.events is not None else EVENTS, low=1, integer=True))
     seeds = int(check_number("seeds", args.seeds if args.seeds is not None else 1, low=1, integer=True))
     rtol = float(check_number("rtol", args.rtol if args.rtol is not None else SIZE_RTOL, low=0.0, low_open=True))
+    check_slips(events, seeds, len(deltas))  # before the transient is run
     perturb = args.perturb or "state"
     steps_for(args.transient, params.dt, "transient")  # before any work, named as given
     t_max = None

@@ -5,7 +5,14 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from stickslip.cli._common import CommandError, Result, add_json_option, add_overwrite_option, owned_out_dir
+from stickslip.cli._common import (
+    CommandError,
+    Result,
+    add_json_option,
+    add_overwrite_option,
+    owned_out_dir,
+)
+from stickslip.cli._reading import reading_run_dir
 
 # The figures `plot` draws (stickslip.plotting.run.run_figures); its --out may hold only these.
 
@@ -50,12 +57,13 @@ def run_plot_command(args: argparse.Namespace) -> Result:
             "their own (default RUN_DIR/figures)"
         )
     formats = tuple(dict.fromkeys(args.format or ("png", "pdf")))
-    try:
-        run = load_run(run_dir)
-    except RunDirDamaged as exc:
-        raise CommandError(f"cannot plot {run_dir}: {exc}") from None
-    with owned_out_dir(out, _FIGURE.fullmatch, "stickslip plot", overwrite=args.overwrite) as out:
-        records = draw_run_figures(run, out, formats=formats)
+    with reading_run_dir(run_dir):  # a run writing into it (chain --resume) and the figures exclude each other
+        try:
+            run = load_run(run_dir)
+        except RunDirDamaged as exc:
+            raise CommandError(f"cannot plot {run_dir}: {exc}") from None
+        with owned_out_dir(out, _FIGURE.fullmatch, "stickslip plot", overwrite=args.overwrite) as out:
+            records = draw_run_figures(run, out, formats=formats)
     lines = []
     for r in records:
         if "files" in r:

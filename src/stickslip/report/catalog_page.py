@@ -18,15 +18,13 @@ from stickslip.analysis.catalog import CATALOG_DOCS, Catalog
 from stickslip.pages import image_src, write_page
 from stickslip.plotting.catalog import catalog_figures
 from stickslip.plotting.style import FIGURE_FORMATS, save_figure
+from stickslip.run.ownership import CATALOG_FIGURES, CATALOG_FILES
 
 __all__ = ["write_catalog", "catalog_statements", "CATALOG_FILES", "FIGURE_STEMS"]
 
-FIGURE_STEMS = ("frequency_magnitude", "ccdf", "recurrence", "moment_rate")
-#: Every file ``stickslip catalog`` may write into its folder.
-CATALOG_FILES = frozenset(
-    {"catalog.parquet", "catalog.csv", "moment_rate.parquet", "moment_rate.csv", "catalog.json", "index.html"}
-    | {f"{stem}.{fmt}" for stem in FIGURE_STEMS for fmt in ("png", "pdf", "svg")}
-)
+#: The figures, and every file ``stickslip catalog`` may write into its folder (named with the run
+#: directory's files, :mod:`stickslip.run.ownership`, so that a chain run knows them).
+FIGURE_STEMS = CATALOG_FIGURES
 
 
 def _g(x: Any, digits: int = 3) -> str:

@@ -41,7 +41,14 @@ from stickslip.models.params import ChainParams, ParameterError, check_number, s
 from stickslip.run import rundir
 
 # The checkpoint file helpers (read_npz, write_npz) are named here too, for checks of the files.
-from stickslip.run.checkpoint import CHECKPOINT_FORMAT, Checkpointer, read_npz, write_npz  # noqa: F401
+from stickslip.run.budget import check_run_outputs
+from stickslip.run.checkpoint import (  # noqa: F401
+    CHECKPOINT_FORMAT,
+    Checkpointer,
+    read_npz,
+    remove_checkpoint,
+    write_npz,
+)
 from stickslip.run.errors import ChainRunError, Interrupted, NonFiniteState, ShortRunWarning
 from stickslip.run.loop import (  # _Kernel named here too, for tests that count its calls
     CheckedAdvance,
@@ -157,6 +164,7 @@ def run_chain(
     """
     check_chain_params(params)
     options = _options(options, overrides, float(check_number("t_end", t_end, low=0.0, low_open=True)), params.dt)
+    check_run_outputs(params.N, params.dt, options)
     check_number("perturbation", perturbation, low=0.0)
     if isinstance(start, ChainState):
         check_start_state(start, params, t_end=options.t_end)
@@ -294,6 +302,7 @@ def resume_chain(
         options.t_end,
         params.dt,
     )
+    check_run_outputs(params.N, params.dt, options)
     outputs = _Outputs(params.N, options.profile_window is not None)
     outputs.parts = parts
     ckpt.since = {k: len(v) for k, v in parts.items()}
@@ -316,8 +325,6 @@ def continue_or_run(
     (:func:`run_chain` with ``options``); an unusable checkpoint is removed. A point of a study
     or reproduction that is killed so loses at most ``checkpoint_interval`` seconds; one stopped
     through ``stop_requested`` loses nothing."""
-    import shutil
-
     ckpt = Checkpointer(Path(run_dir))
     with rundir.owned_by_caller(run_dir):  # a point's folder: the study or sweep owns it
         if ckpt.state_path.is_file():
@@ -329,7 +336,7 @@ def continue_or_run(
                     stop_requested=stop_requested,
                 )
             except ChainRunError:
-                shutil.rmtree(ckpt.dir, ignore_errors=True)
+                remove_checkpoint(run_dir)  # a file of the user's there stays
         return run_chain(
             params,
             t_end,
@@ -445,11 +452,6 @@ class Stepper:
 
 
 def drop_checkpoint(run_dir: str | Path) -> None:
-    """Remove the checkpoint of a finished run (its results are in the run directory)."""
-    import shutil
-
-    path = Path(run_dir) / "checkpoint"
-    # The state file first: a kill part way leaves no checkpoint that lists missing parts.
-    (path / "state.npz").unlink(missing_ok=True)
-    if path.is_dir():
-        shutil.rmtree(path)
+    """Remove the checkpoint of a finished run (its results are in the run directory); a file
+    there that is not the checkpoint's stays (:func:`~stickslip.run.checkpoint.remove_checkpoint`)."""
+    remove_checkpoint(run_dir)

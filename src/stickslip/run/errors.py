@@ -17,6 +17,11 @@ class NonFiniteState(ChainRunError, ArithmeticError):
     :class:`ArithmeticError`, as the single block's :class:`NonFiniteBlock` is)."""
 
 
+class HookError(ChainRunError):
+    """A hook of the run loop broke its contract (:class:`~stickslip.run.loop.Hook`); the message
+    names the hook, the method and what it returned."""
+
+
 class Interrupted(Exception):
     """A run was stopped by a signal after writing its checkpoint."""
 

@@ -175,40 +175,38 @@ class ChainRun:
         with run_dir_for_run(out_dir, overwrite=overwrite):
             return write_run(self, out_dir)
 
-    # The plot_* methods draw into a new Figure and return it, or, given ``ax``, draw there and
-    # return that Axes, as pandas' and seaborn's plots on an ``ax`` do.
+    @property
+    def plot(self):
+        """This run's figures (:class:`stickslip.plotting.run.RunPlots`): ``run.plot.length()``,
+        ``.snapshot(t)``, ``.sizes()``, ``.fronts()``, each returning the Figure drawn in."""
+        from stickslip import accessors
+
+        return accessors.accessor("plot", self)
 
     def plot_length(self, *, ax=None):
         """L(t) against steady sliding: :func:`stickslip.plotting.length`; returns the Figure
         (the Axes ``ax`` when given)."""
-        from stickslip.plotting.run import length
-
-        return _drawn(length(self, ax=ax), ax)
+        return _drawn(self.plot.length(ax=ax), ax)
 
     def plot_snapshot(self, t: float | None = None, *, ax=None):
         """The final state (or the snapshot at ``t``) against steady sliding:
         :func:`stickslip.plotting.snapshot`; returns the Figure (the Axes ``ax`` when given)."""
-        from stickslip.plotting.run import snapshot
-
-        return _drawn(snapshot(self, t, ax=ax), ax)
+        return _drawn(self.plot.snapshot(t, ax=ax), ax)
 
     def plot_sizes(self, *, ax=None, bins: int = 30):
         """The slip-size distribution with its fit: :func:`stickslip.plotting.sizes`; returns the
         Figure (the Axes ``ax`` when given)."""
-        from stickslip.plotting.run import sizes
-
-        return _drawn(sizes(self, ax=ax, bins=bins), ax)
+        return _drawn(self.plot.sizes(ax=ax, bins=bins), ax)
 
     def plot_fronts(self, *, ax=None):
         """The rupture fronts of the largest events: :func:`stickslip.plotting.fronts`; returns the
         Figure (the Axes ``ax`` when given)."""
-        from stickslip.plotting.run import fronts
-
-        return _drawn(fronts(self, ax=ax), ax)
+        return _drawn(self.plot.fronts(ax=ax), ax)
 
 
 def _drawn(fig, ax):
-    """What a ``plot_*`` method returns: the Axes it was given, else the new Figure."""
+    """What a ``plot_*`` method returns: the Axes it was given, else the new Figure (as pandas'
+    and seaborn's plots on an ``ax`` do)."""
     return fig if ax is None else ax
 
 

@@ -28,6 +28,14 @@ RUN_ID_FILE = ".run_id"
 #: (:func:`stickslip.plotting.run.run_figures`): the run owns that folder while it holds only these.
 PLOT_FOLDER = "figures"
 PLOT_FILE = re.compile(r"(length|snapshot_final|snapshot_t[^/]*|sizes|fronts)\.(png|pdf|svg)")
+#: Where ``stickslip catalog`` writes a run's catalogue by default (RUN_DIR/catalog), its figures
+#: and every file it may write there: the run owns that folder while it holds only these.
+CATALOG_FOLDER = "catalog"
+CATALOG_FIGURES = ("frequency_magnitude", "ccdf", "recurrence", "moment_rate")
+CATALOG_FILES = frozenset(
+    {"catalog.parquet", "catalog.csv", "moment_rate.parquet", "moment_rate.csv", "catalog.json", "index.html"}
+    | {f"{stem}.{fmt}" for stem in CATALOG_FIGURES for fmt in ("png", "pdf", "svg")}
+)
 
 
 def only_plot_files(folder: str | Path) -> bool:
@@ -37,6 +45,15 @@ def only_plot_files(folder: str | Path) -> bool:
     if not folder.is_dir():
         return False
     return all(PLOT_FILE.fullmatch(p.name) or is_temporary(p.name) for p in folder.iterdir())
+
+
+def only_catalog_files(folder: str | Path) -> bool:
+    """Whether ``folder`` is a directory holding nothing but what ``stickslip catalog`` writes
+    (:data:`CATALOG_FILES`; and files of a killed write, the lock of one writing it)."""
+    folder = Path(folder)
+    if not folder.is_dir():
+        return False
+    return all(p.name in CATALOG_FILES or p.name in LOCK_FILES or is_temporary(p.name) for p in folder.iterdir())
 
 
 #: The files and folders a chain run writes into its run directory.
@@ -181,9 +198,12 @@ def owned_run_dir(
 
         record = {"pid": os.getpid(), "host": socket.gethostname(), "since": time.strftime("%Y-%m-%dT%H:%M:%S")}
         write_bytes(info, json.dumps(record).encode())
-        for stale in run_dir.glob(".*.tmp"):  # left by a write that was killed
+        for stale in run_dir.glob(".*.tmp"):  # left by a write that was killed (a file, or a staging folder)
             with contextlib.suppress(OSError):
-                stale.unlink()
+                if stale.is_dir() and not stale.is_symlink():
+                    shutil.rmtree(stale)
+                else:
+                    stale.unlink()
         if not run_id:
             yield None
             return

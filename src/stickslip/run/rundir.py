@@ -10,6 +10,7 @@ files it may replace, :mod:`stickslip.run.ownership`. Both are named here too.
 
 from __future__ import annotations
 
+import hashlib
 import json
 from pathlib import Path
 
@@ -79,7 +80,8 @@ def _read(path: Path, reader):
 def load_run(run_dir: str | Path) -> ChainRun:
     """Read a run directory written by :func:`write_run` back into a :class:`ChainRun`; a
     missing or damaged file raises :class:`RunDirDamaged` naming it (a missing folder or file
-    :class:`RunDirMissing`, which is also a :class:`FileNotFoundError`).
+    :class:`RunDirMissing`, which is also a :class:`FileNotFoundError`), and so does a state.nc
+    whose final state no longer has the SHA-256 (``state_sha256``) its run.json records.
 
     Parameters
     ----------
@@ -116,12 +118,30 @@ def load_run(run_dir: str | Path) -> ChainRun:
         ) from None
 
 
+def _state_file_sha256(ds: xr.Dataset) -> str:
+    """SHA-256 of a state.nc's final state, over its arrays as stored and in the order of
+    :meth:`~stickslip.run.state.ChainState.sha256` (x, v, theta as float64 little-endian, then
+    stopped one byte each), so that it equals the ``state_sha256`` its run.json records."""
+    h = hashlib.sha256()
+    for name in ("x", "v", "theta"):
+        h.update(np.ascontiguousarray(ds[name].values, dtype="<f8").tobytes())
+    h.update((np.asarray(ds["stopped"].values) != 0).astype(np.uint8).tobytes())
+    return h.hexdigest()
+
+
 def _load_run(run_dir: Path) -> ChainRun:
     from stickslip import io
 
     meta = _read(run_dir / "run.json", io.read_json)
     ds = _read(run_dir / "state.nc", io.read_dataset)
     params = ChainParams(**meta["params"])
+    recorded = meta["summary"].get("state_sha256")
+    if isinstance(recorded, str) and _state_file_sha256(ds) != recorded:
+        # state.nc replaced or edited after the run: its state is not the one the run ended on
+        raise RunDirDamaged(
+            f"{run_dir / 'state.nc'} does not hold the final state its run.json records "
+            f"(state_sha256 {recorded[:16]}...): the file was changed after the run"
+        )
     state = ChainState.from_blocks(
         ds["x"].values, ds["v"].values, ds["theta"].values, ds["stopped"].values.astype(bool)
     )

@@ -249,8 +249,9 @@ def findings(spec: Study, results: Results | None) -> dict[str, Any]:
 def figures(spec: Study, results: Results | None, page_dir: Path) -> list[tuple]:
     """Figs. 1-4, the stability map and the hysteresis sweep, with their data beside them."""
     from stickslip.plotting.figures import section2_figures
+    from stickslip.report import commands
 
-    return section2_figures(results.outcomes, page_dir) if results else []
+    return section2_figures(results.outcomes, page_dir, commands) if results else []
 
 
 def describe() -> str:

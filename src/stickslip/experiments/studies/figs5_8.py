@@ -141,8 +141,11 @@ def findings(spec: Study, results: Results | None) -> dict[str, Any]:
 def figures(spec: Study, results: Results | None, page_dir: Path) -> list[tuple]:
     """Figs. 5-8, with their data beside them (:func:`stickslip.plotting.figures.chain_figures`)."""
     from stickslip.plotting.figures import chain_figures
+    from stickslip.report import commands
 
-    return chain_figures(results.outcomes["chain-runs"], results.analysis, page_dir, results.mode) if results else []
+    if not results:
+        return []
+    return chain_figures(results.outcomes["chain-runs"], results.analysis, page_dir, results.mode, commands)
 
 
 def describe() -> str:
