@@ -99,7 +99,21 @@ def truncated_mle(mean_log: float, span: float) -> float:
 
 
 def fit_failure(mean_log: float, span: float) -> str:
-    """Why :func:`truncated_mle` has no tau for this mean of log(S/s_min) on a range of ``span``, in words."""
+    """Why :func:`truncated_mle` has no tau for this sample of the doubly truncated power law.
+
+    Parameters
+    ----------
+    mean_log : float
+        The sample's mean of log(S / s_min).
+    span : float
+        log(s_max / s_min), the width of the fitted range.
+
+    Returns
+    -------
+    str
+        The reason in words: every event at one end of the range, or the likelihood's maximum
+        outside :data:`TAU_BRACKET`.
+    """
     if mean_log <= 0.0:
         return "every event in range is at s_min: the likelihood has no maximum"
     if mean_log >= span:
