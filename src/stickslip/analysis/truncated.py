@@ -29,6 +29,18 @@ def mean_log_ratio(e: float, span: float) -> float:
 
     u = log(S/s_min) has density proportional to exp(e u) on [0, span] (a truncated
     exponential), whose mean is span / (1 - exp(-e span)) - 1/e, span/2 at e = 0.
+
+    Parameters
+    ----------
+    e : float
+        1 - tau.
+    span : float
+        log(s_max / s_min) > 0.
+
+    Returns
+    -------
+    float
+        The mean of log(S / s_min), finite for any e.
     """
     x = e * span
     if abs(x) < _SERIES:
@@ -42,6 +54,18 @@ def var_log_ratio(e: float, span: float) -> float:
 
     For the truncated exponential density of u on [0, span]: 1/e^2 - span^2 e^{x} / (e^{x} - 1)^2
     with x = e span, span^2/12 at e = 0.
+
+    Parameters
+    ----------
+    e : float
+        1 - tau.
+    span : float
+        log(s_max / s_min) > 0.
+
+    Returns
+    -------
+    float
+        The variance of log(S / s_min), finite for any e.
     """
     x = e * span
     if abs(x) < 1e-4:
@@ -52,7 +76,21 @@ def var_log_ratio(e: float, span: float) -> float:
 
 
 def log_normaliser(tau: float, s_min: float, s_max: float) -> float:
-    """log Z(tau), Z = integral of S^-tau over [s_min, s_max] (s_max may be inf for tau > 1)."""
+    """log Z(tau), Z = integral of S^-tau over [s_min, s_max]: the normaliser of the truncated
+    power law of Figs. 7, 8.
+
+    Parameters
+    ----------
+    tau : float
+        The exponent (tau > 1 when ``s_max`` is infinite).
+    s_min, s_max : float
+        The range, 0 < s_min < s_max <= inf.
+
+    Returns
+    -------
+    float
+        log Z, written to stay finite for large |(1 - tau) log(s_max / s_min)|.
+    """
     e = 1.0 - tau
     if math.isinf(s_max):
         return e * math.log(s_min) - math.log(-e)
@@ -82,6 +120,18 @@ def truncated_mle(mean_log: float, span: float) -> float:
     Brent's method and checked: the score at the root (the gradient of the log-likelihood per
     event) vanishes to rounding. NaN where the maximum is not inside the bracket (or all
     events sit at one end of the range, where there is no interior maximum).
+
+    Parameters
+    ----------
+    mean_log : float
+        The sample's mean of log(S / s_min).
+    span : float
+        log(s_max / s_min).
+
+    Returns
+    -------
+    float
+        The maximum-likelihood tau, or NaN (:func:`fit_failure` says why).
     """
     if not 0.0 < mean_log < span:
         return math.nan
