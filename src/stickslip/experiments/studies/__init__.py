@@ -12,7 +12,8 @@ N grows (``transition``), the final state and m over (alpha, beta) and (D, beta)
 (``phase-diagram``), the slip-size exponent tau (``exponents``), whether the chain is chaotic
 at the onset (``chaos``) and how long its irregular motion lasts against N (``lifetimes``).
 :data:`PAPER` are the paper's own figures and stated numbers, each with one page: the single
-block of section 2 and the Fourier modes of Fig. 4 (``figs1-4``) and the chain runs of section 3 (``figs5-8``); ``stickslip reproduce`` gathers them into one report
+block of section 2 and the Fourier modes of Fig. 4 (``figs1-4``) and the chain runs of section 3
+(``figs5-8``); ``stickslip reproduce`` gathers them into one report
 (:mod:`stickslip.experiments.reproduce`).
 
 A :class:`Study`'s key hashes its name, the settings every point shares and the package version
