@@ -253,6 +253,11 @@ def line_fit(x: Any, y: Any, y_err: Any) -> dict[str, Any]:
     }
 
 
+def _exp(x: float) -> float:
+    """exp(x), inf beyond the largest float (an extrapolation of exponential growth can be)."""
+    return math.exp(x) if x < 709.0 else math.inf
+
+
 def _extrapolate(fit: dict[str, Any], x: float) -> tuple[float, float]:
     """ln T at ``x`` on a line fit, and its standard error from the covariance."""
     cov = np.asarray(fit["cov"])
@@ -277,8 +282,9 @@ def size_fits(N: Any, mean: Any, mean_err: Any, *, extrapolate_to: float | None 
     -------
     dict
         ``exponential`` and ``power``: the :func:`line_fit` of ln <T> on N and on ln N (slope: the
-        rate per block, or the exponent), with ``ln_T_at``, ``ln_T_at_err``, ``T_at`` and the 1 sigma
-        range ``T_at_low``, ``T_at_high`` where ``extrapolate_to`` is given; ``better``: the form
+        rate per block, or the exponent), with ``ln_T_at``, ``ln_T_at_err`` (and in decades
+        ``log10_T_at``, ``log10_T_at_err``), ``T_at`` and the 1 sigma range ``T_at_low``,
+        ``T_at_high`` (inf beyond the largest float) where ``extrapolate_to`` is given; ``better``: the form
         with the smaller chi-square (``exponential`` or ``power``; None with two points).
 
     Examples
@@ -306,9 +312,11 @@ def size_fits(N: Any, mean: Any, mean_err: Any, *, extrapolate_to: float | None 
             fit.update(
                 ln_T_at=ln_t,
                 ln_T_at_err=ln_err,
-                T_at=math.exp(ln_t),
-                T_at_low=math.exp(ln_t - ln_err),
-                T_at_high=math.exp(ln_t + ln_err),
+                log10_T_at=ln_t / math.log(10.0),
+                log10_T_at_err=ln_err / math.log(10.0),
+                T_at=_exp(ln_t),
+                T_at_low=_exp(ln_t - ln_err),
+                T_at_high=_exp(ln_t + ln_err),
                 at=float(extrapolate_to),
             )
         out[name] = fit

@@ -32,10 +32,13 @@ def survival_figure(curves: list[dict[str, Any]]) -> Figure:
     for ax, beta in zip(flat, betas, strict=False):
         for c in sorted((c for c in curves if c["beta"] == beta), key=lambda c: c["N"]):
             km = c["km"]
-            t = np.concatenate([[0.0], km["t"].to_numpy(float)])
+            t = km["t"].to_numpy(float)
+            positive = t[t > 0]
+            # S = 1 from a little before the first lifetime (a log axis has no t = 0)
+            t = np.concatenate([[positive.min() / 2 if positive.size else 1.0], np.maximum(t, 1e-300)])
             s = np.concatenate([[1.0], km["survival"].to_numpy(float)])
             ax.step(t, s, where="post", color=colours[c["N"]], lw=1.0, label=f"N = {c['N']}")
-        ax.set_xscale("symlog", linthresh=1e3)
+        ax.set_xscale("log")
         ax.set_ylim(-0.02, 1.02)
         ax.set_title(f"beta = {beta:g}", fontsize=8)
         ax.set_xlabel("t since the start")
@@ -71,7 +74,7 @@ def lifetime_figure(points: list[dict[str, Any]], fits: list[dict[str, Any]]) ->
             ax.plot([p["N"] for p in bound], [p["mean_T_low95"] for p in bound], "^", color=colour, ms=5, mfc="none")
         fit = next((f for f in fits if f["beta"] == beta and "exponential" in f), None)
         if fit is not None:
-            n = np.linspace(min(fit["Ns"]), max(p["N"] for p in mine), 50)
+            n = np.linspace(min(fit["Ns"]), max(fit["Ns"]), 50)  # over the N fitted only
             e, pw = fit["exponential"], fit["power"]
             ax.plot(n, np.exp(e["intercept"] + e["slope"] * n), color=colour, lw=1.0)
             ax.plot(n, np.exp(pw["intercept"] + pw["slope"] * np.log(n)), color=colour, lw=1.0, ls="--")

@@ -181,8 +181,9 @@ def _groups(table: pd.DataFrame):
 
 
 def per_point(table: pd.DataFrame) -> list[dict[str, Any]]:
-    """Per beta and N: the starts, ended and censored lifetimes, <T> of the exponential law with its
-    error or its lower bound, the median of the Kaplan-Meier curve, the Weibull test and the
+    """Per beta and N: the starts, ended and censored lifetimes, <T> of the exponential law (the
+    sample mean where none was censored) with its error (the sample's where none was censored)
+    or its lower bound, the median of the Kaplan-Meier curve, the Weibull test and the
     periods reached."""
     from stickslip.analysis.survival import exponential_fit, kaplan_meier
 
@@ -203,7 +204,12 @@ def per_point(table: pd.DataFrame) -> list[dict[str, Any]]:
                 "steady": int((g["end"] == "steady").sum()),
                 "budget": float(g["budget"].max()),
                 "mean_T": fit.mean if fit.ended else None,
-                "mean_T_err": fit.mean_err if fit.ended else None,
+                # every lifetime seen: the sample's standard error (the lifetimes need not be
+                # exponential); else the exponential law's, tau / sqrt(ended)
+                "mean_T_err": (float(np.std(T, ddof=1) / np.sqrt(T.size)) if T.size > 1 else None)
+                if ended.all()
+                else (fit.mean_err if fit.ended else None),
+                "mean_T_err_exponential": fit.mean_err if fit.ended else None,
                 "mean_T_low95": fit.tau_low,
                 "median_T": float(below["t"].iloc[0]) if len(below) else None,
                 "weibull_shape": fit.weibull_shape,
@@ -261,13 +267,20 @@ def conclusions(spec: Study | None, table: pd.DataFrame) -> dict[str, Any]:
             say(f"beta = {f['beta']:g}: fewer than two N with two ended lifetimes; no fit of <T> against N.")
             continue
         e, pw = f["exponential"], f["power"]
-        better = f" ({f['better']} fits better: chi2 {e['chi2']:.3g} against {pw['chi2']:.3g})" if f["better"] else ""
+        chi = f"chi2 {e['chi2']:.3g} against {pw['chi2']:.3g} for {e['dof']} degrees of freedom"
+        if f["better"] is None:
+            better = ""
+        elif abs(e["chi2"] - pw["chi2"]) < 4.0:  # a likelihood ratio below e^2: no clear choice
+            better = f" (neither fits clearly better: {chi})"
+        else:
+            better = f" ({f['better']} fits better: {chi})"
         say(
             f"beta = {f['beta']:g}, N = {', '.join(map(str, f['Ns']))}: ln <T> = a + b N with "
             f"b = {e['slope']:.3g} +- {e['slope_err']:.2g}; ln <T> = a + c ln N with c = {pw['slope']:.3g} +- "
             f"{pw['slope_err']:.2g}{better}. Extrapolated to N = {PAPER_N}: exponential "
-            f"<T> ~ {e['T_at']:.3g} (1 sigma {e['T_at_low']:.3g} .. {e['T_at_high']:.3g}), power law "
-            f"{pw['T_at']:.3g} ({pw['T_at_low']:.3g} .. {pw['T_at_high']:.3g})."
+            f"<T> ~ 10^({e['log10_T_at']:.1f} +- {e['log10_T_at_err']:.1f}), power law "
+            f"10^({pw['log10_T_at']:.2f} +- {pw['log10_T_at_err']:.2f}) = {pw['T_at']:.3g} "
+            f"(1 sigma {pw['T_at_low']:.3g} .. {pw['T_at_high']:.3g})."
         )
     return out
 
@@ -322,7 +335,7 @@ def describe() -> str:
         "(censored). Per N and beta: Kaplan-Meier survival, <T> of the exponential law of censored "
         "lifetimes, the Weibull test, the periods reached; per beta the fits of ln <T> on N and on "
         f"ln N and the extrapolation to N = {PAPER_N}. Grid: --quick {quick.note.split(': ', 1)[1]} "
-        f"({len(quick.points)} points, about 10 minutes on two cores); --full "
+        f"({len(quick.points)} points, about 11 minutes on two cores shared with other work); --full "
         f"{full.note.split(': ', 1)[1]} ({len(full.points)} points, about an hour and a half on two "
         "cores). Outputs in DIR/lifetimes/: table.parquet and table.csv (one row per start: lifetime, "
         "ended, period), survival and lifetime_vs_N (PNG, PDF), study.json, index.html."
