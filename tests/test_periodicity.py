@@ -165,3 +165,24 @@ def test_the_commands(tmp_path, capsys):
     assert code == 2 and "repeats" in stderr and len(stderr.strip().splitlines()) <= 2
     code, _, stderr = run_cli(capsys, "period", str(tmp_path / "none"))
     assert code == 2 and "not a finished chain run directory" in stderr
+
+
+def test_a_resumed_run_reads_the_slips_of_its_checkpoint(tmp_path):
+    from stickslip.run.driver import resume_chain
+    from stickslip.run.errors import Interrupted
+
+    params = stickslip.chain_params(N=5)
+    calls = []
+
+    def stop_soon():  # asked after each kernel call: stop after a few, long before the orbit
+        calls.append(1)
+        return len(calls) == 3
+
+    with pytest.raises(Interrupted):
+        stickslip.run_chain(params, 1e6, out_dir=tmp_path / "run", stop_requested=stop_soon, progress=False)
+    hook = PeriodicStop()
+    run = resume_chain(tmp_path / "run", hooks=[hook])
+    assert hook.result is not None and hook.result.settled_from_slip > 0
+    whole = periodicity(stickslip.run_chain(params, 1e6, progress=False).events)
+    assert (hook.result.period_slips, hook.result.settled_from_slip) == (16, whole.settled_from_slip)
+    assert run.summary["t_reached"] < 1e6
