@@ -47,6 +47,12 @@ def register(sub) -> None:
     )
     # What the run records, its integrator, --out, checkpoints, progress: RunOptions' fields.
     add_run_options(p)
+    p.add_argument(
+        "--until-periodic",
+        action="store_true",
+        help="stop once the slip sequence is periodic (the rule of `stickslip period`, its defaults); "
+        "prints the period and the slip and time from which the sequence repeats",
+    )
     add_json_option(p)
     p.set_defaults(handler=run_chain_command)
 
@@ -198,6 +204,7 @@ _FIXED_BY_CHECKPOINT = ("from_dir", "start", "perturbation", "seed", *run_option
 def run_chain_command(args: argparse.Namespace) -> Result:
     """Handler of `stickslip chain`."""
     progress = not args.no_progress
+    periodic = _periodic_hook(args)
     if args.resume is not None:
         from stickslip.run import driver as chain
         from stickslip.run.rundir import RunDirBusy, owned_run_dir
@@ -233,6 +240,7 @@ def run_chain_command(args: argparse.Namespace) -> Result:
                     progress=progress,
                     handle_signals=True,
                     keep_checkpoint=args.keep_checkpoint,
+                    hooks=periodic,
                 )
         except RunDirBusy as exc:
             raise CommandError(str(exc)) from None
@@ -243,8 +251,12 @@ def run_chain_command(args: argparse.Namespace) -> Result:
             raise CommandError(str(exc)) from None
         except chain.Interrupted as exc:
             return _interrupted(exc, Path(args.resume))
-        return Result(
-            _json_summary(run.summary, Path(args.resume)), _summary_text(run.summary, Path(args.resume), run.params.N)
+        return _with_period(
+            Result(
+                _json_summary(run.summary, Path(args.resume)),
+                _summary_text(run.summary, Path(args.resume), run.params.N),
+            ),
+            periodic,
         )
 
     params = chain_params_from_args(args)  # a bad parameter is refused before the engine loads
@@ -298,6 +310,7 @@ def run_chain_command(args: argparse.Namespace) -> Result:
                 progress=progress,
                 handle_signals=out is not None,
                 run_id=read_run_id(out) if out else None,
+                hooks=periodic,
             )
             run = chain.run_chain(
                 params,
@@ -315,7 +328,30 @@ def run_chain_command(args: argparse.Namespace) -> Result:
     text = _summary_text(run.summary, out, params.N)
     if args.t_end is None:
         text = f"N              {params.N}  (without --t-end a first look; the paper's run is --t-end 2e7)\n" + text
-    return Result(_json_summary(run.summary, out), text)
+    return _with_period(Result(_json_summary(run.summary, out), text), periodic)
+
+
+def _periodic_hook(args: argparse.Namespace) -> list:
+    """With ``--until-periodic``, the hook that ends the run once its slips repeat
+    (:class:`~stickslip.analysis.periodicity.PeriodicStop`); else none."""
+    if not getattr(args, "until_periodic", False):
+        return []
+    from stickslip.analysis.periodicity import PeriodicStop
+
+    return [PeriodicStop()]
+
+
+def _with_period(result: Result, periodic: list) -> Result:
+    """The command's result with the periodicity found by ``--until-periodic`` (its ``periodicity``
+    in JSON, and lines of text)."""
+    if not periodic:
+        return result
+    hook = periodic[0]
+    found = hook.result if hook.result is not None else hook.finish()
+    result.data["periodicity"] = found.to_dict()
+    stop = "stopped: " if hook.result is not None else "ran to the end: "
+    result.text += "\n" + stop + found.text().replace("\n", "\n  ")
+    return result
 
 
 def _own_files(out: str | None):
