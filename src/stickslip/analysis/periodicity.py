@@ -105,8 +105,12 @@ class Periodicity:
         Slips in the sequence.
     t_last : float or None
         Start time of the last slip.
-    rtol, max_period, repeats : float, int, int
-        The rule's tolerance on S, the longest period asked for and the periods the stretch must hold.
+    rtol : float
+        The rule's relative tolerance on S.
+    max_period : int
+        The longest period asked for.
+    repeats : int
+        The periods the stretch must hold.
     longest_period_searched : int
         P = min(max_period, n_slips // repeats).
     rule : str

@@ -104,19 +104,31 @@ class ExponentialFit:
     ----------
     t_from : float
         Where the tail starts.
-    n, n_tail, ended : int
-        Lifetimes in all, those beyond ``t_from``, those of them that ended.
+    n : int
+        Lifetimes in all.
+    n_tail : int
+        Those beyond ``t_from``.
+    ended : int
+        Those of them that ended (d).
     exposure : float
         Total time lived beyond ``t_from``.
-    rate, rate_err : float
-        d / exposure and its standard error rate / sqrt(d) (NaN with d = 0).
-    tau, tau_err : float
-        1 / rate and its standard error tau / sqrt(d) (inf and NaN with d = 0).
-    tau_low, tau_high : float
-        The 95 % interval of tau (Poisson count d in the exposure); with d = 0, tau_low is the
-        one-sided 95 % lower bound exposure / 3.0 and tau_high is inf.
-    mean, mean_err : float
+    rate : float
+        d / exposure.
+    rate_err : float
+        Its standard error rate / sqrt(d) (NaN with d = 0).
+    tau : float
+        1 / rate (inf with d = 0).
+    tau_err : float
+        Its standard error tau / sqrt(d) (NaN with d = 0).
+    tau_low : float
+        The lower end of the 95 % interval of tau (Poisson count d in the exposure); with d = 0,
+        the one-sided 95 % lower bound exposure / 3.0.
+    tau_high : float
+        The upper end of that interval (inf with d = 0).
+    mean : float
         The mean lifetime the fit gives, t_from + tau (for t_from = 0 the censored-data mean).
+    mean_err : float
+        Its standard error.
     weibull_shape : float or None
         The Weibull law's shape k fitted to the same tail (None where fewer than 3 ended).
     exponential_p : float or None
