@@ -94,7 +94,7 @@ def test_extrapolation_of_non_finite_exponents_says_which():
 @pytest.fixture(scope="module")
 def run_dir(tmp_path_factory):
     out = tmp_path_factory.mktemp("damaged") / "run"
-    assert main(["chain", "--N", "20", "--t-end", "1e5", "--out", str(out), "--no-progress"]) == 0
+    assert main(["chain", "--model", "two-blocks", "--t-end", "2e4", "--out", str(out), "--no-progress"]) == 0
     return out
 
 
