@@ -35,12 +35,12 @@ def mean_log_ratio(e: float, span: float) -> float:
     e : float
         1 - tau.
     span : float
-        log(s_max / s_min) > 0.
+        log(s_max / s_min).
 
     Returns
     -------
     float
-        The mean of log(S / s_min), finite for any e.
+        The mean.
     """
     x = e * span
     if abs(x) < _SERIES:
@@ -60,12 +60,12 @@ def var_log_ratio(e: float, span: float) -> float:
     e : float
         1 - tau.
     span : float
-        log(s_max / s_min) > 0.
+        log(s_max / s_min).
 
     Returns
     -------
     float
-        The variance of log(S / s_min), finite for any e.
+        The variance.
     """
     x = e * span
     if abs(x) < 1e-4:
@@ -76,20 +76,19 @@ def var_log_ratio(e: float, span: float) -> float:
 
 
 def log_normaliser(tau: float, s_min: float, s_max: float) -> float:
-    """log Z(tau), Z = integral of S^-tau over [s_min, s_max]: the normaliser of the truncated
-    power law of Figs. 7, 8.
+    """log Z(tau), Z = integral of S^-tau over [s_min, s_max] (s_max may be inf for tau > 1).
 
     Parameters
     ----------
     tau : float
-        The exponent (tau > 1 when ``s_max`` is infinite).
+        The exponent.
     s_min, s_max : float
-        The range, 0 < s_min < s_max <= inf.
+        The range.
 
     Returns
     -------
     float
-        log Z, written to stay finite for large |(1 - tau) log(s_max / s_min)|.
+        log Z, finite for any tau and range.
     """
     e = 1.0 - tau
     if math.isinf(s_max):
@@ -124,14 +123,14 @@ def truncated_mle(mean_log: float, span: float) -> float:
     Parameters
     ----------
     mean_log : float
-        The sample's mean of log(S / s_min).
+        Mean of log(S / s_min) over the events in range.
     span : float
         log(s_max / s_min).
 
     Returns
     -------
     float
-        The maximum-likelihood tau, or NaN (:func:`fit_failure` says why).
+        tau, or NaN (:func:`fit_failure` says why).
     """
     if not 0.0 < mean_log < span:
         return math.nan
@@ -149,20 +148,19 @@ def truncated_mle(mean_log: float, span: float) -> float:
 
 
 def fit_failure(mean_log: float, span: float) -> str:
-    """Why :func:`truncated_mle` has no tau for this sample of the doubly truncated power law.
+    """Why :func:`truncated_mle` has no tau for this mean of log(S/s_min) on a range of ``span``.
 
     Parameters
     ----------
     mean_log : float
-        The sample's mean of log(S / s_min).
+        Mean of log(S / s_min) over the events in range.
     span : float
-        log(s_max / s_min), the width of the fitted range.
+        log(s_max / s_min).
 
     Returns
     -------
     str
-        The reason in words: every event at one end of the range, or the likelihood's maximum
-        outside :data:`TAU_BRACKET`.
+        The reason, in words.
     """
     if mean_log <= 0.0:
         return "every event in range is at s_min: the likelihood has no maximum"
