@@ -166,12 +166,6 @@ PRESETS: dict[str, Preset] = {
 }
 
 
-def _check_names() -> None:
-    from stickslip.models.params import MODELS
-
-    assert tuple(PRESETS) == MODELS, "ChainParams.model and the presets name the same models"
-
-
 def preset(name: str) -> Preset:
     """The preset called ``name``; a ValueError lists the presets."""
     if name not in PRESETS:
@@ -222,7 +216,6 @@ def build_chain_params(model: str = "sakaguchi", **overrides: Any):
     """:func:`chain_params` without the refusal of parameters the composition does not read."""
     from stickslip.models.params import ChainParams, ParameterError, check_number
 
-    _check_names()
     if not isinstance(model, str):
         raise ParameterError(f"model must be a preset's name, one of {', '.join(PRESETS)} (got {model!r})")
     try:
