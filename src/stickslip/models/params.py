@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from stickslip.models.pieces import Piece, piece
-from stickslip.models.presets import PRESETS
+from stickslip.models.preset_table import PRESETS
 
 
 class ParameterError(ValueError):
@@ -224,7 +224,7 @@ def scale_block(p: BlockParams) -> BlockParams:
     )
 
 
-#: The named models: the presets of :mod:`stickslip.models.presets`, in its order (written there once).
+#: The named models: the presets of :mod:`stickslip.models.preset_table`, in its order (written there once).
 MODELS = tuple(PRESETS)
 
 
