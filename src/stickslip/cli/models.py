@@ -20,7 +20,7 @@ def register(sub) -> None:
 
 def run_models_command(args: argparse.Namespace) -> Result:
     """Handler of `stickslip models`."""
-    from stickslip.models.pieces import PIECES
+    from stickslip.models.pieces import PIECES, RULES
     from stickslip.models.presets import PRESETS
 
     data = {
@@ -29,7 +29,7 @@ def run_models_command(args: argparse.Namespace) -> Result:
             kind: [{"name": p.name, "meaning": p.meaning, "reads": list(p.reads)} for p in choices]
             for kind, choices in PIECES.items()
         },
-        "rules": ["ends periodic needs drive plate", "threshold state needs friction state"],
+        "rules": list(RULES),
     }
     lines = []
     for pr in PRESETS.values():

@@ -166,6 +166,8 @@ class LocatedStepper:
     def __init__(self, params: ChainParams, capacity: int = 4096, form: str = "fast"):
         if form not in FORMS:
             raise ParameterError(f"form must be one of {', '.join(FORMS)} (got {form!r})")
+        if not params.drive_piece.located:
+            raise ParameterError(f"drive {params.drive} does not run on the located integrator (use the grid's)")
         self.form = form
         # A wall's ghost cells move with t in the drive's frame: the dense form, which the fast
         # form skips no work of there.
