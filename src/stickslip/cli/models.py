@@ -31,7 +31,7 @@ def per_block_names() -> list[str]:
 
 def run_models_command(args: argparse.Namespace) -> Result:
     """Handler of `stickslip models`."""
-    from stickslip.models.pieces import PIECES
+    from stickslip.models.pieces import PIECES, RULES
     from stickslip.models.presets import PRESETS
 
     data = {
@@ -40,7 +40,7 @@ def run_models_command(args: argparse.Namespace) -> Result:
             kind: [{"name": p.name, "meaning": p.meaning, "reads": list(p.reads)} for p in choices]
             for kind, choices in PIECES.items()
         },
-        "rules": ["ends periodic needs drive plate", "threshold state needs friction state"],
+        "rules": list(RULES),
         "per_block": per_block_names(),
     }
     lines = []

@@ -208,6 +208,11 @@ class PerBlock:
     def __len__(self) -> int:
         return int(self.values.size)
 
+    def __array__(self, dtype=None, copy=None) -> np.ndarray:
+        """The values at blocks 1..N, so that numpy reads a per-block parameter as its array
+        (the closed forms of :mod:`stickslip.models.physics` and the Jacobian take either)."""
+        return self.values if dtype is None else self.values.astype(dtype)
+
     def __eq__(self, other: object) -> bool:
         return isinstance(other, PerBlock) and other._sha == self._sha and other.values.size == self.values.size
 

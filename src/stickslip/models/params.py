@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from stickslip.models.pieces import Piece, piece
+from stickslip.models.preset_table import PRESETS
 
 
 class ParameterError(ValueError):
@@ -231,8 +232,8 @@ def scale_block(p: BlockParams) -> BlockParams:
     )
 
 
-# The named models (presets) of stickslip.models.presets, which checks that it defines these.
-MODELS = ("sakaguchi", "carlson-langer", "train", "batista-carlson", "two-blocks")
+#: The named models: the presets of :mod:`stickslip.models.preset_table`, in its order (written there once).
+MODELS = tuple(PRESETS)
 
 
 def _choice(default: str, kind: str, doc: str) -> Any:
@@ -285,8 +286,9 @@ class ChainParams(_Validated):
         The preset the parameters came from (:func:`stickslip.chain_params` sets it).
     drive, friction, threshold, ends : str
         The pieces (``stickslip models`` lists the choices).
-    Kp, sigma, F0 : float
-        Leaf spring of the plate drive, friction drop of velocity weakening, constant friction
+    Kp, sigma, F0, ... : float
+        The pieces' own parameters (:attr:`~stickslip.models.piece.Piece.params`): the leaf
+        spring of the plate drive, the friction drop of velocity weakening, the constant friction
         of the train model; the rate-and-state laws add ``rs_a``, ``rs_b``, ``Dc``, ``v0``,
         ``mu0``, ``sigma_n``. Each is read only by the pieces that name it (:meth:`used`).
 
@@ -316,12 +318,6 @@ class ChainParams(_Validated):
     friction: str = _choice("state", "friction", "friction of a moving block: state, weakening or strengthening")
     threshold: str = _choice("constant", "threshold", "static threshold: constant (Fs) or state (theta_i)")
     ends: str = _choice("free", "ends", "ends of the chain: free, fixed or periodic (plate drive only)")
-    Kp: float = _positive(1.0, "leaf spring Kp joining each block to the plate (plate drive)")
-    sigma: float = field(
-        default=0.01,
-        metadata={"low": 0.0, "high": 1.0, "high_open": True, "doc": "friction drop sigma of velocity weakening (CL)"},
-    )
-    F0: float = _nonnegative(1.0, "constant part F0 of strengthening friction (train model)")
     M: float = _positive(1.0, "mass M of a block (1: unit masses, the paper's; per block: M_i)")
 
     def __post_init__(self) -> None:
@@ -476,8 +472,6 @@ SYMBOLS = {
     "alpha": r"\alpha",
     "sigma": r"\sigma",
     "Fs": "F_s",
-    "Kp": "K_p",
-    "F0": "F_0",
     "dt": r"\Delta t",
 }
 

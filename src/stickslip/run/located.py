@@ -178,6 +178,8 @@ class LocatedStepper:
         if form not in FORMS:
             raise ParameterError(f"form must be one of {', '.join(FORMS)} (got {form!r})")
         refuse_bonds_and_masses(params, "the located integrator")
+        if not params.drive_piece.located:
+            raise ParameterError(f"drive {params.drive} does not run on the located integrator (use the grid's)")
         self.form = form
         # A wall's ghost cells move with t in the drive's frame: the dense form, which the fast
         # form skips no work of there.

@@ -41,10 +41,11 @@ def _finite(state: ChainState) -> bool:
 
 def _par(p: ChainParams) -> np.ndarray:
     """The kernels' parameter vector: K, V and dt (the pieces' parameters travel as their named
-    tuples, :meth:`~stickslip.models.piece.Piece.kernel_params`)."""
+    tuples, :meth:`~stickslip.models.piece.Piece.kernel_params`). V is the velocity of the pull point
+    p = V t_n, the drive's (:meth:`~stickslip.models.piece.Piece.kernel_velocity`: a force ramp's r)."""
     par = np.zeros(layout.PAR_SIZE)
     par[layout.P_K] = p.K if isinstance(p.K, float) else float(p.K.values[0])
-    par[layout.P_V], par[layout.P_DT] = p.V, p.dt
+    par[layout.P_V], par[layout.P_DT] = p.drive_piece.kernel_velocity(p), p.dt
     return par
 
 

@@ -213,8 +213,9 @@ def steady_deviation(state: ChainState, p: ChainParams) -> float:
     """Distance of a state from steady sliding of the chain (docs/model.md), in the frame moving with V.
 
     The largest of ``|v_i - V|``, ``|theta_i - theta_0|`` and ``|e_i - e_i^ss|`` over all blocks, where
-    e_i = x_{i-1} - x_i are the spring extensions (x_0 = V t_n) and e_i^ss = (c/K)(N - i + 1)
-    those of steady sliding. Infinite unless every block is moving.
+    e_i = x_{i-1} - x_i are the spring extensions (x_0 = V t_n, or the ends' ghost cell under a
+    force drive) and e_i^ss those of steady sliding ((c/K)(N - i + 1) for eq. 4); with the plate
+    drive the positions against the plate's. Infinite unless every block is moving.
     """
     if np.any(state.mov[1:-1] == 0.0) or not physics.has_steady_state(p):
         return float("inf")
@@ -226,13 +227,14 @@ def steady_deviation(state: ChainState, p: ChainParams) -> float:
 
 def _deviation(state: ChainState, p: ChainParams) -> float:
     """:func:`steady_deviation` of a chain that slides (the steady state's closed form)."""
-    if p.drive_piece.leaf_spring:
+    if np.any(physics.drive_stiffness(p) > 0.0):
         # Every block lags the plate by c / Kp: compare positions in the plate's frame.
         ss = physics.chain_steady_state(p, float(np.float64(state.step) * p.dt))
         return float(max(np.max(np.abs(state.v[1:-1] - ss["v"])), np.max(np.abs(state.x[1:-1] - ss["x"]))))
     ss = physics.chain_steady_state(p)
     x = state.x[1:-1]
-    x0 = p.V * (np.float64(state.step) * p.dt)
+    # x_0: the pulling point V t_n (end drive) or the ends' ghost cell (a force drive), as the kernels set it.
+    x0 = physics.left_ghost(p, p.V * (np.float64(state.step) * p.dt), x[0], x[-1])
     ext = np.diff(np.concatenate(([x0], x))) * -1.0
     return float(
         max(
