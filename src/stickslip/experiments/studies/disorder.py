@@ -25,6 +25,7 @@ import pandas as pd
 from stickslip.experiments.studies import Design, Study, finite, short
 from stickslip.experiments.studies.chain_point import t_end_of
 from stickslip.experiments.studies.disorder_points import disorder_check, disorder_task
+from stickslip.models.physics import UNTIL_STEADY
 from stickslip.models.presets import paper_parameters
 
 __all__ = ["DESIGN", "QEW_ZETA", "QEW_ZETA_ERR", "qew_tau", "findings", "ramp_fits", "part_a", "part_c"]
@@ -47,6 +48,18 @@ CL_MEDIUM = {
 }
 
 
+#: The ramp F_start + r t runs from F0 = 2 (nothing slips below the weakest threshold) to
+#: RAMP_END, above every depinning force seen in the exploration (2.2 to 2.52).
+RAMP_START, RAMP_END = 2.0, 2.7
+
+
+def ramp_rate(N: int) -> float:
+    """The ramp's rate r = 0.064 / N (1e-3 at N = 64): the chain's total load grows at the same
+    rate at every N, so slips elsewhere start as often during an avalanche at every N (at a fixed
+    r a long chain's avalanches overlap and merge into one event)."""
+    return 0.064 / N
+
+
 def qew_tau(zeta: float = QEW_ZETA, zeta_err: float = QEW_ZETA_ERR) -> tuple[float, float]:
     """qEW's avalanche-size exponent tau = 2 - 2 / (1 + zeta) (Rosso, Le Doussal and Wiese 2009)
     and its error from zeta's: 1.111 +- 0.001 at zeta = 1.250 +- 0.005."""
@@ -60,21 +73,21 @@ def _fs(w: float) -> Any:
 def _grid(mode: str) -> dict[str, Any]:
     if mode == "tiny":
         return dict(
-            aN=9, abetas=(0.8, 2.0), widths=(0.0, 0.2), sN=19, sloads=5.0, bNs=(16,), bbetas=(1.0,), bseeds=2,
-            bt=400.0, cN=16, cF=(2.1, 2.6), cseeds=1, clF=(0.95, 1.05), ct=60.0,
+            aN=9, abetas=(0.8, 1.4), widths=(0.0, 0.2), sN=19, sloads=5.0, bNs=(16,), bbetas=(1.0,), bseeds=2,
+            scanN=16, cN=16, cF=(2.1, 2.6), cseeds=1, clF=(0.95, 1.05), ct=60.0, clt=20.0,
         )  # fmt: skip
     if mode == "quick":
         return dict(
-            aN=49, abetas=(0.8, 0.9, 1.0, 1.1, 1.2, 1.4), widths=WIDTHS, sN=99, sloads=5.0,
-            bNs=(64, 256, 1024), bbetas=(0.2, 1.0, 3.0, 10.0), bseeds=4, bt=1300.0,
+            aN=49, abetas=(0.8, 0.9, 1.0, 1.1, 1.2, 1.3, 1.4), widths=WIDTHS, sN=99, sloads=5.0,
+            bNs=(64, 256, 1024), bbetas=(0.2, 1.0, 3.0, 10.0), bseeds=4, scanN=256,
             cN=256, cF=(2.05, 2.1, 2.15, 2.2, 2.3, 2.4, 2.6, 2.8), cseeds=2,
-            clF=(0.9, 0.95, 0.98, 1.0, 1.02, 1.05, 1.1), ct=300.0,
+            clF=(0.9, 0.95, 0.98, 1.0, 1.02, 1.05, 1.1), ct=300.0, clt=30.0,
         )  # fmt: skip
     return dict(
-        aN=99, abetas=(0.7, 0.8, 0.9, 0.95, 1.0, 1.05, 1.1, 1.2, 1.3, 1.5), widths=WIDTHS, sN=199, sloads=5.0,
-        bNs=(64, 256, 1024, 3199), bbetas=(0.1, 0.2, 0.5, 1.0, 2.0, 3.0, 5.0, 10.0), bseeds=16, bt=1300.0,
+        aN=99, abetas=(0.7, 0.8, 0.9, 0.95, 1.0, 1.05, 1.1, 1.2, 1.3, 1.4, 1.5, 1.7), widths=WIDTHS, sN=199, sloads=5.0,
+        bNs=(64, 256, 1024, 3199), bbetas=(0.1, 0.2, 0.5, 1.0, 2.0, 3.0, 5.0, 10.0), bseeds=16, scanN=256,
         cN=1024, cF=(2.02, 2.05, 2.1, 2.15, 2.2, 2.25, 2.3, 2.35, 2.4, 2.5, 2.6, 2.8), cseeds=4,
-        clF=(0.9, 0.95, 0.97, 0.98, 0.99, 1.0, 1.01, 1.02, 1.05, 1.1), ct=500.0,
+        clF=(0.9, 0.95, 0.97, 0.98, 0.99, 1.0, 1.01, 1.02, 1.05, 1.1), ct=500.0, clt=50.0,
     )  # fmt: skip
 
 
@@ -89,24 +102,28 @@ def build(mode: str) -> Study:
         base = {"part": "a", "model": "sakaguchi", **paper, "w": w, "Fs": _fs(w), "start": "paper"}
         pts.append({**base, "N": g["sN"], "beta": 0.4, "analysis": "sizes", "t_end": t_end_of(g["sN"], g["sloads"])})
         for b in g["abetas"]:
-            pts.append({**base, "N": g["aN"], "beta": b, "analysis": "order", "t_end": t_end_of(g["aN"], 2.5)})
-    scan_N = g["bNs"][min(2, len(g["bNs"]) - 1)]
+            order = {"analysis": "order", "until_steady": UNTIL_STEADY, "t_end": t_end_of(g["aN"], 2.5)}
+            pts.append({**base, "N": g["aN"], "beta": b, **order})
+    scan_N = g["scanN"]
     cells = {(n, 1.0) for n in g["bNs"]} | {(scan_N, b) for b in g["bbetas"]}
-    ramp = {"part": "b", **MEDIUM, "F_start": 2.0, "r": 1e-3, "t_end": g["bt"], "K": 10.0}
     for n, b in sorted(cells, key=lambda c: (-c[0], c[1])):
+        ramp = {"part": "b", **MEDIUM, "F_start": RAMP_START, "r": ramp_rate(n), "K": 10.0}
+        ramp["t_end"] = round((RAMP_END - RAMP_START) / ramp["r"], 6)
         pts += [{**ramp, "N": n, "beta": b, "disorder_seed": s} for s in range(g["bseeds"])]
     force = {"part": "c", **MEDIUM, "drive": "constant-force", "beta": 1.0, "N": g["cN"], "t_end": g["ct"]}
     pts += [{**force, "F": F, "disorder_seed": s} for F in g["cF"] for s in range(g["cseeds"])]
-    cl = {"part": "c", **CL_MEDIUM, "N": g["cN"], "t_end": g["ct"]}
+    cl = {"part": "c", **CL_MEDIUM, "N": g["cN"], "t_end": g["clt"]}
     pts += [{**cl, "F": F, "disorder_seed": 0} for F in g["clF"]]
     common = {"n_samples": 2000, "average_fraction": 0.5, "spanning": "max_block", "bootstrap": 200, "seed": 0}
     note = (
         f"{mode}: (a) eq. (4) with Fs_i uniform on [3(1-w), 3(1+w)], w in {list(g['widths'])}, N = {g['aN']} at "
-        f"beta in {list(g['abetas'])} (2.5 loading times) and tau at N = {g['sN']}, beta = 0.4 ({g['sloads']:g} "
-        f"loading times); (b) force ramp 2 + 0.001 t to t = {g['bt']:g} from rest, F0 = 2 + beta v, Fs_i uniform "
+        f"beta in {list(g['abetas'])} (2.5 loading times from the paper's start, stopped at steady sliding) "
+        f"and tau at N = {g['sN']}, beta = 0.4 ({g['sloads']:g} loading times); "
+        f"(b) force ramp 2 + r t with r = 0.064 / N from rest to F = {RAMP_END:g}, F0 = 2 + beta v, Fs_i uniform "
         f"on [2, 4], N in {list(g['bNs'])} at beta = 1 and beta in {list(g['bbetas'])} at N = {scan_N}, "
         f"{g['bseeds']} disorder seeds each; (c) constant force from rest to t = {g['ct']:g} at N = {g['cN']}: "
-        f"strengthening F in {list(g['cF'])} ({g['cseeds']} seeds), Carlson-Langer (periodic) F in {list(g['clF'])}"
+        f"strengthening F in {list(g['cF'])} ({g['cseeds']} seeds), Carlson-Langer (periodic) F in {list(g['clF'])} "
+        f"to t = {g['clt']:g}"
     )
     return Study("disorder", mode, common, tuple(pts), note=note)
 
@@ -311,7 +328,8 @@ def figures(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[tuple[str,
     if found["ramp"]:
         caption = (
             "(b) Force ramp on the random medium: tau of the events before depinning, pooled over seeds, against "
-            "N (beta = 1) and against beta; the band is qEW's 2 - 2/(1 + zeta) = 1.111."
+            "N (beta = 1) and against beta (none where no event ended before the chain depinned); the band is "
+            "qEW's 2 - 2/(1 + zeta) = 1.111."
         )
         out.append(("ramp_tau", ramp_figure(found["ramp"], qew_tau()), caption))
     if found["force"]:
