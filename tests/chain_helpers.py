@@ -283,10 +283,14 @@ def model_heun_step(x, v, th, moving, n, p):
     N = len(x)
     dt, h2 = p.dt, 0.5 * p.dt
 
-    def force(X, i, plate):
+    def force(X, i, plate, step):
         f = p.K * ((X[i - 1] - X[i]) - (X[i] - X[i + 1]))
         if p.drive == "plate":
             f = f + p.Kp * (plate - X[i])
+        elif p.drive == "constant-force":
+            f = f + p.F
+        elif p.drive == "force-ramp":
+            f = f + (p.F_start + p.r * (float(step) * p.dt))  # F_start + r t_n, t_n = n dt
         return f
 
     def accel(f, thi, vi):
@@ -306,7 +310,7 @@ def model_heun_step(x, v, th, moving, n, p):
     X, TH, plate = _ghosts(x, th, n, p)
     mid, a1, b1, xs, vs, ths = [], [], [], [], [], []
     for i in range(1, N + 1):
-        f = force(X, i, plate)
+        f = force(X, i, plate, n)
         threshold = TH[i] if p.threshold == "state" else p.Fs
         m = moving[i - 1] or f > threshold  # start rule, at the beginning of the step
         a = accel(f, TH[i], v[i - 1]) if m else 0.0
@@ -321,7 +325,7 @@ def model_heun_step(x, v, th, moving, n, p):
     xn, vn, thn, mn = [], [], [], []
     for i in range(1, N + 1):
         m = mid[i - 1]
-        a2 = accel(force(XS, i, plate2), THS[i], vs[i - 1]) if m else 0.0
+        a2 = accel(force(XS, i, plate2, n + 1), THS[i], vs[i - 1]) if m else 0.0
         b2 = dtheta(THS, i, vs[i - 1])
         thn.append(th[i - 1] + h2 * (b1[i - 1] + b2) if p.friction == "state" else th[i - 1])
         if m:

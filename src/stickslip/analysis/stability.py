@@ -22,7 +22,8 @@ Chain. A Fourier mode exp(i k j) of eq. (5), k the lattice wavenumber in [0, pi]
 discrete Laplacians into -q with q = 2 (1 - cos k); its 3 x 3 mode matrix gives Fig. 4. At
 k -> 0 one eigenvalue vanishes like -K k^2 / (beta - alpha), so long waves are unstable
 exactly for beta < alpha, independent of K, D and V (the derivation is in docs/stability.md).
-The finite chain with the ends of docs/model.md has a 3N x 3N matrix, :func:`chain_jacobian`.
+The finite chain with the ends of docs/model.md has a 3N x 3N matrix, :func:`chain_jacobian`
+(:mod:`stickslip.analysis.jacobian`, assembled from the pieces).
 Both read the friction law's linearisation (:class:`~stickslip.models.piece.Linearisation`), so a
 law with a state variable other than eq. (4)'s (rate-and-state) gets its mode matrices, finite
 Jacobian and critical spring constant (:func:`critical_stiffness`) from the same code.
@@ -42,6 +43,7 @@ import pandas as pd
 import xarray as xr
 from scipy.optimize import brentq
 
+from stickslip.analysis.jacobian import chain_jacobian  # noqa: F401  (the one builder, from the pieces)
 from stickslip.analysis.linear import GROWTH_TOL, _sorted_by_real_part, finite_chain_wavenumbers, lattice_q
 
 # The relatives without a state variable live in stability_modes; their names stay importable here.
@@ -440,31 +442,6 @@ def chain_stability(p: ChainParams, k: np.ndarray | None = None) -> ChainStabili
         k_at_max=k_max,
         unstable=growth > GROWTH_TOL,
         marginal=bool(np.isclose(p.beta, beta_c, rtol=0.0, atol=1e-12)),
-    )
-
-
-def chain_jacobian(p: ChainParams) -> np.ndarray:
-    """The 3N x 3N matrix of eq. (5) for the finite chain with the ends of docs/model.md.
-
-    Variables ordered (dx_1..dx_N, dv_1..dv_N, dtheta_1..dtheta_N). The pulling point moves
-    with the steady state, so dx_0 = 0; the free end has dx_{N+1} = dx_N; theta has no-flux
-    ends, dtheta_0 = dtheta_1 and dtheta_{N+1} = dtheta_N.
-    """
-    N = p.N
-    lin = _linear(p)
-    lap_x = -2.0 * np.eye(N) + np.eye(N, k=1) + np.eye(N, k=-1)
-    lap_x[-1, -1] = -1.0  # free end
-    lap_t = -2.0 * np.eye(N) + np.eye(N, k=1) + np.eye(N, k=-1)
-    lap_t[0, 0] += 1.0  # no flux at both ends
-    lap_t[-1, -1] += 1.0
-    eye = np.eye(N)
-    zero = np.zeros((N, N))
-    return np.block(
-        [
-            [zero, eye, zero],
-            [p.K * lap_x, -lin.phi_v * eye, -lin.phi_theta * eye],
-            [zero, lin.g_v * eye, lin.g_theta * eye + lin.diffusion * lap_t],
-        ]
     )
 
 

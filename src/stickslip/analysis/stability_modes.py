@@ -12,8 +12,9 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
+from stickslip.analysis.jacobian import chain_jacobian
 from stickslip.analysis.linear import GROWTH_TOL, _sorted_by_real_part, finite_chain_wavenumbers, lattice_q
-from stickslip.models import pieces
+from stickslip.models import physics, pieces
 from stickslip.models.params import ChainParams
 
 # ---------------------------------------------------------------------------------------------
@@ -55,16 +56,18 @@ def normal_modes(p: ChainParams) -> tuple[np.ndarray, str]:
     N = p.N
     if not p.ends_piece.steady_sliding:
         raise ValueError(f"ends {p.ends} have no steady sliding (the springs to the walls stretch without bound)")
-    if p.drive_piece.leaf_spring and p.ends_piece.ring:
+    on_ghost = physics.ghost_rows(p)["x0"] != (0.0, 0.0)  # x_0 is not the pulling point
+    if on_ghost and p.ends_piece.ring:
         return 2.0 * np.pi * np.arange(N) / N, "periodic: exp(i k j), k = 2 pi j / N, j = 0..N-1"
-    if p.drive_piece.leaf_spring:
+    if on_ghost:
         return np.pi * np.arange(N) / N, "free ends: cos(k (i - 1/2)), k = pi j / N, j = 0..N-1"
     return finite_chain_wavenumbers(N), "end drive, free end: sin(k i), k = (2m - 1) pi / (2N + 1), m = 1..N"
 
 
 def mode_frequency_squared(p: ChainParams, k: np.ndarray | float) -> np.ndarray:
-    """w_k^2 = Kp + 4 K sin^2(k/2) for the plate drive, 4 K sin^2(k/2) for the end drive."""
-    return (p.Kp if p.drive_piece.leaf_spring else 0.0) + p.K * lattice_q(k)
+    """w_k^2 = Kp + 4 K sin^2(k/2) for the plate drive, 4 K sin^2(k/2) for the end drive (the
+    drive's stiffness, :func:`stickslip.models.physics.drive_stiffness`)."""
+    return float(physics.drive_stiffness(p)[0]) + p.K * lattice_q(k)
 
 
 def mode_roots(p: ChainParams, k: np.ndarray | float) -> np.ndarray:
@@ -98,25 +101,13 @@ def mode_growth_rates(p: ChainParams) -> pd.DataFrame:
 
 
 def chain_jacobian_2n(p: ChainParams) -> np.ndarray:
-    """The 2N x 2N matrix of the linearised chain without state variable, variables (dx, dv).
-
-    dv' = K L dx - Kp dx [plate] - phi'(V) dv with L the spring Laplacian under the model's ends
-    (periodic: circulant; plate, free: x_0 = x_1 and x_{N+1} = x_N; end drive: dx_0 = 0,
-    dx_{N+1} = dx_N). Built from the ends directly, not from :func:`normal_modes`.
-    """
-    N = p.N
-    if not p.ends_piece.steady_sliding:
-        raise ValueError(f"ends {p.ends} have no steady sliding")
-    L = -2.0 * np.eye(N) + np.eye(N, k=1) + np.eye(N, k=-1)
-    if p.ends_piece.ring:
-        L[0, -1] += 1.0
-        L[-1, 0] += 1.0
-    else:
-        L[-1, -1] += 1.0  # x_{N+1} = x_N
-        if p.drive_piece.leaf_spring:
-            L[0, 0] += 1.0  # x_0 = x_1
-    A = p.K * L - (p.Kp if p.drive_piece.leaf_spring else 0.0) * np.eye(N)
-    return np.block([[np.zeros((N, N)), np.eye(N)], [A, -friction_slope(p) * np.eye(N)]])
+    """The 2N x 2N matrix of the linearised chain without state variable, variables (dx, dv):
+    dv' = K L dx - Kp dx [plate] - phi'(V) dv with L the spring Laplacian under the model's ends.
+    The one builder assembled from the pieces, :func:`stickslip.analysis.jacobian.chain_jacobian`,
+    which this is (built from the ends directly, not from :func:`normal_modes`)."""
+    if p.friction_piece.has_state:
+        raise ValueError(f"friction {p.friction} has a state variable: use chain_jacobian (eq. 5)")
+    return chain_jacobian(p)
 
 
 @dataclass(frozen=True)

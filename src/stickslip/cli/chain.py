@@ -83,10 +83,12 @@ def register(sub) -> None:
     )
     b.add_argument(
         "--workload",
-        choices=("default", "partly-stuck"),
+        choices=("default", "partly-stuck", "disordered"),
         default="default",
         help="partly-stuck: the paper's chain loading at beta = 1.3 with part of its blocks stuck "
-        "(N, beta and t-end as given, else 199, 1.3 and 1e4 after a prepared 4e5)",
+        "(N, beta and t-end as given, else 199, 1.3 and 1e4 after a prepared 4e5); disordered: the "
+        "chain with per-block values (as given, else Fs uniform(2.5, 3.5) and beta 10%% normal) "
+        "against the same chain with their means, time per block update (N 199, t-end 2e4)",
     )
     b.add_argument(
         "--profile", action="store_true", help="instead: where the exact integrator spends its time on this workload"
@@ -259,7 +261,8 @@ def run_chain_command(args: argparse.Namespace) -> Result:
             periodic,
         )
 
-    params = chain_params_from_args(args)  # a bad parameter is refused before the engine loads
+    # a bad parameter is refused before the engine loads
+    params = _inherit_per_block(chain_params_from_args(args), args)
     from stickslip.run import driver as chain
     from stickslip.run.rundir import RunDirBusy, read_run_id
 
@@ -397,6 +400,24 @@ def _first_look(params, args, start: str):
     return params, 2e4
 
 
+def _inherit_per_block(params, args):
+    """With --from, the per-block parameters of the run named there (docs/model.md, "Per-block
+    parameters") that the command line does not give: the continued chain is the same medium."""
+    if getattr(args, "from_dir", None) is None or not (Path(args.from_dir) / "run.json").is_file():
+        return params
+    from stickslip import io
+    from stickslip.models.params import ChainParams
+
+    try:
+        before = ChainParams(**io.read_json(Path(args.from_dir) / "run.json")["params"])
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        raise CommandError(f"--from: {exc}") from None
+    keep = {k: v for k, v in before.per_block().items() if getattr(args, f"param_{k}", None) is None}
+    if keep and before.N == params.N:
+        params = params.replace(**keep)
+    return params
+
+
 def _from_state(params, args):
     """The state named by --from, checked against the run's N and --t-end; None without --from."""
     if getattr(args, "from_dir", None) is None:
@@ -468,6 +489,8 @@ def run_bench_command(args: argparse.Namespace) -> Result:
         return _located(args)
     if args.workload == "partly-stuck":
         return _partly_stuck(args)
+    if args.workload == "disordered":
+        return _disordered(args)
     params = chain_params_from_args(args)
     t_end = args.t_end if args.t_end is not None else (2e4 if params.drive_piece.leaf_spring else 2e5)
     check_number("t-end", t_end, low=0.0, low_open=True)
@@ -498,6 +521,21 @@ def _partly_stuck(args: argparse.Namespace) -> Result:
     params, t_prepare, t_timed = _workload(args, bench.PARTLY_STUCK)
     result = bench.partly_stuck(params, t_prepare=t_prepare, t_timed=t_timed, repeat=args.repeat)
     return Result(result, bench.format_partly_stuck(result))
+
+
+def _disordered(args: argparse.Namespace) -> Result:
+    """`stickslip bench --workload disordered`: a disordered chain's time per block update against
+    the uniform chain's (docs/model.md, "Per-block parameters")."""
+    from stickslip.run import bench
+
+    if args.profile or args.start is not None:
+        raise CommandError("--workload disordered starts from the paper's start and has no --profile")
+    w = bench.DISORDERED
+    params = chain_params_from_args(args, **({"N": w["N"]} if args.param_N is None else {}))
+    t_end = args.t_end if args.t_end is not None else w["t_timed"]
+    check_number("t-end", t_end, low=0.0, low_open=True)
+    result = bench.disordered(params, t_end, repeat=args.repeat, seed=args.disorder_seed)
+    return Result(result, bench.format_disordered(result))
 
 
 def _workload(args: argparse.Namespace, w: dict):

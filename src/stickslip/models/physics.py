@@ -6,7 +6,12 @@ package; arrays hold block i at index i - 1. The pulling point is x_0 = V t.
 
 from __future__ import annotations
 
+import dataclasses
+import importlib
+from typing import Any
+
 import numpy as np
+from scipy.optimize import brentq
 
 from stickslip.models.params import BlockParams, ChainParams
 
@@ -33,6 +38,56 @@ def block_steady_state(p: BlockParams) -> dict[str, float]:
     return {"v": p.V, "theta": theta0, "force": force, "lag": force / p.K}
 
 
+def per_block(p: Any, name: str) -> np.ndarray:
+    """The parameter ``name`` of ``p`` at every block, i = 1..N at index i - 1.
+
+    A parameter is a float (the same at every block) or an array of N values (quenched
+    disorder, one value per block); either way this returns N values (read-only for a float).
+    """
+    return np.broadcast_to(np.asarray(getattr(p, name), dtype=float), (p.N,))
+
+
+def is_uniform(p: Any) -> bool:
+    """Whether every block has the same parameters: no field of ``p`` is an array of N values
+    with two different entries (a uniform chain given as arrays counts as uniform)."""
+    for f in dataclasses.fields(p):
+        value = getattr(p, f.name)
+        if isinstance(value, np.ndarray) and value.ndim == 1 and value.size > 1 and np.any(value != value[0]):
+            return False
+    return True
+
+
+class BlockView:
+    """The parameters ``p`` as block ``i`` (0-based) sees them: a field that is an array of N values
+    reads its i-th value, every other field as it is, and ``overrides`` replace fields (the
+    steady velocity of a force drive in place of V).
+
+    What a piece's closed forms (:attr:`~stickslip.models.piece.Piece.steady`, ``linear``,
+    ``slope``) read, so that a piece never learns about per-block arrays.
+    """
+
+    def __init__(self, p: Any, i: int, **overrides: float):
+        self._p = p
+        self._i = i
+        self._overrides = overrides
+
+    def __getattr__(self, name: str) -> Any:
+        if name in self._overrides:
+            return self._overrides[name]
+        value = getattr(self._p, name)
+        if isinstance(value, np.ndarray) and value.ndim == 1:
+            return float(value[self._i])
+        return value
+
+
+def _uniform_view(p: Any, **overrides: float) -> Any:
+    """``p`` itself for a chain of floats, else block 1's view (for a uniform chain given as arrays)."""
+    scalar = all(
+        not (isinstance(getattr(p, f.name), np.ndarray) and getattr(p, f.name).ndim == 1) for f in dataclasses.fields(p)
+    )
+    return p if scalar and not overrides else BlockView(p, 0, **overrides)
+
+
 def steady_friction(p: ChainParams) -> tuple[float, float]:
     """Friction c of a block sliding steadily at v = V, and its state variable theta_0.
 
@@ -44,41 +99,198 @@ def steady_friction(p: ChainParams) -> tuple[float, float]:
     return p.friction_piece.steady(p)
 
 
-def has_steady_state(p: ChainParams) -> bool:
-    """Whether the chain can slide steadily with every block at v = V.
+def block_frictions(p: Any, v: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Each block's friction c_i and state variable theta_i of steady sliding at velocity ``v``
+    (default V): the friction piece's :attr:`~stickslip.models.piece.Piece.steady` read at each
+    block's own parameters (:class:`BlockView`), computed once where every block is alike."""
+    over = {} if v is None else {"V": float(v)}
+    steady = p.friction_piece.steady
+    if is_uniform(p):
+        c, theta0 = steady(_uniform_view(p, **over))
+        return np.full(p.N, c), np.full(p.N, theta0)
+    pairs = [steady(BlockView(p, i, **over)) for i in range(p.N)]
+    return np.array([c for c, _ in pairs]), np.array([th for _, th in pairs])
 
-    The end drive with a free end (eq. 4) and the plate drive with free or periodic ends can;
-    a fixed end holds a spring that stretches for ever, so those compositions cannot.
+
+def applied_forces(p: Any) -> np.ndarray | None:
+    """The constant force of a force drive on each block (:attr:`~stickslip.models.piece.Piece.applied`),
+    or None for a drive that sets the velocity V (end, plate)."""
+    applied = p.drive_piece.applied
+    if applied is None:
+        return None
+    return np.array([applied(BlockView(p, i)) for i in range(p.N)])
+
+
+def drive_stiffness(p: Any) -> np.ndarray:
+    """The stiffness of the spring joining each block to the drive: the drive's compiled ``leaf``
+    (Kp for the plate, 0 for the end drive and the force drives) at each block's parameters."""
+    mod = importlib.import_module(p.drive_piece.module)
+    return np.array([float(mod.leaf.py_func(block_kernel_params(p.drive_piece, p, i))) for i in range(p.N)])
+
+
+def block_kernel_params(piece: Any, p: Any, i: int) -> tuple:
+    """The ``Params`` named tuple of a piece's compiled functions at block ``i`` (0-based)."""
+    view = BlockView(p, i)
+    return importlib.import_module(piece.module).Params(*(float(getattr(view, r)) for r in piece.reads))
+
+
+def ghost_rows(p: Any) -> dict[str, tuple[float, float]]:
+    """The ghost cells of the chain as linear functions of the end blocks, from the pieces' own
+    compiled ``left`` and ``ghost`` (the rows the kernels' :func:`stickslip.kernels.laws._set_ghosts`
+    evaluates), about a state that moves with the drive.
+
+    ``x0``, ``xN1``: the weights (on x_1, on x_N) of x_0 and x_{N+1}; ``th0``, ``thN1`` those of
+    theta_0 and theta_{N+1} (no flux). x_0 of the end drive is the pulling point, which moves with
+    steady sliding, so its weights are 0. The ghost functions are selections, so the weights are exact.
     """
-    return p.ends != "fixed"
+    ends = importlib.import_module(p.ends_piece.module).ghost.py_func
+    left = importlib.import_module(p.drive_piece.module).left.py_func
+    on_ghost = left(0.0, 1.0)  # 1 where x_0 is the ends' ghost cell, 0 where it is the pulling point
+    x_edge, x_other = ends(1.0, 0.0, 0.0), ends(0.0, 1.0, 0.0)
+    th_edge, th_other = ends(1.0, 0.0, 1.0), ends(0.0, 1.0, 0.0)
+    return {
+        "x0": (on_ghost * x_edge, on_ghost * x_other),
+        "xN1": (x_other, x_edge),
+        "th0": (th_edge, th_other),
+        "thN1": (th_other, th_edge),
+    }
+
+
+def left_ghost(p: Any, pull: float, x1: float, xN: float) -> float:
+    """x_0 as the kernels set it (:func:`stickslip.kernels.laws._set_ghosts`): the drive's compiled
+    ``left`` of the pull point ``pull`` and the ends' ``ghost`` of x_1 and x_N (a wall at 0)."""
+    ends = importlib.import_module(p.ends_piece.module).ghost.py_func
+    left = importlib.import_module(p.drive_piece.module).left.py_func
+    return left(pull, ends(x1, xN, 0.0))
+
+
+def laplacian(N: int, rows: tuple[tuple[float, float], tuple[float, float]]) -> np.ndarray:
+    """The N x N discrete Laplacian (x_{i-1} - 2 x_i + x_{i+1}) with the ghost cells x_0 and
+    x_{N+1} given as weights on (x_1, x_N) and (x_1, x_N) (:func:`ghost_rows`)."""
+    L = -2.0 * np.eye(N) + np.eye(N, k=1) + np.eye(N, k=-1)
+    (a1, aN), (b1, bN) = rows
+    L[0, 0] += a1
+    L[0, -1] += aN
+    L[-1, 0] += b1
+    L[-1, -1] += bN
+    return L
+
+
+def has_steady_state(p: ChainParams) -> bool:
+    """Whether the chain can slide steadily with every block at one velocity.
+
+    The end drive with a free end (eq. 4), the plate drive with free or periodic ends and a
+    constant force can; a fixed end holds a spring that stretches for ever, and a force ramp
+    never lets the velocity settle (the pieces' ``steady_sliding``).
+    """
+    return p.ends_piece.steady_sliding and p.drive_piece.steady_sliding
+
+
+def steady_velocity(p: Any) -> float:
+    """The velocity of steady sliding: V where the drive moves at V; under a force drive the v
+    at which the frictions balance the applied forces, sum_i c_i(v) = sum_i F_i (Brent's method;
+    for the strengthening law F0 + beta v it is (sum F_i - sum F0_i) / sum beta_i).
+
+    Raises ValueError where no v >= 0 balances them (the forces below the friction at v = 0).
+    """
+    forces = applied_forces(p)
+    if forces is None:
+        return float(p.V)
+    total = float(np.sum(forces))
+
+    def excess(v: float) -> float:
+        return float(np.sum(block_frictions(p, v)[0])) - total
+
+    if excess(0.0) > 0.0:
+        raise ValueError("the applied force is below the friction at v = 0: the chain cannot slide steadily")
+    hi = 1.0
+    for _ in range(200):
+        if excess(hi) >= 0.0:
+            break
+        hi *= 2.0
+    else:
+        raise ValueError("the friction does not balance the applied force at any velocity")
+    return float(brentq(excess, 0.0, hi, xtol=1e-15, rtol=4.0 * np.finfo(float).eps))
 
 
 def chain_steady_state(p: ChainParams, t: float = 0.0) -> dict[str, np.ndarray]:
-    """Exact discrete steady sliding of the chain, eq. (4) with the ends of docs/model.md.
+    """Exact discrete steady sliding of the chain, eq. (4) with the ends of docs/model.md, for
+    uniform and per-block parameters (:func:`per_block`).
 
-    End drive: v_i = V, theta_i = 1 - alpha V (= 1 - V for alpha = 1), friction
-    c = theta_0 + beta V; every block is pulled by the spring behind it with the friction of all
-    blocks ahead, so x_{i-1} - x_i = (c / K) (N - i + 1), with x_0 = V t.
-    Plate drive (free or periodic ends): every block lags the plate by c / Kp, springs K unstretched.
-    Returns x (length N), v, theta and the extensions ``ext`` (x_{i-1} - x_i, i = 1..N).
+    Every block slides at one velocity v (:func:`steady_velocity`: V, or where the frictions
+    balance a force drive), with its own friction c_i and theta_i at v (:func:`block_frictions`).
+    End drive: the spring behind block i carries the friction of every block from i to the free
+    end, so x_{i-1} - x_i = (1/K) sum_{j >= i} c_j, (c / K) (N - i + 1) for a uniform chain,
+    with x_0 = V t. Force drive (free ends): the same sum of c_j - F_j, which vanishes at block 1;
+    block 1 at v t. Plate drive: every block lags the plate by c / Kp (springs K unstretched) for a
+    uniform chain; otherwise the force balance K (x_{i-1} - 2 x_i + x_{i+1}) + Kp_i (V t - x_i)
+    = c_i, a linear system. Returns x (length N), v, theta, the extensions ``ext``
+    (x_{i-1} - x_i, i = 1..N, x_0 the drive's or the ends' ghost) and ``friction`` (c, or c_i).
     """
     if not has_steady_state(p):
-        raise ValueError(f"the chain with ends {p.ends} has no steady sliding state")
-    c, theta0 = steady_friction(p)
-    if p.drive == "plate":
-        x = np.full(p.N, p.V * t - c / p.Kp)
-        ext = np.zeros(p.N)
+        raise ValueError(f"the chain with drive {p.drive} and ends {p.ends} has no steady sliding state")
+    N = p.N
+    uniform = is_uniform(p)
+    if uniform and p.drive_piece.applied is None:
+        c, theta0 = steady_friction(_uniform_view(p))
+        friction: Any = c
+        v = p.V
+        theta = np.full(N, theta0)
     else:
-        i = np.arange(1, p.N + 1, dtype=np.float64)
-        ext = (c / p.K) * (p.N - i + 1.0)
+        v = steady_velocity(p)
+        cs, theta = block_frictions(p, v)
+        friction = cs if not uniform else float(cs[0])
+        _check_theta_decoupled(p, theta, v)
+    stiff = drive_stiffness(p)
+    rows = ghost_rows(p)
+    if np.any(stiff > 0.0):
+        if uniform:
+            x = np.full(N, p.V * t - friction / float(stiff[0]))
+            ext = np.zeros(N)
+        else:
+            # K L u - Kp u = c with u = x - V t (the springs' rows from the ends).
+            A = p.K * laplacian(N, (rows["x0"], rows["xN1"])) - np.diag(stiff)
+            x = p.V * t + np.linalg.solve(A, cs)
+            ext = _extensions(x, rows)
+    elif applied_forces(p) is None:
+        if uniform:
+            i = np.arange(1, N + 1, dtype=np.float64)
+            ext = (friction / p.K) * (N - i + 1.0)
+        else:
+            ext = np.cumsum(cs[::-1])[::-1] / p.K
         x = p.V * t - np.cumsum(ext)
-    return {
-        "x": x,
-        "v": np.full(p.N, p.V),
-        "theta": np.full(p.N, theta0),
-        "ext": ext,
-        "friction": c,
-    }
+    else:
+        if uniform:
+            ext = np.zeros(N)  # every block carries its own force: the springs stay unstretched
+        elif not p.ends_piece.ring:
+            ext = np.cumsum((cs - applied_forces(p))[::-1])[::-1] / p.K
+            ext[0] = 0.0  # x_0 is block 1's own ghost: the sum vanishes there at the steady v
+        else:
+            # On a ring the springs' force balance fixes the extensions up to a translation.
+            A = p.K * laplacian(N, (rows["x0"], rows["xN1"]))
+            u = np.linalg.lstsq(A, cs - applied_forces(p), rcond=None)[0]
+            ext = _extensions(u, rows)
+        x = v * t - np.concatenate(([0.0], np.cumsum(ext[1:])))
+    return {"x": x, "v": np.full(N, v), "theta": theta, "ext": ext, "friction": friction}
+
+
+def _check_theta_decoupled(p: Any, theta: np.ndarray, v: float) -> None:
+    """Each block's theta_0 is steady only where diffusion does not couple unequal values: refuse
+    per-block theta_0 with D > 0 (the steady theta then solves a nonlinear system, no closed form)."""
+    linear = p.friction_piece.linear
+    if linear is None or np.all(theta == theta[0]):
+        return
+    over = {} if v == p.V else {"V": float(v)}
+    if any(linear(BlockView(p, i, **over)).diffusion != 0.0 for i in range(p.N)):
+        raise ValueError(
+            "blocks with different steady theta_0 coupled by diffusion D > 0 have no closed-form steady state"
+        )
+
+
+def _extensions(x: np.ndarray, rows: dict[str, tuple[float, float]]) -> np.ndarray:
+    """x_{i-1} - x_i, i = 1..N, with x_0 the ends' ghost cell (weights ``rows['x0']``)."""
+    a1, aN = rows["x0"]
+    return np.concatenate(([a1 * x[0] + aN * x[-1]], x[:-1])) - x
 
 
 def chain_steady_length(p: ChainParams) -> float:
@@ -95,7 +307,8 @@ def chain_steady_length(p: ChainParams) -> float:
     -------
     float
         L_ss: 7940.1 for the paper's chain (N = 399); zero for the plate drive (every block lags
-        the plate equally); NaN where there is no steady sliding.
+        the plate equally) and under a uniform constant force; NaN where there is no steady
+        sliding. With per-block parameters, x_1 - x_N of :func:`chain_steady_state`.
 
     Examples
     --------
@@ -106,9 +319,12 @@ def chain_steady_length(p: ChainParams) -> float:
     """
     if not has_steady_state(p):
         return float("nan")
-    if p.drive == "plate":
+    if not is_uniform(p):
+        x = chain_steady_state(p)["x"]
+        return float(x[0] - x[-1])
+    if p.drive_piece.leaf_spring:
         return 0.0
-    c = (1.0 - p.alpha * p.V) + p.beta * p.V if p.friction == "state" else steady_friction(p)[0]
+    c = steady_friction(_uniform_view(p))[0]
     return c / p.K * p.N * (p.N - 1) / 2.0
 
 
@@ -131,7 +347,7 @@ def loading_time(p: ChainParams) -> float:
     NaN for the plate drive (it loads every block at once), for V = 0 and where there is no steady
     sliding.
     """
-    if p.drive != "end" or not p.V > 0 or not has_steady_state(p):
+    if p.drive_piece.leaf_spring or not p.V > 0 or not has_steady_state(p):
         return float("nan")
     return chain_steady_length(p) / p.V
 

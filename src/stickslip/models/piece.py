@@ -93,6 +93,12 @@ def kernel_params(module: str, reads: tuple[str, ...]) -> type:
     return namedtuple("Params", reads, module=module)
 
 
+def _kernel_value(value: Any) -> Any:
+    """A parameter as the kernels read it: a float, or a per-block one padded like x."""
+    padded = getattr(value, "padded", None)
+    return padded() if padded is not None else float(value)
+
+
 @dataclass(frozen=True)
 class Param:
     """A parameter a piece declares: name, default, allowed range and one-line meaning.
@@ -168,8 +174,20 @@ class Piece:
     theta_range: tuple[float, float, bool] | None = None
     #: friction: (friction c, theta_0) of steady sliding at v = V
     steady: Callable[[Any], tuple[float, float]] | None = None
-    #: drive: every block is joined to the plate by the leaf spring Kp
+    #: drive: the drive acts on every block (a leaf spring Kp to the plate, or a force), not on
+    #: block 1 alone, so a stopped block starts at a step known in advance (the kernels' start
+    #: searches, :mod:`stickslip.kernels.triggers`) and x_0 is the ends' ghost cell
     leaf_spring: bool = False
+    #: drive: the constant force on every block at the parameters of one block (a force drive),
+    #: which steady sliding balances with friction (:func:`stickslip.models.physics.steady_velocity`);
+    #: None for a drive that sets the velocity V
+    applied: Callable[[Any], float] | None = None
+    #: drive: the velocity of the kernels' pull point p = V t_n at the parameters ``p``, when it is
+    #: not V (a force ramp reads p = r t_n as its r t); packed as the kernels' V
+    pull_velocity: Callable[[Any], float] | None = None
+    #: drive: runs on the located integrator (:mod:`stickslip.kernels.located`), whose frame
+    #: u = x - V t holds the drive at u = 0
+    located: bool = True
     #: friction without theta: phi'(V), the slope at steady sliding that the linearisation
     #: lambda^2 + phi'(V) lambda + w_k^2 = 0 reads (docs/model.md); None for laws with theta
     slope: Callable[[Any], float] | None = None
@@ -190,7 +208,8 @@ class Piece:
     #: ``force``) use only + - * / on their arguments and float parameters, so they run on 8
     #: blocks at once (:mod:`stickslip.kernels.lanes`)
     lanes: bool = False
-    #: ends: steady sliding exists (a spring to a fixed wall stretches without bound)
+    #: ends and drive: steady sliding exists (a spring to a fixed wall stretches without bound;
+    #: a force ramp never lets the velocity settle)
     steady_sliding: bool = True
     #: ends: the chain closes into a ring (x_0 = x_N, x_{N+1} = x_1)
     ring: bool = False
@@ -200,9 +219,16 @@ class Piece:
 
     def kernel_params(self, p: Any) -> tuple:
         """The parameters of ``p`` the piece's compiled functions read, as the ``Params`` named
-        tuple of its module (floats, in the order of :attr:`reads`)."""
+        tuple of its module, in the order of :attr:`reads`: floats, and a per-block parameter
+        (:class:`~stickslip.models.disorder.PerBlock`) as a float64 array of N + 2 with block i
+        at index i, which the kernels read at each block (:func:`stickslip.kernels.laws.at`)."""
         params = importlib.import_module(self.module).Params
-        return params(*(float(getattr(p, name)) for name in self.reads))
+        return params(*(_kernel_value(getattr(p, name)) for name in self.reads))
+
+    def kernel_velocity(self, p: Any) -> float:
+        """The drive's V as the kernels read it (their pull point p = V t_n): :attr:`pull_velocity`
+        where the drive declares one, else the parameters' V."""
+        return float(self.pull_velocity(p)) if self.pull_velocity is not None else float(p.V)
 
     def start_theta(self, p: Any) -> float:
         """theta_i at the start of a run of the parameters ``p`` (:attr:`theta0`)."""

@@ -5,20 +5,23 @@ the start and stop rules and Heun with t_n = n dt. They differ in
 
 ========== ==========================================================================
 drive      ``end``: a pulling point x_0 = V t joined to block 1 (eq. 4);
-           ``plate``: every block joined to a plate at V t by a leaf spring Kp (BK, CL)
+           ``plate``: every block joined to a plate at V t by a leaf spring Kp (BK, CL);
+           ``constant-force``: a force F on every block; ``force-ramp``: F_start + r t on every
+           block (random-medium protocols, Sakaguchi and Kadowaki)
 friction   ``state``: theta_i + beta v_i, theta from eq. (4);
            ``weakening``: phi(v) = (1 - sigma) / (1 + 2 alpha max(v, 0) / (1 - sigma)) (CL);
            ``strengthening``: F0 + beta v, no state variable (train model);
            ``rate-state``: Dieterich-Ruina with the aging law; ``slip``: with Ruina's slip law;
            one module each in :mod:`stickslip.models.friction`, listed in :data:`FRICTIONS`
 threshold  ``constant``: Fs; ``state``: theta_i (the paper's reading of Batista-Carlson)
-ends       ``free``, ``fixed``, ``periodic`` (plate drive only)
+ends       ``free``, ``fixed``, ``periodic`` (a drive acting on every block only)
 ========== ==========================================================================
 
-A composition is valid when docs/model.md allows it: periodic ends need the plate drive (the end
-drive pulls block 1 only, so the ring has no place for the pulling point), and the state
-threshold needs the state friction (it reads theta). :func:`check_composition` says so in one
-line. Each piece lists the parameters it reads, so a run records exactly those.
+A composition is valid when docs/model.md allows it (:data:`RULES`): periodic ends need a drive
+that acts on every block (the end drive pulls block 1 only, so the ring has no place for the
+pulling point), and the state threshold needs the state friction (it reads eq. (4)'s theta).
+:func:`check_composition` says so in one line. Each piece lists the parameters it reads, so a run
+records exactly those.
 """
 
 from __future__ import annotations
@@ -53,7 +56,7 @@ FRICTIONS = (
 )
 
 #: The drives, one module each in :mod:`stickslip.models.drive`.
-DRIVES = ("end", "plate")
+DRIVES = ("end", "plate", "constant_force", "force_ramp")
 
 #: The static thresholds, one module each in :mod:`stickslip.models.threshold`.
 THRESHOLDS = ("constant", "state")
@@ -91,12 +94,22 @@ def code(kind: str, name: str) -> str:
     return piece(kind, name).module
 
 
+#: The rules of composition (docs/model.md), as ``stickslip models`` states them.
+RULES = (
+    "ends periodic needs a drive that acts on every block (plate, constant-force, force-ramp)",
+    "threshold state needs friction state",
+)
+
+
 def check_composition(drive: str, friction: str, threshold: str, ends: str) -> None:
     """Refuse a composition docs/model.md does not allow, in one line."""
     for kind, name in zip(KINDS, (drive, friction, threshold, ends), strict=False):
         piece(kind, name)
-    if ends == "periodic" and drive != "plate":
-        raise CompositionError("ends periodic needs drive plate (the end drive pulls block 1 only)")
+    if piece("ends", ends).ring and not piece("drive", drive).leaf_spring:
+        every = ", ".join(p.name for p in PIECES["drive"] if p.leaf_spring)
+        raise CompositionError(
+            f"ends {ends} needs a drive that acts on every block ({every}; drive {drive} pulls block 1 only)"
+        )
     if threshold == "state" and friction != "state":
         raise CompositionError(f"threshold state needs friction state (friction {friction} has no theta)")
 

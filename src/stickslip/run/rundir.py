@@ -175,6 +175,10 @@ def _load_run(run_dir: Path) -> ChainRun:
     state.ist[layout.STEP] = int(meta["summary"]["steps"])
     if state.N != params.N:
         raise RunDirDamaged(f"{run_dir / 'state.nc'} holds {state.N} blocks, its run.json N = {params.N}")
+    for name, pb in params.per_block().items():
+        held = ds[f"param_{name}"].values
+        if held.shape != pb.values.shape or held.tobytes() != pb.values.tobytes():
+            raise RunDirDamaged(f"{run_dir / 'state.nc'} holds other per-block values of {name} than its run.json")
     state.of(params)
     # L's time axis was called t_sample before it took the name it has in ChainRun.samples
     t_sample = ds["t_sample"] if "t_sample" in ds.variables else ds["t"]

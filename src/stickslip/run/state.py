@@ -119,7 +119,16 @@ class ChainState:
         With ``amplitude`` > 0, x_i and v_i get independent uniform perturbations in
         [-amplitude, amplitude] drawn from numpy's default generator with ``seed``.
         """
-        s = physics.chain_steady_state(p, 0.0)
+        try:
+            s = physics.chain_steady_state(p, 0.0)
+        except TypeError:
+            if not p.per_block():
+                raise
+            names = ", ".join(p.per_block())
+            raise ParameterError(
+                f"start must be paper or rest for a chain with per-block {names}: the steady state "
+                "of such a chain has no closed form here yet"
+            ) from None
         state = cls.from_blocks(s["x"].copy(), s["v"].copy(), s["theta"], np.zeros(p.N, bool)).of(p)
         return state.perturbed(amplitude, seed)
 
@@ -267,22 +276,44 @@ def _remedy(p: ChainParams, start: str) -> str:
     return " (dt=... in Python, --dt on the command line)"
 
 
+def closed_form(fn, p: ChainParams, *args):
+    """``fn(p, *args)``, a closed form of :mod:`stickslip.models.physics` for a uniform chain; NaN
+    where the chain has per-block parameters (docs/model.md, "Per-block parameters") that the
+    closed form does not take."""
+    try:
+        return fn(p, *args)
+    except TypeError:
+        if not p.per_block():
+            raise
+        return float("nan")
+
+
 def steady_deviation(state: ChainState, p: ChainParams) -> float:
     """Distance of a state from steady sliding of the chain (docs/model.md), in the frame moving with V.
 
     The largest of ``|v_i - V|``, ``|theta_i - theta_0|`` and ``|e_i - e_i^ss|`` over all blocks, where
-    e_i = x_{i-1} - x_i are the spring extensions (x_0 = V t_n) and e_i^ss = (c/K)(N - i + 1)
-    those of steady sliding. Infinite unless every block is moving.
+    e_i = x_{i-1} - x_i are the spring extensions (x_0 = V t_n, or the ends' ghost cell under a
+    force drive) and e_i^ss those of steady sliding ((c/K)(N - i + 1) for eq. 4); with the plate
+    drive the positions against the plate's. Infinite unless every block is moving.
     """
     if np.any(state.mov[1:-1] == 0.0) or not physics.has_steady_state(p):
         return float("inf")
-    if p.drive_piece.leaf_spring:
+    if p.per_block():
+        value = closed_form(lambda q: _deviation(state, q), p)
+        return value if np.isfinite(value) else float("inf")
+    return _deviation(state, p)
+
+
+def _deviation(state: ChainState, p: ChainParams) -> float:
+    """:func:`steady_deviation` of a chain that slides (the steady state's closed form)."""
+    if np.any(physics.drive_stiffness(p) > 0.0):
         # Every block lags the plate by c / Kp: compare positions in the plate's frame.
         ss = physics.chain_steady_state(p, float(np.float64(state.step) * p.dt))
         return float(max(np.max(np.abs(state.v[1:-1] - ss["v"])), np.max(np.abs(state.x[1:-1] - ss["x"]))))
     ss = physics.chain_steady_state(p)
     x = state.x[1:-1]
-    x0 = p.V * (np.float64(state.step) * p.dt)
+    # x_0: the pulling point V t_n (end drive) or the ends' ghost cell (a force drive), as the kernels set it.
+    x0 = physics.left_ghost(p, p.V * (np.float64(state.step) * p.dt), x[0], x[-1])
     ext = np.diff(np.concatenate(([x0], x))) * -1.0
     return float(
         max(
@@ -302,7 +333,7 @@ def loading_warnings(
     (:func:`stickslip.models.physics.loading_time`). One message if the run ends before that, one if
     the <L> average (from ``average_from``, default t_end / 2) starts before it; none otherwise.
     """
-    t_load = physics.loading_time(p)
+    t_load = closed_form(physics.loading_time, p)
     if start not in ("paper", "rest") or not np.isfinite(t_load):
         return []
     where = (

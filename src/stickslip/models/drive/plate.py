@@ -3,7 +3,7 @@ by a leaf spring Kp."""
 
 from __future__ import annotations
 
-from stickslip.models.piece import Piece, kernel_params, njit
+from stickslip.models.piece import Param, Piece, kernel_params, njit
 
 READS = ("Kp",)
 Params = kernel_params(__name__, READS)
@@ -32,6 +32,16 @@ PIECE = Piece(
     "plate",
     "every block joined to a plate at V t by a leaf spring Kp: f_i gains Kp (V t - x_i)",
     READS,
+    params=(
+        Param(
+            "Kp",
+            1.0,
+            "leaf spring Kp joining each block to the plate (plate drive)",
+            low=0.0,
+            low_open=True,
+            symbol="K_p",
+        ),
+    ),
     leaf_spring=True,
     module=__name__,
     lanes=True,

@@ -14,7 +14,7 @@ def ghost(edge, other, wall):
 PIECE = Piece(
     "ends",
     "fixed",
-    "x_{N+1} = 0 (plate drive: also x_0 = 0)",
+    "x_{N+1} = 0 (a drive on every block: also x_0 = 0)",
     steady_sliding=False,
     wall=True,
     module=__name__,

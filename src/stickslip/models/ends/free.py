@@ -11,4 +11,4 @@ def ghost(edge, other, wall):
     return edge
 
 
-PIECE = Piece("ends", "free", "x_{N+1} = x_N (plate drive: also x_0 = x_1)", module=__name__)
+PIECE = Piece("ends", "free", "x_{N+1} = x_N (a drive on every block: also x_0 = x_1)", module=__name__)

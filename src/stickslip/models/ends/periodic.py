@@ -11,4 +11,4 @@ def ghost(edge, other, wall):
     return other
 
 
-PIECE = Piece("ends", "periodic", "x_0 = x_N, x_{N+1} = x_1 (plate drive only)", ring=True, module=__name__)
+PIECE = Piece("ends", "periodic", "x_0 = x_N, x_{N+1} = x_1 (a drive on every block only)", ring=True, module=__name__)

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from stickslip.models.piece import Piece, kernel_params, njit
+from stickslip.models.piece import Param, Piece, kernel_params, njit
 
 READS = ("beta", "F0")
 Params = kernel_params(__name__, READS)
@@ -41,6 +41,7 @@ PIECE = Piece(
     "strengthening",
     "F0 + beta v, no state variable (train model)",
     READS,
+    params=(Param("F0", 1.0, "constant part F0 of strengthening friction (train model)", low=0.0, symbol="F_0"),),
     steady=_steady,
     slope=_slope,
     module=__name__,

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from stickslip.models.piece import Piece, kernel_params, njit
+from stickslip.models.piece import Param, Piece, kernel_params, njit
 
 READS = ("alpha", "sigma")
 Params = kernel_params(__name__, READS)
@@ -56,6 +56,17 @@ PIECE = Piece(
     "weakening",
     "phi(v) = (1 - sigma) / (1 + 2 alpha max(v, 0) / (1 - sigma)) (Carlson-Langer)",
     READS,
+    params=(
+        Param(
+            "sigma",
+            0.01,
+            "friction drop sigma of velocity weakening (CL)",
+            low=0.0,
+            high=1.0,
+            high_open=True,
+            symbol=r"\sigma",
+        ),
+    ),
     steady=_steady,
     slope=_slope,
     stability_extras=_extras,
