@@ -138,3 +138,14 @@ def test_tiny_disorder_study_end_to_end(tmp_path, cluster):
     second = run_study(spec, tmp_path, scheduler=cluster, progress=False)
     assert second["run"] == 0 and second["reused"] == len(spec.points)
     assert second["findings"]["statements"] == first["findings"]["statements"]
+
+
+def test_the_study_has_its_own_help(capsys):
+    from stickslip.cli import main
+
+    with pytest.raises(SystemExit) as stop:
+        main(["study", "disorder", "--help"])
+    assert stop.value.code == 0
+    text = " ".join(capsys.readouterr().out.split())
+    for words in ("usage: stickslip study disorder", "qEW's 1.11", "87 runs", "299 runs", "ramp_tau", "index.html"):
+        assert words in text, words

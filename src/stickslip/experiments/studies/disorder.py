@@ -389,8 +389,9 @@ def describe() -> str:
         "random Fs) under a slowly increased force: tau of its avalanches against N and beta beside qEW's 1.11; "
         "(c) the mean velocity against a constant force through depinning, strengthening against "
         f"Carlson-Langer's weakening. Grid: --quick {quick.note.split(': ', 1)[1]} ({len(quick.points)} runs, "
-        f"about 15 minutes on two loaded cores); --full {full.note.split(': ', 1)[1]} ({len(full.points)} runs, "
-        "about 1.5 hours on two cores). Outputs in DIR/disorder/: table.parquet and table.csv (one row per run), "
+        f"8 to 10 minutes on two free cores, 28 minutes measured on a loaded machine); --full "
+        f"{full.note.split(': ', 1)[1]} ({len(full.points)} runs, estimated 25 to 30 minutes on two free cores). "
+        "Outputs in DIR/disorder/: table.parquet and table.csv (one row per run), "
         "order_beta, ramp_tau and force_velocity (PNG, PDF), study.json, index.html."
     )
 
