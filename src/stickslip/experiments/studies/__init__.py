@@ -10,7 +10,9 @@ naming one.
 :data:`STUDIES` are the questions the paper leaves open: the stick-slip transition at beta = 1 as
 N grows (``transition``), the final state and m over (alpha, beta) and (D, beta)
 (``phase-diagram``), the slip-size exponent tau (``exponents``) and whether the chain is chaotic
-at the onset (``chaos``). :data:`PAPER` are the paper's own figures and stated numbers, each with
+at the onset (``chaos``), and the chain with random thresholds: the transition, avalanches
+under a force ramp beside qEW, depinning under a constant force (``disorder``).
+:data:`PAPER` are the paper's own figures and stated numbers, each with
 one page: the single block of section 2 and the Fourier modes of Fig. 4 (``figs1-4``) and the
 chain runs of section 3 (``figs5-8``); ``stickslip reproduce`` gathers them into one report
 (:mod:`stickslip.experiments.reproduce`).
