@@ -390,7 +390,7 @@ def describe() -> str:
         "(c) the mean velocity against a constant force through depinning, strengthening against "
         f"Carlson-Langer's weakening. Grid: --quick {quick.note.split(': ', 1)[1]} ({len(quick.points)} runs, "
         f"8 to 10 minutes on two free cores, 28 minutes measured on a loaded machine); --full "
-        f"{full.note.split(': ', 1)[1]} ({len(full.points)} runs, estimated 25 to 30 minutes on two free cores). "
+        f"{full.note.split(': ', 1)[1]} ({len(full.points)} runs, estimated 25 to 31 minutes on two free cores). "
         "Outputs in DIR/disorder/: table.parquet and table.csv (one row per run), "
         "order_beta, ramp_tau and force_velocity (PNG, PDF), study.json, index.html."
     )
