@@ -10,7 +10,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from stickslip.experiments.studies import study
+from stickslip.experiments.studies import Study, study
 from stickslip.experiments.studies.disorder import findings, part_a, part_c, qew_tau, ramp_fits
 from stickslip.experiments.studies.disorder_points import depinning_force, seeded_point
 from stickslip.experiments.study_run import run_study
@@ -64,8 +64,9 @@ def _power_law(tau: float, n: int, s_min: float, s_max: float, seed: int) -> np.
 
 def _synthetic() -> pd.DataFrame:
     rows = []
-    # (a): w = 0 leaves stick-slip between 1.1 and 1.2, w = 0.2 between 1.0 and 1.1
-    for w, last in ((0.0, 1.1), (0.2, 1.0)):
+    # (a): w = 0 leaves stick-slip between 1.1 and 1.2, w = 0.2 between 1.0 and 1.1 (brackets that
+    # touch: not moved), w = 0.4 between 0.9 and 1.0 (moved); tau = 1.5 + w exactly
+    for w, last in ((0.0, 1.1), (0.2, 1.0), (0.4, 0.9)):
         for b in (0.9, 1.0, 1.1, 1.2):
             state = "stick-slip" if b <= last else "steady"
             m = 0.3 * (last + 0.05 - b) if b <= last else 0.0
@@ -75,8 +76,8 @@ def _synthetic() -> pd.DataFrame:
         rows.append({"part": "a", "analysis": "sizes", "w": w, "beta": 0.4, "tau": 1.5 + w, "tau_err": 0.02})
     # (b): three seeds of sizes from p(S) ~ S^-1.11 on [1e-3, 10]; one seed never depins
     for s, Fc in enumerate((2.3, 2.5, math.nan)):
-        S = _power_law(1.11, 4000, 1e-3, 10.0, seed=s)
-        rows.append({"part": "b", "N": 256, "beta": 1.0, "F_c": Fc, "sizes": json.dumps(S.tolist())})
+        S = _power_law(1.11, 1500, 1e-3, 10.0, seed=s)
+        rows.append({"part": "b", "N": 256, "beta": 0.5, "F_c": Fc, "sizes": json.dumps(S.tolist())})
     # (c): strengthening, F0 = 2, beta = 1: pinned up to 2.2, then (F - F0) / beta
     for F in (2.1, 2.2, 2.3, 2.4):
         v = F - 2.0 if F >= 2.3 else 0.0
@@ -93,8 +94,8 @@ def test_findings_on_a_synthetic_table():
     assert (a[0.0]["beta_lo"], a[0.0]["beta_hi"]) == (1.1, 1.2) and (a[0.2]["beta_lo"], a[0.2]["beta_hi"]) == (1.0, 1.1)
     assert a[0.0]["m_step"] == pytest.approx(0.3 * 0.05) and a[0.2]["tau"] == pytest.approx(1.7)
 
-    (fit,) = ramp_fits(table, bootstrap=50)
-    assert (fit["seeds"], fit["events"], fit["pinned_runs"]) == (3, 12000, 1)
+    (fit,) = ramp_fits(table, bootstrap=20)
+    assert (fit["seeds"], fit["events"], fit["pinned_runs"]) == (3, 4500, 1)
     assert fit["F_c"] == pytest.approx(2.4) and fit["F_c_sd"] == pytest.approx(math.sqrt(0.02))
     # the pooled sizes come from tau = 1.11: the fit finds it within a few of its errors
     assert abs(fit["tau"] - 1.11) < max(4 * fit["tau_err"], 0.03)
@@ -104,9 +105,12 @@ def test_findings_on_a_synthetic_table():
     assert c["jump_closed_form"] == pytest.approx(0.3) and c["closed_form_dev"] == pytest.approx(0.0, abs=1e-12)
 
     spec = study("disorder", "tiny")
-    found = findings(spec, table)
+    found = findings(Study("disorder", "tiny", {**spec.common, "bootstrap": 20}, spec.points), table)
     text = "\n".join(found["statements"])
-    assert "moved by -0.1 from w = 0" in text
+    assert "moved by -0.1 from w = 0" in text and "moved by -0.2 from w = 0" in text
+    assert "it moves beyond the brackets' widths at w = 0.4;" not in text
+    assert "it moves beyond the brackets' widths at w = 0.4" in text
+    assert "tau at beta = 0.4 changes by +1.00 +- 0.07 per unit w" in text
     assert "qEW's 1.111" in text and "no power law (F - F_c)^theta" in text
 
 
@@ -134,3 +138,14 @@ def test_tiny_disorder_study_end_to_end(tmp_path, cluster):
     second = run_study(spec, tmp_path, scheduler=cluster, progress=False)
     assert second["run"] == 0 and second["reused"] == len(spec.points)
     assert second["findings"]["statements"] == first["findings"]["statements"]
+
+
+def test_the_study_has_its_own_help(capsys):
+    from stickslip.cli import main
+
+    with pytest.raises(SystemExit) as stop:
+        main(["study", "disorder", "--help"])
+    assert stop.value.code == 0
+    text = " ".join(capsys.readouterr().out.split())
+    for words in ("usage: stickslip study disorder", "qEW's 1.11", "87 runs", "299 runs", "ramp_tau", "index.html"):
+        assert words in text, words

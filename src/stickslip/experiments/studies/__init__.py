@@ -10,10 +10,12 @@ naming one.
 :data:`STUDIES` are the questions the paper leaves open: the stick-slip transition at beta = 1 as
 N grows (``transition``), the final state and m over (alpha, beta) and (D, beta)
 (``phase-diagram``), the slip-size exponent tau (``exponents``), whether the chain is chaotic
-at the onset (``chaos``) and how long its irregular motion lasts against N (``lifetimes``).
-:data:`PAPER` are the paper's own figures and stated numbers, each with one page: the single
-block of section 2 and the Fourier modes of Fig. 4 (``figs1-4``) and the chain runs of section 3
-(``figs5-8``); ``stickslip reproduce`` gathers them into one report
+at the onset (``chaos``), how long its irregular motion lasts against N (``lifetimes``), and the
+chain with random thresholds: the transition, avalanches under a force ramp beside qEW,
+depinning under a constant force (``disorder``). :data:`PAPER` are the paper's own figures and
+stated numbers, each with one page: the single block of section 2 and the Fourier modes of Fig. 4
+(``figs1-4``) and the chain runs of section 3 (``figs5-8``); ``stickslip reproduce`` gathers them
+into one report
 (:mod:`stickslip.experiments.reproduce`).
 
 A :class:`Study`'s key hashes its name, the settings every point shares and the package version

@@ -261,6 +261,33 @@ def table_of(frame: pd.DataFrame) -> list[dict[str, Any]]:
     return [{k: float(v) for k, v in r.items()} for r in frame.to_dict(orient="records")]
 
 
+def _a_summary(per_w: list[dict[str, Any]]) -> list[str]:
+    """Part a in two lines: whether the bracket of the transition moves with w beyond its own
+    width, and tau's least-squares change with w (weighted by its errors) with the error of
+    that slope."""
+    out = []
+    ok = [r for r in per_w if finite(r.get("beta_t")) and finite(r.get("beta_t_err"))]
+    ref = next((r for r in ok if r["w"] == 0.0), None)
+    if ref is not None and len(ok) > 1:
+        moved = [r for r in ok if abs(r["beta_t"] - ref["beta_t"]) > r["beta_t_err"] + ref["beta_t_err"]]
+        out.append(
+            f"(a) the transition's bracket at w = 0 is [{short(ref['beta_lo'])}, {short(ref['beta_hi'])}]; "
+            + (
+                "it moves beyond the brackets' widths at w = " + ", ".join(f"{r['w']:g}" for r in moved)
+                if moved
+                else "no width moves it beyond the brackets' widths (the grid's resolution)"
+            )
+        )
+    taus = [r for r in per_w if finite(r.get("tau")) and finite(r.get("tau_err")) and r["tau_err"] > 0]
+    if len(taus) > 2:
+        w = np.array([r["w"] for r in taus])
+        t = np.array([r["tau"] for r in taus])
+        e = np.array([r["tau_err"] for r in taus])
+        (slope, _), cov = np.polyfit(w, t, 1, w=1.0 / e, cov="unscaled")
+        out.append(f"(a) tau at beta = 0.4 changes by {slope:+.2f} +- {math.sqrt(cov[0, 0]):.2f} per unit w")
+    return out
+
+
 def findings(spec: Study, table: pd.DataFrame) -> dict[str, Any]:
     """The statements of the three parts (module docstring) and their numbers."""
     tau_q, tau_q_err = qew_tau()
@@ -276,6 +303,7 @@ def findings(spec: Study, table: pd.DataFrame) -> dict[str, Any]:
             f"{short(r.get('beta_hi'))}{moved}; m at the last stick-slip beta {short(r.get('m_step'))}; "
             f"tau at beta = 0.4: {short(r.get('tau'))} +- {short(r.get('tau_err'), 2)}"
         )
+    say.extend(_a_summary(a["per_w"]))
     for f in fits:
         dev = (f["tau"] - tau_q) / math.hypot(f["tau_err"], tau_q_err) if finite(f["tau_err"]) else math.nan
         say.append(
@@ -352,6 +380,12 @@ def _tables(found: dict[str, Any]) -> list[tuple[str, list[str], list[dict[str, 
     ]  # fmt: skip
 
 
+COST = {
+    "quick": "8 to 10 minutes on two free cores (estimated; 28 minutes measured on a loaded machine)",
+    "full": "25 to 31 minutes on two free cores (estimated)",
+}
+
+
 def describe() -> str:
     """The text of ``stickslip study disorder --help``."""
     quick, full = build("quick"), build("full")
@@ -361,13 +395,14 @@ def describe() -> str:
         "random Fs) under a slowly increased force: tau of its avalanches against N and beta beside qEW's 1.11; "
         "(c) the mean velocity against a constant force through depinning, strengthening against "
         f"Carlson-Langer's weakening. Grid: --quick {quick.note.split(': ', 1)[1]} ({len(quick.points)} runs, "
-        f"about 15 minutes on two loaded cores); --full {full.note.split(': ', 1)[1]} ({len(full.points)} runs, "
-        "about 1.5 hours on two cores). Outputs in DIR/disorder/: table.parquet and table.csv (one row per run), "
+        f"{COST['quick']}); --full {full.note.split(': ', 1)[1]} ({len(full.points)} runs, {COST['full']}). "
+        "Outputs in DIR/disorder/: table.parquet and table.csv (one row per run), "
         "order_beta, ramp_tau and force_velocity (PNG, PDF), study.json, index.html."
     )
 
 
 DESIGN = Design(
+    cost=COST,
     name="disorder",
     summary="random thresholds: the transition, avalanches under a force ramp (qEW), depinning",
     describe=describe,
