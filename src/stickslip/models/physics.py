@@ -191,7 +191,8 @@ def steady_velocity(p: Any) -> float:
     at which the frictions balance the applied forces, sum_i c_i(v) = sum_i F_i (Brent's method;
     for the strengthening law F0 + beta v it is (sum F_i - sum F0_i) / sum beta_i).
 
-    Raises ValueError where no v >= 0 balances them (the forces below the friction at v = 0).
+    The first root above v = 0 found by doubling a bracket (a weakening law below its friction at
+    rest balances on its falling branch). Raises ValueError where no v >= 0 balances them.
     """
     forces = applied_forces(p)
     if forces is None:
@@ -201,15 +202,18 @@ def steady_velocity(p: Any) -> float:
     def excess(v: float) -> float:
         return float(np.sum(block_frictions(p, v)[0])) - total
 
-    if excess(0.0) > 0.0:
-        raise ValueError("the applied force is below the friction at v = 0: the chain cannot slide steadily")
+    at_rest = excess(0.0)
+    if at_rest == 0.0:
+        return 0.0
     hi = 1.0
     for _ in range(200):
-        if excess(hi) >= 0.0:
+        if (excess(hi) > 0.0) != (at_rest > 0.0):
             break
         hi *= 2.0
     else:
-        raise ValueError("the friction does not balance the applied force at any velocity")
+        raise ValueError(
+            f"the friction does not balance the applied force at any velocity (drive {p.drive}, friction {p.friction})"
+        )
     return float(brentq(excess, 0.0, hi, xtol=1e-15, rtol=4.0 * np.finfo(float).eps))
 
 
