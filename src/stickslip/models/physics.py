@@ -6,7 +6,7 @@ package; arrays hold block i at index i - 1. The pulling point is x_0 = V t.
 
 from __future__ import annotations
 
-import dataclasses
+import functools
 import importlib
 from typing import Any
 
@@ -50,11 +50,15 @@ def per_block(p: Any, name: str) -> np.ndarray:
 def is_uniform(p: Any) -> bool:
     """Whether every block has the same parameters: no field of ``p`` is an array of N values
     with two different entries (a uniform chain given as arrays counts as uniform)."""
-    for f in dataclasses.fields(p):
-        value = getattr(p, f.name)
-        if isinstance(value, np.ndarray) and value.ndim == 1 and value.size > 1 and np.any(value != value[0]):
+    for value in _arrays(p):
+        if value.ndim == 1 and value.size > 1 and np.any(value != value[0]):
             return False
     return True
+
+
+def _arrays(p: Any) -> list[np.ndarray]:
+    """The fields of ``p`` that are arrays (none for a chain of floats)."""
+    return [v for v in vars(p).values() if isinstance(v, np.ndarray)]
 
 
 class BlockView:
@@ -80,12 +84,9 @@ class BlockView:
         return value
 
 
-def _uniform_view(p: Any, **overrides: float) -> Any:
+def uniform_view(p: Any, **overrides: float) -> Any:
     """``p`` itself for a chain of floats, else block 1's view (for a uniform chain given as arrays)."""
-    scalar = all(
-        not (isinstance(getattr(p, f.name), np.ndarray) and getattr(p, f.name).ndim == 1) for f in dataclasses.fields(p)
-    )
-    return p if scalar and not overrides else BlockView(p, 0, **overrides)
+    return p if not _arrays(p) and not overrides else BlockView(p, 0, **overrides)
 
 
 def steady_friction(p: ChainParams) -> tuple[float, float]:
@@ -106,7 +107,7 @@ def block_frictions(p: Any, v: float | None = None) -> tuple[np.ndarray, np.ndar
     over = {} if v is None else {"V": float(v)}
     steady = p.friction_piece.steady
     if is_uniform(p):
-        c, theta0 = steady(_uniform_view(p, **over))
+        c, theta0 = steady(uniform_view(p, **over))
         return np.full(p.N, c), np.full(p.N, theta0)
     pairs = [steady(BlockView(p, i, **over)) for i in range(p.N)]
     return np.array([c for c, _ in pairs]), np.array([th for _, th in pairs])
@@ -118,14 +119,38 @@ def applied_forces(p: Any) -> np.ndarray | None:
     applied = p.drive_piece.applied
     if applied is None:
         return None
+    if is_uniform(p):
+        return np.full(p.N, float(applied(BlockView(p, 0))))
     return np.array([applied(BlockView(p, i)) for i in range(p.N)])
 
 
+def _cached(fn):
+    """``fn(p)`` remembered for parameters that hash (floats; a chain with arrays is computed each
+    time), its arrays read-only: the steady stop asks at every sample."""
+    remembered = functools.lru_cache(maxsize=64)(fn)
+
+    @functools.wraps(fn)
+    def wrapper(p):
+        try:
+            out = remembered(p)
+        except TypeError:  # an array among the parameters
+            return fn(p)
+        for a in out.values() if isinstance(out, dict) else (out,):
+            if isinstance(a, np.ndarray):
+                a.flags.writeable = False
+        return out
+
+    return wrapper
+
+
+@_cached
 def drive_stiffness(p: Any) -> np.ndarray:
     """The stiffness of the spring joining each block to the drive: the drive's compiled ``leaf``
     (Kp for the plate, 0 for the end drive and the force drives) at each block's parameters."""
-    mod = importlib.import_module(p.drive_piece.module)
-    return np.array([float(mod.leaf.py_func(block_kernel_params(p.drive_piece, p, i))) for i in range(p.N)])
+    leaf = importlib.import_module(p.drive_piece.module).leaf.py_func
+    if is_uniform(p):
+        return np.full(p.N, float(leaf(block_kernel_params(p.drive_piece, p, 0))))
+    return np.array([float(leaf(block_kernel_params(p.drive_piece, p, i))) for i in range(p.N)])
 
 
 def block_kernel_params(piece: Any, p: Any, i: int) -> tuple:
@@ -134,6 +159,7 @@ def block_kernel_params(piece: Any, p: Any, i: int) -> tuple:
     return importlib.import_module(piece.module).Params(*(float(getattr(view, r)) for r in piece.reads))
 
 
+@_cached
 def ghost_rows(p: Any) -> dict[str, tuple[float, float]]:
     """The ghost cells of the chain as linear functions of the end blocks, from the pieces' own
     compiled ``left`` and ``ghost`` (the rows the kernels' :func:`stickslip.kernels.laws._set_ghosts`
@@ -236,7 +262,7 @@ def chain_steady_state(p: ChainParams, t: float = 0.0) -> dict[str, np.ndarray]:
     N = p.N
     uniform = is_uniform(p)
     if uniform and p.drive_piece.applied is None:
-        c, theta0 = steady_friction(_uniform_view(p))
+        c, theta0 = steady_friction(uniform_view(p))
         friction: Any = c
         v = p.V
         theta = np.full(N, theta0)
@@ -291,6 +317,14 @@ def _check_theta_decoupled(p: Any, theta: np.ndarray, v: float) -> None:
         )
 
 
+@_cached
+def steady_reference(p: Any) -> dict[str, Any]:
+    """:func:`chain_steady_state` at t = 0 and whether the drive holds every block's position (a
+    leaf spring, so steady sliding is compared in the plate's frame): what the steady stop compares
+    a state with at every sample, computed once per parameters."""
+    return {**chain_steady_state(p, 0.0), "pinned": bool(np.any(drive_stiffness(p) > 0.0))}
+
+
 def _extensions(x: np.ndarray, rows: dict[str, tuple[float, float]]) -> np.ndarray:
     """x_{i-1} - x_i, i = 1..N, with x_0 the ends' ghost cell (weights ``rows['x0']``)."""
     a1, aN = rows["x0"]
@@ -328,7 +362,7 @@ def chain_steady_length(p: ChainParams) -> float:
         return float(x[0] - x[-1])
     if p.drive_piece.leaf_spring:
         return 0.0
-    c = steady_friction(_uniform_view(p))[0]
+    c = steady_friction(uniform_view(p))[0]
     return c / p.K * p.N * (p.N - 1) / 2.0
 
 
