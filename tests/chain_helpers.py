@@ -390,3 +390,19 @@ def run_cli(capsys, *argv: str) -> tuple[int, str, str]:
         status = exc.code
     out, err = capsys.readouterr()
     return status, out, err
+
+
+def record_lock_tries(monkeypatch) -> list:
+    """The ``timeout`` of every try at a run directory's lock from now on (0: tried, not waited
+    for), so that a test shows "refused at once" by what was done rather than by a clock."""
+    import filelock
+
+    tries: list = []
+    acquire = filelock.FileLock.acquire
+
+    def spy(self, *args, **kwargs):
+        tries.append(kwargs.get("timeout", args[0] if args else None))
+        return acquire(self, *args, **kwargs)
+
+    monkeypatch.setattr(filelock.FileLock, "acquire", spy)
+    return tries

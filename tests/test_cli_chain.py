@@ -70,7 +70,7 @@ BAD = [
     (["--t-end=-1"], "t-end"),
     (["--t-end", "nan"], "t-end"),
     (["--checkpoint-interval", "0"], "checkpoint-interval"),
-    (["--sample-interval", "0"], "sample_interval"),
+    (["--sample-interval", "0"], "--sample-interval"),
     (["--perturbation=-0.1", "--start", "steady"], "perturbation"),
     (["--snapshot", "1e9"], "snapshot"),
     (["--start", "flat"], "start"),

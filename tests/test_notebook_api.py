@@ -171,15 +171,42 @@ def test_save_writes_the_run_directory_the_command_writes(run, tmp_path):
     # a folder holding a run already is refused, as the command refuses it
     with pytest.raises(ParameterError, match="already holds a finished run"):
         run.save(folder)
+    # ... unless told to replace it, as `stickslip chain --overwrite` does; a user's file stays
+    (folder / "notes.txt").write_text("mine")
+    old_id = (folder / ".run_id").read_text()
+    assert run.save(folder, overwrite=True) == folder
+    assert (folder / "notes.txt").read_text() == "mine" and (folder / ".run_id").read_text() != old_id
+    assert stickslip.load_run(folder).summary["state_sha256"] == run.summary["state_sha256"]
+
+
+def test_a_missing_run_directory_is_a_file_not_found_error(tmp_path):
+    """As Python code expects of a missing path (and still a RunDirDamaged, as before)."""
+    from stickslip.run.rundir import RunDirDamaged
+
+    with pytest.raises(FileNotFoundError, match="no such run directory") as info:
+        stickslip.load_run(tmp_path / "nowhere")
+    assert isinstance(info.value, RunDirDamaged) and info.value.filename == str(tmp_path / "nowhere")
+    (tmp_path / "half").mkdir()
+    with pytest.raises(FileNotFoundError, match="run.json is missing"):
+        stickslip.load_run(tmp_path / "half")
+
+
+def test_a_non_finite_state_is_an_arithmetic_error():
+    from stickslip.run.errors import NonFiniteState
+
+    assert issubclass(NonFiniteState, ArithmeticError)
 
 
 def test_plot_methods_draw_into_the_given_axes(run):
+    """Given ``ax``, a plot method returns that Axes (as pandas' and seaborn's do); without, its
+    new Figure."""
     fig = Figure()
     axes = fig.subplots(2, 2)
-    assert run.plot_length(ax=axes[0, 0]) is fig
-    assert run.plot_snapshot(ax=axes[0, 1]) is fig
-    assert run.plot_sizes(ax=axes[1, 0]) is fig
-    assert run.plot_fronts(ax=axes[1, 1]) is fig
+    assert run.plot_length(ax=axes[0, 0]) is axes[0, 0]
+    assert run.plot_snapshot(ax=axes[0, 1]) is axes[0, 1]
+    assert run.plot_sizes(ax=axes[1, 0]) is axes[1, 0]
+    assert run.plot_fronts(ax=axes[1, 1]) is axes[1, 1]
+    assert isinstance(run.plot_length(), Figure)
     assert len(fig.axes) == 4
     (L,) = [ln for ln in axes[0, 0].get_lines() if ln.get_label().startswith("$L(t)")]
     np.testing.assert_array_equal(L.get_ydata(), run.samples["L"].values)

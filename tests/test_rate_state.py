@@ -286,3 +286,24 @@ def test_command_line(capsys):
     )
     assert status == 0, err
     assert math.isfinite(json.loads(out)["lyapunov_dt0"])
+
+
+def test_the_spring_sliders_tiny_slips_as_documented():
+    """docs/models/rate-state.md, "The spring-slider's tiny slips": at K = 20 (below k_c = 25.5)
+    each large slip (S = 0.0164, one every 16.7) follows two tiny ones (S ~ 1.4e-4)."""
+    import warnings
+
+    from stickslip import chain_params, run_chain
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        run = run_chain(chain_params(N=1, friction="rate-state", K=20), 2000.0)
+    S = run.events["S"].to_numpy()
+    t = run.events["t_start"].to_numpy()
+    large = np.flatnonzero(S > 1e-3)
+    assert (len(S), len(large)) == (362, 110) and large[0] == 32
+    assert np.all(np.diff(large) == 3), "two tiny slips before each large one"
+    assert S[large].mean() == pytest.approx(0.0164, rel=0.01)
+    assert np.median(np.diff(t[large])) == pytest.approx(16.7, rel=0.01)
+    tiny = np.delete(S, large)
+    assert 7e-5 < tiny.min() and tiny.max() < 1.6e-4 and np.median(tiny) == pytest.approx(1.4e-4, rel=0.05)

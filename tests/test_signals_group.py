@@ -43,7 +43,8 @@ def _started(out):
 def _launch_in_group(argv, started, sig, *, settle=1.5, timeout=180.0):
     """Start ``stickslip ARGV`` as the leader of a new process group; once ``started()`` holds and
     ``settle`` seconds more have passed, send ``sig`` to the whole group; return (status, stdout,
-    stderr, seconds from the signal to the end)."""
+    stderr). That the running point stopped at once shows in its folder (a checkpoint, no
+    ``done.json``), not in seconds, which a loaded machine stretches."""
     proc = subprocess.Popen(
         stickslip_cmd() + argv,
         stdout=subprocess.PIPE,
@@ -61,10 +62,9 @@ def _launch_in_group(argv, started, sig, *, settle=1.5, timeout=180.0):
             time.sleep(0.05)
         time.sleep(settle)
         assert proc.poll() is None, "the work ended before the signal: make it longer"
-        sent = time.monotonic()
         os.killpg(proc.pid, sig)
         stdout, stderr = proc.communicate(timeout=timeout)
-        return proc.returncode, stdout, stderr, time.monotonic() - sent
+        return proc.returncode, stdout, stderr
     finally:
         if proc.poll() is None:
             os.killpg(proc.pid, signal.SIGKILL)
@@ -80,11 +80,10 @@ def reference():
 def test_signal_to_the_process_group_of_a_sweep(sig, tmp_path, reference):
     out = tmp_path / "sweep"
     argv = [*SWEEP, "--out", str(out)]
-    status, stdout, stderr, waited = _launch_in_group(argv, lambda: _started(out), sig)
+    status, stdout, stderr = _launch_in_group(argv, lambda: _started(out), sig)
     assert status == 130, stderr
     lines = _said(stderr)
     assert len(lines) == 1 and "interrupted" in lines[0] and "Traceback" not in stderr, stderr
-    assert waited < 30, "the running point stops at once, not after the driver's wait"
     pts = _points(out)
     assert (pts["N=5"] / "done.json").is_file(), "the finished point stays"
     long = pts["N=399"]
@@ -127,7 +126,7 @@ def test_ctrl_c_in_a_terminal_stops_a_sweep(tmp_path):
             if sent is None and _started(out):
                 time.sleep(1.5)
                 os.write(fd, b"\x03")  # the terminal's interrupt character
-                sent = time.monotonic()
+                sent = True
         _, status = os.waitpid(pid, 0)
     finally:
         try:
@@ -138,7 +137,6 @@ def test_ctrl_c_in_a_terminal_stops_a_sweep(tmp_path):
         os.close(fd)
     assert sent is not None, "the long point never started"
     assert os.waitstatus_to_exitcode(status) == 130, text.decode(errors="replace")
-    assert time.monotonic() - sent < 30
     shown = text.decode(errors="replace")
     assert "Traceback" not in shown and "interrupted" in shown, shown
     assert (out / "N=399" / "checkpoint" / "state.npz").is_file()
@@ -151,12 +149,11 @@ def test_sigterm_to_the_process_group_of_a_study(tmp_path):
     start continues that rung from it."""
     out = tmp_path / "studies"
     argv = ["study", "transition", "--quick", "--workers", "1", "--out", str(out), "--no-progress"]
-    status, stdout, stderr, waited = _launch_in_group(
+    status, stdout, stderr = _launch_in_group(
         argv, lambda: bool(list(out.glob("runs/*/points/*/rungs/*/progress.npz"))), signal.SIGTERM, settle=1.0
     )
     assert status == 130 and stdout == "", stderr
     assert len(_said(stderr)) == 1 and "Traceback" not in stderr, stderr
-    assert waited < 30
     (point,) = [p.parent for p in out.glob("runs/*/points/*/point.json")]
     (progress,) = point.glob("rungs/*/progress.npz")
     assert not (point / "done.json").exists() and not (progress.parent / "rung.json").exists()
@@ -166,7 +163,7 @@ def test_sigterm_to_the_process_group_of_a_study(tmp_path):
     step = int(read_npz(progress)[0]["ist"][layout.STEP])
     assert step > 0, "the kept progress holds the work done"
     # the next start continues from there: stopped again, the rung has moved on (or is written)
-    status, _, stderr, _ = _launch_in_group(argv, lambda: True, signal.SIGTERM, settle=15.0)
+    status, _, stderr = _launch_in_group(argv, lambda: True, signal.SIGTERM, settle=15.0)
     assert status == 130, stderr
     written = (progress.parent / "rung.json").is_file()
     assert written or int(read_npz(progress)[0]["ist"][layout.STEP]) > step

@@ -9,7 +9,6 @@ import shutil
 import subprocess
 import sys
 import threading
-import time
 
 import pytest
 
@@ -74,7 +73,15 @@ REFUSED = [
 
 
 @pytest.mark.parametrize("what, base, put, extra, named", REFUSED, ids=[c[0] for c in REFUSED])
-def test_foreign_files_refused_before_the_first_point(what, base, put, extra, named, tmp_path, finished, capsys):
+def test_foreign_files_refused_before_the_first_point(
+    what, base, put, extra, named, tmp_path, finished, capsys, monkeypatch
+):
+    from stickslip.experiments import sweep
+
+    def no_points(*args, **kwargs):
+        raise AssertionError("the points ran before the refusal")
+
+    monkeypatch.setattr(sweep, "run_sweep", no_points)
     out = tmp_path / "out"
     if base == "finished":
         shutil.copytree(finished, out)
@@ -83,12 +90,10 @@ def test_foreign_files_refused_before_the_first_point(what, base, put, extra, na
     put(out)
     before = {p: p.read_bytes() for p in out.rglob("*") if p.is_file()}
     capsys.readouterr()
-    start = time.monotonic()
     status = main([*ARGV, "--out", str(out), *extra])
     stdout, err = capsys.readouterr()
     assert status == 2 and stdout == "", err
     assert err.count("\n") == 1 and "Traceback" not in err and named in err, err
-    assert time.monotonic() - start < 20, "refused up front, not after the points ran"
     assert {p: p.read_bytes() for p in out.rglob("*") if p.is_file()} == before, "nothing written, nothing removed"
 
 
@@ -126,7 +131,8 @@ def test_second_study_into_the_same_folder_refused_at_once(tmp_path):
     try:
         assert holder.stdout.readline().strip() == "held"
         before = _tree(out)
-        start = time.monotonic()
+        # refused at once: waiting for the holder (600 s) would meet the timeout, running points
+        # would change the tree
         proc = subprocess.run(
             [sys.executable, "-m", "stickslip.cli", *ARGV, "--out", str(out)],
             capture_output=True,
@@ -136,7 +142,6 @@ def test_second_study_into_the_same_folder_refused_at_once(tmp_path):
         )
         assert proc.returncode == 2 and proc.stdout == "", proc.stderr
         assert proc.stderr.count("\n") == 1 and f"pid {holder.pid}" in proc.stderr, proc.stderr
-        assert time.monotonic() - start < 30
         assert _tree(out) == before
     finally:
         holder.kill()

@@ -25,9 +25,8 @@ try:
 except PackageNotFoundError:  # running from a source tree that is not installed
     __version__ = "0.0.0+unknown"
 
-# The friction laws' compiled functions (models/friction/) are cached with the kernels, in the
-# directory of this version of them (kernels/_cache.py): set it before the laws are decorated.
-import stickslip.kernels  # noqa: E402,F401
+# The pieces' compiled functions (models/) are decorated when first asked for, after the kernels'
+# cache directory is set (models/piece.py, kernels/_cache.py): importing the package loads no numba.
 from stickslip.models.params import BlockParams, ChainParams, ParameterError  # noqa: E402
 
 #: Names loaded on first use, and the module that holds each.
@@ -43,6 +42,12 @@ _LAZY = {
 }
 
 __all__ = ["BlockParams", "ChainParams", "ParameterError", "__version__", *_LAZY]
+
+# A run's figures, lent by the plotting to the runs (``run.plot.sizes()``, ``run.plot_sizes()``)
+# from above the layers: stickslip.run never imports stickslip.plotting.
+from stickslip import accessors as _accessors  # noqa: E402
+
+_accessors.register("plot", "stickslip.plotting.run:RunPlots")
 
 
 __getattr__, __dir__ = lazy_names(__name__, _LAZY)

@@ -17,13 +17,14 @@ import tempfile
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any
-
-import pandas as pd
-import xarray as xr
+from typing import TYPE_CHECKING, Any
 
 from stickslip import __version__
 from stickslip.jsonable import to_jsonable
+
+if TYPE_CHECKING:  # loaded where a table or dataset is read, so that `stickslip --help` loads neither
+    import pandas as pd
+    import xarray as xr
 
 
 @contextmanager
@@ -99,6 +100,8 @@ def write_dataset(path: str | Path, ds: xr.Dataset) -> Path:
 
 def read_dataset(path: str | Path) -> xr.Dataset:
     """Read a dataset written by :func:`write_dataset` fully into memory."""
+    import xarray as xr
+
     with xr.open_dataset(path, engine="h5netcdf") as ds:
         return ds.load()
 
@@ -157,6 +160,8 @@ def write_table_files(
 
 
 def read_table(path: str | Path) -> pd.DataFrame:
+    import pandas as pd
+
     return pd.read_parquet(path, engine="pyarrow")
 
 

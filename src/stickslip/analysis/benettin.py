@@ -214,8 +214,8 @@ def check_run(params: ChainParams, t_end, interval, d0, transient, align, segmen
     align = float(check_number("align", align, low=0.0, high=t_end - transient, high_open=True))
     segments = int(check_number("segments", segments, low=2, integer=True))
     m = int(round(interval / params.dt))
-    n_lo = steps_for(transient + align, params.dt)
-    n_end = steps_for(t_end, params.dt)
+    n_lo = steps_for(transient + align, params.dt, "transient + align")
+    n_end = steps_for(t_end, params.dt, "t_end")
     counted = -(-(n_end - n_lo) // m) if n_end > n_lo else 0
     if counted < segments:
         need = transient + align + segments * m * params.dt
@@ -271,8 +271,8 @@ def two_trajectory_exponent(
     params = engine.params
     dt = params.dt
     m = int(round(interval / dt))
-    n_end = steps_for(t_end, dt)
-    n_count = steps_for(transient + align, dt)
+    n_end = steps_for(t_end, dt, "t_end")
+    n_count = steps_for(transient + align, dt, "transient + align")
     rng = np.random.default_rng(direction_seed)
     dim = 3 * params.N
 

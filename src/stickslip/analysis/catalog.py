@@ -29,7 +29,7 @@ from stickslip.analysis import magnitudes as mg
 from stickslip.analysis.chain_runs import run_size_statistics, spanning_column, stationary_events, stationary_from
 from stickslip.analysis.model_comparison import compare_distributions, power_law_gof
 from stickslip.analysis.recurrence import recurrence
-from stickslip.models.params import ParameterError
+from stickslip.models.params import ParameterError, check_number
 
 __all__ = [
     "CATALOG_COLUMNS",
@@ -44,6 +44,38 @@ __all__ = [
 
 #: Fewest slips with S > 0 in the stationary window for a catalogue's fits.
 MIN_EVENTS = 50
+#: The most resamples of the bootstrap errors: with 1e5 the error of an error is 0.2%.
+MAX_BOOTSTRAP = 100_000
+#: The most synthetic catalogues of the goodness of fit: with 1e4, p is known to +-0.005.
+MAX_GOF_SIMS = 10_000
+#: The most magnitude bins of width dm over the catalogue's magnitudes: the completeness scan
+#: fits a b-value at each bin (work growing as the square of their number).
+MAX_MAGNITUDE_BINS = 10_000
+
+
+def check_counts(bootstrap: int, gof_sims: int, names: tuple[str, str] = ("bootstrap", "gof_sims")) -> None:
+    """Refuse counts of work that do not end in reasonable time (:data:`MAX_BOOTSTRAP`,
+    :data:`MAX_GOF_SIMS`; ParameterError in one line naming them as ``names`` says)."""
+    from stickslip.run.budget import check_count
+
+    check_count(names[0], bootstrap, MAX_BOOTSTRAP, "the errors' own errors are then 0.2%; more changes nothing")
+    check_count(names[1], gof_sims, MAX_GOF_SIMS, "p is then known to +-0.005; more changes nothing")
+
+
+def check_magnitude_bins(M: np.ndarray, dm: float) -> None:
+    """Refuse a bin ``dm`` that cuts the catalogue's magnitudes into more than
+    :data:`MAX_MAGNITUDE_BINS` bins, saying how many and what they would cost."""
+    if dm <= 0 or M.size == 0:
+        return
+    span = float(np.nanmax(M) - np.nanmin(M))
+    bins = span / dm + 1
+    if bins > MAX_MAGNITUDE_BINS:
+        raise ParameterError(
+            f"dm = {dm:g} cuts the magnitudes (from {float(np.nanmin(M)):.3g} to {float(np.nanmax(M)):.3g}) into "
+            f"{bins:.3g} bins, about {8 * bins / 2**30:.3g} GiB per scan of them and {bins:.3g} scans; "
+            f"at most {MAX_MAGNITUDE_BINS} bins: dm >= {span / (MAX_MAGNITUDE_BINS - 1):.2g} here"
+        )
+
 
 CATALOG_COLUMNS = ["event", "t_start", "duration", "S", "magnitude", "epicentre", "extent", "reach", "spans"]
 CATALOG_DOCS = {
@@ -240,6 +272,18 @@ class Catalog:
     intervals: dict[str, np.ndarray] = field(default_factory=dict)
 
 
+def check_catalog_options(dm: Any, bootstrap: Any, gof_sims: Any, seed: Any, spell=None) -> None:
+    """The one check of a catalogue's options, for :func:`catalog_analysis` and ``stickslip
+    catalog`` alike: ``dm`` (the magnitude bin of the b-value) in [0, 1], the counts of
+    resamples and synthetic catalogues and the seed whole numbers >= 0. ``spell`` names an
+    argument as the user gave it (``gof-sims`` on the command line)."""
+    name = spell if spell is not None else (lambda n: n)
+    check_number(name("dm"), dm, low=0.0, high=1.0)
+    check_number(name("bootstrap"), bootstrap, low=0, integer=True)
+    check_number(name("gof_sims"), gof_sims, low=0, integer=True)
+    check_number(name("seed"), seed, low=0, integer=True)
+
+
 def catalog_analysis(
     run,
     *,
@@ -275,8 +319,11 @@ def catalog_analysis(
     Raises
     ------
     ParameterError
-        For a run with fewer than ``min_events`` slips (one line).
+        For a run with fewer than ``min_events`` slips, or counts or a bin whose work cannot
+        finish (:data:`MAX_BOOTSTRAP`, :data:`MAX_GOF_SIMS`, :data:`MAX_MAGNITUDE_BINS`; one line).
     """
+    check_catalog_options(dm, bootstrap, gof_sims, seed)
+    check_counts(bootstrap, gof_sims)
     if isinstance(run, (str, Path)):
         run = load_catalog_run(run)
     from stickslip.run.state import loading_warnings
@@ -289,12 +336,17 @@ def catalog_analysis(
             f"{len(positive)} slips with S > 0 at t >= {t_from:g} (the run's stationary window, "
             f"{len(run.events)} in all); a catalogue's fits need at least {min_events}: run longer"
         )
+    check_magnitude_bins(positive["magnitude"].to_numpy(dtype=np.float64), dm)
     p = run.params
     start = (run.start or {}).get("kind", "paper") if isinstance(run.start, dict) else "paper"
+    from stickslip.models.presets import is_paper_run
+
     summary: dict[str, Any] = {
         "model": p.model,
         "pieces": p.pieces,
         "N": p.N,
+        # the paper's chain at the paper's parameters: its beta picks the paper's numbers to cite
+        "paper_beta": float(p.beta) if is_paper_run(p) else None,
         "t_end": float(run.summary.get("t_end", run.options.t_end)),
         "window": {
             "t_from": t_from,
@@ -344,7 +396,10 @@ def catalog_analysis(
         cat.candidates = comparison.pop("objects")
         summary["distributions"] = comparison
         if gof_sims > 0:
-            summary["goodness_of_fit"] = power_law_gof(S, fit.s_max, sims=gof_sims, seed=seed)
+            try:
+                summary["goodness_of_fit"] = power_law_gof(S, fit.s_max, sims=gof_sims, seed=seed)
+            except ValueError as exc:
+                summary["goodness_of_fit"] = {"reason": f"no fit: {exc}"}
         else:
             summary["goodness_of_fit"] = {"reason": "not computed (gof_sims = 0)"}
     else:

@@ -293,6 +293,14 @@ def size_statistics(
     }
 
 
+def _sizes_or_none(run, *, small_only: bool) -> dict[str, Any] | None:
+    """:func:`run_size_statistics`, or None where the sizes have no power-law fit."""
+    try:
+        return run_size_statistics(run, small_only=small_only)
+    except ValueError:
+        return None
+
+
 def front_speeds(run, N: int, t_from: float) -> pd.DataFrame:
     """Per-event rupture-front speeds of every event after ``t_from`` that reached block N (Fig. 6).
 
@@ -464,8 +472,8 @@ def chain_analysis(outcome) -> dict[str, Any]:
     out["run1"], out["run02"] = run1, run02
     ev1, ev02 = stationary_events(run1), stationary_events(run02)
     out["events1"], out["events02"] = ev1, ev02
-    out["sizes1"] = run_size_statistics(run1, small_only=False) if len(ev1) >= 10 else None
-    out["sizes02"] = run_size_statistics(run02, small_only=True) if len(ev02) >= 10 else None
+    out["sizes1"] = _sizes_or_none(run1, small_only=False) if len(ev1) >= 10 else None
+    out["sizes02"] = _sizes_or_none(run02, small_only=True) if len(ev02) >= 10 else None
     out["fronts"] = front_statistics(run1, fig_N, t_from)
     return out
 
@@ -532,7 +540,11 @@ def sizes_summary(
     if len(events) < 20:
         out.update(tau=math.nan, tau_err=math.nan, error_note=f"only {len(events)} events after t = {t_from:g}")
         return out
-    st = size_statistics(events, run.params.N, small_only=True, seed=seed, spanning=spanning, bootstrap=bootstrap)
+    try:
+        st = size_statistics(events, run.params.N, small_only=True, seed=seed, spanning=spanning, bootstrap=bootstrap)
+    except ValueError as exc:  # no power law on the range: the row says why
+        out.update(tau=math.nan, tau_err=math.nan, error_note=str(exc))
+        return out
     fit = st["fit"]
     out.update(
         tau=fit.tau,

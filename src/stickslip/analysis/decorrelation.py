@@ -184,6 +184,23 @@ class LocatedSequences:
 _NO_ROWS = np.zeros((0, 4))
 
 
+def check_slips(events: int | None, seeds: int, n_deltas: int) -> None:
+    """Refuse a measurement of :func:`sequence_decorrelation` that simulates more than
+    :data:`~stickslip.run.budget.MAX_SLIPS` slips: ``events`` in each of ``seeds`` windows, for
+    the reference and each of the ``n_deltas`` perturbed sequences (ParameterError, one line)."""
+    from stickslip.run.budget import MAX_SLIPS
+
+    if events is None:
+        return
+    slips = events * seeds * (1 + n_deltas)
+    if slips > MAX_SLIPS:
+        raise ParameterError(
+            f"events = {events} and seeds = {seeds} with {n_deltas} deltas ask for {slips:.3g} slips "
+            f"simulated; at most {MAX_SLIPS:.0e} (at some 1e5 slips a second, three hours): "
+            "ask for fewer events or seeds"
+        )
+
+
 def sequence_decorrelation(
     source,
     start,
@@ -227,6 +244,7 @@ def sequence_decorrelation(
         raise ParameterError("give at least one delta")
     if perturbation != "state":
         _check_parameter_perturbation(params, perturbation, deltas)
+    check_slips(events, seeds, len(deltas))
     dt = params.dt
     ref = start
     rows: list[dict[str, Any]] = []

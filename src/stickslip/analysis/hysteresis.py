@@ -17,13 +17,16 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
-import xarray as xr
 
 from stickslip.models.params import BlockParams, ParameterError, check_number, steps_for
-from stickslip.run.block import INTEGRATOR, BlockState, simulate_block
+
+if TYPE_CHECKING:  # the engine and xarray load where a sweep runs (`stickslip --help` reads the defaults)
+    import xarray as xr
+
+    from stickslip.run.block import BlockState
 
 #: Defaults of the sweep. The range holds the paper's V = 0.345; 400 time units per value of
 #: V is about 160 stick-slip periods near V = 0.3 (T ~ 2.4), long enough for the transient
@@ -105,6 +108,8 @@ class HysteresisResult:
 
     def summary(self) -> dict:
         """The numbers of the sweep as a plain dict (JSON-able)."""
+        from stickslip.run.block import INTEGRATOR
+
         return {
             "V_up": self.V_up,
             "V_down": self.V_down,
@@ -116,20 +121,22 @@ class HysteresisResult:
         }
 
 
-def _no_series(p: BlockParams, t: float) -> int:
+def _no_series(p: BlockParams, t: float, name: str) -> int:
     """An ``every`` that keeps only the first and last state (the statistics see every step)."""
-    return max(1, steps_for(t, p.dt))
+    return max(1, steps_for(t, p.dt, name))
 
 
 def _hold(params: BlockParams, V: float, settings: SweepSettings, state: BlockState) -> tuple[dict, BlockState]:
     """Hold V for one step of the sweep: discard the transient, measure the rest."""
+    from stickslip.run.block import simulate_block
+
     p = params.replace(V=float(V))
     t_transient = settings.transient * settings.time_per_step
     t_measure = settings.time_per_step - t_transient
     if t_transient > 0.0:
-        transient = simulate_block(p, t_transient, initial=state, every=_no_series(p, t_transient))
+        transient = simulate_block(p, t_transient, initial=state, every=_no_series(p, t_transient, "t_transient"))
         state = transient.restart_state()
-    run = simulate_block(p, t_measure, initial=state, every=_no_series(p, t_measure))
+    run = simulate_block(p, t_measure, initial=state, every=_no_series(p, t_measure, "t_measure"))
     starts = run.slips["t_c"].to_numpy()
     period = float(np.mean(np.diff(starts))) if starts.size >= 2 else math.nan
     row = {
@@ -155,6 +162,11 @@ def hysteresis_sweep(
     docstring). ``params.V`` is not read. The paper's inverse transition, stick-slip -> steady
     sliding going up, is at V = 0.345 for beta = 1, Fs = 3, K = 10.
     """
+    import pandas as pd
+    import xarray as xr
+
+    from stickslip.run.block import INTEGRATOR, BlockState
+
     settings = SweepSettings() if settings is None else settings
     state = BlockState() if initial is None else initial
     grid = settings.V_grid()

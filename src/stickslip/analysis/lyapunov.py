@@ -364,7 +364,7 @@ def largest_lyapunov(
     t_end, interval, d0, transient, align, segments = check_run(params, t_end, interval, d0, transient, align, segments)
     grid = GridEngine(params, engine, frame)
     dt = params.dt
-    n0 = steps_for(transient, dt)
+    n0 = steps_for(transient, dt, "transient")
     wall0 = time.perf_counter()
 
     if n0 > (start.step if isinstance(start, ChainState) else 0):

@@ -215,7 +215,7 @@ def flow_lyapunov(
     engine = LocatedEngine(params, neutral=neutral, flow_floor=flow_floor, max_wait=m if max_wait is None else max_wait)
     wall0 = time.perf_counter()
     ref = start_state(params, start, perturbation=perturbation, seed=seed)
-    ref, _ = engine.stepper.advance(ref, steps_for(transient, dt))
+    ref, _ = engine.stepper.advance(ref, steps_for(transient, dt, "transient"))
     return two_trajectory_exponent(
         engine,
         ref,

@@ -18,8 +18,9 @@ What is written here by hand, and why: the b-value of Aki (1965) with Utsu's (19
 for magnitudes binned to dm, its error by Shi and Bolt (1982), and the goodness-of-fit
 completeness test of Wiemer and Wyss (2000) are one-line formulas that no library of this
 package's dependencies provides (scipy has no b-value; ``scipy.stats.bootstrap`` resamples the
-estimate for the bootstrap error). The doubly truncated Gutenberg-Richter fit is the maximum of
-``scipy.stats.truncexpon``'s likelihood.
+estimate for the bootstrap error). The doubly truncated Gutenberg-Richter fit solves the
+likelihood equation of the truncated exponential (``scipy.stats.truncexpon`` for b > 0) with the
+power-law fit's solver (:mod:`stickslip.analysis.truncated`), so that the two agree.
 """
 
 from __future__ import annotations
@@ -29,7 +30,9 @@ from dataclasses import asdict, dataclass
 from typing import Any
 
 import numpy as np
-from scipy import optimize, stats
+from scipy import stats
+
+from stickslip.analysis.truncated import TAU_BRACKET, fit_failure, truncated_mle, var_log_ratio
 
 __all__ = [
     "magnitude",
@@ -238,13 +241,18 @@ def b_value(M: Any, mc: float, *, dm: float = DM, bootstrap: int = 200, seed: in
     Raises
     ------
     ValueError
-        With fewer than 2 events above mc.
+        With fewer than 2 events above mc, or all of them in one bin (every magnitude equal: the
+        estimator then returns log10(e) / (dm/2), a number set by the bin alone).
     """
     m = bin_magnitudes(M, dm)
     m = m[np.isfinite(m) & (m >= mc - 1e-9 * max(dm, 1.0))]
     n = int(m.size)
     if n < 2:
         raise ValueError(f"need at least 2 events with M >= mc = {mc:g} for a b-value (got {n})")
+    if float(np.ptp(m)) <= 1e-9 * max(dm, 1.0):
+        raise ValueError(
+            f"all {n} magnitudes at or above mc = {mc:g} are equal ({float(m[0]):.3g}): no spread, no b-value"
+        )
     b = float(_aki_utsu(m, mc, dm))
     shi_bolt = 2.30 * b * b * math.sqrt(float(np.sum((m - m.mean()) ** 2)) / (n * (n - 1)))
     err_boot = math.nan
@@ -254,6 +262,9 @@ def b_value(M: Any, mc: float, *, dm: float = DM, bootstrap: int = 200, seed: in
             lambda x, axis=-1: _aki_utsu(x, mc, dm, axis),
             n_resamples=bootstrap,
             vectorized=True,
+            # resamples in batches of at most 2**24 magnitudes: the memory of a large catalogue
+            # times many resamples stays bounded (one batch, as before, where it fits)
+            batch=None if bootstrap * n <= 2**24 else max(1, 2**24 // n),
             method="percentile",
             rng=np.random.default_rng(seed),
         )
@@ -394,18 +405,31 @@ class TruncatedGR:
         return asdict(self)
 
 
-def _truncexpon_negll(beta: float, u: np.ndarray, width: float) -> float:
-    return -float(np.sum(stats.truncexpon.logpdf(u, beta * width, scale=1.0 / beta)))
+#: log(S / s_min) per unit of M - m_min (M = (2/3) log10 S).
+LN_PER_M = 1.5 * LN10
+
+
+def _log_truncexp_normaliser(beta: float, width: float) -> float:
+    """log of the integral of exp(-beta u) over [0, width], finite for any beta."""
+    x = beta * width
+    if abs(x) < 1e-6:
+        return math.log(width) - x / 2.0
+    if x > 0:
+        return math.log(-math.expm1(-x)) - math.log(beta)
+    return -x + math.log(-math.expm1(x)) - math.log(-beta)
 
 
 def truncated_gr_fit(M: Any, m_min: float, m_max: float | None = None) -> TruncatedGR:
     """Doubly truncated Gutenberg-Richter fit (Page 1968): maximum likelihood of b for continuous
     magnitudes on [m_min, m_max].
 
-    The density of u = M - m_min is ``scipy.stats.truncexpon`` with rate beta = b ln 10 cut at
-    m_max - m_min; its likelihood is maximised over beta. For M = (2/3) log10 S this is the power
-    law in S truncated to [S(m_min), S(m_max)] with tau = 1 + (2/3) b, the model of
-    :func:`stickslip.analysis.statistics.fit_power_law`, so the two fits agree.
+    u = M - m_min has the truncated exponential density of rate beta = b ln 10 on [0, W],
+    W = m_max - m_min (``scipy.stats.truncexpon`` for beta > 0; beta <= 0 is a flat or growing
+    density). The likelihood is concave in beta and its maximum solves E_beta[u] = mean(u). For
+    M = (2/3) log10 S this is the power law in S truncated to [S(m_min), S(m_max)] with
+    tau = 1 + (2/3) b, the model of :func:`stickslip.analysis.statistics.fit_power_law`: the
+    equation is solved in those units (u 1.5 ln 10 = log(S / s_min)) by the same bracketed,
+    checked root (:func:`stickslip.analysis.truncated.truncated_mle`), so the two fits agree.
 
     Parameters
     ----------
@@ -420,6 +444,13 @@ def truncated_gr_fit(M: Any, m_min: float, m_max: float | None = None) -> Trunca
     -------
     TruncatedGR
         b, its error, the range and tau.
+
+    Raises
+    ------
+    ValueError
+        With fewer than 2 magnitudes in range, or where the likelihood has no maximum with tau in
+        :data:`~stickslip.analysis.truncated.TAU_BRACKET` (the message says why): the fit is then
+        left out, not reported.
     """
     M = np.asarray(M, dtype=np.float64)
     top = float(np.nanmax(M)) if m_max is None else float(m_max)
@@ -428,26 +459,25 @@ def truncated_gr_fit(M: Any, m_min: float, m_max: float | None = None) -> Trunca
     n = int(u.size)
     if n < 2 or not width > 0:
         raise ValueError(f"need at least 2 magnitudes in [{m_min:g}, {top:g}] for a truncated Gutenberg-Richter fit")
-    # unimodal in log(beta): a bounded search from a nearly uniform density to 100 times the
-    # untruncated estimate 1 / mean(u)
-    res = optimize.minimize_scalar(
-        lambda lb: _truncexpon_negll(math.exp(lb), u, width),
-        bounds=(math.log(1e-6 / width), math.log(100.0 / max(float(u.mean()), 1e-12))),
-        method="bounded",
-        options={"xatol": 1e-11},
-    )
-    beta = math.exp(float(res.x))
-    x = beta * width
-    # Fisher information per event: Var(u) = 1/beta^2 - width^2 e^x / (e^x - 1)^2
-    info = 1.0 / beta**2 - width**2 / (4.0 * math.sinh(x / 2.0) ** 2)
+    span, mean_log = width * LN_PER_M, float(u.mean()) * LN_PER_M
+    tau = truncated_mle(mean_log, span)
+    if not math.isfinite(tau):
+        why = fit_failure(mean_log, span)
+        lo, hi = (b_from_tau(t) for t in TAU_BRACKET)
+        why = why.replace(f"tau in [{TAU_BRACKET[0]:g}, {TAU_BRACKET[1]:g}]", f"b in [{lo:g}, {hi:g}]")
+        raise ValueError(f"no truncated Gutenberg-Richter law on M in [{m_min:.3g}, {top:.3g}] ({n} events): {why}")
+    beta = (tau - 1.0) * LN_PER_M
+    # Fisher information per event in beta: Var(u) of the fitted law
+    info = var_log_ratio(-beta, width)
     beta_err = 1.0 / math.sqrt(n * info) if info > 0 else math.nan
-    b = beta / LN10
+    # log-likelihood of u: -beta sum(u) - n log(integral of e^{-beta u} over [0, W])
+    loglik = -beta * float(u.sum()) - n * _log_truncexp_normaliser(beta, width)
     return TruncatedGR(
-        b=b,
+        b=beta / LN10,
         b_err=beta_err / LN10,
         m_min=float(m_min),
         m_max=top,
         n=n,
-        loglikelihood=-float(res.fun),
-        tau=tau_from_b(b),
+        loglikelihood=loglik,
+        tau=float(tau),
     )

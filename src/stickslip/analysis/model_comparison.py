@@ -144,13 +144,30 @@ def _log_cutoff_normaliser(alpha: float, lam: float, lo: float, hi: float) -> fl
     return e * math.log(lo) - z + math.log(value)
 
 
+#: Largest gain in log-likelihood a Newton step from a fit's optimum may still promise: above it the
+#: search stopped short of the maximum and the fit is left out.
+MAX_DECREMENT = 1e-3
+
+
 def _maximise(negll: Callable[[np.ndarray], float], start: np.ndarray) -> np.ndarray:
-    """The minimum of a negative log-likelihood in unconstrained coordinates (Nelder-Mead, then polished)."""
+    """The minimum of a negative log-likelihood in unconstrained coordinates (Nelder-Mead, then
+    polished by BFGS), checked: finite, and the Newton decrement g^T H^-1 g / 2 there (gradient g
+    by finite differences, H^-1 BFGS's) below :data:`MAX_DECREMENT`; else ValueError."""
     best = optimize.minimize(
         negll, start, method="Nelder-Mead", options={"xatol": 1e-10, "fatol": 1e-12, "maxiter": 4000}
     )
     polished = optimize.minimize(negll, best.x, method="BFGS")
-    return polished.x if polished.fun <= best.fun else best.x
+    x = polished.x if polished.fun <= best.fun else best.x
+    value = negll(x)
+    if not math.isfinite(value) or value >= 1e300:
+        raise ValueError("the likelihood is not finite at the search's end")
+    g = optimize.approx_fprime(x, negll, 1e-7 * np.maximum(1.0, np.abs(x)))
+    decrement = 0.5 * float(g @ np.atleast_2d(polished.hess_inv) @ g)
+    if not math.isfinite(decrement) or abs(decrement) > MAX_DECREMENT:
+        raise ValueError(
+            f"the search did not reach the likelihood's maximum (a Newton step would gain {decrement:.2g})"
+        )
+    return x
 
 
 def fit_candidate(name: str, S: Any, s_min: float, s_max: float = math.inf) -> CandidateFit:
@@ -382,9 +399,13 @@ def _draw_truncated_power_law(rng: np.random.Generator, n: int, tau: float, lo: 
     """n draws of the power law truncated to [lo, hi] by inverting its CDF."""
     u = rng.random(n)
     e = 1.0 - tau
+    span = math.log(hi / lo)
     if abs(e) < 1e-12:
-        return lo * (hi / lo) ** u
-    return lo * (1.0 + u * math.expm1(e * math.log(hi / lo))) ** (1.0 / e)
+        return lo * np.exp(u * span)
+    x = e * span
+    # w = log(1 + u (e^x - 1)) / e, without forming e^x (it overflows for a long range)
+    w = (x + np.log(u + (1.0 - u) * math.exp(-x))) / e if x > 0 else np.log1p(u * math.expm1(x)) / e
+    return lo * np.exp(np.clip(w, 0.0, span))
 
 
 def power_law_gof(S: Any, s_max: float | None = None, *, sims: int = 200, seed: int = 0) -> dict[str, Any]:
@@ -417,7 +438,7 @@ def power_law_gof(S: Any, s_max: float | None = None, *, sims: int = 200, seed: 
     values = values[np.isfinite(values) & (values > 0)]
     hi = float(values.max()) if s_max is None else float(s_max)
     values = values[values <= hi]
-    fit = fit_power_law(values, s_max=hi, bootstrap=0)
+    fit = fit_power_law(values, s_max=hi, bootstrap=0)  # no fit: the ValueError says why
     below = values[values < fit.s_min]
     n, n_tail = int(values.size), int(fit.n)
     rng = np.random.default_rng(seed)

@@ -97,7 +97,8 @@ def fit_renewal(name: str, dt: Any) -> dict[str, Any]:
     Raises
     ------
     ValueError
-        For fewer than 2 positive times.
+        For fewer than 2 positive times, or where scipy's fit does not end at a maximum of the
+        likelihood (the observed information is not positive definite): left out, not reported.
     """
     dt = np.asarray(dt, dtype=np.float64)
     dt = dt[np.isfinite(dt) & (dt > 0)]
@@ -109,13 +110,18 @@ def fit_renewal(name: str, dt: Any) -> dict[str, Any]:
     loglik = float(_loglik(name, dt, log_p))
     # One fourth-order difference with steps of 2% in each parameter: the log-likelihood of many
     # events is too large for smaller steps (rounding), and refining them costs 20 times as much.
-    hess = differentiate.hessian(lambda lp: _loglik(name, dt, lp), log_p, initial_step=0.02, order=4, maxiter=1)
-    try:
-        cov = np.linalg.inv(-np.atleast_2d(hess.ddf))
-        log_err = np.sqrt(np.diag(cov))
-    except np.linalg.LinAlgError:
-        cov = np.full((native.size, native.size), np.nan)
-        log_err = np.full(native.size, np.nan)
+    # A sharply peaked likelihood (nearly periodic slips: a Weibull shape of hundreds) needs
+    # smaller steps: they shrink tenfold until the information is positive definite, as it is at
+    # a maximum; if it never is, the fit did not end at one and is left out.
+    for step in (0.02, 2e-3, 2e-4, 2e-5):
+        hess = differentiate.hessian(lambda lp: _loglik(name, dt, lp), log_p, initial_step=step, order=4, maxiter=1)
+        info = -np.atleast_2d(hess.ddf)
+        if np.all(np.isfinite(info)) and np.all(np.linalg.eigvalsh(0.5 * (info + info.T)) > 0):
+            break
+    else:
+        raise ValueError(f"{name}: the search did not end at a maximum of the likelihood")
+    cov = np.linalg.inv(info)
+    log_err = np.sqrt(np.diag(cov))
     err = native * log_err  # delta method from the log scale
     k = native.size
     if name == "exponential":

@@ -294,7 +294,7 @@ def period_sweep(
         p = params.replace(V=V)
         T = law.period(V)
         t_end = first_start_time(p) + (periods + 0.5) * T
-        steps = steps_for(t_end, p.dt)
+        steps = steps_for(t_end, p.dt, "t_end")
         run = simulate_block(p, t_end, every=max(1, steps))
         s = run.summary()
         rows.append(

@@ -33,7 +33,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 import xarray as xr
-from scipy import optimize, stats
+from scipy import stats
 
 from stickslip.analysis.fronts import (
     CentralInterval,
@@ -48,6 +48,7 @@ from stickslip.analysis.fronts import (
 # Rupture fronts (Fig. 6) live in fronts, time averages (Fig. 5b) in order; their names stay
 # importable here.
 from stickslip.analysis.order import TimeAverage, time_average
+from stickslip.analysis.truncated import TAU_BRACKET, fit_failure, log_normaliser, truncated_mle, var_log_ratio
 
 __all__ = [
     "size_distribution",
@@ -166,84 +167,15 @@ def size_distribution(
 # ---------------------------------------------------------------------------------------------
 # Truncated power-law fit (Figs. 7a, 8a)
 
-# |(1 - tau) log(s_max/s_min)| below this: use the series of the mean of log(S/s_min).
-_SERIES = 1e-6
-# exp() of more than this overflows a float64.
-_EXP_LIMIT = 700.0
-
-
-def _mean_log_ratio(e: float, span: float) -> float:
-    """E[log(S/s_min)] for p(S) ~ S^-tau on [s_min, s_max], e = 1 - tau, span = log(s_max/s_min).
-
-    u = log(S/s_min) has density proportional to exp(e u) on [0, span] (a truncated
-    exponential), whose mean is span / (1 - exp(-e span)) - 1/e, span/2 at e = 0.
-    """
-    x = e * span
-    if abs(x) < _SERIES:
-        return span / 2.0 + e * span * span / 12.0
-    x = min(max(x, -_EXP_LIMIT), _EXP_LIMIT)
-    return span / (-math.expm1(-x)) - 1.0 / e
-
-
-def _var_log_ratio(e: float, span: float) -> float:
-    """Var[log(S/s_min)] under the truncated power law: the Fisher information per event in tau.
-
-    For the truncated exponential density of u on [0, span]: 1/e^2 - span^2 e^{x} / (e^{x} - 1)^2
-    with x = e span, span^2/12 at e = 0.
-    """
-    x = e * span
-    if abs(x) < 1e-4:
-        return span * span / 12.0 * (1.0 - x * x / 60.0)
-    x = min(max(x, -_EXP_LIMIT), _EXP_LIMIT)
-    # span^2 e^x / (e^x - 1)^2 = span^2 / (4 sinh^2(x/2))
-    return 1.0 / (e * e) - span * span / (4.0 * math.sinh(x / 2.0) ** 2)
-
-
-def _log_normaliser(tau: float, s_min: float, s_max: float) -> float:
-    """log Z(tau), Z = integral of S^-tau over [s_min, s_max] (s_max may be inf for tau > 1)."""
-    e = 1.0 - tau
-    if math.isinf(s_max):
-        return e * math.log(s_min) - math.log(-e)
-    span = math.log(s_max / s_min)
-    x = e * span
-    if abs(x) < _SERIES:
-        return math.log(span) + x / 2.0
-    # Z = s_min^e (exp(x) - 1) / e, written to stay finite for large |x|
-    if x > 0:
-        return e * math.log(s_min) + x + math.log(-math.expm1(-x) / e)
-    return e * math.log(s_min) + math.log(math.expm1(x) / e)
-
-
-def _truncated_mle(mean_log: float, span: float) -> float:
-    """The tau solving the likelihood equation E_tau[log(S/s_min)] = mean of log(S/s_min).
-
-    The truncated power law is an exponential family in tau, so the log-likelihood is concave
-    and this root is its unique maximum. The mean is increasing in e = 1 - tau, from 0 (e -> -inf)
-    to span (e -> +inf); the root is bracketed by doubling.
-    """
-    if not 0.0 < mean_log < span:
-        # all events at one end of the range: the likelihood has no interior maximum
-        return math.inf if mean_log <= 0.0 else -math.inf
-
-    def score(e: float) -> float:
-        return _mean_log_ratio(e, span) - mean_log
-
-    lo, hi = -1.0, 1.0
-    while score(lo) > 0.0:
-        lo *= 2.0
-    while score(hi) < 0.0:
-        hi *= 2.0
-    e = optimize.brentq(score, lo, hi, xtol=1e-14, rtol=4 * np.finfo(float).eps, maxiter=200)
-    return 1.0 - e
-
 
 def _tau_from_mean(mean_log: float, span: float) -> float:
     """tau from the mean of log(S/s_min) over the events in range: truncated MLE, or the closed
     form if span = inf."""
     if math.isinf(span):
         # untruncated continuous power law: tau = 1 + n / sum log(S/s_min)
-        return 1.0 + 1.0 / mean_log if mean_log > 0.0 else math.inf
-    return _truncated_mle(mean_log, span)
+        tau = 1.0 + 1.0 / mean_log if mean_log > 0.0 else math.nan
+        return tau if TAU_BRACKET[0] < tau < TAU_BRACKET[1] else math.nan
+    return truncated_mle(mean_log, span)
 
 
 def _fit_tau(log_ratio: np.ndarray, span: float) -> float:
@@ -342,7 +274,7 @@ def truncated_power_law_pdf(s: Any, tau: float, s_min: float, s_max: float = mat
     [0.0, 1.0, 0.0625]
     """
     s = np.asarray(s, dtype=np.float64)
-    log_z = _log_normaliser(tau, s_min, s_max)
+    log_z = log_normaliser(tau, s_min, s_max)
     inside = (s >= s_min) & (s <= s_max)
     with np.errstate(divide="ignore", invalid="ignore"):
         out = np.exp(-tau * np.log(s) - log_z)
@@ -355,7 +287,11 @@ def _truncated_cdf(s: np.ndarray, tau: float, s_min: float, s_max: float) -> np.
         return np.log(s / s_min) / math.log(s_max / s_min)
     if math.isinf(s_max):
         return 1.0 - (s / s_min) ** e
-    return np.expm1(e * np.log(s / s_min)) / math.expm1(e * math.log(s_max / s_min))
+    w, span = np.log(s / s_min), math.log(s_max / s_min)
+    if e > 0:
+        # (e^{ew} - 1) / (e^{e span} - 1) without forming e^{e span}, which overflows for a long range
+        return np.exp(e * (w - span)) * -np.expm1(-e * w) / -math.expm1(-e * span)
+    return np.expm1(e * w) / math.expm1(e * span)
 
 
 #: Defaults of :func:`choose_s_min`: candidates from the smallest S up to this quantile of S ...
@@ -461,7 +397,7 @@ def choose_s_min(S: Any, s_max: float | None = None, **candidates: Any) -> float
         s_min; the smallest S where there is no candidate (too few events).
     """
     scan = s_min_scan(S, s_max, **candidates)
-    scan = scan[np.isfinite(scan["ks_distance"])]
+    scan = scan[np.isfinite(scan["ks_distance"].to_numpy(dtype=np.float64))]  # an empty scan's column is object
     if scan.empty:
         values, _ = _positive_finite(S)
         return float(values.min())
@@ -513,6 +449,13 @@ def fit_power_law(
     PowerLawFit
         tau, its errors, the range and its events, the log-likelihood and the KS distance.
 
+    Raises
+    ------
+    ValueError
+        With fewer than 2 events in range, or where the likelihood has no maximum with tau in
+        :data:`~stickslip.analysis.truncated.TAU_BRACKET` (the message says which): such a fit
+        is left out, not reported.
+
     Examples
     --------
     >>> import numpy as np
@@ -550,6 +493,9 @@ def fit_power_law(
     if n < 2:
         raise ValueError(f"need at least 2 events in [s_min, s_max] (got {n})")
     log_ratio = np.log(x / lo)
+    if not math.isfinite(tau):
+        why = fit_failure(float(log_ratio.mean()), span) if truncated else "every event in range is at s_min"
+        raise ValueError(f"no power law on S in [{lo:.3g}, {hi:.3g}] ({n} events): {why}")
 
     tau_err = math.nan
     if bootstrap > 0:
@@ -568,14 +514,11 @@ def fit_power_law(
         finite = estimates[np.isfinite(estimates)]  # a resample with every event at one end has no fit
         tau_err = float(finite.std(ddof=1)) if finite.size > 1 else math.nan
 
-    if math.isfinite(tau):
-        s_hi = math.inf if not truncated else hi
-        info = _var_log_ratio(1.0 - tau, span) if truncated else 1.0 / (tau - 1.0) ** 2
-        tau_err_fisher = 1.0 / math.sqrt(n * info) if info > 0 else math.nan
-        loglik = float(-tau * np.log(x).sum() - n * _log_normaliser(tau, lo, s_hi))
-        ks = _ks_distance(x, tau, lo, s_hi)
-    else:
-        tau_err_fisher = loglik = ks = math.nan
+    s_hi = math.inf if not truncated else hi
+    info = var_log_ratio(1.0 - tau, span) if truncated else 1.0 / (tau - 1.0) ** 2
+    tau_err_fisher = 1.0 / math.sqrt(n * info) if info > 0 else math.nan
+    loglik = float(-tau * np.log(x).sum() - n * log_normaliser(tau, lo, s_hi))
+    ks = _ks_distance(x, tau, lo, s_hi)
 
     method = (
         "maximum likelihood, continuous power law truncated to [s_min, s_max]"

@@ -295,6 +295,16 @@ def run_option_dests(control: bool | None = False) -> tuple[str, ...]:
     return tuple(_run_option_dest(cli) for _, cli in _run_option_fields(control))
 
 
+def run_option_spelling(field_name: str) -> str:
+    """The command-line spelling of a field of :class:`~stickslip.run.options.RunOptions`
+    (``out_dir`` is ``--out``, ``snapshot_times`` ``--snapshot``), for the refusals of
+    :meth:`~stickslip.run.options.RunOptions.validated`, which the command and the API share."""
+    for f, cli in _run_option_fields():
+        if f.name == field_name:
+            return "--" + cli["option"]
+    return option_name(field_name)
+
+
 def run_options_from_args(args: argparse.Namespace, t_end: float):
     """The :class:`~stickslip.run.options.RunOptions` of the options :func:`add_run_options`
     added (the field's default where one is not given), with ``t_end``; not yet validated."""
@@ -381,6 +391,9 @@ OUT_FILES: dict[str, frozenset[str]] = {
     "stability chain": frozenset({"fig4.nc", "mode_growth.nc", "stability_chain.json"})
     | _figures("fig4", "mode_growth"),
     "hysteresis": frozenset({"hysteresis.nc", "hysteresis.json"}) | _figures("hysteresis"),
+    "lab step": frozenset({"step.nc", "step.json"}) | _figures("step"),
+    "lab shs": frozenset({"shs.nc", "shs.json"}) | _figures("shs"),
+    "lab fit": frozenset({"fit.nc", "fit.json", "posterior.nc"}) | _figures("fit", "posterior"),
     "sweep": frozenset({"summary.parquet", "summary.csv"}),
     "reproduce": frozenset({"runs", *PAPER, "report.json", "report.html", MANIFEST}),
 }
@@ -507,7 +520,8 @@ def chain_params_from_args(args: argparse.Namespace, **overrides: Any):
     """Validated ChainParams from ``--model``, the pieces and the parameter options.
 
     An option the composition does not read (``--D`` with weakening friction, say) is refused
-    rather than silently ignored.
+    rather than silently ignored. ``overrides`` are the command's own defaults (a workload's N and
+    beta), not the user's: those the composition does not read are left out, never refused.
     """
     from stickslip.models.params import ChainParams
     from stickslip.models.presets import build_chain_params, refuse_unread
@@ -523,9 +537,12 @@ def chain_params_from_args(args: argparse.Namespace, **overrides: Any):
     for name in ("l", "nu"):
         if getattr(args, f"param_{name}", None) is not None:
             values[name] = getattr(args, f"param_{name}")
-    values.update(overrides)
-    params = build_chain_params(args.model or "sakaguchi", **values)
-    refuse_unread(params, values, prefix="--", spell=option_name)
+    model = args.model or "sakaguchi"
+    if overrides:
+        reads = set(build_chain_params(model, **values).used())
+        values.update({k: v for k, v in overrides.items() if k in reads})
+    params = build_chain_params(model, **values)
+    refuse_unread(params, {k: v for k, v in values.items() if k not in overrides}, prefix="--", spell=option_name)
     return params
 
 

@@ -12,22 +12,9 @@ from __future__ import annotations
 import argparse
 import math
 from pathlib import Path
-from typing import Any
-
-import xarray as xr
+from typing import TYPE_CHECKING, Any
 
 from stickslip import io
-from stickslip.analysis.slip_limit import (
-    PAPER_DURATION,
-    PAPER_FORCE_AT_STOP,
-    NoStopError,
-    SlipLimit,
-    heun_slip_limit,
-    matches_paper,
-    paper_V_values,
-    period_sweep,
-    solve_slip_limit,
-)
 from stickslip.cli._common import (
     OUT_FILES,
     CommandError,
@@ -42,13 +29,10 @@ from stickslip.cli._common import (
     params_from_args,
 )
 from stickslip.models.params import MAX_STEPS, BlockParams, ParameterError, check_number, steps_for
-from stickslip.run.block import (
-    INTEGRATOR,
-    BlockRun,
-    first_start_time,
-    n_samples,
-    simulate_block,
-)
+
+if TYPE_CHECKING:  # loaded where used: `stickslip --help` loads no numba, scipy or xarray
+    from stickslip.analysis.slip_limit import SlipLimit
+    from stickslip.run.block import BlockRun
 
 #: Periods of the law simulated after the first slip when --t-end is not given.
 DEFAULT_PERIODS = 3.5
@@ -109,6 +93,8 @@ def _law_or_none(p: BlockParams) -> SlipLimit | None:
     """The accurate eq. (3) at these parameters, or None where it has no slip that ends (or one
     too stiff or too long to resolve: sqrt(K/M) > 1e4 or Fs > 1000 sigma; or where the threshold
     is not the constant Fs that eq. (3) starts from)."""
+    from stickslip.analysis.slip_limit import NoStopError, solve_slip_limit
+
     if p.threshold_piece.has_state or math.sqrt(p.K / p.M) > 1e4 or p.Fs / p.sigma > 1e3:
         return None
     try:
@@ -119,6 +105,8 @@ def _law_or_none(p: BlockParams) -> SlipLimit | None:
 
 def default_t_end(p: BlockParams, law: SlipLimit | None) -> float:
     """First start plus 3.5 periods of the law (2 Fs / (K V) per period where eq. (3) has none)."""
+    from stickslip.run.block import first_start_time
+
     if p.V <= 0.0:
         raise ParameterError("t_end must be given when V = 0 (the block never starts)")
     # Without eq. (3): the spring must be loaded by about twice the threshold per cycle.
@@ -132,6 +120,8 @@ def default_t_end(p: BlockParams, law: SlipLimit | None) -> float:
 
 def run_block(args: argparse.Namespace) -> Result:
     """Handler of ``stickslip block``: eq. (1), its slips, Figs. 1-3."""
+    from stickslip.run.block import n_samples, simulate_block
+
     # Everything is validated before --out is created, so bad input writes nothing.
     p = block_params_from_args(args)
     every = int(check_number("every", args.every, low=1, high=MAX_STEPS, integer=True))
@@ -141,7 +131,7 @@ def run_block(args: argparse.Namespace) -> Result:
         raise CommandError("--fig3 writes figures and needs --out DIR")
     law = _law_or_none(p)
     t_end = float(args.t_end) if args.t_end is not None else default_t_end(p, law)
-    steps = steps_for(t_end, p.dt)
+    steps = steps_for(t_end, p.dt, "t_end")
     if steps > MAX_BLOCK_STEPS:
         raise CommandError(
             f"t_end must be <= {MAX_BLOCK_STEPS * p.dt:g} for the single block (at most "
@@ -164,6 +154,8 @@ def run_block(args: argparse.Namespace) -> Result:
 
 def block_report(run: BlockRun, law: SlipLimit | None) -> dict[str, Any]:
     """The JSON document of ``stickslip block``: summary, period law, slips, parameters."""
+    from stickslip.run.block import INTEGRATOR
+
     data: dict[str, Any] = run.summary()
     data["params"] = run.params.to_dict()
     data["integrator"] = INTEGRATOR
@@ -208,6 +200,8 @@ def block_text(d: dict[str, Any]) -> str:
 def _fig2_source(run: BlockRun) -> tuple[BlockRun, int] | None:
     """A run with every step stored around the second slip of ``run`` (the first if it has one
     slip), and that slip's row in it; None without slips (Fig. 2)."""
+    from stickslip.run.block import simulate_block
+
     if len(run.slips) == 0:
         return None
     index = 1 if len(run.slips) > 1 else 0
@@ -216,7 +210,7 @@ def _fig2_source(run: BlockRun) -> tuple[BlockRun, int] | None:
     # Re-run to just before the slip without storing, then store every step through it.
     p = run.params
     lead = max(0.0, float(run.slips["t_c"].iloc[index]) - 10 * p.dt)
-    before = simulate_block(p, lead, initial=run.initial, every=max(1, steps_for(lead, p.dt)))
+    before = simulate_block(p, lead, initial=run.initial, every=max(1, steps_for(lead, p.dt, "t_end")))
     span = 2.0 * float(run.slips["duration"].iloc[index]) + 20 * p.dt
     fine = simulate_block(p, span, initial=before.restart_state())
     return (fine, 0) if len(fine.slips) else None
@@ -224,8 +218,12 @@ def _fig2_source(run: BlockRun) -> tuple[BlockRun, int] | None:
 
 def write_block_outputs(out: Path, run: BlockRun, law: SlipLimit | None, *, fig3: bool = False) -> list[Path]:
     """Write a run's series, slip table, run.json and Figs. 1-2 (and Fig. 3) to ``out``."""
+    import xarray as xr
+
+    from stickslip.analysis.slip_limit import paper_V_values, period_sweep
     from stickslip.plotting.block import fig1_position, fig2_slip, fig3_period, slip_window
     from stickslip.plotting.style import save_figure
+    from stickslip.run.block import INTEGRATOR
 
     written = [
         io.write_dataset(out / "series.nc", run.series),
@@ -270,6 +268,15 @@ def write_block_outputs(out: Path, run: BlockRun, law: SlipLimit | None, *, fig3
 
 def run_slip_limit(args: argparse.Namespace) -> Result:
     """Handler of ``stickslip slip-limit``: eq. (3), the Heun comparison and the period law."""
+    from stickslip.analysis.slip_limit import (
+        PAPER_DURATION,
+        PAPER_FORCE_AT_STOP,
+        NoStopError,
+        heun_slip_limit,
+        matches_paper,
+        solve_slip_limit,
+    )
+
     p = params_from_args(BlockParams, args)
     rtol = check_number("rtol", args.rtol, low=1e-13, high=1e-2)
     atol = check_number("atol", args.atol, low=0.0, low_open=True, high=1e-2)

@@ -15,7 +15,7 @@ from stickslip.cli._common import (
     int_arg,
     owned_out_dir,
 )
-from stickslip.models.params import check_number
+from stickslip.cli._reading import reading_run_dir, staged_writes
 
 
 def register(sub) -> None:
@@ -60,13 +60,10 @@ def register(sub) -> None:
 
 def run_catalog_command(args: argparse.Namespace) -> Result:
     """Handler of `stickslip catalog`."""
-    from stickslip.analysis.catalog import catalog_analysis, load_catalog_run
-    from stickslip.report.catalog_page import CATALOG_FILES, write_catalog
+    from stickslip.analysis.catalog import check_catalog_options, check_counts
 
-    check_number("dm", args.dm, low=0.0, high=1.0)
-    check_number("bootstrap", args.bootstrap, low=0, integer=True)
-    check_number("gof-sims", args.gof_sims, low=0, integer=True)
-    check_number("seed", args.seed, low=0, integer=True)
+    check_catalog_options(args.dm, args.bootstrap, args.gof_sims, args.seed, spell=lambda n: n.replace("_", "-"))
+    check_counts(args.bootstrap, args.gof_sims, ("bootstrap", "gof-sims"))  # before the run is read: refused at once
     run_dir = Path(args.run_dir)
     out = Path(args.out) if args.out else run_dir / "catalog"
     if out.resolve() == run_dir.resolve():
@@ -74,6 +71,15 @@ def run_catalog_command(args: argparse.Namespace) -> Result:
             f"--out {out} is the run directory itself; the catalogue goes into a folder of its own "
             "(default RUN_DIR/catalog)"
         )
+    with reading_run_dir(run_dir):  # a run writing into it (chain --resume) and the catalogue exclude each other
+        return _catalog(args, run_dir, out)
+
+
+def _catalog(args: argparse.Namespace, run_dir: Path, out: Path) -> Result:
+    """The catalogue of ``run_dir`` into ``out``, the run directory held."""
+    from stickslip.analysis.catalog import catalog_analysis, load_catalog_run
+    from stickslip.report.catalog_page import CATALOG_FILES, write_catalog
+
     run = load_catalog_run(run_dir)
     cat = catalog_analysis(run, dm=args.dm, bootstrap=args.bootstrap, gof_sims=args.gof_sims, seed=args.seed)
     command = "stickslip catalog " + shlex.join(
@@ -90,7 +96,9 @@ def run_catalog_command(args: argparse.Namespace) -> Result:
         ]
     )
     with owned_out_dir(out, CATALOG_FILES, "stickslip catalog", overwrite=args.overwrite) as out:
-        written = write_catalog(cat, out, run_dir=run_dir, command=command)
+        # written whole or not at all: a stop (SIGINT, SIGTERM, an error) leaves no half catalogue
+        with staged_writes(out, CATALOG_FILES.__contains__) as stage:
+            written = write_catalog(cat, stage, run_dir=run_dir, command=command)
     data = {"out": str(out), "run_dir": str(run_dir), **cat.summary, **written}
     data["outputs"] = [str(out / name) for name in written["outputs"]]
     lines = [f"{cat.summary['n_events']} slips at t >= {cat.summary['window']['t_from']:g} (stationary window)"]

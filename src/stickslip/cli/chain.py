@@ -20,11 +20,10 @@ from stickslip.cli._common import (
     int_arg,
     owned_out_dir,
     run_option_dests,
+    run_option_spelling,
     run_options_from_args,
 )
 from stickslip.models.params import MAX_PERTURBATION, check_number, steps_for
-from stickslip.run.ownership import PLOT_FOLDER, only_plot_files
-from stickslip.run.rundir import OWN_FILES, RunDirBusy, owned_run_dir, read_run_id
 
 
 def register(sub) -> None:
@@ -198,10 +197,11 @@ _FIXED_BY_CHECKPOINT = ("from_dir", "start", "perturbation", "seed", *run_option
 
 def run_chain_command(args: argparse.Namespace) -> Result:
     """Handler of `stickslip chain`."""
-    from stickslip.run import driver as chain
-
     progress = not args.no_progress
     if args.resume is not None:
+        from stickslip.run import driver as chain
+        from stickslip.run.rundir import RunDirBusy, owned_run_dir
+
         if not args.resume.strip():
             raise CommandError("--resume must name a run directory (got '')")
         if not Path(args.resume).is_dir():
@@ -247,7 +247,10 @@ def run_chain_command(args: argparse.Namespace) -> Result:
             _json_summary(run.summary, Path(args.resume)), _summary_text(run.summary, Path(args.resume), run.params.N)
         )
 
-    params = chain_params_from_args(args)
+    params = chain_params_from_args(args)  # a bad parameter is refused before the engine loads
+    from stickslip.run import driver as chain
+    from stickslip.run.rundir import RunDirBusy, read_run_id
+
     from_state = _from_state(params, args)
     start, amplitude, seed = _start_of(params, args)
     params, t_end = _first_look(params, args, start) if args.t_end is None else (params, args.t_end)
@@ -262,20 +265,16 @@ def run_chain_command(args: argparse.Namespace) -> Result:
             setattr(args, name, default)
     check_number("t-end", t_end, low=0.0, low_open=True)
     steps_for(t_end, params.dt, "t-end")
-    if args.out is None:
-        for flag, value in (
-            ("--checkpoint-interval", args.checkpoint_interval),
-            ("--overwrite", args.overwrite or None),
-            ("--keep-checkpoint", args.keep_checkpoint),
-        ):
-            if value is not None:
-                raise CommandError(f"{flag} needs --out (a run without a run directory writes no checkpoints)")
+    if args.out is None and args.overwrite:
+        raise CommandError("--overwrite needs --out (a run without a run directory writes nothing to replace)")
     interval = 300.0 if args.checkpoint_interval is None else args.checkpoint_interval
-    check_number("checkpoint-interval", interval, low=0.0, low_open=True)
     options = run_options_from_args(args, t_end)
-    check_number("profile-min-blocks", options.profile_min_blocks, low=0, integer=True)
-    # Validate every option before anything is written.
-    options.validated(params.dt)
+    # Validate every option before anything is written, where run_chain does (one place), and
+    # refuse outputs no machine can hold.
+    options.validated(params.dt, spell=run_option_spelling)
+    from stickslip.run.budget import check_run_outputs
+
+    check_run_outputs(params.N, params.dt, options)
     check_number("perturbation", args.perturbation, low=0.0, high=MAX_PERTURBATION)
     own = _own_files(args.out)
     out = check_out_owned(args.out, own, "stickslip chain", overwrite=args.overwrite)
@@ -288,6 +287,8 @@ def run_chain_command(args: argparse.Namespace) -> Result:
             raise CommandError(f"{out} already holds a finished run; choose another --out or give --overwrite")
     try:
         with owned_out_dir(out, own, "stickslip chain", overwrite=args.overwrite, run_id=True) as out:
+            if args.overwrite:
+                _remove_derived(out)
             # The command's own defaults: a progress bar on any terminal, checkpoints every
             # `interval` and on signals where it writes, into the folder it owns.
             options = dataclasses.replace(
@@ -318,12 +319,31 @@ def run_chain_command(args: argparse.Namespace) -> Result:
 
 
 def _own_files(out: str | None):
-    """What `chain` treats as its own in ``--out``: a run's files, and the figures `stickslip plot`
-    drew from that run into RUN_DIR/figures (``--overwrite`` replaces them with the run)."""
+    """What `chain` treats as its own in ``--out``: a run's files, the figures `stickslip plot`
+    drew from that run into RUN_DIR/figures and the catalogue `stickslip catalog` wrote into
+    RUN_DIR/catalog (``--overwrite`` removes them with the run they were read from; either folder
+    holding other files too is left alone)."""
+    from stickslip.run.ownership import CATALOG_FOLDER, PLOT_FOLDER, only_catalog_files, only_plot_files
+    from stickslip.run.rundir import OWN_FILES
+
     if out is None:
         return OWN_FILES
-    folder = Path(out) / PLOT_FOLDER
-    return lambda name: name in OWN_FILES or (name == PLOT_FOLDER and only_plot_files(folder))
+    figures, catalog = Path(out) / PLOT_FOLDER, Path(out) / CATALOG_FOLDER
+    return lambda name: (
+        name in OWN_FILES
+        or (name == PLOT_FOLDER and only_plot_files(figures))
+        or (name == CATALOG_FOLDER and only_catalog_files(catalog))
+    )
+
+
+def _remove_derived(out: Path) -> None:
+    """With ``--overwrite``: the figures and catalogue of the replaced run that a folder of them
+    holding other files too still had (those other files stay)."""
+    from stickslip.run.ownership import CATALOG_FILES, CATALOG_FOLDER, PLOT_FILE, PLOT_FOLDER, remove_own_files
+
+    for folder, own in ((PLOT_FOLDER, PLOT_FILE.fullmatch), (CATALOG_FOLDER, CATALOG_FILES.__contains__)):
+        if (out / folder).is_dir():
+            remove_own_files(out / folder, own)
 
 
 def _first_look(params, args, start: str):
@@ -377,10 +397,9 @@ def _start_of(params, args) -> tuple[str, float, int]:
 
     preset = PRESETS[params.model]
     start = args.start or preset.start
-    if args.perturbation is not None and start == "paper":
-        raise CommandError("--perturbation goes with --start steady or --start rest (the paper's start has none)")
-    if args.seed is not None and start == "paper":
-        raise CommandError("--seed goes with --start steady or --start rest (the paper's start draws no numbers)")
+    from stickslip.run.state import check_start_draw
+
+    check_start_draw(start, args.perturbation, args.seed, cli=True)  # None: not given
     if start == "rest":
         amplitude = args.perturbation if args.perturbation is not None else preset.start_options.get("amplitude", 0.0)
         check_number("perturbation", amplitude, low=0.0, high=MAX_PERTURBATION)
@@ -423,8 +442,15 @@ def run_bench_command(args: argparse.Namespace) -> Result:
     if args.profile:
         result = bench.profile(params, t_end, start=start, perturbation=amplitude, seed=seed)
         return Result(result, bench.format_profile(result))
-    result = bench.compare(params, t_end, start=start, repeat=args.repeat, perturbation=amplitude, seed=seed)
+    _say(bench.expected_cost(params, t_end, args.repeat))  # up front: the default runs for a minute or more
+    result = bench.compare(params, t_end, start=start, repeat=args.repeat, perturbation=amplitude, seed=seed, say=_say)
     return Result(result, bench.format_result(result))
+
+
+def _say(line: str) -> None:
+    """A line of `stickslip bench` on stderr (stdout keeps the result, and --json its document)."""
+    sys.stderr.write(f"stickslip bench: {line}\n")
+    sys.stderr.flush()
 
 
 def _partly_stuck(args: argparse.Namespace) -> Result:
@@ -439,9 +465,11 @@ def _partly_stuck(args: argparse.Namespace) -> Result:
 
 
 def _workload(args: argparse.Namespace, w: dict):
-    """The parameters, preparation time and timed span of a bench workload ``w`` (its N and beta
-    unless given), the preparation scaled with the loading time L_ss / V ~ N^2."""
-    overrides = {k: w[k] for k in ("N", "beta") if getattr(args, f"param_{k}", None) is None}
+    """The parameters, preparation time and timed span of a bench workload ``w``, the preparation
+    scaled with the loading time L_ss / V ~ N^2. The workload's N and beta are the paper's chain's
+    (unless given); another model keeps its own, and a parameter it does not read is not set."""
+    paper = (args.model or "sakaguchi") == "sakaguchi"
+    overrides = {k: w[k] for k in ("N", "beta") if paper and getattr(args, f"param_{k}", None) is None}
     params = chain_params_from_args(args, **overrides)
     t_timed = args.t_end if args.t_end is not None else w["t_timed"]
     check_number("t-end", t_timed, low=0.0, low_open=True)

@@ -10,7 +10,7 @@ import argparse
 import sys
 
 from stickslip.cli._common import CommandError, Result, float_arg
-from stickslip.models.params import check_number
+from stickslip.models.params import check_number, steps_for
 
 #: The default deltas of ``--deltas``.
 DEFAULT_DELTAS = "1e-12,1e-10,1e-8,1e-6"
@@ -95,6 +95,7 @@ def run(params, args: argparse.Namespace) -> Result:
         SIZE_RTOL,
         GridSequences,
         LocatedSequences,
+        check_slips,
         sequence_decorrelation,
     )
 
@@ -102,7 +103,9 @@ def run(params, args: argparse.Namespace) -> Result:
     events = int(check_number("events", args.events if args.events is not None else EVENTS, low=1, integer=True))
     seeds = int(check_number("seeds", args.seeds if args.seeds is not None else 1, low=1, integer=True))
     rtol = float(check_number("rtol", args.rtol if args.rtol is not None else SIZE_RTOL, low=0.0, low_open=True))
+    check_slips(events, seeds, len(deltas))  # before the transient is run
     perturb = args.perturb or "state"
+    steps_for(args.transient, params.dt, "transient")  # before any work, named as given
     t_max = None
     if args.t_end is not None:
         if not args.t_end > args.transient:
@@ -156,13 +159,12 @@ def _start(params, args, located: bool):
     """The state at ``--transient`` from ``--start`` and, on the grid, the transient's loading
     check (:func:`stickslip.run.loaded.loaded_state`, kept in ``--state-cache``): the engine's
     state (grid) or the located integrator's (located, as before; no check)."""
-    from stickslip.models.params import steps_for
 
     if located:
         from stickslip.run.located import LocatedStepper, start_state
 
         ref = start_state(params, args.start, perturbation=args.perturbation, seed=args.seed)
-        ref, _ = LocatedStepper(params).advance(ref, steps_for(args.transient, params.dt))
+        ref, _ = LocatedStepper(params).advance(ref, steps_for(args.transient, params.dt, "transient"))
         return ref, None
     from stickslip.run.loaded import loaded_state
     from stickslip.run.state import initial_state

@@ -208,10 +208,11 @@ def run_lyapunov_command(args: argparse.Namespace) -> Result:
     preset = PRESETS[params.model]
     if args.start is None:
         args.start = preset.start
+    from stickslip.run.state import check_start_draw
+
+    check_start_draw(args.start, args.perturbation, args.seed, cli=True)  # as `chain` and run_chain check it
     if args.perturbation is None:
         args.perturbation = preset.start_options.get("amplitude", 0.0) if args.start == "rest" else 0.0
-    if args.seed is not None and args.start == "paper":
-        raise CommandError("--seed goes with --start steady or --start rest (the paper's start draws no numbers)")
     if args.seed is None:
         args.seed = preset.start_options.get("seed", 0)
     check_number("perturbation", args.perturbation, low=0.0, high=MAX_PERTURBATION)
@@ -346,7 +347,7 @@ def _finite_size(params, args) -> Result:
     # A check further apart than the longest cycle (--t-end) would never look at the distance.
     check = max(1, int(round(check_number("check", args.check, low=params.dt, high=args.t_end) / params.dt)))
     ref = start_state(params, args.start, perturbation=args.perturbation, seed=args.seed)
-    ref, _ = LocatedStepper(params).advance(ref, steps_for(args.transient, params.dt))
+    ref, _ = LocatedStepper(params).advance(ref, steps_for(args.transient, params.dt, "transient"))
     pair = LocatedPair(params, ref, neutral=args.neutral, direction_seed=args.direction_seed)
     res = finite_size_exponents(
         pair, deltas, cycles=args.cycles, check_steps=check, max_cycle_time=args.t_end, pooled_below=1e-6

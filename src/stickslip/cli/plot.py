@@ -5,11 +5,16 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from stickslip.cli._common import CommandError, Result, add_json_option, add_overwrite_option, owned_out_dir
+from stickslip.cli._common import (
+    CommandError,
+    Result,
+    add_json_option,
+    add_overwrite_option,
+    owned_out_dir,
+)
+from stickslip.cli._reading import reading_run_dir
 
 # The figures `plot` draws (stickslip.plotting.run.run_figures); its --out may hold only these.
-from stickslip.run.ownership import PLOT_FILE as _FIGURE
-from stickslip.run.ownership import PLOT_FOLDER
 
 
 def register(sub) -> None:
@@ -38,6 +43,8 @@ def register(sub) -> None:
 def run_plot_command(args: argparse.Namespace) -> Result:
     """Handler of `stickslip plot`."""
     from stickslip.plotting.run import draw_run_figures
+    from stickslip.run.ownership import PLOT_FILE as _FIGURE
+    from stickslip.run.ownership import PLOT_FOLDER
     from stickslip.run.rundir import RunDirDamaged, load_run
 
     run_dir = Path(args.run_dir)
@@ -50,12 +57,13 @@ def run_plot_command(args: argparse.Namespace) -> Result:
             "their own (default RUN_DIR/figures)"
         )
     formats = tuple(dict.fromkeys(args.format or ("png", "pdf")))
-    try:
-        run = load_run(run_dir)
-    except RunDirDamaged as exc:
-        raise CommandError(f"cannot plot {run_dir}: {exc}") from None
-    with owned_out_dir(out, _FIGURE.fullmatch, "stickslip plot", overwrite=args.overwrite) as out:
-        records = draw_run_figures(run, out, formats=formats)
+    with reading_run_dir(run_dir):  # a run writing into it (chain --resume) and the figures exclude each other
+        try:
+            run = load_run(run_dir)
+        except RunDirDamaged as exc:
+            raise CommandError(f"cannot plot {run_dir}: {exc}") from None
+        with owned_out_dir(out, _FIGURE.fullmatch, "stickslip plot", overwrite=args.overwrite) as out:
+            records = draw_run_figures(run, out, formats=formats)
     lines = []
     for r in records:
         if "files" in r:

@@ -103,11 +103,21 @@ def _run(out, args: argparse.Namespace, workers: int | None) -> Result:
     return Result(result, _text(result))
 
 
+#: Width of the agreement column of the summary table (its text wraps, whole words, below).
+AGREEMENT_WIDTH = 60
+
+
 def _text(result: dict) -> str:
+    """The summary on stdout: a row per stated number, its agreement in full (wrapped at word
+    boundaries, never cut), the studies, the figures and the report."""
+    import textwrap
+
     lines = [f"stickslip reproduce --{result['mode']}: {result['wall_seconds']:.1f} s"]
     width = max(len(r["where"]) for r in result["rows"]) if result["rows"] else 0
     for r in result["rows"]:
-        lines.append(f"  {r['where']:<{width}}  {r['agreement'][:60]:<60}  {r['quantity']}")
+        first, *more = textwrap.wrap(str(r["agreement"]), AGREEMENT_WIDTH, break_long_words=False) or [""]
+        lines.append(f"  {r['where']:<{width}}  {first:<{AGREEMENT_WIDTH}}  {r['quantity']}")
+        lines += [f"  {'':<{width}}  {line}" for line in more]
     for s in result["studies"]:
         lines.append(f"  {s['study']}: {s['points']} points ({s['reused']} reused); page {s['page']}")
     lines.append(f"figures: {len(result['figures'])}")

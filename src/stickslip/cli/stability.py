@@ -17,14 +17,9 @@ import argparse
 import dataclasses
 import math
 from pathlib import Path
-from typing import Any
-
-import numpy as np
-import xarray as xr
+from typing import TYPE_CHECKING, Any
 
 from stickslip import io
-from stickslip.analysis import hysteresis as hy
-from stickslip.analysis import stability as st
 from stickslip.cli._common import (
     OUT_FILES,
     CommandError,
@@ -42,7 +37,11 @@ from stickslip.cli._common import (
     params_from_args,
 )
 from stickslip.models.params import BlockParams, ChainParams, ParameterError, check_number
-from stickslip.run.block import INTEGRATOR
+
+if TYPE_CHECKING:  # loaded where used: `stickslip --help` loads no numba, scipy or xarray
+    import numpy as np
+
+    from stickslip.analysis import hysteresis as hy
 
 #: Points of the stability map (beta x V) and of the Hopf curve.
 MAP_BETAS = 121
@@ -58,6 +57,8 @@ _LINEAR = "linearisation about steady sliding, numpy.linalg.eigvals; Hopf point 
 
 def register(sub) -> None:
     """Add ``stability`` (with ``block`` and ``chain``) and ``hysteresis`` to the parser."""
+    from stickslip.analysis import hysteresis as hy
+
     s = sub.add_parser(
         "stability",
         help="linear stability of steady sliding: the block (eq. 2) and the chain (eq. 5, Fig. 4)",
@@ -148,6 +149,10 @@ def _is_paper_block(p: BlockParams) -> bool:
 
 def run_stability_block(args: argparse.Namespace) -> Result:
     """Handler of ``stickslip stability block``: Hopf point and eigenvalues of eq. (2)."""
+    import numpy as np
+
+    from stickslip.analysis import stability as st
+
     with_V = args.param_V is not None
     p = params_from_args(BlockParams, args)
     check_out_owned(args.out, _BLOCK_MAP, "stickslip stability block", overwrite=args.overwrite)
@@ -188,6 +193,9 @@ def run_stability_block(args: argparse.Namespace) -> Result:
 
 
 def _write_block_map(out: Path, p: BlockParams, data: dict, with_V: bool) -> list[Path]:
+    import numpy as np
+
+    from stickslip.analysis import stability as st
     from stickslip.plotting.stability import plot_stability_map
     from stickslip.plotting.style import save_figure
 
@@ -236,6 +244,8 @@ def _block_text(d: dict[str, Any]) -> str:
 def run_stability_chain(args: argparse.Namespace) -> Result:
     """Handler of ``stickslip stability chain``: Fourier modes of eq. (5), Fig. 4; the relatives
     without state variable mode by mode (:func:`run_stability_modes`)."""
+    from stickslip.analysis import stability as st
+
     for name in ("Fs", "dt"):
         if getattr(args, f"param_{name}", None) is not None:
             raise CommandError(f"--{name} is not read by the linear stability of steady sliding")
@@ -292,6 +302,8 @@ def run_stability_law(args: argparse.Namespace, p: ChainParams, with_N: bool) ->
     the 3 x 3 mode matrices and the finite chain's Jacobian from the law's linearisation, and the
     critical spring constant K_c (analysis.stability.critical_stiffness). Without --N: the
     spring-slider, N = 1."""
+    from stickslip.analysis import stability as st
+
     if p.drive_piece.leaf_spring or not p.ends_piece.steady_sliding:
         raise CommandError(f"friction {p.friction} is covered with drive end and ends free only")
     if p.V <= 0.0:
@@ -336,6 +348,10 @@ def _law_text(d: dict[str, Any]) -> str:
 
 
 def _write_fig4(out: Path, p: ChainParams, data: dict) -> list[Path]:
+    import numpy as np
+    import xarray as xr
+
+    from stickslip.analysis import stability as st
     from stickslip.plotting.stability import plot_fig4
     from stickslip.plotting.style import save_figure
 
@@ -372,6 +388,8 @@ def run_stability_modes(args: argparse.Namespace, p: ChainParams) -> Result:
 
     Each normal mode obeys lambda^2 + phi'(V) lambda + w_k^2 = 0 (analysis.stability).
     """
+    from stickslip.analysis import stability as st
+
     if p.V <= 0.0:
         raise CommandError(f"steady sliding needs V > 0 (got V={p.V:g})")
     if not p.ends_piece.steady_sliding:
@@ -408,6 +426,7 @@ def run_stability_modes(args: argparse.Namespace, p: ChainParams) -> Result:
 
 
 def _write_mode_growth(out: Path, p: ChainParams, data: dict) -> list[Path]:
+    from stickslip.analysis import stability as st
     from stickslip.plotting.stability import plot_mode_growth
     from stickslip.plotting.style import save_figure
 
@@ -443,6 +462,8 @@ def _modes_text(d: dict[str, Any]) -> str:
 
 def run_hysteresis(args: argparse.Namespace) -> Result:
     """Handler of ``stickslip hysteresis``: the adiabatic sweep of V of section 2."""
+    from stickslip.analysis import hysteresis as hy
+
     p = block_params_from_args(args)
     settings = hy.SweepSettings(
         V_min=args.V_min, V_max=args.V_max, dV=args.dV,
@@ -469,6 +490,7 @@ def run_hysteresis(args: argparse.Namespace) -> Result:
 def _write_hysteresis(out: Path, result: hy.HysteresisResult, data: dict) -> list[Path]:
     from stickslip.plotting.stability import plot_hysteresis
     from stickslip.plotting.style import save_figure
+    from stickslip.run.block import INTEGRATOR
 
     written = [io.write_dataset(out / "hysteresis.nc", result.data)]
     written += save_figure(plot_hysteresis(result.data), out / "hysteresis")

@@ -179,7 +179,7 @@ def _check_options(model: str, params, settings: dict[str, Any]) -> None:
     from stickslip.models.params import ParameterError, steps_for
 
     if model == "block":  # the system swept (single block or chain), not a model piece
-        steps_for(settings["t_end"], params.dt)
+        steps_for(settings["t_end"], params.dt, "t_end")
         check_number("every", settings.get("every", 1), low=1, high=MAX_STEPS, integer=True)
         return
     from stickslip.run.driver import INTEGRATORS, STARTS, RunOptions

@@ -15,7 +15,7 @@ Layout::
 
 from __future__ import annotations
 
-import shutil
+import contextlib
 import sys
 import time
 from pathlib import Path
@@ -287,7 +287,10 @@ def foreign_files(out: str | Path) -> list[str]:
         def points(path: Path, rel: str):
             if path.is_file():
                 return path.name in {f"{SUMMARY_NAME}.parquet", f"{SUMMARY_NAME}.csv", STOP_FILE}
-            return (path / POINT_FILE).is_file() and entry
+            if not (path / POINT_FILE).is_file():
+                # a point stopped at its first write (a full disk) left its folder with nothing in it
+                return path.is_dir() and all(is_temporary(p.name) or p.name in LOCK_FILES for p in path.iterdir())
+            return _point_entry(path) if entry is True else entry
 
         def study_runs(path: Path, rel: str):
             if path.name == "points" and path.is_dir():
@@ -309,9 +312,43 @@ def foreign_files(out: str | Path) -> list[str]:
     return foreign
 
 
+def _point_entry(point: Path):
+    """The test of a point's entries (the walk of :func:`foreign_files`) for a study without a
+    ``point_entry``: the sweep's bookkeeping and the run's lock and id; in its checkpoint only a
+    checkpoint's files (:data:`~stickslip.run.checkpoint.CHECKPOINT_FILE`); in a finished point
+    (its done.json records its files) only those; in one still running, what its task writes."""
+    from stickslip.experiments.cache import BOOKKEEPING
+    from stickslip.run.checkpoint import CHECKPOINT_FILE
+    from stickslip.run.rundir import LOCK_FILES, RUN_ID_FILE
+
+    try:
+        files = io.read_json(point / "done.json").get("files")
+    except (OSError, ValueError, AttributeError):
+        files = None
+    recorded = set(files) if isinstance(files, dict) else None
+
+    def checkpoint(path: Path, rel: str) -> bool:
+        return path.is_file() and CHECKPOINT_FILE.fullmatch(path.name) is not None
+
+    def inside(path: Path, rel: str):
+        if recorded is None:
+            return True
+        return inside if path.is_dir() else path.relative_to(point).as_posix() in recorded
+
+    def top(path: Path, rel: str):
+        if path.name in BOOKKEEPING or path.name in LOCK_FILES or path.name == RUN_ID_FILE:
+            return True
+        if path.name == "checkpoint" and path.is_dir():
+            return checkpoint
+        return inside(path, rel)
+
+    return top
+
+
 def remove_study_files(out: str | Path, spec: Study) -> None:
     """``--overwrite``: remove what this study wrote under ``out`` (its page files and its runs
-    folder); every other file stays."""
+    folder); every other file stays (:func:`foreign_files`: a file of the user's in a point's
+    folder or checkpoint too)."""
     out = Path(out)
     own = read_manifest(out)
     page_dir = out / spec.name
@@ -319,6 +356,18 @@ def remove_study_files(out: str | Path, spec: Study) -> None:
         path = out / rel
         if path.parent == page_dir and path.is_file():
             path.unlink()
-    shutil.rmtree(spec.runs_dir(out), ignore_errors=True)
+    runs = spec.runs_dir(out)
+    foreign = {out / rel for rel in foreign_files(out)}
+    if runs.is_dir():
+        for path in sorted(runs.rglob("*"), key=lambda p: len(p.parts), reverse=True):  # deepest first
+            if path in foreign or foreign & set(path.parents):
+                continue
+            if path.is_dir() and not path.is_symlink():
+                with contextlib.suppress(OSError):
+                    path.rmdir()  # a folder still holding a foreign file stays
+            else:
+                path.unlink()
+        with contextlib.suppress(OSError):
+            runs.rmdir()
     if own:
         io.write_json(out / MANIFEST, {"files": sorted(p for p in own if (out / p).exists())})

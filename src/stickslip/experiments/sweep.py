@@ -23,7 +23,6 @@ import logging
 import math
 import os
 import re
-import shutil
 import sys
 import time
 import traceback
@@ -150,10 +149,11 @@ def _run_point(
     for stale in (DONE_FILE, ERROR_FILE):
         (directory / stale).unlink(missing_ok=True)
     if spec_before(directory) != spec:
-        # a checkpoint of other settings (run length, start, package version) is not continued
-        from stickslip.run.checkpoint import Checkpointer
+        # a checkpoint of other settings (run length, start, package version) is not continued;
+        # a file of the user's in it stays
+        from stickslip.run.checkpoint import remove_checkpoint
 
-        shutil.rmtree(Checkpointer(directory).dir, ignore_errors=True)
+        remove_checkpoint(directory)
     write_json(directory / POINT_FILE, {"spec": spec})
     start = time.perf_counter()
     try:

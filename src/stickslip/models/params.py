@@ -411,9 +411,10 @@ SYMBOLS = {
 }
 
 
-def steps_for(t_end: float, dt: float, name: str = "t_end") -> int:
+def steps_for(t_end: float, dt: float, name: str) -> int:
     """Number of steps n with t_n = n dt reaching ``t_end`` (rounded to the nearest step);
-    at most :data:`MAX_STEPS`."""
+    at most :data:`MAX_STEPS`. ``name`` is what a refusal calls the time: the parameter or option
+    the caller was given (``transient``, ``t-end``), never one it was not."""
     t_end = check_number(name, t_end, low=0.0)
     if t_end / dt > MAX_STEPS + 0.5:
         raise ParameterError(

@@ -147,10 +147,17 @@ def _cached(fn):
 def drive_stiffness(p: Any) -> np.ndarray:
     """The stiffness of the spring joining each block to the drive: the drive's compiled ``leaf``
     (Kp for the plate, 0 for the end drive and the force drives) at each block's parameters."""
-    leaf = importlib.import_module(p.drive_piece.module).leaf.py_func
+    leaf = _python(p.drive_piece.module, "leaf")
     if is_uniform(p):
         return np.full(p.N, float(leaf(block_kernel_params(p.drive_piece, p, 0))))
     return np.array([float(leaf(block_kernel_params(p.drive_piece, p, i))) for i in range(p.N)])
+
+
+def _python(module: str, name: str) -> Any:
+    """A piece's compiled function ``name`` as plain Python (its ``py_func``), without compiling it
+    (a function still waiting for numba, :func:`stickslip.models.piece.njit`, is read as it is)."""
+    fn = vars(importlib.import_module(module))[name]
+    return getattr(fn, "py_func", None) or fn.__wrapped__
 
 
 def block_kernel_params(piece: Any, p: Any, i: int) -> tuple:
@@ -169,8 +176,8 @@ def ghost_rows(p: Any) -> dict[str, tuple[float, float]]:
     theta_0 and theta_{N+1} (no flux). x_0 of the end drive is the pulling point, which moves with
     steady sliding, so its weights are 0. The ghost functions are selections, so the weights are exact.
     """
-    ends = importlib.import_module(p.ends_piece.module).ghost.py_func
-    left = importlib.import_module(p.drive_piece.module).left.py_func
+    ends = _python(p.ends_piece.module, "ghost")
+    left = _python(p.drive_piece.module, "left")
     on_ghost = left(0.0, 1.0)  # 1 where x_0 is the ends' ghost cell, 0 where it is the pulling point
     x_edge, x_other = ends(1.0, 0.0, 0.0), ends(0.0, 1.0, 0.0)
     th_edge, th_other = ends(1.0, 0.0, 1.0), ends(0.0, 1.0, 0.0)
@@ -185,8 +192,8 @@ def ghost_rows(p: Any) -> dict[str, tuple[float, float]]:
 def left_ghost(p: Any, pull: float, x1: float, xN: float) -> float:
     """x_0 as the kernels set it (:func:`stickslip.kernels.laws._set_ghosts`): the drive's compiled
     ``left`` of the pull point ``pull`` and the ends' ``ghost`` of x_1 and x_N (a wall at 0)."""
-    ends = importlib.import_module(p.ends_piece.module).ghost.py_func
-    left = importlib.import_module(p.drive_piece.module).left.py_func
+    ends = _python(p.ends_piece.module, "ghost")
+    left = _python(p.drive_piece.module, "left")
     return left(pull, ends(x1, xN, 0.0))
 
 

@@ -7,11 +7,17 @@ stability analysis reads. Every piece is one module of :mod:`stickslip.models` (
 ``drive``, ``threshold``, ``ends``) that also holds the compiled functions every integrator calls
 (:attr:`Piece.module`, the contract in :mod:`stickslip.kernels.laws`) and the named tuple of the
 parameters they read (:func:`kernel_params`).
+
+Those functions are compiled with numba when first asked for (:func:`njit`), not when their module
+is imported: the pieces describe every model to the command line and to ``import stickslip``,
+which then print help or check parameters without loading numba (and scipy through it).
 """
 
 from __future__ import annotations
 
 import importlib
+import sys
+import types
 from collections import namedtuple
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -20,6 +26,64 @@ from typing import Any
 
 class CompositionError(ValueError):
     """A choice of pieces that docs/model.md does not allow; the message is one line."""
+
+
+class _Pending:
+    """A piece's function waiting for :func:`numba.njit` with ``options``; called from Python
+    before then, it compiles its module's functions (:func:`_compile_module`) and calls its own."""
+
+    __slots__ = ("fn", "options", "__wrapped__")
+
+    def __init__(self, fn: Callable, options: dict[str, Any]):
+        self.fn, self.options, self.__wrapped__ = fn, options, fn
+
+    def __call__(self, *args: Any) -> Any:
+        return _compile_module(sys.modules[self.fn.__module__])[self.fn.__name__](*args)
+
+
+def _compile_module(module: types.ModuleType) -> dict[str, Any]:
+    """Compile every pending function of ``module`` (into its namespace) and return the namespace.
+
+    All at once, so that a compiled function finds the others it calls by name compiled too. The
+    kernels' cache directory is set first (:mod:`stickslip.kernels`, on import), as numba picks a
+    function's cache directory when it decorates it.
+    """
+    namespace = vars(module)
+    pending = {k: v for k, v in namespace.items() if isinstance(v, _Pending)}
+    if pending:
+        from numba import njit as numba_njit
+
+        import stickslip.kernels  # noqa: F401  (the cache directory, before numba decorates)
+
+        for name, waiting in pending.items():
+            namespace[name] = numba_njit(**waiting.options)(waiting.fn)
+    return namespace
+
+
+class _PieceModule(types.ModuleType):
+    """A piece's module whose pending functions (:func:`njit`) are compiled when one is read as an
+    attribute (``module.accel``, as the kernels read a piece's functions when they are compiled)."""
+
+    def __getattribute__(self, name: str) -> Any:
+        value = super().__getattribute__(name)
+        if isinstance(value, _Pending):
+            return _compile_module(self)[name]
+        return value
+
+
+def njit(**options: Any) -> Callable[[Callable], Any]:
+    """:func:`numba.njit` with ``options`` (``cache=True, inline="always"``), applied when the
+    function is first asked for: read from its module by the kernels, or called. The compiled
+    function is numba's own, so the kernels inline it and its bits are those of a function
+    decorated on import; only numba's import (and compilation) waits until a model runs."""
+
+    def mark(fn: Callable) -> _Pending:
+        module = sys.modules[fn.__module__]
+        if not isinstance(module, _PieceModule):
+            module.__class__ = _PieceModule
+        return _Pending(fn, options)
+
+    return mark
 
 
 def kernel_params(module: str, reads: tuple[str, ...]) -> type:

@@ -29,7 +29,7 @@ def fig1_position(run: BlockRun) -> Figure:
     ax.set_xlabel("$t$")
     ax.set_ylabel("$x$")
     ax.set_xlim(0.0, float(s["t"][-1]))
-    ax.set_title(f"Fig. 1: single block, {_param_text(run.params)}", fontsize=9)
+    ax.set_title(f"Fig. 1: single block, {_param_text(run.params)}", fontsize=9, wrap=True)
     return fig
 
 
@@ -73,7 +73,7 @@ def fig2_slip(run: BlockRun, limit: SlipLimit, index: int | None = None) -> Figu
     ax_p.set_ylabel(r"$\theta$")
     ax_p.set_title("(b)", loc="left")
     ax_p.legend()
-    fig.suptitle(f"Fig. 2: one slip, {_param_text(run.params)}", fontsize=9)
+    fig.suptitle(f"Fig. 2: one slip, {_param_text(run.params)}", fontsize=9, wrap=True)
     return fig
 
 
@@ -95,7 +95,7 @@ def fig3_period(sweep: pd.DataFrame, limit: SlipLimit) -> Figure:
     ax.set_ylabel("period $T$")
     ax.legend()
     ax.set_title(rf"Fig. 3: $K={limit.params.K:g}$, $\beta={limit.params.beta:g}$, $F_s={limit.params.Fs:g}$",
-                 fontsize=9)  # fmt: skip
+                 fontsize=9, wrap=True)  # fmt: skip
     ax_d.axhline(0.0, color="0.5", lw=0.8)
     ax_d.plot(V, 100.0 * sweep["rel_dev"], "o-", color=SIM["color"], ms=4, lw=0.8)
     ax_d.set_xlabel("$V$")

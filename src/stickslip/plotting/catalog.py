@@ -76,7 +76,7 @@ def frequency_magnitude_figure(catalog) -> Figure | None:
     ax.set_xlabel("magnitude $M = \\frac{2}{3}\\log_{10} S$")
     ax.set_ylabel("number of slips")
     ax.legend(loc="lower left", fontsize=8)
-    ax.set_title(f"frequency-magnitude: {_title(catalog)}", loc="left", fontsize=9)
+    ax.set_title(f"frequency-magnitude: {_title(catalog)}", loc="left", fontsize=9, wrap=True)
     return fig
 
 
@@ -105,7 +105,7 @@ def ccdf_figure(catalog) -> Figure | None:
     ax.set_xlabel("$S$")
     ax.set_ylabel("$P(S' \\geq S)$")
     ax.legend(loc="lower left", fontsize=7)
-    ax.set_title(f"which distribution: {_title(catalog)}", loc="left", fontsize=9)
+    ax.set_title(f"which distribution: {_title(catalog)}", loc="left", fontsize=9, wrap=True)
     return fig
 
 
@@ -137,9 +137,9 @@ def recurrence_figure(catalog) -> Figure | None:
         ax.ticklabel_format(axis="x", style="sci", scilimits=(-3, 4))
         ax.set_xlabel("inter-event time $\\Delta t$")
         ax.set_ylabel("density")
-        ax.set_title(f"{key} slips, CV = {rec[key]['cv']:.3g}", loc="left", fontsize=9)
+        ax.set_title(f"{key} slips, CV = {rec[key]['cv']:.3g}", loc="left", fontsize=9, wrap=True)
         ax.legend(fontsize=7)
-    fig.suptitle(f"recurrence: {_title(catalog)}", fontsize=9)
+    fig.suptitle(f"recurrence: {_title(catalog)}", fontsize=9, wrap=True)
     return fig
 
 
@@ -164,7 +164,7 @@ def moment_rate_figure(catalog) -> Figure | None:
     ax.set_xlabel("time since the slip's start")
     ax.set_ylabel("moment rate $\\sum_i \\Delta x_i / W$")
     ax.legend(fontsize=7)
-    ax.set_title(f"moment rate of the largest slips: {_title(catalog)}", loc="left", fontsize=9)
+    ax.set_title(f"moment rate of the largest slips: {_title(catalog)}", loc="left", fontsize=9, wrap=True)
     return fig
 
 

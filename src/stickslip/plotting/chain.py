@@ -26,7 +26,7 @@ from stickslip.analysis.statistics import EdgeSpeed, FrontSpeed, PowerLawFit, ce
 from stickslip.models.params import ChainParams
 from stickslip.models.physics import chain_steady_length, chain_steady_profile_paper, chain_steady_state
 from stickslip.models.presets import is_paper_model, is_paper_run, model_title
-from stickslip.plotting.style import PAPER, SIM, THEORY, new_figure
+from stickslip.plotting.style import PAPER, SIM, THEORY, new_figure, ordinal
 
 __all__ = [
     "snapshot_figure",
@@ -120,7 +120,7 @@ def snapshot_figure(x: Any, params: ChainParams, t: float, *, ax=None, paper_fig
     ax_r.set_ylabel(r"$x_i - x_i^{ss}$")
     ax_r.set_xlim(1, params.N)
     ax_r.legend(loc="lower left", fontsize=8)
-    fig.suptitle(title, fontsize=9)
+    fig.suptitle(title, fontsize=9, wrap=True)
     return fig
 
 
@@ -283,7 +283,7 @@ def _waterfall(ax, sub: xr.Dataset, window: float | None, edge: EdgeSpeed | None
     ax.set_xlabel("block $i$")
     ax.set_xlim(blocks.min(), blocks.max())
     w = f"{window:g}" if window else "W"
-    every_text = f", every {every}th window" if every > 1 else ""
+    every_text = f", every {ordinal(every)} window" if every > 1 else ""
     ax.text(
         0.99,
         0.01,
@@ -350,7 +350,7 @@ def _speed_histogram(ax, speeds: np.ndarray, title: str, level: float = 0.9) -> 
     """Per-event front speeds with the paper's c, its percentile and the central ``level`` (Fig. 6)."""
     x = np.asarray(speeds, dtype=np.float64)
     x = x[np.isfinite(x)]
-    ax.set_title(title, loc="left", fontsize=9)
+    ax.set_title(title, loc="left", fontsize=9, wrap=True)
     ax.set_xlabel("front speed $c$ (blocks per time unit)")
     ax.set_ylabel("events")
     if x.size == 0:
@@ -456,9 +456,9 @@ def fronts_figure(
         _waterfall(ax_w, sub, window, edge)
         letter = letters[row] if row < 8 else str(row)
         t0 = float(sub["profile_t"].values[0])
-        ax_w.set_title(f"({letter}) {label}, $t_s \\approx {t0:.6g}$", loc="left", fontsize=9)
+        ax_w.set_title(f"({letter}) {label}, $t_s \\approx {t0:.6g}$", loc="left", fontsize=9, wrap=True)
         _arrivals(ax_t, first_move, front, params.K, edge, paper)
-        ax_t.set_title(f"front: blocks {front.i_min}-{front.i_max}", loc="left", fontsize=9)
+        ax_t.set_title(f"front: blocks {front.i_min}-{front.i_max}", loc="left", fontsize=9, wrap=True)
     if speeds is not None:
         letter = letters[len(fronts)]
         _speed_histogram(
@@ -469,7 +469,7 @@ def fronts_figure(
             speeds["c_leading_edge"].to_numpy(dtype=float),
             f"({letter}) per event: leading edge of the windows",
         )
-    fig.suptitle(_title("rupture fronts", params, paper_figure, "Fig. 6"), fontsize=9)
+    fig.suptitle(_title("rupture fronts", params, paper_figure, "Fig. 6"), fontsize=9, wrap=True)
     return fig
 
 
@@ -568,7 +568,7 @@ def sizes_figure(
     ax_b.set_xlabel("event start time $t$")
     ax_b.set_ylabel("$S$")
     ax_b.set_title("(b)", loc="left")
-    fig.suptitle(title, fontsize=9)
+    fig.suptitle(title, fontsize=9, wrap=True)
     return fig
 
 

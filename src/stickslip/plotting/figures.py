@@ -22,7 +22,6 @@ import xarray as xr
 from stickslip import io
 from stickslip.analysis.chain_runs import fig6_start_note, sweep_table
 from stickslip.outcome import Outcome, chain_params
-from stickslip.report.commands import block_command, chain_command, hysteresis_command, sweep_command
 
 #: A drawn figure: its stem, the figure, its caption and the further fields of its report entry.
 Drawn = tuple[str, Any, str, dict[str, Any]]
@@ -32,7 +31,7 @@ def _figure(stem: str, label: str, caption: str, fig, data: list[Path], command:
     return stem, fig, caption, {"figure": label, "data": [p.name for p in data], "command": command}
 
 
-def _fig1_2(o: dict[str, Outcome], d: Path) -> list[Drawn]:
+def _fig1_2(o: dict[str, Outcome], d: Path, cmd) -> list[Drawn]:
     """Figs. 1 and 2 from the block run and eq. (3)."""
     from stickslip.plotting.block import fig1_position, fig2_slip, slip_window
 
@@ -49,7 +48,7 @@ def _fig1_2(o: dict[str, Outcome], d: Path) -> list[Drawn]:
             "stick-slip with period 344.",
             fig1_position(run),
             [f1],
-            block_command(o["block"]),
+            cmd.block_command(o["block"]),
         )
     ]
     w = slip_window(run)
@@ -75,7 +74,7 @@ def _fig1_2(o: dict[str, Outcome], d: Path) -> list[Drawn]:
             "overlap.",
             fig2_slip(run, law),
             [f2],
-            block_command(o["block"]),
+            cmd.block_command(o["block"]),
         )
     )
     return figs
@@ -123,7 +122,7 @@ def _stability_map(o: dict[str, Outcome], d: Path) -> list[Drawn]:
     ]
 
 
-def _hysteresis(o: dict[str, Outcome], d: Path) -> list[Drawn]:
+def _hysteresis(o: dict[str, Outcome], d: Path, cmd) -> list[Drawn]:
     """Section 2: V raised slowly and lowered again; the inverse transition at V_up."""
     from stickslip.plotting.stability import plot_hysteresis
 
@@ -138,7 +137,7 @@ def _hysteresis(o: dict[str, Outcome], d: Path) -> list[Drawn]:
             "(min v = 0) ends at V_up (the paper: 0.345).",
             plot_hysteresis(data),
             [f],
-            hysteresis_command(o["hysteresis"], draw=True),
+            cmd.hysteresis_command(o["hysteresis"], draw=True),
         )
     ]
 
@@ -163,7 +162,7 @@ def _fig4(o: dict[str, Outcome], d: Path) -> list[Drawn]:
     ]
 
 
-def _fig5(o: dict[str, Outcome], a: dict[str, Any], d: Path, mode: str) -> list[Drawn]:
+def _fig5(o: dict[str, Outcome], a: dict[str, Any], d: Path, mode: str, cmd) -> list[Drawn]:
     """Fig. 5: (a) snapshot at the end of the beta = 1 run; (b) <L> against beta."""
     from stickslip.models.physics import chain_steady_profile_paper, chain_steady_state
     from stickslip.plotting.chain import fig5a_snapshot, fig5b_length
@@ -192,7 +191,7 @@ def _fig5(o: dict[str, Outcome], a: dict[str, Any], d: Path, mode: str) -> list[
             "paper's continuum form (dotted).",
             fig5a_snapshot(snap, p, t, paper_figure="Fig. 5(a)"),
             fa,
-            chain_command(o["chain-runs"], p.N, 1.0, plot="snapshot_final"),
+            cmd.chain_command(o["chain-runs"], p.N, 1.0, plot="snapshot_final"),
         )
     ]
     sweep = sweep_table(a)
@@ -211,13 +210,13 @@ def _fig5(o: dict[str, Outcome], a: dict[str, Any], d: Path, mode: str) -> list[
             "runs above beta_c that had not settled into steady sliding by their end.",
             fig5b_length(sweep, q, paper_figure="Fig. 5(b)"),
             fb,
-            sweep_command(o["chain-runs"], mode),
+            cmd.sweep_command(o["chain-runs"], mode),
         )
     )
     return figs
 
 
-def _fig6(o: dict[str, Outcome], a: dict[str, Any], d: Path) -> list[Drawn]:
+def _fig6(o: dict[str, Outcome], a: dict[str, Any], d: Path, cmd) -> list[Drawn]:
     """Fig. 6: rupture fronts of a large and an intermediate event at beta = 1, and c per event."""
     from stickslip.analysis.statistics import central_interval
     from stickslip.plotting.chain import PAPER_FRONT_SPEED, fig6_fronts
@@ -277,12 +276,12 @@ def _fig6(o: dict[str, Outcome], a: dict[str, Any], d: Path) -> list[Drawn]:
             caption,
             fig,
             [f1, *f2, *f3, *f4],
-            chain_command(o["chain-runs"], run.params.N, 1.0, plot="fronts"),
+            cmd.chain_command(o["chain-runs"], run.params.N, 1.0, plot="fronts"),
         )
     ]
 
 
-def _fig7_8(o: dict[str, Outcome], a: dict[str, Any], d: Path, which: str) -> list[Drawn]:
+def _fig7_8(o: dict[str, Outcome], a: dict[str, Any], d: Path, which: str, cmd) -> list[Drawn]:
     """Figs. 7 (beta = 1) and 8 (beta = 0.2): slip-size distribution and S against time."""
     from stickslip.analysis.statistics import size_distribution
     from stickslip.plotting.chain import fig7_8_sizes
@@ -313,7 +312,7 @@ def _fig7_8(o: dict[str, Outcome], a: dict[str, Any], d: Path, which: str) -> li
             caption,
             fig7_8_sizes(events, fit, beta, paper_tau=paper_tau, paper_figure=label),
             [*f1, f2],
-            chain_command(o["chain-runs"], N, beta, plot="sizes"),
+            cmd.chain_command(o["chain-runs"], N, beta, plot="sizes"),
         )
     ]
 
@@ -330,32 +329,35 @@ def _draw(steps: list[tuple[str, Callable[[], list[Drawn]]]]) -> list[tuple]:
     return out
 
 
-def section2_figures(outcomes: dict[str, Outcome], page_dir: Path) -> list[tuple]:
+def section2_figures(outcomes: dict[str, Outcome], page_dir: Path, commands) -> list[tuple]:
     """Figs. 1-4 and the two figures of section 2 (the stability map, the hysteresis sweep) from the
     outcomes of the experiments of :mod:`stickslip.experiments.studies.figs1_4`, their data
-    written into ``page_dir``."""
-    d = Path(page_dir)
+    written into ``page_dir``. ``commands`` makes the command line of each figure's entry
+    (``block_command``, ``hysteresis_command``: :mod:`stickslip.report.commands`, handed down by
+    the study, as the drawing does not know the command line)."""
+    d, cmd = Path(page_dir), commands
     return _draw(
         [
-            ("fig1, fig2", lambda: _fig1_2(outcomes, d)),
+            ("fig1, fig2", lambda: _fig1_2(outcomes, d, cmd)),
             ("fig3", lambda: _fig3(outcomes, d)),
             ("stability_map", lambda: _stability_map(outcomes, d)),
-            ("hysteresis", lambda: _hysteresis(outcomes, d)),
+            ("hysteresis", lambda: _hysteresis(outcomes, d, cmd)),
             ("fig4", lambda: _fig4(outcomes, d)),
         ]
     )
 
 
-def chain_figures(outcome: Outcome, analysis: dict[str, Any], page_dir: Path, mode: str) -> list[tuple]:
+def chain_figures(outcome: Outcome, analysis: dict[str, Any], page_dir: Path, mode: str, commands) -> list[tuple]:
     """Figs. 5-8 from the chain runs of :mod:`stickslip.experiments.studies.figs5_8` and their
     ``analysis`` (:func:`stickslip.analysis.chain_runs.chain_analysis`), their data written into
-    ``page_dir``."""
-    d, o = Path(page_dir), {"chain-runs": outcome}
+    ``page_dir``. ``commands`` makes the command line of each figure's entry (``chain_command``,
+    ``sweep_command``: :mod:`stickslip.report.commands`, handed down by the study)."""
+    d, o, cmd = Path(page_dir), {"chain-runs": outcome}, commands
     return _draw(
         [
-            ("fig5a, fig5b", lambda: _fig5(o, analysis, d, mode)),
-            ("fig6", lambda: _fig6(o, analysis, d)),
-            ("fig7", lambda: _fig7_8(o, analysis, d, "7")),
-            ("fig8", lambda: _fig7_8(o, analysis, d, "8")),
+            ("fig5a, fig5b", lambda: _fig5(o, analysis, d, mode, cmd)),
+            ("fig6", lambda: _fig6(o, analysis, d, cmd)),
+            ("fig7", lambda: _fig7_8(o, analysis, d, "7", cmd)),
+            ("fig8", lambda: _fig7_8(o, analysis, d, "8", cmd)),
         ]
     )

@@ -133,9 +133,27 @@ def sizes(run, *, ax=None, bins: int = 30) -> Figure:
     Returns
     -------
     matplotlib.figure.Figure
+
+    Raises
+    ------
+    ParameterError
+        With fewer than :data:`MIN_EVENTS_FOR_SIZES` slips with S > 0 in the stationary window, or
+        where the sizes have no power-law fit (the message says why; one line).
     """
-    stats = run_size_statistics(run, small_only=False)
-    return sizes_figure(stationary_events(run), stats["fit"], params=run.params, bins=bins, ax=ax)
+    from stickslip.models.params import ParameterError
+
+    window = stationary_events(run)
+    n_pos = int(np.count_nonzero(window["S"].to_numpy(dtype=float) > 0)) if len(window) else 0
+    if n_pos < MIN_EVENTS_FOR_SIZES:
+        raise ParameterError(
+            f"{n_pos} slips with S > 0 at t >= {stationary_from(run):g} (the run's stationary window); "
+            f"a size distribution needs at least {MIN_EVENTS_FOR_SIZES}: run longer"
+        )
+    try:
+        stats = run_size_statistics(run, small_only=False)
+    except ValueError as exc:
+        raise ParameterError(f"no size distribution to draw: {exc}") from None
+    return sizes_figure(window, stats["fit"], params=run.params, bins=bins, ax=ax)
 
 
 def fronts(run, *, ax=None) -> Figure:
@@ -166,6 +184,42 @@ def fronts(run, *, ax=None) -> Figure:
         window=run.options.profile_window,
         ax=ax,
     )
+
+
+class RunPlots:
+    """The figures of one chain run (eq. 4), lent to it as ``run.plot`` (:mod:`stickslip.accessors`).
+
+    Parameters
+    ----------
+    run : ChainRun
+        The run drawn.
+
+    Examples
+    --------
+    >>> import stickslip
+    >>> run = stickslip.run_chain(stickslip.chain_params(N=10), 2e4)
+    >>> type(run.plot.length()).__name__
+    'Figure'
+    """
+
+    def __init__(self, run):
+        self.run = run
+
+    def length(self, *, ax=None) -> Figure:
+        """L(t) against steady sliding (:func:`length`)."""
+        return length(self.run, ax=ax)
+
+    def snapshot(self, t: float | None = None, *, ax=None) -> Figure:
+        """The final state, or the snapshot at ``t``, against steady sliding (Fig. 5a; :func:`snapshot`)."""
+        return snapshot(self.run, t, ax=ax)
+
+    def sizes(self, *, ax=None, bins: int = 30) -> Figure:
+        """The slip-size distribution with its fit (Figs. 7, 8; :func:`sizes`)."""
+        return sizes(self.run, ax=ax, bins=bins)
+
+    def fronts(self, *, ax=None) -> Figure:
+        """The rupture fronts of the largest events (Fig. 6; :func:`fronts`)."""
+        return fronts(self.run, ax=ax)
 
 
 def run_figures(run, *, max_snapshots: int = 4) -> list[RunFigure]:
@@ -215,8 +269,17 @@ def run_figures(run, *, max_snapshots: int = 4) -> list[RunFigure]:
     # The stationary window shared with `reproduce` and `catalog` (analysis.chain_runs.stationary_from).
     window = stationary_events(run)
     n_pos = int(np.count_nonzero(window["S"].to_numpy(dtype=float) > 0)) if len(window) else 0
+    stats = None
+    why = (
+        f"{n_pos} events with S > 0 at t >= {stationary_from(run):g}, the stationary window "
+        f"(a distribution needs {MIN_EVENTS_FOR_SIZES})"
+    )
     if n_pos >= MIN_EVENTS_FOR_SIZES:
-        stats = run_size_statistics(run, small_only=False)
+        try:
+            stats = run_size_statistics(run, small_only=False)
+        except ValueError as exc:  # no power law on the sizes: the figure says why
+            why = f"no power-law fit: {exc}"
+    if stats is not None:
         out.append(
             RunFigure(
                 "sizes",
@@ -231,8 +294,7 @@ def run_figures(run, *, max_snapshots: int = 4) -> list[RunFigure]:
                 "sizes",
                 "slip-size distribution",
                 None,
-                f"{n_pos} events with S > 0 at t >= {stationary_from(run):g}, the stationary window "
-                f"(a distribution needs {MIN_EVENTS_FOR_SIZES})",
+                why,
             )
         )
     if run.profiles.sizes.get("profile_row", 0) and len(events):

@@ -98,6 +98,7 @@ def plot_fig4(ds: xr.Dataset, *, k_zoom: float = 0.3) -> Figure:
         f"$K = {attrs.get('K', float('nan')):g}$, $D = {attrs.get('D', float('nan')):g}$, "
         f"$V = {attrs.get('V', float('nan')):g}$",
         fontsize=9,
+        wrap=True,
     )
     return fig
 

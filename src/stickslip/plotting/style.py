@@ -35,6 +35,14 @@ THEORY = {"color": "C3", "lw": 1.2, "ls": "--"}  # analytic/limit curves: dashed
 PAPER = {"color": "0.4", "lw": 1.0, "ls": ":"}  # the paper's own formula where it differs
 
 
+def ordinal(n: int) -> str:
+    """``n`` as an English ordinal (1st, 2nd, 3rd, 4th, 11th, 12th, 13th, 21st, 112th), for a
+    figure's words (Fig. 6: "every 2nd window")."""
+    n = int(n)
+    suffix = "th" if n % 100 in (11, 12, 13) else {1: "st", 2: "nd", 3: "rd"}.get(n % 10, "th")
+    return f"{n}{suffix}"
+
+
 def new_figure(nrows: int = 1, ncols: int = 1, *, width: float = 5.0, height: float = 3.6, **kw):
     """A Figure and its axes in the project's style; no pyplot state is kept.
 
@@ -55,6 +63,18 @@ def new_figure(nrows: int = 1, ncols: int = 1, *, width: float = 5.0, height: fl
         fig = Figure(figsize=(width * ncols, height * nrows), layout="constrained")
         axes = fig.subplots(nrows, ncols, squeeze=True, **kw)
     return fig, axes
+
+
+def fit_titles(fig: Figure) -> Figure:
+    """Let the titles of ``fig`` (its suptitle, each Axes' titles) wrap at the figure's edges, as
+    matplotlib wraps a text with ``wrap=True`` when it draws it, instead of running past them (a
+    model's parameters make long titles: Fig. 5(a)'s was cut at both edges). Returns ``fig``."""
+    texts = list(fig.texts)
+    for ax in fig.axes:
+        texts += [t for t in (ax.title, getattr(ax, "_left_title", None), getattr(ax, "_right_title", None)) if t]
+    for text in texts:
+        text.set_wrap(True)
+    return fig
 
 
 #: Every figure is saved in these formats: PNG to look at, PDF to print or put in a paper.
@@ -87,6 +107,7 @@ def save_figure(fig: Figure, path: str | Path, *, formats: tuple[str, ...] = FIG
 
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
+    fit_titles(fig)
     written = []
     with matplotlib.rc_context(RC):
         for fmt in formats:
@@ -98,4 +119,15 @@ def save_figure(fig: Figure, path: str | Path, *, formats: tuple[str, ...] = FIG
     return written
 
 
-__all__ = ["new_figure", "save_figure", "FIGURE_FORMATS", "plt", "SIM", "THEORY", "PAPER", "RC"]
+__all__ = [
+    "new_figure",
+    "save_figure",
+    "fit_titles",
+    "ordinal",
+    "FIGURE_FORMATS",
+    "plt",
+    "SIM",
+    "THEORY",
+    "PAPER",
+    "RC",
+]

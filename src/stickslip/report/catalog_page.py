@@ -18,19 +18,30 @@ from stickslip.analysis.catalog import CATALOG_DOCS, Catalog
 from stickslip.pages import image_src, write_page
 from stickslip.plotting.catalog import catalog_figures
 from stickslip.plotting.style import FIGURE_FORMATS, save_figure
+from stickslip.run.ownership import CATALOG_FIGURES, CATALOG_FILES
 
 __all__ = ["write_catalog", "catalog_statements", "CATALOG_FILES", "FIGURE_STEMS"]
 
-FIGURE_STEMS = ("frequency_magnitude", "ccdf", "recurrence", "moment_rate")
-#: Every file ``stickslip catalog`` may write into its folder.
-CATALOG_FILES = frozenset(
-    {"catalog.parquet", "catalog.csv", "moment_rate.parquet", "moment_rate.csv", "catalog.json", "index.html"}
-    | {f"{stem}.{fmt}" for stem in FIGURE_STEMS for fmt in ("png", "pdf", "svg")}
-)
+#: The figures, and every file ``stickslip catalog`` may write into its folder (named with the run
+#: directory's files, :mod:`stickslip.run.ownership`, so that a chain run knows them).
+FIGURE_STEMS = CATALOG_FIGURES
 
 
 def _g(x: Any, digits: int = 3) -> str:
     return "n/a" if x is None or (isinstance(x, float) and not math.isfinite(x)) else f"{x:.{digits}g}"
+
+
+#: What the paper states of the slip sizes of its chain (section 3, Figs. 7, 8), by beta: cited
+#: only on the catalogue of a run of the paper's chain at that beta.
+PAPER_SIZES = {
+    1.0: {"whole_range": "; the paper: 1.5 at beta = 1"},
+    0.2: {"below_spanning": " (the paper: about 1.6 and an excess at beta = 0.2)"},
+}
+
+
+def _paper_says(summary: dict[str, Any], reading: str) -> str:
+    """The paper's statement on ``reading`` for this run, or "" for a run the paper did not make."""
+    return PAPER_SIZES.get(summary.get("paper_beta"), {}).get(reading, "")
 
 
 def catalog_statements(summary: dict[str, Any]) -> list[str]:
@@ -41,14 +52,14 @@ def catalog_statements(summary: dict[str, Any]) -> list[str]:
     if "tau" in w:
         out.append(
             f"Size exponent tau = {_g(w['tau'])} ± {_g(w['tau_err'], 2)} (truncated power law on S in "
-            f"[{_g(w['s_min'])}, {_g(w['s_max'])}], {w['n']} slips; the paper: 1.5 at beta = 1)."
+            f"[{_g(w['s_min'])}, {_g(w['s_max'])}], {w['n']} slips{_paper_says(summary, 'whole_range')})."
         )
     b = sizes.get("below_spanning", {})
     if "tau" in b:
         out.append(
             f"Below the smallest system-spanning slip (S < {_g(b['s_max'])}): tau = {_g(b['tau'])} ± "
             f"{_g(b['tau_err'], 2)}; spanning slips are {_g(b['excess'])} times as many as that power law "
-            "predicts (the paper: about 1.6 and an excess at beta = 0.2)."
+            f"predicts{_paper_says(summary, 'below_spanning')}."
         )
     fm = summary["frequency_magnitude"]
     bv = fm.get("b_value")

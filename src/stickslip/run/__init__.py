@@ -9,7 +9,8 @@ directories (:mod:`~stickslip.run.rundir`); :mod:`~stickslip.run.block` runs the
 
 Public here: :func:`~stickslip.run.driver.run_chain` and :func:`~stickslip.run.driver.resume_chain`,
 their options (:class:`~stickslip.run.options.RunOptions`), and the hooks a caller adds to a
-run's loop (:class:`~stickslip.run.loop.Hook`, which sees a :class:`~stickslip.run.loop.Loop`).
+run's loop (:class:`~stickslip.run.loop.Hook`, which sees a :class:`~stickslip.run.loop.Loop`;
+:class:`~stickslip.run.errors.HookError` when one breaks its contract).
 """
 
 from stickslip.lazy import lazy_names
@@ -22,6 +23,7 @@ _LAZY = {
     "RunOptions": "stickslip.run.options",
     "Hook": "stickslip.run.loop",
     "Loop": "stickslip.run.loop",
+    "HookError": "stickslip.run.errors",
 }
 
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import platform
 import time
+from collections.abc import Callable
 from typing import Any
 
 from stickslip.models.params import ChainParams
@@ -32,18 +33,22 @@ def compare(
     repeat: int = 1,
     perturbation: float = 0.0,
     seed: int = 0,
+    say: Callable[[str], None] | None = None,
 ) -> dict[str, Any]:
     """Time ``dense`` and ``exact`` on the chain of eq. (4), or any model of the family, from
     ``start`` (with ``perturbation`` and ``seed``) to ``t_end``.
 
     Returns the times (fastest of ``repeat``), their ratio, ns per block-step of each,
     and whether the two runs are identical (state hash, event table and first moves).
+    ``say`` is told, in a line, which integrator runs now.
     """
     _warm(params, start)
     best: dict[str, float] = {}
     runs = {}
     for integrator in ("dense", "exact"):
-        for _ in range(repeat):
+        for k in range(repeat):
+            if say is not None:
+                say(f"running {integrator}" + (f" ({k + 1} of {repeat})" if repeat > 1 else ""))
             t0 = time.perf_counter()
             run = run_chain(params, t_end, integrator=integrator, start=start, perturbation=perturbation, seed=seed)
             elapsed = time.perf_counter() - t0
@@ -89,6 +94,25 @@ def compare(
         "state_sha256": e.summary["state_sha256"],
         "machine": platform.processor() or platform.machine(),
     }
+
+
+#: Rough cost of the dense integrator per block-step on one quiet core (ns; docs/performance.md
+#: measures 4-5), for the notice of what a benchmark will cost before it starts.
+DENSE_NS_PER_BLOCK_STEP = 5.0
+
+
+def expected_cost(params: ChainParams, t_end: float, repeat: int = 1) -> str:
+    """One line of what :func:`compare` is about to do and about how long it takes: the dense
+    reference visits every block at every step (N x steps block-steps), the exact path a small
+    part of them."""
+    steps = int(round(t_end / params.dt))
+    block_steps = params.N * steps
+    seconds = repeat * block_steps * DENSE_NS_PER_BLOCK_STEP * 1e-9
+    shown = f"{seconds:.0f} s" if seconds < 120 else f"{seconds / 60:.0f} min"
+    return (
+        f"timing dense then exact on {params.model} N={params.N} to t_end={t_end:g} ({block_steps:.2g} "
+        f"block-steps): about {shown} on a quiet core, longer on a busy machine (--t-end shortens it)"
+    )
 
 
 def format_result(r: dict[str, Any]) -> str:

@@ -177,7 +177,7 @@ def simulate_block(
         raise TypeError("params must be a BlockParams")
     initial = BlockState() if initial is None else initial
     every = int(check_number("every", every, low=1, integer=True))
-    steps = steps_for(t_end, params.dt)
+    steps = steps_for(t_end, params.dt, "t_end")
     n_out = n_samples(steps, every)
 
     out_t = np.empty(n_out)

@@ -121,6 +121,30 @@ def _check_layout(arrays: dict[str, np.ndarray], header: dict[str, Any]) -> None
             )
 
 
+#: The files of a checkpoint folder: its state file and its parts (and files of a killed write).
+CHECKPOINT_FILE = re.compile(r"state\.npz|part-\d{6}\.npz|\..+\.tmp")
+
+
+def remove_checkpoint(run_dir: str | Path) -> list[str]:
+    """Remove the checkpoint of ``run_dir``: its state file first (a kill part way leaves no
+    checkpoint that lists missing parts), then its parts, then the folder if that leaves it
+    empty. A file that is not a checkpoint's (:data:`CHECKPOINT_FILE`) is never removed; returns
+    the names of those left."""
+    path = Path(run_dir) / "checkpoint"
+    if not path.is_dir():
+        return []
+    (path / "state.npz").unlink(missing_ok=True)
+    kept = []
+    for entry in sorted(path.iterdir()):
+        if entry.is_file() and CHECKPOINT_FILE.fullmatch(entry.name):
+            entry.unlink(missing_ok=True)
+        else:
+            kept.append(entry.name)
+    if not kept:
+        path.rmdir()
+    return kept
+
+
 class Checkpointer:
     """Checkpoints of one run directory: ``checkpoint/state.npz`` plus append-only output parts.
 

@@ -41,7 +41,14 @@ from stickslip.models.params import ChainParams, ParameterError, check_number, s
 from stickslip.run import rundir
 
 # The checkpoint file helpers (read_npz, write_npz) are named here too, for checks of the files.
-from stickslip.run.checkpoint import CHECKPOINT_FORMAT, Checkpointer, read_npz, write_npz  # noqa: F401
+from stickslip.run.budget import check_run_outputs
+from stickslip.run.checkpoint import (  # noqa: F401
+    CHECKPOINT_FORMAT,
+    Checkpointer,
+    read_npz,
+    remove_checkpoint,
+    write_npz,
+)
 from stickslip.run.errors import ChainRunError, Interrupted, NonFiniteState, ShortRunWarning
 from stickslip.run.loop import (  # _Kernel named here too, for tests that count its calls
     CheckedAdvance,
@@ -63,7 +70,14 @@ from stickslip.run.options import INTEGRATORS, RunOptions
 from stickslip.run.outputs import EVENT_COLUMNS, ChainRun, _assemble, _Outputs
 from stickslip.run.progress import Progress, SignalFlag, show_progress
 from stickslip.run.rundir import load_run, read_run_id, write_run
-from stickslip.run.state import STARTS, ChainState, initial_state, loading_warnings, steady_deviation
+from stickslip.run.state import (
+    STARTS,
+    ChainState,
+    check_start_draw,
+    initial_state,
+    loading_warnings,
+    steady_deviation,
+)
 from stickslip.run.validate import check_chain_params, check_checkpoint_state, check_start_state
 
 __all__ = [
@@ -150,12 +164,15 @@ def run_chain(
     """
     check_chain_params(params)
     options = _options(options, overrides, float(check_number("t_end", t_end, low=0.0, low_open=True)), params.dt)
+    check_run_outputs(params.N, params.dt, options)
     check_number("perturbation", perturbation, low=0.0)
     if isinstance(start, ChainState):
         check_start_state(start, params, t_end=options.t_end)
         state = start.copy()
         start_info: dict[str, Any] = {"kind": "state", "sha256": start.sha256()}
     else:
+        # the defaults (0.0, 0) draw nothing: only another value is a draw the paper's start lacks
+        check_start_draw(start, perturbation if perturbation != 0.0 else None, seed if seed != 0 else None)
         state = initial_state(params, start, amplitude=perturbation, seed=seed)
         start_info = {"kind": start, "perturbation": perturbation, "seed": seed}
         for message in loading_warnings(params, options.t_end, options.average_from, start):
@@ -175,6 +192,11 @@ def _options(options: RunOptions | None, overrides: dict[str, Any], t_end: float
     unknown = sorted(set(overrides) - set(_FIELDS))
     if unknown:
         raise TypeError(f"run_chain() got an unexpected keyword argument {unknown[0]!r}")
+    if options is not None and not isinstance(options, RunOptions):
+        raise ParameterError(
+            f"options must be a RunOptions (stickslip.RunOptions(...)), or give its fields as keywords "
+            f"of run_chain (got {type(options).__name__})"
+        )
     options = RunOptions() if options is None else options
     if options.t_end is not None and options.t_end != t_end:
         raise ParameterError(f"options.t_end {options.t_end:g} differs from t_end {t_end:g}; give one")
@@ -183,14 +205,13 @@ def _options(options: RunOptions | None, overrides: dict[str, Any], t_end: float
     for hook in hooks:
         if not isinstance(hook, Hook):
             raise ParameterError(f"hooks must be Hook instances (stickslip.run.Hook; got {type(hook).__name__})")
+    options = dataclasses.replace(options, t_end=t_end, hooks=hooks).validated(dt)  # as given, then as used
     return dataclasses.replace(
         options,
-        t_end=t_end,
         snapshot_times=tuple(float(t) for t in options.snapshot_times),
         profile_min_blocks=int(options.profile_min_blocks),
         sample_moving=bool(options.sample_moving),
-        hooks=hooks,
-    ).validated(dt)
+    )
 
 
 def resume_chain(
@@ -261,7 +282,7 @@ def resume_chain(
         )
     if t_end is not None:
         t_end = float(check_number("t_end", t_end, low=0.0))
-        if steps_for(t_end, params.dt) < state.step:
+        if steps_for(t_end, params.dt, "t_end") < state.step:
             raise ParameterError(f"t_end must be >= the checkpoint's time {state.step * params.dt:g} (got {t_end:g})")
         options = dataclasses.replace(options, t_end=t_end)
     if keep_checkpoint is None:
@@ -281,6 +302,7 @@ def resume_chain(
         options.t_end,
         params.dt,
     )
+    check_run_outputs(params.N, params.dt, options)
     outputs = _Outputs(params.N, options.profile_window is not None)
     outputs.parts = parts
     ckpt.since = {k: len(v) for k, v in parts.items()}
@@ -303,8 +325,6 @@ def continue_or_run(
     (:func:`run_chain` with ``options``); an unusable checkpoint is removed. A point of a study
     or reproduction that is killed so loses at most ``checkpoint_interval`` seconds; one stopped
     through ``stop_requested`` loses nothing."""
-    import shutil
-
     ckpt = Checkpointer(Path(run_dir))
     with rundir.owned_by_caller(run_dir):  # a point's folder: the study or sweep owns it
         if ckpt.state_path.is_file():
@@ -316,7 +336,7 @@ def continue_or_run(
                     stop_requested=stop_requested,
                 )
             except ChainRunError:
-                shutil.rmtree(ckpt.dir, ignore_errors=True)
+                remove_checkpoint(run_dir)  # a file of the user's there stays
         return run_chain(
             params,
             t_end,
@@ -330,7 +350,7 @@ def continue_or_run(
 def _drive(params, options, start_info, state, outputs, *, checkpointer, wall_before) -> ChainRun:
     """The run loop (:func:`stickslip.run.loop.run_loop`) with the hooks ``options`` asks for and
     the caller's own, then the results, written into ``options.out_dir`` if given."""
-    n_end = steps_for(options.t_end, params.dt)
+    n_end = steps_for(options.t_end, params.dt, "t_end")
     sample_every = int(round(options.sample_interval / params.dt))
     profile_every = int(round(options.profile_window / params.dt)) if options.profile_window else 0
     last_moving = max((int(a[-1, 0]) for a in outputs.parts["moving"] if len(a)), default=-1)
@@ -358,7 +378,8 @@ def _drive(params, options, start_info, state, outputs, *, checkpointer, wall_be
     hooks: list[Hook] = []
     if options.snapshot_times:
         done = set(int(s) for a in outputs.parts["snap_step"] for s in a)
-        hooks.append(Snapshots([steps_for(t, params.dt) for t in options.snapshot_times], done, n_end))
+        steps = [steps_for(t, params.dt, "snapshot_times") for t in options.snapshot_times]
+        hooks.append(Snapshots(steps, done, n_end))
     if options.sample_moving and not outputs.moving_from_kernel:
         hooks.append(MovingCounts(sample_every, last_moving))
     if options.until_steady is not None:
@@ -431,11 +452,6 @@ class Stepper:
 
 
 def drop_checkpoint(run_dir: str | Path) -> None:
-    """Remove the checkpoint of a finished run (its results are in the run directory)."""
-    import shutil
-
-    path = Path(run_dir) / "checkpoint"
-    # The state file first: a kill part way leaves no checkpoint that lists missing parts.
-    (path / "state.npz").unlink(missing_ok=True)
-    if path.is_dir():
-        shutil.rmtree(path)
+    """Remove the checkpoint of a finished run (its results are in the run directory); a file
+    there that is not the checkpoint's stays (:func:`~stickslip.run.checkpoint.remove_checkpoint`)."""
+    remove_checkpoint(run_dir)

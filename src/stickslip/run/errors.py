@@ -12,8 +12,14 @@ class ChainRunError(RuntimeError):
     """A chain run cannot go on (non-finite state, bad checkpoint)."""
 
 
-class NonFiniteState(ChainRunError):
-    """The state of the chain became non-finite; the message names the time and the block."""
+class NonFiniteState(ChainRunError, ArithmeticError):
+    """The state of the chain became non-finite; the message names the time and the block (an
+    :class:`ArithmeticError`, as the single block's :class:`NonFiniteBlock` is)."""
+
+
+class HookError(ChainRunError):
+    """A hook of the run loop broke its contract (:class:`~stickslip.run.loop.Hook`); the message
+    names the hook, the method and what it returned."""
 
 
 class Interrupted(Exception):

@@ -31,7 +31,7 @@ from typing import Any
 import numpy as np
 
 from stickslip import __version__
-from stickslip.models.params import ChainParams, check_number
+from stickslip.models.params import ChainParams, check_number, steps_for
 from stickslip.run.state import ChainState
 
 __all__ = [
@@ -182,6 +182,7 @@ def loaded_state(
     from stickslip.run.errors import short_runs_expected
 
     transient = float(check_number("transient", transient, low=0.0, low_open=True))
+    steps_for(transient, params.dt, "transient")  # refused as what the caller gave, not as run_chain's t_end
     spec = loaded_spec(params, transient, start, perturbation, seed)
     wall0 = time.perf_counter()
     if cache is None:

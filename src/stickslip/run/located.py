@@ -282,6 +282,6 @@ def run_located(
     ``form``: "fast" or "dense" (:data:`FORMS`), the same bits.
     """
     state = start_state(params, start, perturbation=perturbation, seed=seed)
-    n_end = steps_for(t_end, params.dt)
+    n_end = steps_for(t_end, params.dt, "t_end")
     state, events = LocatedStepper(params, form=form).advance(state, n_end)
     return LocatedRun(params, state, events_frame(events))

@@ -18,6 +18,7 @@ step and the block (docs/chain.md, "Non-finite values").
 from __future__ import annotations
 
 import bisect
+import numbers
 import time
 from collections.abc import Callable, Sequence
 from typing import Any
@@ -27,7 +28,7 @@ import numpy as np
 from stickslip.kernels import dense, entry, exact, layout, plate
 from stickslip.models.params import ChainParams
 from stickslip.models.pieces import stopped_blocks_still
-from stickslip.run.errors import Interrupted, NonFiniteState
+from stickslip.run.errors import HookError, Interrupted, NonFiniteState
 from stickslip.run.state import ChainState, line_aligned, steady_deviation
 
 NEVER = np.iinfo(np.int64).max  # a hook that needs no stop
@@ -166,17 +167,20 @@ class Hook:
     The loop calls the kernel to the nearest step any hook asks for, and between calls serves
     every hook. The contract, each method optional:
 
-    * ``stop_at(n)``: the next step after ``n`` at which this hook needs the kernel to stop
-      (:attr:`NEVER` if none). The kernel stops at every step asked for that is not after the
-      run's end.
+    * ``stop_at(n)``: the next step after ``n`` (an integer > n) at which this hook needs the
+      kernel to stop (:attr:`NEVER` if none). The kernel stops at every step asked for that is
+      not after the run's end.
     * ``at(loop, n)``: act at step ``n`` (``loop.state.step``), before the next call. It is
       called at the run's first step, at every step any hook asked for, at the last step, and
       wherever else the kernel stopped (its buffers filled), so a hook checks ``n`` itself.
-      True ends the run there (a short run, as ``until_steady`` ends one).
+      True ends the run there (a short run, as ``until_steady`` ends one); False or None go on.
     * ``after(loop, status, elapsed, now)``: act after each kernel call, given its status,
       its wall-clock seconds and the clock (:func:`time.perf_counter`); setting
-      ``loop.stopping`` stops the run as a signal does.
+      ``loop.stopping = True`` stops the run as a signal does (no later hook clears it).
     * ``close()``: release what the hook holds, once, however the run ends.
+
+    The loop checks what ``stop_at`` and ``at`` return where it calls them and raises
+    :class:`~stickslip.run.errors.HookError`, naming the hook, for anything else.
 
     A hook reads ``loop.state`` and ``loop.params`` (:class:`Loop`) and never changes the state;
     where the kernel stops decides only when the hooks act, never what it computes, so a hook
@@ -321,7 +325,9 @@ class StopRequests(Hook):
         self.flag, self.stop_requested = flag, stop_requested
 
     def after(self, loop, status, elapsed, now):
-        loop.stopping = self.flag.set or (self.stop_requested is not None and self.stop_requested())
+        # only ever sets the stop: a caller's hook may have asked for one before this one
+        if self.flag.set or (self.stop_requested is not None and self.stop_requested()):
+            loop.stopping = True
 
 
 class Checkpoints(Hook):
@@ -343,15 +349,48 @@ class Checkpoints(Hook):
         self.last = now
 
 
+def _hook_name(hook: Hook) -> str:
+    return type(hook).__qualname__
+
+
+def _checked_stop(hook: Hook, n: int) -> int:
+    """``hook.stop_at(n)``, checked: an integer step after ``n`` (a step at or before ``n`` would
+    call the kernel for nothing, again and again)."""
+    step = hook.stop_at(n)
+    if not isinstance(step, numbers.Integral) or isinstance(step, bool):
+        raise HookError(
+            f"hook {_hook_name(hook)}.stop_at({n}) returned {step!r} ({type(step).__name__}): "
+            "it must return an integer step after n, or Hook.NEVER"
+        )
+    if step <= n:
+        raise HookError(
+            f"hook {_hook_name(hook)}.stop_at({n}) returned {int(step)}: it must return a step after n "
+            f"(> {n}), or Hook.NEVER; a step at or before n would stop the run where it stands forever"
+        )
+    return int(step)
+
+
+def _checked_at(hook: Hook, loop: Loop, n: int) -> bool:
+    """``hook.at(loop, n)``, checked: True, False (or None, nothing to say)."""
+    ended = hook.at(loop, n)
+    if ended is None or isinstance(ended, (bool, np.bool_)):
+        return bool(ended)
+    raise HookError(
+        f"hook {_hook_name(hook)}.at(loop, {n}) returned {ended!r} ({type(ended).__name__}): "
+        "it must return True (end the run here) or False"
+    )
+
+
 def run_loop(loop: Loop, advance: CheckedAdvance, hooks: Sequence[Hook], checkpoint_path=None) -> None:
     """Advance ``loop.state`` to ``loop.n_end`` (or until a hook ends the run), calling the kernel
     to the nearest step a hook needs and letting each hook act there; a stop asked for raises
-    :class:`~stickslip.run.errors.Interrupted` (after the hooks have checkpointed)."""
+    :class:`~stickslip.run.errors.Interrupted` (after the hooks have checkpointed). A hook that
+    breaks its contract (:class:`Hook`) raises :class:`~stickslip.run.errors.HookError` naming it."""
     state, outputs, n_end = loop.state, loop.outputs, loop.n_end
     try:
         while True:
             n = state.step
-            ended = [hook.at(loop, n) for hook in hooks]  # every hook acts before the run ends
+            ended = [_checked_at(hook, loop, n) for hook in hooks]  # every hook acts before the run ends
             if any(ended):
                 break
             if n >= n_end:
@@ -361,7 +400,7 @@ def run_loop(loop: Loop, advance: CheckedAdvance, hooks: Sequence[Hook], checkpo
                     outputs.flush(state.ist)
                     continue
                 break
-            target = min(n_end, min((hook.stop_at(n) for hook in hooks), default=NEVER))
+            target = min(n_end, min((_checked_stop(hook, n) for hook in hooks), default=NEVER))
             c0 = time.perf_counter()
             status = advance(state, target)
             elapsed = time.perf_counter() - c0

@@ -169,30 +169,49 @@ class RunOptions:
     stop_requested: Callable[[], bool] | None = _control(None)
     hooks: Sequence[Hook] = _control(())
 
-    def validated(self, dt: float) -> RunOptions:
-        """Check every option against the time step (ranges in docs/limits.md); returns self."""
+    def validated(self, dt: float, spell: Callable[[str], str] | None = None) -> RunOptions:
+        """Check every option against the time step (ranges in docs/limits.md); returns self.
+
+        The one place where a run's options are checked, for :func:`~stickslip.run.driver.run_chain`
+        and ``stickslip chain`` alike; ``spell`` names a field as the caller's user gave it
+        (``--sample-interval`` on the command line; default the field's own name).
+        """
+        name = spell if spell is not None else (lambda field_name: field_name)
         if self.t_end is None:
             raise ParameterError("t_end must be given (run_chain's own argument)")
-        steps_for(self.t_end, dt)
+        steps_for(self.t_end, dt, "t_end")
         longest = MAX_STEPS * dt
-        check_number("sample_interval", self.sample_interval, low=0.0, low_open=True, high=longest)
+        check_number(name("sample_interval"), self.sample_interval, low=0.0, low_open=True, high=longest)
         if round(self.sample_interval / dt) < 1:
-            raise ParameterError(f"sample_interval must be >= dt = {dt:g} (got {self.sample_interval!r})")
+            raise ParameterError(f"{name('sample_interval')} must be >= dt = {dt:g} (got {self.sample_interval!r})")
         if self.average_from is not None:
-            check_number("average_from", self.average_from, low=0.0, high=self.t_end)
+            check_number(name("average_from"), self.average_from, low=0.0, high=self.t_end)
+        if isinstance(self.snapshot_times, (str, bytes)) or not isinstance(self.snapshot_times, Sequence):
+            raise ParameterError(
+                f"{name('snapshot_times')} must be a sequence of times, e.g. (10.0,) (got {self.snapshot_times!r})"
+            )
         for t in self.snapshot_times:
-            check_number("snapshot time", t, low=0.0, high=self.t_end)
+            check_number(name("snapshot_times"), t, low=0.0, high=self.t_end)
         if self.profile_window is not None:
-            check_number("profile_window", self.profile_window, low=0.0, low_open=True, high=longest)
+            check_number(name("profile_window"), self.profile_window, low=0.0, low_open=True, high=longest)
             if round(self.profile_window / dt) < 1:
-                raise ParameterError(f"profile_window must be >= dt = {dt:g} (got {self.profile_window!r})")
-        check_number("profile_min_blocks", self.profile_min_blocks, low=0, integer=True)
+                raise ParameterError(f"{name('profile_window')} must be >= dt = {dt:g} (got {self.profile_window!r})")
+        check_number(name("profile_min_blocks"), self.profile_min_blocks, low=0, integer=True)
         if self.until_steady is not None:
-            check_number("until_steady", self.until_steady, low=0.0, low_open=True)
+            check_number(name("until_steady"), self.until_steady, low=0.0, low_open=True)
         if self.integrator not in INTEGRATORS:
-            raise ParameterError(f"integrator must be one of {', '.join(INTEGRATORS)} (got {self.integrator!r})")
+            raise ParameterError(
+                f"{name('integrator')} must be one of {', '.join(INTEGRATORS)} (got {self.integrator!r})"
+            )
+        if self.out_dir is not None and not str(self.out_dir).strip():
+            raise ParameterError(f"{name('out_dir')} must name a directory (got '')")
         if self.checkpoint_interval is not None:
-            check_number("checkpoint_interval", self.checkpoint_interval, low=0.0, low_open=True)
+            check_number(name("checkpoint_interval"), self.checkpoint_interval, low=0.0, low_open=True)
+        for field_name in ("checkpoint_interval", "keep_checkpoint"):
+            if self.out_dir is None and getattr(self, field_name) not in (None, False):
+                raise ParameterError(
+                    f"{name(field_name)} needs {name('out_dir')} (a run without a run directory writes no checkpoints)"
+                )
         return self
 
     def recorded(self) -> RunOptions:

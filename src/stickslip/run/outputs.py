@@ -140,7 +140,7 @@ class ChainRun:
             f"         state sha256 {s['state_sha256'][:16]}...)"
         )
 
-    def save(self, out_dir: str | Path) -> Path:
+    def save(self, out_dir: str | Path, *, overwrite: bool = False) -> Path:
         """Write the run directory ``stickslip chain --out DIR`` writes (run.json, state.nc,
         events and first_move as Parquet and CSV), for :func:`~stickslip.run.rundir.load_run`
         and ``stickslip plot`` to read.
@@ -152,6 +152,9 @@ class ChainRun:
         ----------
         out_dir : str or Path
             The run directory; created if missing.
+        overwrite : bool
+            Replace a run already there (as ``stickslip chain --overwrite``): its files are
+            removed first; other files in the folder stay.
 
         Returns
         -------
@@ -169,33 +172,42 @@ class ChainRun:
         from stickslip.run.ownership import run_dir_for_run
         from stickslip.run.runfiles import write_run
 
-        with run_dir_for_run(out_dir):
+        with run_dir_for_run(out_dir, overwrite=overwrite):
             return write_run(self, out_dir)
 
-    def plot_length(self, *, ax=None):
-        """L(t) against steady sliding: :func:`stickslip.plotting.length`; returns the Figure."""
-        from stickslip.plotting.run import length
+    @property
+    def plot(self):
+        """This run's figures (:class:`stickslip.plotting.run.RunPlots`): ``run.plot.length()``,
+        ``.snapshot(t)``, ``.sizes()``, ``.fronts()``, each returning the Figure drawn in."""
+        from stickslip import accessors
 
-        return length(self, ax=ax)
+        return accessors.accessor("plot", self)
+
+    def plot_length(self, *, ax=None):
+        """L(t) against steady sliding: :func:`stickslip.plotting.length`; returns the Figure
+        (the Axes ``ax`` when given)."""
+        return _drawn(self.plot.length(ax=ax), ax)
 
     def plot_snapshot(self, t: float | None = None, *, ax=None):
         """The final state (or the snapshot at ``t``) against steady sliding:
-        :func:`stickslip.plotting.snapshot`; returns the Figure."""
-        from stickslip.plotting.run import snapshot
-
-        return snapshot(self, t, ax=ax)
+        :func:`stickslip.plotting.snapshot`; returns the Figure (the Axes ``ax`` when given)."""
+        return _drawn(self.plot.snapshot(t, ax=ax), ax)
 
     def plot_sizes(self, *, ax=None, bins: int = 30):
-        """The slip-size distribution with its fit: :func:`stickslip.plotting.sizes`; returns the Figure."""
-        from stickslip.plotting.run import sizes
-
-        return sizes(self, ax=ax, bins=bins)
+        """The slip-size distribution with its fit: :func:`stickslip.plotting.sizes`; returns the
+        Figure (the Axes ``ax`` when given)."""
+        return _drawn(self.plot.sizes(ax=ax, bins=bins), ax)
 
     def plot_fronts(self, *, ax=None):
-        """The rupture fronts of the largest events: :func:`stickslip.plotting.fronts`; returns the Figure."""
-        from stickslip.plotting.run import fronts
+        """The rupture fronts of the largest events: :func:`stickslip.plotting.fronts`; returns the
+        Figure (the Axes ``ax`` when given)."""
+        return _drawn(self.plot.fronts(ax=ax), ax)
 
-        return fronts(self, ax=ax)
+
+def _drawn(fig, ax):
+    """What a ``plot_*`` method returns: the Axes it was given, else the new Figure (as pandas'
+    and seaborn's plots on an ``ax`` do)."""
+    return fig if ax is None else ax
 
 
 class _Outputs:
@@ -355,7 +367,7 @@ def _assemble(params, options, integrator, start_info, state, outputs, wall, ste
         # From the stop on, the chain is taken to slide steadily: L = L_ss at the remaining samples.
         L_ss = physics.chain_steady_length(params)
         sample_every = int(round(options.sample_interval / dt))
-        n_end = steps_for(options.t_end, dt)
+        n_end = steps_for(options.t_end, dt, "t_end")
         later = np.arange((state.step // sample_every + 1) * sample_every, n_end + 1, sample_every) * dt
         n_virtual = int(np.count_nonzero(later >= avg_from - 0.5 * dt))
         L_values = np.concatenate([L_values, np.full(n_virtual, L_ss)])

@@ -28,6 +28,14 @@ RUN_ID_FILE = ".run_id"
 #: (:func:`stickslip.plotting.run.run_figures`): the run owns that folder while it holds only these.
 PLOT_FOLDER = "figures"
 PLOT_FILE = re.compile(r"(length|snapshot_final|snapshot_t[^/]*|sizes|fronts)\.(png|pdf|svg)")
+#: Where ``stickslip catalog`` writes a run's catalogue by default (RUN_DIR/catalog), its figures
+#: and every file it may write there: the run owns that folder while it holds only these.
+CATALOG_FOLDER = "catalog"
+CATALOG_FIGURES = ("frequency_magnitude", "ccdf", "recurrence", "moment_rate")
+CATALOG_FILES = frozenset(
+    {"catalog.parquet", "catalog.csv", "moment_rate.parquet", "moment_rate.csv", "catalog.json", "index.html"}
+    | {f"{stem}.{fmt}" for stem in CATALOG_FIGURES for fmt in ("png", "pdf", "svg")}
+)
 
 
 def only_plot_files(folder: str | Path) -> bool:
@@ -37,6 +45,15 @@ def only_plot_files(folder: str | Path) -> bool:
     if not folder.is_dir():
         return False
     return all(PLOT_FILE.fullmatch(p.name) or is_temporary(p.name) for p in folder.iterdir())
+
+
+def only_catalog_files(folder: str | Path) -> bool:
+    """Whether ``folder`` is a directory holding nothing but what ``stickslip catalog`` writes
+    (:data:`CATALOG_FILES`; and files of a killed write, the lock of one writing it)."""
+    folder = Path(folder)
+    if not folder.is_dir():
+        return False
+    return all(p.name in CATALOG_FILES or p.name in LOCK_FILES or is_temporary(p.name) for p in folder.iterdir())
 
 
 #: The files and folders a chain run writes into its run directory.
@@ -84,22 +101,27 @@ def run_dir_for_resume(run_dir: str | Path) -> Iterator[None]:
 
 
 @contextlib.contextmanager
-def run_dir_for_run(out_dir: str | Path | None, run_id: str | None = None) -> Iterator[str | None]:
+def run_dir_for_run(
+    out_dir: str | Path | None, run_id: str | None = None, *, overwrite: bool = False
+) -> Iterator[str | None]:
     """The run directory of ``run_chain(out_dir=...)``, owned as ``stickslip chain --out`` owns it:
     a folder holding files a chain run does not write, or a run already (finished, or with a
     checkpoint to resume), is refused with ParameterError before anything is written; the folder
     is locked for the run (a second writer gets :class:`RunDirBusy`, naming the holder) and gets
     a run id, which is yielded. A folder this process already holds (the command's) or that its
-    caller owns (:func:`owned_by_caller`) is taken as it is, with ``run_id``."""
+    caller owns (:func:`owned_by_caller`) is taken as it is, with ``run_id``. With ``overwrite``
+    (``--overwrite``), a run's own files there are removed first and other files stay."""
+    from stickslip.models.params import ParameterError
+
+    if out_dir is not None and not str(out_dir).strip():
+        raise ParameterError("out_dir must name a directory (got '')")
     if out_dir is None or os.path.realpath(out_dir) in _HELD:
         yield run_id
         return
-    from stickslip.models.params import ParameterError
-
     out = Path(out_dir)
     if out.exists() and not out.is_dir():
         raise ParameterError(f"out_dir {out} is not a directory")
-    if out.is_dir():
+    if out.is_dir() and not overwrite:
         foreign = sorted(n for n in os.listdir(out) if n not in OWN_FILES and not is_temporary(n))
         if foreign:
             shown = ", ".join(foreign[:3]) + (", ..." if len(foreign) > 3 else "")
@@ -111,8 +133,14 @@ def run_dir_for_run(out_dir: str | Path | None, run_id: str | None = None) -> It
                 f"{out} already holds a run; continue it with resume_chain({str(out)!r}) or choose another out_dir"
             )
         if (out / "run.json").exists():
-            raise ParameterError(f"{out} already holds a finished run; choose another out_dir")
-    with owned_run_dir(out) as rid:
+            raise ParameterError(f"{out} already holds a finished run; choose another out_dir or overwrite=True")
+    with owned_run_dir(out, new_id=not overwrite) as rid:
+        if overwrite:
+            from stickslip.io import write_bytes
+
+            remove_own_files(out)
+            rid = uuid.uuid4().hex
+            write_bytes(out / RUN_ID_FILE, (rid + "\n").encode())
         yield rid
 
 
@@ -170,9 +198,12 @@ def owned_run_dir(
 
         record = {"pid": os.getpid(), "host": socket.gethostname(), "since": time.strftime("%Y-%m-%dT%H:%M:%S")}
         write_bytes(info, json.dumps(record).encode())
-        for stale in run_dir.glob(".*.tmp"):  # left by a write that was killed
+        for stale in run_dir.glob(".*.tmp"):  # left by a write that was killed (a file, or a staging folder)
             with contextlib.suppress(OSError):
-                stale.unlink()
+                if stale.is_dir() and not stale.is_symlink():
+                    shutil.rmtree(stale)
+                else:
+                    stale.unlink()
         if not run_id:
             yield None
             return

@@ -10,6 +10,7 @@ files it may replace, :mod:`stickslip.run.ownership`. Both are named here too.
 
 from __future__ import annotations
 
+import hashlib
 import json
 from pathlib import Path
 
@@ -53,12 +54,24 @@ class RunDirDamaged(ValueError):
     """A file of a run directory is missing, truncated or not what :func:`write_run` writes."""
 
 
+class RunDirMissing(RunDirDamaged, FileNotFoundError):
+    """A run directory, or a file it must hold, is not there: a :class:`FileNotFoundError` as
+    Python code expects of a missing path (and a :class:`RunDirDamaged` as before)."""
+
+    def __init__(self, message: str, path: Path):
+        super().__init__(message)
+        self.filename = str(path)
+
+    def __str__(self) -> str:  # the message, not OSError's "[Errno None] None: path"
+        return str(self.args[0])
+
+
 def _read(path: Path, reader):
     """``reader(path)``, any failure of it a :class:`RunDirDamaged` naming the file."""
     try:
         return reader(path)
     except FileNotFoundError:
-        raise RunDirDamaged(f"{path} is missing") from None
+        raise RunDirMissing(f"{path} is missing", path) from None
     except Exception as exc:  # truncated, overwritten, another format: all the same to a reader
         why = str(exc).strip().splitlines()[0][:120] if str(exc).strip() else type(exc).__name__
         raise RunDirDamaged(f"{path} is damaged or not a file of this package ({why})") from None
@@ -66,7 +79,9 @@ def _read(path: Path, reader):
 
 def load_run(run_dir: str | Path) -> ChainRun:
     """Read a run directory written by :func:`write_run` back into a :class:`ChainRun`; a
-    missing or damaged file raises :class:`RunDirDamaged` naming it.
+    missing or damaged file raises :class:`RunDirDamaged` naming it (a missing folder or file
+    :class:`RunDirMissing`, which is also a :class:`FileNotFoundError`), and so does a state.nc
+    whose final state no longer has the SHA-256 (``state_sha256``) its run.json records.
 
     Parameters
     ----------
@@ -89,6 +104,10 @@ def load_run(run_dir: str | Path) -> ChainRun:
     (True, True)
     """
     run_dir = Path(run_dir)
+    if run_dir.exists() and not run_dir.is_dir():
+        raise RunDirDamaged(f"{run_dir} is not a directory (a run directory holds run.json, state.nc, ...)")
+    if not run_dir.exists():
+        raise RunDirMissing(f"{run_dir}: no such run directory", run_dir)
     try:
         return _load_run(run_dir)
     except RunDirDamaged:
@@ -99,12 +118,30 @@ def load_run(run_dir: str | Path) -> ChainRun:
         ) from None
 
 
+def _state_file_sha256(ds: xr.Dataset) -> str:
+    """SHA-256 of a state.nc's final state, over its arrays as stored and in the order of
+    :meth:`~stickslip.run.state.ChainState.sha256` (x, v, theta as float64 little-endian, then
+    stopped one byte each), so that it equals the ``state_sha256`` its run.json records."""
+    h = hashlib.sha256()
+    for name in ("x", "v", "theta"):
+        h.update(np.ascontiguousarray(ds[name].values, dtype="<f8").tobytes())
+    h.update((np.asarray(ds["stopped"].values) != 0).astype(np.uint8).tobytes())
+    return h.hexdigest()
+
+
 def _load_run(run_dir: Path) -> ChainRun:
     from stickslip import io
 
     meta = _read(run_dir / "run.json", io.read_json)
     ds = _read(run_dir / "state.nc", io.read_dataset)
     params = ChainParams(**meta["params"])
+    recorded = meta["summary"].get("state_sha256")
+    if isinstance(recorded, str) and _state_file_sha256(ds) != recorded:
+        # state.nc replaced or edited after the run: its state is not the one the run ended on
+        raise RunDirDamaged(
+            f"{run_dir / 'state.nc'} does not hold the final state its run.json records "
+            f"(state_sha256 {recorded[:16]}...): the file was changed after the run"
+        )
     state = ChainState.from_blocks(
         ds["x"].values, ds["v"].values, ds["theta"].values, ds["stopped"].values.astype(bool)
     )

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import hashlib
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -175,17 +176,95 @@ def model_of(p: ChainParams) -> dict[str, str]:
     return {"model": p.model, **p.pieces}
 
 
+def check_start_draw(start: str, perturbation: Any, seed: Any, *, cli: bool = False) -> None:
+    """Refuse a perturbation or a seed (None: not given) with a start that draws no numbers (the
+    paper's, section 3): the one check that ``run_chain`` and ``stickslip chain`` share. ``cli``
+    spells the options (``--perturbation``, ``--start steady``) instead of the arguments."""
+    if start != "paper":
+        return
+    if cli:
+        steady, rest, amplitude, seed_name = "--start steady", "--start rest", "--perturbation", "--seed"
+    else:
+        steady, rest, amplitude, seed_name = "start='steady'", "start='rest'", "perturbation", "seed"
+    if perturbation is not None:
+        raise ParameterError(f"{amplitude} goes with {steady} or {rest} (the paper's start has none)")
+    if seed is not None:
+        raise ParameterError(f"{seed_name} goes with {steady} or {rest} (the paper's start draws no numbers)")
+
+
 def initial_state(p: ChainParams, start: str = "paper", *, amplitude: float = 0.0, seed: int = 0) -> ChainState:
     """The initial state named by ``start``: 'paper' (section 3), 'steady' (docs/model.md) or 'rest'
     (every block stuck, x_i = -A u_i: Carlson-Langer's start, docs/model.md)."""
     amplitude = check_number("perturbation", amplitude, low=0.0, high=MAX_PERTURBATION)
     if start == "paper":
-        return ChainState.paper(p)
-    if start == "steady":
-        return ChainState.steady(p, amplitude, seed)
-    if start == "rest":
-        return ChainState.rest(p, amplitude, seed)
-    raise ParameterError(f"start must be one of {', '.join(STARTS)} (got {start!r})")
+        state = ChainState.paper(p)
+    elif start == "steady":
+        state = ChainState.steady(p, amplitude, seed)
+    elif start == "rest":
+        state = ChainState.rest(p, amplitude, seed)
+    else:
+        raise ParameterError(f"start must be one of {', '.join(STARTS)} (got {start!r})")
+    problem = first_step_problem(state, p)
+    if problem is not None:
+        raise ParameterError(f"start {start}: {problem}{_remedy(p, start)}")
+    return state
+
+
+def first_step_problem(state: ChainState, p: ChainParams) -> str | None:
+    """Why the first step of Heun (docs/model.md) from ``state`` leaves the friction law's range of
+    theta (:attr:`~stickslip.models.piece.Piece.theta_range`), or None.
+
+    The law's dtheta/dt (its ``rate``, read in plain Python) at each moving block gives Heun's
+    predictor theta + dt rate and the corrected theta + dt (rate + rate') / 2 at the block's
+    velocity; a start far from the law's steady sliding (Ruina's slip law at the paper's v = 0.1,
+    v theta / D_c = 100) sends theta below 0 in one step of dt = 0.005, and the run would die of a
+    non-finite state at step 1.
+    """
+    import importlib
+
+    law = p.friction_piece
+    bounds = law.theta_range
+    if not law.has_state or bounds is None:
+        return None
+    low, high, low_open = bounds
+    rate = importlib.import_module(law.module).rate.py_func
+    lp = law.kernel_params(p)
+
+    def inside(th: float) -> bool:
+        return bool(np.isfinite(th)) and (th > low if low_open else th >= low) and th <= high
+
+    th, v = state.th, state.v
+    seen = set()
+    for i in range(1, p.N + 1):
+        key = (th[i - 1], th[i], th[i + 1], v[i])
+        if state.mov[i] == 0.0 or key in seen:  # the named starts repeat one block N times
+            continue
+        seen.add(key)
+        r = float(rate(th[i - 1], th[i], th[i + 1], v[i], lp))
+        pred = th[i] + p.dt * r
+        corrected = pred
+        if inside(pred):
+            corrected = th[i] + 0.5 * p.dt * (r + float(rate(th[i - 1], pred, th[i + 1], v[i], lp)))
+        if not (inside(pred) and inside(corrected)):
+            shown = "(" + f"{low:g}, {high:g}" + ("]" if high < float("inf") else ")")
+            step = f"dt below {0.5 * (th[i] - low) / abs(r):.2g}" if r < 0 and th[i] > low else "a smaller dt"
+            return (
+                f"theta of block {i} leaves {shown} in the first step of dt = {p.dt:g} (theta {th[i]:.3g}, "
+                f"dtheta/dt {r:.3g} at v = {v[i]:.3g}, friction {p.friction}): the run would become "
+                f"non-finite at once; {step}"
+            )
+    return None
+
+
+def _remedy(p: ChainParams, start: str) -> str:
+    """What to do instead of a start whose first step fails: steady sliding, where the law's theta
+    rests, when the chain has it; else only a smaller dt (said by :func:`first_step_problem`)."""
+    if start != "steady" and physics.has_steady_state(p):
+        return (
+            " (dt=... in Python, --dt on the command line), or start from steady sliding "
+            "(start='steady', --start steady)"
+        )
+    return " (dt=... in Python, --dt on the command line)"
 
 
 def steady_deviation(state: ChainState, p: ChainParams) -> float:

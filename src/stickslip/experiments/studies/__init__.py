@@ -124,6 +124,7 @@ class Design:
 
     - ``name``, ``summary`` (one line for ``stickslip study --help``) and ``describe`` (the text
       of ``stickslip study NAME --help``: what it measures, its grid, its cost, its outputs);
+    - ``cost``: the wall time of each mode, as ``describe`` and the README state it (one text);
     - ``build(mode, **options)``: the :class:`Study` of a mode;
     - ``task(point, point_dir)``: one point on a worker (a task of ``run_sweep``);
     - ``check(cfg)``: refuse a point's merged settings (ParameterError) before any work starts;
@@ -161,6 +162,7 @@ class Design:
     load: Callable[..., Any] | None = None
     point_name: Callable[[dict[str, Any]], str] | None = None
     command: Callable[[str], str] | None = None
+    cost: dict[str, str] = field(default_factory=dict)
 
 
 def design(name: str) -> Design:

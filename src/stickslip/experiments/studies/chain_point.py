@@ -10,8 +10,6 @@ import math
 from pathlib import Path
 from typing import Any
 
-from stickslip.experiments.sweep_points import point_params, preset_start
-
 __all__ = ["order_task", "sizes_task", "check_point", "loading_time", "t_end_of"]
 
 
@@ -31,6 +29,8 @@ def t_end_of(N: int, loads: float) -> float:
 
 def point_run_options(cfg: dict[str, Any], params) -> tuple[float, dict[str, Any]]:
     """Run length and :func:`~stickslip.run.driver.run_chain` options of a point."""
+    from stickslip.experiments.sweep_points import preset_start
+
     t_end = float(cfg["t_end"])
     options: dict[str, Any] = {
         **preset_start(params, cfg),
@@ -45,6 +45,8 @@ def point_run_options(cfg: dict[str, Any], params) -> tuple[float, dict[str, Any
 
 def check_point(cfg: dict[str, Any]) -> None:
     """Raise ParameterError (one line) unless a point's merged settings make a valid run."""
+    from stickslip.experiments.sweep_points import point_params
+
     point_run_options(cfg, point_params("chain", cfg))
 
 
@@ -52,6 +54,7 @@ def _run(point: dict[str, Any], point_dir: Path, analyse) -> dict[str, Any]:
     """The point's chain run (continued from its checkpoint): the summary fields every point
     stores and ``analyse(run, params, options)``, the summary of its ``done.json``."""
     from stickslip.experiments.sweep import run_chain_point
+    from stickslip.experiments.sweep_points import point_params
 
     params = point_params("chain", point)
     t_end, options = point_run_options(point, params)

@@ -36,13 +36,13 @@ from __future__ import annotations
 import math
 import time
 from pathlib import Path
-from typing import Any
-
-import pandas as pd
+from typing import TYPE_CHECKING, Any
 
 from stickslip.experiments.studies import Design, Study, finite, short
-from stickslip.experiments.sweep_points import point_params
 from stickslip.models.presets import PRESETS, is_paper
+
+if TYPE_CHECKING:  # loaded where used, so that listing the studies loads no heavy module
+    import pandas as pd
 
 __all__ = ["DESIGN", "chaos_point", "conclusions", "MIN_FLOW_SLIPS"]
 
@@ -136,6 +136,7 @@ def check_point(cfg: dict[str, Any], params=None) -> None:
     a valid measurement."""
     from stickslip.analysis.benettin import check_run
     from stickslip.analysis.decorrelation import PERTURBATIONS
+    from stickslip.experiments.sweep_points import point_params
     from stickslip.models.params import ParameterError, check_number
 
     params = point_params("chain", cfg) if params is None else params
@@ -282,6 +283,8 @@ def _num(x) -> float:
 
 def task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     """One point on a worker (:func:`chaos_point`)."""
+    from stickslip.experiments.sweep_points import point_params
+
     return chaos_point(point, point_params("chain", point), Path(point_dir))
 
 
@@ -389,6 +392,8 @@ def figures(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[tuple[str,
     folder beside ``page_dir`` (the curves of :mod:`stickslip.plotting.chaos`: chain points by N
     then beta, the relatives last), and ``decorrelation.csv``/``.parquet`` in ``page_dir``: every
     n(delta) row (point, N, beta, kind, delta, seed, events, decorrelated, t_decorrelated)."""
+    import pandas as pd
+
     from stickslip import io
     from stickslip.plotting import chaos as pc
 
@@ -439,6 +444,10 @@ def figures(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[tuple[str,
     return out
 
 
+#: The wall time of each mode (``stickslip study --help``, the README).
+COST = {"quick": "about 8 minutes on two cores", "full": "about an hour on two cores"}
+
+
 def describe() -> str:
     """The text of ``stickslip study chaos --help``."""
     quick, full = build("quick"), build("full")
@@ -448,15 +457,16 @@ def describe() -> str:
         "dt/4, extrapolated to dt -> 0), the number of slips n(delta) that agree between a run and a "
         "twin perturbed by delta (the state, Fs or V), the threshold delta* and the verdict "
         "(chaotic, stable chaos, regular or undetermined); two blocks and Carlson-Langer as known answers. "
-        f"Grid: --quick {quick.note.split(': ', 1)[1]} ({len(quick.points)} points, about 8 minutes "
-        f"on two cores); --full {full.note.split(': ', 1)[1]} ({len(full.points)} points, about an "
-        "hour on two cores). Outputs in DIR/chaos/: table.parquet and table.csv (one row per point: "
+        f"Grid: --quick {quick.note.split(': ', 1)[1]} ({len(quick.points)} points, {COST['quick']}"
+        f"); --full {full.note.split(': ', 1)[1]} ({len(full.points)} points, {COST['full']})."
+        " Outputs in DIR/chaos/: table.parquet and table.csv (one row per point: "
         "verdict, exponent, delta* per kind), decorrelation.csv, decorrelation, flow_ladder and "
         "threshold (PNG, PDF), study.json, index.html."
     )
 
 
 DESIGN = Design(
+    cost=COST,
     name="chaos",
     summary="the flow's exponent, slip decorrelation and its threshold delta* against N; the verdict",
     describe=describe,

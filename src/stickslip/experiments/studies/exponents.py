@@ -9,14 +9,16 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
 
 from stickslip.experiments.studies import Design, Study, finite, short
 from stickslip.experiments.studies.chain_point import check_point, sizes_task, t_end_of
 from stickslip.models.presets import PRESETS, is_paper
+
+if TYPE_CHECKING:  # loaded where used, so that listing the studies loads no heavy module
+    import pandas as pd
 
 __all__ = ["DESIGN"]
 
@@ -121,6 +123,10 @@ def _family_panels(table: pd.DataFrame, points: Path) -> list[tuple[str, pd.Data
     return panels
 
 
+#: The wall time of each mode (``stickslip study --help``, the README).
+COST = {"quick": "4 to 5 minutes on two cores", "full": "about 25 minutes on two cores"}
+
+
 def describe() -> str:
     """The text of ``stickslip study exponents --help``."""
     quick, full = build("quick"), build("full")
@@ -128,9 +134,8 @@ def describe() -> str:
         "Does the slip-size exponent tau of eq. (4) (Figs. 7, 8) change with beta? A truncated power "
         "law below the smallest spanning event, s_min by least KS distance, bootstrap errors, and the "
         "excess of great events; Carlson-Langer as the known power law. "
-        f"Grid: --quick {quick.note.split(': ', 1)[1]} ({len(quick.points)} runs, 4 to 5 minutes "
-        f"on two cores); --full {full.note.split(': ', 1)[1]} ({len(full.points)} runs, about 25 minutes on "
-        "two cores). "
+        f"Grid: --quick {quick.note.split(': ', 1)[1]} ({len(quick.points)} runs, {COST['quick']}"
+        f"); --full {full.note.split(': ', 1)[1]} ({len(full.points)} runs, {COST['full']}). "
         "Outputs in DIR/exponents/: table.parquet and table.csv (one row per run: tau, its error, the "
         "fitted range, the excess), tau_beta and family_sizes (Carlson-Langer beside beta = 0.2; PNG, PDF), "
         "study.json, index.html."
@@ -138,6 +143,7 @@ def describe() -> str:
 
 
 DESIGN = Design(
+    cost=COST,
     name="exponents",
     summary="slip-size exponent tau against beta, and Carlson-Langer",
     describe=describe,

@@ -16,24 +16,20 @@ import dataclasses
 from collections import namedtuple
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
 
 from stickslip import io
-from stickslip.analysis import hysteresis as hy
-from stickslip.analysis import stability as st
-from stickslip.analysis.slip_limit import SlipLimit, heun_slip_limit, paper_V_values, period_sweep, solve_slip_limit
 from stickslip.experiments.cache import spec_key
 from stickslip.experiments.studies import Design, Study
-from stickslip.experiments.sweep import DONE_FILE
 from stickslip.models.params import BlockParams, ChainParams
 from stickslip.models.presets import block_params, paper_parameters
 from stickslip.outcome import Outcome, Results
 from stickslip.report.commands import reproduce_command
-from stickslip.report.rows import findings_of, section2_rows, stated_numbers
-from stickslip.run.block import BlockRun, BlockState, simulate_block
+
+if TYPE_CHECKING:  # loaded where used, so that listing the studies loads no heavy module
+    import pandas as pd
 
 __all__ = ["DESIGN", "task"]
 
@@ -87,6 +83,8 @@ def _reads(key: str, file: str) -> Callable[[dict[str, Any], Path, dict[str, Any
 
 def _compute_block_run(cfg: dict[str, Any], run_dir: Path) -> dict[str, Any]:
     """Eq. (1) at the paper's parameters with every step stored (Figs. 1, 2)."""
+    from stickslip.run.block import simulate_block
+
     run = simulate_block(BlockParams(**cfg["params"]), cfg["t_end"], every=1)
     io.write_dataset(run_dir / "series.nc", run.series)
     io.write_table_files(run_dir / "slips", run.slips)
@@ -95,6 +93,8 @@ def _compute_block_run(cfg: dict[str, Any], run_dir: Path) -> dict[str, Any]:
 
 
 def _load_block_run(cfg: dict[str, Any], run_dir: Path, summary: dict[str, Any]) -> dict[str, Any]:
+    from stickslip.run.block import BlockRun, BlockState
+
     numbers = {k: int(summary[k]) for k in ("steps", "every", "n_stops", "n_starts")}
     numbers |= {k: float(summary[k]) for k in ("v_min", "v_max")}
     series, slips = io.read_dataset(run_dir / "series.nc"), io.read_table(run_dir / "slips.parquet")
@@ -103,6 +103,8 @@ def _load_block_run(cfg: dict[str, Any], run_dir: Path, summary: dict[str, Any])
 
 def _compute_slip_limit(cfg: dict[str, Any], run_dir: Path) -> dict[str, Any]:
     """Eq. (3) accurately (DOP853, event v = 0) and with the Heun step of the paper."""
+    from stickslip.analysis.slip_limit import heun_slip_limit, solve_slip_limit
+
     p = BlockParams(**cfg["params"])
     law = solve_slip_limit(p, rtol=cfg["options"]["rtol"], atol=cfg["options"]["atol"])
     heun = heun_slip_limit(p)
@@ -111,6 +113,8 @@ def _compute_slip_limit(cfg: dict[str, Any], run_dir: Path) -> dict[str, Any]:
 
 
 def _load_slip_limit(cfg: dict[str, Any], run_dir: Path, summary: dict[str, Any]) -> dict[str, Any]:
+    from stickslip.analysis.slip_limit import SlipLimit
+
     numbers = {k: float(summary[k]) for k in ("duration", "force_at_stop", "slip", "theta_at_stop")}
     curve = io.read_dataset(run_dir / "curve.nc")
     return {"law": SlipLimit(BlockParams(**cfg["params"]), **numbers, method=str(summary["method"]), curve=curve)}
@@ -118,6 +122,8 @@ def _load_slip_limit(cfg: dict[str, Any], run_dir: Path, summary: dict[str, Any]
 
 def _compute_period_sweep(cfg: dict[str, Any], run_dir: Path) -> dict[str, Any]:
     """Simulated stick-slip period at log-spaced V (Fig. 3)."""
+    from stickslip.analysis.slip_limit import paper_V_values, period_sweep
+
     o = cfg["options"]
     V = paper_V_values(o["n"], o["V_min"], o["V_max"])
     table = period_sweep(BlockParams(**cfg["params"]), V, periods=o["periods"])
@@ -132,6 +138,8 @@ def _compute_period_sweep(cfg: dict[str, Any], run_dir: Path) -> dict[str, Any]:
 
 def _compute_block_stability(cfg: dict[str, Any], run_dir: Path) -> dict[str, Any]:
     """Eq. (2): Hopf point at the point's beta, stability for all V at ``beta_stable``, the map."""
+    from stickslip.analysis import stability as st
+
     p = BlockParams(**cfg["params"])
     hopf = st.hopf_point(p)
     q = p.replace(beta=float(cfg["options"]["beta_stable"]))
@@ -158,6 +166,8 @@ def _compute_block_stability(cfg: dict[str, Any], run_dir: Path) -> dict[str, An
 
 def _compute_hysteresis(cfg: dict[str, Any], run_dir: Path) -> dict[str, Any]:
     """V raised slowly and lowered again for the single block (the inverse transition, sec. 2)."""
+    from stickslip.analysis import hysteresis as hy
+
     result = hy.hysteresis_sweep(BlockParams(**cfg["params"]), hy.SweepSettings(**cfg["options"]))
     io.write_dataset(run_dir / "hysteresis.nc", result.data)
     return result.summary()
@@ -165,6 +175,8 @@ def _compute_hysteresis(cfg: dict[str, Any], run_dir: Path) -> dict[str, Any]:
 
 def _compute_chain_modes(cfg: dict[str, Any], run_dir: Path) -> dict[str, Any]:
     """Fourier modes of the linearised chain at the betas of Fig. 4, and the critical beta."""
+    from stickslip.analysis import stability as st
+
     p = ChainParams(**cfg["params"])
     betas = [float(b) for b in cfg["options"]["betas"]]
     ds = st.fig4_data(p, betas=betas, k=np.linspace(0.0, np.pi, int(cfg["options"]["n_k"])))
@@ -211,6 +223,8 @@ def point_name(point: dict[str, Any]) -> str:
 def load(spec: Study, table: pd.DataFrame, points_dir: Path) -> Results | None:
     """Every experiment's result read back from its folder (None unless each experiment of
     section 2 and Fig. 4 finished)."""
+    from stickslip.experiments.sweep import DONE_FILE
+
     rows = {r.point_dir: r for r in table.itertuples()}
     if {p["experiment"] for p in spec.points if point_name(p) in rows} != set(_RUNNERS):
         return None
@@ -227,14 +241,17 @@ def load(spec: Study, table: pd.DataFrame, points_dir: Path) -> Results | None:
 def findings(spec: Study, results: Results | None) -> dict[str, Any]:
     """The rows of the paper's stated numbers of section 2, eq. (3), Figs. 3 and 4
     (:func:`stickslip.report.rows.section2_rows`), and one statement per row."""
+    from stickslip.report.rows import findings_of, section2_rows
+
     return findings_of(section2_rows(results.outcomes) if results else None)
 
 
 def figures(spec: Study, results: Results | None, page_dir: Path) -> list[tuple]:
     """Figs. 1-4, the stability map and the hysteresis sweep, with their data beside them."""
     from stickslip.plotting.figures import section2_figures
+    from stickslip.report import commands
 
-    return section2_figures(results.outcomes, page_dir) if results else []
+    return section2_figures(results.outcomes, page_dir, commands) if results else []
 
 
 def describe() -> str:
@@ -251,6 +268,14 @@ def describe() -> str:
     )
 
 
+def _stated_numbers(*args: Any, **kwargs: Any) -> Any:
+    """The paper's stated numbers: :func:`stickslip.report.rows.stated_numbers`, loaded when a
+    page is written (listing the studies loads no report)."""
+    from stickslip.report.rows import stated_numbers
+
+    return stated_numbers(*args, **kwargs)
+
+
 DESIGN = Design(
     name="figs1-4",
     summary="section 2 and Fig. 4 of the paper",
@@ -261,7 +286,7 @@ DESIGN = Design(
     findings=findings,
     figures=figures,
     columns=("experiment", "t_end", "params", "options"),
-    tables=stated_numbers,
+    tables=_stated_numbers,
     load=load,
     point_name=point_name,
     command=reproduce_command,

@@ -13,21 +13,19 @@ from __future__ import annotations
 
 import functools
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
 
-from stickslip.analysis.chain_runs import chain_analysis, run_summary
 from stickslip.experiments.studies import Design, Study
-from stickslip.experiments.sweep import point_name, run_chain_point
 from stickslip.jsonable import table_records
 from stickslip.models.physics import UNTIL_STEADY
 from stickslip.models.presets import paper_parameters
 from stickslip.outcome import Outcome, Results, point_settings
 from stickslip.report.commands import reproduce_command
-from stickslip.report.rows import chain_rows, findings_of, stated_numbers
-from stickslip.run.driver import load_run
+
+if TYPE_CHECKING:  # loaded where used, so that listing the studies loads no heavy module
+    import pandas as pd
 
 __all__ = ["DESIGN", "chain_point_task"]
 
@@ -93,6 +91,9 @@ def chain_point_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     (:func:`stickslip.experiments.sweep.run_chain_point`). Returns the run's summary with <L> and
     its batch-means error (Fig. 5b) and the final state ("steady sliding" or "stick-slip", section 3).
     """
+    from stickslip.analysis.chain_runs import run_summary
+    from stickslip.experiments.sweep import run_chain_point
+
     params, t_end, options = point_settings(point)
     run = run_chain_point(params, t_end, point_dir, **options)
     return {**run_summary(run, params, options["average_from"], UNTIL_STEADY), "t_end_requested": t_end}
@@ -106,6 +107,12 @@ def check(cfg: dict[str, Any]) -> None:
 def load(spec: Study, table: pd.DataFrame, points_dir: Path) -> Results | None:
     """The chain runs (each read from its folder when first asked for) and their analysis
     (:func:`stickslip.analysis.chain_runs.chain_analysis`); None unless every run finished."""
+    import pandas as pd
+
+    from stickslip.analysis.chain_runs import chain_analysis
+    from stickslip.experiments.sweep import point_name
+    from stickslip.run.driver import load_run
+
     if len(table) < len(spec.points):
         return None
     # as the table reads back from JSON; the final state of each run is its task's
@@ -126,14 +133,19 @@ def load(spec: Study, table: pd.DataFrame, points_dir: Path) -> Results | None:
 def findings(spec: Study, results: Results | None) -> dict[str, Any]:
     """The rows of section 3 and Figs. 5-8 (:func:`stickslip.report.rows.chain_rows`), and one
     statement per row."""
+    from stickslip.report.rows import chain_rows, findings_of
+
     return findings_of(chain_rows(results.outcomes["chain-runs"], results.analysis, results.mode) if results else None)
 
 
 def figures(spec: Study, results: Results | None, page_dir: Path) -> list[tuple]:
     """Figs. 5-8, with their data beside them (:func:`stickslip.plotting.figures.chain_figures`)."""
     from stickslip.plotting.figures import chain_figures
+    from stickslip.report import commands
 
-    return chain_figures(results.outcomes["chain-runs"], results.analysis, page_dir, results.mode) if results else []
+    if not results:
+        return []
+    return chain_figures(results.outcomes["chain-runs"], results.analysis, page_dir, results.mode, commands)
 
 
 def describe() -> str:
@@ -152,6 +164,14 @@ def describe() -> str:
     )
 
 
+def _stated_numbers(*args: Any, **kwargs: Any) -> Any:
+    """The paper's stated numbers: :func:`stickslip.report.rows.stated_numbers`, loaded when a
+    page is written (listing the studies loads no report)."""
+    from stickslip.report.rows import stated_numbers
+
+    return stated_numbers(*args, **kwargs)
+
+
 DESIGN = Design(
     name="figs5-8",
     summary="section 3 of the paper: chain runs for Figs. 5-8",
@@ -162,7 +182,7 @@ DESIGN = Design(
     findings=findings,
     figures=figures,
     columns=("N", "beta", "final_state", "L_mean", "L_err", "L_steady", "n_events", "t_end"),
-    tables=stated_numbers,
+    tables=_stated_numbers,
     load=load,
     command=reproduce_command,
 )

@@ -8,14 +8,15 @@ parameter (:func:`stickslip.experiments.studies.chain_point.order_task`).
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
-
-import pandas as pd
+from typing import TYPE_CHECKING, Any
 
 from stickslip.experiments.studies import Design, Study, short
 from stickslip.experiments.studies.chain_point import check_point, order_task, t_end_of
 from stickslip.models.physics import UNTIL_STEADY
 from stickslip.models.presets import paper_parameters
+
+if TYPE_CHECKING:  # loaded where used, so that listing the studies loads no heavy module
+    import pandas as pd
 
 __all__ = ["DESIGN"]
 
@@ -115,6 +116,10 @@ def figures(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[tuple[str,
     ]
 
 
+#: The wall time of each mode (``stickslip study --help``, the README).
+COST = {"quick": "7 to 8 minutes on two cores", "full": "about 80 minutes on two cores"}
+
+
 def describe() -> str:
     """The text of ``stickslip study phase-diagram --help``."""
     quick, full = build("quick"), build("full")
@@ -123,9 +128,8 @@ def describe() -> str:
         "beta) at D = 5 and (D, beta) at alpha = 1? Each cell is run from the paper's start and from "
         "steady sliding perturbed by 0.01 (two starts that end differently mark hysteresis), 2.5 "
         "loading times, and compared with beta_c = alpha of linear stability. "
-        f"Grid: --quick {quick.note.split(': ', 1)[1]} ({len(quick.points)} runs, 7 to 8 minutes "
-        f"on two cores); --full {full.note.split(': ', 1)[1]} ({len(full.points)} runs, about 80 minutes "
-        "on two cores). "
+        f"Grid: --quick {quick.note.split(': ', 1)[1]} ({len(quick.points)} runs, {COST['quick']}"
+        f"); --full {full.note.split(': ', 1)[1]} ({len(full.points)} runs, {COST['full']}). "
         "Outputs in DIR/phase-diagram/: table.parquet and table.csv (one row per run: final state, m "
         "and its error, stuck fraction), phase_alpha_beta and phase_D_beta (PNG, PDF), study.json, "
         "index.html."
@@ -133,6 +137,7 @@ def describe() -> str:
 
 
 DESIGN = Design(
+    cost=COST,
     name="phase-diagram",
     summary="final state over (alpha, beta) and (D, beta), from two starts",
     describe=describe,

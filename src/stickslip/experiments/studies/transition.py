@@ -20,18 +20,17 @@ import math
 import tempfile
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
 
-from stickslip.analysis.adaptive import STOP_BATCHES
-from stickslip.analysis.order import power_law_fit
-from stickslip.experiments.ladders import ladder_entry, ladder_task, params_at
 from stickslip.experiments.studies import Design, Option, Study
 from stickslip.jsonable import table_records
 from stickslip.models.params import MAX_BLOCKS, check_number
 from stickslip.models.presets import paper_parameters
+
+if TYPE_CHECKING:  # loaded where used, so that listing the studies loads no heavy module
+    import pandas as pd
 
 __all__ = ["DESIGN", "ladder_points", "transition_loop", "per_n_summary", "ROW_COLUMNS", "PER_N_COLUMNS", "LADDER_NS"]
 
@@ -74,6 +73,8 @@ def _grids(N: int, mode: str) -> tuple[list[float], list[float]]:
 def ladder_points(mode: str, extra_Ns: tuple[int, ...] = ()) -> tuple[dict[str, Any], list[dict[str, Any]]]:
     """The shared settings and the ladders (one per N and direction) of a mode; large N first (the
     up ladder of the largest chain is the longest task: it sets the wall time on a few workers)."""
+    from stickslip.analysis.adaptive import STOP_BATCHES
+
     common = {
         **paper_parameters("N", "beta"),
         "model": "sakaguchi",
@@ -113,6 +114,8 @@ def build(mode: str, extra_Ns: Sequence[int] = ()) -> Study:
 
 def check(cfg: dict[str, Any]) -> None:
     """Refuse a ladder whose chain at one of its betas is not a valid chain (ParameterError)."""
+    from stickslip.experiments.ladders import params_at
+
     for beta in cfg["betas"]:
         params_at(cfg, float(beta))
 
@@ -170,6 +173,8 @@ def per_n_summary(rows: pd.DataFrame) -> pd.DataFrame:
         m and ``step_phi`` of the stuck fraction at beta_t with their errors, ``replicas``,
         ``undecided`` and ``rungs``.
     """
+    import pandas as pd
+
     out = []
     if "replica" not in rows:
         rows = rows.assign(replica=0)
@@ -194,6 +199,8 @@ def per_n_summary(rows: pd.DataFrame) -> pd.DataFrame:
 
 
 def _fits(per_n: pd.DataFrame) -> dict[str, Any]:
+    from stickslip.analysis.order import power_law_fit
+
     bt, step = per_n.dropna(subset=["beta_t"]), per_n.dropna(subset=["step"])
     return {
         "beta_t_minus_1": power_law_fit(bt["N"], bt["beta_t"] - 1.0, bt["beta_t_err"].fillna(bt["beta_t"] - 1.0)),
@@ -249,6 +256,8 @@ def figures(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[tuple[str,
 
 def _rows_table(rows: list[dict[str, Any]]) -> pd.DataFrame:
     """The rungs as the study's table: :data:`ROW_COLUMNS` first, by N, branch, replica and beta."""
+    import pandas as pd
+
     table = pd.DataFrame(rows)
     if len(table):
         table = table[[c for c in ROW_COLUMNS if c in table] + [c for c in table if c not in ROW_COLUMNS]]
@@ -323,8 +332,12 @@ def transition_loop(
     folder = Path(out_dir) if out_dir is not None else Path(tempfile.mkdtemp(prefix="stickslip-transition-"))
     rows: list[dict[str, Any]] = []
     for point in points:
-        rows += ladder_task(point, folder / f"N{N}-{point['direction']}-{point['replica']}")["rows"]
+        rows += _ladder_task(point, folder / f"N{N}-{point['direction']}-{point['replica']}")["rows"]
     return _rows_table(rows)
+
+
+#: The wall time of each mode (``stickslip study --help``, the README).
+COST = {"quick": "5 to 11 minutes on two cores", "full": "about 45 minutes on two free cores"}
 
 
 def describe() -> str:
@@ -337,27 +350,48 @@ def describe() -> str:
         "ladder starts from steady sliding and goes down until a block sticks; each bisects the "
         "bracket it finds. Each rung stops when its answer is known (error of m, steady sliding "
         "reached, or its cap). "
-        f"Grid: --quick {quick.note.split(': ', 1)[1]} ({len(quick.points)} ladders, 5 to 11 minutes "
-        f"on two cores); --full {full.note.split(': ', 1)[1]} ({len(full.points)} ladders, about 45 "
-        "minutes on two free cores); --extra-n adds a chain (1599: hours). Outputs in "
+        f"Grid: --quick {quick.note.split(': ', 1)[1]} ({len(quick.points)} ladders, {COST['quick']}"
+        f"); --full {full.note.split(': ', 1)[1]} ({len(full.points)} ladders, {COST['full']}); "
+        "--extra-n adds a chain (1599: hours)."
+        " Outputs in "
         "DIR/transition/: table.parquet and table.csv (one row per rung: m, the stuck fraction, "
         "their errors, the final state), loops and scaling (PNG, PDF), study.json (with beta_t, "
         "the lower edge and the step per N and their power laws in N), index.html."
     )
 
 
+def _ladder_task(*args: Any, **kwargs: Any) -> dict[str, Any]:
+    """A point of the study: :func:`stickslip.experiments.ladders.ladder_task`, loaded when a point
+    runs (listing the studies, as ``stickslip --help`` does, loads no engine)."""
+    from stickslip.experiments.ladders import ladder_task
+
+    return ladder_task(*args, **kwargs)
+
+
+# A point's stored result is keyed by its task's name (experiments/sweep.py): the ladders' own.
+_ladder_task.__module__, _ladder_task.__qualname__ = "stickslip.experiments.ladders", "ladder_task"
+
+
+def _ladder_entry(*args: Any, **kwargs: Any) -> Any:
+    """:func:`stickslip.experiments.ladders.ladder_entry`, loaded when asked."""
+    from stickslip.experiments.ladders import ladder_entry
+
+    return ladder_entry(*args, **kwargs)
+
+
 DESIGN = Design(
+    cost=COST,
     name="transition",
     summary="the edges of the stick-slip loop at beta = 1 against N, by continuation in beta",
     describe=describe,
     build=build,
-    task=ladder_task,
+    task=_ladder_task,
     check=check,
     findings=findings,
     figures=figures,
     columns=tuple(ROW_COLUMNS),
     rows=rungs,
     tables=lambda found: [("Per N", PER_N_COLUMNS + ["undecided", "rungs"], found.get("per_N", []))],
-    point_entry=ladder_entry,
+    point_entry=_ladder_entry,
     options=(Option("--extra-n", "extra_Ns", "N", "add a chain of N blocks (both ladders), e.g. 1599; repeatable"),),
 )

@@ -3,9 +3,7 @@ by a leaf spring Kp."""
 
 from __future__ import annotations
 
-from numba import njit
-
-from stickslip.models.piece import Param, Piece, kernel_params
+from stickslip.models.piece import Param, Piece, kernel_params, njit
 
 READS = ("Kp",)
 Params = kernel_params(__name__, READS)

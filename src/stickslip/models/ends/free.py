@@ -2,9 +2,7 @@
 
 from __future__ import annotations
 
-from numba import njit
-
-from stickslip.models.piece import Piece
+from stickslip.models.piece import Piece, njit
 
 
 @njit(cache=True, inline="always")

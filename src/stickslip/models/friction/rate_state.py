@@ -28,9 +28,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from numba import njit
-
-from stickslip.models.piece import Linearisation, Param, Piece, kernel_params
+from stickslip.models.piece import Linearisation, Param, Piece, kernel_params, njit
 
 READS = ("rs_a", "rs_b", "Dc", "v0", "mu0", "sigma_n")
 Params = kernel_params(__name__, READS)

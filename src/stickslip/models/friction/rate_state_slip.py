@@ -24,10 +24,8 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
-
 from stickslip.models.friction import rate_state as aging
-from stickslip.models.piece import Piece, kernel_params
+from stickslip.models.piece import Piece, kernel_params, njit
 
 READS = aging.READS
 Params = kernel_params(__name__, READS)

@@ -9,9 +9,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from numba import njit
-
-from stickslip.models.piece import Linearisation, Piece, kernel_params
+from stickslip.models.piece import Linearisation, Piece, kernel_params, njit
 
 READS = ("beta", "alpha", "D")
 Params = kernel_params(__name__, READS)

@@ -8,9 +8,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from numba import njit
-
-from stickslip.models.piece import Param, Piece, kernel_params
+from stickslip.models.piece import Param, Piece, kernel_params, njit
 
 READS = ("beta", "F0")
 Params = kernel_params(__name__, READS)

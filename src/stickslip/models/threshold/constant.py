@@ -2,9 +2,7 @@
 
 from __future__ import annotations
 
-from numba import njit
-
-from stickslip.models.piece import Piece, kernel_params
+from stickslip.models.piece import Piece, kernel_params, njit
 
 READS = ("Fs",)
 Params = kernel_params(__name__, READS)

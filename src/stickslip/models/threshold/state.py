@@ -3,9 +3,7 @@ Batista-Carlson, docs/model.md)."""
 
 from __future__ import annotations
 
-from numba import njit
-
-from stickslip.models.piece import Piece, kernel_params
+from stickslip.models.piece import Piece, kernel_params, njit
 
 READS: tuple[str, ...] = ()
 Params = kernel_params(__name__, READS)
