@@ -11,7 +11,6 @@ import importlib
 from typing import Any
 
 import numpy as np
-from scipy.optimize import brentq
 
 from stickslip.models.params import BlockParams, ChainParams
 
@@ -230,6 +229,8 @@ def steady_velocity(p: Any) -> float:
     forces = applied_forces(p)
     if forces is None:
         return float(p.V)
+    from scipy.optimize import brentq  # here: the command line's help loads no scipy
+
     total = float(np.sum(forces))
 
     def excess(v: float) -> float:
