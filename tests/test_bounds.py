@@ -72,7 +72,7 @@ def test_a_magnitude_bin_too_fine_is_refused_with_its_cost():
 
 def test_catalog_dm_too_fine_writes_nothing(tmp_path, capsys):
     run = tmp_path / "run"
-    assert main(["chain", "--N", "20", "--t-end", "1e5", "--out", str(run), "--no-progress"]) == 0
+    assert main(["chain", "--model", "two-blocks", "--t-end", "2e4", "--out", str(run), "--no-progress"]) == 0
     capsys.readouterr()
     assert main(["catalog", str(run), "--dm", "1e-9", "--bootstrap", "0", "--gof-sims", "0"]) == 2
     _one_line(capsys, "dm = 1e-09", "bins")

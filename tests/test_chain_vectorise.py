@@ -62,9 +62,9 @@ def _example_args(name: str) -> tuple:
     a = [np.linspace(0.5, 1.5, 12) for _ in range(10)]
     lo, hi = 1, 10
     dt, p = 0.005, 0.0
-    # The paper's model: K, the end drive, the threshold's Fs and eq. (4)'s law (beta, alpha, D);
+    # The paper's model: K, the end drive, the threshold's Fs, eq. (4)'s law (beta, alpha, D), unit masses;
     # pieces as literals (their modules' paths).
-    mp = (10.0, end_drive.Params(), constant_threshold.Params(3.0), state_law.Params(1.0, 1.0, 5.0))
+    mp = (10.0, end_drive.Params(), constant_threshold.Params(3.0), state_law.Params(1.0, 1.0, 5.0), None)
     end, state, constant = end_drive.__name__, state_law.__name__, constant_threshold.__name__
     return {
         "_stage1": (*a, lo, hi, p, mp, dt, end, state, constant),

@@ -251,7 +251,7 @@ _GUARD_SCRIPT = textwrap.dedent(
         assert (dst[16 - n:] == 1.0).all() and (dst[:16 - n] == 2.0).all()
 
     END, STATE = end.__name__, state.__name__
-    mp = (10.0, end.Params(), constant.Params(3.0), state.Params(1.0, 1.0, 5.0))
+    mp = (10.0, end.Params(), constant.Params(3.0), state.Params(1.0, 1.0, 5.0), None)
 
     @numba.njit
     def run(x, v, th, xs, vs, ths, mm, a1, b1, lo, hi):
@@ -361,12 +361,48 @@ END, PLATE = end_drive.__name__, plate_drive.__name__
 STATE, STRENGTHENING, RATE_STATE = state_law.__name__, strengthening.__name__, rate_state.__name__
 
 # The paper's model (end drive, eq. 4's law) and the plate-driven train model's pieces.
+_R = np.random.default_rng(11)
+
+
+def _per_block(lo, hi):
+    """Values per block, padded like x (docs/model.md, "Per-block parameters")."""
+    return _R.uniform(lo, hi, N + 2)
+
+
 PIECES = {
-    "paper": (END, STATE, (10.0, end_drive.Params(), constant_threshold.Params(3.0), state_law.Params(1.0, 1.0, 5.0))),
+    "paper": (
+        END,
+        STATE,
+        (10.0, end_drive.Params(), constant_threshold.Params(3.0), state_law.Params(1.0, 1.0, 5.0), None),
+    ),
     "plate-strengthening": (
         PLATE,
         STRENGTHENING,
-        (2.5, plate_drive.Params(1.0), constant_threshold.Params(3.0), strengthening.Params(0.5, 1.0)),
+        (2.5, plate_drive.Params(1.0), constant_threshold.Params(3.0), strengthening.Params(0.5, 1.0), None),
+    ),
+    # Springs per bond, masses and the laws' parameters per block: the gather as lanes reads each
+    # block's own values, as the loop does.
+    "paper-per-block": (
+        END,
+        STATE,
+        (
+            _per_block(5.0, 15.0),
+            end_drive.Params(),
+            constant_threshold.Params(_per_block(2.0, 4.0)),
+            state_law.Params(_per_block(0.5, 1.5), 1.0, _per_block(1.0, 6.0)),
+            _per_block(0.5, 2.0),
+        ),
+    ),
+    "plate-strengthening-per-block": (
+        PLATE,
+        STRENGTHENING,
+        (
+            2.5,
+            plate_drive.Params(_per_block(0.5, 1.5)),
+            constant_threshold.Params(3.0),
+            strengthening.Params(_per_block(0.2, 0.8), _per_block(0.5, 1.5)),
+            0.7,
+        ),
     ),
 }
 
@@ -516,6 +552,7 @@ def test_the_pieces_choose_lanes_or_loop():
         end_drive.Params(),
         constant_threshold.Params(3.0),
         rate_state.PIECE.kernel_params(ChainParams(friction="rate-state")),
+        None,
     )
     assert "llvm.masked.load" in _stub_ir(STATE, mp_state)
     # Rate-and-state friction (a logarithm, not + - * /) keeps the loop.

@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 from stickslip.kernels.located_lazy import _advance_lazy, _segment
+from stickslip.models.disorder import Quenched
 from stickslip.models.params import ChainParams, ParameterError
 from stickslip.models.presets import chain_params
 from stickslip.run.driver import run_chain
@@ -87,6 +88,19 @@ CASES = {
     "state-threshold": (chain_params("batista-carlson"), 100.0, 150.0, False),
     # Fixed ends read t in their ghost cells: the fast form runs the dense one.
     "fixed-ends": (chain_params("sakaguchi", N=10, V=0.01, ends="fixed"), 200.0, 200.0, False),
+    # Per-block thresholds and friction (docs/model.md, "Per-block parameters").
+    "eq4-disordered": (
+        chain_params("sakaguchi", N=16, V=0.01, Fs=Quenched("uniform", 2.5, 3.5), beta=Quenched("normal", 0.5, 0.05)),
+        300.0,
+        400.0,
+        True,
+    ),
+    "carlson-langer-disordered": (
+        chain_params("carlson-langer", N=16, Fs=Quenched("uniform", 0.8, 1.2), Kp=Quenched("uniform", 0.8, 1.2)),
+        20.0,
+        300.0,
+        True,
+    ),
 }
 
 

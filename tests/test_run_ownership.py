@@ -18,12 +18,14 @@ from stickslip.cli import main
 from stickslip.run.ownership import CATALOG_FILES
 
 FAST = ["--bootstrap", "0", "--gof-sims", "0"]
+# a run of some 700 slips in a fraction of a second
+RUN = ["chain", "--model", "two-blocks", "--t-end", "2e4", "--no-progress"]
 
 
 @pytest.fixture(scope="module")
 def run_dir(tmp_path_factory):
     out = tmp_path_factory.mktemp("own") / "run"
-    assert main(["chain", "--N", "20", "--t-end", "1e5", "--out", str(out), "--no-progress"]) == 0
+    assert main([*RUN, "--out", str(out)]) == 0
     return out
 
 
@@ -71,7 +73,7 @@ def test_chain_overwrite_removes_the_replaced_runs_catalogue(run, capsys):
     assert main(argv) == 0
     assert not (run / "catalog").exists()
     # a catalogue folder with a file of the user's: the catalogue goes, the user's file stays
-    assert main(["chain", "--N", "20", "--t-end", "1e5", "--out", str(run), "--no-progress", "--overwrite"]) == 0
+    assert main([*RUN, "--out", str(run), "--overwrite"]) == 0
     assert main(["catalog", str(run), *FAST]) == 0
     (run / "catalog" / "notes.txt").write_text("mine")
     assert main(argv) == 0

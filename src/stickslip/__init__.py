@@ -39,6 +39,7 @@ _LAZY = {
     "resume_chain": "stickslip.run.driver",
     "load_run": "stickslip.run.rundir",
     "simulate_block": "stickslip.run.block",
+    "Quenched": "stickslip.models.disorder",
 }
 
 __all__ = ["BlockParams", "ChainParams", "ParameterError", "__version__", *_LAZY]

@@ -31,6 +31,9 @@ from stickslip.models.params import ChainParams, ParameterError, check_number, s
 
 #: Largest allowed initial separation: beyond it the twin is not a small perturbation.
 D0_MAX = 1e-3
+#: Smallest allowed initial separation: below it the twin differs from the reference by less than
+#: the rounding of the state's numbers (2.2e-16 of them), and the separation is lost.
+D0_MIN = 1e-15
 
 METHOD = "Benettin et al. (1980) two-trajectory method with renormalisation"
 #: Renormalisations between two questions to ``stop_requested`` (a file's existence).
@@ -207,7 +210,7 @@ def check_run(params: ChainParams, t_end, interval, d0, transient, align, segmen
     """Validate the options; returns (t_end, interval, d0, transient, align, segments) as numbers."""
     t_end = float(check_number("t_end", t_end, low=0.0, low_open=True))
     interval = float(check_number("interval", interval, low=params.dt))
-    d0 = float(check_number("d0", d0, low=0.0, high=D0_MAX, low_open=True))
+    d0 = float(check_number("d0", d0, low=D0_MIN, high=D0_MAX))
     transient = float(check_number("transient", transient, low=0.0, high=t_end, high_open=True))
     if align is None:
         align = 0.1 * (t_end - transient)

@@ -239,11 +239,17 @@ def extrapolate(dts, values, errors, order: int = 2) -> tuple[float, float, floa
 
     Returns (lambda_0, its error, c). The error is the fit's standard error, scaled up by
     sqrt(chi^2 / dof) when the points scatter more than their error bars say (dof = points - 2);
-    with two points, the propagated error bars.
+    with two points, the propagated error bars. Raises ValueError (one line) where an exponent is
+    not finite or the steps do not differ (the fit's matrix would be singular).
     """
     h = np.asarray(dts, dtype=float) ** order
     y = np.asarray(values, dtype=float)
     e = np.asarray(errors, dtype=float)
+    if not np.all(np.isfinite(y)):
+        bad = ", ".join(f"{d:g}" for d, v in zip(dts, y, strict=True) if not math.isfinite(v))
+        raise ValueError(f"no extrapolation: the exponent at dt = {bad} is not finite")
+    if np.unique(h).size < 2:
+        raise ValueError("no extrapolation: it needs two different steps")
     floor = 1e-12 * max(1.0, float(np.max(np.abs(y))))
     e = np.where(np.isfinite(e) & (e > floor), e, floor)
     A = np.column_stack((np.ones_like(h), h)) / e[:, None]

@@ -29,6 +29,18 @@ def mean_log_ratio(e: float, span: float) -> float:
 
     u = log(S/s_min) has density proportional to exp(e u) on [0, span] (a truncated
     exponential), whose mean is span / (1 - exp(-e span)) - 1/e, span/2 at e = 0.
+
+    Parameters
+    ----------
+    e : float
+        1 - tau.
+    span : float
+        log(s_max / s_min).
+
+    Returns
+    -------
+    float
+        The mean.
     """
     x = e * span
     if abs(x) < _SERIES:
@@ -42,6 +54,18 @@ def var_log_ratio(e: float, span: float) -> float:
 
     For the truncated exponential density of u on [0, span]: 1/e^2 - span^2 e^{x} / (e^{x} - 1)^2
     with x = e span, span^2/12 at e = 0.
+
+    Parameters
+    ----------
+    e : float
+        1 - tau.
+    span : float
+        log(s_max / s_min).
+
+    Returns
+    -------
+    float
+        The variance.
     """
     x = e * span
     if abs(x) < 1e-4:
@@ -52,7 +76,20 @@ def var_log_ratio(e: float, span: float) -> float:
 
 
 def log_normaliser(tau: float, s_min: float, s_max: float) -> float:
-    """log Z(tau), Z = integral of S^-tau over [s_min, s_max] (s_max may be inf for tau > 1)."""
+    """log Z(tau), Z = integral of S^-tau over [s_min, s_max] (s_max may be inf for tau > 1).
+
+    Parameters
+    ----------
+    tau : float
+        The exponent.
+    s_min, s_max : float
+        The range.
+
+    Returns
+    -------
+    float
+        log Z, finite for any tau and range.
+    """
     e = 1.0 - tau
     if math.isinf(s_max):
         return e * math.log(s_min) - math.log(-e)
@@ -82,6 +119,18 @@ def truncated_mle(mean_log: float, span: float) -> float:
     Brent's method and checked: the score at the root (the gradient of the log-likelihood per
     event) vanishes to rounding. NaN where the maximum is not inside the bracket (or all
     events sit at one end of the range, where there is no interior maximum).
+
+    Parameters
+    ----------
+    mean_log : float
+        Mean of log(S / s_min) over the events in range.
+    span : float
+        log(s_max / s_min).
+
+    Returns
+    -------
+    float
+        tau, or NaN (:func:`fit_failure` says why).
     """
     if not 0.0 < mean_log < span:
         return math.nan
@@ -99,7 +148,20 @@ def truncated_mle(mean_log: float, span: float) -> float:
 
 
 def fit_failure(mean_log: float, span: float) -> str:
-    """Why :func:`truncated_mle` has no tau for this mean of log(S/s_min) on a range of ``span``, in words."""
+    """Why :func:`truncated_mle` has no tau for this mean of log(S/s_min) on a range of ``span``.
+
+    Parameters
+    ----------
+    mean_log : float
+        Mean of log(S / s_min) over the events in range.
+    span : float
+        log(s_max / s_min).
+
+    Returns
+    -------
+    str
+        The reason, in words.
+    """
     if mean_log <= 0.0:
         return "every event in range is at s_min: the likelihood has no maximum"
     if mean_log >= span:

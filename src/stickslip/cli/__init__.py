@@ -57,6 +57,7 @@ def build_parser() -> argparse.ArgumentParser:
         lab,
         lyapunov,
         models,
+        period,
         plot,
         reproduce,
         stability,
@@ -73,7 +74,21 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"stickslip {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
-    for module in (block, stability, chain, models, sweep, reproduce, study, lyapunov, plot, catalog, compile, lab):
+    for module in (
+        block,
+        stability,
+        chain,
+        models,
+        sweep,
+        reproduce,
+        study,
+        lyapunov,
+        plot,
+        catalog,
+        period,
+        compile,
+        lab,
+    ):
         module.register(sub)
     parser.commands = sub.choices
     return parser

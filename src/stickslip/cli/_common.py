@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from stickslip.cli._per_block import add_disorder_seed, may_vary, per_block_arg, seeded
 from stickslip.experiments.studies import MANIFEST, PAPER
 from stickslip.jsonable import to_jsonable
 from stickslip.models.params import _range_text
@@ -234,7 +235,10 @@ def add_param_options(
         else:
             default = f"{f.default:g}" if isinstance(f.default, float) else f"{f.default}"
         flag = option_name(f.name)
-        convert = _number(kind, f.name, allowed)
+        if params_cls is ChainParams and may_vary(f):
+            convert = per_block_arg(f.name, allowed)
+        else:
+            convert = _number(kind, f.name, allowed)
         group.add_argument(
             flag,
             dest=f"param_{f.name}",
@@ -513,6 +517,7 @@ def add_model_options(parser: argparse.ArgumentParser, helps: dict[str, str] | N
         metavar="nu",
         help="Carlson-Langer's plate velocity nu (sets V; default 0.01 for carlson-langer, two-blocks)",
     )
+    add_disorder_seed(group, _number(int, "disorder-seed"))
     add_param_options(parser, ChainParams, helps=helps)
 
 
@@ -531,7 +536,7 @@ def chain_params_from_args(args: argparse.Namespace, **overrides: Any):
         if getattr(args, kind, None) is not None:
             values[kind] = getattr(args, kind)
     for f in dataclasses.fields(ChainParams):
-        value = getattr(args, f"param_{f.name}", None)
+        value = seeded(getattr(args, f"param_{f.name}", None), getattr(args, "disorder_seed", 0))
         if value is not None:
             values[f.name] = value
     for name in ("l", "nu"):

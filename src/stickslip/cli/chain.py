@@ -47,6 +47,12 @@ def register(sub) -> None:
     )
     # What the run records, its integrator, --out, checkpoints, progress: RunOptions' fields.
     add_run_options(p)
+    p.add_argument(
+        "--until-periodic",
+        action="store_true",
+        help="stop once the slip sequence is periodic (the rule of `stickslip period`, its defaults); "
+        "prints the period and the slip and time from which the sequence repeats",
+    )
     add_json_option(p)
     p.set_defaults(handler=run_chain_command)
 
@@ -77,10 +83,12 @@ def register(sub) -> None:
     )
     b.add_argument(
         "--workload",
-        choices=("default", "partly-stuck"),
+        choices=("default", "partly-stuck", "disordered"),
         default="default",
         help="partly-stuck: the paper's chain loading at beta = 1.3 with part of its blocks stuck "
-        "(N, beta and t-end as given, else 199, 1.3 and 1e4 after a prepared 4e5)",
+        "(N, beta and t-end as given, else 199, 1.3 and 1e4 after a prepared 4e5); disordered: the "
+        "chain with per-block values (as given, else Fs uniform(2.5, 3.5) and beta 10%% normal) "
+        "against the same chain with their means, time per block update (N 199, t-end 2e4)",
     )
     b.add_argument(
         "--profile", action="store_true", help="instead: where the exact integrator spends its time on this workload"
@@ -198,6 +206,7 @@ _FIXED_BY_CHECKPOINT = ("from_dir", "start", "perturbation", "seed", *run_option
 def run_chain_command(args: argparse.Namespace) -> Result:
     """Handler of `stickslip chain`."""
     progress = not args.no_progress
+    periodic = _periodic_hook(args)
     if args.resume is not None:
         from stickslip.run import driver as chain
         from stickslip.run.rundir import RunDirBusy, owned_run_dir
@@ -233,6 +242,7 @@ def run_chain_command(args: argparse.Namespace) -> Result:
                     progress=progress,
                     handle_signals=True,
                     keep_checkpoint=args.keep_checkpoint,
+                    hooks=periodic,
                 )
         except RunDirBusy as exc:
             raise CommandError(str(exc)) from None
@@ -243,11 +253,16 @@ def run_chain_command(args: argparse.Namespace) -> Result:
             raise CommandError(str(exc)) from None
         except chain.Interrupted as exc:
             return _interrupted(exc, Path(args.resume))
-        return Result(
-            _json_summary(run.summary, Path(args.resume)), _summary_text(run.summary, Path(args.resume), run.params.N)
+        return _with_period(
+            Result(
+                _json_summary(run.summary, Path(args.resume)),
+                _summary_text(run.summary, Path(args.resume), run.params.N),
+            ),
+            periodic,
         )
 
-    params = chain_params_from_args(args)  # a bad parameter is refused before the engine loads
+    # a bad parameter is refused before the engine loads
+    params = _inherit_per_block(chain_params_from_args(args), args)
     from stickslip.run import driver as chain
     from stickslip.run.rundir import RunDirBusy, read_run_id
 
@@ -298,6 +313,7 @@ def run_chain_command(args: argparse.Namespace) -> Result:
                 progress=progress,
                 handle_signals=out is not None,
                 run_id=read_run_id(out) if out else None,
+                hooks=periodic,
             )
             run = chain.run_chain(
                 params,
@@ -315,7 +331,30 @@ def run_chain_command(args: argparse.Namespace) -> Result:
     text = _summary_text(run.summary, out, params.N)
     if args.t_end is None:
         text = f"N              {params.N}  (without --t-end a first look; the paper's run is --t-end 2e7)\n" + text
-    return Result(_json_summary(run.summary, out), text)
+    return _with_period(Result(_json_summary(run.summary, out), text), periodic)
+
+
+def _periodic_hook(args: argparse.Namespace) -> list:
+    """With ``--until-periodic``, the hook that ends the run once its slips repeat
+    (:class:`~stickslip.analysis.periodicity.PeriodicStop`); else none."""
+    if not getattr(args, "until_periodic", False):
+        return []
+    from stickslip.analysis.periodicity import PeriodicStop
+
+    return [PeriodicStop()]
+
+
+def _with_period(result: Result, periodic: list) -> Result:
+    """The command's result with the periodicity found by ``--until-periodic`` (its ``periodicity``
+    in JSON, and lines of text)."""
+    if not periodic:
+        return result
+    hook = periodic[0]
+    found = hook.result if hook.result is not None else hook.finish()
+    result.data["periodicity"] = found.to_dict()
+    stop = "stopped: " if hook.result is not None else "ran to the end: "
+    result.text += "\n" + stop + found.text().replace("\n", "\n  ")
+    return result
 
 
 def _own_files(out: str | None):
@@ -359,6 +398,24 @@ def _first_look(params, args, start: str):
         if t_end == t_end:
             return looked, t_end
     return params, 2e4
+
+
+def _inherit_per_block(params, args):
+    """With --from, the per-block parameters of the run named there (docs/model.md, "Per-block
+    parameters") that the command line does not give: the continued chain is the same medium."""
+    if getattr(args, "from_dir", None) is None or not (Path(args.from_dir) / "run.json").is_file():
+        return params
+    from stickslip import io
+    from stickslip.models.params import ChainParams
+
+    try:
+        before = ChainParams(**io.read_json(Path(args.from_dir) / "run.json")["params"])
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        raise CommandError(f"--from: {exc}") from None
+    keep = {k: v for k, v in before.per_block().items() if getattr(args, f"param_{k}", None) is None}
+    if keep and before.N == params.N:
+        params = params.replace(**keep)
+    return params
 
 
 def _from_state(params, args):
@@ -432,6 +489,8 @@ def run_bench_command(args: argparse.Namespace) -> Result:
         return _located(args)
     if args.workload == "partly-stuck":
         return _partly_stuck(args)
+    if args.workload == "disordered":
+        return _disordered(args)
     params = chain_params_from_args(args)
     t_end = args.t_end if args.t_end is not None else (2e4 if params.drive_piece.leaf_spring else 2e5)
     check_number("t-end", t_end, low=0.0, low_open=True)
@@ -462,6 +521,21 @@ def _partly_stuck(args: argparse.Namespace) -> Result:
     params, t_prepare, t_timed = _workload(args, bench.PARTLY_STUCK)
     result = bench.partly_stuck(params, t_prepare=t_prepare, t_timed=t_timed, repeat=args.repeat)
     return Result(result, bench.format_partly_stuck(result))
+
+
+def _disordered(args: argparse.Namespace) -> Result:
+    """`stickslip bench --workload disordered`: a disordered chain's time per block update against
+    the uniform chain's (docs/model.md, "Per-block parameters")."""
+    from stickslip.run import bench
+
+    if args.profile or args.start is not None:
+        raise CommandError("--workload disordered starts from the paper's start and has no --profile")
+    w = bench.DISORDERED
+    params = chain_params_from_args(args, **({"N": w["N"]} if args.param_N is None else {}))
+    t_end = args.t_end if args.t_end is not None else w["t_timed"]
+    check_number("t-end", t_end, low=0.0, low_open=True)
+    result = bench.disordered(params, t_end, repeat=args.repeat, seed=args.disorder_seed)
+    return Result(result, bench.format_disordered(result))
 
 
 def _workload(args: argparse.Namespace, w: dict):

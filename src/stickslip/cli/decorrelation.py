@@ -114,6 +114,10 @@ def run(params, args: argparse.Namespace) -> Result:
     located = args.switches == "located"
     if located and args.state_cache is not None:
         raise CommandError("--state-cache keeps the engine's state: it needs --switches grid")
+    if args.state_cache is not None:
+        from stickslip.run.loaded import check_cache_folder
+
+        check_cache_folder(args.state_cache, "--state-cache")
     source = LocatedSequences(params) if located else GridSequences(params)
     start, loading = _start(params, args, located)
     say = None

@@ -328,7 +328,15 @@ def _located(params, args, kw) -> Result:
     if args.finite_size:
         return _finite_size(params, args)
     check_number("levels", args.levels, low=2, high=6, integer=True)
-    ladder = flow_ladder(params, args.t_end, levels=args.levels, neutral=args.neutral, **kw)
+    import numpy as np
+
+    try:
+        ladder = flow_ladder(params, args.t_end, levels=args.levels, neutral=args.neutral, **kw)
+    except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:
+        if isinstance(exc, ParameterError):
+            raise
+        # an extreme dt or d0: the ladder's numbers are not finite, or its fit has no answer
+        raise CommandError(f"--switches located at dt = {params.dt:g}, d0 = {args.d0:g}: {exc}") from None
     data = ladder.to_dict()
     return Result(data, _ladder_text(data))
 

@@ -18,6 +18,17 @@ def register(sub) -> None:
     p.set_defaults(handler=run_models_command)
 
 
+def per_block_names() -> list[str]:
+    """The parameters that may differ from block to block: K (per bond), M and every numeric
+    parameter a piece reads (not N, V, dt)."""
+    import dataclasses
+
+    from stickslip.cli._per_block import may_vary
+    from stickslip.models.params import ChainParams
+
+    return [f.name for f in dataclasses.fields(ChainParams) if "choices" not in f.metadata and may_vary(f)]
+
+
 def run_models_command(args: argparse.Namespace) -> Result:
     """Handler of `stickslip models`."""
     from stickslip.models.pieces import PIECES, RULES
@@ -30,6 +41,7 @@ def run_models_command(args: argparse.Namespace) -> Result:
             for kind, choices in PIECES.items()
         },
         "rules": list(RULES),
+        "per_block": per_block_names(),
     }
     lines = []
     for pr in PRESETS.values():
@@ -48,4 +60,8 @@ def run_models_command(args: argparse.Namespace) -> Result:
             reads = f"  [reads {', '.join(p.reads)}]" if p.reads else ""
             lines.append(f"  {kind:9s} {p.name:13s} {p.meaning}{reads}")
     lines.append("rules: " + "; ".join(data["rules"]))
+    lines.append(
+        "per block (a number, an array, or e.g. --Fs 'uniform(2.5, 3.5)' with --disorder-seed S; "
+        "docs/model.md, per-block parameters): " + ", ".join(data["per_block"])
+    )
     return Result(data, "\n".join(lines))

@@ -45,7 +45,7 @@ def run_dense(args, drive, friction, threshold, ends):
     first_step, x0ev, prof_meta = args.first_step, args.x0ev, args.prof_meta
     n_end, profile_every = args.n_end, args.profile_every
     N = x.shape[0] - 2
-    mp, V, dt = _unpack(par, args.dp, args.tp, args.law)
+    mp, V, dt = _unpack(par, args.dp, args.tp, args.law, args.kb, args.mass)
     K, dp, tp = mp[0], mp[1], mp[2]
     h2 = 0.5 * dt
     cap_ev, cap_fm, cap_p = ev_int.shape[0], fm.shape[0], prof_x.shape[0]
@@ -64,13 +64,13 @@ def run_dense(args, drive, friction, threshold, ends):
         p1 = _pull(V, n, dt)
         _set_ghosts(x, th, N, p1, drive, ends)
         for i in range(1, N + 1):
-            f = _force(x[i - 1], x[i], x[i + 1], K, dp, p1, drive)
-            if mov[i] != 0.0 or f > _threshold(th[i], tp, threshold):
+            f = _force(x[i - 1], x[i], x[i + 1], K, dp, p1, drive, i)
+            if mov[i] != 0.0 or f > _threshold(th[i], tp, threshold, i):
                 mm[i] = 1.0
             else:
                 mm[i] = 0.0
-            a1[i] = _accel(f, th[i], v[i], mm[i], mp, friction)
-            b1[i] = _dtheta(th[i - 1], th[i], th[i + 1], v[i], mp, friction)
+            a1[i] = _accel(f, th[i], v[i], mm[i], mp, friction, i)
+            b1[i] = _dtheta(th[i - 1], th[i], th[i + 1], v[i], mp, friction, i)
             xs[i] = x[i] + dt * v[i]
             vs[i] = v[i] + dt * a1[i]
             ths[i] = th[i] + dt * b1[i]
@@ -80,9 +80,9 @@ def run_dense(args, drive, friction, threshold, ends):
         n_moving = 0
         bad = 0
         for i in range(1, N + 1):
-            f2 = _force(xs[i - 1], xs[i], xs[i + 1], K, dp, p2, drive)
-            a2 = _accel(f2, ths[i], vs[i], mm[i], mp, friction)
-            b2 = _dtheta(ths[i - 1], ths[i], ths[i + 1], vs[i], mp, friction)
+            f2 = _force(xs[i - 1], xs[i], xs[i + 1], K, dp, p2, drive, i)
+            a2 = _accel(f2, ths[i], vs[i], mm[i], mp, friction, i)
+            b2 = _dtheta(ths[i - 1], ths[i], ths[i + 1], vs[i], mp, friction, i)
             th[i] = th[i] + h2 * (b1[i] + b2)
             if mm[i] != 0.0:
                 x[i] = x[i] + h2 * (v[i] + vs[i])

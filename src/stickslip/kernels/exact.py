@@ -125,7 +125,9 @@ def _slide_steps(args, ra0, rb0, hi, mp, V, dt, drive, friction, threshold, ends
             return ra0, rb0, _NEVER
         p1 = _pull(V, n, dt)
         _set_ghosts(x, th, N, p1, drive, ends)
-        if not every and _force(x[fh - 1], x[fh], x[fh + 1], K, dp, p1, drive) > _threshold(th[fh], tp, threshold):
+        if not every and _force(x[fh - 1], x[fh], x[fh + 1], K, dp, p1, drive, fh) > _threshold(
+            th[fh], tp, threshold, fh
+        ):
             return ra0, rb0, _NEVER  # block rb0+1 starts: run_exact's general step
         _stage1_run(x, v, th, xs, vs, ths, a1, b1, ra0, rp, p1, mp, dt, drive, friction)
         if not every:
@@ -187,7 +189,7 @@ def run_exact(args, drive, friction, threshold, ends):
     prof_x, n_end, profile_every = args.prof_x, args.n_end, args.profile_every
     first_step, x0ev, prof_meta = args.first_step, args.x0ev, args.prof_meta
     N = x.shape[0] - 2
-    mp, V, dt = _unpack(par, args.dp, args.tp, args.law)
+    mp, V, dt = _unpack(par, args.dp, args.tp, args.law, args.kb, args.mass)
     K, dp, tp = mp[0], mp[1], mp[2]
     h2 = 0.5 * dt
     cap_ev, cap_fm, cap_p = ev_int.shape[0], fm.shape[0], prof_x.shape[0]
@@ -233,8 +235,8 @@ def run_exact(args, drive, friction, threshold, ends):
             mh = ist[MECH_HI]
             if not has(drive, "leaf_spring"):
                 x2 = _right_of_first(x, N, ends)
-                if mov[1] != 0.0 or _force(_pull(V, n, dt), x[1], x2, K, dp, 0.0, drive) > _threshold(
-                    th[1], tp, threshold
+                if mov[1] != 0.0 or _force(_pull(V, n, dt), x[1], x2, K, dp, 0.0, drive, 1) > _threshold(
+                    th[1], tp, threshold, 1
                 ):
                     lo = 1
                     if hi < 1:
@@ -267,7 +269,7 @@ def run_exact(args, drive, friction, threshold, ends):
                     target = ist[NEXT_PROFILE]
                 if not has(drive, "leaf_spring"):
                     ist[STEP] = pull_trigger(
-                        x, N, V, dt, K, _threshold(th[1], tp, threshold), n + 1, target, dp, drive, ends
+                        x, N, V, dt, K, _threshold(th[1], tp, threshold, 1), n + 1, target, dp, drive, ends
                     )
                 else:
                     ist[STEP] = t_next if t_next < target else target
@@ -322,8 +324,8 @@ def run_exact(args, drive, friction, threshold, ends):
                     if (
                         fh == rb0 + 1
                         and mov[fh] == 0.0
-                        and not _force(x[fh - 1], x[fh], x[fh + 1], K, dp, p1, drive)
-                        > _threshold(th[fh], tp, threshold)
+                        and not _force(x[fh - 1], x[fh], x[fh + 1], K, dp, p1, drive, fh)
+                        > _threshold(th[fh], tp, threshold, fh)
                     ):
                         # The one block past the run stays stopped (the start rule of _stage1): it
                         # gets the stopped blocks' stage 1 below, equal to _stage1's but for a1 and

@@ -42,6 +42,8 @@ import numpy as np
 from numba import njit, types
 from numba.extending import intrinsic, overload
 
+from stickslip.kernels import lanes
+
 
 def _module(piece):
     """The module of a piece, from the literal a kernel is compiled for (None otherwise)."""
@@ -139,33 +141,127 @@ def has(typingctx, piece, name):
     return types.boolean(piece, name), codegen
 
 
+def at(params, i):
+    """A piece's parameters (its module's ``Params``) at block ``i``: each field that is an array
+    over the blocks (per-block parameters, docs/model.md "Per-block parameters") read at ``i``,
+    each float as it is; ``params`` itself when every field is a float (a uniform chain's code
+    is then the code without this function). ``i`` is a block index, or ``(i, n)``: blocks
+    i..i+n-1 as 8 lanes (:mod:`stickslip.kernels.lanes`)."""
+    return params
+
+
+def _is_array(ty) -> bool:
+    return isinstance(ty, types.Array)
+
+
+@overload(at)
+def _at(params, i):
+    if not isinstance(params, types.BaseNamedTuple):
+        return None
+    if not any(_is_array(t) for t in params.types):
+        return lambda params, i: params
+    group = isinstance(i, types.BaseTuple)
+    fields = []
+    for name, ty in zip(params.fields, params.types, strict=True):
+        if not _is_array(ty):
+            fields.append(f"params.{name}")
+        elif group:
+            fields.append(f"_load(params.{name}.ctypes.data, i[0], i[1])")
+        else:
+            fields.append(f"params.{name}[i]")
+    # The piece's own named tuple, built with the gathered fields (numba builds a named tuple
+    # from its class).
+    source = f"def impl(params, i):\n    return _cls({', '.join(fields)})\n"
+    scope = {"_cls": params.instance_class, "_load": lanes.load}
+    exec(source, scope)
+    return scope["impl"]
+
+
+def _springs(xl, xc, xr, K, dp, p, drive, i):
+    """The drive's force on block i with the springs K: one K for every spring, or K per bond."""
+
+
+@overload(_springs, prefer_literal=True)
+def _springs_impl(xl, xc, xr, K, dp, p, drive, i):
+    if isinstance(K, types.Float):
+
+        def uniform(xl, xc, xr, K, dp, p, drive, i):
+            return call(drive, "force", xl, xc, xr, K, p, dp)
+
+        return uniform
+    if not _is_array(K):
+        return None
+    if isinstance(i, types.BaseTuple):
+
+        def bonds8(xl, xc, xr, K, dp, p, drive, i):
+            kl = lanes.load(K.ctypes.data, i[0], i[1])
+            kr = lanes.load(K.ctypes.data, i[0] + np.uint64(1), i[1])
+            return (kl * (xl - xc) - kr * (xc - xr)) + call(drive, "force", xl, xc, xr, 0.0, p, dp)
+
+        return bonds8
+
+    if isinstance(i, types.Integer) and not i.signed:
+
+        def bonds_u(xl, xc, xr, K, dp, p, drive, i):
+            return (K[i] * (xl - xc) - K[i + np.uint64(1)] * (xc - xr)) + call(drive, "force", xl, xc, xr, 0.0, p, dp)
+
+        return bonds_u
+
+    def bonds(xl, xc, xr, K, dp, p, drive, i):
+        return (K[i] * (xl - xc) - K[i + 1] * (xc - xr)) + call(drive, "force", xl, xc, xr, 0.0, p, dp)
+
+    return bonds
+
+
+def per_mass(a, M, i):
+    """(force - friction) / M_i: ``a`` itself for unit mass (``M`` None), else divided by the
+    mass M (a float) or M_i (an array over the blocks)."""
+    return a
+
+
+@overload(per_mass)
+def _per_mass(a, M, i):
+    if isinstance(M, types.NoneType):
+        return lambda a, M, i: a
+    if isinstance(M, types.Float):
+        return lambda a, M, i: a / M
+    if not _is_array(M):
+        return None
+    if isinstance(i, types.BaseTuple):
+        return lambda a, M, i: a / lanes.load(M.ctypes.data, i[0], i[1])
+    return lambda a, M, i: a / M[i]
+
+
 @njit(cache=True, inline="always")
-def _force(xl, xc, xr, K, dp, p, drive):
-    """Spring force on a block: the drive's ``force``, K (x_{i+1} - 2 x_i + x_{i-1}) (eq. 4), plus
+def _force(xl, xc, xr, K, dp, p, drive, i):
+    """Spring force on block i: the drive's ``force``, K (x_{i+1} - 2 x_i + x_{i-1}) (eq. 4), plus
     Kp (V t - x_i) from the plate at p = V t with the plate drive (Burridge-Knopoff,
-    Carlson-Langer); ``dp`` the drive's parameters."""
-    return call(drive, "force", xl, xc, xr, K, p, dp)
+    Carlson-Langer); ``dp`` the drive's parameters. With springs per bond (K an array, K[i] the
+    spring between blocks i-1 and i): K_i (x_{i-1} - x_i) - K_{i+1} (x_i - x_{i+1}) plus the
+    drive's force with K = 0 (docs/model.md, "Per-block parameters")."""
+    return _springs(xl, xc, xr, K, at(dp, i), p, drive, i)
 
 
 @njit(cache=True, inline="always")
-def _accel(f, th, v, m, mp, friction):
-    """dv/dt of a block times the moving mask m (1.0 moving, 0.0 stopped): m (f - friction) with
-    the law's own ``accel``; ``mp`` = (K, the drive's, the threshold's and the law's parameters)."""
-    return m * law_accel(friction, f, v, th, mp[3])
+def _accel(f, th, v, m, mp, friction, i):
+    """dv/dt of block i times the moving mask m (1.0 moving, 0.0 stopped): m (f - friction) with
+    the law's own ``accel``, divided by the block's mass where the chain has one; ``mp`` = (K, the
+    drive's, the threshold's and the law's parameters, the masses)."""
+    return m * per_mass(law_accel(friction, f, v, th, at(mp[3], i)), mp[4], i)
 
 
 @njit(cache=True, inline="always")
-def _dtheta(thl, th, thr, v, mp, friction):
-    """dtheta/dt of the law (its ``rate``), for moving and stopped blocks alike; 0 for laws
-    without a state variable."""
-    return law_rate(friction, thl, th, thr, v, mp[3])
+def _dtheta(thl, th, thr, v, mp, friction, i):
+    """dtheta/dt of the law (its ``rate``) at block i, for moving and stopped blocks alike; 0 for
+    laws without a state variable."""
+    return law_rate(friction, thl, th, thr, v, at(mp[3], i))
 
 
 @njit(cache=True, inline="always")
-def _threshold(th, tp, threshold):
-    """Static threshold of the start rule: the threshold piece's ``value`` (Fs, or theta_i), its
-    parameters ``tp``."""
-    return call(threshold, "value", th, tp)
+def _threshold(th, tp, threshold, i):
+    """Static threshold of the start rule at block i: the threshold piece's ``value`` (Fs, or
+    theta_i), its parameters ``tp``."""
+    return call(threshold, "value", th, at(tp, i))
 
 
 @njit(cache=True, inline="always")

@@ -42,7 +42,8 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
+from numba import njit, types
+from numba.extending import overload
 
 # Indices into the int64 state vector ``ist``.
 STEP = 0  # n: the state held is at t_n = n dt
@@ -112,6 +113,8 @@ class ChainArgs(NamedTuple):
     dp: tuple  # the drive's parameters (its module's Params named tuple)
     tp: tuple  # the threshold's parameters (its module's Params named tuple)
     law: tuple  # the friction law's parameters (its module's Params named tuple)
+    kb: object  # None (every spring K, par[P_K]), or float64 (N + 2): kb[i] the spring between blocks i-1 and i
+    mass: object  # None (unit masses), or float64 (N + 2): the mass of block i at i
     ev_int: np.ndarray  # event buffer (columns above) and each event's S
     ev_S: np.ndarray
     fm: np.ndarray  # first moves: (event, block, step)
@@ -141,8 +144,21 @@ def _merge(a_lo, a_hi, b_lo, b_hi):
     return min(a_lo, b_lo), max(a_hi, b_hi)
 
 
+def _springs_of(par, kb):
+    """K from the parameter vector, or the springs per bond ``kb``."""
+    return kb
+
+
+@overload(_springs_of)
+def _springs_of_impl(par, kb):
+    if isinstance(kb, types.NoneType):
+        return lambda par, kb: par[P_K]
+    return lambda par, kb: kb
+
+
 @njit(cache=True, inline="always")
-def _unpack(par, dp, tp, law):
-    """mp = (K, the drive's, the threshold's and the law's parameters), V and dt from the
-    parameter vector and the pieces' named tuples."""
-    return (par[P_K], dp, tp, law), par[P_V], par[P_DT]
+def _unpack(par, dp, tp, law, kb, mass):
+    """mp = (K, the drive's, the threshold's and the law's parameters, the masses), V and dt from
+    the parameter vector and the pieces' named tuples; K is the float par[P_K], or the springs
+    per bond ``kb`` where the chain has them; the masses are None for unit masses."""
+    return (_springs_of(par, kb), dp, tp, law, mass), par[P_V], par[P_DT]

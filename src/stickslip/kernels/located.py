@@ -47,7 +47,7 @@ import numpy as np
 from numba import njit
 
 from stickslip.kernels.laws import _force as _spring_force
-from stickslip.kernels.laws import _threshold, call, has, law_accel, law_rate
+from stickslip.kernels.laws import _threshold, at, call, has, law_accel, law_rate
 from stickslip.kernels.layout import P_DT, P_K, P_V
 
 # Integer state vector.
@@ -73,13 +73,13 @@ def _ghosts(u, th, N, t, V, drive, ends):
 def _force(u, i, par, dp, drive):
     """Spring force on block i (eq. 4), plus Kp (0 - u_i) from the plate (at u = 0 in this frame)
     with the plate drive: the engine's expression."""
-    return _spring_force(u[i - 1], u[i], u[i + 1], par[P_K], dp, 0.0, drive)
+    return _spring_force(u[i - 1], u[i], u[i + 1], par[P_K], dp, 0.0, drive, i)
 
 
 @njit(cache=True, inline="always")
 def _gap(u, th, i, par, tp, dp, drive, threshold):
     """g_i = f_i - threshold_i: a stuck block starts where it turns positive."""
-    return _force(u, i, par, dp, drive) - _threshold(th[i], tp, threshold)
+    return _force(u, i, par, dp, drive) - _threshold(th[i], tp, threshold, i)
 
 
 @njit(cache=True, inline="always")
@@ -91,10 +91,10 @@ def _rates(u, v, th, mov, N, t, par, lp, dp, drive, friction, ends, du, dv, dth)
     for i in range(1, N + 1):
         du[i] = v[i] - V
         if mov[i] != 0.0:
-            dv[i] = law_accel(friction, _force(u, i, par, dp, drive), v[i], th[i], lp)
+            dv[i] = law_accel(friction, _force(u, i, par, dp, drive), v[i], th[i], at(lp, i))
         else:
             dv[i] = 0.0
-        dth[i] = law_rate(friction, th[i - 1], th[i], th[i + 1], v[i], lp)
+        dth[i] = law_rate(friction, th[i - 1], th[i], th[i + 1], v[i], at(lp, i))
 
 
 @njit(cache=True, inline="always")
@@ -199,10 +199,10 @@ def _heun_near(i, h, t, u, v, th, mov, N, par, lp, dp, drive, friction, ends, sc
         _predict_u(N, h, u, v, th, V, sc)
     _ghosts(pu, pth, N, t + h, V, drive, ends)
     if mov[i] != 0.0:
-        k2v[i] = law_accel(friction, _force(pu, i, par, dp, drive), pv[i], pth[i], lp)
+        k2v[i] = law_accel(friction, _force(pu, i, par, dp, drive), pv[i], pth[i], at(lp, i))
     else:
         k2v[i] = 0.0
-    k2th[i] = law_rate(friction, pth[i - 1], pth[i], pth[i + 1], pv[i], lp)
+    k2th[i] = law_rate(friction, pth[i - 1], pth[i], pth[i + 1], pv[i], at(lp, i))
     ov[i] = v[i] + 0.5 * h * (k1v[i] + k2v[i])
     oth[i] = th[i] + 0.5 * h * (k1th[i] + k2th[i])
     _ghosts(ou, oth, N, t + h, V, drive, ends)

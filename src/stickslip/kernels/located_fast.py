@@ -30,7 +30,7 @@ import numpy as np
 from numba import njit
 
 from stickslip.kernels.laws import _force as _spring_force
-from stickslip.kernels.laws import _threshold, has, law_accel, law_rate
+from stickslip.kernels.laws import _threshold, at, has, law_accel, law_rate
 from stickslip.kernels.layout import (
     P_DT,
     P_K,
@@ -102,9 +102,11 @@ def _stage1_near(a, b, u, v, th, mov, sc, h, V, K, dp, lp, drive, friction):
     one = np.uint64(1)
     for i in range(np.uint64(a), np.uint64(b) + one):
         k1u[i] = v[i] - V
-        acc = law_accel(friction, _spring_force(u[i - one], u[i], u[i + one], K, dp, 0.0, drive), v[i], th[i], lp)
+        acc = law_accel(
+            friction, _spring_force(u[i - one], u[i], u[i + one], K, dp, 0.0, drive, i), v[i], th[i], at(lp, i)
+        )
         k1v[i] = acc if mov[i] != 0.0 else 0.0
-        k1th[i] = law_rate(friction, th[i - one], th[i], th[i + one], v[i], lp)
+        k1th[i] = law_rate(friction, th[i - one], th[i], th[i + one], v[i], at(lp, i))
         pu[i] = u[i] + h * k1u[i]
         pv[i] = v[i] + h * k1v[i]
         pth[i] = th[i] + h * k1th[i]
@@ -117,9 +119,11 @@ def _stage2_near(a, b, u, v, th, mov, sc, h, V, K, dp, lp, drive, friction):
     one = np.uint64(1)
     for i in range(np.uint64(a), np.uint64(b) + one):
         k2u[i] = pv[i] - V
-        acc = law_accel(friction, _spring_force(pu[i - one], pu[i], pu[i + one], K, dp, 0.0, drive), pv[i], pth[i], lp)
+        acc = law_accel(
+            friction, _spring_force(pu[i - one], pu[i], pu[i + one], K, dp, 0.0, drive, i), pv[i], pth[i], at(lp, i)
+        )
         k2v[i] = acc if mov[i] != 0.0 else 0.0
-        k2th[i] = law_rate(friction, pth[i - one], pth[i], pth[i + one], pv[i], lp)
+        k2th[i] = law_rate(friction, pth[i - one], pth[i], pth[i + one], pv[i], at(lp, i))
         ou[i] = u[i] + 0.5 * h * (k1u[i] + k2u[i])
         ov[i] = v[i] + 0.5 * h * (k1v[i] + k2v[i])
         oth[i] = th[i] + 0.5 * h * (k1th[i] + k2th[i])
@@ -133,7 +137,7 @@ def _fires(a, b, x, th, v0, v1, mov, K, dp, tp, drive, threshold, end):
     one = np.uint64(1)
     f = False
     for i in range(np.uint64(a), np.uint64(b) + one):
-        g = _spring_force(x[i - one], x[i], x[i + one], K, dp, 0.0, drive) - _threshold(th[i], tp, threshold)
+        g = _spring_force(x[i - one], x[i], x[i + one], K, dp, 0.0, drive, i) - _threshold(th[i], tp, threshold, i)
         stops = (v0[i] > 0.0) & (v1[i] <= 0.0) if end else v0[i] < 0.0
         f |= (g > 0.0) if mov[i] == 0.0 else stops
     return f

@@ -27,7 +27,7 @@ import numpy as np
 from numba import njit
 
 from stickslip.kernels.laws import _force as _spring_force
-from stickslip.kernels.laws import _threshold, call, has
+from stickslip.kernels.laws import _threshold, at, call, has
 from stickslip.kernels.layout import P_K
 
 _BIG = np.int64(1) << np.int64(62)
@@ -166,7 +166,7 @@ def _horizon(j, m, ahead, u, us, sd, se, th, N, c, par, tp, dp, drive, threshold
     there, else the last step up to which it provably does not (module docstring, 2), its
     neighbours staying stuck and the steps full. The u are brought to m - ahead and taken
     ``ahead`` (0 or 1) steps further without storing."""
-    K, Kp = par[P_K], call(drive, "leaf", dp)
+    K, Kp = par[P_K], call(drive, "leaf", at(dp, j))
     jl = _left(j, N, drive, ends)
     jr = _right(j, N, ends)
     m0 = m - ahead
@@ -192,8 +192,8 @@ def _horizon(j, m, ahead, u, us, sd, se, th, N, c, par, tp, dp, drive, threshold
             uc, ur = uc + c, ur + c
             if jl >= 0:
                 ul = ul + c
-    F = _spring_force(ul, uc, ur, K, dp, 0.0, drive)
-    thr = _threshold(th[j], tp, threshold)
+    F = _spring_force(ul, uc, ur, K, dp, 0.0, drive, j)
+    thr = _threshold(th[j], tp, threshold, j)
     if F - thr > 0.0:
         return True, m
     if L == 0:

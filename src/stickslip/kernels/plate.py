@@ -139,7 +139,7 @@ def run_sparse(args, drive, friction, threshold, ends):
     ev_int, fm, prof_x, n_end, profile_every = args.ev_int, args.fm, args.prof_x, args.n_end, args.profile_every
     prof_meta = args.prof_meta
     N = x.shape[0] - 2
-    mp, V, dt = _unpack(par, args.dp, args.tp, args.law)
+    mp, V, dt = _unpack(par, args.dp, args.tp, args.law, args.kb, args.mass)
     K, dp, tp = mp[0], mp[1], mp[2]
     h2 = 0.5 * dt
     cap_ev, cap_fm, cap_p = ev_int.shape[0], fm.shape[0], prof_x.shape[0]
@@ -177,7 +177,7 @@ def run_sparse(args, drive, friction, threshold, ends):
     for i in range(1, N + 1):
         if mov[i] == 0.0:
             m = _plate_trigger(
-                x[i - 1], x[i], x[i + 1], _threshold(th[i], tp, threshold), K, dp, V, dt, n0, n_end, drive
+                x[i - 1], x[i], x[i + 1], _threshold(th[i], tp, threshold, i), K, dp, V, dt, n0, n_end, drive, i
             )
             nq, t_next = _settle(i, m, n0, trig, queue, nq, t_next)
     if n0 < n_end:
@@ -228,13 +228,13 @@ def run_sparse(args, drive, friction, threshold, ends):
         fired = False
         for k in range(nq):
             i = queue[k]
-            f = _force(x[i - one], x[i], x[i + one], K, dp, p1, drive)
-            fired |= f > _threshold(th[i], tp, threshold)
+            f = _force(x[i - one], x[i], x[i + one], K, dp, p1, drive, i)
+            fired |= f > _threshold(th[i], tp, threshold, i)
         if fired:
             for k in range(nq):
                 i = queue[k]
-                f = _force(x[i - one], x[i], x[i + one], K, dp, p1, drive)
-                fire = f > _threshold(th[i], tp, threshold)
+                f = _force(x[i - one], x[i], x[i + one], K, dp, p1, drive, i)
+                fire = f > _threshold(th[i], tp, threshold, i)
                 movers[nmov + nst] = i
                 still[nsl] = i
                 nst += 1 if fire else 0
@@ -254,8 +254,8 @@ def run_sparse(args, drive, friction, threshold, ends):
                     if 0 <= t and t <= n:
                         i = np.uint64(j)
                         trig[i] = _NEVER
-                        f = _force(x[i - one], x[i], x[i + one], K, dp, p1, drive)
-                        if f > _threshold(th[i], tp, threshold):
+                        f = _force(x[i - one], x[i], x[i + one], K, dp, p1, drive, i)
+                        if f > _threshold(th[i], tp, threshold, i):
                             movers[nmov + nst] = i
                             nst += 1
                         else:
@@ -280,20 +280,20 @@ def run_sparse(args, drive, friction, threshold, ends):
         if packed:
             for k in range(na):
                 i = movers[k]
-                fb[k] = _force(x[i - one], x[i], x[i + one], K, dp, p1, drive)
+                fb[k] = _force(x[i - one], x[i], x[i + one], K, dp, p1, drive, i)
                 vi = v[i]
                 vb[k] = vi
                 xs[i] = x[i] + dt * vi
             for k in range(na):
-                a = _accel(fb[k], 0.0, vb[k], 1.0, mp, friction)
+                a = _accel(fb[k], 0.0, vb[k], 1.0, mp, friction, movers[k])
                 acc[k] = a
                 vsb[k] = vb[k] + dt * a
         else:
             for k in range(na):
                 i = movers[k]
-                f = _force(x[i - one], x[i], x[i + one], K, dp, p1, drive)
+                f = _force(x[i - one], x[i], x[i + one], K, dp, p1, drive, i)
                 vi = v[i]
-                a = _accel(f, 0.0, vi, 1.0, mp, friction)
+                a = _accel(f, 0.0, vi, 1.0, mp, friction, i)
                 vb[k] = vi
                 acc[k] = a
                 vsb[k] = vi + dt * a
@@ -324,9 +324,9 @@ def run_sparse(args, drive, friction, threshold, ends):
         if packed:
             for k in range(na):
                 i = movers[k]
-                fb[k] = _force(xs[i - one], xs[i], xs[i + one], K, dp, p2, drive)
+                fb[k] = _force(xs[i - one], xs[i], xs[i + one], K, dp, p2, drive, i)
             for k in range(na):
-                a2 = _accel(fb[k], 0.0, vsb[k], 1.0, mp, friction)
+                a2 = _accel(fb[k], 0.0, vsb[k], 1.0, mp, friction, movers[k])
                 vn = vb[k] + h2 * (acc[k] + a2)
                 keep = vn > 0.0
                 vb[k] = vn if keep else 0.0
@@ -341,10 +341,10 @@ def run_sparse(args, drive, friction, threshold, ends):
         else:
             for k in range(na):
                 i = movers[k]
-                f2 = _force(xs[i - one], xs[i], xs[i + one], K, dp, p2, drive)
+                f2 = _force(xs[i - one], xs[i], xs[i + one], K, dp, p2, drive, i)
                 sv = vsb[k]
                 vo = vb[k]
-                vn = vo + h2 * (acc[k] + _accel(f2, 0.0, sv, 1.0, mp, friction))
+                vn = vo + h2 * (acc[k] + _accel(f2, 0.0, sv, 1.0, mp, friction, i))
                 keep = vn > 0.0
                 x[i] = x[i] + h2 * (vo + sv)
                 v[i] = vn if keep else 0.0
@@ -420,7 +420,7 @@ def run_sparse(args, drive, friction, threshold, ends):
                         x[i - one],
                         x[i],
                         x[i + one],
-                        _threshold(th[i], tp, threshold),
+                        _threshold(th[i], tp, threshold, i),
                         K,
                         dp,
                         V,
@@ -428,6 +428,7 @@ def run_sparse(args, drive, friction, threshold, ends):
                         n + 1,
                         n_end,
                         drive,
+                        i,
                     )
                     nq, t_next = _settle(i, m, n + 1, trig, queue, nq, t_next)
             if ns > 0:

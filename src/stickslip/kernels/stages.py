@@ -52,15 +52,15 @@ def _stage1(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, p, mp, dt, drive, fr
     starts = False
     for k in range(n):
         i = u0 + np.uint64(k)
-        f = _force(x[i - one], x[i], x[i + one], K, dp, p, drive)
+        f = _force(x[i - one], x[i], x[i + one], K, dp, p, drive, i)
         mo = mov[i]
-        m = 1.0 if f > _threshold(th[i], tp, threshold) else mo
+        m = 1.0 if f > _threshold(th[i], tp, threshold, i) else mo
         mm[i] = m
         first = min(first, k if m != 0.0 else n)
         last = max(last, k if m != 0.0 else -1)
         starts |= m != mo
-        a = _accel(f, th[i], v[i], m, mp, friction)
-        b = _dtheta(th[i - one], th[i], th[i + one], v[i], mp, friction)
+        a = _accel(f, th[i], v[i], m, mp, friction, i)
+        b = _dtheta(th[i - one], th[i], th[i + one], v[i], mp, friction, i)
         a1[i] = a
         b1[i] = b
         xs[i] = x[i] + dt * v[i]
@@ -78,7 +78,7 @@ def _stage1_theta_loop(x, v, th, xs, vs, ths, mm, b1, lo, hi, mp, dt, friction):
     """
     one = np.uint64(1)
     for i in range(np.uint64(lo), np.uint64(hi) + one):
-        b = _dtheta(th[i - one], th[i], th[i + one], v[i], mp, friction)
+        b = _dtheta(th[i - one], th[i], th[i + one], v[i], mp, friction, i)
         b1[i] = b
         xs[i] = x[i] + dt * v[i]
         vs[i] = v[i]
@@ -97,7 +97,7 @@ def _stage1_theta_only_loop(v, th, ths, b1, lo, hi, mp, dt, friction):
     """
     one = np.uint64(1)
     for i in range(np.uint64(lo), np.uint64(hi) + one):
-        b = _dtheta(th[i - one], th[i], th[i + one], v[i], mp, friction)
+        b = _dtheta(th[i - one], th[i], th[i + one], v[i], mp, friction, i)
         b1[i] = b
         ths[i] = th[i] + dt * b
 
@@ -117,7 +117,7 @@ def _stage2_theta_loop(th, ths, v, b1, lo, hi, mp, h2, friction):
     c_hi = -1
     for k in range(n):
         i = u0 + np.uint64(k)
-        b2 = _dtheta(ths[i - one], ths[i], ths[i + one], v[i], mp, friction)
+        b2 = _dtheta(ths[i - one], ths[i], ths[i + one], v[i], mp, friction, i)
         tho = th[i]
         thn = tho + h2 * (b1[i] + b2)
         th[i] = thn
@@ -145,9 +145,9 @@ def _stage2(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, p, mp, h2, drive, fr
     for k in range(n):
         i = u0 + np.uint64(k)
         m = mm[i]
-        f2 = _force(xs[i - one], xs[i], xs[i + one], K, dp, p, drive)
-        a2 = _accel(f2, ths[i], vs[i], m, mp, friction)
-        b2 = _dtheta(ths[i - one], ths[i], ths[i + one], vs[i], mp, friction)
+        f2 = _force(xs[i - one], xs[i], xs[i + one], K, dp, p, drive, i)
+        a2 = _accel(f2, ths[i], vs[i], m, mp, friction, i)
+        b2 = _dtheta(ths[i - one], ths[i], ths[i + one], vs[i], mp, friction, i)
         xo = x[i]
         vo = v[i]
         tho = th[i]
@@ -187,9 +187,9 @@ def _stage1_run_loop(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, dt, drive, fr
         xi = x[i]
         vi = v[i]
         ti = th[i]
-        f = _force(x[i - one], xi, x[i + one], K, dp, p, drive)
-        a = _accel(f, ti, vi, 1.0, mp, friction)
-        b = _dtheta(th[i - one], ti, th[i + one], vi, mp, friction)
+        f = _force(x[i - one], xi, x[i + one], K, dp, p, drive, i)
+        a = _accel(f, ti, vi, 1.0, mp, friction, i)
+        b = _dtheta(th[i - one], ti, th[i + one], vi, mp, friction, i)
         xs[i] = xi + dt * vi
         vs[i] = vi + dt * a
         ths[i] = ti + dt * b
@@ -214,9 +214,9 @@ def _stage2_run_loop(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, h2, drive, fr
         vi = v[i]
         vsi = vs[i]
         tsi = ths[i]
-        f2 = _force(xs[i - one], xs[i], xs[i + one], K, dp, p, drive)
-        a2 = _accel(f2, tsi, vsi, 1.0, mp, friction)
-        b2 = _dtheta(ths[i - one], tsi, ths[i + one], vsi, mp, friction)
+        f2 = _force(xs[i - one], xs[i], xs[i + one], K, dp, p, drive, i)
+        a2 = _accel(f2, tsi, vsi, 1.0, mp, friction, i)
+        b2 = _dtheta(ths[i - one], tsi, ths[i + one], vsi, mp, friction, i)
         xn = x[i] + h2 * (vi + vsi)
         vn = vi + h2 * (a1[i] + a2)
         thn = th[i] + h2 * (b1[i] + b2)
@@ -237,9 +237,10 @@ def _stage1_group(x, v, th, xs, vs, ths, a1, b1, i, n, p, mp, dt, drive, frictio
     xi = lanes.load(x, i, n)
     vi = lanes.load(v, i, n)
     ti = lanes.load(th, i, n)
-    f = _force(lanes.load(x, i - one, n), xi, lanes.load(x, i + one, n), K, dp, p, drive)
-    a = _accel(f, ti, vi, 1.0, mp, friction)
-    b = _dtheta(lanes.load(th, i - one, n), ti, lanes.load(th, i + one, n), vi, mp, friction)
+    g = (i, n)
+    f = _force(lanes.load(x, i - one, n), xi, lanes.load(x, i + one, n), K, dp, p, drive, g)
+    a = _accel(f, ti, vi, 1.0, mp, friction, g)
+    b = _dtheta(lanes.load(th, i - one, n), ti, lanes.load(th, i + one, n), vi, mp, friction, g)
     lanes.store(xs, i, n, xi + dt * vi)
     lanes.store(vs, i, n, vi + dt * a)
     lanes.store(ths, i, n, ti + dt * b)
@@ -256,9 +257,10 @@ def _stage2_group(x, v, th, xs, vs, ths, a1, b1, i, n, p, mp, h2, drive, frictio
     vi = lanes.load(v, i, n)
     vsi = lanes.load(vs, i, n)
     tsi = lanes.load(ths, i, n)
-    f2 = _force(lanes.load(xs, i - one, n), lanes.load(xs, i, n), lanes.load(xs, i + one, n), K, dp, p, drive)
-    a2 = _accel(f2, tsi, vsi, 1.0, mp, friction)
-    b2 = _dtheta(lanes.load(ths, i - one, n), tsi, lanes.load(ths, i + one, n), vsi, mp, friction)
+    g = (i, n)
+    f2 = _force(lanes.load(xs, i - one, n), lanes.load(xs, i, n), lanes.load(xs, i + one, n), K, dp, p, drive, g)
+    a2 = _accel(f2, tsi, vsi, 1.0, mp, friction, g)
+    b2 = _dtheta(lanes.load(ths, i - one, n), tsi, lanes.load(ths, i + one, n), vsi, mp, friction, g)
     vn = vi + h2 * (lanes.load(a1, i, n) + a2)
     lanes.store(x, i, n, lanes.load(x, i, n) + h2 * (vi + vsi))
     lanes.store(v, i, n, vn)
@@ -305,7 +307,7 @@ def _theta1_group(x, v, th, xs, vs, ths, mm, b1, i, n, mp, dt, friction, full):
     one = np.uint64(1)
     vi = lanes.load(v, i, n)
     ti = lanes.load(th, i, n)
-    b = _dtheta(lanes.load(th, i - one, n), ti, lanes.load(th, i + one, n), vi, mp, friction)
+    b = _dtheta(lanes.load(th, i - one, n), ti, lanes.load(th, i + one, n), vi, mp, friction, (i, n))
     lanes.store(b1, i, n, b)
     lanes.store(ths, i, n, ti + dt * b)
     if full:
@@ -349,7 +351,7 @@ def _theta2_group(th, ths, v, b1, i, n, mp, h2, friction):
     whose state variable changed (:func:`stickslip.kernels.lanes.changed`)."""
     one = np.uint64(1)
     tsl, tsi, tsr = lanes.load(ths, i - one, n), lanes.load(ths, i, n), lanes.load(ths, i + one, n)
-    b2 = _dtheta(tsl, tsi, tsr, lanes.load(v, i, n), mp, friction)
+    b2 = _dtheta(tsl, tsi, tsr, lanes.load(v, i, n), mp, friction, (i, n))
     tho = lanes.load(th, i, n)
     thn = tho + h2 * (lanes.load(b1, i, n) + b2)
     lanes.store(th, i, n, thn)

@@ -21,7 +21,7 @@ import numpy as np
 from numba import njit
 from numba.extending import overload
 
-from stickslip.kernels.laws import _force, _pull, _right_of_first, _threshold, call, piece_attr
+from stickslip.kernels.laws import _force, _pull, _right_of_first, _threshold, at, call, piece_attr
 from stickslip.kernels.layout import _NEVER
 
 
@@ -34,13 +34,13 @@ def _first_trigger(x, N, V, dt, K, thr, n_lo, n_hi, dp, drive, ends):
     """
     x1 = x[1]
     x2 = _right_of_first(x, N, ends)
-    if n_lo >= n_hi or not (_force(_pull(V, n_hi - 1, dt), x1, x2, K, dp, 0.0, drive) > thr):
+    if n_lo >= n_hi or not (_force(_pull(V, n_hi - 1, dt), x1, x2, K, dp, 0.0, drive, 1) > thr):
         return n_hi
     lo = n_lo
     hi = n_hi - 1  # invariant: fires at hi
     while lo < hi:
         mid = lo + (hi - lo) // 2
-        if _force(_pull(V, mid, dt), x1, x2, K, dp, 0.0, drive) > thr:
+        if _force(_pull(V, mid, dt), x1, x2, K, dp, 0.0, drive, 1) > thr:
             hi = mid
         else:
             lo = mid + 1
@@ -48,12 +48,12 @@ def _first_trigger(x, N, V, dt, K, thr, n_lo, n_hi, dp, drive, ends):
 
 
 @njit(cache=True, inline="always")
-def _plate_fires(xl, xc, xr, thr, K, dp, V, dt, m, drive):
-    return _force(xl, xc, xr, K, dp, _pull(V, m, dt), drive) > thr
+def _plate_fires(xl, xc, xr, thr, K, dp, V, dt, m, drive, i):
+    return _force(xl, xc, xr, K, dp, _pull(V, m, dt), drive, i) > thr
 
 
 @njit(cache=True)
-def _plate_trigger(xl, xc, xr, thr, K, dp, V, dt, n0, n_cap, drive):
+def _plate_trigger(xl, xc, xr, thr, K, dp, V, dt, n0, n_cap, drive, i):
     """Plate drive: first step m in [n0, n_cap) at which a stopped block with neighbours xl, xr
     starts (f > thr), else n_cap.
 
@@ -62,32 +62,32 @@ def _plate_trigger(xl, xc, xr, thr, K, dp, V, dt, n0, n_cap, drive):
     """
     if n0 >= n_cap:
         return n_cap
-    if _plate_fires(xl, xc, xr, thr, K, dp, V, dt, n0, drive):
+    if _plate_fires(xl, xc, xr, thr, K, dp, V, dt, n0, drive, i):
         return n0
-    if not _plate_fires(xl, xc, xr, thr, K, dp, V, dt, n_cap - 1, drive):
+    if not _plate_fires(xl, xc, xr, thr, K, dp, V, dt, n_cap - 1, drive, i):
         return n_cap
     lo = n0  # does not fire
     hi = n_cap - 1  # fires
-    f0 = _force(xl, xc, xr, K, dp, _pull(V, n0, dt), drive)
-    rate = call(drive, "leaf", dp) * V * dt
+    f0 = _force(xl, xc, xr, K, dp, _pull(V, n0, dt), drive, i)
+    rate = call(drive, "leaf", at(dp, i)) * V * dt
     if rate > 0.0:
         guess = (thr - f0) / rate
         if guess < np.float64(hi - lo):
             g = lo + 1 + np.int64(guess)
             if g < hi:
-                if _plate_fires(xl, xc, xr, thr, K, dp, V, dt, g, drive):
+                if _plate_fires(xl, xc, xr, thr, K, dp, V, dt, g, drive, i):
                     hi = g
-                    if not _plate_fires(xl, xc, xr, thr, K, dp, V, dt, g - 1, drive):
+                    if not _plate_fires(xl, xc, xr, thr, K, dp, V, dt, g - 1, drive, i):
                         return g
                     hi = g - 1
                 else:
                     lo = g
-                    if _plate_fires(xl, xc, xr, thr, K, dp, V, dt, g + 1, drive):
+                    if _plate_fires(xl, xc, xr, thr, K, dp, V, dt, g + 1, drive, i):
                         return g + 1
                     lo = g + 1
     while hi - lo > 1:
         mid = lo + (hi - lo) // 2
-        if _plate_fires(xl, xc, xr, thr, K, dp, V, dt, mid, drive):
+        if _plate_fires(xl, xc, xr, thr, K, dp, V, dt, mid, drive, i):
             hi = mid
         else:
             lo = mid
@@ -117,7 +117,7 @@ def _plate_triggers(x, th, mov, mm, trig, lo, hi, every, n0, n_cap, mp, V, dt, d
             continue
         if mov[i] == 0.0:
             m = _plate_trigger(
-                x[i - 1], x[i], x[i + 1], _threshold(th[i], tp, threshold), K, dp, V, dt, n0, n_cap, drive
+                x[i - 1], x[i], x[i + 1], _threshold(th[i], tp, threshold, i), K, dp, V, dt, n0, n_cap, drive, i
             )
             trig[i] = m
             if m < t_min:

@@ -12,6 +12,8 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
+
 from stickslip.models.pieces import Piece, piece
 from stickslip.models.preset_table import PRESETS
 
@@ -96,13 +98,19 @@ def _nonnegative(default: float, doc: str) -> Any:
     return field(default=default, metadata={"low": 0.0, "doc": doc})
 
 
+def _per_block(value: Any) -> bool:
+    from stickslip.models.disorder import PerBlock
+
+    return isinstance(value, PerBlock)
+
+
 class _Validated:
     """Mixin: validate every field from its metadata after construction."""
 
     def __post_init__(self) -> None:
         for f in dataclasses.fields(self):  # type: ignore[arg-type]
             meta = f.metadata
-            if meta.get("text"):
+            if meta.get("text") or _per_block(getattr(self, f.name)):
                 continue
             if "choices" in meta:
                 value = getattr(self, f.name)
@@ -310,6 +318,59 @@ class ChainParams(_Validated):
     friction: str = _choice("state", "friction", "friction of a moving block: state, weakening or strengthening")
     threshold: str = _choice("constant", "threshold", "static threshold: constant (Fs) or state (theta_i)")
     ends: str = _choice("free", "ends", "ends of the chain: free, fixed or periodic (plate drive only)")
+    M: float = _positive(1.0, "mass M of a block (1: unit masses, the paper's; per block: M_i)")
+
+    def __post_init__(self) -> None:
+        """Per-block values (arrays, :class:`~stickslip.models.disorder.Quenched` specs, ``file:``
+        names) drawn and checked first (:func:`stickslip.models.disorder.resolve`), then every
+        field as :class:`_Validated` does."""
+        from stickslip.models.disorder import NOT_PER_BLOCK, DisorderError, resolve
+
+        N = check_number("N", self.N, low=1, high=MAX_BLOCKS, integer=True)
+        for f in dataclasses.fields(self):
+            meta = f.metadata
+            if meta.get("text") or "choices" in meta or meta.get("integer") or f.name in NOT_PER_BLOCK:
+                value = getattr(self, f.name)
+                if f.name in NOT_PER_BLOCK and not isinstance(value, (int, float, str)) and value is not None:
+                    if resolve(f.name, value, N, None, None) is not None:
+                        raise ParameterError(f"{f.name} cannot differ from block to block (one number)")
+                continue
+            low, high = meta.get("low"), meta.get("high")
+            allowed = _range_text(low, high, meta.get("low_open", False), meta.get("high_open", False))
+            try:
+                pb = resolve(f.name, getattr(self, f.name), N, low, high)
+            except DisorderError as exc:
+                raise ParameterError(f"{f.name} must be {allowed} at every block: {exc}") from None
+            if pb is None:
+                continue
+            bad = ~np.isfinite(pb.values)
+            if low is not None:
+                bad |= pb.values <= low if meta.get("low_open") else pb.values < low
+            if high is not None:
+                bad |= pb.values >= high if meta.get("high_open") else pb.values > high
+            if bad.any():
+                i = int(np.flatnonzero(bad)[0])
+                raise ParameterError(
+                    f"{f.name} must be {allowed} at every block (got {pb.values[i]:g} at block {i + 1} "
+                    f"of {pb.spec_text})"
+                )
+            object.__setattr__(self, f.name, pb)
+        super().__post_init__()
+
+    def per_block(self) -> dict[str, Any]:
+        """The parameters that differ from block to block, each a
+        :class:`~stickslip.models.disorder.PerBlock` (docs/model.md, "Per-block parameters")."""
+        return {f.name: getattr(self, f.name) for f in dataclasses.fields(self) if _per_block(getattr(self, f.name))}
+
+    def _extremes(self, pick: str) -> Any:
+        """The parameters with each per-block value replaced by its smallest (``pick="min"``) or
+        largest value: what the pieces' cross-field checks read."""
+        from types import SimpleNamespace
+
+        values = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+        for name, pb in self.per_block().items():
+            values[name] = float(getattr(pb.values, pick)())
+        return SimpleNamespace(**values)
 
     def _check(self) -> None:
         from stickslip.models.pieces import CompositionError, check_composition
@@ -318,10 +379,12 @@ class ChainParams(_Validated):
             check_composition(self.drive, self.friction, self.threshold, self.ends)
         except CompositionError as exc:
             raise ParameterError(str(exc)) from None
+        views = (self._extremes("min"), self._extremes("max")) if self.per_block() else (self,)
         for pc in (self.drive_piece, self.friction_piece, self.threshold_piece, self.ends_piece):
-            message = pc.check(self) if pc.check is not None else None
-            if message:
-                raise ParameterError(message)
+            for view in views:
+                message = pc.check(view) if pc.check is not None else None
+                if message:
+                    raise ParameterError(message)
 
     @property
     def pieces(self) -> dict[str, str]:
@@ -360,11 +423,13 @@ class ChainParams(_Validated):
         """The numerical parameters this composition reads."""
         from stickslip.models.pieces import reads
 
-        return ("N", "K", "V", "dt") + reads(**self.pieces)
+        mass = ("M",) if _per_block(self.M) or self.M != 1.0 else ()
+        return ("N", "K", "V", "dt") + reads(**self.pieces) + mass
 
     def to_dict(self) -> dict[str, Any]:
         """The model (preset name and pieces) and every parameter it reads."""
-        d = dataclasses.asdict(self)
+        d = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+        d = {k: v.record() if _per_block(v) else v for k, v in d.items()}
         used = set(self.used())
         return {k: v for k, v in d.items() if k in used or k in ("model", "drive", "friction", "threshold", "ends")}
 
@@ -390,7 +455,7 @@ class ChainParams(_Validated):
     def __repr__(self) -> str:
         """The model and the parameters it reads (those it ignores stay at their defaults), so
         that ``eval(repr(p)) == p``."""
-        d = self.to_dict()
+        d = {k: getattr(self, k) if isinstance(v, dict) else v for k, v in self.to_dict().items()}
         shown = {"model": d.pop("model")}
         shown.update({k: d.pop(k) for k in PIECE_DEFAULTS if d[k] != PIECE_DEFAULTS[k]})
         for k in PIECE_DEFAULTS:

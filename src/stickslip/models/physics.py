@@ -37,13 +37,24 @@ def block_steady_state(p: BlockParams) -> dict[str, float]:
     return {"v": p.V, "theta": theta0, "force": force, "lag": force / p.K}
 
 
+def _block_values(value: Any) -> np.ndarray | None:
+    """The N values of a per-block parameter (an array, or the values of a
+    :class:`~stickslip.models.disorder.PerBlock`), None for a number."""
+    if isinstance(value, np.ndarray):
+        return value
+    values = getattr(value, "values", None)
+    return values if isinstance(values, np.ndarray) else None
+
+
 def per_block(p: Any, name: str) -> np.ndarray:
     """The parameter ``name`` of ``p`` at every block, i = 1..N at index i - 1.
 
     A parameter is a float (the same at every block) or an array of N values (quenched
     disorder, one value per block); either way this returns N values (read-only for a float).
     """
-    return np.broadcast_to(np.asarray(getattr(p, name), dtype=float), (p.N,))
+    value = getattr(p, name)
+    values = _block_values(value)
+    return np.broadcast_to(np.asarray(value if values is None else values, dtype=float), (p.N,))
 
 
 def is_uniform(p: Any) -> bool:
@@ -57,7 +68,7 @@ def is_uniform(p: Any) -> bool:
 
 def _arrays(p: Any) -> list[np.ndarray]:
     """The fields of ``p`` that are arrays (none for a chain of floats)."""
-    return [v for v in vars(p).values() if isinstance(v, np.ndarray)]
+    return [a for a in (_block_values(v) for v in vars(p).values()) if a is not None]
 
 
 class BlockView:
@@ -78,8 +89,9 @@ class BlockView:
         if name in self._overrides:
             return self._overrides[name]
         value = getattr(self._p, name)
-        if isinstance(value, np.ndarray) and value.ndim == 1:
-            return float(value[self._i])
+        values = _block_values(value)
+        if values is not None and values.ndim == 1:
+            return float(values[self._i])
         return value
 
 

@@ -93,6 +93,12 @@ def kernel_params(module: str, reads: tuple[str, ...]) -> type:
     return namedtuple("Params", reads, module=module)
 
 
+def _kernel_value(value: Any) -> Any:
+    """A parameter as the kernels read it: a float, or a per-block one padded like x."""
+    padded = getattr(value, "padded", None)
+    return padded() if padded is not None else float(value)
+
+
 @dataclass(frozen=True)
 class Param:
     """A parameter a piece declares: name, default, allowed range and one-line meaning.
@@ -213,9 +219,11 @@ class Piece:
 
     def kernel_params(self, p: Any) -> tuple:
         """The parameters of ``p`` the piece's compiled functions read, as the ``Params`` named
-        tuple of its module (floats, in the order of :attr:`reads`)."""
+        tuple of its module, in the order of :attr:`reads`: floats, and a per-block parameter
+        (:class:`~stickslip.models.disorder.PerBlock`) as a float64 array of N + 2 with block i
+        at index i, which the kernels read at each block (:func:`stickslip.kernels.laws.at`)."""
         params = importlib.import_module(self.module).Params
-        return params(*(float(getattr(p, name)) for name in self.reads))
+        return params(*(_kernel_value(getattr(p, name)) for name in self.reads))
 
     def kernel_velocity(self, p: Any) -> float:
         """The drive's V as the kernels read it (their pull point p = V t_n): :attr:`pull_velocity`

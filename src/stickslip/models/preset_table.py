@@ -120,7 +120,7 @@ PRESETS: dict[str, Preset] = {
     ),
     "train": Preset(
         "train",
-        "the train model (Elmer): the paper's chain with constant friction",
+        "the train model (de Sousa Vieira; Elmer's velocity strengthening): the paper's chain with F0 + beta v",
         dict(drive="end", friction="strengthening", threshold="constant", ends="free"),
         dict(N=399, K=10.0, V=0.001, beta=1.0, F0=1.0, Fs=3.0, dt=0.005),
         "paper",
@@ -128,8 +128,11 @@ PRESETS: dict[str, Preset] = {
             "dv_i/dt = K (x_{i+1} - 2 x_i + x_{i-1}) - F0 - beta v_i while moving, x_0 = V t, free "
             "end; a stuck block starts when its force exceeds Fs"
         ),
-        source="F.-J. Elmer; here the paper's chain with alpha = 0 and theta = F0 = 1",
-        note="Elmer's own parametrisation was not available; this is one member of the model",
+        source=(
+            "M. de Sousa Vieira, Phys. Rev. A 46, 6288 (1992) (the model); F.-J. Elmer, arXiv:adap-org/9710002 "
+            "(1997) (velocity-strengthening friction); here the paper's chain with alpha = 0 and theta = F0 = 1"
+        ),
+        note="the published parametrisations were not available; this is one member of the model",
         note_in_runs=True,
         label="train model",
     ),
@@ -158,7 +161,10 @@ PRESETS: dict[str, Preset] = {
         "rest",
         {"amplitude": 0.01, "seed": 0},
         equations="as carlson-langer with N = 2 and free ends (x_0 = x_1, x_3 = x_2)",
-        source="M. de Sousa Vieira, Phys. Rev. A 46, 6288 (1992); H. Sakaguchi and T. Morita (2013)",
+        source=(
+            "M. de Sousa Vieira, Phys. Lett. A 198, 407 (1995), cond-mat/9312072; "
+            "H. Sakaguchi and S. Morita, arXiv:1309.4583 (2013)"
+        ),
         symbols={"l": "sqrt(K)", "nu": "V", "alpha": "alpha", "sigma": "sigma"},
         label="two blocks",
     ),

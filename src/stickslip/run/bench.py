@@ -19,7 +19,8 @@ from stickslip.run.errors import short_runs_expected
 
 def _warm(params: ChainParams, start: str) -> None:
     """Compile (or load from cache) both kernels so compilation is not timed."""
-    small = params.replace(N=min(params.N, 3))
+    n = min(params.N, 3)
+    small = params.replace(N=n, **{k: v.values[:n] for k, v in params.per_block().items()})
     for integrator in ("dense", "exact"):
         run_chain(small, 20 * small.dt, integrator=integrator, start=start)
 
@@ -417,3 +418,104 @@ def format_located(r: dict[str, Any]) -> str:
             f"identical  {'yes' if r['identical'] else 'NO'}   sha256 {r['state_sha256'][:16]}...",
         ]
     )
+
+
+#: The disordered workload: the paper's chain from its start with thresholds Fs uniform in
+#: [2.5, 3.5] and beta normal about its value (10%), against the same chain with the means.
+DISORDERED = {"N": 199, "t_timed": 2e4, "Fs": ("uniform", 2.5, 3.5), "beta_width": 0.1}
+
+
+def disordered_pair(params: ChainParams, seed: int = 0) -> tuple[ChainParams, ChainParams]:
+    """(uniform, disordered): ``params`` with per-block values, and the same chain with each
+    per-block value replaced by its mean; where ``params`` has none, the disorder of
+    :data:`DISORDERED` (Fs uniform in [2.5, 3.5], beta normal with 10% width, seed ``seed``)."""
+    from stickslip.models.disorder import Quenched
+
+    if params.per_block():
+        return params.replace(**{k: float(v.values.mean()) for k, v in params.per_block().items()}), params
+    disorder = {"Fs": Quenched(*DISORDERED["Fs"], seed=seed)}
+    if "beta" in params.used() and params.beta > 0:
+        disorder["beta"] = Quenched("normal", params.beta, DISORDERED["beta_width"] * params.beta, seed=seed)
+    return params, params.replace(**disorder)
+
+
+@short_runs_expected()  # a fixed workload, short of the loading time on purpose
+def disordered(params: ChainParams, t_end: float, *, repeat: int = 1, seed: int = 0) -> dict[str, Any]:
+    """Time per block update of a disordered chain against the uniform one (docs/model.md,
+    "Per-block parameters"), both integrators, in one process.
+
+    The four runs (uniform and disordered, dense and exact) are alternated, in CPU time of this
+    process, the fastest of ``repeat``. ``ratio_to_uniform``: the disordered chain's exact ns per
+    block update over the uniform chain's; ``ratio_dense``: the same for dense per block-step
+    (the same work per step whatever the dynamics). ``identical``: dense = exact on each chain.
+    """
+    chains = dict(zip(("uniform", "disordered"), disordered_pair(params, seed), strict=True))
+    for p in chains.values():
+        _warm(p, "paper")
+    best: dict[tuple[str, str], float] = {}
+    runs = {}
+    for _ in range(repeat):
+        for name, p in chains.items():
+            for integrator in ("dense", "exact"):
+                t0 = time.process_time()
+                run = run_chain(p, t_end, integrator=integrator, start="paper")
+                key = (name, integrator)
+                best[key] = min(best.get(key, float("inf")), time.process_time() - t0)
+                runs[key] = run
+    out: dict[str, Any] = {}
+    for name, p in chains.items():
+        d, e = runs[(name, "dense")], runs[(name, "exact")]
+        block_steps = p.N * d.steps
+        out[name] = {
+            "per_block": {k: v.describe() for k, v in p.per_block().items()},
+            "dense_seconds": best[(name, "dense")],
+            "exact_seconds": best[(name, "exact")],
+            "exact_block_updates": e.summary["block_updates"],
+            "ns_per_update_exact": 1e9 * best[(name, "exact")] / max(e.summary["block_updates"], 1),
+            "ns_per_block_step_dense": 1e9 * best[(name, "dense")] / max(block_steps, 1),
+            "identical": d.summary["state_sha256"] == e.summary["state_sha256"]
+            and d.events.equals(e.events)
+            and bool((d.samples["L"].values == e.samples["L"].values).all()),
+            "n_events": e.summary["n_events"],
+            "state_sha256": e.summary["state_sha256"],
+        }
+    u, g = out["uniform"], out["disordered"]
+    return {
+        "workload": {
+            "name": "disordered",
+            "model": params.model,
+            "N": params.N,
+            "t_end": t_end,
+            "start": "paper",
+            "steps": runs[("uniform", "dense")].steps,
+        },
+        "timer": "process CPU time, best of repeat, the four runs alternated",
+        "repeat": repeat,
+        **out,
+        "ratio_to_uniform": g["ns_per_update_exact"] / u["ns_per_update_exact"],
+        "ratio_dense": g["ns_per_block_step_dense"] / u["ns_per_block_step_dense"],
+        "identical": bool(u["identical"] and g["identical"]),
+        "machine": platform.processor() or platform.machine(),
+    }
+
+
+def format_disordered(r: dict[str, Any]) -> str:
+    """Human-readable lines of :func:`disordered`'s result."""
+    w = r["workload"]
+    lines = [
+        f"workload   disordered against uniform: {w['model']} N={w['N']} t_end={w['t_end']:g} from the paper's "
+        f"start ({w['steps']} steps)"
+    ]
+    for name in ("uniform", "disordered"):
+        c = r[name]
+        spec = ", ".join(f"{k} {v['spec']}" for k, v in c["per_block"].items()) or "every block alike"
+        lines.append(
+            f"{name:10s} exact {c['ns_per_update_exact']:.3g} ns/block update ({c['exact_block_updates']} updates), "
+            f"dense {c['ns_per_block_step_dense']:.3g} ns/block-step, {c['n_events']} events; {spec}"
+        )
+    lines += [
+        f"ratio      {r['ratio_to_uniform']:.3f} exact per block update, {r['ratio_dense']:.3f} dense per block-step "
+        f"(CPU time, best of {r['repeat']})",
+        f"identical  {'yes' if r['identical'] else 'NO'} (dense = exact on both chains)",
+    ]
+    return "\n".join(lines)

@@ -183,6 +183,8 @@ def loaded_state(
 
     transient = float(check_number("transient", transient, low=0.0, low_open=True))
     steps_for(transient, params.dt, "transient")  # refused as what the caller gave, not as run_chain's t_end
+    if cache is not None:
+        check_cache_folder(cache)  # before the transient's first chunk
     spec = loaded_spec(params, transient, start, perturbation, seed)
     wall0 = time.perf_counter()
     if cache is None:
@@ -236,6 +238,47 @@ def loaded_state(
     partial.unlink(missing_ok=True)
     assert isinstance(state, ChainState)
     return LoadedState(state, _info(tally, state, wall_before + time.perf_counter() - wall0, False, path))
+
+
+def check_cache_folder(folder: str | Path, name: str = "cache") -> Path:
+    """Refuse a cache folder that cannot be read from and written to, before any work: a file, a
+    path under a file, a folder (or the folder it would be made in) that is not writable, as on a
+    read-only file system. Nothing is created.
+
+    Parameters
+    ----------
+    folder : str or Path
+        The cache folder of :func:`loaded_state`.
+    name : str
+        The option named in the message (``--state-cache`` on the command line).
+
+    Returns
+    -------
+    Path
+        The folder.
+
+    Raises
+    ------
+    ParameterError
+        One line naming ``name``, the folder and what is wrong.
+    """
+    import os
+
+    from stickslip.models.params import ParameterError
+
+    folder = Path(folder)
+    if str(folder).strip() == "":
+        raise ParameterError(f"{name} must name a folder (got '')")
+    if folder.exists() and not folder.is_dir():
+        raise ParameterError(f"{name} {folder} is a file, not a folder")
+    probe = folder
+    while not probe.exists() and probe.parent != probe:
+        probe = probe.parent
+    if not probe.is_dir():
+        raise ParameterError(f"{name} {folder}: cannot make a folder there ({probe} is a file)")
+    if not os.access(probe, os.W_OK | os.X_OK):
+        raise ParameterError(f"{name} {folder}: {probe} is not writable (a read-only file system, or its permissions)")
+    return folder
 
 
 def _info(tally: _Tally, state: ChainState, wall: float, cached: bool, path) -> dict[str, Any]:

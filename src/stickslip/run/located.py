@@ -131,8 +131,19 @@ def parameter_vector(p: ChainParams) -> np.ndarray:
     the threshold's and the friction law's parameters go separately
     (:meth:`~stickslip.models.piece.Piece.kernel_params`)."""
     par = np.zeros(layout.PAR_SIZE)
-    par[layout.P_K], par[layout.P_V], par[layout.P_DT] = p.K, p.V, p.dt
+    par[layout.P_K] = p.K if isinstance(p.K, float) else float(p.K.values[0])
+    par[layout.P_V], par[layout.P_DT] = p.V, p.dt
     return par
+
+
+def refuse_bonds_and_masses(params: ChainParams, what: str) -> None:
+    """Refuse springs that differ from bond to bond and masses other than 1, which ``what`` does
+    not take (the pieces' per-block parameters it does; docs/model.md, "Per-block parameters")."""
+    K, M = params.per_block().get("K"), params.M
+    if K is not None and bool((K.values != K.values[0]).any()):
+        raise ParameterError(f"K must be one number for {what} (springs per bond are for the grid integrators)")
+    if not isinstance(M, float) or M != 1.0:
+        raise ParameterError(f"M must be 1 for {what} (masses are for the grid integrators)")
 
 
 # Positions of the pieces among the arguments of L.advance and L.rates (compiled as literals).
@@ -166,6 +177,7 @@ class LocatedStepper:
     def __init__(self, params: ChainParams, capacity: int = 4096, form: str = "fast"):
         if form not in FORMS:
             raise ParameterError(f"form must be one of {', '.join(FORMS)} (got {form!r})")
+        refuse_bonds_and_masses(params, "the located integrator")
         if not params.drive_piece.located:
             raise ParameterError(f"drive {params.drive} does not run on the located integrator (use the grid's)")
         self.form = form

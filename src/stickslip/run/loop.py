@@ -45,8 +45,25 @@ def _par(p: ChainParams) -> np.ndarray:
     tuples, :meth:`~stickslip.models.piece.Piece.kernel_params`). V is the velocity of the pull point
     p = V t_n, the drive's (:meth:`~stickslip.models.piece.Piece.kernel_velocity`: a force ramp's r)."""
     par = np.zeros(layout.PAR_SIZE)
-    par[layout.P_K], par[layout.P_V], par[layout.P_DT] = p.K, p.drive_piece.kernel_velocity(p), p.dt
+    par[layout.P_K] = p.K if isinstance(p.K, float) else float(p.K.values[0])
+    par[layout.P_V], par[layout.P_DT] = p.drive_piece.kernel_velocity(p), p.dt
     return par
+
+
+def chain_extras(p: ChainParams) -> tuple:
+    """The springs per bond and the masses as the kernels read them (``ChainArgs.kb``,
+    ``ChainArgs.mass``): None for one spring K (in ``par``) and for unit masses."""
+    from stickslip.models.disorder import PerBlock
+
+    # Springs all alike take the uniform expression K ((x_{i-1} - x_i) - (x_i - x_{i+1})), whose
+    # rounding differs from the per-bond one's.
+    bonds = isinstance(p.K, PerBlock) and bool((p.K.values != p.K.values[0]).any())
+    kb = p.K.bonds(ring=p.ends_piece.ring) if bonds else None
+    if isinstance(p.M, PerBlock):
+        mass = p.M.padded()
+    else:
+        mass = None if p.M == 1.0 else float(p.M)
+    return kb, mass
 
 
 def _scratch(N: int) -> list[np.ndarray]:
@@ -70,7 +87,7 @@ class _Kernel:
         pieces_p = tuple(
             pc.kernel_params(params) for pc in (params.drive_piece, params.threshold_piece, params.friction_piece)
         )
-        self.rest = (par, *pieces_p, *outputs.kernel_args())
+        self.rest = (par, *pieces_p, *chain_extras(params), *outputs.kernel_args())
         # sample_every, profile_every, profile_min_blocks, stop_all_moving (layout.ChainArgs)
         self.tail = tuple(np.int64(t) for t in ints)
         self.pieces = params.codes

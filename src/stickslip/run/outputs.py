@@ -21,7 +21,7 @@ from stickslip.kernels import layout
 from stickslip.models import physics
 from stickslip.models.params import ChainParams, steps_for
 from stickslip.run.options import RunOptions
-from stickslip.run.state import ChainState
+from stickslip.run.state import ChainState, closed_form
 
 EVENT_COLUMNS = [
     "event",
@@ -365,7 +365,7 @@ def _assemble(params, options, integrator, start_info, state, outputs, wall, ste
     early: dict[str, Any] = {"stopped_early": False}
     if steady_at:
         # From the stop on, the chain is taken to slide steadily: L = L_ss at the remaining samples.
-        L_ss = physics.chain_steady_length(params)
+        L_ss = closed_form(physics.chain_steady_length, params)
         sample_every = int(round(options.sample_interval / dt))
         n_end = steps_for(options.t_end, dt, "t_end")
         later = np.arange((state.step // sample_every + 1) * sample_every, n_end + 1, sample_every) * dt
@@ -394,7 +394,7 @@ def _assemble(params, options, integrator, start_info, state, outputs, wall, ste
         "L_final": L_final,
         "L_mean": L_mean,
         "L_mean_from": avg_from,
-        "L_steady": physics.chain_steady_length(params),
+        "L_steady": closed_form(physics.chain_steady_length, params),
         "t_end": options.t_end if steady_at else state.step * dt,
         "t_reached": state.step * dt,
         "steps": state.step,

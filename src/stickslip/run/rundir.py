@@ -129,6 +129,33 @@ def _state_file_sha256(ds: xr.Dataset) -> str:
     return h.hexdigest()
 
 
+#: The columns of events.parquet every reader of a run uses (:data:`EVENT_DOCS`).
+EVENT_COLUMNS = ("event", "t_start", "duration", "S", "start_block", "max_block", "n_blocks")
+
+
+def _check_events(events, path: Path):
+    """``events`` (a run's events.parquet) as :func:`write_run` writes it, else a
+    :class:`RunDirDamaged` naming the file and what is wrong: every column of
+    :data:`EVENT_COLUMNS`, numbers only, finite, and each event once, in order."""
+    import pandas as pd
+
+    missing = [c for c in EVENT_COLUMNS if c not in events.columns]
+    if missing:
+        raise RunDirDamaged(f"{path} is not a table of events: it lacks the column(s) {', '.join(missing)}")
+    for c in EVENT_COLUMNS:
+        column = events[c]
+        if len(column) and not (pd.api.types.is_numeric_dtype(column) and not pd.api.types.is_bool_dtype(column)):
+            raise RunDirDamaged(f"{path}: column {c} holds {column.dtype} values, not numbers")
+        values = column.to_numpy(dtype=np.float64) if len(column) else np.empty(0)
+        bad = ~np.isfinite(values)
+        if bad.any():
+            raise RunDirDamaged(f"{path}: column {c} holds {int(bad.sum())} non-finite value(s) (NaN or inf)")
+    numbers = events["event"].to_numpy(dtype=np.float64)
+    if numbers.size > 1 and not np.all(np.diff(numbers) > 0):
+        raise RunDirDamaged(f"{path}: events repeated or out of order (column event is not increasing)")
+    return events
+
+
 def _load_run(run_dir: Path) -> ChainRun:
     from stickslip import io
 
@@ -148,6 +175,10 @@ def _load_run(run_dir: Path) -> ChainRun:
     state.ist[layout.STEP] = int(meta["summary"]["steps"])
     if state.N != params.N:
         raise RunDirDamaged(f"{run_dir / 'state.nc'} holds {state.N} blocks, its run.json N = {params.N}")
+    for name, pb in params.per_block().items():
+        held = ds[f"param_{name}"].values
+        if held.shape != pb.values.shape or held.tobytes() != pb.values.tobytes():
+            raise RunDirDamaged(f"{run_dir / 'state.nc'} holds other per-block values of {name} than its run.json")
     state.of(params)
     # L's time axis was called t_sample before it took the name it has in ChainRun.samples
     t_sample = ds["t_sample"] if "t_sample" in ds.variables else ds["t"]
@@ -169,7 +200,7 @@ def _load_run(run_dir: Path) -> ChainRun:
         meta["integrator"],
         meta["start"],
         state,
-        _read(run_dir / "events.parquet", io.read_table),
+        _check_events(_read(run_dir / "events.parquet", io.read_table), run_dir / "events.parquet"),
         _read(run_dir / "first_move.parquet", io.read_table),
         samples,
         snapshots,

@@ -124,6 +124,10 @@ def write_run(run: Any, out_dir: str | Path) -> Path:
             "t_end": run.summary["t_end"],
         },
     )
+    for name, pb in run.params.per_block().items():
+        # Per-block parameters over the blocks, with their provenance (docs/model.md).
+        attrs = {k: v for k, v in pb.describe().items() if v is not None}
+        ds[f"param_{name}"] = ("block", pb.values, {"long_name": f"{name} at each block", **attrs})
     if "n_moving" in run.samples:
         ds["n_moving"] = ("t_moving", run.samples["n_moving"].values)
         ds = ds.assign_coords(t_moving=run.samples["t_moving"].values)

@@ -119,7 +119,16 @@ class ChainState:
         With ``amplitude`` > 0, x_i and v_i get independent uniform perturbations in
         [-amplitude, amplitude] drawn from numpy's default generator with ``seed``.
         """
-        s = physics.chain_steady_state(p, 0.0)
+        try:
+            s = physics.chain_steady_state(p, 0.0)
+        except TypeError:
+            if not p.per_block():
+                raise
+            names = ", ".join(p.per_block())
+            raise ParameterError(
+                f"start must be paper or rest for a chain with per-block {names}: the steady state "
+                "of such a chain has no closed form here yet"
+            ) from None
         state = cls.from_blocks(s["x"].copy(), s["v"].copy(), s["theta"], np.zeros(p.N, bool)).of(p)
         return state.perturbed(amplitude, seed)
 
@@ -267,6 +276,18 @@ def _remedy(p: ChainParams, start: str) -> str:
     return " (dt=... in Python, --dt on the command line)"
 
 
+def closed_form(fn, p: ChainParams, *args):
+    """``fn(p, *args)``, a closed form of :mod:`stickslip.models.physics` for a uniform chain; NaN
+    where the chain has per-block parameters (docs/model.md, "Per-block parameters") that the
+    closed form does not take."""
+    try:
+        return fn(p, *args)
+    except TypeError:
+        if not p.per_block():
+            raise
+        return float("nan")
+
+
 def steady_deviation(state: ChainState, p: ChainParams) -> float:
     """Distance of a state from steady sliding of the chain (docs/model.md), in the frame moving with V.
 
@@ -277,6 +298,14 @@ def steady_deviation(state: ChainState, p: ChainParams) -> float:
     """
     if np.any(state.mov[1:-1] == 0.0) or not physics.has_steady_state(p):
         return float("inf")
+    if p.per_block():
+        value = closed_form(lambda q: _deviation(state, q), p)
+        return value if np.isfinite(value) else float("inf")
+    return _deviation(state, p)
+
+
+def _deviation(state: ChainState, p: ChainParams) -> float:
+    """:func:`steady_deviation` of a chain that slides (the steady state's closed form)."""
     ss = physics.steady_reference(p)
     if ss["pinned"]:
         # Every block lags the plate by c / Kp: compare positions in the plate's frame.
@@ -304,7 +333,7 @@ def loading_warnings(
     (:func:`stickslip.models.physics.loading_time`). One message if the run ends before that, one if
     the <L> average (from ``average_from``, default t_end / 2) starts before it; none otherwise.
     """
-    t_load = physics.loading_time(p)
+    t_load = closed_form(physics.loading_time, p)
     if start not in ("paper", "rest") or not np.isfinite(t_load):
         return []
     where = (

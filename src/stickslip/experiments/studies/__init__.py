@@ -9,10 +9,11 @@ naming one.
 
 :data:`STUDIES` are the questions the paper leaves open: the stick-slip transition at beta = 1 as
 N grows (``transition``), the final state and m over (alpha, beta) and (D, beta)
-(``phase-diagram``), the slip-size exponent tau (``exponents``) and whether the chain is chaotic
-at the onset (``chaos``). :data:`PAPER` are the paper's own figures and stated numbers, each with
-one page: the single block of section 2 and the Fourier modes of Fig. 4 (``figs1-4``) and the
-chain runs of section 3 (``figs5-8``); ``stickslip reproduce`` gathers them into one report
+(``phase-diagram``), the slip-size exponent tau (``exponents``), whether the chain is chaotic
+at the onset (``chaos``) and how long its irregular motion lasts against N (``lifetimes``).
+:data:`PAPER` are the paper's own figures and stated numbers, each with one page: the single
+block of section 2 and the Fourier modes of Fig. 4 (``figs1-4``) and the chain runs of section 3
+(``figs5-8``); ``stickslip reproduce`` gathers them into one report
 (:mod:`stickslip.experiments.reproduce`).
 
 A :class:`Study`'s key hashes its name, the settings every point shares and the package version
@@ -47,7 +48,7 @@ __all__ = [
 ]
 
 #: The studies, each the module of its name (``-`` read as ``_``) in this package.
-STUDIES = ("transition", "phase-diagram", "exponents", "chaos")
+STUDIES = ("transition", "phase-diagram", "exponents", "chaos", "lifetimes", "disorder")
 #: The studies of ``stickslip reproduce`` (the paper's figures and stated numbers), in report order.
 PAPER = ("figs1-4", "figs5-8")
 #: The record, at the top of a study's output folder, of every page file its studies wrote.

@@ -1,0 +1,121 @@
+"""The lifetimes study (issue 51, item 2 of its build list): one start's lifetime against a plain
+run, the findings against the survival fits, refusals, and the tiny study end to end."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import stickslip
+from stickslip.analysis.periodicity import periodicity
+from stickslip.analysis.survival import exponential_fit
+from stickslip.experiments.studies import lifetimes, study
+from stickslip.experiments.study_run import run_study
+from stickslip.experiments.sweep_points import point_params
+from stickslip.models.params import ParameterError
+
+_RULE = {"rtol": 1e-6, "max_period": 500, "repeats": 3, "until_steady": 1e-6, "perturbation": 0.05}
+
+
+def test_a_start_ends_where_its_plain_run_settles():
+    # N = 5, beta = 1 from a perturbed paper start: the lifetime is the start of the orbit that a
+    # plain run to the same length, read by the detector, finds
+    cfg = {"model": "sakaguchi", "N": 5, "beta": 1.0, "start": "paper", "seed": 3, "budget": 5e5, **_RULE}
+    params = point_params("chain", cfg)
+    row = lifetimes.lifetime_point(cfg, params)
+    state = lifetimes.start_state(params, "paper", 0.05, 3)
+    # the draw by hand: x_i = 0 moved by numpy's uniform draw with the seed
+    expected = np.random.default_rng(3).uniform(-0.05, 0.05, 5)
+    assert np.array_equal(state.x[1:-1], expected)
+    plain = stickslip.run_chain(params, 5e5, start=state, progress=False)
+    found = periodicity(plain.events)
+    assert found.period_slips is not None and row["ended"] and row["end"] == "periodic"
+    assert row["lifetime"] == found.settled_from_t and row["period_slips"] == found.period_slips
+    assert row["t_start"] == 0.0 and row["t_reached"] < 5e5
+
+
+def test_a_loaded_start_counts_from_twice_the_loading_time():
+    cfg = {"model": "sakaguchi", "N": 3, "beta": 1.0, "start": "loaded", "seed": 0, "budget": 2e5, **_RULE}
+    row = lifetimes.lifetime_point(cfg, point_params("chain", cfg))
+    # L_ss / V for N = 3 (docs/model.md): L_ss = 0.3, V = 0.001, so twice 300
+    assert row["t_start"] == pytest.approx(600.0)
+    assert row["lifetime"] >= 0.0
+
+
+def _table(rng):
+    rows = []
+    for beta, growth in ((0.5, 0.6), (1.0, 0.3)):
+        for N in (3, 5, 7, 9):
+            tau = 1e3 * math.exp(growth * N)
+            life = rng.exponential(tau, 40)
+            budget = 3 * 1e3 * math.exp(0.3 * 9)
+            for k, T in enumerate(life):
+                ended = T <= budget
+                rows.append(
+                    {
+                        "status": "ok",
+                        "model": "sakaguchi",
+                        "N": N,
+                        "beta": beta,
+                        "start": "paper",
+                        "seed": k,
+                        "lifetime": min(T, budget),
+                        "ended": ended,
+                        "end": "periodic" if ended else "censored",
+                        "period_slips": 4 if ended else None,
+                        "slips": 100,
+                        "t_reached": budget,
+                        "budget": budget,
+                    }
+                )
+    return pd.DataFrame(rows)
+
+
+def test_findings_are_the_survival_fits_of_each_point():
+    table = _table(np.random.default_rng(0))
+    found = lifetimes.conclusions(None, table)
+    for p in found["points"]:
+        g = table[(table["beta"] == p["beta"]) & (table["N"] == p["N"])]
+        fit = exponential_fit(g["lifetime"], g["ended"])
+        assert p["ended"] == int(g["ended"].sum()) and p["starts"] == 40
+        if fit.ended:
+            assert p["mean_T"] == pytest.approx(fit.mean)
+        if g["ended"].all():  # none censored: the sample mean and its standard error
+            T = g["lifetime"].to_numpy()
+            assert p["mean_T"] == pytest.approx(T.mean())
+            assert p["mean_T_err"] == pytest.approx(T.std(ddof=1) / math.sqrt(T.size))
+        elif fit.ended:
+            assert p["mean_T_err"] == pytest.approx(fit.mean_err)
+    fits = {f["beta"]: f for f in found["fits"]}
+    # the planted growth rates per block, within three errors
+    for beta, growth in ((0.5, 0.6), (1.0, 0.3)):
+        e = fits[beta]["exponential"]
+        assert abs(e["slope"] - growth) < 3 * e["slope_err"] + 0.05
+        assert e["at"] == 399 and e["T_at_low"] < e["T_at"] < e["T_at_high"]
+    assert any("Extrapolated to N = 399" in s for s in found["statements"])
+
+
+def test_bad_points_are_refused():
+    base = {"model": "sakaguchi", "N": 3, "beta": 1.0, "seed": 0, "budget": 1e3, **_RULE}
+    with pytest.raises(ParameterError, match="start"):
+        lifetimes.check_point({**base, "start": "steady"})
+    with pytest.raises(ParameterError, match="budget"):
+        lifetimes.check_point({**base, "start": "paper", "budget": -1.0})
+
+
+def test_tiny_lifetimes_study_end_to_end(tmp_path):
+    spec = study("lifetimes", "tiny")
+    first = run_study(spec, tmp_path, n_workers=1, progress=False)
+    assert first["failed"] == 0 and first["run"] == len(spec.points) == 6
+    rows = first["rows"]
+    assert all(r["end"] in ("periodic", "steady", "censored") for r in rows)
+    assert all((r["end"] != "censored") == r["ended"] for r in rows)
+    for name in ("survival", "lifetime_vs_N"):
+        assert (tmp_path / "lifetimes" / f"{name}.png").is_file()
+    points = first["findings"]["points"]
+    assert sorted((p["beta"], p["N"]) for p in points) == [(1.0, 3), (1.0, 5)]
+    second = run_study(spec, tmp_path, n_workers=1, progress=False)
+    assert second["run"] == 0 and second["reused"] == 6
