@@ -255,3 +255,18 @@ def test_paper_steady_state_is_the_closed_form():
     np.testing.assert_allclose(ss["ext"], c / p.K * (49 - i + 1), rtol=1e-15)
     assert ss["friction"] == pytest.approx(c, rel=1e-15)
     assert math.isclose(physics.chain_steady_length(p), c / p.K * 49 * 48 / 2, rel_tol=1e-15)
+
+
+def test_per_block_parameters_from_chain_params():
+    # The package's own per-block parameters (chain_params with arrays) give the steady state and
+    # Jacobian of the arrays built here, and the steady start is steady to round-off.
+    from stickslip.run.state import ChainState, steady_deviation
+
+    beta, D = np.linspace(0.6, 1.4, 9), np.linspace(0.0, 2.0, 9)
+    p = chain_params(N=9, beta=beta, D=D)
+    q = _disordered(chain_params(N=9), beta=beta, D=D)
+    a, b = physics.chain_steady_state(p, 1.5), physics.chain_steady_state(q, 1.5)
+    for key in ("x", "v", "theta", "ext"):
+        assert np.array_equal(a[key], b[key]), key
+    assert np.array_equal(chain_jacobian(p), chain_jacobian(q))
+    assert steady_deviation(ChainState.steady(p), p) < 1e-13

@@ -16,7 +16,12 @@ from stickslip.models.presets import PRESETS, chain_params
 
 #: A drive, a threshold and an end condition reach the kernels as the import paths of their modules.
 PIECE_MODULES = {
-    "drive": {"end": "stickslip.models.drive.end", "plate": "stickslip.models.drive.plate"},
+    "drive": {
+        "end": "stickslip.models.drive.end",
+        "plate": "stickslip.models.drive.plate",
+        "constant-force": "stickslip.models.drive.constant_force",
+        "force-ramp": "stickslip.models.drive.force_ramp",
+    },
     "threshold": {"constant": "stickslip.models.threshold.constant", "state": "stickslip.models.threshold.state"},
     "ends": {
         "free": "stickslip.models.ends.free",
@@ -186,3 +191,20 @@ def test_paper_stability_numbers_unchanged():
     assert st.chain_stability(p.replace(beta=1.5)).max_growth_rate < 0.0
     with pytest.raises(ValueError, match="no state variable"):
         st.chain_mode_matrix(chain_params("train"), 0.3)
+
+
+def test_force_drives_compiled_functions():
+    # The force on a block from the drive's own compiled function, run as Python: the springs
+    # K ((x_{i-1} - x_i) - (x_i - x_{i+1})) plus F, or F_start + p with p = r t_n; no leaf spring;
+    # x_0 is the ghost cell.
+    from stickslip.models.drive import constant_force, force_ramp
+
+    cf = constant_force.Params(3.2)
+    assert constant_force.force.py_func(1.0, 0.5, 0.25, 10.0, 99.0, cf) == 10.0 * (0.5 - 0.25) + 3.2
+    assert constant_force.leaf.py_func(cf) == 0.0 and constant_force.left.py_func(99.0, 0.5) == 0.5
+    fr = force_ramp.Params(0.5, 1e-3)
+    assert force_ramp.force.py_func(1.0, 0.5, 0.25, 10.0, 0.2, fr) == 10.0 * (0.5 - 0.25) + (0.5 + 0.2)
+    assert force_ramp.leaf.py_func(fr) == 0.0 and force_ramp.left.py_func(99.0, 0.5) == 0.5
+    for name in ("constant-force", "force-ramp"):
+        pc = pieces.piece("drive", name)
+        assert pc.leaf_spring and not pc.located

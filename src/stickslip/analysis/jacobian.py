@@ -55,13 +55,8 @@ def block_linearisations(p: Any, v: float | None = None) -> list[Linearisation]:
         return Linearisation(0.0, law.slope(q), 0.0, 0.0, 0.0)
 
     if physics.is_uniform(p):
-        return [one(p if not over and _plain(p) else physics.BlockView(p, 0, **over))] * p.N
+        return [one(physics.uniform_view(p, **over))] * p.N
     return [one(physics.BlockView(p, i, **over)) for i in range(p.N)]
-
-
-def _plain(p: Any) -> bool:
-    """No field of ``p`` is an array (the pieces read ``p`` itself, as before arrays existed)."""
-    return not any(isinstance(getattr(p, name), np.ndarray) for name in p.__dataclass_fields__)
 
 
 def chain_jacobian(p: Any) -> np.ndarray:

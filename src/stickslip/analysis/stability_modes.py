@@ -36,6 +36,9 @@ def friction_slope(p: ChainParams) -> float:
     """
     slope = p.friction_piece.slope
     if slope is not None:
+        if p.drive_piece.applied is not None:
+            # A force drive: the slope at the velocity where friction balances the force.
+            return slope(physics.BlockView(p, 0, V=physics.steady_velocity(p)))
         return slope(p)
     raise ValueError(f"friction {p.friction} has a state variable: use chain_mode_matrix (eq. 5)")
 
@@ -56,6 +59,8 @@ def normal_modes(p: ChainParams) -> tuple[np.ndarray, str]:
     N = p.N
     if not p.ends_piece.steady_sliding:
         raise ValueError(f"ends {p.ends} have no steady sliding (the springs to the walls stretch without bound)")
+    if not physics.has_steady_state(p):
+        raise ValueError(f"drive {p.drive} has no steady sliding")
     on_ghost = physics.ghost_rows(p)["x0"] != (0.0, 0.0)  # x_0 is not the pulling point
     if on_ghost and p.ends_piece.ring:
         return 2.0 * np.pi * np.arange(N) / N, "periodic: exp(i k j), k = 2 pi j / N, j = 0..N-1"

@@ -260,8 +260,8 @@ def run_stability_chain(args: argparse.Namespace) -> Result:
         return run_stability_law(args, p, with_N)
     if p.drive_piece.leaf_spring:
         raise CommandError(
-            "friction state with drive plate is not covered: use friction weakening or "
-            "strengthening with the plate drive"
+            f"friction state with drive {p.drive} is not covered: use friction weakening or "
+            f"strengthening with the {p.drive} drive"
         )
     if with_N:
         check_number("N", p.N, low=1, high=MAX_FINITE_N, integer=True)
@@ -394,11 +394,16 @@ def run_stability_modes(args: argparse.Namespace, p: ChainParams) -> Result:
         raise CommandError(f"steady sliding needs V > 0 (got V={p.V:g})")
     if not p.ends_piece.steady_sliding:
         raise CommandError(f"ends {p.ends} have no steady sliding (the springs to the walls stretch without bound)")
+    if not p.drive_piece.steady_sliding:
+        raise CommandError(f"drive {p.drive} has no steady sliding (the force never stops growing)")
     if p.N > MAX_FINITE_N:
         raise CommandError(f"N must be <= {MAX_FINITE_N} for the mode table (got N={p.N})")
     check_out_owned(args.out, _CHAIN_MAP, "stickslip stability chain", overwrite=args.overwrite)
 
-    s = st.mode_stability(p)
+    try:
+        s = st.mode_stability(p)
+    except ValueError as exc:  # a force drive's force that no steady velocity balances
+        raise CommandError(str(exc)) from None
     data: dict[str, Any] = {
         "params": {k: v for k, v in p.to_dict().items() if k not in ("Fs", "dt")},
         "friction_slope": s.friction_slope,

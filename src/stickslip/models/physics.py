@@ -6,12 +6,11 @@ package; arrays hold block i at index i - 1. The pulling point is x_0 = V t.
 
 from __future__ import annotations
 
-import dataclasses
+import functools
 import importlib
 from typing import Any
 
 import numpy as np
-from scipy.optimize import brentq
 
 from stickslip.models.params import BlockParams, ChainParams
 
@@ -38,23 +37,38 @@ def block_steady_state(p: BlockParams) -> dict[str, float]:
     return {"v": p.V, "theta": theta0, "force": force, "lag": force / p.K}
 
 
+def _block_values(value: Any) -> np.ndarray | None:
+    """The N values of a per-block parameter (an array, or the values of a
+    :class:`~stickslip.models.disorder.PerBlock`), None for a number."""
+    if isinstance(value, np.ndarray):
+        return value
+    values = getattr(value, "values", None)
+    return values if isinstance(values, np.ndarray) else None
+
+
 def per_block(p: Any, name: str) -> np.ndarray:
     """The parameter ``name`` of ``p`` at every block, i = 1..N at index i - 1.
 
     A parameter is a float (the same at every block) or an array of N values (quenched
     disorder, one value per block); either way this returns N values (read-only for a float).
     """
-    return np.broadcast_to(np.asarray(getattr(p, name), dtype=float), (p.N,))
+    value = getattr(p, name)
+    values = _block_values(value)
+    return np.broadcast_to(np.asarray(value if values is None else values, dtype=float), (p.N,))
 
 
 def is_uniform(p: Any) -> bool:
     """Whether every block has the same parameters: no field of ``p`` is an array of N values
     with two different entries (a uniform chain given as arrays counts as uniform)."""
-    for f in dataclasses.fields(p):
-        value = getattr(p, f.name)
-        if isinstance(value, np.ndarray) and value.ndim == 1 and value.size > 1 and np.any(value != value[0]):
+    for value in _arrays(p):
+        if value.ndim == 1 and value.size > 1 and np.any(value != value[0]):
             return False
     return True
+
+
+def _arrays(p: Any) -> list[np.ndarray]:
+    """The fields of ``p`` that are arrays (none for a chain of floats)."""
+    return [a for a in (_block_values(v) for v in vars(p).values()) if a is not None]
 
 
 class BlockView:
@@ -75,17 +89,15 @@ class BlockView:
         if name in self._overrides:
             return self._overrides[name]
         value = getattr(self._p, name)
-        if isinstance(value, np.ndarray) and value.ndim == 1:
-            return float(value[self._i])
+        values = _block_values(value)
+        if values is not None and values.ndim == 1:
+            return float(values[self._i])
         return value
 
 
-def _uniform_view(p: Any, **overrides: float) -> Any:
+def uniform_view(p: Any, **overrides: float) -> Any:
     """``p`` itself for a chain of floats, else block 1's view (for a uniform chain given as arrays)."""
-    scalar = all(
-        not (isinstance(getattr(p, f.name), np.ndarray) and getattr(p, f.name).ndim == 1) for f in dataclasses.fields(p)
-    )
-    return p if scalar and not overrides else BlockView(p, 0, **overrides)
+    return p if not _arrays(p) and not overrides else BlockView(p, 0, **overrides)
 
 
 def steady_friction(p: ChainParams) -> tuple[float, float]:
@@ -106,7 +118,7 @@ def block_frictions(p: Any, v: float | None = None) -> tuple[np.ndarray, np.ndar
     over = {} if v is None else {"V": float(v)}
     steady = p.friction_piece.steady
     if is_uniform(p):
-        c, theta0 = steady(_uniform_view(p, **over))
+        c, theta0 = steady(uniform_view(p, **over))
         return np.full(p.N, c), np.full(p.N, theta0)
     pairs = [steady(BlockView(p, i, **over)) for i in range(p.N)]
     return np.array([c for c, _ in pairs]), np.array([th for _, th in pairs])
@@ -118,14 +130,45 @@ def applied_forces(p: Any) -> np.ndarray | None:
     applied = p.drive_piece.applied
     if applied is None:
         return None
+    if is_uniform(p):
+        return np.full(p.N, float(applied(BlockView(p, 0))))
     return np.array([applied(BlockView(p, i)) for i in range(p.N)])
 
 
+def _cached(fn):
+    """``fn(p)`` remembered for parameters that hash (floats; a chain with arrays is computed each
+    time), its arrays read-only: the steady stop asks at every sample."""
+    remembered = functools.lru_cache(maxsize=64)(fn)
+
+    @functools.wraps(fn)
+    def wrapper(p):
+        try:
+            out = remembered(p)
+        except TypeError:  # an array among the parameters
+            return fn(p)
+        for a in out.values() if isinstance(out, dict) else (out,):
+            if isinstance(a, np.ndarray):
+                a.flags.writeable = False
+        return out
+
+    return wrapper
+
+
+@_cached
 def drive_stiffness(p: Any) -> np.ndarray:
     """The stiffness of the spring joining each block to the drive: the drive's compiled ``leaf``
     (Kp for the plate, 0 for the end drive and the force drives) at each block's parameters."""
-    mod = importlib.import_module(p.drive_piece.module)
-    return np.array([float(mod.leaf.py_func(block_kernel_params(p.drive_piece, p, i))) for i in range(p.N)])
+    leaf = _python(p.drive_piece.module, "leaf")
+    if is_uniform(p):
+        return np.full(p.N, float(leaf(block_kernel_params(p.drive_piece, p, 0))))
+    return np.array([float(leaf(block_kernel_params(p.drive_piece, p, i))) for i in range(p.N)])
+
+
+def _python(module: str, name: str) -> Any:
+    """A piece's compiled function ``name`` as plain Python (its ``py_func``), without compiling it
+    (a function still waiting for numba, :func:`stickslip.models.piece.njit`, is read as it is)."""
+    fn = vars(importlib.import_module(module))[name]
+    return getattr(fn, "py_func", None) or fn.__wrapped__
 
 
 def block_kernel_params(piece: Any, p: Any, i: int) -> tuple:
@@ -134,6 +177,7 @@ def block_kernel_params(piece: Any, p: Any, i: int) -> tuple:
     return importlib.import_module(piece.module).Params(*(float(getattr(view, r)) for r in piece.reads))
 
 
+@_cached
 def ghost_rows(p: Any) -> dict[str, tuple[float, float]]:
     """The ghost cells of the chain as linear functions of the end blocks, from the pieces' own
     compiled ``left`` and ``ghost`` (the rows the kernels' :func:`stickslip.kernels.laws._set_ghosts`
@@ -143,8 +187,8 @@ def ghost_rows(p: Any) -> dict[str, tuple[float, float]]:
     theta_0 and theta_{N+1} (no flux). x_0 of the end drive is the pulling point, which moves with
     steady sliding, so its weights are 0. The ghost functions are selections, so the weights are exact.
     """
-    ends = importlib.import_module(p.ends_piece.module).ghost.py_func
-    left = importlib.import_module(p.drive_piece.module).left.py_func
+    ends = _python(p.ends_piece.module, "ghost")
+    left = _python(p.drive_piece.module, "left")
     on_ghost = left(0.0, 1.0)  # 1 where x_0 is the ends' ghost cell, 0 where it is the pulling point
     x_edge, x_other = ends(1.0, 0.0, 0.0), ends(0.0, 1.0, 0.0)
     th_edge, th_other = ends(1.0, 0.0, 1.0), ends(0.0, 1.0, 0.0)
@@ -159,8 +203,8 @@ def ghost_rows(p: Any) -> dict[str, tuple[float, float]]:
 def left_ghost(p: Any, pull: float, x1: float, xN: float) -> float:
     """x_0 as the kernels set it (:func:`stickslip.kernels.laws._set_ghosts`): the drive's compiled
     ``left`` of the pull point ``pull`` and the ends' ``ghost`` of x_1 and x_N (a wall at 0)."""
-    ends = importlib.import_module(p.ends_piece.module).ghost.py_func
-    left = importlib.import_module(p.drive_piece.module).left.py_func
+    ends = _python(p.ends_piece.module, "ghost")
+    left = _python(p.drive_piece.module, "left")
     return left(pull, ends(x1, xN, 0.0))
 
 
@@ -191,25 +235,31 @@ def steady_velocity(p: Any) -> float:
     at which the frictions balance the applied forces, sum_i c_i(v) = sum_i F_i (Brent's method;
     for the strengthening law F0 + beta v it is (sum F_i - sum F0_i) / sum beta_i).
 
-    Raises ValueError where no v >= 0 balances them (the forces below the friction at v = 0).
+    The first root above v = 0 found by doubling a bracket (a weakening law below its friction at
+    rest balances on its falling branch). Raises ValueError where no v >= 0 balances them.
     """
     forces = applied_forces(p)
     if forces is None:
         return float(p.V)
+    from scipy.optimize import brentq  # here: the command line's help loads no scipy
+
     total = float(np.sum(forces))
 
     def excess(v: float) -> float:
         return float(np.sum(block_frictions(p, v)[0])) - total
 
-    if excess(0.0) > 0.0:
-        raise ValueError("the applied force is below the friction at v = 0: the chain cannot slide steadily")
+    at_rest = excess(0.0)
+    if at_rest == 0.0:
+        return 0.0
     hi = 1.0
     for _ in range(200):
-        if excess(hi) >= 0.0:
+        if (excess(hi) > 0.0) != (at_rest > 0.0):
             break
         hi *= 2.0
     else:
-        raise ValueError("the friction does not balance the applied force at any velocity")
+        raise ValueError(
+            f"the friction does not balance the applied force at any velocity (drive {p.drive}, friction {p.friction})"
+        )
     return float(brentq(excess, 0.0, hi, xtol=1e-15, rtol=4.0 * np.finfo(float).eps))
 
 
@@ -232,7 +282,7 @@ def chain_steady_state(p: ChainParams, t: float = 0.0) -> dict[str, np.ndarray]:
     N = p.N
     uniform = is_uniform(p)
     if uniform and p.drive_piece.applied is None:
-        c, theta0 = steady_friction(_uniform_view(p))
+        c, theta0 = steady_friction(uniform_view(p))
         friction: Any = c
         v = p.V
         theta = np.full(N, theta0)
@@ -287,6 +337,14 @@ def _check_theta_decoupled(p: Any, theta: np.ndarray, v: float) -> None:
         )
 
 
+@_cached
+def steady_reference(p: Any) -> dict[str, Any]:
+    """:func:`chain_steady_state` at t = 0 and whether the drive holds every block's position (a
+    leaf spring, so steady sliding is compared in the plate's frame): what the steady stop compares
+    a state with at every sample, computed once per parameters."""
+    return {**chain_steady_state(p, 0.0), "pinned": bool(np.any(drive_stiffness(p) > 0.0))}
+
+
 def _extensions(x: np.ndarray, rows: dict[str, tuple[float, float]]) -> np.ndarray:
     """x_{i-1} - x_i, i = 1..N, with x_0 the ends' ghost cell (weights ``rows['x0']``)."""
     a1, aN = rows["x0"]
@@ -324,7 +382,7 @@ def chain_steady_length(p: ChainParams) -> float:
         return float(x[0] - x[-1])
     if p.drive_piece.leaf_spring:
         return 0.0
-    c = steady_friction(_uniform_view(p))[0]
+    c = steady_friction(uniform_view(p))[0]
     return c / p.K * p.N * (p.N - 1) / 2.0
 
 

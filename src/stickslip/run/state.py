@@ -306,11 +306,11 @@ def steady_deviation(state: ChainState, p: ChainParams) -> float:
 
 def _deviation(state: ChainState, p: ChainParams) -> float:
     """:func:`steady_deviation` of a chain that slides (the steady state's closed form)."""
-    if np.any(physics.drive_stiffness(p) > 0.0):
+    ss = physics.steady_reference(p)
+    if ss["pinned"]:
         # Every block lags the plate by c / Kp: compare positions in the plate's frame.
         ss = physics.chain_steady_state(p, float(np.float64(state.step) * p.dt))
         return float(max(np.max(np.abs(state.v[1:-1] - ss["v"])), np.max(np.abs(state.x[1:-1] - ss["x"]))))
-    ss = physics.chain_steady_state(p)
     x = state.x[1:-1]
     # x_0: the pulling point V t_n (end drive) or the ends' ghost cell (a force drive), as the kernels set it.
     x0 = physics.left_ghost(p, p.V * (np.float64(state.step) * p.dt), x[0], x[-1])

@@ -20,9 +20,7 @@ at rest.
 
 from __future__ import annotations
 
-from numba import njit
-
-from stickslip.models.piece import Param, Piece, kernel_params
+from stickslip.models.piece import Param, Piece, kernel_params, njit
 
 READS = ("F",)
 Params = kernel_params(__name__, READS)

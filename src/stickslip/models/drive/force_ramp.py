@@ -21,9 +21,7 @@ the drive at u = 0). No steady sliding: the force never stops growing.
 
 from __future__ import annotations
 
-from numba import njit
-
-from stickslip.models.piece import Param, Piece, kernel_params
+from stickslip.models.piece import Param, Piece, kernel_params, njit
 
 READS = ("F_start", "r")
 Params = kernel_params(__name__, READS)
