@@ -35,6 +35,7 @@ from typing import Any
 
 import numpy as np
 
+from stickslip.analysis.period_rule import MAX_PERIOD, REPEATS, RTOL
 from stickslip.kernels import layout
 from stickslip.models.params import ParameterError, check_number
 from stickslip.run.loop import Hook, Loop
@@ -50,14 +51,6 @@ __all__ = [
     "rule_text",
 ]
 
-#: Default relative tolerance on the slip size S: a settled orbit of the chain repeats its sizes
-#: to about 1e-12, the single block's (whose slips start at a different fraction of a step each
-#: time) to about 4e-7; successive slips of the loading pulse differ by 1e-6 to 1e-5.
-RTOL = 1e-6
-#: Default longest period searched, in slips.
-MAX_PERIOD = 500
-#: Default number of periods the periodic stretch must hold.
-REPEATS = 3
 #: Slips compared first on each p: a wrong period fails on them at once.
 _PROBE = 8
 

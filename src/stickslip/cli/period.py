@@ -11,7 +11,7 @@ from stickslip.cli._common import CommandError, Result, add_json_option, float_a
 def add_rule_options(p: argparse.ArgumentParser, prefix: str = "") -> None:
     """The options of the matching rule (:func:`stickslip.analysis.periodicity.find_period`),
     named ``--{prefix}rtol``, ``--{prefix}max-period`` and ``--{prefix}repeats``."""
-    from stickslip.analysis.periodicity import MAX_PERIOD, REPEATS, RTOL
+    from stickslip.analysis.period_rule import MAX_PERIOD, REPEATS, RTOL
 
     p.add_argument(
         f"--{prefix}rtol",

@@ -17,16 +17,18 @@ from __future__ import annotations
 import json
 import math
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
 
 from stickslip.experiments.studies import Design, Study, finite, short
 from stickslip.experiments.studies.chain_point import t_end_of
 from stickslip.experiments.studies.disorder_points import disorder_check, disorder_task
 from stickslip.models.physics import UNTIL_STEADY
 from stickslip.models.presets import paper_parameters
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 __all__ = ["DESIGN", "QEW_ZETA", "QEW_ZETA_ERR", "qew_tau", "findings", "ramp_fits", "part_a", "part_c"]
 

@@ -31,13 +31,15 @@ from __future__ import annotations
 
 import time
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
 
 from stickslip.experiments.studies import Design, Study, short
 from stickslip.experiments.sweep_points import point_params
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 __all__ = ["DESIGN", "lifetime_point", "conclusions", "start_state", "PAPER_N"]
 
@@ -185,6 +187,8 @@ def per_point(table: pd.DataFrame) -> list[dict[str, Any]]:
     sample mean where none was censored) with its error (the sample's where none was censored)
     or its lower bound, the median of the Kaplan-Meier curve, the Weibull test and the
     periods reached."""
+    import pandas
+
     from stickslip.analysis.survival import exponential_fit, kaplan_meier
 
     out = []
@@ -193,7 +197,7 @@ def per_point(table: pd.DataFrame) -> list[dict[str, Any]]:
         fit = exponential_fit(T, ended)
         km = kaplan_meier(T, ended)
         below = km[km["survival"] <= 0.5]
-        periods = pd.Series(g.loc[g["end"] == "periodic", "period_slips"]).dropna().astype(int)
+        periods = pandas.Series(g.loc[g["end"] == "periodic", "period_slips"]).dropna().astype(int)
         out.append(
             {
                 "beta": beta,
