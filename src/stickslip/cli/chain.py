@@ -79,7 +79,7 @@ def register(sub) -> None:
         type=int_arg("repeat", ">= 1"),
         default=None,
         help="time each integrator this many times, alternated, keep the fastest (default 1; 3 with "
-        "--workload partly-stuck, whose exact run lasts a quarter second)",
+        "--workload partly-stuck or disordered, whose exact runs last a fraction of a second)",
     )
     b.add_argument(
         "--workload",
@@ -483,7 +483,7 @@ def run_bench_command(args: argparse.Namespace) -> Result:
 
     if args.repeat is None:
         # A short timing is the noisier one: the partly stuck workload's exact run takes about 0.25 s.
-        args.repeat = 3 if args.workload == "partly-stuck" else 1
+        args.repeat = 3 if args.workload in ("partly-stuck", "disordered") else 1
     check_number("repeat", args.repeat, low=1, integer=True)
     if args.switches == "located":
         return _located(args)

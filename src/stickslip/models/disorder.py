@@ -205,6 +205,10 @@ class PerBlock:
         checking them against their SHA-256."""
         return {**self.describe(), "values": [float(x) for x in self.values]}
 
+    def __format__(self, spec: str) -> str:
+        """The spec where a number would be formatted (``f"{p.Fs:g}"`` in a title or a summary)."""
+        return self.spec_text
+
     def __len__(self) -> int:
         return int(self.values.size)
 
