@@ -91,3 +91,11 @@ def test_lyapunov_refuses_a_draw_with_the_papers_start_through_the_same_check(ar
     assert main(["lyapunov", "--N", "3", *argv]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "goes with --start steady or --start rest" in err, err
+
+
+def test_snapshot_times_may_be_any_sequence_of_numbers():
+    import numpy as np
+
+    for times in ((5.0, 10.0), [5.0, 10.0], np.array([5.0, 10.0])):
+        run = run_chain(P, 20.0, snapshot_times=times)
+        assert run.snapshots.sizes["snapshot_time"] == 3  # the two and the final state

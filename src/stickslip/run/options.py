@@ -10,7 +10,7 @@ and help as metadata (``cli``), from which the command line is built
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -186,7 +186,7 @@ class RunOptions:
             raise ParameterError(f"{name('sample_interval')} must be >= dt = {dt:g} (got {self.sample_interval!r})")
         if self.average_from is not None:
             check_number(name("average_from"), self.average_from, low=0.0, high=self.t_end)
-        if isinstance(self.snapshot_times, (str, bytes)) or not isinstance(self.snapshot_times, Sequence):
+        if isinstance(self.snapshot_times, (str, bytes)) or not isinstance(self.snapshot_times, Iterable):
             raise ParameterError(
                 f"{name('snapshot_times')} must be a sequence of times, e.g. (10.0,) (got {self.snapshot_times!r})"
             )
