@@ -54,6 +54,7 @@ def build_parser() -> argparse.ArgumentParser:
         catalog,
         chain,
         compile,
+        lab,
         lyapunov,
         models,
         plot,
@@ -72,7 +73,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"stickslip {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
-    for module in (block, stability, chain, models, sweep, reproduce, study, lyapunov, plot, catalog, compile):
+    for module in (block, stability, chain, models, sweep, reproduce, study, lyapunov, plot, catalog, compile, lab):
         module.register(sub)
     parser.commands = sub.choices
     return parser
@@ -104,7 +105,8 @@ def main(argv: list[str] | None = None) -> int:
     args, extra = parser.parse_known_args(argv)
     if extra:  # refused by the command's own parser: its usage line, and its options to suggest from
         parser.commands[args.command].error(f"unrecognized arguments: {' '.join(extra)}")
-    name = " ".join(v for v in (args.command, getattr(args, "stability_command", None)) if v)
+    sub_command = getattr(args, "stability_command", None) or getattr(args, "lab_command", None)
+    name = " ".join(v for v in (args.command, sub_command) if v)
     try:
         with warnings.catch_warnings(), heartbeat(name, enabled=_beats(args)):
             warnings.showwarning = _one_line_warning(args.command)

@@ -385,6 +385,9 @@ OUT_FILES: dict[str, frozenset[str]] = {
     "stability chain": frozenset({"fig4.nc", "mode_growth.nc", "stability_chain.json"})
     | _figures("fig4", "mode_growth"),
     "hysteresis": frozenset({"hysteresis.nc", "hysteresis.json"}) | _figures("hysteresis"),
+    "lab step": frozenset({"step.nc", "step.json"}) | _figures("step"),
+    "lab shs": frozenset({"shs.nc", "shs.json"}) | _figures("shs"),
+    "lab fit": frozenset({"fit.nc", "fit.json", "posterior.nc"}) | _figures("fit", "posterior"),
     "sweep": frozenset({"summary.parquet", "summary.csv"}),
     "reproduce": frozenset({"runs", *PAPER, "report.json", "report.html", MANIFEST}),
 }

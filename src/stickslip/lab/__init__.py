@@ -1,0 +1,38 @@
+"""The rock-friction laboratory: load histories, the quasi-static spring-slider, fitting.
+
+A layer of its own beside :mod:`stickslip.analysis`: it imports :mod:`stickslip.models` (and
+the shared helpers), never the plotting, the reports or the command line.
+
+- :class:`LoadHistory`: velocity steps, holds, tables and lab records (CSV) of the load point;
+- :class:`RateState`: rate-and-state friction in the lab's conventions, any number of state
+  variables, each with its own law (aging, slip, PRZ, Nagata), log or asinh form;
+- :func:`quasi_static`: the massless spring-slider k (p - x) = mu + eta v over a history;
+- :func:`critical_stiffness`: k_c of steady sliding, one or more state variables;
+- :func:`fit`: least-squares fits of records, with standard errors and correlations;
+- :mod:`stickslip.lab.protocols`: velocity steps and slide-hold-slide tests as one call.
+"""
+
+from stickslip.lab.fit import FitResult, fit
+from stickslip.lab.history import LoadHistory
+from stickslip.lab.laws import LAWS, RateState, steady_friction, steady_theta
+from stickslip.lab.protocols import slide_hold_slide, velocity_step
+from stickslip.lab.quasi_static import quasi_static
+from stickslip.lab.records import Record, detrend, synthetic
+from stickslip.lab.stability import critical_stiffness
+
+__all__ = [
+    "LAWS",
+    "FitResult",
+    "LoadHistory",
+    "RateState",
+    "Record",
+    "critical_stiffness",
+    "detrend",
+    "fit",
+    "quasi_static",
+    "slide_hold_slide",
+    "steady_friction",
+    "steady_theta",
+    "synthetic",
+    "velocity_step",
+]

@@ -1,0 +1,87 @@
+"""The lab's speed, measured as ratios in one run: the quasi-static spring-slider against a
+plain-Python odeint model of the same equations, and the CPU time of a four-parameter fit.
+
+The case is the field's standard velocity step: a = 0.005, b = 0.01, D_c = 10, mu0 = 0.6, V0 = 1,
+k = 1e-3, the load point stepping 1 -> 10 at t = 10, run to t = 100 with 1001 outputs, at rtol 1e-10
+in both. Each timing is the least of ``repeats`` runs after one run that compiles (wall-clock
+``perf_counter``; the fit's ``process_time``). How the numbers compare with the targets is in
+docs/lab.md and docs/performance.md.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from stickslip.lab.fit import fit
+from stickslip.lab.history import LoadHistory
+from stickslip.lab.laws import RateState
+from stickslip.lab.quasi_static import quasi_static, solve
+from stickslip.lab.records import synthetic
+from stickslip.lab.reference import odeint_one_state
+
+__all__ = ["bench"]
+
+CASE = dict(a=0.005, b=0.01, Dc=10.0, mu0=0.6, V0=1.0, k=1e-3)
+
+
+def _best(fn, repeats: int) -> float:
+    best = np.inf
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        fn()
+        best = min(best, time.perf_counter() - t0)
+    return best
+
+
+def bench(repeats: int = 5) -> dict:
+    """Time the velocity step both ways and a four-parameter fit (module docstring).
+
+    Returns
+    -------
+    dict
+        ``quasi_static_s`` (the Dataset), ``arrays_s`` (:func:`~stickslip.lab.quasi_static.solve`,
+        arrays as odeint returns them), ``odeint_s``, ``speed_ratio`` and ``speed_ratio_arrays``
+        (odeint's time over each), ``max_abs_mu_difference``,
+        ``fit_cpu_s`` (a, b, D_c, mu0 from a noisy 500-sample record), ``fit_evaluations`` and the
+        fitted values with their standard errors.
+    """
+    model = RateState(**CASE)
+    history = LoadHistory.steps([1.0, 10.0], [10.0, 90.0])
+    t = np.linspace(0.0, 100.0, 1001)
+    qs = lambda: quasi_static(model, history, t=t, rtol=1e-10)
+    ref = lambda: odeint_one_state(
+        CASE["a"], CASE["b"], CASE["Dc"], CASE["mu0"], CASE["V0"], CASE["k"], history, t, rtol=1e-10
+    )
+    arrays = lambda: solve(model, history, t, rtol=1e-10)
+    ds = qs()
+    mu_ref = ref()[0]
+    t_qs = _best(qs, repeats)
+    t_arrays = _best(arrays, repeats)
+    t_ref = _best(ref, repeats)
+    rec = synthetic(model, history, n=500, noise=1e-4, rng=0)
+    start = model.with_values(a=0.007, b=0.007, Dc=5.0, mu0=0.59)
+    fit(rec, start, ("a", "b", "Dc", "mu0"))  # compiles nothing new; warms the caches
+    cpu = np.inf
+    for _ in range(max(1, repeats // 2)):
+        res = fit(rec, start, ("a", "b", "Dc", "mu0"))
+        cpu = min(cpu, res.cpu_seconds)
+    return {
+        "case": {**CASE, "law": "aging", "step": "V 1 -> 10 at t = 10, t_end = 100, 1001 outputs, rtol 1e-10"},
+        "quasi_static_s": t_qs,
+        "odeint_s": t_ref,
+        "speed_ratio": t_ref / t_qs,
+        "arrays_s": t_arrays,
+        "speed_ratio_arrays": t_ref / t_arrays,
+        "max_abs_mu_difference": float(np.max(np.abs(ds.mu.values - mu_ref))),
+        "quasi_static_steps": int(ds.attrs["steps"]),
+        "fit_cpu_s": cpu,
+        "fit_evaluations": res.evaluations,
+        "fit": {
+            n: {"value": float(v), "stderr": float(e)}
+            for n, v, e in zip(res.names, res.values, res.errors, strict=True)
+        },
+        "fit_truth": {"a": CASE["a"], "b": CASE["b"], "Dc": CASE["Dc"], "mu0": CASE["mu0"]},
+        "repeats": repeats,
+    }
