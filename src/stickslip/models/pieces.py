@@ -7,7 +7,8 @@ the start and stop rules and Heun with t_n = n dt. They differ in
 drive      ``end``: a pulling point x_0 = V t joined to block 1 (eq. 4);
            ``plate``: every block joined to a plate at V t by a leaf spring Kp (BK, CL);
            ``constant-force``: a force F on every block; ``force-ramp``: F_start + r t on every
-           block (random-medium protocols, Sakaguchi and Kadowaki)
+           block (random-medium protocols, Sakaguchi and Kadowaki); ``history``: the pulling
+           point of eq. (4) moved along a load history p(t) (steps, holds, tables)
 friction   ``state``: theta_i + beta v_i, theta from eq. (4);
            ``weakening``: phi(v) = (1 - sigma) / (1 + 2 alpha max(v, 0) / (1 - sigma)) (CL);
            ``strengthening``: F0 + beta v, no state variable (train model);
@@ -56,7 +57,7 @@ FRICTIONS = (
 )
 
 #: The drives, one module each in :mod:`stickslip.models.drive`.
-DRIVES = ("end", "plate", "constant_force", "force_ramp")
+DRIVES = ("end", "plate", "constant_force", "force_ramp", "history")
 
 #: The static thresholds, one module each in :mod:`stickslip.models.threshold`.
 THRESHOLDS = ("constant", "state")
