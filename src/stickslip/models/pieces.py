@@ -14,7 +14,8 @@ friction   ``state``: theta_i + beta v_i, theta from eq. (4);
            ``strengthening``: F0 + beta v, no state variable (train model);
            ``rate-state``: Dieterich-Ruina with the aging law; ``slip``: with Ruina's slip law;
            one module each in :mod:`stickslip.models.friction`, listed in :data:`FRICTIONS`
-threshold  ``constant``: Fs; ``state``: theta_i (the paper's reading of Batista-Carlson)
+threshold  ``constant``: Fs; ``state``: theta_i (the paper's reading of Batista-Carlson);
+           ``none``: no static threshold, for rate-and-state (a block starts when f_i > 0)
 ends       ``free``, ``fixed``, ``periodic`` (a drive acting on every block only)
 ========== ==========================================================================
 
@@ -60,7 +61,7 @@ FRICTIONS = (
 DRIVES = ("end", "plate", "constant_force", "force_ramp", "history")
 
 #: The static thresholds, one module each in :mod:`stickslip.models.threshold`.
-THRESHOLDS = ("constant", "state")
+THRESHOLDS = ("constant", "state", "none")
 
 #: The end conditions, one module each in :mod:`stickslip.models.ends`.
 ENDS = ("free", "fixed", "periodic")
@@ -99,6 +100,7 @@ def code(kind: str, name: str) -> str:
 RULES = (
     "ends periodic needs a drive that acts on every block (plate, constant-force, force-ramp)",
     "threshold state needs friction state",
+    "threshold none needs a rate-and-state friction (rate-state, rate-state-slip)",
 )
 
 
@@ -113,6 +115,10 @@ def check_composition(drive: str, friction: str, threshold: str, ends: str) -> N
         )
     if threshold == "state" and friction != "state":
         raise CompositionError(f"threshold state needs friction state (friction {friction} has no theta)")
+    if threshold == "none" and not friction.startswith("rate-state"):
+        raise CompositionError(
+            f"threshold none needs a rate-and-state friction (rate-state, rate-state-slip; got friction {friction})"
+        )
 
 
 def stopped_blocks_still(drive: Piece, friction: Piece) -> bool:
