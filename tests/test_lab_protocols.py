@@ -104,6 +104,8 @@ def test_bench_measures_both_routes_and_they_agree(capsys):
     d = _json(capsys, "lab", "bench", "--repeats", "1")
     assert d["max_abs_mu_difference"] < 1e-9
     assert d["speed_ratio"] > 0.0 and d["fit_cpu_s"] > 0.0
+    inertial = d["inertial_history"]
+    assert inertial["steps"] == 276_000 and inertial["ratio"] == inertial["history_s"] / inertial["constant_s"]
     for name in ("a", "b", "Dc", "mu0"):
         v, e = d["fit"][name]["value"], d["fit"][name]["stderr"]
         assert abs(v - d["fit_truth"][name]) < 5.0 * e

@@ -13,7 +13,7 @@ def may_vary(f) -> bool:
     parameters")."""
     from stickslip.models.disorder import NOT_PER_BLOCK
 
-    return not f.metadata.get("integer") and f.name not in NOT_PER_BLOCK
+    return not f.metadata.get("integer") and not f.metadata.get("text") and f.name not in NOT_PER_BLOCK
 
 
 def per_block_arg(name: str, allowed: str = ""):

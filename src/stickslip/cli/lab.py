@@ -310,6 +310,9 @@ def run_bench(args) -> Result:
         f"{data['speed_ratio']:.3g}x faster ({data['speed_ratio_arrays']:.3g}x without the Dataset); "
         f"max |mu - mu_odeint| = {data['max_abs_mu_difference']:.2g}\n"
         f"four-parameter fit (a, b, Dc, mu0; 500 noisy samples): {data['fit_cpu_s']:.3g} s CPU, "
-        f"{data['fit_evaluations']} model evaluations"
+        f"{data['fit_evaluations']} model evaluations\n"
+        f"inertial route (N = 1, M = 1e-3, {data['inertial_history']['steps']} steps): slide-hold-slide history "
+        f"{data['inertial_history']['history_s'] * 1e3:.3g} ms, constant V "
+        f"{data['inertial_history']['constant_s'] * 1e3:.3g} ms: {data['inertial_history']['ratio']:.3g}x"
     )
     return Result(data=data, text=text)

@@ -61,7 +61,7 @@ def run_dense(args, drive, friction, threshold, ends):
             return DONE
         if ist[EV_COUNT] >= cap_ev or ist[FM_COUNT] + N > cap_fm or (profile_every > 0 and ist[P_COUNT] + 2 > cap_p):
             return _overflow(ist, N, cap_ev, cap_fm)
-        p1 = _pull(V, n, dt)
+        p1 = _pull(V, n, dt, dp, drive)
         _set_ghosts(x, th, N, p1, drive, ends)
         for i in range(1, N + 1):
             f = _force(x[i - 1], x[i], x[i + 1], K, dp, p1, drive, i)
@@ -74,7 +74,7 @@ def run_dense(args, drive, friction, threshold, ends):
             xs[i] = x[i] + dt * v[i]
             vs[i] = v[i] + dt * a1[i]
             ths[i] = th[i] + dt * b1[i]
-        p2 = _pull(V, n + 1, dt)
+        p2 = _pull(V, n + 1, dt, dp, drive)
         _set_ghosts(xs, ths, N, p2, drive, ends)
         _start_and_first_moves(n, 1, N, x, mm, first_step, x0ev, ist, prof_x, prof_meta, N, profile_every)
         n_moving = 0

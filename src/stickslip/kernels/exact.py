@@ -123,7 +123,7 @@ def _slide_steps(args, ra0, rb0, hi, mp, V, dt, drive, friction, threshold, ends
             or (profile_every > 0 and ist[P_COUNT] + 2 > cap_p)
         ):
             return ra0, rb0, _NEVER
-        p1 = _pull(V, n, dt)
+        p1 = _pull(V, n, dt, dp, drive)
         _set_ghosts(x, th, N, p1, drive, ends)
         if not every and _force(x[fh - 1], x[fh], x[fh + 1], K, dp, p1, drive, fh) > _threshold(
             th[fh], tp, threshold, fh
@@ -132,7 +132,7 @@ def _slide_steps(args, ra0, rb0, hi, mp, V, dt, drive, friction, threshold, ends
         _stage1_run(x, v, th, xs, vs, ths, a1, b1, ra0, rp, p1, mp, dt, drive, friction)
         if not every:
             _stage1_theta(x, v, th, xs, vs, ths, mm, b1, fh, h1, mp, dt, friction)
-        p2 = _pull(V, n + 1, dt)
+        p2 = _pull(V, n + 1, dt, dp, drive)
         _set_ghosts(xs, ths, N, p2, drive, ends)
         c_hi = rb0
         if has(friction, "has_state") and not every:
@@ -235,7 +235,7 @@ def run_exact(args, drive, friction, threshold, ends):
             mh = ist[MECH_HI]
             if not has(drive, "leaf_spring"):
                 x2 = _right_of_first(x, N, ends)
-                if mov[1] != 0.0 or _force(_pull(V, n, dt), x[1], x2, K, dp, 0.0, drive, 1) > _threshold(
+                if mov[1] != 0.0 or _force(_pull(V, n, dt, dp, drive), x[1], x2, K, dp, 0.0, drive, 1) > _threshold(
                     th[1], tp, threshold, 1
                 ):
                     lo = 1
@@ -287,7 +287,7 @@ def run_exact(args, drive, friction, threshold, ends):
                     t_next = t
                 continue
 
-            p1 = _pull(V, n, dt)
+            p1 = _pull(V, n, dt, dp, drive)
             _set_ghosts(x, th, N, p1, drive, ends)
             l1 = lo - 1 if lo > 1 else 1
             h1 = hi + 1 if hi < N else N
@@ -365,7 +365,7 @@ def run_exact(args, drive, friction, threshold, ends):
                             _stage1_theta_only(v, th, ths, b1, b_ + 1, h1, mp, dt, friction)
             elif has(friction, "has_state"):
                 _stage1_theta_only(v, th, ths, b1, l1, h1, mp, dt, friction)
-            p2 = _pull(V, n + 1, dt)
+            p2 = _pull(V, n + 1, dt, dp, drive)
             _set_ghosts(xs, ths, N, p2, drive, ends)
             # Only a block that starts in this step can move for the first time in an event.
             if (ist[EV_ACTIVE] == 1 and starts) or (ist[N_MOVING] == 0 and first <= last):

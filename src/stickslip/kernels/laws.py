@@ -154,16 +154,21 @@ def _is_array(ty) -> bool:
     return isinstance(ty, types.Array)
 
 
+def _is_per_block(ty) -> bool:
+    """A field over the blocks (1-D); a table (a load history's breakpoints, 2-D) is not gathered."""
+    return isinstance(ty, types.Array) and ty.ndim == 1
+
+
 @overload(at)
 def _at(params, i):
     if not isinstance(params, types.BaseNamedTuple):
         return None
-    if not any(_is_array(t) for t in params.types):
+    if not any(_is_per_block(t) for t in params.types):
         return lambda params, i: params
     group = isinstance(i, types.BaseTuple)
     fields = []
     for name, ty in zip(params.fields, params.types, strict=True):
-        if not _is_array(ty):
+        if not _is_per_block(ty):
             fields.append(f"params.{name}")
         elif group:
             fields.append(f"_load(params.{name}.ctypes.data, i[0], i[1])")
@@ -264,10 +269,33 @@ def _threshold(th, tp, threshold, i):
     return call(threshold, "value", th, at(tp, i))
 
 
-@njit(cache=True, inline="always")
-def _pull(V, n, dt):
-    """Pulling point (or plate) V t_n with t_n = n dt from the integer step count (docs/model.md)."""
+def pull_point(V, n, dt, dp, drive):
+    """The drive's load point at step n: its module's ``pull(n, dt, dp)`` where it has one (a load
+    history), else V t_n = V * (n dt)."""
+    mod = importlib.import_module(drive)
+    if hasattr(mod, "pull"):
+        return mod.pull(n, dt, dp)
     return V * (np.float64(n) * dt)
+
+
+@overload(pull_point, prefer_literal=True)
+def _pull_point(V, n, dt, dp, drive):
+    mod = _module(drive)
+    if mod is None:
+        return None
+    if hasattr(mod, "pull"):
+        fn = mod.pull
+        return lambda V, n, dt, dp, drive: fn(n, dt, dp)
+    # Every constant-velocity drive: today's expression, so their runs keep their bits.
+    return lambda V, n, dt, dp, drive: V * (np.float64(n) * dt)
+
+
+@njit(cache=True, inline="always")
+def _pull(V, n, dt, dp, drive):
+    """Pulling point (or plate) at t_n = n dt from the integer step count (docs/model.md): V t_n
+    = V * (n dt) for the drives at a constant velocity, the drive's own ``pull`` for a load
+    history (:mod:`stickslip.models.drive.history`), chosen when the kernel is compiled."""
+    return pull_point(V, n, dt, dp, drive)
 
 
 @njit(cache=True, inline="always")

@@ -219,7 +219,7 @@ def run_sparse(args, drive, friction, threshold, ends):
             n_chk = n_end if n_end < ist[NEXT_SAMPLE] else ist[NEXT_SAMPLE]
             if profile_every > 0 and active and ist[NEXT_PROFILE] < n_chk:
                 n_chk = ist[NEXT_PROFILE]
-        p1 = _pull(V, n, dt)
+        p1 = _pull(V, n, dt, dp, drive)
         # Start rule of the stopped candidates: the queue, and (rarely) the plate's due starts.
         # Each goes to the starters (after the movers) or to the blocks that stay stopped; the
         # latter stay marked as queued.
@@ -299,7 +299,7 @@ def run_sparse(args, drive, friction, threshold, ends):
                 vsb[k] = vi + dt * a
                 xs[i] = x[i] + dt * vi
         _x_ghosts(xs, N, ends)
-        p2 = _pull(V, n + 1, dt)
+        p2 = _pull(V, n + 1, dt, dp, drive)
         # Event start and first moves (as events._start_and_first_moves): a block moves for
         # the first time in an event only in the step it starts.
         if nst > 0 and (active or nmov == 0):

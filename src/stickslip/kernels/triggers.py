@@ -34,13 +34,13 @@ def _first_trigger(x, N, V, dt, K, thr, n_lo, n_hi, dp, drive, ends):
     """
     x1 = x[1]
     x2 = _right_of_first(x, N, ends)
-    if n_lo >= n_hi or not (_force(_pull(V, n_hi - 1, dt), x1, x2, K, dp, 0.0, drive, 1) > thr):
+    if n_lo >= n_hi or not (_force(_pull(V, n_hi - 1, dt, dp, drive), x1, x2, K, dp, 0.0, drive, 1) > thr):
         return n_hi
     lo = n_lo
     hi = n_hi - 1  # invariant: fires at hi
     while lo < hi:
         mid = lo + (hi - lo) // 2
-        if _force(_pull(V, mid, dt), x1, x2, K, dp, 0.0, drive, 1) > thr:
+        if _force(_pull(V, mid, dt, dp, drive), x1, x2, K, dp, 0.0, drive, 1) > thr:
             hi = mid
         else:
             lo = mid + 1
@@ -49,7 +49,7 @@ def _first_trigger(x, N, V, dt, K, thr, n_lo, n_hi, dp, drive, ends):
 
 @njit(cache=True, inline="always")
 def _plate_fires(xl, xc, xr, thr, K, dp, V, dt, m, drive, i):
-    return _force(xl, xc, xr, K, dp, _pull(V, m, dt), drive, i) > thr
+    return _force(xl, xc, xr, K, dp, _pull(V, m, dt, dp, drive), drive, i) > thr
 
 
 @njit(cache=True)
@@ -68,7 +68,7 @@ def _plate_trigger(xl, xc, xr, thr, K, dp, V, dt, n0, n_cap, drive, i):
         return n_cap
     lo = n0  # does not fire
     hi = n_cap - 1  # fires
-    f0 = _force(xl, xc, xr, K, dp, _pull(V, n0, dt), drive, i)
+    f0 = _force(xl, xc, xr, K, dp, _pull(V, n0, dt, dp, drive), drive, i)
     rate = call(drive, "leaf", at(dp, i)) * V * dt
     if rate > 0.0:
         guess = (thr - f0) / rate

@@ -1,5 +1,7 @@
 """The lab's speed, measured as ratios in one run: the quasi-static spring-slider against a
-plain-Python odeint model of the same equations, and the CPU time of a four-parameter fit.
+plain-Python odeint model of the same equations, the CPU time of a four-parameter fit, and the
+inertial route (the chain's single block with a small mass, rate-and-state without a static
+threshold) driven by a slide-hold-slide load history against the same run at a constant V.
 
 The case is the field's standard velocity step: a = 0.005, b = 0.01, D_c = 10, mu0 = 0.6, V0 = 1,
 k = 1e-3, the load point stepping 1 -> 10 at t = 10, run to t = 100 with 1001 outputs, at rtol 1e-10
@@ -21,7 +23,7 @@ from stickslip.lab.quasi_static import quasi_static, solve
 from stickslip.lab.records import synthetic
 from stickslip.lab.reference import odeint_one_state
 
-__all__ = ["bench"]
+__all__ = ["bench", "inertial_history_cost"]
 
 CASE = dict(a=0.005, b=0.01, Dc=10.0, mu0=0.6, V0=1.0, k=1e-3)
 
@@ -35,6 +37,54 @@ def _best(fn, repeats: int) -> float:
     return best
 
 
+def inertial_history_cost(repeats: int = 3, M: float = 1e-3) -> dict:
+    """The inertial route's cost with a load history against its cost at a constant V: the chain's
+    single block (N = 1, mass ``M``, dt = M / 4, the exact integrator) with the case's
+    rate-and-state law and no static threshold, driven by a slide-hold-slide history (V = 1 for 20,
+    a hold of 10, V = 1 for 40; drive ``history``) and by the end drive at V = 1, over the same
+    steps from steady sliding. Each timing is the least of ``repeats`` runs, taken in turns, after
+    one that compiles.
+
+    Returns
+    -------
+    dict
+        ``history_s``, ``constant_s``, their ratio ``ratio`` (target: at most 1.1) and ``steps``.
+    """
+    from stickslip.lab.laws import friction_of
+    from stickslip.models.presets import chain_params
+    from stickslip.run.driver import ChainState, run_chain
+
+    law = dict(
+        friction="rate-state", threshold="none", rs_a=CASE["a"], rs_b=CASE["b"], Dc=CASE["Dc"], v0=CASE["V0"],
+        mu0=CASE["mu0"], sigma_n=1.0, K=CASE["k"], M=M, dt=M / 4, V=1.0,
+    )  # fmt: skip
+    shs = LoadHistory.steps([1.0, 0.0, 1.0], [20.0, 10.0, 40.0])
+    x0 = -friction_of(RateState(**CASE, form="asinh"), 1.0, np.array([CASE["Dc"]])) / CASE["k"]
+    t_end = 69.0
+    runs = {
+        "history": chain_params("sakaguchi", N=1, drive="history", history=shs, **law),
+        "constant": chain_params("sakaguchi", N=1, **law),
+    }
+    go = {
+        name: lambda p=p: run_chain(
+            p, t_end, integrator="exact", start=ChainState.from_blocks([x0], [1.0], [CASE["Dc"]], [False])
+        )
+        for name, p in runs.items()
+    }
+    for fn in go.values():
+        fn()
+    times = dict.fromkeys(go, np.inf)
+    for _ in range(repeats):  # interleaved, so a change in the machine's load meets both alike
+        for name, fn in go.items():
+            times[name] = min(times[name], _best(fn, 1))
+    return {
+        "history_s": times["history"],
+        "constant_s": times["constant"],
+        "ratio": times["history"] / times["constant"],
+        "steps": int(round(t_end / (M / 4))),
+    }
+
+
 def bench(repeats: int = 5) -> dict:
     """Time the velocity step both ways and a four-parameter fit (module docstring).
 
@@ -44,8 +94,9 @@ def bench(repeats: int = 5) -> dict:
         ``quasi_static_s`` (the Dataset), ``arrays_s`` (:func:`~stickslip.lab.quasi_static.solve`,
         arrays as odeint returns them), ``odeint_s``, ``speed_ratio`` and ``speed_ratio_arrays``
         (odeint's time over each), ``max_abs_mu_difference``,
-        ``fit_cpu_s`` (a, b, D_c, mu0 from a noisy 500-sample record), ``fit_evaluations`` and the
-        fitted values with their standard errors.
+        ``fit_cpu_s`` (a, b, D_c, mu0 from a noisy 500-sample record), ``fit_evaluations``, the
+        fitted values with their standard errors, and ``inertial_history``
+        (:func:`inertial_history_cost`).
     """
     model = RateState(**CASE)
     history = LoadHistory.steps([1.0, 10.0], [10.0, 90.0])
@@ -83,5 +134,6 @@ def bench(repeats: int = 5) -> dict:
             for n, v, e in zip(res.names, res.values, res.errors, strict=True)
         },
         "fit_truth": {"a": CASE["a"], "b": CASE["b"], "Dc": CASE["Dc"], "mu0": CASE["mu0"]},
+        "inertial_history": inertial_history_cost(max(1, repeats // 2)),
         "repeats": repeats,
     }

@@ -319,6 +319,10 @@ class ChainParams(_Validated):
     threshold: str = _choice("constant", "threshold", "static threshold: constant (Fs) or state (theta_i)")
     ends: str = _choice("free", "ends", "ends of the chain: free, fixed or periodic (plate drive only)")
     M: float = _positive(1.0, "mass M of a block (1: unit masses, the paper's; per block: M_i)")
+    history: Any = field(
+        default=None,
+        metadata={"text": True, "doc": "load history p(t) of drive history (a stickslip.lab.LoadHistory)"},
+    )
 
     def __post_init__(self) -> None:
         """Per-block values (arrays, :class:`~stickslip.models.disorder.Quenched` specs, ``file:``
@@ -430,6 +434,10 @@ class ChainParams(_Validated):
         """The model (preset name and pieces) and every parameter it reads."""
         d = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
         d = {k: v.record() if _per_block(v) else v for k, v in d.items()}
+        if d["history"] is not None:
+            from stickslip.models.drive.history import record
+
+            d["history"] = record(d["history"])
         used = set(self.used())
         return {k: v for k, v in d.items() if k in used or k in ("model", "drive", "friction", "threshold", "ends")}
 
@@ -438,7 +446,7 @@ class ChainParams(_Validated):
         return {
             k: v
             for k, v in super().field_docs().items()
-            if k not in ("model", "drive", "friction", "threshold", "ends")
+            if k not in ("model", "drive", "friction", "threshold", "ends", "history")
         }
 
     @classmethod

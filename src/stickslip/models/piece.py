@@ -185,6 +185,12 @@ class Piece:
     #: drive: the velocity of the kernels' pull point p = V t_n at the parameters ``p``, when it is
     #: not V (a force ramp reads p = r t_n as its r t); packed as the kernels' V
     pull_velocity: Callable[[Any], float] | None = None
+    #: the kernels' ``Params`` of the parameters ``p``, where the piece packs them itself (a load
+    #: history's table of breakpoints); None: each parameter of :attr:`reads` as a float or per block
+    pack: Callable[[Any], tuple] | None = None
+    #: drive: whether its load point never moves back at the parameters ``p`` (None: always), which
+    #: the exact integrator's start searches need; a drive that does runs dense
+    monotone: Callable[[Any], bool] | None = None
     #: drive: runs on the located integrator (:mod:`stickslip.kernels.located`), whose frame
     #: u = x - V t holds the drive at u = 0
     located: bool = True
@@ -222,6 +228,8 @@ class Piece:
         tuple of its module, in the order of :attr:`reads`: floats, and a per-block parameter
         (:class:`~stickslip.models.disorder.PerBlock`) as a float64 array of N + 2 with block i
         at index i, which the kernels read at each block (:func:`stickslip.kernels.laws.at`)."""
+        if self.pack is not None:
+            return self.pack(p)
         params = importlib.import_module(self.module).Params
         return params(*(_kernel_value(getattr(p, name)) for name in self.reads))
 

@@ -7,13 +7,15 @@ the start and stop rules and Heun with t_n = n dt. They differ in
 drive      ``end``: a pulling point x_0 = V t joined to block 1 (eq. 4);
            ``plate``: every block joined to a plate at V t by a leaf spring Kp (BK, CL);
            ``constant-force``: a force F on every block; ``force-ramp``: F_start + r t on every
-           block (random-medium protocols, Sakaguchi and Kadowaki)
+           block (random-medium protocols, Sakaguchi and Kadowaki); ``history``: the pulling
+           point of eq. (4) moved along a load history p(t) (steps, holds, tables)
 friction   ``state``: theta_i + beta v_i, theta from eq. (4);
            ``weakening``: phi(v) = (1 - sigma) / (1 + 2 alpha max(v, 0) / (1 - sigma)) (CL);
            ``strengthening``: F0 + beta v, no state variable (train model);
            ``rate-state``: Dieterich-Ruina with the aging law; ``slip``: with Ruina's slip law;
            one module each in :mod:`stickslip.models.friction`, listed in :data:`FRICTIONS`
-threshold  ``constant``: Fs; ``state``: theta_i (the paper's reading of Batista-Carlson)
+threshold  ``constant``: Fs; ``state``: theta_i (the paper's reading of Batista-Carlson);
+           ``none``: no static threshold, for rate-and-state (a block starts when f_i > 0)
 ends       ``free``, ``fixed``, ``periodic`` (a drive acting on every block only)
 ========== ==========================================================================
 
@@ -56,10 +58,10 @@ FRICTIONS = (
 )
 
 #: The drives, one module each in :mod:`stickslip.models.drive`.
-DRIVES = ("end", "plate", "constant_force", "force_ramp")
+DRIVES = ("end", "plate", "constant_force", "force_ramp", "history")
 
 #: The static thresholds, one module each in :mod:`stickslip.models.threshold`.
-THRESHOLDS = ("constant", "state")
+THRESHOLDS = ("constant", "state", "none")
 
 #: The end conditions, one module each in :mod:`stickslip.models.ends`.
 ENDS = ("free", "fixed", "periodic")
@@ -98,6 +100,7 @@ def code(kind: str, name: str) -> str:
 RULES = (
     "ends periodic needs a drive that acts on every block (plate, constant-force, force-ramp)",
     "threshold state needs friction state",
+    "threshold none needs a rate-and-state friction (rate-state, rate-state-slip)",
 )
 
 
@@ -112,6 +115,10 @@ def check_composition(drive: str, friction: str, threshold: str, ends: str) -> N
         )
     if threshold == "state" and friction != "state":
         raise CompositionError(f"threshold state needs friction state (friction {friction} has no theta)")
+    if threshold == "none" and not friction.startswith("rate-state"):
+        raise CompositionError(
+            f"threshold none needs a rate-and-state friction (rate-state, rate-state-slip; got friction {friction})"
+        )
 
 
 def stopped_blocks_still(drive: Piece, friction: Piece) -> bool:

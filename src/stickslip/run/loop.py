@@ -81,6 +81,10 @@ class _Kernel:
     """
 
     def __init__(self, name, params, state, scratch, par, outputs, ints):
+        monotone = params.drive_piece.monotone
+        if name == "exact" and monotone is not None and not monotone(params):
+            # The start searches of the fast paths need a load point that never moves back.
+            name = "dense"
         if name == "exact" and stopped_blocks_still(params.drive_piece, params.friction_piece):
             name = "sparse"
         self.scratch = tuple(scratch)

@@ -1,0 +1,145 @@
+"""A load history: the pulling point x_0 = p(t_n) of eq. (4), joined to block 1 by the spring K,
+moved along a continuous, piecewise-linear p(t) (velocity steps, holds at V = 0, tables; a
+:class:`stickslip.lab.LoadHistory`) instead of V t.
+
+The history is the parameter ``history`` of :class:`~stickslip.models.params.ChainParams`: an
+object with ``times`` (increasing breakpoints t_0 < ... < t_m) and ``positions`` (p_0, ..., p_m),
+a ``LoadHistory`` or a pair of arrays. The kernels receive it as one table (``Params.table``, a
+3 x (m + 1) array: the breakpoints, the positions and the velocities V_k = (p_k+1 - p_k) /
+(t_k+1 - t_k) of the intervals), which :func:`stickslip.kernels.laws.at` leaves whole (it gathers
+1-D fields only), and read the load point at step n with :func:`pull`:
+
+    p(t_n) = min(p_k + V_k (t_n - t_k), p_k+1)   on [t_k, t_k+1), with t_n = n dt,
+
+p_0 before t_0 and p_m from t_m on (held, as ``LoadHistory.position``). The clamp keeps p(t_n)
+non-decreasing across a breakpoint whatever the rounding of V_k, so the exact integrator's start
+search (:func:`stickslip.kernels.triggers._first_trigger`, a bisection on the step's own force)
+is exact for it; a history whose positions decrease (only a pair of arrays can) takes the dense
+integrator (:func:`monotone`, :attr:`~stickslip.models.piece.Piece.monotone`). On one interval
+from t_0 = 0, p_0 = 0, p(t_n) = V_0 (n dt) is the end drive's V * (n dt) bit for bit while
+n dt < t_1 and V_0 rounds to V.
+
+Not on the located integrator (its frame u = x - V t needs a constant V). No steady sliding.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from numba import njit
+
+from stickslip.models.piece import Piece, kernel_params
+
+READS = ("history",)
+#: The kernels' parameters: the table of breakpoints, positions and velocities (3 x (m + 1)).
+Params = kernel_params(__name__, ("table",))
+
+
+@njit(cache=True, inline="always")
+def force(xl, xc, xr, K, p, dp):
+    """K (x_{i+1} - 2 x_i + x_{i-1}) (eq. 4); block 1 reads the load point as its x_0."""
+    return K * ((xl - xc) - (xc - xr))
+
+
+@njit(cache=True, inline="always")
+def leaf(dp):
+    """No spring to the drive but block 1's."""
+    return 0.0
+
+
+@njit(cache=True, inline="always")
+def left(p, ghost):
+    """x_0 is the load point."""
+    return p
+
+
+@njit(cache=True, inline="always")
+def pull(n, dt, dp):
+    """The load point p(t_n), t_n = n dt (module docstring): linear on the interval of t_n,
+    clamped to the interval's end position, held before the first and after the last breakpoint."""
+    tb = dp.table[0]
+    pb = dp.table[1]
+    vb = dp.table[2]
+    t = np.float64(n) * dt
+    m = tb.shape[0] - 1
+    if t >= tb[m]:
+        return pb[m]
+    if t < tb[0]:
+        return pb[0]
+    k = np.searchsorted(tb, t, side="right") - 1
+    q = pb[k] + vb[k] * (t - tb[k])
+    if vb[k] >= 0.0:
+        return min(q, pb[k + 1])
+    return max(q, pb[k + 1])
+
+
+def pull_py(n: int, dt: float, table: np.ndarray) -> float:
+    """:func:`pull` in plain Python (the oracle of the tests and of the run's ghost cell)."""
+    tb, pb, vb = table
+    t = float(n) * dt
+    m = len(tb) - 1
+    if t >= tb[m]:
+        return float(pb[m])
+    if t < tb[0]:
+        return float(pb[0])
+    k = max(i for i in range(m) if tb[i] <= t)
+    q = pb[k] + vb[k] * (t - tb[k])
+    return float(min(q, pb[k + 1]) if vb[k] >= 0.0 else max(q, pb[k + 1]))
+
+
+def table(history: Any) -> np.ndarray:
+    """The kernels' table of a history (``LoadHistory``, a pair (times, positions) or a dict with
+    ``times`` and ``positions``): a C-contiguous 3 x (m + 1) float64 array; a ValueError of one
+    line for anything else (:class:`~stickslip.models.params.ChainParams` says it as its
+    ParameterError)."""
+    if history is None:
+        raise ValueError("history must be given for drive history (a LoadHistory or (times, positions))")
+    if isinstance(history, dict):
+        times, positions = history.get("times"), history.get("positions")
+    elif hasattr(history, "times"):
+        times, positions = history.times, history.positions
+    else:
+        times, positions = history
+    t = np.asarray(times, dtype=float).ravel()
+    p = np.asarray(positions, dtype=float).ravel()
+    if t.size < 2 or t.size != p.size or not (np.isfinite(t).all() and np.isfinite(p).all()):
+        raise ValueError("history must have at least two finite breakpoints with one finite position each")
+    if t[0] < 0.0 or (np.diff(t) <= 0.0).any():
+        raise ValueError("history times must be >= 0 and increasing")
+    v = np.append(np.diff(p) / np.diff(t), 0.0)
+    return np.ascontiguousarray(np.stack([t, p, v]))
+
+
+def monotone(history: Any) -> bool:
+    """Whether the load point never moves back (positions non-decreasing): the exact integrator's
+    start searches need it."""
+    return bool((np.diff(table(history)[1]) >= 0.0).all())
+
+
+def record(history: Any) -> dict[str, list[float]]:
+    """The history as run.json records it: its breakpoints and positions."""
+    tb = table(history)
+    return {"times": tb[0].tolist(), "positions": tb[1].tolist()}
+
+
+def _check(p: Any) -> str | None:
+    try:
+        table(getattr(p, "history", None))
+    except ValueError as exc:
+        return str(exc)
+    return None
+
+
+PIECE = Piece(
+    "drive",
+    "history",
+    "pulling point x_0 = p(t) joined to block 1 by the spring K, p(t) a load history (steps, holds, tables)",
+    READS,
+    check=_check,
+    pack=lambda p: Params(table(p.history)),
+    monotone=lambda p: monotone(p.history),
+    steady_sliding=False,
+    located=False,
+    module=__name__,
+)
