@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from stickslip.lab import LoadHistory, RateState
-from stickslip.lab.fit import fit
+from stickslip.lab.fitting import fit
 from stickslip.lab.records import Record, detrend, synthetic
 from stickslip.models.params import ParameterError
 

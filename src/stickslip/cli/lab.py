@@ -243,7 +243,7 @@ def run_fit(args) -> Result:
     """Handler of ``stickslip lab fit``."""
     from dataclasses import replace
 
-    from stickslip.lab.fit import fit
+    from stickslip.lab.fitting import fit
     from stickslip.lab.records import Record, detrend
 
     model = _model(args)

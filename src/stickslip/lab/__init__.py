@@ -12,12 +12,12 @@ the shared helpers), never the plotting, the reports or the command line.
 - :mod:`stickslip.lab.protocols`: velocity steps and slide-hold-slide tests as one call.
 """
 
-from stickslip.lab.fit import FitResult, fit
+from stickslip.lab.fitting import FitResult, fit
 from stickslip.lab.history import LoadHistory
 from stickslip.lab.laws import LAWS, RateState, steady_friction, steady_theta
 from stickslip.lab.protocols import slide_hold_slide, velocity_step
-from stickslip.lab.quasi_static import quasi_static
 from stickslip.lab.records import Record, detrend, synthetic
+from stickslip.lab.spring_slider import quasi_static
 from stickslip.lab.stability import critical_stiffness
 
 __all__ = [

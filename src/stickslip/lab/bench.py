@@ -16,12 +16,12 @@ import time
 
 import numpy as np
 
-from stickslip.lab.fit import fit
+from stickslip.lab.fitting import fit
 from stickslip.lab.history import LoadHistory
 from stickslip.lab.laws import RateState
-from stickslip.lab.quasi_static import quasi_static, solve
 from stickslip.lab.records import synthetic
 from stickslip.lab.reference import odeint_one_state
+from stickslip.lab.spring_slider import quasi_static, solve
 
 __all__ = ["bench", "inertial_history_cost"]
 
@@ -91,7 +91,7 @@ def bench(repeats: int = 5) -> dict:
     Returns
     -------
     dict
-        ``quasi_static_s`` (the Dataset), ``arrays_s`` (:func:`~stickslip.lab.quasi_static.solve`,
+        ``quasi_static_s`` (the Dataset), ``arrays_s`` (:func:`~stickslip.lab.spring_slider.solve`,
         arrays as odeint returns them), ``odeint_s``, ``speed_ratio`` and ``speed_ratio_arrays``
         (odeint's time over each), ``max_abs_mu_difference``,
         ``fit_cpu_s`` (a, b, D_c, mu0 from a noisy 500-sample record), ``fit_evaluations``, the

@@ -4,7 +4,7 @@ and the DOP853 integrator that steps it.
 They sit together because numba's on-disk cache stamps a compiled function with its own source
 file only: an integrator that calls a right-hand side in another module would be loaded stale
 after that module changed. The equations are those of :mod:`stickslip.lab.laws` (the friction,
-the laws) and :mod:`stickslip.lab.quasi_static` (the spring-slider); the integrator is described
+the laws) and :mod:`stickslip.lab.spring_slider` (the spring-slider); the integrator is described
 in :mod:`stickslip.lab.integrate`.
 """
 
@@ -70,7 +70,7 @@ def slip_rate(tau, psi, a, V0, eta, form):
 @njit(cache=True)
 def rhs(t, y, out, vlp, a, mu0, V0, k, eta, form, b, sdc, cb, codes):
     """The quasi-static spring-slider k (p(t) - x) = tau = mu(v, theta) + eta v
-    (:mod:`stickslip.lab.quasi_static`) as d/dt of y = (tau, theta_1 .. theta_m):
+    (:mod:`stickslip.lab.spring_slider`) as d/dt of y = (tau, theta_1 .. theta_m):
 
         dtau/dt = k (V(t) - v),   dtheta_k/dt by law k (:mod:`stickslip.lab.laws`),
 

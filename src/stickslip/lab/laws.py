@@ -19,7 +19,7 @@ At steady sliding x_k = 1, theta_k = s_k D_c,k / V, and every law gives
 mu_ss = mu0 + (a - sum_k b_k) ln(V / V0).
 
 The parameters are the lab's: friction mu (shear over normal stress), a, b_k, D_c,k (a length, e.g.
-um), mu0 at the reference velocity V0, and, for the spring-slider of :mod:`stickslip.lab.quasi_static`,
+um), mu0 at the reference velocity V0, and, for the spring-slider of :mod:`stickslip.lab.spring_slider`,
 the stiffness k in friction per unit displacement and an optional radiation damping eta (friction
 per unit slip rate). The compiled friction and right-hand side (:func:`stickslip.lab.compiled.rhs`)
 are what the integrators evaluate.

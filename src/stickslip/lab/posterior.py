@@ -1,6 +1,6 @@
 """Bayesian posteriors of a fit's parameters by Markov-chain Monte Carlo (emcee, optional).
 
-The likelihood is the fit's (:func:`stickslip.lab.fit.fit`): the weighted residuals are Gaussian
+The likelihood is the fit's (:func:`stickslip.lab.fitting.fit`): the weighted residuals are Gaussian
 with the standard deviation s the fit estimated (sqrt(sum of squared residuals / (n - p))), so
 log L = -sum r_i^2 / (2 s^2); the prior is flat within the parameters' bounds (a, D_c, k, eta > 0).
 The walkers of emcee's affine-invariant ensemble sampler (Goodman and Weare 2010; Foreman-Mackey
@@ -94,7 +94,7 @@ def posterior(result, *, walkers: int | None = None, steps: int = 2000, burn: in
     Parameters
     ----------
     result : FitResult
-        What :func:`stickslip.lab.fit.fit` returned.
+        What :func:`stickslip.lab.fitting.fit` returned.
     walkers : int, optional
         Walkers of the ensemble (default 4 per parameter, at least 16).
     steps : int

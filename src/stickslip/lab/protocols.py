@@ -20,7 +20,7 @@ import xarray as xr
 
 from stickslip.lab.history import LoadHistory
 from stickslip.lab.laws import RateState, steady_friction
-from stickslip.lab.quasi_static import quasi_static
+from stickslip.lab.spring_slider import quasi_static
 from stickslip.models.params import ParameterError, check_number
 
 __all__ = ["slide_hold_slide", "velocity_step"]
@@ -76,12 +76,12 @@ def velocity_step(
         Output points per interval (and as many clustered after each step).
     rtol : float
     method : str
-        The integrator (:func:`stickslip.lab.quasi_static.quasi_static`).
+        The integrator (:func:`stickslip.lab.spring_slider.quasi_static`).
 
     Returns
     -------
     ds : xarray.Dataset
-        The run (:func:`stickslip.lab.quasi_static.quasi_static`).
+        The run (:func:`stickslip.lab.spring_slider.quasi_static`).
     summary : dict
         ``steps``: per step V_before, V_after, mu before, mu_peak (the extreme after the step),
         its time, mu at the end, the closed-form steady friction of the spring mu_ss + eta V and
@@ -159,7 +159,7 @@ def slide_hold_slide(
         Output points per interval (and as many clustered after each breakpoint).
     rtol : float
     method : str
-        The integrator (:func:`stickslip.lab.quasi_static.quasi_static`).
+        The integrator (:func:`stickslip.lab.spring_slider.quasi_static`).
 
     Returns
     -------

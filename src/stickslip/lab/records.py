@@ -1,6 +1,6 @@
 """Friction records of a laboratory test: time, friction and the load history that drove it.
 
-A :class:`Record` is what :func:`stickslip.lab.fit.fit` fits: samples (t_i, mu_i) of the friction, the
+A :class:`Record` is what :func:`stickslip.lab.fitting.fit` fits: samples (t_i, mu_i) of the friction, the
 :class:`~stickslip.lab.history.LoadHistory` of the load point, and optionally weights (one over the
 noise of each sample) and a window of time that the fit reads. :func:`detrend` removes a linear
 trend of friction with load-point displacement (slip hardening or weakening over a whole test, which
@@ -191,7 +191,7 @@ def synthetic(model, history: LoadHistory, *, n: int = 500, noise: float = 0.0, 
     -------
     Record
     """
-    from stickslip.lab.quasi_static import quasi_static
+    from stickslip.lab.spring_slider import quasi_static
 
     t = np.linspace(history.times[0], history.t_end, int(check_number("n", n, low=2, integer=True)))
     ds = quasi_static(model, history, t=t)

@@ -1,6 +1,6 @@
 """A plain-Python spring-slider on :func:`scipy.integrate.odeint`: the yardstick of the compiled one.
 
-The same equations as :mod:`stickslip.lab.quasi_static` in the log form, written once more by hand,
+The same equations as :mod:`stickslip.lab.spring_slider` in the log form, written once more by hand,
 statement by statement, as a lab's own script would: tau = k (p - x) = mu + eta v,
 dtau/dt = k (V - v), mu = mu0 + a ln(v / V0) + sum_k b_k ln(V0 theta_k / (s_k D_c,k)), each
 theta_k by its law; v in closed form without damping, by Brent's method on

@@ -77,13 +77,13 @@ def plot_shs(ds: xr.Dataset, summary: dict) -> Figure:
 
 
 def plot_fit(result) -> Figure:
-    """A fit (:class:`stickslip.lab.fit.FitResult`): data and model of each record against time, and
+    """A fit (:class:`stickslip.lab.fitting.FitResult`): data and model of each record against time, and
     the residuals below; samples outside the fit's window in grey.
 
     Parameters
     ----------
     result : FitResult
-        What :func:`stickslip.lab.fit.fit` returned.
+        What :func:`stickslip.lab.fitting.fit` returned.
 
     Returns
     -------

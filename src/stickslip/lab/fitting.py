@@ -1,7 +1,7 @@
 """Least-squares fits of rate-and-state parameters to friction records, with standard errors.
 
 The model friction of record r at its samples is the quasi-static spring-slider's
-(:func:`stickslip.lab.quasi_static.quasi_static`) plus an optional linear trend s_r (p(t) - p(t_0)) in
+(:func:`stickslip.lab.spring_slider.quasi_static`) plus an optional linear trend s_r (p(t) - p(t_0)) in
 load-point displacement (``trend``; see also :func:`stickslip.lab.records.detrend`). The residuals
 w_i (mu_model(t_i) - mu_i) of all records, inside their windows, are minimised by
 :func:`scipy.optimize.least_squares` (trust-region reflective, bounds a > 0, D_c > 0, k > 0) over the
@@ -28,8 +28,8 @@ from scipy.optimize import least_squares
 
 from stickslip.lab.integrate import IntegrationError
 from stickslip.lab.laws import RateState
-from stickslip.lab.quasi_static import solve
 from stickslip.lab.records import Record
+from stickslip.lab.spring_slider import solve
 from stickslip.models.params import ParameterError
 
 __all__ = ["FitResult", "fit", "model_friction"]
@@ -80,7 +80,7 @@ def model_friction(
     rtol : float
         Tolerance of the integration.
     method : str
-        The integrator (:func:`stickslip.lab.quasi_static.quasi_static`).
+        The integrator (:func:`stickslip.lab.spring_slider.quasi_static`).
 
     Returns
     -------
@@ -298,7 +298,7 @@ def fit(
     rtol : float
         Tolerance of the spring-slider's integration.
     method : str
-        Its integrator (:func:`stickslip.lab.quasi_static.quasi_static`).
+        Its integrator (:func:`stickslip.lab.spring_slider.quasi_static`).
     diff_step : float
         Relative step of the finite-difference Jacobian.
 
