@@ -180,7 +180,7 @@ def dop853_history(y0, seg_t, seg_v, t_out, rtol, atol, max_steps, A, B, C, E3, 
     [seg_t[i], seg_t[i+1]), writing y and v at each of the sorted times ``t_out``.
 
     The step is scipy's DOP853 (:mod:`stickslip.lab.integrate`): error norm
-    |h| ||e5||^2 / sqrt((||e5||^2 + 0.01 ||e3||^2) n), step factor 0.9 err^(-1/8) within [0.2, 10],
+    ``|h| ||e5||^2 / sqrt((||e5||^2 + 0.01 ||e3||^2) n)``, step factor 0.9 err^(-1/8) within [0.2, 10],
     no growth right after a rejection; outputs inside a step by :func:`_dense`.
     Returns (Y, v, status, steps, evaluations).
     """

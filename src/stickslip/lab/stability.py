@@ -120,7 +120,7 @@ def growth_rate(model: RateState, k: float, V: float | None = None) -> float:
 
 def critical_stiffness_numeric(model: RateState, V: float | None = None, *, k_max: float | None = None) -> float:
     """k_c as the largest stiffness at which the linearised system has a growing mode: a scan
-    over k on a log grid up to ``k_max`` (default 10 sum |b_k| / D_c,k), refined by Brent's
+    over k on a log grid up to ``k_max`` (default ``10 sum |b_k| / D_c,k``), refined by Brent's
     method (module docstring).
 
     Parameters
