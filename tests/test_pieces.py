@@ -21,8 +21,13 @@ PIECE_MODULES = {
         "plate": "stickslip.models.drive.plate",
         "constant-force": "stickslip.models.drive.constant_force",
         "force-ramp": "stickslip.models.drive.force_ramp",
+        "history": "stickslip.models.drive.history",
     },
-    "threshold": {"constant": "stickslip.models.threshold.constant", "state": "stickslip.models.threshold.state"},
+    "threshold": {
+        "constant": "stickslip.models.threshold.constant",
+        "state": "stickslip.models.threshold.state",
+        "none": "stickslip.models.threshold.none",
+    },
     "ends": {
         "free": "stickslip.models.ends.free",
         "fixed": "stickslip.models.ends.fixed",
