@@ -119,7 +119,8 @@ class LoadHistory:
             raise ParameterError(f"velocities must be >= 0 (got {v[v < 0.0][0]:g})")
         if np.any(d <= 0.0):
             raise ParameterError(f"durations must be > 0 (got {d[d <= 0.0][0]:g})")
-        return cls.from_velocities(np.concatenate([[0.0], np.cumsum(d)]), v)
+        # The positions from the displacements V_i T_i themselves, not from differences of the summed times.
+        return cls(np.concatenate([[0.0], np.cumsum(d)]), np.concatenate([[0.0], np.cumsum(v * d)]))
 
     @classmethod
     def slide_hold_slide(
@@ -237,11 +238,11 @@ class LoadHistory:
 
     def merged(self, rtol: float = 1e-9) -> LoadHistory:
         """The same history without the breakpoints where the velocity does not change (to
-        ``rtol`` of the largest velocity): a record sampled at a steady rate becomes one interval,
-        so an integrator restarts only where the load point's velocity really steps."""
+        ``rtol`` of the larger of the two velocities there): a record sampled at a steady rate
+        becomes one interval, so an integrator restarts only where the load point's velocity
+        really steps; a hold beside a slow slide stays apart however slow the slide."""
         v = self.velocities
-        tol = rtol * max(float(np.max(np.abs(v))), 1e-300)
-        keep = np.concatenate([[True], np.abs(np.diff(v)) > tol, [True]])
+        keep = np.concatenate([[True], np.abs(np.diff(v)) > rtol * np.maximum(np.abs(v[:-1]), np.abs(v[1:])), [True]])
         if keep.all():
             return self
         return LoadHistory(self.times[keep], self.positions[keep])

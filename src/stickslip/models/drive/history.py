@@ -27,9 +27,8 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from numba import njit
 
-from stickslip.models.piece import Piece, kernel_params
+from stickslip.models.piece import Piece, kernel_params, njit
 
 READS = ("history",)
 #: The kernels' parameters: the table of breakpoints, positions and velocities (3 x (m + 1)).

@@ -17,9 +17,7 @@ M goes to 0 the inertial solution tends to the quasi-static one, linearly in M.
 
 from __future__ import annotations
 
-from numba import njit
-
-from stickslip.models.piece import Piece, kernel_params
+from stickslip.models.piece import Piece, kernel_params, njit
 
 READS: tuple[str, ...] = ()
 Params = kernel_params(__name__, READS)
