@@ -277,11 +277,64 @@ def _ghosts(xa, tha, step, p):
     return [left] + list(xa) + [right], [thl] + list(tha) + [thr], pull
 
 
+def random_start(p, seed: int, pstop: float):
+    """A random chain state for the exactness tests: x in [-0.3, 0.3], v in [0, 0.2], theta in
+    [0.3, 1] (0 for a law without theta), each block stopped (v = 0) with probability ``pstop``;
+    returns (x, v, theta, stopped)."""
+    rng = np.random.default_rng(seed)
+    x = rng.uniform(-0.3, 0.3, p.N)
+    v = rng.uniform(0.0, 0.2, p.N)
+    th = rng.uniform(0.3, 1.0, p.N) if p.friction == "state" else np.zeros(p.N)
+    stopped = rng.random(p.N) < pstop
+    return x, np.where(stopped, 0.0, v), th, stopped
+
+
+def heun_frame(x, v, th, moving, n, p, force, accel, dtheta, threshold):
+    """One Heun step from t_n = n dt (docs/model.md) with the model's pieces given as plain
+    functions: ``force(X, i, plate, step)``, ``accel(f, theta_i, v_i, i)``, ``dtheta(TH, i, v_i)``
+    and ``threshold(TH, i)``; the start rule at the beginning of the step, the stop rule at its
+    end. Lists of blocks 1..N at index 0..N-1; returns (x, v, th, moving, mid)."""
+    N = len(x)
+    dt, h2 = p.dt, 0.5 * p.dt
+    X, TH, plate = _ghosts(x, th, n, p)
+    mid, a1, b1, xs, vs, ths = [], [], [], [], [], []
+    for i in range(1, N + 1):
+        f = force(X, i, plate, n)
+        m = moving[i - 1] or f > threshold(TH, i)  # start rule, at the beginning of the step
+        a = accel(f, TH[i], v[i - 1], i) if m else 0.0
+        b = dtheta(TH, i, v[i - 1])
+        mid.append(m)
+        a1.append(a)
+        b1.append(b)
+        xs.append(x[i - 1] + dt * v[i - 1])
+        vs.append(v[i - 1] + dt * a)
+        ths.append(th[i - 1] + dt * b)
+    XS, THS, plate2 = _ghosts(xs, ths, n + 1, p)
+    xn, vn, thn, mn = [], [], [], []
+    for i in range(1, N + 1):
+        m = mid[i - 1]
+        a2 = accel(force(XS, i, plate2, n + 1), THS[i], vs[i - 1], i) if m else 0.0
+        b2 = dtheta(THS, i, vs[i - 1])
+        thn.append(th[i - 1] + h2 * (b1[i - 1] + b2) if p.friction == "state" else th[i - 1])
+        if m:
+            xn.append(x[i - 1] + h2 * (v[i - 1] + vs[i - 1]))
+            vel = v[i - 1] + h2 * (a1[i - 1] + a2)
+            if vel <= 0.0:  # stop rule, at the end of the step
+                vn.append(0.0)
+                mn.append(False)
+            else:
+                vn.append(vel)
+                mn.append(True)
+        else:  # stuck: x fixed, v = 0
+            xn.append(x[i - 1])
+            vn.append(0.0)
+            mn.append(False)
+    return xn, vn, thn, mn, mid
+
+
 def model_heun_step(x, v, th, moving, n, p):
     """One Heun step of the model ``p`` (ChainParams with pieces) from t_n = n dt; lists of
     blocks 1..N at index 0..N-1. Returns (x, v, th, moving, mid) as :func:`heun_step`."""
-    N = len(x)
-    dt, h2 = p.dt, 0.5 * p.dt
 
     def force(X, i, plate, step):
         f = p.K * ((X[i - 1] - X[i]) - (X[i] - X[i + 1]))
@@ -307,41 +360,8 @@ def model_heun_step(x, v, th, moving, n, p):
         return (TH[i] * (1.0 - TH[i]) - p.alpha * TH[i] * vi
                 + p.D * ((TH[i - 1] - TH[i]) - (TH[i] - TH[i + 1])))  # fmt: skip
 
-    X, TH, plate = _ghosts(x, th, n, p)
-    mid, a1, b1, xs, vs, ths = [], [], [], [], [], []
-    for i in range(1, N + 1):
-        f = force(X, i, plate, n)
-        threshold = TH[i] if p.threshold == "state" else p.Fs
-        m = moving[i - 1] or f > threshold  # start rule, at the beginning of the step
-        a = accel(f, TH[i], v[i - 1]) if m else 0.0
-        b = dtheta(TH, i, v[i - 1])
-        mid.append(m)
-        a1.append(a)
-        b1.append(b)
-        xs.append(x[i - 1] + dt * v[i - 1])
-        vs.append(v[i - 1] + dt * a)
-        ths.append(th[i - 1] + dt * b)
-    XS, THS, plate2 = _ghosts(xs, ths, n + 1, p)
-    xn, vn, thn, mn = [], [], [], []
-    for i in range(1, N + 1):
-        m = mid[i - 1]
-        a2 = accel(force(XS, i, plate2, n + 1), THS[i], vs[i - 1]) if m else 0.0
-        b2 = dtheta(THS, i, vs[i - 1])
-        thn.append(th[i - 1] + h2 * (b1[i - 1] + b2) if p.friction == "state" else th[i - 1])
-        if m:
-            xn.append(x[i - 1] + h2 * (v[i - 1] + vs[i - 1]))
-            vel = v[i - 1] + h2 * (a1[i - 1] + a2)
-            if vel <= 0.0:  # stop rule, at the end of the step
-                vn.append(0.0)
-                mn.append(False)
-            else:
-                vn.append(vel)
-                mn.append(True)
-        else:  # stuck: x fixed, v = 0
-            xn.append(x[i - 1])
-            vn.append(0.0)
-            mn.append(False)
-    return xn, vn, thn, mn, mid
+    threshold = (lambda TH, i: TH[i]) if p.threshold == "state" else (lambda TH, i: p.Fs)
+    return heun_frame(x, v, th, moving, n, p, force, lambda f, thi, vi, i: accel(f, thi, vi), dtheta, threshold)
 
 
 def error_lines(err: str) -> list[str]:
@@ -377,6 +397,16 @@ def is_real_command(command: str) -> bool:
         except SystemExit:
             return False
     return True
+
+
+def one_line_error(capsys, *names: str) -> str:
+    """stderr as ``capsys`` read it, after checking it is one line, no traceback and nothing on
+    stdout, and that it names each of ``names``."""
+    out, err = capsys.readouterr()
+    assert out == "" and err.count("\n") == 1 and "Traceback" not in err, err
+    for name in names:
+        assert name in err, err
+    return err
 
 
 def run_cli(capsys, *argv: str) -> tuple[int, str, str]:

@@ -8,20 +8,13 @@ import numpy as np
 import pytest
 
 import stickslip.run.budget as budget
+from chain_helpers import one_line_error
 from stickslip.analysis.catalog import MAX_BOOTSTRAP, MAX_GOF_SIMS, check_magnitude_bins
 from stickslip.analysis.decorrelation import sequence_decorrelation
 from stickslip.cli import main
 from stickslip.models.params import ParameterError
 from stickslip.models.presets import chain_params
 from stickslip.run import run_chain
-
-
-def _one_line(capsys, *names):
-    out, err = capsys.readouterr()
-    assert out == "" and err.count("\n") == 1 and "Traceback" not in err, err
-    for name in names:
-        assert name in err, err
-    return err
 
 
 @pytest.mark.parametrize(
@@ -34,7 +27,7 @@ def _one_line(capsys, *names):
 def test_chain_outputs_no_machine_can_hold_are_refused_before_the_run(flags, option, tmp_path, capsys):
     out = tmp_path / "run"
     assert main(["chain", "--N", "10", "--t-end", "1e8", *flags, "--out", str(out), "--no-progress"]) == 2
-    err = _one_line(capsys, option, "GiB of memory")
+    err = one_line_error(capsys, option, "GiB of memory")
     assert "more than this machine's" in err
     assert not out.exists()
     with pytest.raises(ParameterError, match=option):
@@ -59,7 +52,7 @@ def test_snapshots_beyond_memory_are_refused(monkeypatch, tmp_path):
 def test_catalog_counts_without_end_are_refused_before_the_run_is_read(option, value, limit, tmp_path, capsys):
     # the run directory does not exist: the refusal is the count's, before anything is read
     assert main(["catalog", str(tmp_path / "no-run"), option, value]) == 2
-    _one_line(capsys, f"{option.lstrip('-')} must be <= {limit}")
+    one_line_error(capsys, f"{option.lstrip('-')} must be <= {limit}")
     assert not (tmp_path / "no-run").exists()
 
 
@@ -75,7 +68,7 @@ def test_catalog_dm_too_fine_writes_nothing(tmp_path, capsys):
     assert main(["chain", "--model", "two-blocks", "--t-end", "2e4", "--out", str(run), "--no-progress"]) == 0
     capsys.readouterr()
     assert main(["catalog", str(run), "--dm", "1e-9", "--bootstrap", "0", "--gof-sims", "0"]) == 2
-    _one_line(capsys, "dm = 1e-09", "bins")
+    one_line_error(capsys, "dm = 1e-09", "bins")
     assert not (run / "catalog").exists()
 
 
@@ -100,6 +93,6 @@ def test_decorrelation_slips_beyond_the_limit_are_refused_before_any_run(monkeyp
 
     monkeypatch.setattr(cli_dec, "_start", no_transient)
     assert main(["lyapunov", "--N", "5", "--decorrelation", "--events", "1000000000000"]) == 2
-    _one_line(capsys, "slips simulated")
+    one_line_error(capsys, "slips simulated")
     assert main(["lyapunov", "--N", "5", "--decorrelation", "--seeds", "1000000000"]) == 2
-    _one_line(capsys, "seeds = 1000000000")
+    one_line_error(capsys, "seeds = 1000000000")

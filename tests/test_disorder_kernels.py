@@ -14,7 +14,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from chain_helpers import _ghosts, assert_bits_equal, assert_same_run, oracle_run
+from chain_helpers import assert_bits_equal, assert_same_run, heun_frame, oracle_run, random_start
 from stickslip import Quenched
 from stickslip.models.params import ChainParams
 from stickslip.run.driver import ChainState, run_chain
@@ -60,8 +60,6 @@ def _value(p, name):
 def het_heun_step(x, v, th, moving, n, p):
     """One Heun step of the heterogeneous chain ``p`` (docs/model.md, "Per-block parameters")
     from t_n = n dt; blocks 1..N at index 0..N-1."""
-    N = len(x)
-    dt, h2 = p.dt, 0.5 * p.dt
     K = _value(p, "K")
     bonds = len(set(K)) > 1
     # K_{N+1}: K_1 on a ring (the same spring), K_N otherwise.
@@ -99,46 +97,14 @@ def het_heun_step(x, v, th, moving, n, p):
         j = i - 1
         return TH[i] * (1.0 - TH[i]) - alpha[j] * TH[i] * vi + D[j] * ((TH[i - 1] - TH[i]) - (TH[i] - TH[i + 1]))
 
-    X, TH, plate = _ghosts(x, th, n, p)
-    mid, a1, b1, xs, vs, ths = [], [], [], [], [], []
-    for i in range(1, N + 1):
-        f = force(X, i, plate)
-        threshold = TH[i] if p.threshold == "state" else Fs[i - 1]
-        m = moving[i - 1] or f > threshold
-        a = accel(f, TH[i], v[i - 1], i) if m else 0.0
-        b = dtheta(TH, i, v[i - 1])
-        mid.append(m)
-        a1.append(a)
-        b1.append(b)
-        xs.append(x[i - 1] + dt * v[i - 1])
-        vs.append(v[i - 1] + dt * a)
-        ths.append(th[i - 1] + dt * b)
-    XS, THS, plate2 = _ghosts(xs, ths, n + 1, p)
-    xn, vn, thn, mn = [], [], [], []
-    for i in range(1, N + 1):
-        m = mid[i - 1]
-        a2 = accel(force(XS, i, plate2), THS[i], vs[i - 1], i) if m else 0.0
-        b2 = dtheta(THS, i, vs[i - 1])
-        thn.append(th[i - 1] + h2 * (b1[i - 1] + b2) if p.friction == "state" else th[i - 1])
-        if m:
-            xn.append(x[i - 1] + h2 * (v[i - 1] + vs[i - 1]))
-            vel = v[i - 1] + h2 * (a1[i - 1] + a2)
-            vn.append(vel if vel > 0.0 else 0.0)
-            mn.append(vel > 0.0)
-        else:
-            xn.append(x[i - 1])
-            vn.append(0.0)
-            mn.append(False)
-    return xn, vn, thn, mn, mid
+    def threshold(TH, i):
+        return TH[i] if p.threshold == "state" else Fs[i - 1]
+
+    return heun_frame(x, v, th, moving, n, p, lambda X, i, plate, step: force(X, i, plate), accel, dtheta, threshold)
 
 
 def _start(p, seed, pstop=0.5):
-    rng = np.random.default_rng(seed)
-    x = rng.uniform(-0.3, 0.3, p.N)
-    v = rng.uniform(0.0, 0.2, p.N)
-    th = rng.uniform(0.3, 1.0, p.N) if p.friction == "state" else np.zeros(p.N)
-    stopped = rng.random(p.N) < pstop
-    return x, np.where(stopped, 0.0, v), th, stopped
+    return random_start(p, seed, pstop)
 
 
 def _runs(p, start, steps):

@@ -10,9 +10,8 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from chain_helpers import error_lines
+from chain_helpers import error_lines, run_cli
 from stickslip import ChainParams, ParameterError, Quenched, chain_params
-from stickslip.cli import main
 from stickslip.models.disorder import PerBlock, parse
 
 
@@ -110,11 +109,7 @@ CLI_BAD = [
 @pytest.mark.parametrize("argv, words", CLI_BAD, ids=[c.split("--Fs ")[-1] for c, _ in CLI_BAD])
 def test_bad_specs_on_the_command_line_are_one_line_and_exit_2(argv, words, tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
-    try:
-        status = main(shlex.split(argv))
-    except SystemExit as exc:
-        status = exc.code
-    out, err = capsys.readouterr()
+    status, out, err = run_cli(capsys, *shlex.split(argv))
     assert status == 2, err
     assert "Traceback" not in err and len(error_lines(err)) == 1, err
     assert words in err, err

@@ -13,7 +13,7 @@ import pytest
 import xarray as xr
 
 from chain_helpers import assert_same_run
-from stickslip import ChainParams, Quenched, load_run
+from stickslip import ChainParams, Quenched, chain_params, load_run
 from stickslip.cli import main
 from stickslip.run import driver as C
 from stickslip.run.driver import ChainRunError, resume_chain, run_chain
@@ -86,3 +86,17 @@ def test_bench_disordered_reports_both_chains_in_one_run(monkeypatch, capsys):
     for key in ("ratio_to_uniform", "ratio_dense"):
         assert out[key] > 0
     assert out["uniform"]["ns_per_update_exact"] > 0 and out["disordered"]["exact_block_updates"] > 0
+
+
+def test_a_chain_without_a_closed_form_steady_state_runs_and_says_so():
+    """Per-block alpha gives each block its own theta_0 = 1 - alpha_i V, which the diffusion D = 5
+    couples: no closed-form steady sliding, so the run's L_steady is NaN, not an error."""
+    import math
+
+    from stickslip.models import physics
+
+    p = chain_params("sakaguchi", N=9, alpha=Quenched("uniform", 0.5, 1.5, seed=1))
+    with pytest.raises(physics.NoClosedForm):
+        physics.chain_steady_length(p)
+    run = run_chain(p, 200.0)
+    assert math.isnan(run.summary["L_steady"])

@@ -13,7 +13,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from chain_helpers import assert_bits_equal, assert_same_run, model_heun_step, oracle_run
+from chain_helpers import assert_bits_equal, assert_same_run, model_heun_step, oracle_run, random_start
 from stickslip.models.params import ChainParams
 from stickslip.models.pieces import CompositionError, check_composition, names
 from stickslip.models.presets import PRESETS, chain_params
@@ -67,12 +67,7 @@ def test_forty_four_compositions_are_valid_and_the_rest_refused():
 
 
 def _state(p, seed, pstop=0.6):
-    rng = np.random.default_rng(seed)
-    x = rng.uniform(-0.3, 0.3, p.N)
-    v = rng.uniform(0.0, 0.2, p.N)
-    th = rng.uniform(0.3, 1.0, p.N) if p.friction == "state" else np.zeros(p.N)
-    stopped = rng.random(p.N) < pstop
-    return x, np.where(stopped, 0.0, v), th, stopped
+    return random_start(p, seed, pstop)
 
 
 def _compare_with_oracle(p, start_arrays, steps):

@@ -11,17 +11,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from chain_helpers import one_line_error
 from stickslip.cli import main
 from stickslip.models.params import ParameterError
 from stickslip.models.presets import chain_params
-
-
-def _one_line(capsys, *names):
-    out, err = capsys.readouterr()
-    assert out == "" and err.count("\n") == 1 and "Traceback" not in err, err
-    for name in names:
-        assert name in err, err
-    return err
 
 
 @pytest.fixture
@@ -50,7 +43,7 @@ def test_a_state_cache_that_cannot_be_used_is_one_line_before_the_transient(
         monkeypatch.setattr(os, "access", lambda p, m: False if str(p).startswith(str(tmp_path / "ro")) else real(p, m))
     argv = ["lyapunov", "--N", "5", "--decorrelation", "--transient", "100", "--state-cache", str(cache)]
     assert main(argv) == 2
-    _one_line(capsys, "--state-cache", str(cache))
+    one_line_error(capsys, "--state-cache", str(cache))
     assert not (tmp_path / "ro" / "cache").exists()
 
 
@@ -65,11 +58,11 @@ def test_a_state_cache_that_is_a_file_is_refused_from_python(tmp_path):
 @pytest.mark.parametrize("d0", ["1e-300", "1e-20"])
 def test_located_switches_refuse_a_d0_below_rounding(d0, capsys):
     assert main(["lyapunov", "--N", "5", "--switches", "located", "--t-end", "200", "--d0", d0]) == 2
-    _one_line(capsys, "d0 must be >= 1e-15")
+    one_line_error(capsys, "d0 must be >= 1e-15")
 
 
 @pytest.mark.parametrize("error", [np.linalg.LinAlgError("Singular matrix"), FloatingPointError("overflow")])
-def test_a_located_ladder_without_answer_is_one_line(error, monkeypatch, capsys):
+def test_a_located_ladder_without_answer_isone_line_error(error, monkeypatch, capsys):
     import stickslip.analysis.lyapunov_flow as flow
 
     def fails(*a, **k):
@@ -77,7 +70,7 @@ def test_a_located_ladder_without_answer_is_one_line(error, monkeypatch, capsys)
 
     monkeypatch.setattr(flow, "flow_ladder", fails)
     assert main(["lyapunov", "--N", "5", "--switches", "located", "--t-end", "200"]) == 2
-    _one_line(capsys, "--switches located at dt = 0.005")
+    one_line_error(capsys, "--switches located at dt = 0.005")
 
 
 def test_extrapolation_of_non_finite_exponents_says_which():
@@ -126,7 +119,7 @@ DAMAGE = [
 
 
 @pytest.mark.parametrize("what, damage, says", DAMAGE, ids=[d[0] for d in DAMAGE])
-def test_catalog_of_a_damaged_events_table_is_one_line(what, damage, says, run_dir, tmp_path, capsys):
+def test_catalog_of_a_damaged_events_table_isone_line_error(what, damage, says, run_dir, tmp_path, capsys):
     from stickslip.run.rundir import RunDirDamaged, load_run
 
     run = tmp_path / "run"
@@ -134,7 +127,7 @@ def test_catalog_of_a_damaged_events_table_is_one_line(what, damage, says, run_d
     damage(run)
     capsys.readouterr()
     assert main(["catalog", str(run), "--bootstrap", "0", "--gof-sims", "0"]) == 2
-    _one_line(capsys, "events.parquet", says)
+    one_line_error(capsys, "events.parquet", says)
     assert not (run / "catalog").exists()
     with pytest.raises(RunDirDamaged, match=says.replace("(", r"\(").replace(")", r"\)")):
         load_run(run)

@@ -205,7 +205,37 @@ class LoadHistory:
             increase or the load point moves backwards.
         """
         columns = read_csv_columns(path)
-        t = column(columns, time, path)
+        return cls.from_columns(columns, column(columns, time, path), path, displacement, velocity)
+
+    @classmethod
+    def from_columns(
+        cls,
+        columns: dict[str, np.ndarray],
+        t: np.ndarray,
+        path: str | Path,
+        displacement: str | None = None,
+        velocity: str | None = None,
+    ) -> LoadHistory:
+        """The load point of a record's columns at its times ``t`` (:meth:`from_csv`, and the fit's
+        records): the displacement column named, else the velocity column, else the first of
+        :data:`DISPLACEMENT_NAMES`, then :data:`VELOCITY_NAMES` present.
+
+        Parameters
+        ----------
+        columns : dict of str to array
+            The record's columns by name (:func:`read_csv_columns`).
+        t : array of float
+            The times.
+        path : str or Path
+            The file, for the messages.
+        displacement, velocity : str, optional
+            The column to read.
+
+        Returns
+        -------
+        LoadHistory
+            A table of the displacements, or the velocities held on each sample interval.
+        """
         if displacement is None and velocity is None:
             displacement = next((c for c in DISPLACEMENT_NAMES if c in columns), None)
             if displacement is None:

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from stickslip.lab.history import DISPLACEMENT_NAMES, VELOCITY_NAMES, LoadHistory, column, read_csv_columns
+from stickslip.lab.history import LoadHistory, column, read_csv_columns
 from stickslip.models.params import ParameterError, check_number
 
 __all__ = ["Record", "detrend", "synthetic"]
@@ -120,19 +120,7 @@ class Record:
             friction = next((c for c in FRICTION_NAMES if c in columns), FRICTION_NAMES[0])
         t = column(columns, time, path)
         mu = column(columns, friction, path)
-        if displacement is None and velocity is None:
-            displacement = next((c for c in DISPLACEMENT_NAMES if c in columns), None)
-            if displacement is None:
-                velocity = next((c for c in VELOCITY_NAMES if c in columns), None)
-        if displacement is None and velocity is None:
-            raise ParameterError(
-                f"{path}: no load-point column (looked for {', '.join(DISPLACEMENT_NAMES + VELOCITY_NAMES)}; "
-                f"found {', '.join(columns)})"
-            )
-        if displacement is not None:
-            history = LoadHistory(t, column(columns, displacement, path))
-        else:
-            history = LoadHistory.from_velocities(t, column(columns, velocity, path))
+        history = LoadHistory.from_columns(columns, t, path, displacement, velocity)
         return cls(t, mu, history, window=window, name=Path(path).stem)
 
     def __repr__(self) -> str:

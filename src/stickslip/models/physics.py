@@ -19,6 +19,11 @@ from stickslip.models.params import BlockParams, ChainParams
 UNTIL_STEADY = 1e-6
 
 
+class NoClosedForm(ValueError):
+    """The chain's steady sliding has no closed form here (per-block theta_0 coupled by diffusion,
+    or no velocity at which the frictions balance the applied force); the message is one line."""
+
+
 def sliding_friction(V: float, beta: float) -> float:
     """Friction of steady sliding, c = theta_0 + beta v_0 = 1 - (1 - beta) V (sections 2, 3)."""
     return 1.0 - (1.0 - beta) * V
@@ -257,7 +262,7 @@ def steady_velocity(p: Any) -> float:
             break
         hi *= 2.0
     else:
-        raise ValueError(
+        raise NoClosedForm(
             f"the friction does not balance the applied force at any velocity (drive {p.drive}, friction {p.friction})"
         )
     return float(brentq(excess, 0.0, hi, xtol=1e-15, rtol=4.0 * np.finfo(float).eps))
@@ -332,7 +337,7 @@ def _check_theta_decoupled(p: Any, theta: np.ndarray, v: float) -> None:
         return
     over = {} if v == p.V else {"V": float(v)}
     if any(linear(BlockView(p, i, **over)).diffusion != 0.0 for i in range(p.N)):
-        raise ValueError(
+        raise NoClosedForm(
             "blocks with different steady theta_0 coupled by diffusion D > 0 have no closed-form steady state"
         )
 
@@ -382,8 +387,9 @@ def chain_steady_length(p: ChainParams) -> float:
         return float(x[0] - x[-1])
     if p.drive_piece.leaf_spring:
         return 0.0
-    c = steady_friction(uniform_view(p))[0]
-    return c / p.K * p.N * (p.N - 1) / 2.0
+    q = uniform_view(p)
+    c = steady_friction(q)[0]
+    return c / q.K * p.N * (p.N - 1) / 2.0
 
 
 def chain_steady_profile_paper(p: ChainParams, t: float = 0.0) -> np.ndarray:

@@ -284,19 +284,13 @@ def _remedy(p: ChainParams, start: str) -> str:
 
 
 def closed_form(fn, p: ChainParams, *args):
-    """``fn(p, *args)``, a closed form of :mod:`stickslip.models.physics` for a uniform chain (also
-    one given as arrays of equal values); NaN where the chain has per-block parameters
-    (docs/model.md, "Per-block parameters") that differ and that the closed form does not take."""
+    """``fn(p, *args)``, a closed form of :mod:`stickslip.models.physics`; NaN where the chain's
+    per-block parameters leave it without one (:class:`~stickslip.models.physics.NoClosedForm`,
+    docs/model.md, "Per-block parameters")."""
     try:
         return fn(p, *args)
-    except TypeError:
-        per_block = p.per_block()
-        if not per_block:
-            raise
-    if all(bool((v.values == v.values[0]).all()) for v in per_block.values()):
-        # Every block alike, given as arrays: the uniform chain's closed form.
-        return fn(p.replace(**{k: float(v.values[0]) for k, v in per_block.items()}), *args)
-    return float("nan")
+    except physics.NoClosedForm:
+        return float("nan")
 
 
 def steady_deviation(state: ChainState, p: ChainParams) -> float:
