@@ -37,9 +37,10 @@ def test_editing_a_called_module_recompiles_the_cached_kernel(tmp_path):
     assert _run(tmp_path) == "51"  # from the cache
     laws = tmp_path / "stickslip" / "kernels" / "laws.py"
     text = laws.read_text()
-    old = "return V * (np.float64(n) * dt)"
+    # The constant-velocity drives' pulling point, which _pull's overload compiles in.
+    old = "lambda V, n, dt, dp, drive: V * (np.float64(n) * dt)"
     assert old in text
-    laws.write_text(text.replace(old, "return 2.0 * V * (np.float64(n) * dt)"))
+    laws.write_text(text.replace(old, "lambda V, n, dt, dp, drive: 2.0 * V * (np.float64(n) * dt)"))
     assert _run(tmp_path) == "26"
 
 

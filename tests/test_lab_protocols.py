@@ -100,6 +100,7 @@ def test_cli_fit_bad_csv(capsys, tmp_path):
     assert "no load-point column" in capsys.readouterr().err
 
 
+@pytest.mark.slow  # a benchmark: both routes timed on the full workload (about a minute)
 def test_bench_measures_both_routes_and_they_agree(capsys):
     d = _json(capsys, "lab", "bench", "--repeats", "1")
     assert d["max_abs_mu_difference"] < 1e-9

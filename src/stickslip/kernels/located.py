@@ -57,7 +57,10 @@ IST_SIZE = 8
 F_T_START, F_SUM_START = range(2)
 EVF_SIZE = 2
 
-DONE, EVENTS_FULL, NONFINITE = 0, 1, 2
+DONE, EVENTS_FULL, NONFINITE, NO_PROGRESS = 0, 1, 2, 3
+#: Switches one grid step may locate before :func:`_steps` gives up on it (NO_PROGRESS): each
+#: block starts and stops at most a few times in a step; more means switches that repeat at one time.
+SWITCHES_PER_BLOCK = 8
 
 
 @njit(cache=True, inline="always")
@@ -275,6 +278,7 @@ def _steps(
         if ist[I_EVENTS] > ev_t.shape[0] - 4:
             return EVENTS_FULL
         s = 0.0
+        located = 0
         while True:
             t = n * dt + s
             # Switches due now: a stuck block above its threshold, a moving one below v = 0.
@@ -331,6 +335,10 @@ def _steps(
             s_new = s + tau
             if tau >= h or s_new >= dt:
                 break
+            located += 1
+            if located > SWITCHES_PER_BLOCK * N + 16:
+                ist[I_STEP] = n
+                return NO_PROGRESS
             s = s_new
         n += 1
         ist[I_STEP] = n
@@ -347,7 +355,8 @@ def advance(
     """Advance the state (u, v, theta, moving mask) at step ist[I_STEP] to step n_end.
 
     Returns DONE, EVENTS_FULL (the event buffer has fewer than 4 free rows; the state is at the
-    grid step ist[I_STEP], continue after emptying it) or NONFINITE. See the module docstring.
+    grid step ist[I_STEP], continue after emptying it), NONFINITE or NO_PROGRESS (switches that
+    repeat at one time in step ist[I_STEP], :data:`SWITCHES_PER_BLOCK`). See the module docstring.
     This is the dense form: every block at every step, and each trial step of a switch's
     location over the whole chain (the reference of :mod:`stickslip.kernels.located_fast`).
     """

@@ -235,6 +235,12 @@ class LocatedStepper:
             r = int(state.ist[L.I_EVENTS])
             if r:
                 parts.append(np.column_stack((self.ev_t[:r], self.ev_i[:r])))
+            if status == L.NO_PROGRESS:
+                raise FloatingPointError(
+                    f"the located integrator made no progress in step {state.step}: switches repeat at one"
+                    " time (a block that starts where its friction at v = 0+ exceeds its force stops again"
+                    " at once; the grid integrators take such a chain)"
+                )
             if status == L.NONFINITE:
                 raise FloatingPointError(f"the located integrator met a non-finite value at step {state.step}")
             if status == L.DONE:
