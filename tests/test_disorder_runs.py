@@ -15,8 +15,10 @@ import xarray as xr
 from chain_helpers import assert_same_run
 from stickslip import ChainParams, Quenched, chain_params, load_run
 from stickslip.cli import main
+from stickslip.models.params import ParameterError
 from stickslip.run import driver as C
 from stickslip.run.driver import ChainRunError, resume_chain, run_chain
+from stickslip.run.state import ChainState
 
 # Fs and beta per block (the disordered bench's chain): one compilation for the whole file.
 P = ChainParams(N=6, V=0.01, Fs=Quenched("uniform", 2.5, 3.5, seed=3), beta=Quenched("normal", 1.0, 0.1, seed=3))
@@ -100,3 +102,6 @@ def test_a_chain_without_a_closed_form_steady_state_runs_and_says_so():
         physics.chain_steady_length(p)
     run = run_chain(p, 200.0)
     assert math.isnan(run.summary["L_steady"])
+    # A steady start is refused with the reason, as a bad parameter.
+    with pytest.raises(ParameterError, match="start must be paper or rest for this chain: .*theta_0"):
+        ChainState.steady(p)

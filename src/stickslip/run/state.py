@@ -122,14 +122,8 @@ class ChainState:
         """
         try:
             s = physics.chain_steady_state(p, 0.0)
-        except TypeError:
-            if not p.per_block():
-                raise
-            names = ", ".join(p.per_block())
-            raise ParameterError(
-                f"start must be paper or rest for a chain with per-block {names}: the steady state "
-                "of such a chain has no closed form here yet"
-            ) from None
+        except physics.NoClosedForm as e:
+            raise ParameterError(f"start must be paper or rest for this chain: {e}") from None
         state = cls.from_blocks(s["x"].copy(), s["v"].copy(), s["theta"], np.zeros(p.N, bool)).of(p)
         return state.perturbed(amplitude, seed)
 
