@@ -26,6 +26,19 @@ def test_a_spec_draws_from_numpys_generator_with_a_stream_per_parameter():
     assert q.Fs == p.Fs and hash(q.Fs) == hash(p.Fs)
 
 
+def test_a_drawn_medium_follows_n_and_an_array_does_not():
+    """replace(N=...) draws a spec's medium anew for N blocks, from numpy's stream of its seed;
+    an array of the old length is refused with the lengths."""
+    p = ChainParams(N=8, Fs=Quenched("uniform", 2.5, 3.5, seed=3), beta=Quenched("uniform", 0.5, 1.5))
+    q = p.replace(N=12)
+    rng = np.random.default_rng(np.random.SeedSequence(3, spawn_key=(zlib.crc32(b"Fs"),)))
+    np.testing.assert_array_equal(q.Fs.values, rng.uniform(2.5, 3.5, 12))
+    assert q.Fs.spec_text == p.Fs.spec_text and len(q.beta) == 12 and q.beta.seed == p.beta.seed
+    assert q.replace(N=8).per_block() == p.per_block()
+    with pytest.raises(ParameterError, match="needs N = 12 values \\(got 8\\)"):
+        ChainParams(N=8, Fs=np.linspace(2.5, 3.5, 8)).replace(N=12)
+
+
 def test_the_truncated_normal_stays_in_the_range_and_follows_its_law():
     p = ChainParams(N=4000, beta=Quenched("normal", 0.05, 0.2, seed=1))
     b = p.beta.values

@@ -269,9 +269,12 @@ def resolve(name: str, value: Any, n: int, low: float | None, high: float | None
     used (the caller adds the parameter's name and range); the range itself is checked by the
     caller on :attr:`PerBlock.values`."""
     if isinstance(value, PerBlock):
-        if len(value) != n:
-            raise DisorderError(f"needs N = {n} values (got {len(value)})")
-        return value
+        if len(value) == n:
+            return value
+        if isinstance(value.spec, Quenched):
+            # A drawn medium follows N (``replace(N=...)``): the same spec and seed, N values.
+            return resolve(name, value.spec, n, low, high, value.seed if value.seed is not None else seed)
+        raise DisorderError(f"needs N = {n} values (got {len(value)})")
     if isinstance(value, dict):
         return _from_record(value, n)
     if isinstance(value, str) and not value.startswith("file:"):
