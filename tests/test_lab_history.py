@@ -85,10 +85,11 @@ def test_any_steps_are_continuous_and_their_slope_is_the_velocity(segments):
     v, d = zip(*segments, strict=True)
     h = LoadHistory.steps(v, d)
     assert h.breakpoints.size == len(v) + 1
-    # V_i from positions: exact up to the rounding of p_i, p_i+1 (a slow step after a long fast one).
-    p = np.abs(h.positions)
-    bound = 4.0 * np.finfo(float).eps * (p[:-1] + p[1:] + np.abs(v) * np.diff(h.times)) / np.diff(h.times)
-    assert np.all(np.abs(h.velocities - np.asarray(v)) <= bound + 1e-12 * np.abs(v))
+    # V_i from the summed positions and times: exact up to their rounding, (n + 2) eps of each
+    # (a short step after long ones keeps fewer digits).
+    p, t, dt = np.abs(h.positions), h.times, np.diff(h.times)
+    bound = (len(v) + 2) * np.finfo(float).eps * (p[:-1] + p[1:] + np.abs(v) * (t[:-1] + t[1:])) / dt
+    assert np.all(np.abs(h.velocities - np.asarray(v)) <= bound)
     mid = 0.5 * (h.times[:-1] + h.times[1:])
     np.testing.assert_array_equal(h.velocity(mid), h.velocities)
     # p(t) at each breakpoint is the sum of the displacements before it, from either side
