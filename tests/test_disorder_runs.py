@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 import shlex
 
 import numpy as np
@@ -15,6 +16,7 @@ import xarray as xr
 from chain_helpers import assert_same_run
 from stickslip import ChainParams, Quenched, chain_params, load_run
 from stickslip.cli import main
+from stickslip.models import physics
 from stickslip.models.params import ParameterError
 from stickslip.run import driver as C
 from stickslip.run.driver import ChainRunError, resume_chain, run_chain
@@ -93,10 +95,6 @@ def test_bench_disordered_reports_both_chains_in_one_run(monkeypatch, capsys):
 def test_a_chain_without_a_closed_form_steady_state_runs_and_says_so():
     """Per-block alpha gives each block its own theta_0 = 1 - alpha_i V, which the diffusion D = 5
     couples: no closed-form steady sliding, so the run's L_steady is NaN, not an error."""
-    import math
-
-    from stickslip.models import physics
-
     p = chain_params("sakaguchi", N=9, alpha=Quenched("uniform", 0.5, 1.5, seed=1))
     with pytest.raises(physics.NoClosedForm):
         physics.chain_steady_length(p)

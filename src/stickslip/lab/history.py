@@ -264,7 +264,8 @@ class LoadHistory:
     @property
     def velocities(self) -> np.ndarray:
         """V_i = (p_i+1 - p_i) / (t_i+1 - t_i), the load-point velocity on each interval (exact up to
-        the rounding of the positions: a slow step after a long fast one keeps fewer digits)."""
+        the rounding of the summed positions and times: a short step after long ones keeps fewer
+        digits)."""
         return np.diff(self.positions) / np.diff(self.times)
 
     def merged(self, rtol: float = 1e-9) -> LoadHistory:
