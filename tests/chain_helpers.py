@@ -49,7 +49,7 @@ def assert_same_state(a, b, skip: tuple[str, ...] = ()) -> None:
     """Two ChainStates hold the same model state bit for bit (ghost cells excluded)."""
     assert a.sha256() == b.sha256()
     for name in ("x", "v", "th", "mov", "first_step", "x0ev"):
-        assert_bits_equal(getattr(a, name)[1:-1], getattr(b, name)[1:-1], f"state.{name}")
+        assert_bits_equal(a.arrays()[name][1:-1], b.arrays()[name][1:-1], f"state.{name}")
     for name, idx in IST_MODEL.items():
         if name in skip:
             continue

@@ -33,7 +33,7 @@ def _same_state(a: ChainState, b: ChainState) -> bool:
 
     keep = np.ones(layout.IST_SIZE, bool)
     keep[layout.NEXT_SAMPLE] = False
-    return all(np.array_equal(getattr(a, k), getattr(b, k)) for k in ChainState.ARRAYS if k != "ist") and (
+    return all(np.array_equal(a.arrays()[k], b.arrays()[k]) for k in ChainState.ARRAYS if k != "ist") and (
         np.array_equal(a.ist[keep], b.ist[keep])
     )
 

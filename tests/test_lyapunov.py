@@ -150,13 +150,13 @@ def test_twin_runs_in_a_frame_moved_back_along_the_drive():
     ref = run_chain(p, 1000.0).state
     eng = GridEngine(p)
     twin = eng.twin(ref, np.ones(3), 1e-10)
-    assert twin.shift > 0 and abs(twin.base.x[1]) < 1.0 and ref.x[1] > 400
+    assert twin.shift > 0 and abs(twin.base.x[0]) < 1.0 and ref.x[0] > 400
     # the copy is the reference's motion: same velocity, theta and spring force
-    assert twin.base.v[1] == ref.v[1] and twin.base.th[1] == ref.th[1]
-    f_ref = p.V * ref.step * p.dt - ref.x[1]
-    assert p.V * twin.base.step * p.dt - twin.base.x[1] == pytest.approx(f_ref, abs=1e-12)
+    assert twin.base.v[0] == ref.v[0] and twin.base.theta[0] == ref.theta[0]
+    f_ref = p.V * ref.step * p.dt - ref.x[0]
+    assert p.V * twin.base.step * p.dt - twin.base.x[0] == pytest.approx(f_ref, abs=1e-12)
     ref, twin, _ = eng.advance(ref, twin, ref.step + round(10.0 / p.dt))
-    assert abs(twin.base.x[1]) < 2.0 and twin.base.step + twin.shift == ref.step
+    assert abs(twin.base.x[0]) < 2.0 and twin.base.step + twin.shift == ref.step
     # fixed ends read t: the twin stays beside the reference
     wall = GridEngine(ChainParams(N=3, ends="fixed"))
     assert wall.twin(run_chain(ChainParams(N=3, ends="fixed"), 100.0).state, np.ones(9), 1e-10).base is None

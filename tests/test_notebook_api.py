@@ -325,3 +325,17 @@ def test_a_snapshot_of_a_model_without_a_steady_profile_is_refused_in_one_line()
 
     with pytest.raises(ValueError, match=r"no steady sliding profile .* \(Carlson-Langer\)$"):
         ssp.snapshot(SimpleNamespace(params=chain_params("carlson-langer")))
+
+
+def test_a_states_public_arrays_hold_the_blocks(run):
+    """run.state.x, .v and .theta are x_1..x_N (no ghost cells), views of the kernels' arrays:
+    their means are the blocks' (before, run.state.v had N + 2 entries)."""
+    s = run.state
+    b = s.blocks()
+    assert s.x.shape == s.v.shape == s.theta.shape == (run.params.N,)
+    np.testing.assert_array_equal(s.x, b["x"])
+    np.testing.assert_array_equal(s.v, b["v"])
+    np.testing.assert_array_equal(s.theta, b["theta"])
+    assert s.v.mean() == sum(b["v"]) / run.params.N
+    assert s.x[0] - s.x[-1] == run.summary["L_final"]  # L = x_1 - x_N
+    assert np.shares_memory(s.x, s.xg) and s.xg.shape == (run.params.N + 2,)

@@ -111,7 +111,7 @@ class _Every(Hook):
     def at(self, loop, n):
         if n % self.every == 0:
             s = loop.state
-            self.kept[n] = (s.x.copy(), s.v.copy(), s.th.copy(), s.mov.copy())
+            self.kept[n] = (s.xg.copy(), s.vg.copy(), s.thg.copy(), s.mov.copy())
         return n == self.end
 
     def close(self):
@@ -119,7 +119,7 @@ class _Every(Hook):
 
 
 def _same_bits(kept, state):
-    now = (state.x, state.v, state.th, state.mov)
+    now = (state.xg, state.vg, state.thg, state.mov)
     return all(a[1:-1].tobytes() == b[1:-1].tobytes() for a, b in zip(kept, now, strict=True))
 
 

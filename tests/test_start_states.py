@@ -43,7 +43,7 @@ def run_cli_ok(*argv):
 
 
 def _arrays(state):
-    return {k: getattr(state, k).copy() for k in ChainState.ARRAYS}
+    return {k: a.copy() for k, a in state.arrays().items()}
 
 
 def _set(name, index, value):
@@ -135,7 +135,7 @@ def test_run_chain_refuses_a_bad_start_state(case, damage, words, good):
     _, state = good
     arrays = _arrays(state)
     damage(arrays)
-    bad = ChainState(**arrays)
+    bad = ChainState(**{ChainState.FIELDS.get(k, k): a for k, a in arrays.items()})
     with pytest.raises(ParameterError) as info:
         run_chain(_params(), 600.0, start=bad)
     assert words in str(info.value) and "\n" not in str(info.value)

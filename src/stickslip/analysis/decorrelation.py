@@ -137,7 +137,7 @@ class GridSequences:
         out.model = state.model
         bounds = params.friction_piece.theta_range
         if bounds is not None:  # a stuck block's theta at the end of its range stays in it
-            np.clip(out.th[1:-1], bounds[0], bounds[1], out=out.th[1:-1])
+            np.clip(out.theta, bounds[0], bounds[1], out=out.theta)
         return out
 
     def run(self, params: ChainParams, state, step: int):

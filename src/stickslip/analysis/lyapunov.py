@@ -58,12 +58,12 @@ def separation(ref: ChainState, twin: ChainState, params: ChainParams) -> np.nda
     e_i = x_{i-1} - x_i with the same pulling point for both, so de_i = dx_{i-1} - dx_i, dx_0 = 0.
     With the plate drive y = (sqrt(Kp) dx, v, theta) (module docstring).
     """
-    dx = twin.x[1:-1] - ref.x[1:-1]
+    dx = twin.x - ref.x
     if params.drive_piece.leaf_spring:
-        return np.concatenate((math.sqrt(params.Kp) * dx, twin.v[1:-1] - ref.v[1:-1], twin.th[1:-1] - ref.th[1:-1]))
+        return np.concatenate((math.sqrt(params.Kp) * dx, twin.v - ref.v, twin.theta - ref.theta))
     de = np.concatenate(([0.0], dx[:-1])) - dx
-    dv = twin.v[1:-1] - ref.v[1:-1]
-    dth = twin.th[1:-1] - ref.th[1:-1]
+    dv = twin.v - ref.v
+    dth = twin.theta - ref.theta
     return np.concatenate((math.sqrt(params.K) * de, dv, dth))
 
 
@@ -252,7 +252,7 @@ class GridEngine:
         the steps over which the drive moves by R (after it, within -R/2 .. 3R/2)."""
         p = self.params
         n = state.step
-        x = state.x[1:-1]
+        x = state.x
         drive = p.V * (np.float64(n) * p.dt)
         lo, hi = min(float(x.min()), drive), max(float(x.max()), drive)
         rate = p.V * p.dt  # drive per step

@@ -436,7 +436,7 @@ def _from_state(params, args):
         state = final_state(args.from_dir)
     except (OSError, ValueError, KeyError) as exc:
         raise CommandError(f"--from: {exc}") from None
-    n_state = state.x.shape[0] - 2 if getattr(state.x, "ndim", 0) == 1 else None
+    n_state = state.xg.shape[0] - 2 if getattr(state.xg, "ndim", 0) == 1 else None
     if n_state is not None and n_state != params.N:
         raise CommandError(f"--from: the state there has {n_state} blocks, the run N = {params.N} (give --N {n_state})")
     check_start_state(state, params, where=f"--from: the state in {args.from_dir}")

@@ -71,7 +71,7 @@ def write_state_npz(
 ) -> None:
     """A chain state kept with what it was made from (``header["spec"]``) and further ``arrays``
     (a loaded state, a rung's progress), by :func:`write_npz`."""
-    write_npz(path, {k: getattr(state, k) for k in ChainState.ARRAYS} | dict(arrays or {}), header)
+    write_npz(path, state.arrays() | dict(arrays or {}), header)
 
 
 def read_state_npz(
@@ -93,7 +93,9 @@ def read_state_npz(
     shapes = {k: (params.N + 2,) for k in ChainState.ARRAYS if k != "ist"} | {"ist": (layout.IST_SIZE,)}
     if any(k not in arrays or arrays[k].shape != s for k, s in shapes.items()):
         return None
-    state = ChainState(**{k: arrays.pop(k).copy() for k in ChainState.ARRAYS}, model=model_of(params))
+    state = ChainState.from_arrays(arrays, model=model_of(params))
+    for k in ChainState.ARRAYS:
+        arrays.pop(k)
     return state, header, arrays
 
 
@@ -169,7 +171,7 @@ class Checkpointer:
         name = f"part-{len(self.parts):06d}.npz"
         digest = write_npz(self.dir / name, new, {"format": CHECKPOINT_FORMAT})
         self.parts.append({"file": name, "sha256": digest})
-        arrays = {k: getattr(state, k) for k in ChainState.ARRAYS}
+        arrays = state.arrays()
         full_header = dict(
             header, format=CHECKPOINT_FORMAT, parts=self.parts, version=__version__, ist_size=layout.IST_SIZE
         )
@@ -188,7 +190,7 @@ class Checkpointer:
         if missing:
             raise ChainRunError(f"checkpoint is missing arrays {missing}")
         _check_layout(arrays, header)
-        state = ChainState(**{k: arrays[k].copy() for k in ChainState.ARRAYS})
+        state = ChainState.from_arrays(arrays)
         parts: dict[str, list[np.ndarray]] = {k: [] for k in PART_KEYS}
         listed = header.get("parts", [])
         if not isinstance(listed, list) or not all(

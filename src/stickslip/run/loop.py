@@ -37,7 +37,7 @@ _KERNELS = {"dense": dense.run_dense, "exact": exact.run_exact, "sparse": plate.
 
 
 def _finite(state: ChainState) -> bool:
-    return bool(np.isfinite(state.x).all() and np.isfinite(state.v).all() and np.isfinite(state.th).all())
+    return bool(np.isfinite(state.xg).all() and np.isfinite(state.vg).all() and np.isfinite(state.thg).all())
 
 
 def _par(p: ChainParams) -> np.ndarray:
@@ -99,9 +99,9 @@ class _Kernel:
 
     def _args(self, state, target):
         return layout.ChainArgs(
-            state.x,
-            state.v,
-            state.th,
+            state.xg,
+            state.vg,
+            state.thg,
             state.mov,
             *self.scratch,
             state.first_step,

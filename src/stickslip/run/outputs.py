@@ -265,8 +265,9 @@ class _Outputs:
         ist[layout.EV_P_FIRST] = 0
 
     def add_snapshot(self, step: int, x: np.ndarray) -> None:
+        """Keep x_1..x_N (``state.x``, no ghost cells) at ``step``."""
         self.parts["snap_step"].append(np.array([step], dtype=np.int64))
-        self.parts["snap_x"].append(x[1:-1].copy()[None, :])
+        self.parts["snap_x"].append(np.array(x, dtype=np.float64)[None, :])
 
     def add_moving(self, step: int, n_moving: int) -> None:
         self.parts["moving"].append(np.array([[step, n_moving]], dtype=np.int64))
@@ -348,7 +349,7 @@ def _assemble(params, options, integrator, start_info, state, outputs, wall, ste
         samples = samples.assign_coords(t_moving=("t_moving", mv[:, 0] * dt, time_attrs))
     blocks = np.arange(1, params.N + 1)
     snap_steps = list(parts["snap_step"]) + [state.step]
-    snap_x = np.vstack([parts["snap_x"].reshape(-1, params.N), state.x[1:-1][None, :]])
+    snap_x = np.vstack([parts["snap_x"].reshape(-1, params.N), state.x[None, :]])
     order = np.argsort(snap_steps, kind="stable")
     snapshots = xr.DataArray(
         snap_x[order],
@@ -358,7 +359,7 @@ def _assemble(params, options, integrator, start_info, state, outputs, wall, ste
         attrs={"long_name": "block positions x_i"},
     )
     profiles = _profiles(parts, events, options, params)
-    L_final = float(state.x[1] - state.x[-2])
+    L_final = float(state.x[0] - state.x[-1])
     avg_from = options.average_from if options.average_from is not None else options.t_end / 2
     sel = t_samples >= avg_from - 0.5 * dt
     L_values = parts["samp_L"][sel]
@@ -382,7 +383,7 @@ def _assemble(params, options, integrator, start_info, state, outputs, wall, ste
             "t_steady": steady_at["t_steady"],
             "steady_deviation": steady_at["deviation"],
             "until_steady": options.until_steady,
-            "L_final_simulated": float(state.x[1] - state.x[-2]),
+            "L_final_simulated": float(state.x[0] - state.x[-1]),
         }
     L_mean = float(np.mean(L_values)) if len(L_values) else float("nan")
     summary = {

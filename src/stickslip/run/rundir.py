@@ -220,7 +220,7 @@ def write_state_file(path: str | Path, state: ChainState) -> Path:
 
     from stickslip import io
 
-    arrays = {k: getattr(state, k) for k in ChainState.ARRAYS}
+    arrays = state.arrays()
     if state.model is not None:
         arrays["__model__"] = np.frombuffer(json.dumps(state.model, sort_keys=True).encode(), dtype=np.uint8)
     buf = BytesIO()
@@ -253,7 +253,7 @@ def read_state_file(path: str | Path) -> ChainState:
             model = None
         if not isinstance(model, dict) or not all(isinstance(v, str) for v in model.values()):
             raise ValueError(f"{path} is damaged: its model record is unreadable")
-    return ChainState(**{k: arrays[k].copy() for k in ChainState.ARRAYS}, model=model)
+    return ChainState.from_arrays(arrays, model=model)
 
 
 def final_state(path: str | Path) -> ChainState:

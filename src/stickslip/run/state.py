@@ -40,37 +40,67 @@ def line_aligned(a: np.ndarray) -> np.ndarray:
 
 @dataclass
 class ChainState:
-    """Everything the kernels need to continue a run (arrays with ghost cells, see kernels).
+    """Everything the kernels need to continue a run.
 
-    x, v, th, mov: positions, velocities, state variables and moving mask (1.0/0.0) of
-    blocks 1..N at index 1..N; first_step, x0ev: per-block bookkeeping of the event in
-    progress; ist: the integer state vector (step count, event bookkeeping, active range);
-    model: the model the state belongs to (:func:`model_of` its parameters), None when unknown
-    (a state built from blocks).
+    The public arrays hold the N blocks, block i at index i - 1: :attr:`x`, :attr:`v` and
+    :attr:`theta` (views: ``run.state.v.mean()`` is the blocks' mean velocity), as
+    :meth:`blocks` copies them. The kernels' arrays carry ghost cells at index 0 and N + 1 (see
+    kernels) and are the fields: xg, vg, thg, mov: positions, velocities, state variables and
+    moving mask (1.0/0.0) of blocks 1..N at index 1..N; first_step, x0ev: per-block bookkeeping
+    of the event in progress; ist: the integer state vector (step count, event bookkeeping,
+    active range); model: the model the state belongs to (:func:`model_of` its parameters),
+    None when unknown (a state built from blocks).
     """
 
-    x: np.ndarray
-    v: np.ndarray
-    th: np.ndarray
+    xg: np.ndarray
+    vg: np.ndarray
+    thg: np.ndarray
     mov: np.ndarray
     first_step: np.ndarray
     x0ev: np.ndarray
     ist: np.ndarray
     model: dict[str, str] | None = None
 
+    #: The arrays as files name them (checkpoints, state files), in order.
     ARRAYS = ("x", "v", "th", "mov", "first_step", "x0ev", "ist")
+    #: The field holding each array of :data:`ARRAYS` (with its ghost cells).
+    FIELDS = {"x": "xg", "v": "vg", "th": "thg"}
 
     def __post_init__(self):
         # The kernels' float arrays with block 1 at a line's start, wherever they came from.
-        for name in ("x", "v", "th", "mov"):
+        for name in ("xg", "vg", "thg", "mov"):
             a = getattr(self, name)
             if isinstance(a, np.ndarray) and a.ndim == 1 and a.dtype == np.float64:
                 if (a.ctypes.data + a.itemsize) % LINE or not a.flags.c_contiguous:
                     setattr(self, name, line_aligned(a))
 
     @property
+    def x(self) -> np.ndarray:
+        """x_1..x_N (a view of the blocks, no ghost cells)."""
+        return self.xg[1:-1]
+
+    @property
+    def v(self) -> np.ndarray:
+        """v_1..v_N (a view of the blocks, no ghost cells)."""
+        return self.vg[1:-1]
+
+    @property
+    def theta(self) -> np.ndarray:
+        """theta_1..theta_N (a view of the blocks, no ghost cells)."""
+        return self.thg[1:-1]
+
+    def arrays(self) -> dict[str, np.ndarray]:
+        """Every array by its name in :data:`ARRAYS` (the kernels' arrays, ghost cells included)."""
+        return {k: getattr(self, self.FIELDS.get(k, k)) for k in self.ARRAYS}
+
+    @classmethod
+    def from_arrays(cls, arrays: dict[str, np.ndarray], model: dict[str, str] | None = None) -> ChainState:
+        """A state from copies of the arrays named as :meth:`arrays` names them."""
+        return cls(**{cls.FIELDS.get(k, k): np.array(arrays[k], copy=True) for k in cls.ARRAYS}, model=model)
+
+    @property
     def N(self) -> int:
-        return self.x.shape[0] - 2
+        return self.xg.shape[0] - 2
 
     @property
     def step(self) -> int:
@@ -85,7 +115,7 @@ class ChainState:
         if x.ndim != 1 or any(shape != (N,) for shape in shapes.values()):
             raise ValueError(f"the per-block arrays differ in shape: {shapes}")
         arrays = {}
-        for name, values in (("x", x), ("v", v), ("th", theta)):
+        for name, values in (("xg", x), ("vg", v), ("thg", theta)):
             a = np.zeros(N + 2)
             # Adding 0.0 turns -0.0 into +0.0, so "changed" (a float compare) sees every bit.
             a[1:-1] = np.asarray(values, dtype=np.float64) + 0.0
@@ -93,7 +123,7 @@ class ChainState:
         stopped = np.asarray(stopped, dtype=bool)
         mov = np.zeros(N + 2)
         mov[1:-1] = np.where(stopped, 0.0, 1.0)
-        arrays["v"][1:-1] = np.where(stopped, 0.0, arrays["v"][1:-1])
+        arrays["vg"][1:-1] = np.where(stopped, 0.0, arrays["vg"][1:-1])
         ist = np.zeros(layout.IST_SIZE, dtype=np.int64)
         ist[layout.N_MOVING] = int(np.count_nonzero(~stopped))
         ist[layout.ACT_LO], ist[layout.ACT_HI] = 1, N
@@ -136,8 +166,8 @@ class ChainState:
         if amplitude > 0:
             rng = np.random.default_rng(seed)
             moving = s.mov[1:-1] != 0.0
-            s.x[1:-1] += np.where(moving, rng.uniform(-amplitude, amplitude, s.N), 0.0)
-            s.v[1:-1] += np.where(moving, rng.uniform(-amplitude, amplitude, s.N), 0.0)
+            s.xg[1:-1] += np.where(moving, rng.uniform(-amplitude, amplitude, s.N), 0.0)
+            s.vg[1:-1] += np.where(moving, rng.uniform(-amplitude, amplitude, s.N), 0.0)
         return s
 
     @classmethod
@@ -156,22 +186,22 @@ class ChainState:
     def blocks(self) -> dict[str, np.ndarray]:
         """Per-block copies: x, v, theta (float64) and stopped (bool), block i at index i - 1."""
         return {
-            "x": self.x[1:-1].copy(),
-            "v": self.v[1:-1].copy(),
-            "theta": self.th[1:-1].copy(),
+            "x": self.x.copy(),
+            "v": self.v.copy(),
+            "theta": self.theta.copy(),
             "stopped": self.mov[1:-1] == 0.0,
         }
 
     def sha256(self) -> str:
         """SHA-256 of x, v, theta (float64 little-endian, block order) then stopped (1 byte each)."""
         h = hashlib.sha256()
-        for a in (self.x, self.v, self.th):
-            h.update(np.ascontiguousarray(a[1:-1], dtype="<f8").tobytes())
+        for a in (self.x, self.v, self.theta):
+            h.update(np.ascontiguousarray(a, dtype="<f8").tobytes())
         h.update((self.mov[1:-1] == 0.0).astype(np.uint8).tobytes())
         return h.hexdigest()
 
     def copy(self) -> ChainState:
-        return ChainState(**{k: getattr(self, k).copy() for k in self.ARRAYS}, model=self.model)
+        return ChainState.from_arrays(self.arrays(), model=self.model)
 
 
 def model_of(p: ChainParams) -> dict[str, str]:
@@ -245,7 +275,7 @@ def first_step_problem(state: ChainState, p: ChainParams) -> str | None:
             return math.nan
         return r if math.isfinite(r) and math.isfinite(force) else math.nan
 
-    th, v = state.th, state.v
+    th, v = state.thg, state.vg
     seen = set()
     for i in range(1, p.N + 1):
         key = (th[i - 1], th[i], th[i + 1], v[i])
@@ -309,15 +339,15 @@ def _deviation(state: ChainState, p: ChainParams) -> float:
     if ss["pinned"]:
         # Every block lags the plate by c / Kp: compare positions in the plate's frame.
         ss = physics.chain_steady_state(p, float(np.float64(state.step) * p.dt))
-        return float(max(np.max(np.abs(state.v[1:-1] - ss["v"])), np.max(np.abs(state.x[1:-1] - ss["x"]))))
-    x = state.x[1:-1]
+        return float(max(np.max(np.abs(state.v - ss["v"])), np.max(np.abs(state.x - ss["x"]))))
+    x = state.x
     # x_0: the pulling point V t_n (end drive) or the ends' ghost cell (a force drive), as the kernels set it.
     x0 = physics.left_ghost(p, p.V * (np.float64(state.step) * p.dt), x[0], x[-1])
     ext = np.diff(np.concatenate(([x0], x))) * -1.0
     return float(
         max(
-            np.max(np.abs(state.v[1:-1] - ss["v"])),
-            np.max(np.abs(state.th[1:-1] - ss["theta"])),
+            np.max(np.abs(state.v - ss["v"])),
+            np.max(np.abs(state.theta - ss["theta"])),
             np.max(np.abs(ext - ss["ext"])),
         )
     )

@@ -28,8 +28,9 @@ _INT = ("first_step",)
 
 def array_problem(state, N: int) -> str | None:
     """What is wrong with the arrays of ``state`` for a chain of N blocks (type, shape), or None."""
+    fields = getattr(state, "FIELDS", {})
     for name in (*_FLOAT, *_INT, "ist"):
-        a = getattr(state, name, None)
+        a = getattr(state, fields.get(name, name), None)
         dtype = np.int64 if name in (*_INT, "ist") else np.float64
         shape = (layout.IST_SIZE,) if name == "ist" else (N + 2,)
         if not isinstance(a, np.ndarray):
@@ -55,13 +56,13 @@ def state_problem(state, params: ChainParams) -> str | None:
     ist = state.ist
     step = int(ist[layout.STEP])
     inner = slice(1, N + 1)
-    for name in ("x", "v", "th", "x0ev"):
-        if not np.isfinite(getattr(state, name)[inner]).all():
+    for name, a in (("x", state.xg), ("v", state.vg), ("th", state.thg), ("x0ev", state.x0ev)):
+        if not np.isfinite(a[inner]).all():
             return f"{name} is not finite"
     bounds = params.friction_piece.theta_range
     if bounds is not None:
         low, high, low_open = bounds
-        th = state.th[inner]
+        th = state.thg[inner]
         if ((th <= low) if low_open else (th < low)).any() or (th > high).any():
             allowed = f"{'>' if low_open else '>='} {low:g}" + (f" and <= {high:g}" if np.isfinite(high) else "")
             return f"theta must be {allowed} for friction {params.friction} (got {th.min():g} to {th.max():g})"
@@ -70,7 +71,7 @@ def state_problem(state, params: ChainParams) -> str | None:
     mov = state.mov[inner]
     if not np.isin(mov, (0.0, 1.0)).all():
         return "the moving mask holds values other than 0 and 1"
-    if (state.v[inner][mov == 0.0] != 0.0).any():
+    if (state.vg[inner][mov == 0.0] != 0.0).any():
         return "a stopped block has a velocity other than 0"
     if int(ist[layout.N_MOVING]) != int(np.count_nonzero(mov)):
         return f"N_MOVING {int(ist[layout.N_MOVING])} != {int(np.count_nonzero(mov))} moving blocks"
@@ -150,7 +151,7 @@ def check_start_state(state, params: ChainParams, where: str = "the start state"
 
     if not isinstance(state, ChainState):
         raise ParameterError(f"{where} must be a ChainState or a start name (got {type(state).__name__})")
-    n_state = getattr(state.x, "shape", (0,))[0] - 2 if getattr(state.x, "ndim", 0) == 1 else None
+    n_state = getattr(state.xg, "shape", (0,))[0] - 2 if getattr(state.xg, "ndim", 0) == 1 else None
     if n_state is not None and n_state != params.N:
         raise ParameterError(f"{where} has {n_state} blocks but N = {params.N}")
     problem = array_problem(state, params.N)
