@@ -117,7 +117,7 @@ def start_state(params, start: str, amplitude: float, seed: int, stop_requested=
             ).state
     state = state.copy()
     rng = np.random.default_rng(seed)
-    state.x[1:-1] += rng.uniform(-amplitude, amplitude, params.N)
+    state.x[:] += rng.uniform(-amplitude, amplitude, params.N)
     return state
 
 
