@@ -168,6 +168,23 @@ def test_stepper_reports_a_nonfinite_state_at_the_oracles_step_and_block(integra
     assert int(re.search(r"block (\d+)", msg).group(1)) == block
 
 
+def test_a_replay_restores_the_state_in_place():
+    """The exact kernel's non-finite call is replayed with dense from the values before it, in
+    the state's own arrays: a holder of those arrays (the loop's outputs, a hook) sees the replay,
+    and the arrays' values before the call are the ones dense starts from (the replay ends at the
+    oracle's step, as a dense run from the start does)."""
+    N, K = 5, 1e6
+    p = ChainParams(N=N, K=K)
+    step, _ = oracle_run([0.0] * N, [0.1] * N, [0.1] * N, [True] * N, p, 2000).nonfinite
+    state = initial_state(p, "paper")
+    held = (state.xg, state.vg, state.thg, state.mov, state.ist)
+    advance = CheckedAdvance("exact", p, state, _scratch(N), _par(p), _Outputs(N, False), (2000, 0, 0, 0))
+    with pytest.raises(NonFiniteState):
+        advance(state, 2000)
+    assert all(a is b for a, b in zip(held, (state.xg, state.vg, state.thg, state.mov, state.ist), strict=True))
+    assert state.step == step  # where a dense run from the start stops
+
+
 def test_stepper_ends_where_run_chain_ends():
     p = chain_params(N=10)
     state, events = Stepper(p).advance(initial_state(p, "paper"), 4_000_000)

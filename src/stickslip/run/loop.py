@@ -124,7 +124,7 @@ class CheckedAdvance:
     non-finite values; if the state holds one after its call, the call is replayed from a copy
     with ``dense``, which follows the same arithmetic and checks each step. A non-finite state
     raises :class:`~stickslip.run.errors.NonFiniteState` naming the time, step and block.
-    ``state`` is updated in place (after a replay it holds the copy's arrays).
+    ``state`` is updated in place (before a replay its arrays get the copy's values back).
     """
 
     def __init__(self, integrator: str, params: ChainParams, state: ChainState, scratch, par, outputs, ints):
@@ -138,7 +138,7 @@ class CheckedAdvance:
         before = state.copy() if self.check else None
         status = self.kernel(state, target)
         if before is not None and not _finite(state):
-            state.__dict__.update(before.__dict__)
+            state.restore(before)
             if self._reference is None:
                 self._reference = _Kernel("dense", *self._build)
             status = self._reference(state, target)

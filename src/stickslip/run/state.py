@@ -203,6 +203,14 @@ class ChainState:
     def copy(self) -> ChainState:
         return ChainState.from_arrays(self.arrays(), model=self.model)
 
+    def restore(self, saved: ChainState) -> None:
+        """Put the values of ``saved`` (a :meth:`copy` of this state) back into this state's
+        arrays, in place: whatever holds these arrays sees the restored values."""
+        for name in self.ARRAYS:
+            field = self.FIELDS.get(name, name)
+            np.copyto(getattr(self, field), getattr(saved, field))
+        self.model = saved.model
+
 
 def model_of(p: ChainParams) -> dict[str, str]:
     """The model a state of the parameters ``p`` belongs to: the preset's name and the four pieces
