@@ -55,6 +55,28 @@ def test_depinning_force_is_the_first_sample_with_every_block_moving():
     assert math.isnan(depinning_force(t, [0, 3, 7, 7], 8, 2.0, 0.01))
 
 
+def test_a_ramp_run_ends_where_the_chain_depins_and_loses_nothing(tmp_path):
+    """A point of part b stops at the first sample with every block moving; the run to the
+    ramp's end without the stop has the same event sizes and F_c (no event ends after depinning:
+    F is above F0, so no sliding block stops), and it is still sliding everywhere at its end."""
+    from stickslip.experiments.studies.disorder import MEDIUM, RAMP_END, RAMP_START
+    from stickslip.experiments.studies.disorder_points import _run_from_rest, ramp_task
+
+    point = {"part": "b", **MEDIUM, "F_start": RAMP_START, "r": 0.004, "K": 10.0, "N": 16, "beta": 1.0}
+    point["t_end"] = (RAMP_END - RAMP_START) / point["r"]
+    row = ramp_task(point, tmp_path / "stopped")
+    params, full = _run_from_rest(point, tmp_path / "full", point["t_end"])
+    assert row["t_stop"] < 0.9 * point["t_end"] and math.isfinite(row["F_c"])
+    assert row["F_end"] == pytest.approx(row["F_c"], rel=1e-12)
+    S_full = full.events["S"].to_numpy(dtype=float)
+    assert json.loads(row["sizes"]) == S_full.tolist() and len(S_full) > 5
+    samples = full.samples
+    assert row["F_c"] == depinning_force(
+        samples["t"].values, samples["n_moving"].values, params.N, RAMP_START, point["r"]
+    )
+    assert not full.state.blocks()["stopped"].any()
+
+
 def _power_law(tau: float, n: int, s_min: float, s_max: float, seed: int) -> np.ndarray:
     """Inverse CDF of p(S) ~ S^-tau on [s_min, s_max]."""
     u = np.random.default_rng(seed).uniform(size=n)

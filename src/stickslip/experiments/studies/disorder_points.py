@@ -24,7 +24,15 @@ import numpy as np
 
 from stickslip.experiments.sweep_points import point_params
 
-__all__ = ["seeded_point", "disorder_task", "disorder_check", "ramp_task", "force_task", "depinning_force"]
+__all__ = [
+    "seeded_point",
+    "disorder_task",
+    "disorder_check",
+    "ramp_task",
+    "force_task",
+    "depinning_force",
+    "depinned_stop",
+]
 
 #: Keys of a point that are the study's own (not ChainParams fields nor run options).
 _OWN = ("part", "disorder_seed", "w")
@@ -75,13 +83,12 @@ def disorder_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     raise ValueError(f"part must be a, b or c (got {part!r})")
 
 
-def _run_from_rest(point: dict[str, Any], point_dir: Path, t_end: float):
+def _run_from_rest(point: dict[str, Any], point_dir: Path, t_end: float, hooks=()):
     """The point's chain from rest at x_i = 0 (every block stuck, springs unstretched), sampled
-    with the count of moving blocks."""
+    with the count of moving blocks (``n_samples`` samples to ``t_end``, default 400)."""
     from stickslip.experiments.sweep import run_chain_point
 
     params = _params(point)
-    n_samples = int(point.get("n_samples", 400))
     run = run_chain_point(
         params,
         t_end,
@@ -89,10 +96,33 @@ def _run_from_rest(point: dict[str, Any], point_dir: Path, t_end: float):
         start="rest",
         perturbation=0.0,
         seed=0,
-        sample_interval=max(t_end / n_samples, params.dt),
+        sample_interval=_sample_interval(point, params, t_end),
         sample_moving=True,
+        hooks=tuple(hooks),
     )
     return params, run
+
+
+def _sample_interval(point: dict[str, Any], params, t_end: float) -> float:
+    return max(t_end / int(point.get("n_samples", 400)), params.dt)
+
+
+def depinned_stop(every: int):
+    """A run hook (:class:`stickslip.run.Hook`) that ends a ramp run of part b at the first
+    multiple of ``every`` steps (the sampling steps) with every block moving: the chain has
+    depinned, and with F above the strengthening law's F0 a sliding block never stops again, so
+    no event ends after it and the rest of the ramp (every block sliding, the costliest steps)
+    adds nothing to the sizes or to F_c."""
+    from stickslip.run import Hook
+
+    class DepinnedStop(Hook):
+        def stop_at(self, n):
+            return (n // every + 1) * every
+
+        def at(self, loop, n):
+            return n % every == 0 and bool(np.all(loop.state.mov[1:-1] != 0.0))
+
+    return DepinnedStop()
 
 
 def depinning_force(t: Any, n_moving: Any, N: int, F_start: float, r: float) -> float:
@@ -107,9 +137,12 @@ def depinning_force(t: Any, n_moving: Any, N: int, F_start: float, r: float) -> 
 def ramp_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     """The force ramp F_start + r t on a chain at rest with random thresholds (part b): the
     sizes S of the events that ended (as JSON text, for the study to pool over seeds), the force
-    F_c where every block first moves, and the run's costs."""
+    F_c where every block first moves, and the run's costs. The run ends at F_c
+    (:func:`depinned_stop`) or at ``t_end``; ``t_stop`` and ``F_end`` say where."""
     t_end = float(point["t_end"])
-    params, run = _run_from_rest(point, point_dir, t_end)
+    p = _params(point)
+    every = int(round(_sample_interval(point, p, t_end) / p.dt))  # the run's sampling steps
+    params, run = _run_from_rest(point, point_dir, t_end, hooks=[depinned_stop(every)])
     samples = run.samples
     F_start, r = float(point["F_start"]), float(point["r"])
     F_c = depinning_force(samples["t"].values, samples["n_moving"].values, params.N, F_start, r)
@@ -118,10 +151,11 @@ def ramp_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     blocks = run.state.blocks()
     return {
         "t_end": t_end,
+        "t_stop": float(run.state.step * params.dt),
         "n_events": int(len(events)),
         "n_events_total": int(run.summary["n_events"]),
         "F_c": F_c,
-        "F_end": F_start + r * t_end,
+        "F_end": F_start + r * float(run.state.step * params.dt),
         "moving_end": int(np.count_nonzero(~blocks["stopped"])),
         "v_end": float(np.mean(blocks["v"])),
         "S_max": float(S.max()) if S.size else math.nan,
