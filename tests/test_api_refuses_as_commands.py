@@ -1,6 +1,6 @@
 """The Python API refuses what the commands refuse, through the same checks
 (:meth:`RunOptions.validated`, :func:`stickslip.run.state.check_start_draw`,
-:func:`stickslip.analysis.catalog.check_catalog_options`): before, ``run_chain`` took
+:func:`stickslip.analysis.stats.catalog.check_catalog_options`): before, ``run_chain`` took
 ``checkpoint_interval`` without ``out_dir``, ``profile_min_blocks=2.5`` (as 2),
 ``snapshot_times="10"`` (as the times 1 and 0), a seed with the paper's start; ``options={...}``
 died of an AttributeError; ``run.save("")`` wrote into the working directory's name."""
@@ -12,7 +12,7 @@ import math
 import pytest
 
 from stickslip import RunOptions, chain_params, run_chain
-from stickslip.analysis.catalog import catalog_analysis
+from stickslip.analysis.stats.catalog import catalog_analysis
 from stickslip.cli import main
 from stickslip.models.params import ParameterError
 

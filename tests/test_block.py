@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from stickslip.analysis.slip_limit import PAPER_DURATION, PAPER_FORCE_AT_STOP, period_sweep, solve_slip_limit
+from stickslip.analysis.dynamics.slip_limit import PAPER_DURATION, PAPER_FORCE_AT_STOP, period_sweep, solve_slip_limit
 from stickslip.models.params import BlockParams, ParameterError, scale_block
 from stickslip.run.block import BlockState, simulate_block
 

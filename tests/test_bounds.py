@@ -9,8 +9,8 @@ import pytest
 
 import stickslip.run.budget as budget
 from chain_helpers import one_line_error
-from stickslip.analysis.catalog import MAX_BOOTSTRAP, MAX_GOF_SIMS, check_magnitude_bins
-from stickslip.analysis.decorrelation import sequence_decorrelation
+from stickslip.analysis.dynamics.decorrelation import sequence_decorrelation
+from stickslip.analysis.stats.catalog import MAX_BOOTSTRAP, MAX_GOF_SIMS, check_magnitude_bins
 from stickslip.cli import main
 from stickslip.models.params import ParameterError
 from stickslip.models.presets import chain_params

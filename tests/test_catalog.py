@@ -156,7 +156,7 @@ def test_bad_options_get_one_line(run_dir, capsys, argv):
 
 
 def test_magnitude_of_non_positive_sizes_is_nan():
-    from stickslip.analysis.magnitudes import magnitude
+    from stickslip.analysis.stats.magnitudes import magnitude
 
     assert np.isnan(magnitude([0.0, -1.0])).all() and magnitude([1000.0])[0] == pytest.approx(2.0)
     assert math.isclose(float(magnitude(10.0**1.5)), 1.0)

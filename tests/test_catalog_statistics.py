@@ -15,10 +15,10 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from stickslip.analysis import magnitudes as mg
-from stickslip.analysis import model_comparison as mc
-from stickslip.analysis.recurrence import fit_renewal, recurrence
-from stickslip.analysis.statistics import fit_power_law
+from stickslip.analysis.stats import magnitudes as mg
+from stickslip.analysis.stats import model_comparison as mc
+from stickslip.analysis.stats.recurrence import fit_renewal, recurrence
+from stickslip.analysis.stats.statistics import fit_power_law
 
 SEEDS = range(100)
 

@@ -13,7 +13,7 @@ import math
 import numpy as np
 import pytest
 
-from stickslip.analysis.decorrelation import (
+from stickslip.analysis.dynamics.decorrelation import (
     GridSequences,
     event_decorrelation,
     first_disagreement,
@@ -128,7 +128,7 @@ def test_verdict_on_synthetic_inputs():
 
 
 def test_delta_star_by_hand():
-    from stickslip.analysis.threshold import delta_star
+    from stickslip.analysis.dynamics.threshold import delta_star
 
     out = delta_star(THRESHOLD)
     assert out["per_seed"] == [1e-4, 1e-6, None] and out["censored"] == 1
@@ -146,7 +146,7 @@ def test_delta_star_by_hand():
 
 
 def test_threshold_fit_by_hand():
-    from stickslip.analysis.threshold import threshold_fit
+    from stickslip.analysis.dynamics.threshold import threshold_fit
 
     # x = log10 N = 1, 1, 2, 2; y = -3, -5, -4, -6: slope -1, intercept -3, residuals +-1,
     # s^2 = 4 / 2, sum (x - 1.5)^2 = 1, so the slope's error is sqrt(2): no trend at two errors
@@ -338,7 +338,7 @@ def test_a_thousand_slips_of_the_chain_in_minutes():
 def test_a_reference_that_stops_slipping_ends_its_window():
     """Steady sliding (eq. 1 above the inverse transition, V = 0.5) has no slips: the window of
     slips ends once the reference has been quiet for long, and nothing is compared."""
-    from stickslip.analysis.decorrelation import QUIET_STEPS
+    from stickslip.analysis.dynamics.decorrelation import QUIET_STEPS
     from stickslip.run.state import initial_state
 
     p = ChainParams(N=1, V=0.5)

@@ -7,8 +7,8 @@ from __future__ import annotations
 import numpy as np
 
 from stickslip import ChainParams, Quenched
-from stickslip.analysis.decorrelation import event_decorrelation
-from stickslip.analysis.lyapunov import largest_lyapunov
+from stickslip.analysis.dynamics.decorrelation import event_decorrelation
+from stickslip.analysis.dynamics.lyapunov import largest_lyapunov
 from stickslip.models.presets import chain_params
 from stickslip.run.driver import run_chain
 

@@ -10,10 +10,10 @@ import math
 import numpy as np
 import pytest
 
-from stickslip.analysis import magnitudes as mg
-from stickslip.analysis.model_comparison import _draw_truncated_power_law, _maximise, power_law_gof
-from stickslip.analysis.recurrence import fit_renewal
-from stickslip.analysis.statistics import _truncated_cdf, fit_power_law
+from stickslip.analysis.stats import magnitudes as mg
+from stickslip.analysis.stats.model_comparison import _draw_truncated_power_law, _maximise, power_law_gof
+from stickslip.analysis.stats.recurrence import fit_renewal
+from stickslip.analysis.stats.statistics import _truncated_cdf, fit_power_law
 
 
 def bounded_power_law(n, tau, lo, hi, seed):

@@ -1,4 +1,4 @@
-"""Finite-size Lyapunov exponents (stickslip.analysis.fsle).
+"""Finite-size Lyapunov exponents (stickslip.analysis.dynamics.fsle).
 
 Known answer: the Lorenz system (sigma 10, rho 28, beta 8/3), whose largest exponent is 0.9056
 (Sprott, Chaos and Time-Series Analysis, 2003), run through the same finite_size_exponents that
@@ -13,7 +13,7 @@ import math
 import numpy as np
 import pytest
 
-from stickslip.analysis.fsle import finite_size_exponents, thresholds
+from stickslip.analysis.dynamics.fsle import finite_size_exponents, thresholds
 from stickslip.cli import main
 from stickslip.models.params import ParameterError
 

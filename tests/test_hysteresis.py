@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from stickslip.analysis.hysteresis import SweepSettings, hysteresis_sweep
+from stickslip.analysis.dynamics.hysteresis import SweepSettings, hysteresis_sweep
 from stickslip.models.params import BlockParams, ParameterError
 from stickslip.run.block import simulate_block
 

@@ -1,4 +1,4 @@
-"""The Jacobian about steady sliding assembled from the pieces (analysis.jacobian) and the steady
+"""The Jacobian about steady sliding assembled from the pieces (analysis.dynamics.jacobian) and the steady
 state of a chain with per-block parameters (models.physics).
 
 Uniform chains: the eigenvalues equal the Fourier modes' (eq. 5, Fig. 4; the relatives'
@@ -15,9 +15,9 @@ import numpy as np
 import pytest
 
 from stickslip import chain_params
-from stickslip.analysis import stability as st
-from stickslip.analysis.jacobian import chain_jacobian
-from stickslip.analysis.linear import finite_chain_wavenumbers
+from stickslip.analysis.dynamics import stability as st
+from stickslip.analysis.dynamics.jacobian import chain_jacobian
+from stickslip.analysis.dynamics.linear import finite_chain_wavenumbers
 from stickslip.models import physics
 
 

@@ -11,7 +11,7 @@ import pytest
 from scipy.signal import lfilter
 
 from chain_helpers import run_cli_subprocess
-from stickslip.analysis.adaptive import assess, mser_cut
+from stickslip.analysis.dynamics.adaptive import assess, mser_cut
 from stickslip.experiments.ladders import ladder_task
 from stickslip.experiments.studies.transition import (
     PER_N_COLUMNS,
@@ -180,7 +180,7 @@ def test_down_ladder_leaves_steady_sliding_below_one(tmp_path):
     blocks stick. The down ladder brackets that edge."""
     from scipy.optimize import brentq
 
-    from stickslip.analysis.stability import chain_finite_eigenvalues
+    from stickslip.analysis.dynamics.stability import chain_finite_eigenvalues
 
     res = ladder_task(_tiny_ladder("down", [2.0, 1.2, 0.8]), tmp_path)
     states = {r["beta"]: r["branch_state"] for r in res["rows"]}

@@ -10,8 +10,8 @@ import pandas as pd
 import pytest
 
 import stickslip
-from stickslip.analysis.periodicity import periodicity
-from stickslip.analysis.survival import exponential_fit
+from stickslip.analysis.stats.periodicity import periodicity
+from stickslip.analysis.stats.survival import exponential_fit
 from stickslip.experiments.studies import lifetimes, study
 from stickslip.experiments.study_run import run_study
 from stickslip.experiments.sweep_points import point_params

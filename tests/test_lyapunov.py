@@ -2,11 +2,11 @@
 
 Known answers, none computed by the code under test:
 - steady sliding of the single block (the chain with N = 1) at beta = 1, V = 0.5: the exponent
-  is the largest real part of the eigenvalues of eq. (2) (stickslip.analysis.stability);
+  is the largest real part of the eigenvalues of eq. (2) (stickslip.analysis.dynamics.stability);
 - the stick-slip cycle of the single block at the paper's parameters: a tiny twin starts each
   slip at the same step as the reference (the start rule is tested on the time grid), so the
   separation is multiplied once per cycle by m = d f_end / d Fs of the slip of eq. (3)
-  (stickslip.analysis.slip_limit, an adaptive integrator): lambda = ln|m| / T(V). A twin much farther
+  (stickslip.analysis.dynamics.slip_limit, an adaptive integrator): lambda = ln|m| / T(V). A twin much farther
   away than the grid spacing V dt starts at another step and sees the neutral phase of the
   continuous-time cycle: lambda close to 0.
 """
@@ -21,15 +21,15 @@ import pytest
 from matplotlib.figure import Figure
 
 from chain_helpers import run_cli
-from stickslip.analysis.lyapunov import (
+from stickslip.analysis.dynamics.lyapunov import (
     largest_lyapunov,
     lyapunov_convergence,
     lyapunov_vs_beta,
     separation,
     twin_state,
 )
-from stickslip.analysis.slip_limit import solve_slip_limit
-from stickslip.analysis.stability import block_eigenvalues, chain_finite_eigenvalues
+from stickslip.analysis.dynamics.slip_limit import solve_slip_limit
+from stickslip.analysis.dynamics.stability import block_eigenvalues, chain_finite_eigenvalues
 from stickslip.models.params import BlockParams, ChainParams, ParameterError
 from stickslip.plotting.lyapunov import plot_lyapunov_beta
 from stickslip.run.driver import run_chain
@@ -144,7 +144,7 @@ def test_sliding_block_ten_times_the_defaults():
 
 
 def test_twin_runs_in_a_frame_moved_back_along_the_drive():
-    from stickslip.analysis.lyapunov import GridEngine
+    from stickslip.analysis.dynamics.lyapunov import GridEngine
 
     p = ChainParams(N=1, V=0.5)
     ref = run_chain(p, 1000.0).state
@@ -397,7 +397,7 @@ class _LinearEngine:
 
 
 def test_one_loop_serves_any_engine_linear_flow():
-    from stickslip.analysis.benettin import two_trajectory_exponent
+    from stickslip.analysis.dynamics.benettin import two_trajectory_exponent
 
     p = ChainParams(N=1, dt=0.01)
     # a damped oscillator (-0.2 +- 2 i) and a faster decay (-0.7)

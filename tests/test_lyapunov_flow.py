@@ -1,9 +1,9 @@
-"""The exponent of the flow (stickslip.analysis.lyapunov_flow): known answers, the neutral
+"""The exponent of the flow (stickslip.analysis.dynamics.lyapunov_flow): known answers, the neutral
 direction, the extrapolation and the command line.
 
 Known answers, none computed by the code under test:
 - steady sliding of the single block at V = 0.5: the largest real part of the eigenvalues of
-  eq. (2) (stickslip.analysis.stability, a 3 x 3 eigenvalue problem), -0.4865;
+  eq. (2) (stickslip.analysis.dynamics.stability, a 3 x 3 eigenvalue problem), -0.4865;
 - a periodic orbit (the single block's stick-slip cycle): the largest exponent of a limit cycle
   is zero, the exponent of a shift in time; with that direction removed the transverse exponent
   is negative (the stuck block's theta relaxes at rate about 1 and a stop contracts v);
@@ -20,15 +20,15 @@ import numpy as np
 import pytest
 
 from chain_helpers import run_cli
-from stickslip.analysis.benettin import remove_flow
-from stickslip.analysis.lyapunov_flow import (
+from stickslip.analysis.dynamics.benettin import remove_flow
+from stickslip.analysis.dynamics.lyapunov_flow import (
     extrapolate,
     flow_direction,
     flow_lyapunov,
     separation,
     twin_state,
 )
-from stickslip.analysis.stability import block_eigenvalues
+from stickslip.analysis.dynamics.stability import block_eigenvalues
 from stickslip.models.params import BlockParams, ChainParams, ParameterError
 from stickslip.models.presets import chain_params
 from stickslip.run.located import LocatedStepper, start_state

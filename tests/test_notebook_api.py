@@ -36,18 +36,18 @@ DOCTEST_MODULES = (
     "stickslip.plotting",
     "stickslip.experiments.studies.transition",
     "stickslip.experiments.sweep",
-    "stickslip.analysis.adaptive",
-    "stickslip.analysis.chain_runs",
-    "stickslip.analysis.fronts",
-    "stickslip.analysis.magnitudes",
-    "stickslip.analysis.order",
-    "stickslip.analysis.recurrence",
-    "stickslip.analysis.slip_limit",
-    "stickslip.analysis.stability",
-    "stickslip.analysis.stable_chaos",
-    "stickslip.analysis.statistics",
+    "stickslip.analysis.dynamics.adaptive",
+    "stickslip.analysis.stats.chain_runs",
+    "stickslip.analysis.stats.fronts",
+    "stickslip.analysis.stats.magnitudes",
+    "stickslip.analysis.stats.order",
+    "stickslip.analysis.stats.recurrence",
+    "stickslip.analysis.dynamics.slip_limit",
+    "stickslip.analysis.dynamics.stability",
+    "stickslip.analysis.dynamics.stable_chaos",
+    "stickslip.analysis.stats.statistics",
     "stickslip.models.physics",
-    "stickslip.analysis.lyapunov",
+    "stickslip.analysis.dynamics.lyapunov",
 )
 
 
@@ -67,7 +67,10 @@ def public_names() -> list[tuple[str, str]]:
     import stickslip.analysis
 
     modules = ["stickslip", "stickslip.plotting"]
-    modules += [f"stickslip.analysis.{m.name}" for m in pkgutil.iter_modules(stickslip.analysis.__path__)]
+    found_modules = pkgutil.walk_packages(stickslip.analysis.__path__, "stickslip.analysis.")
+    analysis = [m.name for m in found_modules if not m.ispkg]
+    assert {"stickslip.analysis.dynamics.lyapunov", "stickslip.analysis.stats.catalog"} <= set(analysis)
+    modules += analysis
     names = [(m, n) for m in modules for n in getattr(importlib.import_module(m), "__all__", ())]
     for page in [*GALLERY.glob("gallery/*.md"), GALLERY / "tutorial.md"]:
         for module, imported in re.findall(r"^from (stickslip[\w.]*) import (.+)$", page.read_text(), re.M):
@@ -88,7 +91,8 @@ def test_the_public_names_are_those_of_the_api():
     names = {f"{m}.{n}" for m, n in public_names()}
     assert len(names) > 90
     for name in ("stickslip.largest_lyapunov", "stickslip.run_chain", "stickslip.plotting.sizes",
-                 "stickslip.analysis.statistics.fit_power_law", "stickslip.analysis.stability.critical_stiffness",
+                 "stickslip.analysis.stats.statistics.fit_power_law",
+                 "stickslip.analysis.dynamics.stability.critical_stiffness",
                  "stickslip.experiments.studies.transition.transition_loop"):  # fmt: skip
         assert name in names, name
 
@@ -233,7 +237,7 @@ def test_labels_come_from_the_model():
 def test_figures_of_carlson_langer_carry_its_name_and_no_paper_figure():
     """A size distribution and a waterfall of a Carlson-Langer run: its name and parameters,
     no beta, no "Fig. N", no paper's front speed."""
-    from stickslip.analysis.statistics import fit_power_law, front_speed
+    from stickslip.analysis.stats.statistics import fit_power_law, front_speed
     from stickslip.plotting.chain import fronts_figure, sizes_figure
 
     cl = chain_params("carlson-langer", N=30)
@@ -270,7 +274,7 @@ def test_old_plotting_names_still_work():
 
 
 def test_fig4_has_its_title_and_panel_letters():
-    from stickslip.analysis.stability import fig4_data
+    from stickslip.analysis.dynamics.stability import fig4_data
     from stickslip.plotting.stability import plot_fig4
 
     fig = plot_fig4(fig4_data(ChainParams(), k=np.linspace(0.0, np.pi, 40)))

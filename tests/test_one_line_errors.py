@@ -63,7 +63,7 @@ def test_located_switches_refuse_a_d0_below_rounding(d0, capsys):
 
 @pytest.mark.parametrize("error", [np.linalg.LinAlgError("Singular matrix"), FloatingPointError("overflow")])
 def test_a_located_ladder_without_answer_isone_line_error(error, monkeypatch, capsys):
-    import stickslip.analysis.lyapunov_flow as flow
+    import stickslip.analysis.dynamics.lyapunov_flow as flow
 
     def fails(*a, **k):
         raise error
@@ -74,7 +74,7 @@ def test_a_located_ladder_without_answer_isone_line_error(error, monkeypatch, ca
 
 
 def test_extrapolation_of_non_finite_exponents_says_which():
-    from stickslip.analysis.lyapunov_flow import extrapolate
+    from stickslip.analysis.dynamics.lyapunov_flow import extrapolate
 
     with pytest.raises(ValueError, match=r"the exponent at dt = 0.0025 is not finite"):
         extrapolate([0.005, 0.0025], [0.1, math.nan], [0.01, 0.01])

@@ -11,7 +11,7 @@ import pytest
 from tests.chain_helpers import run_cli
 
 import stickslip
-from stickslip.analysis.periodicity import PeriodicStop, find_period, periodicity
+from stickslip.analysis.stats.periodicity import PeriodicStop, find_period, periodicity
 from stickslip.models.params import ParameterError
 
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from stickslip.analysis import stability as st
+from stickslip.analysis.dynamics import stability as st
 from stickslip.models import pieces
 from stickslip.models.params import BlockParams, ChainParams
 from stickslip.models.presets import PRESETS, chain_params

@@ -8,7 +8,7 @@ import pytest
 import xarray as xr
 from matplotlib.figure import Figure
 
-from stickslip.analysis.statistics import fit_power_law, front_speed
+from stickslip.analysis.stats.statistics import fit_power_law, front_speed
 from stickslip.models.params import ChainParams
 from stickslip.plotting.chain import fig5a_snapshot, fig5b_length, fig6_fronts, fig7_8_sizes
 from stickslip.plotting.style import save_figure

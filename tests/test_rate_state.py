@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from chain_helpers import assert_same_run, run_cli
-from stickslip.analysis import stability as st
+from stickslip.analysis.dynamics import stability as st
 from stickslip.models.friction.rate_state import mu_lp
 from stickslip.models.params import ChainParams, ParameterError
 from stickslip.models.pieces import CompositionError, check_composition

@@ -347,7 +347,7 @@ def test_help_lists_the_modes(capsys):
 
 
 def test_plot_reproduce_and_catalog_give_the_same_tau_on_the_same_run(tiny_run, tmp_path, capsys):
-    """One stationary window (analysis.chain_runs.stationary_from) and one fit for all three."""
+    """One stationary window (analysis.stats.chain_runs.stationary_from) and one fit for all three."""
     out, _ = tiny_run
     spec = figs5_8.build("tiny")
     points = out / "runs" / spec.dirname / "points"

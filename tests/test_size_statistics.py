@@ -1,4 +1,4 @@
-"""The slip-size fit of Figs. 7, 8 and the exponents study (analysis.chain_runs.size_statistics) on
+"""The slip-size fit of Figs. 7, 8 and the exponents study (analysis.stats.chain_runs.size_statistics) on
 synthetic power laws: it gives back their exponent, and great events added show as an excess."""
 
 from __future__ import annotations
@@ -9,7 +9,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from stickslip.analysis.chain_runs import size_statistics
+from stickslip.analysis.stats.chain_runs import size_statistics
 
 N = 50
 

@@ -13,7 +13,7 @@ import math
 import numpy as np
 import pytest
 
-from stickslip.analysis import stability as st
+from stickslip.analysis.dynamics import stability as st
 from stickslip.models.friction import rate_state, rate_state_slip
 from stickslip.models.params import ChainParams
 from stickslip.run.driver import run_chain

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from stickslip.analysis.slip_limit import NoStopError, heun_slip_limit, solve_slip_limit
+from stickslip.analysis.dynamics.slip_limit import NoStopError, heun_slip_limit, solve_slip_limit
 from stickslip.models.params import BlockParams, ParameterError
 from stickslip.plotting.block import slip_window
 from stickslip.run.block import simulate_block

@@ -15,7 +15,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as hs
 
-from stickslip.analysis import stability as st
+from stickslip.analysis.dynamics import stability as st
 from stickslip.models.params import BlockParams, ChainParams, scale_block
 from stickslip.models.physics import chain_steady_state
 

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from scipy.optimize import linear_sum_assignment
 
-from stickslip.analysis import stability as st
+from stickslip.analysis.dynamics import stability as st
 from stickslip.cli import main
 from stickslip.models.presets import chain_params
 from stickslip.plotting.stability import plot_mode_growth

@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from stickslip.analysis.stable_chaos import front_position, perturbation_front, steady_lifetime
+from stickslip.analysis.dynamics.stable_chaos import front_position, perturbation_front, steady_lifetime
 from stickslip.models.params import ChainParams, ParameterError
 from stickslip.run.located import LocatedState
 

@@ -18,7 +18,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy import stats
 
-from stickslip.analysis.statistics import (
+from stickslip.analysis.stats.statistics import (
     fit_power_law,
     front_speed,
     pick_front_events,
@@ -373,13 +373,13 @@ def test_default_s_max_is_the_callers_cutoff_and_explicit_ranges_are_kept():
 
 
 def test_choose_s_min_stays_importable_from_chain_runs():
-    from stickslip.analysis import chain_runs, statistics
+    from stickslip.analysis.stats import chain_runs, statistics
 
     assert chain_runs.choose_s_min is statistics.choose_s_min
 
 
 def test_central_interval_places_a_value_in_a_known_distribution():
-    from stickslip.analysis.statistics import central_interval
+    from stickslip.analysis.stats.statistics import central_interval
 
     sample = np.arange(1, 101, dtype=float)  # 1..100
     inside = central_interval(sample, 50.5)
@@ -391,7 +391,7 @@ def test_central_interval_places_a_value_in_a_known_distribution():
 
 
 def test_central_interval_percentile_counts_ties_half():
-    from stickslip.analysis.statistics import central_interval
+    from stickslip.analysis.stats.statistics import central_interval
 
     sample = [1.0, 2.0, 2.0, 3.0, 4.0]
     # 1 below, 2 equal: (1 + 2 / 2) / 5
@@ -400,7 +400,7 @@ def test_central_interval_percentile_counts_ties_half():
 
 
 def test_leading_edge_speed_of_a_known_front():
-    from stickslip.analysis.statistics import leading_edge_speed
+    from stickslip.analysis.stats.statistics import leading_edge_speed
 
     speed, N, window = 1.6, 200, 20.0
     t_first = np.arange(1, N + 1) / speed

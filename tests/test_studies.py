@@ -17,7 +17,7 @@ import pytest
 from scipy.signal import lfilter
 
 from chain_helpers import error_lines
-from stickslip.analysis.order import (
+from stickslip.analysis.stats.order import (
     batch_means,
     classify_final_state,
     integrated_time,
@@ -276,7 +276,7 @@ def _delta_star_by_hand(rows, seed):
 
 def test_tiny_chaos_study_end_to_end(tmp_path, cluster):
     from stickslip import io
-    from stickslip.analysis.decorrelation import VERDICTS
+    from stickslip.analysis.dynamics.decorrelation import VERDICTS
 
     spec = study("chaos", "tiny")
     first = run_study(spec, tmp_path, scheduler=cluster, progress=False)
@@ -512,7 +512,7 @@ def test_each_study_has_its_own_help(name, says, capsys):
 def test_sizes_summary_fits_the_events_after_the_transient_only():
     """The exponents study's analysis of one run: the events counted are those that start at or
     after t_from (counted here by hand); with fewer than 20 of them there is no fit, and it says why."""
-    from stickslip.analysis.chain_runs import sizes_summary
+    from stickslip.analysis.stats.chain_runs import sizes_summary
     from stickslip.models.presets import chain_params
     from stickslip.run.driver import run_chain
 

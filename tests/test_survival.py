@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from stickslip.analysis.survival import exponential_fit, kaplan_meier, line_fit, size_fits
+from stickslip.analysis.stats.survival import exponential_fit, kaplan_meier, line_fit, size_fits
 from stickslip.models.params import ParameterError
 
 

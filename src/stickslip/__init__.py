@@ -35,7 +35,7 @@ _LAZY = {
     "RunOptions": "stickslip.run.options",
     "Hook": "stickslip.run.loop",
     "chain_params": "stickslip.models.presets",
-    "largest_lyapunov": "stickslip.analysis.lyapunov",
+    "largest_lyapunov": "stickslip.analysis.dynamics.lyapunov",
     "resume_chain": "stickslip.run.driver",
     "load_run": "stickslip.run.rundir",
     "simulate_block": "stickslip.run.block",

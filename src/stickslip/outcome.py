@@ -36,7 +36,7 @@ class Outcome:
 class Results:
     """What the findings and figures of one of the paper's studies read: the ``outcomes`` of its
     experiments by name, the ``analysis`` of the chain runs of Figs. 5-8
-    (:func:`stickslip.analysis.chain_runs.chain_analysis`; None for the other studies) and the
+    (:func:`stickslip.analysis.stats.chain_runs.chain_analysis`; None for the other studies) and the
     ``mode``."""
 
     outcomes: dict[str, Outcome]

@@ -31,7 +31,7 @@ from stickslip.cli._common import (
 from stickslip.models.params import MAX_STEPS, BlockParams, ParameterError, check_number, steps_for
 
 if TYPE_CHECKING:  # loaded where used: `stickslip --help` loads no numba, scipy or xarray
-    from stickslip.analysis.slip_limit import SlipLimit
+    from stickslip.analysis.dynamics.slip_limit import SlipLimit
     from stickslip.run.block import BlockRun
 
 #: Periods of the law simulated after the first slip when --t-end is not given.
@@ -93,7 +93,7 @@ def _law_or_none(p: BlockParams) -> SlipLimit | None:
     """The accurate eq. (3) at these parameters, or None where it has no slip that ends (or one
     too stiff or too long to resolve: sqrt(K/M) > 1e4 or Fs > 1000 sigma; or where the threshold
     is not the constant Fs that eq. (3) starts from)."""
-    from stickslip.analysis.slip_limit import NoStopError, solve_slip_limit
+    from stickslip.analysis.dynamics.slip_limit import NoStopError, solve_slip_limit
 
     if p.threshold_piece.has_state or math.sqrt(p.K / p.M) > 1e4 or p.Fs / p.sigma > 1e3:
         return None
@@ -220,7 +220,7 @@ def write_block_outputs(out: Path, run: BlockRun, law: SlipLimit | None, *, fig3
     """Write a run's series, slip table, run.json and Figs. 1-2 (and Fig. 3) to ``out``."""
     import xarray as xr
 
-    from stickslip.analysis.slip_limit import paper_V_values, period_sweep
+    from stickslip.analysis.dynamics.slip_limit import paper_V_values, period_sweep
     from stickslip.plotting.block import fig1_position, fig2_slip, fig3_period, slip_window
     from stickslip.plotting.style import save_figure
     from stickslip.run.block import INTEGRATOR
@@ -268,7 +268,7 @@ def write_block_outputs(out: Path, run: BlockRun, law: SlipLimit | None, *, fig3
 
 def run_slip_limit(args: argparse.Namespace) -> Result:
     """Handler of ``stickslip slip-limit``: eq. (3), the Heun comparison and the period law."""
-    from stickslip.analysis.slip_limit import (
+    from stickslip.analysis.dynamics.slip_limit import (
         PAPER_DURATION,
         PAPER_FORCE_AT_STOP,
         NoStopError,

@@ -60,7 +60,7 @@ def register(sub) -> None:
 
 def run_catalog_command(args: argparse.Namespace) -> Result:
     """Handler of `stickslip catalog`."""
-    from stickslip.analysis.catalog import check_catalog_options, check_counts
+    from stickslip.analysis.stats.catalog import check_catalog_options, check_counts
 
     check_catalog_options(args.dm, args.bootstrap, args.gof_sims, args.seed, spell=lambda n: n.replace("_", "-"))
     check_counts(args.bootstrap, args.gof_sims, ("bootstrap", "gof-sims"))  # before the run is read: refused at once
@@ -77,7 +77,7 @@ def run_catalog_command(args: argparse.Namespace) -> Result:
 
 def _catalog(args: argparse.Namespace, run_dir: Path, out: Path) -> Result:
     """The catalogue of ``run_dir`` into ``out``, the run directory held."""
-    from stickslip.analysis.catalog import catalog_analysis, load_catalog_run
+    from stickslip.analysis.stats.catalog import catalog_analysis, load_catalog_run
     from stickslip.report.catalog_page import CATALOG_FILES, write_catalog
 
     run = load_catalog_run(run_dir)

@@ -336,10 +336,10 @@ def run_chain_command(args: argparse.Namespace) -> Result:
 
 def _periodic_hook(args: argparse.Namespace) -> list:
     """With ``--until-periodic``, the hook that ends the run once its slips repeat
-    (:class:`~stickslip.analysis.periodicity.PeriodicStop`); else none."""
+    (:class:`~stickslip.analysis.stats.periodicity.PeriodicStop`); else none."""
     if not getattr(args, "until_periodic", False):
         return []
-    from stickslip.analysis.periodicity import PeriodicStop
+    from stickslip.analysis.stats.periodicity import PeriodicStop
 
     return [PeriodicStop()]
 

@@ -1,6 +1,6 @@
 """`stickslip lyapunov --decorrelation`: slip sequences of a reference and its twins, compared.
 
-The options and the handler of the mode (:func:`stickslip.analysis.decorrelation.sequence_decorrelation`);
+The options and the handler of the mode (:func:`stickslip.analysis.dynamics.decorrelation.sequence_decorrelation`);
 the subcommand itself is :mod:`stickslip.cli.lyapunov`.
 """
 
@@ -90,7 +90,7 @@ def deltas_arg(text: str) -> list[float]:
 def run(params, args: argparse.Namespace) -> Result:
     """`--decorrelation` with either switch rule, from the state at ``--transient``: a window of
     ``--events`` reference slips (cut at ``--t-end`` when given), ``--seeds`` windows."""
-    from stickslip.analysis.decorrelation import (
+    from stickslip.analysis.dynamics.decorrelation import (
         EVENTS,
         SIZE_RTOL,
         GridSequences,

@@ -1,9 +1,9 @@
 """`stickslip lyapunov`: the largest Lyapunov exponent of the chain of eq. (4) (eq. (1) at N = 1).
 
-Benettin et al. (1980) two-trajectory method (:mod:`stickslip.analysis.lyapunov`). ``--convergence``
+Benettin et al. (1980) two-trajectory method (:mod:`stickslip.analysis.dynamics.lyapunov`). ``--convergence``
 tabulates the exponent against d0, the renormalisation interval and the run length;
 ``--betas`` tabulates it against beta, and ``--plot FILE`` draws that table. ``--switches located``
-measures the exponent of the flow instead (:mod:`stickslip.analysis.lyapunov_flow`): located
+measures the exponent of the flow instead (:mod:`stickslip.analysis.dynamics.lyapunov_flow`): located
 switches, the time-shift direction removed, at dt, dt/2, dt/4 and extrapolated to dt -> 0.
 ``--decorrelation`` compares slip sequences of perturbed twins (:mod:`stickslip.cli.decorrelation`).
 """
@@ -200,8 +200,8 @@ def _result_text(d: dict) -> str:
 
 def run_lyapunov_command(args: argparse.Namespace) -> Result:
     """Handler of `stickslip lyapunov`."""
-    from stickslip.analysis import lyapunov as ly
-    from stickslip.analysis.benettin import check_run
+    from stickslip.analysis.dynamics import lyapunov as ly
+    from stickslip.analysis.dynamics.benettin import check_run
     from stickslip.models.presets import PRESETS
 
     params = chain_params_from_args(args)
@@ -316,8 +316,8 @@ def _ladder_text(d: dict) -> str:
 
 
 def _located(params, args, kw) -> Result:
-    """`--switches located`: the ladder of :func:`stickslip.analysis.lyapunov_flow.flow_ladder`."""
-    from stickslip.analysis.lyapunov_flow import flow_ladder
+    """`--switches located`: the ladder of :func:`stickslip.analysis.dynamics.lyapunov_flow.flow_ladder`."""
+    from stickslip.analysis.dynamics.lyapunov_flow import flow_ladder
 
     if args.convergence or args.betas is not None:
         raise CommandError("--switches located runs one ladder; --convergence and --betas go with --switches grid")
@@ -342,8 +342,8 @@ def _located(params, args, kw) -> Result:
 
 
 def _finite_size(params, args) -> Result:
-    """`--switches located --finite-size`: :func:`stickslip.analysis.fsle.finite_size_exponents`."""
-    from stickslip.analysis.fsle import LocatedPair, finite_size_exponents, thresholds
+    """`--switches located --finite-size`: :func:`stickslip.analysis.dynamics.fsle.finite_size_exponents`."""
+    from stickslip.analysis.dynamics.fsle import LocatedPair, finite_size_exponents, thresholds
     from stickslip.models.params import steps_for
     from stickslip.run.located import LocatedStepper, start_state
 
@@ -388,8 +388,8 @@ def _decorrelation(params, args) -> Result:
 
 
 def _fronts(params, args) -> Result:
-    """`--switches located --fronts`: :func:`stickslip.analysis.stable_chaos.perturbation_front`."""
-    from stickslip.analysis.stable_chaos import perturbation_front
+    """`--switches located --fronts`: :func:`stickslip.analysis.dynamics.stable_chaos.perturbation_front`."""
+    from stickslip.analysis.dynamics.stable_chaos import perturbation_front
     from stickslip.run.loaded import located_start
 
     if not args.t_end > args.transient:
@@ -445,8 +445,8 @@ def _refuse_ignored(args) -> None:
 
 
 def _lifetimes(params, args) -> Result:
-    """`--lifetimes`: :func:`stickslip.analysis.stable_chaos.steady_lifetime` at each N."""
-    from stickslip.analysis.stable_chaos import steady_lifetime
+    """`--lifetimes`: :func:`stickslip.analysis.dynamics.stable_chaos.steady_lifetime` at each N."""
+    from stickslip.analysis.dynamics.stable_chaos import steady_lifetime
     from stickslip.experiments.studies.chain_point import loading_time
 
     try:

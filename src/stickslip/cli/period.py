@@ -9,9 +9,9 @@ from stickslip.cli._common import CommandError, Result, add_json_option, float_a
 
 
 def add_rule_options(p: argparse.ArgumentParser, prefix: str = "") -> None:
-    """The options of the matching rule (:func:`stickslip.analysis.periodicity.find_period`),
+    """The options of the matching rule (:func:`stickslip.analysis.stats.periodicity.find_period`),
     named ``--{prefix}rtol``, ``--{prefix}max-period`` and ``--{prefix}repeats``."""
-    from stickslip.analysis.period_rule import MAX_PERIOD, REPEATS, RTOL
+    from stickslip.analysis.stats.period_rule import MAX_PERIOD, REPEATS, RTOL
 
     p.add_argument(
         f"--{prefix}rtol",
@@ -66,7 +66,7 @@ def register(sub) -> None:
 
 def run_period_command(args: argparse.Namespace) -> Result:
     """Handler of `stickslip period`."""
-    from stickslip.analysis.periodicity import periodicity
+    from stickslip.analysis.stats.periodicity import periodicity
     from stickslip.run.rundir import RunDirDamaged, load_run
 
     rule = rule_from_args(args)

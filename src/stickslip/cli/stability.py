@@ -41,7 +41,7 @@ from stickslip.models.params import BlockParams, ChainParams, ParameterError, ch
 if TYPE_CHECKING:  # loaded where used: `stickslip --help` loads no numba, scipy or xarray
     import numpy as np
 
-    from stickslip.analysis import hysteresis as hy
+    from stickslip.analysis.dynamics import hysteresis as hy
 
 #: Points of the stability map (beta x V) and of the Hopf curve.
 MAP_BETAS = 121
@@ -57,7 +57,7 @@ _LINEAR = "linearisation about steady sliding, numpy.linalg.eigvals; Hopf point 
 
 def register(sub) -> None:
     """Add ``stability`` (with ``block`` and ``chain``) and ``hysteresis`` to the parser."""
-    from stickslip.analysis import hysteresis as hy
+    from stickslip.analysis.dynamics import hysteresis as hy
 
     s = sub.add_parser(
         "stability",
@@ -151,7 +151,7 @@ def run_stability_block(args: argparse.Namespace) -> Result:
     """Handler of ``stickslip stability block``: Hopf point and eigenvalues of eq. (2)."""
     import numpy as np
 
-    from stickslip.analysis import stability as st
+    from stickslip.analysis.dynamics import stability as st
 
     with_V = args.param_V is not None
     p = params_from_args(BlockParams, args)
@@ -195,7 +195,7 @@ def run_stability_block(args: argparse.Namespace) -> Result:
 def _write_block_map(out: Path, p: BlockParams, data: dict, with_V: bool) -> list[Path]:
     import numpy as np
 
-    from stickslip.analysis import stability as st
+    from stickslip.analysis.dynamics import stability as st
     from stickslip.plotting.stability import plot_stability_map
     from stickslip.plotting.style import save_figure
 
@@ -244,7 +244,7 @@ def _block_text(d: dict[str, Any]) -> str:
 def run_stability_chain(args: argparse.Namespace) -> Result:
     """Handler of ``stickslip stability chain``: Fourier modes of eq. (5), Fig. 4; the relatives
     without state variable mode by mode (:func:`run_stability_modes`)."""
-    from stickslip.analysis import stability as st
+    from stickslip.analysis.dynamics import stability as st
 
     for name in ("Fs", "dt"):
         if getattr(args, f"param_{name}", None) is not None:
@@ -300,9 +300,9 @@ def run_stability_chain(args: argparse.Namespace) -> Result:
 def run_stability_law(args: argparse.Namespace, p: ChainParams, with_N: bool) -> Result:
     """Steady sliding of a chain whose law has a state variable other than eq. (4)'s (rate-and-state):
     the 3 x 3 mode matrices and the finite chain's Jacobian from the law's linearisation, and the
-    critical spring constant K_c (analysis.stability.critical_stiffness). Without --N: the
+    critical spring constant K_c (analysis.dynamics.stability.critical_stiffness). Without --N: the
     spring-slider, N = 1."""
-    from stickslip.analysis import stability as st
+    from stickslip.analysis.dynamics import stability as st
 
     if p.drive_piece.leaf_spring or not p.ends_piece.steady_sliding:
         raise CommandError(f"friction {p.friction} is covered with drive end and ends free only")
@@ -351,7 +351,7 @@ def _write_fig4(out: Path, p: ChainParams, data: dict) -> list[Path]:
     import numpy as np
     import xarray as xr
 
-    from stickslip.analysis import stability as st
+    from stickslip.analysis.dynamics import stability as st
     from stickslip.plotting.stability import plot_fig4
     from stickslip.plotting.style import save_figure
 
@@ -386,9 +386,9 @@ def _chain_text(d: dict[str, Any]) -> str:
 def run_stability_modes(args: argparse.Namespace, p: ChainParams) -> Result:
     """Growth rates of steady sliding mode by mode: plate drive (CL) or train model.
 
-    Each normal mode obeys lambda^2 + phi'(V) lambda + w_k^2 = 0 (analysis.stability).
+    Each normal mode obeys lambda^2 + phi'(V) lambda + w_k^2 = 0 (analysis.dynamics.stability).
     """
-    from stickslip.analysis import stability as st
+    from stickslip.analysis.dynamics import stability as st
 
     if p.V <= 0.0:
         raise CommandError(f"steady sliding needs V > 0 (got V={p.V:g})")
@@ -426,7 +426,7 @@ def run_stability_modes(args: argparse.Namespace, p: ChainParams) -> Result:
 
 
 def _write_mode_growth(out: Path, p: ChainParams, data: dict) -> list[Path]:
-    from stickslip.analysis import stability as st
+    from stickslip.analysis.dynamics import stability as st
     from stickslip.plotting.stability import plot_mode_growth
     from stickslip.plotting.style import save_figure
 
@@ -462,7 +462,7 @@ def _modes_text(d: dict[str, Any]) -> str:
 
 def run_hysteresis(args: argparse.Namespace) -> Result:
     """Handler of ``stickslip hysteresis``: the adiabatic sweep of V of section 2."""
-    from stickslip.analysis import hysteresis as hy
+    from stickslip.analysis.dynamics import hysteresis as hy
 
     p = block_params_from_args(args)
     settings = hy.SweepSettings(

@@ -12,7 +12,7 @@ runs points ("rungs") one after the other, each starting from the final state of
   same amount, to the next smaller beta, until a rung leaves steady sliding (some block sticks);
   then bisects. Linear stability puts that lower edge at beta = 1.
 
-A rung runs in segments until its answer is known (:func:`stickslip.analysis.adaptive.run_rung`).
+A rung runs in segments until its answer is known (:func:`stickslip.analysis.dynamics.adaptive.run_rung`).
 Each finished rung is written to ``<ladder>/rungs/<k>-beta<b>/`` (``rung.json``, the final state
 ``state.npz``, the samples ``samples.npz``), and a running rung keeps its progress after each
 segment there (``progress.npz``); a ladder started again replays its finished rungs and continues
@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 
 from stickslip import io
-from stickslip.analysis.adaptive import STOP_BATCHES, run_rung
+from stickslip.analysis.dynamics.adaptive import STOP_BATCHES, run_rung
 from stickslip.experiments.cache import BOOKKEEPING, canonical, file_sha256, read_done, sealed
 from stickslip.experiments.sweep_points import point_params
 from stickslip.jsonable import to_jsonable
@@ -99,7 +99,7 @@ def _replay(rdir: Path, spec: dict[str, Any], params) -> tuple[dict[str, Any] | 
 
 
 def _keep_progress(path: Path, spec: dict[str, Any], progress: dict[str, Any]) -> None:
-    """A rung's progress after a segment (:func:`stickslip.analysis.adaptive.run_rung`) to ``path``,
+    """A rung's progress after a segment (:func:`stickslip.analysis.dynamics.adaptive.run_rung`) to ``path``,
     with its spec and checksum (:func:`stickslip.run.checkpoint.write_state_npz`): an interrupted
     rung loses at most the segment it was in."""
     arrays = {k: np.asarray(progress[k]) for k in ("t", "L", "n_moving")}

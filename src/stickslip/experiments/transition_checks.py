@@ -2,7 +2,7 @@
 measure (:mod:`stickslip.experiments.studies.transition`).
 
 * :func:`paper_start_check`: m = 1 - <L>/L_ss from the paper's start (x_i = 0, section 3) over the
-  second half of a run of 4 loading times (:func:`stickslip.analysis.order.order_summary`)
+  second half of a run of 4 loading times (:func:`stickslip.analysis.stats.order.order_summary`)
   against the up ladder's m at the same (N, beta): the difference in units of the combined error.
 * :func:`longer_check`: a rung run again from the same start state for ``factor`` times its
   adaptive length, without the stop rule; its m against the adaptive one.
@@ -16,8 +16,8 @@ from pathlib import Path
 from typing import Any
 
 from stickslip import io
-from stickslip.analysis.adaptive import run_rung
-from stickslip.analysis.order import order_summary
+from stickslip.analysis.dynamics.adaptive import run_rung
+from stickslip.analysis.stats.order import order_summary
 from stickslip.experiments.ladders import params_at
 from stickslip.experiments.studies.chain_point import point_run_options, t_end_of
 from stickslip.experiments.sweep import point_name

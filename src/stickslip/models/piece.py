@@ -136,7 +136,7 @@ class Linearisation:
     Friction force phi(v, theta) of a moving block and state law dtheta/dt = g(v, theta)
     (+ ``diffusion`` times the discrete Laplacian of theta): ``theta0`` the steady state,
     ``phi_v`` = dphi/dv, ``phi_theta`` = dphi/dtheta, ``g_v`` = dg/dv, ``g_theta`` = dg/dtheta
-    there. The chain's Fourier mode matrix and finite Jacobian (analysis.stability) read these.
+    there. The chain's Fourier mode matrix and finite Jacobian (analysis.dynamics.stability) read these.
     """
 
     theta0: float

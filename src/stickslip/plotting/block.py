@@ -1,8 +1,8 @@
 """Figures 1-3 of the paper: the single block and spring (section 2).
 
 Each function takes results (a :class:`~stickslip.run.block.BlockRun`, a
-:class:`~stickslip.analysis.slip_limit.SlipLimit`, the table of :func:`~stickslip.analysis.slip_limit.period_sweep`)
-and returns a matplotlib Figure.
+:class:`~stickslip.analysis.dynamics.slip_limit.SlipLimit`, the table of
+:func:`~stickslip.analysis.dynamics.slip_limit.period_sweep`) and returns a matplotlib Figure.
 """
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ import pandas as pd
 import xarray as xr
 from matplotlib.figure import Figure
 
-from stickslip.analysis.slip_limit import SlipLimit
+from stickslip.analysis.dynamics.slip_limit import SlipLimit
 from stickslip.plotting.style import SIM, THEORY, new_figure
 from stickslip.run.block import BlockRun
 
@@ -80,7 +80,7 @@ def fig2_slip(run: BlockRun, limit: SlipLimit, index: int | None = None) -> Figu
 def fig3_period(sweep: pd.DataFrame, limit: SlipLimit) -> Figure:
     """Fig. 3: period of the stick-slip oscillation against V, simulated (marks) and the law (dashed).
 
-    ``sweep`` is the table of :func:`~stickslip.analysis.slip_limit.period_sweep`; the dashed curve is
+    ``sweep`` is the table of :func:`~stickslip.analysis.dynamics.slip_limit.period_sweep`; the dashed curve is
     T(V) = a + b / (K V) from eq. (3) (``limit``). The lower panel shows the relative deviation
     of the simulated period from the law.
     """

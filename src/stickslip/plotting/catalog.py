@@ -1,6 +1,6 @@
 """Figures of a slip catalogue (``stickslip catalog``): frequency-magnitude, CCDF, recurrence, moment rate.
 
-Each function takes the :class:`~stickslip.analysis.catalog.Catalog` of a run and returns a
+Each function takes the :class:`~stickslip.analysis.stats.catalog.Catalog` of a run and returns a
 matplotlib Figure, or None when the catalogue has nothing to draw (the caller says why).
 """
 
@@ -11,8 +11,8 @@ import math
 import numpy as np
 from matplotlib.figure import Figure
 
-from stickslip.analysis import magnitudes as mg
-from stickslip.analysis.recurrence import renewal_pdf
+from stickslip.analysis.stats import magnitudes as mg
+from stickslip.analysis.stats.recurrence import renewal_pdf
 from stickslip.plotting.style import PAPER, SIM, THEORY, new_figure
 
 __all__ = ["frequency_magnitude_figure", "ccdf_figure", "recurrence_figure", "moment_rate_figure", "catalog_figures"]

@@ -2,7 +2,7 @@
 
 Each function takes results of a chain run (a snapshot of x_i, a table of <L> against beta, the
 ``profiles``/``first_move``/``events`` tables) and analysis results from
-:mod:`stickslip.analysis.statistics`, and returns a matplotlib Figure; given ``ax``, it draws its
+:mod:`stickslip.analysis.stats.statistics`, and returns a matplotlib Figure; given ``ax``, it draws its
 main panel into that Axes and returns the Axes' Figure. Titles name the model and the parameters
 it reads (:func:`stickslip.models.presets.model_title`); "Fig. N" appears only on the paper's
 runs (:func:`stickslip.models.presets.is_paper_run`) or where the caller names the figure
@@ -22,7 +22,7 @@ import xarray as xr
 from matplotlib import cm
 from matplotlib.figure import Figure
 
-from stickslip.analysis.statistics import EdgeSpeed, FrontSpeed, PowerLawFit, central_interval, size_distribution
+from stickslip.analysis.stats.statistics import EdgeSpeed, FrontSpeed, PowerLawFit, central_interval, size_distribution
 from stickslip.models.params import ChainParams
 from stickslip.models.physics import chain_steady_length, chain_steady_profile_paper, chain_steady_state
 from stickslip.models.presets import is_paper_model, is_paper_run, model_title
@@ -395,7 +395,7 @@ def fronts_figure(
     Delta t = ``window`` (20 in the paper) from the event's start, stacked upwards in time like
     the paper's plot, with a scale bar for Delta x_i. Right: the time each block first moved
     against i, the front speed fitted over the far part of the chain
-    (:func:`~stickslip.analysis.statistics.front_speed`), the sound speed sqrt(K) (3.16 for
+    (:func:`~stickslip.analysis.stats.statistics.front_speed`), the sound speed sqrt(K) (3.16 for
     K = 10) and, for the paper's chain, its c = 1.43 as slopes from the same point.
 
     Parameters
@@ -406,7 +406,7 @@ def fronts_figure(
     first_move : pandas.DataFrame
         ``ChainRun.first_move``: columns ``event``, ``block``, ``t_first``.
     fronts : sequence of FrontSpeed
-        The fitted fronts, one per event drawn (:func:`~stickslip.analysis.statistics.front_speed`).
+        The fitted fronts, one per event drawn (:func:`~stickslip.analysis.stats.statistics.front_speed`).
     params : ChainParams
         The run's model (titles, sqrt(K), the paper's c only for eq. 4).
     labels : sequence of str, optional
@@ -488,7 +488,7 @@ def sizes_figure(
     paper's Figs. 7 at beta = 1 and 8 at beta = 0.2).
 
     (a): the density of S on logarithmic bins
-    (:func:`~stickslip.analysis.statistics.size_distribution`) with the fitted power law
+    (:func:`~stickslip.analysis.stats.statistics.size_distribution`) with the fitted power law
     p ~ S^-tau over [s_min, s_max], scaled by the share of events in that range. (b): S of every
     event against its start time.
 
@@ -497,7 +497,7 @@ def sizes_figure(
     events : pandas.DataFrame
         The events (``S``, ``t_start``), usually the stationary window's.
     fit : PowerLawFit
-        The fit drawn (:func:`~stickslip.analysis.statistics.fit_power_law`).
+        The fit drawn (:func:`~stickslip.analysis.stats.statistics.fit_power_law`).
     beta : float, optional
         For the title, without ``params``.
     params : ChainParams, optional

@@ -11,8 +11,8 @@ a dict with ``label``, ``N`` and ``beta`` (None for the relatives) and the data 
   started delta apart (``decorrelation``: for each kind of perturbation, rows of ``delta``,
   ``seed``, ``events``, ``decorrelated``), one panel per kind and N, one line per beta and
   window; windows that still agreed at the end are open markers at the slips compared;
-* :func:`threshold_figure`: delta* against N (:func:`stickslip.analysis.threshold.delta_star`,
-  :func:`~stickslip.analysis.threshold.threshold_fit`), one panel per kind, one colour per beta.
+* :func:`threshold_figure`: delta* against N (:func:`stickslip.analysis.dynamics.threshold.delta_star`,
+  :func:`~stickslip.analysis.dynamics.threshold.threshold_fit`), one panel per kind, one colour per beta.
 """
 
 from __future__ import annotations

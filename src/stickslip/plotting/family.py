@@ -1,7 +1,7 @@
 """Slip-size statistics across the model family: Carlson-Langer beside the paper's Fig. 8 chain.
 
 The function takes event tables and the results of
-:func:`stickslip.analysis.chain_runs.size_statistics` and returns a matplotlib Figure.
+:func:`stickslip.analysis.stats.chain_runs.size_statistics` and returns a matplotlib Figure.
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from stickslip.analysis.statistics import size_distribution
+from stickslip.analysis.stats.statistics import size_distribution
 from stickslip.plotting.style import SIM, THEORY, new_figure
 
 __all__ = ["family_sizes"]

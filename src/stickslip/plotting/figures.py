@@ -20,7 +20,7 @@ import pandas as pd
 import xarray as xr
 
 from stickslip import io
-from stickslip.analysis.chain_runs import fig6_start_note, sweep_table
+from stickslip.analysis.stats.chain_runs import fig6_start_note, sweep_table
 from stickslip.outcome import Outcome, chain_params
 
 #: A drawn figure: its stem, the figure, its caption and the further fields of its report entry.
@@ -218,7 +218,7 @@ def _fig5(o: dict[str, Outcome], a: dict[str, Any], d: Path, mode: str, cmd) -> 
 
 def _fig6(o: dict[str, Outcome], a: dict[str, Any], d: Path, cmd) -> list[Drawn]:
     """Fig. 6: rupture fronts of a large and an intermediate event at beta = 1, and c per event."""
-    from stickslip.analysis.statistics import central_interval
+    from stickslip.analysis.stats.statistics import central_interval
     from stickslip.plotting.chain import PAPER_FRONT_SPEED, fig6_fronts
 
     fr = a["fronts"]
@@ -283,7 +283,7 @@ def _fig6(o: dict[str, Outcome], a: dict[str, Any], d: Path, cmd) -> list[Drawn]
 
 def _fig7_8(o: dict[str, Outcome], a: dict[str, Any], d: Path, which: str, cmd) -> list[Drawn]:
     """Figs. 7 (beta = 1) and 8 (beta = 0.2): slip-size distribution and S against time."""
-    from stickslip.analysis.statistics import size_distribution
+    from stickslip.analysis.stats.statistics import size_distribution
     from stickslip.plotting.chain import fig7_8_sizes
 
     beta, stem, label, paper_tau = (1.0, "fig7", "Fig. 7", 1.5) if which == "7" else (0.2, "fig8", "Fig. 8", 1.6)
@@ -349,7 +349,7 @@ def section2_figures(outcomes: dict[str, Outcome], page_dir: Path, commands) -> 
 
 def chain_figures(outcome: Outcome, analysis: dict[str, Any], page_dir: Path, mode: str, commands) -> list[tuple]:
     """Figs. 5-8 from the chain runs of :mod:`stickslip.experiments.studies.figs5_8` and their
-    ``analysis`` (:func:`stickslip.analysis.chain_runs.chain_analysis`), their data written into
+    ``analysis`` (:func:`stickslip.analysis.stats.chain_runs.chain_analysis`), their data written into
     ``page_dir``. ``commands`` makes the command line of each figure's entry (``chain_command``,
     ``sweep_command``: :mod:`stickslip.report.commands`, handed down by the study)."""
     d, o, cmd = Path(page_dir), {"chain-runs": outcome}, commands

@@ -2,9 +2,9 @@
 the chain of eq. (4) lasts against N.
 
 * :func:`survival_figure`: Kaplan-Meier survival curves S(t) = P(T > t)
-  (:func:`stickslip.analysis.survival.kaplan_meier`), one panel per beta, one curve per N;
+  (:func:`stickslip.analysis.stats.survival.kaplan_meier`), one panel per beta, one curve per N;
 * :func:`lifetime_figure`: <T> against N with its error (lower bounds where no lifetime ended)
-  and the fits of ln <T> on N and on ln N (:func:`stickslip.analysis.survival.size_fits`).
+  and the fits of ln <T> on N and on ln N (:func:`stickslip.analysis.stats.survival.size_fits`).
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ __all__ = ["survival_figure", "lifetime_figure"]
 
 def survival_figure(curves: list[dict[str, Any]]) -> Figure:
     """Kaplan-Meier survival of the irregular motion: ``curves`` of ``beta``, ``N`` and ``km`` (the
-    DataFrame of :func:`~stickslip.analysis.survival.kaplan_meier`), a step curve per N in a panel
+    DataFrame of :func:`~stickslip.analysis.stats.survival.kaplan_meier`), a step curve per N in a panel
     per beta; a curve that stays above 0 ends at its last censored lifetime."""
     betas = sorted({c["beta"] for c in curves})
     fig, axes = new_figure(1, max(1, len(betas)), width=3.0, height=2.6)

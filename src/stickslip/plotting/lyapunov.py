@@ -1,4 +1,4 @@
-"""The largest Lyapunov exponent against beta (:func:`stickslip.analysis.lyapunov.lyapunov_vs_beta`)."""
+"""The largest Lyapunov exponent against beta (:func:`stickslip.analysis.dynamics.lyapunov.lyapunov_vs_beta`)."""
 
 from __future__ import annotations
 

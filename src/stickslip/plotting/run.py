@@ -19,7 +19,12 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
-from stickslip.analysis.chain_runs import front_statistics, run_size_statistics, stationary_events, stationary_from
+from stickslip.analysis.stats.chain_runs import (
+    front_statistics,
+    run_size_statistics,
+    stationary_events,
+    stationary_from,
+)
 from stickslip.models.physics import chain_steady_length, has_steady_state, loading_time
 from stickslip.models.presets import model_name, model_title
 from stickslip.plotting.chain import fronts_figure, sizes_figure, snapshot_figure
@@ -120,7 +125,7 @@ def snapshot(run, t: float | None = None, *, ax=None) -> Figure:
 
 def sizes(run, *, ax=None, bins: int = 30) -> Figure:
     """The slip-size distribution of ``run``'s stationary window with its truncated power-law
-    fit (:func:`~stickslip.analysis.chain_runs.run_size_statistics`), and S against time (Figs. 7, 8).
+    fit (:func:`~stickslip.analysis.stats.chain_runs.run_size_statistics`), and S against time (Figs. 7, 8).
 
     Parameters
     ----------
@@ -266,7 +271,7 @@ def run_figures(run, *, max_snapshots: int = 4) -> list[RunFigure]:
     else:
         out.append(RunFigure("snapshot_final", "final state", None, "no steady sliding profile for this model"))
     events = run.events
-    # The stationary window shared with `reproduce` and `catalog` (analysis.chain_runs.stationary_from).
+    # The stationary window shared with `reproduce` and `catalog` (analysis.stats.chain_runs.stationary_from).
     window = stationary_events(run)
     n_pos = int(np.count_nonzero(window["S"].to_numpy(dtype=float) > 0)) if len(window) else 0
     stats = None

@@ -1,7 +1,7 @@
 """Figures of the linear stability (section 2, Fig. 4) and of the hysteresis loop (section 2).
 
-Each function takes results (the Datasets of :mod:`stickslip.analysis.stability` and
-:mod:`stickslip.analysis.hysteresis`) and returns a matplotlib Figure.
+Each function takes results (the Datasets of :mod:`stickslip.analysis.dynamics.stability` and
+:mod:`stickslip.analysis.dynamics.hysteresis`) and returns a matplotlib Figure.
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ PAPER_SWEEP = {"K": 10.0, "beta": 1.0, "Fs": 3.0, "alpha": 1.0, "M": 1.0, "sigma
 def plot_stability_map(curve: xr.Dataset, growth: xr.DataArray | None = None, *, mark: dict | None = None) -> Figure:
     """Stability map of steady sliding of the block (section 2, eq. 2): V_c(beta) at fixed K.
 
-    ``curve`` is :func:`stickslip.analysis.stability.hopf_curve`; ``growth`` (optional) the largest
+    ``curve`` is :func:`stickslip.analysis.dynamics.stability.hopf_curve`; ``growth`` (optional) the largest
     Re(lambda) over (beta, V), shown as shading; ``mark`` an optional {"beta", "V"} point.
     """
     fig, ax = new_figure(width=5.6, height=4.0)
@@ -67,7 +67,7 @@ def plot_stability_map(curve: xr.Dataset, growth: xr.DataArray | None = None, *,
 def plot_fig4(ds: xr.Dataset, *, k_zoom: float = 0.3) -> Figure:
     """Fig. 4: real parts of the two largest eigenvalues of the Fourier modes of eq. (5).
 
-    ``ds`` is :func:`stickslip.analysis.stability.fig4_data`. Left: 0 <= k <= pi; right: the long
+    ``ds`` is :func:`stickslip.analysis.dynamics.stability.fig4_data`. Left: 0 <= k <= pi; right: the long
     waves k <= ``k_zoom``, where the instability for beta < alpha lives. Solid: largest,
     dashed: second largest; one colour per beta.
     """
@@ -106,7 +106,7 @@ def plot_fig4(ds: xr.Dataset, *, k_zoom: float = 0.3) -> Figure:
 def plot_hysteresis(sweep: xr.Dataset) -> Figure:
     """Bifurcation diagram of the single block (section 2): max and min of v against V.
 
-    ``sweep`` is :func:`stickslip.analysis.hysteresis.hysteresis_sweep`'s ``data``: both sweeps, with
+    ``sweep`` is :func:`stickslip.analysis.dynamics.hysteresis.hysteresis_sweep`'s ``data``: both sweeps, with
     the transitions V_up and V_down marked and the paper's V = 0.345 for comparison.
     """
     fig, ax = new_figure(width=6.0, height=4.0)
@@ -178,9 +178,9 @@ def plot_hysteresis(sweep: xr.Dataset) -> Figure:
 def plot_mode_growth(ds: xr.Dataset, modes=None) -> Figure:
     """Growth rate of steady sliding against k for a chain without state variable (like Fig. 4).
 
-    ``ds`` is :func:`stickslip.analysis.stability.mode_dispersion`: Re of both roots of
+    ``ds`` is :func:`stickslip.analysis.dynamics.stability.mode_dispersion`: Re of both roots of
     lambda^2 + phi'(V) lambda + w_k^2 = 0 (plate drive of Carlson-Langer, or the train model);
-    ``modes`` (optional) :func:`~stickslip.analysis.stability.mode_growth_rates`, the finite
+    ``modes`` (optional) :func:`~stickslip.analysis.dynamics.stability.mode_growth_rates`, the finite
     chain's modes, drawn as points (k folded into [0, pi]).
     """
     fig, ax = new_figure(width=5.6, height=4.0)

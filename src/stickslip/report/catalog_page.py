@@ -1,6 +1,6 @@
 """The outputs of ``stickslip catalog``: the catalogue's tables, figures, JSON and its page.
 
-:func:`write_catalog` writes, into one folder, what :func:`stickslip.analysis.catalog.catalog_analysis`
+:func:`write_catalog` writes, into one folder, what :func:`stickslip.analysis.stats.catalog.catalog_analysis`
 found: ``catalog.parquet``/``.csv`` (one row per slip), ``moment_rate.parquet``/``.csv`` (where
 the run kept profiles), ``catalog.json`` (every number), the figures of
 :mod:`stickslip.plotting.catalog` as PNG and PDF, and ``index.html`` from the package's template
@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import Any
 
 from stickslip import io
-from stickslip.analysis.catalog import CATALOG_DOCS, Catalog
+from stickslip.analysis.stats.catalog import CATALOG_DOCS, Catalog
 from stickslip.pages import image_src, write_page
 from stickslip.plotting.catalog import catalog_figures
 from stickslip.plotting.style import FIGURE_FORMATS, save_figure

@@ -16,8 +16,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from stickslip.analysis.chain_runs import fig6_start_note, sweep_table
-from stickslip.analysis.statistics import central_interval
+from stickslip.analysis.stats.chain_runs import fig6_start_note, sweep_table
+from stickslip.analysis.stats.statistics import central_interval
 from stickslip.models.physics import chain_steady_state
 from stickslip.outcome import Outcome
 from stickslip.report.commands import chain_command, hysteresis_command, sweep_command
@@ -280,7 +280,7 @@ def front_speed_row(
 
 def chain_rows(o: Outcome, a: dict[str, Any], mode: str) -> list[ReportRow]:
     """Rows of section 3 and Figs. 5-8 from the chain runs (``o``) and their analysis ``a``
-    (:func:`stickslip.analysis.chain_runs.chain_analysis`)."""
+    (:func:`stickslip.analysis.stats.chain_runs.chain_analysis`)."""
     rows = [_final_state_row(o, a, mode)]
     tiny = mode == "tiny"
 

@@ -4,7 +4,7 @@ A run starts at t = 0 from a :class:`BlockState` and advances eq. (1) with the c
 step of :mod:`stickslip.kernels.block` (start and stop rules of docs/model.md). It returns a
 :class:`BlockRun`: the time series as an xarray Dataset, the table of slips as a pandas
 DataFrame, the final state and a few statistics gathered over every step. The period sweep of
-Fig. 3 is :func:`stickslip.analysis.slip_limit.period_sweep`.
+Fig. 3 is :func:`stickslip.analysis.dynamics.slip_limit.period_sweep`.
 """
 
 from __future__ import annotations

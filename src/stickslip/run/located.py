@@ -5,7 +5,7 @@ stands in") with Heun's method in which a block starts at the time its force rea
 threshold and stops at the time its velocity reaches zero, both located inside the step to
 round-off (:mod:`stickslip.kernels.located`). Its trajectories converge to the solution of the
 equations with switches at second order in dt. It is a reference for studies (the exponent of
-the flow, :mod:`stickslip.analysis.lyapunov_flow`), not the engine: :func:`stickslip.run_chain`
+the flow, :mod:`stickslip.analysis.dynamics.lyapunov_flow`), not the engine: :func:`stickslip.run_chain`
 keeps the gridded rules of docs/model.md and its bit-exact results. It runs in a fast form by
 default (:mod:`stickslip.kernels.located_fast`, docs/performance.md), bit for bit the dense one
 (``form="dense"``).

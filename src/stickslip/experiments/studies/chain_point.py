@@ -72,7 +72,7 @@ def _run(point: dict[str, Any], point_dir: Path, analyse) -> dict[str, Any]:
 
 def order_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     """One chain run and its order parameter and final state, a task of ``run_sweep``."""
-    from stickslip.analysis.order import order_summary
+    from stickslip.analysis.stats.order import order_summary
 
     return _run(point, point_dir, lambda run, params, options: order_summary(run, params, options["average_from"]))
 
@@ -80,7 +80,7 @@ def order_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
 def sizes_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     """One chain run and its slip-size exponent over the events after its transient, a task of
     ``run_sweep``."""
-    from stickslip.analysis.chain_runs import sizes_summary
+    from stickslip.analysis.stats.chain_runs import sizes_summary
 
     def sizes(run, params, options) -> dict[str, Any]:
         t_from = float(point.get("transient", point.get("average_fraction", 0.5))) * float(run.options.t_end)

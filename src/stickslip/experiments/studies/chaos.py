@@ -7,14 +7,14 @@ or Carlson-Langer as known answers) measures from the engine's state at the end 
 (:func:`stickslip.run.loaded.loaded_state`, kept in the point's folder with its loading check):
 
 - the flow's largest exponent by two trajectories with located switches
-  (:func:`stickslip.analysis.lyapunov_flow.flow_lyapunov`) at dt, dt/2, dt/4 over ``flow_t``
+  (:func:`stickslip.analysis.dynamics.lyapunov_flow.flow_lyapunov`) at dt, dt/2, dt/4 over ``flow_t``
   (some :data:`MIN_FLOW_SLIPS` slips or more per rung in the chain's points), extrapolated to
-  dt -> 0 (:func:`stickslip.analysis.lyapunov_flow.extrapolate`);
-- n(delta) on the engine's map (:func:`stickslip.analysis.decorrelation.sequence_decorrelation`,
+  dt -> 0 (:func:`stickslip.analysis.dynamics.lyapunov_flow.extrapolate`);
+- n(delta) on the engine's map (:func:`stickslip.analysis.dynamics.decorrelation.sequence_decorrelation`,
   as ``stickslip lyapunov --decorrelation``) for each kind of perturbation (state, Fs, V) and each
   delta over ``seeds`` consecutive windows of ``events`` slips, and delta* per kind
-  (:func:`stickslip.analysis.threshold.delta_star`);
-- the verdict (:func:`stickslip.analysis.decorrelation.verdict`) from the exponent and the
+  (:func:`stickslip.analysis.dynamics.threshold.delta_star`);
+- the verdict (:func:`stickslip.analysis.dynamics.decorrelation.verdict`) from the exponent and the
   state's n(delta).
 
 Each part (rung, kind) is written to ``parts/`` as it finishes and read back, not run again, when
@@ -27,7 +27,7 @@ The findings (:func:`conclusions`, from the table): each point's verdict with it
 flow's exponent and the slips its rungs counted, the loading check; delta* per point and kind
 (geometric mean over the windows, its error in decades, the range) and, for each beta and kind,
 the least-squares slope of log10 delta* (one point per window) on log10 N
-(:func:`stickslip.analysis.threshold.threshold_fit`). The figures (:mod:`stickslip.plotting.chaos`)
+(:func:`stickslip.analysis.dynamics.threshold.threshold_fit`). The figures (:mod:`stickslip.plotting.chaos`)
 read each point's ``flow.json``.
 """
 
@@ -134,8 +134,8 @@ def check_point(cfg: dict[str, Any], params=None) -> None:
     """Raise ParameterError (one line) unless a chaos point's merged settings and its model
     ``params`` (by default :func:`~stickslip.experiments.sweep_points.point_params` of them) make
     a valid measurement."""
-    from stickslip.analysis.benettin import check_run
-    from stickslip.analysis.decorrelation import PERTURBATIONS
+    from stickslip.analysis.dynamics.benettin import check_run
+    from stickslip.analysis.dynamics.decorrelation import PERTURBATIONS
     from stickslip.experiments.sweep_points import point_params
     from stickslip.models.params import ParameterError, check_number
 
@@ -184,9 +184,9 @@ def chaos_point(cfg: dict[str, Any], params, point_dir: Path) -> dict[str, Any]:
     ``flow.json`` (loading check, ladder, n(delta) of every kind, delta*, verdict) into
     ``point_dir`` and returns the table's columns."""
     from stickslip import __version__, io
-    from stickslip.analysis.decorrelation import GridSequences, sequence_decorrelation, verdict
-    from stickslip.analysis.lyapunov_flow import LADDER_COLUMNS, extrapolate, flow_lyapunov
-    from stickslip.analysis.threshold import delta_star
+    from stickslip.analysis.dynamics.decorrelation import GridSequences, sequence_decorrelation, verdict
+    from stickslip.analysis.dynamics.lyapunov_flow import LADDER_COLUMNS, extrapolate, flow_lyapunov
+    from stickslip.analysis.dynamics.threshold import delta_star
     from stickslip.experiments.sweep import stop_requested
     from stickslip.experiments.sweep_points import preset_start
     from stickslip.run.errors import Interrupted
@@ -300,8 +300,8 @@ def _value(x) -> float | None:
 def thresholds(table: pd.DataFrame) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
     """delta* of every chain point and kind (``N``, ``beta``, ``kind``, ``per_seed``,
     ``geometric_mean``, ``log10_err``, ``low``, ``high``, ``censored``) and, for each beta and
-    kind, :func:`~stickslip.analysis.threshold.threshold_fit` of its points."""
-    from stickslip.analysis.threshold import threshold_fit
+    kind, :func:`~stickslip.analysis.dynamics.threshold.threshold_fit` of its points."""
+    from stickslip.analysis.dynamics.threshold import threshold_fit
 
     out = []
     for _, row in table[table["model"].map(is_paper)].sort_values(["N", "beta"]).iterrows():

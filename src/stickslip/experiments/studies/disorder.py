@@ -142,10 +142,10 @@ def _rows(table: pd.DataFrame, part: str) -> pd.DataFrame:
 
 def part_a(table: pd.DataFrame) -> dict[str, Any]:
     """Per w: the bracket of the transition in beta (last stick-slip beta, first steady above it,
-    :func:`~stickslip.analysis.order.transition_bracket`), m at the last stick-slip beta (the
+    :func:`~stickslip.analysis.stats.order.transition_bracket`), m at the last stick-slip beta (the
     step a continuous transition makes small), and tau at beta = 0.4 with its error; the change of
     the bracket's middle and of tau from w = 0."""
-    from stickslip.analysis.order import transition_bracket
+    from stickslip.analysis.stats.order import transition_bracket
 
     rows = _rows(table, "a")
     order = rows[rows["analysis"] == "order"] if "analysis" in rows else rows.iloc[:0]
@@ -171,10 +171,10 @@ def part_a(table: pd.DataFrame) -> dict[str, Any]:
 
 def ramp_fits(table: pd.DataFrame, bootstrap: int = 200) -> list[dict[str, Any]]:
     """Part b per (N, beta): the event sizes of every seed pooled and fitted with the truncated
-    power law (:func:`~stickslip.analysis.statistics.fit_power_law`, s_min by least KS distance),
+    power law (:func:`~stickslip.analysis.stats.statistics.fit_power_law`, s_min by least KS distance),
     the depinning force F_c (mean and spread over seeds), the events per run and the seeds where
     the chain never depinned."""
-    from stickslip.analysis.statistics import fit_power_law
+    from stickslip.analysis.stats.statistics import fit_power_law
 
     rows = _rows(table, "b")
     out = []
@@ -205,9 +205,9 @@ def ramp_fits(table: pd.DataFrame, bootstrap: int = 200) -> list[dict[str, Any]]
 
 def _distributions(table: pd.DataFrame, fits: list[dict[str, Any]]) -> dict[str, Any]:
     """The catalogue's comparison of the power law with the other candidates
-    (:func:`~stickslip.analysis.model_comparison.compare_distributions`) on the pooled sizes of the
+    (:func:`~stickslip.analysis.stats.model_comparison.compare_distributions`) on the pooled sizes of the
     largest chain at beta = 1, on its fitted range."""
-    from stickslip.analysis.model_comparison import compare_distributions
+    from stickslip.analysis.stats.model_comparison import compare_distributions
 
     ok = [f for f in fits if f["beta"] == 1.0 and finite(f["tau"])]
     if not ok:

@@ -102,9 +102,9 @@ def figures(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[tuple[str,
 
 def _family_panels(table: pd.DataFrame, points: Path) -> list[tuple[str, pd.DataFrame, dict[str, Any]]]:
     """(title, events, statistics) of the relative's run and of eq. (4) at its smallest beta, each
-    fitted as its point was (:func:`stickslip.analysis.chain_runs.size_statistics`); none without a fit."""
+    fitted as its point was (:func:`stickslip.analysis.stats.chain_runs.size_statistics`); none without a fit."""
     from stickslip import io
-    from stickslip.analysis.chain_runs import size_statistics
+    from stickslip.analysis.stats.chain_runs import size_statistics
 
     fitted = table[np.isfinite(table["tau"].astype(float))] if "tau" in table else table.iloc[:0]
     chain = fitted[fitted["model"].map(is_paper)].sort_values("beta")

@@ -103,7 +103,7 @@ def _load_block_run(cfg: dict[str, Any], run_dir: Path, summary: dict[str, Any])
 
 def _compute_slip_limit(cfg: dict[str, Any], run_dir: Path) -> dict[str, Any]:
     """Eq. (3) accurately (DOP853, event v = 0) and with the Heun step of the paper."""
-    from stickslip.analysis.slip_limit import heun_slip_limit, solve_slip_limit
+    from stickslip.analysis.dynamics.slip_limit import heun_slip_limit, solve_slip_limit
 
     p = BlockParams(**cfg["params"])
     law = solve_slip_limit(p, rtol=cfg["options"]["rtol"], atol=cfg["options"]["atol"])
@@ -113,7 +113,7 @@ def _compute_slip_limit(cfg: dict[str, Any], run_dir: Path) -> dict[str, Any]:
 
 
 def _load_slip_limit(cfg: dict[str, Any], run_dir: Path, summary: dict[str, Any]) -> dict[str, Any]:
-    from stickslip.analysis.slip_limit import SlipLimit
+    from stickslip.analysis.dynamics.slip_limit import SlipLimit
 
     numbers = {k: float(summary[k]) for k in ("duration", "force_at_stop", "slip", "theta_at_stop")}
     curve = io.read_dataset(run_dir / "curve.nc")
@@ -122,7 +122,7 @@ def _load_slip_limit(cfg: dict[str, Any], run_dir: Path, summary: dict[str, Any]
 
 def _compute_period_sweep(cfg: dict[str, Any], run_dir: Path) -> dict[str, Any]:
     """Simulated stick-slip period at log-spaced V (Fig. 3)."""
-    from stickslip.analysis.slip_limit import paper_V_values, period_sweep
+    from stickslip.analysis.dynamics.slip_limit import paper_V_values, period_sweep
 
     o = cfg["options"]
     V = paper_V_values(o["n"], o["V_min"], o["V_max"])
@@ -138,7 +138,7 @@ def _compute_period_sweep(cfg: dict[str, Any], run_dir: Path) -> dict[str, Any]:
 
 def _compute_block_stability(cfg: dict[str, Any], run_dir: Path) -> dict[str, Any]:
     """Eq. (2): Hopf point at the point's beta, stability for all V at ``beta_stable``, the map."""
-    from stickslip.analysis import stability as st
+    from stickslip.analysis.dynamics import stability as st
 
     p = BlockParams(**cfg["params"])
     hopf = st.hopf_point(p)
@@ -166,7 +166,7 @@ def _compute_block_stability(cfg: dict[str, Any], run_dir: Path) -> dict[str, An
 
 def _compute_hysteresis(cfg: dict[str, Any], run_dir: Path) -> dict[str, Any]:
     """V raised slowly and lowered again for the single block (the inverse transition, sec. 2)."""
-    from stickslip.analysis import hysteresis as hy
+    from stickslip.analysis.dynamics import hysteresis as hy
 
     result = hy.hysteresis_sweep(BlockParams(**cfg["params"]), hy.SweepSettings(**cfg["options"]))
     io.write_dataset(run_dir / "hysteresis.nc", result.data)
@@ -175,7 +175,7 @@ def _compute_hysteresis(cfg: dict[str, Any], run_dir: Path) -> dict[str, Any]:
 
 def _compute_chain_modes(cfg: dict[str, Any], run_dir: Path) -> dict[str, Any]:
     """Fourier modes of the linearised chain at the betas of Fig. 4, and the critical beta."""
-    from stickslip.analysis import stability as st
+    from stickslip.analysis.dynamics import stability as st
 
     p = ChainParams(**cfg["params"])
     betas = [float(b) for b in cfg["options"]["betas"]]

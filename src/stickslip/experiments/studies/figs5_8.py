@@ -91,7 +91,7 @@ def chain_point_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     (:func:`stickslip.experiments.sweep.run_chain_point`). Returns the run's summary with <L> and
     its batch-means error (Fig. 5b) and the final state ("steady sliding" or "stick-slip", section 3).
     """
-    from stickslip.analysis.chain_runs import run_summary
+    from stickslip.analysis.stats.chain_runs import run_summary
     from stickslip.experiments.sweep import run_chain_point
 
     params, t_end, options = point_settings(point)
@@ -106,10 +106,10 @@ def check(cfg: dict[str, Any]) -> None:
 
 def load(spec: Study, table: pd.DataFrame, points_dir: Path) -> Results | None:
     """The chain runs (each read from its folder when first asked for) and their analysis
-    (:func:`stickslip.analysis.chain_runs.chain_analysis`); None unless every run finished."""
+    (:func:`stickslip.analysis.stats.chain_runs.chain_analysis`); None unless every run finished."""
     import pandas as pd
 
-    from stickslip.analysis.chain_runs import chain_analysis
+    from stickslip.analysis.stats.chain_runs import chain_analysis
     from stickslip.experiments.sweep import point_name
     from stickslip.run.driver import load_run
 

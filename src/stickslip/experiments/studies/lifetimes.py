@@ -4,7 +4,7 @@ against N, the standard test of stable chaos (Politi, Livi, Oppo and Kapral, Eur
 with the system size (docs/studies/lifetimes.md).
 
 A point is one start of the paper's chain at one N and beta, run until its slip sequence is
-periodic (:class:`stickslip.analysis.periodicity.PeriodicStop`), it slides steadily
+periodic (:class:`stickslip.analysis.stats.periodicity.PeriodicStop`), it slides steadily
 (``until_steady``) or its budget of time is spent:
 
 - ``paper``: the paper's start (x = 0, v = 0.1, theta = 0.1), every x_i moved by a uniform draw
@@ -19,10 +19,10 @@ censored there. A lifetime that ends within the last stretch the detector needs 
 is seen as censored: the budget is that much shorter in effect.
 
 The findings (:func:`conclusions`), per beta and N: the lifetimes ended and censored, <T> by
-the maximum-likelihood exponential law of censored data (:func:`stickslip.analysis.survival.exponential_fit`;
+the maximum-likelihood exponential law of censored data (:func:`stickslip.analysis.stats.survival.exponential_fit`;
 a lower bound where none ended), the Weibull test of the exponential law (stable chaos predicts
 it), the periods reached; per beta the fits of ln <T> on N and on ln N
-(:func:`stickslip.analysis.survival.size_fits`) over the N with at least two ended lifetimes,
+(:func:`stickslip.analysis.stats.survival.size_fits`) over the N with at least two ended lifetimes,
 which fits better, and the extrapolation to the paper's N = 399. The figures: Kaplan-Meier
 survival curves and <T> against N (:mod:`stickslip.plotting.lifetimes`).
 """
@@ -124,7 +124,7 @@ def start_state(params, start: str, amplitude: float, seed: int, stop_requested=
 def lifetime_point(cfg: dict[str, Any], params, point_dir: Path | None = None) -> dict[str, Any]:
     """One start (module docstring): its lifetime, whether it ended (on a periodic orbit or in
     steady sliding) or was censored, and the orbit's period."""
-    from stickslip.analysis.periodicity import PeriodicStop
+    from stickslip.analysis.stats.periodicity import PeriodicStop
     from stickslip.experiments.sweep import stop_requested
     from stickslip.run.driver import run_chain
 
@@ -189,7 +189,7 @@ def per_point(table: pd.DataFrame) -> list[dict[str, Any]]:
     periods reached."""
     import pandas
 
-    from stickslip.analysis.survival import exponential_fit, kaplan_meier
+    from stickslip.analysis.stats.survival import exponential_fit, kaplan_meier
 
     out = []
     for beta, N, g in _groups(table):
@@ -226,9 +226,9 @@ def per_point(table: pd.DataFrame) -> list[dict[str, Any]]:
 
 
 def fits(points: list[dict[str, Any]]) -> list[dict[str, Any]]:
-    """Per beta, :func:`~stickslip.analysis.survival.size_fits` of <T> against N over the N with at
+    """Per beta, :func:`~stickslip.analysis.stats.survival.size_fits` of <T> against N over the N with at
     least two ended lifetimes, extrapolated to N = 399."""
-    from stickslip.analysis.survival import size_fits
+    from stickslip.analysis.stats.survival import size_fits
 
     out = []
     for beta in sorted({p["beta"] for p in points}):
@@ -292,7 +292,7 @@ def conclusions(spec: Study | None, table: pd.DataFrame) -> dict[str, Any]:
 def figures(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[tuple[str, Any, str]]:
     """Kaplan-Meier survival curves (one panel per beta, one curve per N) and <T> against N with
     the fits."""
-    from stickslip.analysis.survival import kaplan_meier
+    from stickslip.analysis.stats.survival import kaplan_meier
     from stickslip.plotting import lifetimes as pl
 
     curves = []

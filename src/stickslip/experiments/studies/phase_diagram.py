@@ -67,7 +67,7 @@ def build(mode: str) -> Study:
 def findings(spec: Study, table: pd.DataFrame) -> dict[str, Any]:
     """Cells where the two starts disagree, the settled cells on the side of beta_c = alpha that
     linear stability predicts, and the bracket of the transition for each alpha and each D."""
-    from stickslip.analysis.order import transition_bracket
+    from stickslip.analysis.stats.order import transition_bracket
 
     out: dict[str, Any] = {"statements": [], "disagree": []}
     say = out["statements"].append

@@ -7,7 +7,7 @@ and retried, an interrupted one continues its running rung from its last finishe
 the rungs, per N (:func:`per_n_summary`): the loop's upper edge ``beta_t``, its lower edge (linear
 stability of steady sliding puts it at beta = 1) and the step of the order parameter m at beta_t
 (from steady sliding's 0); and the power laws beta_t - 1 ~ N^b and (size of the step) ~ N^b
-(:func:`stickslip.analysis.order.power_law_fit`).
+(:func:`stickslip.analysis.stats.order.power_law_fit`).
 
 Layout: ``OUT/runs/transition-<key>/points/<ladder>/rungs/...`` and ``OUT/transition/`` (table,
 figures, ``study.json``, ``index.html``).
@@ -73,7 +73,7 @@ def _grids(N: int, mode: str) -> tuple[list[float], list[float]]:
 def ladder_points(mode: str, extra_Ns: tuple[int, ...] = ()) -> tuple[dict[str, Any], list[dict[str, Any]]]:
     """The shared settings and the ladders (one per N and direction) of a mode; large N first (the
     up ladder of the largest chain is the longest task: it sets the wall time on a few workers)."""
-    from stickslip.analysis.adaptive import STOP_BATCHES
+    from stickslip.analysis.dynamics.adaptive import STOP_BATCHES
 
     common = {
         **paper_parameters("N", "beta"),
@@ -199,7 +199,7 @@ def per_n_summary(rows: pd.DataFrame) -> pd.DataFrame:
 
 
 def _fits(per_n: pd.DataFrame) -> dict[str, Any]:
-    from stickslip.analysis.order import power_law_fit
+    from stickslip.analysis.stats.order import power_law_fit
 
     bt, step = per_n.dropna(subset=["beta_t"]), per_n.dropna(subset=["step"])
     return {

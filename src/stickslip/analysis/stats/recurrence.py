@@ -52,7 +52,7 @@ def inter_event_times(t_start: Any) -> np.ndarray:
 
     Examples
     --------
-    >>> from stickslip.analysis.recurrence import inter_event_times
+    >>> from stickslip.analysis.stats.recurrence import inter_event_times
     >>> inter_event_times([5.0, 1.0, 2.5]).tolist()
     [1.5, 2.5]
     """

@@ -6,7 +6,7 @@ end of the range kept: every candidate is a density normalised on the fit range 
 
 =========================  ==============================================================
 ``power_law``              p ~ S^-tau; on a finite range the truncated power law of Figs. 7, 8
-                           (:func:`stickslip.analysis.statistics.fit_power_law`)
+                           (:func:`stickslip.analysis.stats.statistics.fit_power_law`)
 ``power_law_exp_cutoff``   p ~ S^-alpha exp(-lambda S) (Clauset et al.'s "truncated power law")
 ``lognormal``              ``scipy.stats.lognorm``
 ``exponential``            ``scipy.stats.expon``
@@ -37,7 +37,7 @@ from typing import Any
 import numpy as np
 from scipy import integrate, optimize, special, stats
 
-from stickslip.analysis.statistics import choose_s_min, fit_power_law, truncated_power_law_pdf
+from stickslip.analysis.stats.statistics import choose_s_min, fit_power_law, truncated_power_law_pdf
 
 __all__ = [
     "CANDIDATES",
@@ -412,7 +412,7 @@ def power_law_gof(S: Any, s_max: float | None = None, *, sims: int = 200, seed: 
     """Goodness of fit of the truncated power law of Figs. 7, 8 by the KS bootstrap of Clauset et al.
     (2009, sec. 4.1).
 
-    The data's fit (s_min by :func:`~stickslip.analysis.statistics.choose_s_min`) has KS distance
+    The data's fit (s_min by :func:`~stickslip.analysis.stats.statistics.choose_s_min`) has KS distance
     D. Each synthetic catalogue has as many sizes up to s_max as the data: each one, with the
     probability n_tail / n, drawn from the fitted power law, else drawn from the data below s_min;
     it is fitted the same way (its own s_min) and gives D_k.

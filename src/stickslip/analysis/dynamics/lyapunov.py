@@ -1,7 +1,7 @@
 """The largest Lyapunov exponent of the chain of eq. (4) (and of eq. (1) as the chain with N = 1).
 
 Two-trajectory method of Benettin, Galgani, Giorgilli and Strelcyn (Meccanica 15, 9, 1980),
-:mod:`stickslip.analysis.benettin`, over the chain engine (:class:`GridEngine`, the map of
+:mod:`stickslip.analysis.dynamics.benettin`, over the chain engine (:class:`GridEngine`, the map of
 :func:`stickslip.run.driver.run_chain`): a reference trajectory and a twin a distance d0 away
 are advanced side by side; every ``interval`` the distance d is measured and the twin is put
 back at distance d0 along the current separation. The exponent is the mean of ln(d / d0) per
@@ -42,7 +42,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from stickslip.analysis.benettin import METHOD, LyapunovResult, check_run, two_trajectory_exponent
+from stickslip.analysis.dynamics.benettin import METHOD, LyapunovResult, check_run, two_trajectory_exponent
 from stickslip.models.params import ChainParams, ParameterError, steps_for
 from stickslip.run.driver import ChainState, Stepper, run_chain
 from stickslip.run.errors import short_runs_expected
@@ -304,7 +304,7 @@ def largest_lyapunov(
     (:func:`twin_state`). The renormalisations ending after transient + ``align`` give the
     exponent: the sum of ln(d / d0) over their total time; its error is the standard error of the
     exponents of ``segments`` consecutive groups of them
-    (:func:`stickslip.analysis.benettin.two_trajectory_exponent` with :class:`GridEngine`). The
+    (:func:`stickslip.analysis.dynamics.benettin.two_trajectory_exponent` with :class:`GridEngine`). The
     reference is continued exactly as one uninterrupted run: its final state is bit for bit
     ``run_chain(params, t_end, start=start, ...).state``. d0 is the realised distance after
     rounding, so ln(d / d0) is not biased by the rounding of the twin's positions (docs/lyapunov.md).

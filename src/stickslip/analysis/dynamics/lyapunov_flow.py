@@ -1,6 +1,6 @@
 """The largest Lyapunov exponent of the flow: the equations with switches, dt -> 0.
 
-:mod:`stickslip.analysis.lyapunov` measures the exponent of the gridded map the engine integrates
+:mod:`stickslip.analysis.dynamics.lyapunov` measures the exponent of the gridded map the engine integrates
 (starts tested at the beginning of a step, stops at its end, docs/model.md). Here the same
 two-trajectory method (Benettin, Galgani, Giorgilli and Strelcyn, Meccanica 15, 9, 1980) runs on
 the integrator with located switches (:mod:`stickslip.run.located`): reference and twin each
@@ -40,7 +40,7 @@ from typing import Any
 
 import numpy as np
 
-from stickslip.analysis.benettin import LyapunovResult, check_run, two_trajectory_exponent
+from stickslip.analysis.dynamics.benettin import LyapunovResult, check_run, two_trajectory_exponent
 from stickslip.models.params import ChainParams, ParameterError, check_number, steps_for
 from stickslip.run.located import LocatedState, LocatedStepper, rates, start_state
 from stickslip.run.state import ChainState
@@ -116,7 +116,7 @@ def twin_state(ref: LocatedState, direction: np.ndarray, d0: float, params: Chai
 
 class LocatedEngine:
     """The equations with located switches (:class:`stickslip.run.located.LocatedStepper`) for
-    :func:`stickslip.analysis.benettin.two_trajectory_exponent`.
+    :func:`stickslip.analysis.dynamics.benettin.two_trajectory_exponent`.
 
     Separations in y (:func:`separation`), twins by :func:`twin_state`; the neutral direction is
     the flow F(y_ref) with ``neutral='remove'`` (none where its norm is not above ``flow_floor``,
@@ -205,8 +205,8 @@ def flow_lyapunov(
     have the same stuck blocks, at most ``max_wait`` steps, default one interval); the separation
     (less its component along the flow with ``neutral='remove'``, module docstring) gives
     ln(d / d0) and the twin is put back d0 away along it. Counted and averaged as in
-    :func:`stickslip.analysis.lyapunov.largest_lyapunov`: one loop,
-    :func:`stickslip.analysis.benettin.two_trajectory_exponent` with :class:`LocatedEngine`
+    :func:`stickslip.analysis.dynamics.lyapunov.largest_lyapunov`: one loop,
+    :func:`stickslip.analysis.dynamics.benettin.two_trajectory_exponent` with :class:`LocatedEngine`
     (``stop_requested``: asked now and then whether to stop, as there).
     """
     t_end, interval, d0, transient, align, segments = check_run(params, t_end, interval, d0, transient, align, segments)

@@ -1,4 +1,4 @@
-"""The defaults of the matching rule of :mod:`stickslip.analysis.periodicity`, in a module of their
+"""The defaults of the matching rule of :mod:`stickslip.analysis.stats.periodicity`, in a module of their
 own so that the command line states them without loading the engine."""
 
 from __future__ import annotations

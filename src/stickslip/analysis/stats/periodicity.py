@@ -35,7 +35,7 @@ from typing import Any
 
 import numpy as np
 
-from stickslip.analysis.period_rule import MAX_PERIOD, REPEATS, RTOL
+from stickslip.analysis.stats.period_rule import MAX_PERIOD, REPEATS, RTOL
 from stickslip.kernels import layout
 from stickslip.models.params import ParameterError, check_number
 from stickslip.run.loop import Hook, Loop
@@ -195,7 +195,7 @@ def find_period(
 
     Examples
     --------
-    >>> from stickslip.analysis.periodicity import find_period
+    >>> from stickslip.analysis.stats.periodicity import find_period
     >>> sizes = [5.0, 3.0, 1.0, 2.0, 1.0, 2.0, 1.0, 2.0, 1.0, 2.0, 1.0, 2.0]
     >>> r = find_period([1] * 12, [1] * 12, sizes, range(12))
     >>> r.period_slips, r.settled_from_slip, r.settled_from_t, r.period_t
@@ -270,7 +270,7 @@ def periodicity(events: Any, **rule: Any) -> Periodicity:
     Examples
     --------
     >>> import stickslip
-    >>> from stickslip.analysis.periodicity import periodicity
+    >>> from stickslip.analysis.stats.periodicity import periodicity
     >>> run = stickslip.run_chain(stickslip.chain_params(N=5), 1e6, progress=False)
     >>> r = periodicity(run.events)
     >>> r.period_slips, r.settled_from_slip
@@ -298,7 +298,7 @@ class PeriodicStop(Hook):
     Examples
     --------
     >>> import stickslip
-    >>> from stickslip.analysis.periodicity import PeriodicStop
+    >>> from stickslip.analysis.stats.periodicity import PeriodicStop
     >>> hook = PeriodicStop()
     >>> run = stickslip.run_chain(stickslip.chain_params(N=5), 1e7, hooks=[hook], progress=False)
     >>> hook.result.period_slips, hook.result.settled_from_slip, run.summary["t_reached"] < 1e7

@@ -28,7 +28,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from stickslip.analysis.benettin import remove_flow
+from stickslip.analysis.dynamics.benettin import remove_flow
 from stickslip.models.params import ChainParams, ParameterError, check_number
 
 
@@ -108,7 +108,7 @@ def finite_size_exponents(
     max_cycle_time: float = math.inf,
     pooled_below: float | None = None,
 ) -> FSLEResult:
-    """lambda(delta) of :mod:`this module <stickslip.analysis.fsle>` from ``cycles`` cycles of ``pair``.
+    """lambda(delta) of :mod:`this module <stickslip.analysis.dynamics.fsle>` from ``cycles`` cycles of ``pair``.
 
     The distance is read every ``check_steps`` steps and the crossing times interpolated in
     ln d; the first ``discard`` cycles (the separation turning into the growing direction) are
@@ -188,12 +188,12 @@ def pooled_rate(deltas: np.ndarray, cross_totals: np.ndarray) -> tuple[float, fl
 class LocatedPair:
     """Reference and twin of a model of the family on the located integrator (a :class:`Pair`).
 
-    Distances as in :mod:`stickslip.analysis.lyapunov_flow` (y coordinates, the component along
+    Distances as in :mod:`stickslip.analysis.dynamics.lyapunov_flow` (y coordinates, the component along
     the flow removed with ``neutral='remove'``); the twin is rebuilt on the reference's branch.
     """
 
     def __init__(self, params: ChainParams, ref, *, neutral: str = "remove", direction_seed: int = 0):
-        from stickslip.analysis.lyapunov_flow import LocatedEngine
+        from stickslip.analysis.dynamics.lyapunov_flow import LocatedEngine
 
         self.params = params
         self.dt = params.dt

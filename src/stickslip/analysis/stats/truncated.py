@@ -4,7 +4,7 @@ proportional to exp(e u) with e = 1 - tau: its mean, variance and normaliser wri
 finite for any e and span, and the maximum-likelihood exponent.
 
 The doubly truncated Gutenberg-Richter law of the magnitudes M = (2/3) log10 S
-(:mod:`stickslip.analysis.magnitudes`) is the same law: M - m_min = u / (1.5 ln 10), exponential
+(:mod:`stickslip.analysis.stats.magnitudes`) is the same law: M - m_min = u / (1.5 ln 10), exponential
 with rate b ln 10 where -e = (tau - 1) = b / 1.5. Both fits solve their likelihood equation here,
 so they agree: b = (3/2)(tau - 1).
 """

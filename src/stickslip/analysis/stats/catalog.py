@@ -2,16 +2,16 @@
 
 :func:`slip_catalog` turns the events of a chain run (eq. 4, or any model of its family) into a
 catalogue: per slip its start time, duration, size S, magnitude M = (2/3) log10 S
-(:mod:`stickslip.analysis.magnitudes`), epicentre (the block that moved first), extent (the
+(:mod:`stickslip.analysis.stats.magnitudes`), epicentre (the block that moved first), extent (the
 blocks that moved), reach (the farthest block) and whether it spans the system
-(:func:`stickslip.analysis.chain_runs.spanning_column`), over the stationary window of
-:func:`stickslip.analysis.chain_runs.stationary_from` that ``plot`` and ``reproduce`` use too.
+(:func:`stickslip.analysis.stats.chain_runs.spanning_column`), over the stationary window of
+:func:`stickslip.analysis.stats.chain_runs.stationary_from` that ``plot`` and ``reproduce`` use too.
 
 :func:`catalog_analysis` adds what is read from such a catalogue: the frequency-magnitude
 statistics (b-value, completeness, doubly truncated Gutenberg-Richter, the size exponent tau of
 Figs. 7, 8 and the relation b = (3/2)(tau - 1)), which distribution the sizes follow
-(:mod:`stickslip.analysis.model_comparison`), the recurrence of all and of system-spanning slips
-(:mod:`stickslip.analysis.recurrence`) and the moment rate of the largest events whose
+(:mod:`stickslip.analysis.stats.model_comparison`), the recurrence of all and of system-spanning slips
+(:mod:`stickslip.analysis.stats.recurrence`) and the moment rate of the largest events whose
 displacement profiles the run kept. Every part that cannot be computed says why instead.
 """
 
@@ -25,10 +25,10 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from stickslip.analysis import magnitudes as mg
-from stickslip.analysis.chain_runs import run_size_statistics, spanning_column, stationary_events, stationary_from
-from stickslip.analysis.model_comparison import compare_distributions, power_law_gof
-from stickslip.analysis.recurrence import recurrence
+from stickslip.analysis.stats import magnitudes as mg
+from stickslip.analysis.stats.chain_runs import run_size_statistics, spanning_column, stationary_events, stationary_from
+from stickslip.analysis.stats.model_comparison import compare_distributions, power_law_gof
+from stickslip.analysis.stats.recurrence import recurrence
 from stickslip.models.params import ParameterError, check_number
 
 __all__ = [
@@ -254,7 +254,7 @@ class Catalog:
     summary : dict
         Every number read from it, JSON-able.
     size_fits : dict
-        The Figs. 7/8 statistics (:func:`~stickslip.analysis.chain_runs.run_size_statistics`) by
+        The Figs. 7/8 statistics (:func:`~stickslip.analysis.stats.chain_runs.run_size_statistics`) by
         reading ("whole range", "below spanning").
     candidates : dict
         The fitted candidate densities of the sizes.

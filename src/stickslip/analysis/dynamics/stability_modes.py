@@ -12,8 +12,8 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from stickslip.analysis.jacobian import chain_jacobian
-from stickslip.analysis.linear import GROWTH_TOL, _sorted_by_real_part, finite_chain_wavenumbers, lattice_q
+from stickslip.analysis.dynamics.jacobian import chain_jacobian
+from stickslip.analysis.dynamics.linear import GROWTH_TOL, _sorted_by_real_part, finite_chain_wavenumbers, lattice_q
 from stickslip.models import physics, pieces
 from stickslip.models.params import ChainParams
 
@@ -108,7 +108,7 @@ def mode_growth_rates(p: ChainParams) -> pd.DataFrame:
 def chain_jacobian_2n(p: ChainParams) -> np.ndarray:
     """The 2N x 2N matrix of the linearised chain without state variable, variables (dx, dv):
     dv' = K L dx - Kp dx [plate] - phi'(V) dv with L the spring Laplacian under the model's ends.
-    The one builder assembled from the pieces, :func:`stickslip.analysis.jacobian.chain_jacobian`,
+    The one builder assembled from the pieces, :func:`stickslip.analysis.dynamics.jacobian.chain_jacobian`,
     which this is (built from the ends directly, not from :func:`normal_modes`)."""
     if p.friction_piece.has_state:
         raise ValueError(f"friction {p.friction} has a state variable: use chain_jacobian (eq. 5)")

@@ -11,8 +11,8 @@ What the loop needs of an integrator is :class:`TwoTrajectoryEngine`: advance bo
 the separation in the coordinates of the norm, a twin built along a direction, the projection
 onto the reference's branch (no velocity on a stuck block), whether both have the same blocks
 stuck, and, optionally, a neutral direction whose component is removed before measuring (the
-flow's shift in time). :class:`stickslip.analysis.lyapunov.GridEngine` is the engine's map
-(starts and stops on the time grid); :class:`stickslip.analysis.lyapunov_flow.LocatedEngine` the
+flow's shift in time). :class:`stickslip.analysis.dynamics.lyapunov.GridEngine` is the engine's map
+(starts and stops on the time grid); :class:`stickslip.analysis.dynamics.lyapunov_flow.LocatedEngine` the
 equations with located switches. Both give a :class:`LyapunovResult`.
 """
 

@@ -83,7 +83,7 @@ def integrated_time(x: np.ndarray, *, c: float = 6.0) -> float:
     Examples
     --------
     >>> import numpy as np
-    >>> from stickslip.analysis.order import integrated_time
+    >>> from stickslip.analysis.stats.order import integrated_time
     >>> float(integrated_time(np.random.default_rng(0).normal(size=20000))) < 0.6  # white noise
     True
     """
@@ -322,7 +322,7 @@ def transition_bracket(betas, states) -> dict[str, Any]:
 
     Examples
     --------
-    >>> from stickslip.analysis.order import transition_bracket
+    >>> from stickslip.analysis.stats.order import transition_bracket
     >>> b = transition_bracket([0.9, 1.0, 1.1, 1.2], ["stick-slip", "stick-slip", "undecided", "steady"])
     >>> b["lo"], b["hi"], b["undecided"]
     (1.0, 1.2, [1.1])
@@ -376,7 +376,7 @@ def power_law_fit(x, y, yerr=None) -> dict[str, float]:
     Examples
     --------
     >>> import numpy as np
-    >>> from stickslip.analysis.order import power_law_fit
+    >>> from stickslip.analysis.stats.order import power_law_fit
     >>> fit = power_law_fit([10, 100, 1000], 2.0 * np.array([10, 100, 1000]) ** -0.5)
     >>> round(fit["b"], 12), round(fit["A"], 12)
     (-0.5, 2.0)
@@ -520,7 +520,7 @@ def order_summary(run, params, t_from: float) -> dict[str, Any]:
 
 def time_average(series: xr.DataArray, t_from: float | None = None, *, n_batches: int = 10) -> TimeAverage:
     """<L>, the time average of L(t) = x_1 - x_N (or any series on coordinate ``t``) for Fig. 5b,
-    with its error from batch means (:func:`stickslip.analysis.order.batch_means`; the samples left
+    with its error from batch means (:func:`stickslip.analysis.stats.order.batch_means`; the samples left
     over are dropped at the start).
 
     Parameters

@@ -69,7 +69,7 @@ def kaplan_meier(times: Any, ended: Any, *, confidence: float = 0.95) -> pd.Data
 
     Examples
     --------
-    >>> from stickslip.analysis.survival import kaplan_meier
+    >>> from stickslip.analysis.stats.survival import kaplan_meier
     >>> km = kaplan_meier([1.0, 2.0, 3.0, 4.0], [True, False, True, True])
     >>> km["survival"].round(4).tolist()
     [0.75, 0.75, 0.375, 0.0]
@@ -193,7 +193,7 @@ def exponential_fit(times: Any, ended: Any, *, t_from: float = 0.0) -> Exponenti
 
     Examples
     --------
-    >>> from stickslip.analysis.survival import exponential_fit
+    >>> from stickslip.analysis.stats.survival import exponential_fit
     >>> fit = exponential_fit([1.0, 2.0, 3.0, 10.0], [True, True, True, False])
     >>> fit.ended, fit.exposure, fit.rate, fit.tau
     (3, 16.0, 0.1875, 5.333333333333333)
@@ -237,7 +237,7 @@ def line_fit(x: Any, y: Any, y_err: Any) -> dict[str, Any]:
 
     Examples
     --------
-    >>> from stickslip.analysis.survival import line_fit
+    >>> from stickslip.analysis.stats.survival import line_fit
     >>> f = line_fit([0.0, 1.0, 2.0], [1.0, 3.0, 5.0], [0.1, 0.1, 0.1])
     >>> round(f["slope"], 12), round(f["intercept"], 12), round(f["chi2"], 12)
     (2.0, 1.0, 0.0)
@@ -303,7 +303,7 @@ def size_fits(N: Any, mean: Any, mean_err: Any, *, extrapolate_to: float | None 
     --------
     >>> import math
     >>> import numpy as np
-    >>> from stickslip.analysis.survival import size_fits
+    >>> from stickslip.analysis.stats.survival import size_fits
     >>> N = np.array([3.0, 5.0, 7.0, 9.0])
     >>> f = size_fits(N, 10 * np.exp(0.5 * N), np.exp(0.5 * N), extrapolate_to=11)
     >>> round(f["exponential"]["slope"], 9), f["better"], round(f["exponential"]["T_at"] / (10 * math.exp(5.5)), 9)

@@ -23,7 +23,7 @@ discrete Laplacians into -q with q = 2 (1 - cos k); its 3 x 3 mode matrix gives 
 k -> 0 one eigenvalue vanishes like -K k^2 / (beta - alpha), so long waves are unstable
 exactly for beta < alpha, independent of K, D and V (the derivation is in docs/stability.md).
 The finite chain with the ends of docs/model.md has a 3N x 3N matrix, :func:`chain_jacobian`
-(:mod:`stickslip.analysis.jacobian`, assembled from the pieces).
+(:mod:`stickslip.analysis.dynamics.jacobian`, assembled from the pieces).
 Both read the friction law's linearisation (:class:`~stickslip.models.piece.Linearisation`), so a
 law with a state variable other than eq. (4)'s (rate-and-state) gets its mode matrices, finite
 Jacobian and critical spring constant (:func:`critical_stiffness`) from the same code.
@@ -43,11 +43,11 @@ import pandas as pd
 import xarray as xr
 from scipy.optimize import brentq
 
-from stickslip.analysis.jacobian import chain_jacobian  # noqa: F401  (the one builder, from the pieces)
-from stickslip.analysis.linear import GROWTH_TOL, _sorted_by_real_part, finite_chain_wavenumbers, lattice_q
+from stickslip.analysis.dynamics.jacobian import chain_jacobian  # noqa: F401  (the one builder, from the pieces)
+from stickslip.analysis.dynamics.linear import GROWTH_TOL, _sorted_by_real_part, finite_chain_wavenumbers, lattice_q
 
 # The relatives without a state variable live in stability_modes; their names stay importable here.
-from stickslip.analysis.stability_modes import (  # noqa: F401
+from stickslip.analysis.dynamics.stability_modes import (  # noqa: F401
     ModeStability,
     chain_jacobian_2n,
     friction_slope,
@@ -463,7 +463,7 @@ def chain_finite_eigenvalues(p: ChainParams) -> np.ndarray:
     Examples
     --------
     >>> from stickslip import chain_params
-    >>> from stickslip.analysis.stability import chain_finite_eigenvalues
+    >>> from stickslip.analysis.dynamics.stability import chain_finite_eigenvalues
     >>> bool(chain_finite_eigenvalues(chain_params(N=9, beta=1.2))[0].real < 0)
     True
     """
@@ -493,7 +493,7 @@ def critical_stiffness(p: ChainParams) -> float:
     Examples
     --------
     >>> from stickslip import chain_params
-    >>> from stickslip.analysis.stability import critical_stiffness
+    >>> from stickslip.analysis.dynamics.stability import critical_stiffness
     >>> round(critical_stiffness(chain_params(friction="rate-state", N=1)), 9)
     25.5
     """

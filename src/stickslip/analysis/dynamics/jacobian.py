@@ -20,8 +20,8 @@ where each piece gives its part:
 
 M_i is the block's mass where the parameters carry one (``M``), else 1. For eq. (4) this is the
 3N x 3N matrix of eq. (5) with the ends of docs/model.md; for a uniform chain its eigenvalues are
-the Fourier modes' (:func:`stickslip.analysis.stability.chain_mode_matrix`, Fig. 4, and
-:func:`stickslip.analysis.stability_modes.mode_roots`) where the modes diagonalise it.
+the Fourier modes' (:func:`stickslip.analysis.dynamics.stability.chain_mode_matrix`, Fig. 4, and
+:func:`stickslip.analysis.dynamics.stability_modes.mode_roots`) where the modes diagonalise it.
 """
 
 from __future__ import annotations
@@ -81,7 +81,7 @@ def chain_jacobian(p: Any) -> np.ndarray:
     Examples
     --------
     >>> from stickslip import chain_params
-    >>> from stickslip.analysis.jacobian import chain_jacobian
+    >>> from stickslip.analysis.dynamics.jacobian import chain_jacobian
     >>> chain_jacobian(chain_params(N=3)).shape
     (9, 9)
     >>> chain_jacobian(chain_params("train", N=3)).shape

@@ -149,7 +149,7 @@ def solve_slip_limit(
     Examples
     --------
     >>> from stickslip import BlockParams
-    >>> from stickslip.analysis.slip_limit import solve_slip_limit
+    >>> from stickslip.analysis.dynamics.slip_limit import solve_slip_limit
     >>> law = solve_slip_limit(BlockParams(), dense=False)
     >>> print(f"T(V) = {law.law_a:.3f} + {law.law_b:.3f} / (K V)")  # the paper: 1.035 + 3.432 / (K V)
     T(V) = 1.037 + 3.432 / (K V)

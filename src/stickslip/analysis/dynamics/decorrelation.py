@@ -1,7 +1,7 @@
 """Decorrelation of slip sequences, and the verdict chaotic / stable chaos / regular.
 
 A reference and a twin start from one state: the twin moved by delta along a fixed direction
-(y coordinates of :mod:`stickslip.analysis.lyapunov`, on the reference's branch), or run with
+(y coordinates of :mod:`stickslip.analysis.dynamics.lyapunov`, on the reference's branch), or run with
 Fs or V changed by delta (relative). Their slips are compared in order, with the engine's map
 (:class:`GridSequences`, :func:`stickslip.run.driver.run_chain`) or the equations with located
 switches (:class:`LocatedSequences`). The k-th slips disagree when they start at different
@@ -13,7 +13,7 @@ leaves that to the slip's identity (docs/lyapunov.md). n(delta), the slips that 
 first disagreement, is what :func:`sequence_decorrelation` measures. A chaotic flow (largest
 exponent lambda > 0) gives n ~ ln(1/delta) / (lambda T) with T the mean time between slips,
 whatever delta; a finite-amplitude instability decorrelates the sequence only above a threshold
-delta* (:mod:`stickslip.analysis.threshold`), below which the slips stay the same.
+delta* (:mod:`stickslip.analysis.dynamics.threshold`), below which the slips stay the same.
 
 :func:`verdict` turns the flow's exponent with its error and the state's n(delta) over windows of
 slips into one of :data:`VERDICTS`: ``chaotic`` (a positive exponent), ``stable chaos`` (no
@@ -123,15 +123,15 @@ class GridSequences:
     def prepare(self, state):
         """The start state with the clock restarted (positions relative to the drive kept), so
         that a twin with another V starts from the same forces; fixed ends read t and keep it."""
-        from stickslip.analysis.lyapunov import moved_back
+        from stickslip.analysis.dynamics.lyapunov import moved_back
 
         if self.params.ends_piece.wall or state.step == 0:
             return state.copy()
         return moved_back(state, state.step, self.params)
 
     def twin(self, params: ChainParams, state, direction: np.ndarray, delta: float):
-        """``state`` moved by delta along ``direction`` (y, :func:`stickslip.analysis.lyapunov.twin_state`)."""
-        from stickslip.analysis.lyapunov import twin_state
+        """``state`` moved by delta along ``direction`` (y, :func:`stickslip.analysis.dynamics.lyapunov.twin_state`)."""
+        from stickslip.analysis.dynamics.lyapunov import twin_state
 
         out = twin_state(state, direction, delta, params)
         out.model = state.model
@@ -166,8 +166,9 @@ class LocatedSequences:
         return state.copy()
 
     def twin(self, params: ChainParams, state, direction: np.ndarray, delta: float):
-        """``state`` moved by delta along ``direction`` (:func:`stickslip.analysis.lyapunov_flow.twin_state`)."""
-        from stickslip.analysis.lyapunov_flow import twin_state
+        """``state`` moved by delta along ``direction``
+        (:func:`stickslip.analysis.dynamics.lyapunov_flow.twin_state`)."""
+        from stickslip.analysis.dynamics.lyapunov_flow import twin_state
 
         return twin_state(state, direction, delta, params)
 
@@ -378,7 +379,7 @@ def event_decorrelation(
     direction_seed: int = 0,
     chunk: float | None = None,
 ) -> Decorrelation:
-    """n(delta) of :mod:`this module <stickslip.analysis.decorrelation>` over a window of time,
+    """n(delta) of :mod:`this module <stickslip.analysis.dynamics.decorrelation>` over a window of time,
     with located switches: :func:`sequence_decorrelation` with :class:`LocatedSequences`.
 
     ``start`` is a :class:`~stickslip.run.located.LocatedState` (or anything
@@ -421,7 +422,7 @@ class Verdict:
     ``label``: one of :data:`VERDICTS`; ``text``: the label with what it holds for (the window of
     slips, the deltas); ``window``: slips compared per window (the smallest over the windows);
     ``delta_min``, ``delta_max``: the smallest and largest delta tested; ``threshold``: the bracket
-    (``below``, ``low``] of :func:`stickslip.analysis.threshold.delta_star` where some window
+    (``below``, ``low``] of :func:`stickslip.analysis.dynamics.threshold.delta_star` where some window
     decorrelated; ``windows_decorrelated``, ``windows``: how many windows decorrelated at some delta.
     """
 
@@ -467,7 +468,7 @@ def verdict(lyapunov, lyapunov_err, rows, *, window: int | None, sigmas: float =
     - ``regular``: the exponent not above ``sigmas`` errors and no window decorrelated at any
       delta: regular over ``window`` slips for delta up to the largest tested, and only so.
     """
-    from stickslip.analysis.threshold import delta_star
+    from stickslip.analysis.dynamics.threshold import delta_star
 
     rows = [r for r in rows if float(r["delta"]) > 0.0]
     if not rows:

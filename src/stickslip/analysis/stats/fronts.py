@@ -2,7 +2,7 @@
 
 Blocks are numbered 1..N (docs/model.md); the functions take the labelled tables of a chain run
 (``events``, ``first_move``) and return frozen dataclasses. Importable also from
-:mod:`stickslip.analysis.statistics`.
+:mod:`stickslip.analysis.stats.statistics`.
 """
 
 from __future__ import annotations
@@ -104,7 +104,7 @@ def front_speed(
     Examples
     --------
     >>> import pandas as pd
-    >>> from stickslip.analysis.statistics import front_speed
+    >>> from stickslip.analysis.stats.statistics import front_speed
     >>> fm = pd.DataFrame({"event": 0, "block": range(1, 21), "t_first": [i / 1.43 for i in range(1, 21)]})
     >>> round(front_speed(fm, 0).speed, 9), front_speed(fm, 0).i_min
     (1.43, 10)
@@ -325,7 +325,7 @@ def central_interval(sample: Any, value: float, *, level: float = 0.9) -> Centra
 
     Examples
     --------
-    >>> from stickslip.analysis.statistics import central_interval
+    >>> from stickslip.analysis.stats.statistics import central_interval
     >>> c = central_interval(range(1, 101), 50.5)
     >>> c.inside, c.percentile
     (True, 50.0)

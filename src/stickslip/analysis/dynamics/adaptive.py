@@ -7,11 +7,11 @@ samples so far and says whether the point may stop. Three pieces:
   error rule (MSER, White 1997; MSER-5: on means of 5 samples): the cut d minimises
   var(x[d:]) / (n - d)^2 over the first half of the series, so a drift at the start is cut
   exactly as long as it raises the error of the mean more than the lost samples do;
-* the order parameter m = 1 - <L>/L_ss (:mod:`stickslip.analysis.order`) and the second order
+* the order parameter m = 1 - <L>/L_ss (:mod:`stickslip.analysis.stats.order`) and the second order
   parameter, the time-averaged fraction of stuck blocks ``phi = 1 - <n_moving>/N``, which is zero
   in steady sliding by construction (every block moves) and positive in stick-slip;
 * the stop rule: the batch-means error of m below a target with at least :data:`STOP_BATCHES`
-  batches of :data:`~stickslip.analysis.order.BATCH_TAUS` tau_int each. Sixteen, not the eight
+  batches of :data:`~stickslip.analysis.stats.order.BATCH_TAUS` tau_int each. Sixteen, not the eight
   that make an estimate ``reliable``: in stick-slip the largest events come about once per loading
   time, and a window of about one loading time underestimates both tau_int and the spread of the
   batch means. At N = 99, beta = 0.8 a stop at 8 batches gave m = 0.122 +- 0.006 after 1.8
@@ -28,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from stickslip.analysis.order import MeanEstimate, mean_with_error
+from stickslip.analysis.stats.order import MeanEstimate, mean_with_error
 
 __all__ = ["mser_cut", "Assessment", "assess", "run_rung", "STUCK_SLIDING", "STOP_BATCHES"]
 
@@ -61,7 +61,7 @@ def mser_cut(x: np.ndarray, block: int = MSER_BLOCK) -> int:
     Examples
     --------
     >>> import numpy as np
-    >>> from stickslip.analysis.adaptive import mser_cut
+    >>> from stickslip.analysis.dynamics.adaptive import mser_cut
     >>> mser_cut(np.concatenate([np.linspace(10.0, 0.0, 50), np.zeros(450)]))
     50
     """
@@ -88,7 +88,7 @@ class Assessment:
     ----------
     m : MeanEstimate
         The order parameter m over the kept window with its batch-means error
-        (:func:`stickslip.analysis.order.mean_with_error`).
+        (:func:`stickslip.analysis.stats.order.mean_with_error`).
     phi : MeanEstimate
         The stuck fraction phi over the kept window, likewise.
     t_cut : float

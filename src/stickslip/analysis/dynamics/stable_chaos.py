@@ -1,7 +1,7 @@
 """Two further tests of stable chaos (Politi and Torcini, arXiv 0902.2545, sections 3 and 5).
 
 In stable chaos the largest Lyapunov exponent is negative or zero, yet the motion is irregular.
-Two signatures besides the decorrelation of :mod:`stickslip.analysis.decorrelation`:
+Two signatures besides the decorrelation of :mod:`stickslip.analysis.dynamics.decorrelation`:
 
 * **Finite perturbations propagate faster than infinitesimal ones.** A perturbation put on one
   block spreads along the chain; its front is the farthest block whose difference from the
@@ -71,7 +71,7 @@ def front_position(diff: np.ndarray, block: int, threshold: float) -> int:
     Examples
     --------
     >>> import numpy as np
-    >>> from stickslip.analysis.stable_chaos import front_position
+    >>> from stickslip.analysis.dynamics.stable_chaos import front_position
     >>> front_position(np.array([1.0, 0.5, 0.2, 0.0]), 0, 0.3)
     2
     """

@@ -20,7 +20,7 @@ completeness test of Wiemer and Wyss (2000) are one-line formulas that no librar
 package's dependencies provides (scipy has no b-value; ``scipy.stats.bootstrap`` resamples the
 estimate for the bootstrap error). The doubly truncated Gutenberg-Richter fit solves the
 likelihood equation of the truncated exponential (``scipy.stats.truncexpon`` for b > 0) with the
-power-law fit's solver (:mod:`stickslip.analysis.truncated`), so that the two agree.
+power-law fit's solver (:mod:`stickslip.analysis.stats.truncated`), so that the two agree.
 """
 
 from __future__ import annotations
@@ -32,7 +32,7 @@ from typing import Any
 import numpy as np
 from scipy import stats
 
-from stickslip.analysis.truncated import TAU_BRACKET, fit_failure, truncated_mle, var_log_ratio
+from stickslip.analysis.stats.truncated import TAU_BRACKET, fit_failure, truncated_mle, var_log_ratio
 
 __all__ = [
     "magnitude",
@@ -73,7 +73,7 @@ def magnitude(S: Any) -> np.ndarray:
 
     Examples
     --------
-    >>> from stickslip.analysis.magnitudes import magnitude
+    >>> from stickslip.analysis.stats.magnitudes import magnitude
     >>> magnitude([1.0, 1000.0]).tolist()
     [0.0, 2.0]
     """
@@ -113,7 +113,7 @@ def b_from_tau(tau: float) -> float:
 
     Examples
     --------
-    >>> from stickslip.analysis.magnitudes import b_from_tau, tau_from_b
+    >>> from stickslip.analysis.stats.magnitudes import b_from_tau, tau_from_b
     >>> b_from_tau(1.5), tau_from_b(0.75)
     (0.75, 1.5)
     """
@@ -427,9 +427,9 @@ def truncated_gr_fit(M: Any, m_min: float, m_max: float | None = None) -> Trunca
     W = m_max - m_min (``scipy.stats.truncexpon`` for beta > 0; beta <= 0 is a flat or growing
     density). The likelihood is concave in beta and its maximum solves E_beta[u] = mean(u). For
     M = (2/3) log10 S this is the power law in S truncated to [S(m_min), S(m_max)] with
-    tau = 1 + (2/3) b, the model of :func:`stickslip.analysis.statistics.fit_power_law`: the
+    tau = 1 + (2/3) b, the model of :func:`stickslip.analysis.stats.statistics.fit_power_law`: the
     equation is solved in those units (u 1.5 ln 10 = log(S / s_min)) by the same bracketed,
-    checked root (:func:`stickslip.analysis.truncated.truncated_mle`), so the two fits agree.
+    checked root (:func:`stickslip.analysis.stats.truncated.truncated_mle`), so the two fits agree.
 
     Parameters
     ----------
@@ -449,7 +449,7 @@ def truncated_gr_fit(M: Any, m_min: float, m_max: float | None = None) -> Trunca
     ------
     ValueError
         With fewer than 2 magnitudes in range, or where the likelihood has no maximum with tau in
-        :data:`~stickslip.analysis.truncated.TAU_BRACKET` (the message says why): the fit is then
+        :data:`~stickslip.analysis.stats.truncated.TAU_BRACKET` (the message says why): the fit is then
         left out, not reported.
     """
     M = np.asarray(M, dtype=np.float64)

@@ -2,7 +2,7 @@
 
 The discrete Laplacian on exp(i k j) has the eigenvalue -q, q = 4 sin^2(k/2) (eq. 5, Fig. 4);
 the finite chain's sine modes are those of docs/model.md's ends. Used by
-:mod:`stickslip.analysis.stability` (eq. 2, eq. 5) and :mod:`stickslip.analysis.stability_modes`.
+:mod:`stickslip.analysis.dynamics.stability` (eq. 2, eq. 5) and :mod:`stickslip.analysis.dynamics.stability_modes`.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """Analysis of chain runs: slip-size statistics (Figs. 7, 8); rupture fronts (Fig. 6) and time
-averages (Fig. 5b) are importable here from :mod:`~stickslip.analysis.fronts` and
-:mod:`~stickslip.analysis.order`. A slip's size is S = sum_i (x_i(end) - x_i(start)) (docs/model.md).
+averages (Fig. 5b) are importable here from :mod:`~stickslip.analysis.stats.fronts` and
+:mod:`~stickslip.analysis.stats.order`. A slip's size is S = sum_i (x_i(end) - x_i(start)) (docs/model.md).
 
 Power-law fit. The paper quotes p(S) ~ S^-tau with tau about 1.5 at beta = 1 (Fig. 7) and
 about 1.6 for small S at beta = 0.2 (Fig. 8). A finite chain cuts the distribution off near
@@ -35,7 +35,7 @@ import pandas as pd
 import xarray as xr
 from scipy import stats
 
-from stickslip.analysis.fronts import (
+from stickslip.analysis.stats.fronts import (
     CentralInterval,
     EdgeSpeed,
     FrontSpeed,
@@ -47,8 +47,8 @@ from stickslip.analysis.fronts import (
 
 # Rupture fronts (Fig. 6) live in fronts, time averages (Fig. 5b) in order; their names stay
 # importable here.
-from stickslip.analysis.order import TimeAverage, time_average
-from stickslip.analysis.truncated import TAU_BRACKET, fit_failure, log_normaliser, truncated_mle, var_log_ratio
+from stickslip.analysis.stats.order import TimeAverage, time_average
+from stickslip.analysis.stats.truncated import TAU_BRACKET, fit_failure, log_normaliser, truncated_mle, var_log_ratio
 
 __all__ = [
     "size_distribution",
@@ -112,7 +112,7 @@ def size_distribution(
 
     Examples
     --------
-    >>> from stickslip.analysis.statistics import size_distribution
+    >>> from stickslip.analysis.stats.statistics import size_distribution
     >>> d = size_distribution([1.0, 2.0, 4.0, 8.0, -1.0], bins=[1.0, 4.0, 16.0])
     >>> d["count"].values.tolist(), d.attrs["n_dropped"], float((d["density"] * d["width"]).sum())
     ([2, 2], 1, 1.0)
@@ -269,7 +269,7 @@ def truncated_power_law_pdf(s: Any, tau: float, s_min: float, s_max: float = mat
 
     Examples
     --------
-    >>> from stickslip.analysis.statistics import truncated_power_law_pdf
+    >>> from stickslip.analysis.stats.statistics import truncated_power_law_pdf
     >>> truncated_power_law_pdf([0.5, 1.0, 4.0], 2.0, 1.0).tolist()  # S^-2 on [1, inf)
     [0.0, 1.0, 0.0625]
     """
@@ -453,13 +453,13 @@ def fit_power_law(
     ------
     ValueError
         With fewer than 2 events in range, or where the likelihood has no maximum with tau in
-        :data:`~stickslip.analysis.truncated.TAU_BRACKET` (the message says which): such a fit
+        :data:`~stickslip.analysis.stats.truncated.TAU_BRACKET` (the message says which): such a fit
         is left out, not reported.
 
     Examples
     --------
     >>> import numpy as np
-    >>> from stickslip.analysis.statistics import fit_power_law
+    >>> from stickslip.analysis.stats.statistics import fit_power_law
     >>> u = np.random.default_rng(1).uniform(size=5000)
     >>> S = (1.0 - u * (1.0 - 1e3 ** -0.5)) ** -2.0  # p(S) ~ S^-1.5 on [1, 1000]
     >>> fit = fit_power_law(S, s_min=1.0, s_max=1e3, bootstrap=0)

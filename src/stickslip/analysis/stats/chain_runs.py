@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from stickslip.analysis.statistics import (
+from stickslip.analysis.stats.statistics import (
     choose_s_min,
     fit_power_law,
     front_speed,
@@ -26,7 +26,7 @@ from stickslip.models.params import ChainParams
 from stickslip.models.physics import chain_steady_length
 from stickslip.run.state import steady_deviation
 
-# choose_s_min lives in stickslip.analysis.statistics; the name is kept importable from here.
+# choose_s_min lives in stickslip.analysis.stats.statistics; the name is kept importable from here.
 __all__ = [
     "stationary_from",
     "stationary_events",
@@ -129,7 +129,7 @@ def run_size_statistics(run, *, small_only: bool, seed: int = 0, bootstrap: int 
     -------
     dict
         :func:`size_statistics`'s (``fit``, a
-        :class:`~stickslip.analysis.statistics.PowerLawFit`, the spanning events and the excess of
+        :class:`~stickslip.analysis.stats.statistics.PowerLawFit`, the spanning events and the excess of
         large events) with ``t_from`` (start of the window) and ``spanning``.
 
     Raises
@@ -140,7 +140,7 @@ def run_size_statistics(run, *, small_only: bool, seed: int = 0, bootstrap: int 
     Examples
     --------
     >>> import stickslip
-    >>> from stickslip.analysis.chain_runs import run_size_statistics
+    >>> from stickslip.analysis.stats.chain_runs import run_size_statistics
     >>> run = stickslip.run_chain(stickslip.chain_params(N=12), 6e4)
     >>> fit = run_size_statistics(run, small_only=False, bootstrap=0)["fit"]
     >>> 1.0 < fit.tau < 3.0 and fit.n <= fit.n_total
@@ -234,8 +234,8 @@ def size_statistics(
     The events that span the system set the largest sizes. With ``small_only`` (Fig. 8, "about
     1.6 for small S") the power law is fitted below the smallest spanning event, s_span; otherwise
     (Fig. 7) up to the largest S, with the cut-off in the likelihood. s_min is the default of
-    :func:`~stickslip.analysis.statistics.fit_power_law`
-    (:func:`~stickslip.analysis.statistics.choose_s_min`, least KS distance).
+    :func:`~stickslip.analysis.stats.statistics.fit_power_law`
+    (:func:`~stickslip.analysis.stats.statistics.choose_s_min`, least KS distance).
 
     Parameters
     ----------
@@ -257,7 +257,7 @@ def size_statistics(
     Returns
     -------
     dict
-        ``fit`` (:class:`~stickslip.analysis.statistics.PowerLawFit`), ``n_events``,
+        ``fit`` (:class:`~stickslip.analysis.stats.statistics.PowerLawFit`), ``n_events``,
         ``n_spanning``, ``s_span``, ``S_max``, ``largest_reaches_N``, and ``excess``: the number of
         events with S >= s_span (``observed``) over the number the fitted power law, continued
         without cut-off beyond s_span, predicts for them (``expected``); the paper's "excess of
@@ -305,9 +305,9 @@ def front_speeds(run, N: int, t_from: float) -> pd.DataFrame:
     """Per-event rupture-front speeds of every event after ``t_from`` that reached block N (Fig. 6).
 
     Two definitions side by side: ``c_first_move``, the least-squares slope of block against
-    first-move time over the far half (:func:`~stickslip.analysis.statistics.front_speed`), and
+    first-move time over the far half (:func:`~stickslip.analysis.stats.statistics.front_speed`), and
     ``c_leading_edge``, the slope of the leading edge of the Delta x_i windows against window
-    end (:func:`~stickslip.analysis.statistics.leading_edge_speed`).
+    end (:func:`~stickslip.analysis.stats.statistics.leading_edge_speed`).
 
     Parameters
     ----------
@@ -353,7 +353,7 @@ def front_speeds(run, N: int, t_from: float) -> pd.DataFrame:
 def front_statistics(run, N: int, t_from: float) -> dict[str, Any]:
     """Rupture fronts for Fig. 6: the picked large and intermediate events and all spanning ones.
 
-    The picks (:func:`stickslip.analysis.statistics.pick_front_events`) are made among the events
+    The picks (:func:`stickslip.analysis.stats.statistics.pick_front_events`) are made among the events
     after ``t_from`` whose displacement profiles were stored.
 
     Parameters
@@ -368,7 +368,7 @@ def front_statistics(run, N: int, t_from: float) -> dict[str, Any]:
     Returns
     -------
     dict
-        ``fronts`` (the picks' :class:`~stickslip.analysis.statistics.FrontSpeed`), their
+        ``fronts`` (the picks' :class:`~stickslip.analysis.stats.statistics.FrontSpeed`), their
         ``labels`` and ``edges`` (leading-edge fits, None where there is none), ``picks``,
         ``per_event`` (:func:`front_speeds`), ``speeds`` (its first-move column without NaN),
         ``median_speed`` and ``quartiles`` of them, and ``t_first_span`` (start of the run's

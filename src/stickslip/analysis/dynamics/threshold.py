@@ -1,6 +1,6 @@
 """The finite-amplitude threshold delta* of slip-sequence decorrelation, and how it moves with N.
 
-:func:`stickslip.analysis.decorrelation.sequence_decorrelation` gives n(delta) for a list of
+:func:`stickslip.analysis.dynamics.decorrelation.sequence_decorrelation` gives n(delta) for a list of
 deltas and several windows ("seeds"): the slips that agree before the first disagreement, and
 whether the twin disagreed within the window at all. From those rows:
 
@@ -41,7 +41,7 @@ def delta_star(rows) -> dict[str, Any]:
     ----------
     rows : iterable of dict
         Rows with ``delta``, ``seed`` and ``decorrelated`` (the rows of
-        :class:`~stickslip.analysis.decorrelation.Decorrelation`), every seed with every delta.
+        :class:`~stickslip.analysis.dynamics.decorrelation.Decorrelation`), every seed with every delta.
 
     Returns
     -------
