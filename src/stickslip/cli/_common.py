@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from stickslip.cli._history import add_history_option, take_history
 from stickslip.cli._per_block import add_disorder_seed, may_vary, per_block_arg, seeded
 from stickslip.experiments.studies import MANIFEST, PAPER
 from stickslip.jsonable import to_jsonable
@@ -518,6 +519,7 @@ def add_model_options(parser: argparse.ArgumentParser, helps: dict[str, str] | N
         help="Carlson-Langer's plate velocity nu (sets V; default 0.01 for carlson-langer, two-blocks)",
     )
     add_disorder_seed(group, _number(int, "disorder-seed"))
+    add_history_option(group)
     add_param_options(parser, ChainParams, helps=helps)
 
 
@@ -542,6 +544,7 @@ def chain_params_from_args(args: argparse.Namespace, **overrides: Any):
     for name in ("l", "nu"):
         if getattr(args, f"param_{name}", None) is not None:
             values[name] = getattr(args, f"param_{name}")
+    take_history(args, values)
     model = args.model or "sakaguchi"
     if overrides:
         reads = set(build_chain_params(model, **values).used())
