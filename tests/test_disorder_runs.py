@@ -90,6 +90,11 @@ def test_bench_disordered_reports_both_chains_in_one_run(monkeypatch, capsys):
     for key in ("ratio_to_uniform", "ratio_dense"):
         assert out[key] > 0
     assert out["uniform"]["ns_per_update_exact"] > 0 and out["disordered"]["exact_block_updates"] > 0
+    # the exact runs are timed over ten times t_end: their updates are those of a run that long
+    assert out["disordered"]["exact_t_end"] == 2000.0
+    drawn = {"Fs": Quenched("uniform", 2.5, 3.5, seed=0), "beta": Quenched("normal", 1.0, 0.1, seed=0)}
+    long = run_chain(chain_params(N=6, V=0.01, **drawn), 2000.0, start="paper")
+    assert out["disordered"]["exact_block_updates"] == long.summary["block_updates"]
 
 
 def test_a_chain_without_a_closed_form_steady_state_runs_and_says_so():
