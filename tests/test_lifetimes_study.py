@@ -109,13 +109,23 @@ def test_bad_points_are_refused():
 def test_tiny_lifetimes_study_end_to_end(tmp_path):
     spec = study("lifetimes", "tiny")
     first = run_study(spec, tmp_path, n_workers=1, progress=False)
-    assert first["failed"] == 0 and first["run"] == len(spec.points) == 6
-    rows = first["rows"]
+    # the chain's six starts, one start of two blocks, the exponents of the chain and of two blocks
+    assert first["failed"] == 0 and first["run"] == len(spec.points) == 9
+    rows = [r for r in first["rows"] if r.get("measure") != "exponent"]
+    assert len(rows) == 7
     assert all(r["end"] in ("periodic", "steady", "censored") for r in rows)
     assert all((r["end"] != "censored") == r["ended"] for r in rows)
-    for name in ("survival", "lifetime_vs_N"):
+    for name in ("survival", "lifetime_vs_N", "exponent_vs_N"):
         assert (tmp_path / "lifetimes" / f"{name}.png").is_file()
-    points = first["findings"]["points"]
-    assert sorted((p["beta"], p["N"]) for p in points) == [(1.0, 3), (1.0, 5)]
+    found = first["findings"]
+    assert sorted((p["model"], p["beta"], p["N"]) for p in found["points"]) == [
+        ("sakaguchi", 1.0, 3),
+        ("sakaguchi", 1.0, 5),
+        ("two-blocks", None, 2),
+    ]
+    assert sorted((e["model"], e["N"]) for e in found["exponents"]) == [("sakaguchi", 3), ("two-blocks", 2)]
+    verdicts = {(v["model"], v["N"]): v["verdict"] for v in found["verdicts"]}
+    assert set(verdicts) == {("sakaguchi", 3), ("sakaguchi", 5), ("two-blocks", 2)}
+    assert all(v in ("periodic", "steady", "chaotic", "stable chaos", "undetermined") for v in verdicts.values())
     second = run_study(spec, tmp_path, n_workers=1, progress=False)
-    assert second["run"] == 0 and second["reused"] == 6
+    assert second["run"] == 0 and second["reused"] == 9
