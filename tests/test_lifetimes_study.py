@@ -129,3 +129,48 @@ def test_tiny_lifetimes_study_end_to_end(tmp_path):
     assert all(v in ("periodic", "steady", "chaotic", "stable chaos", "undetermined") for v in verdicts.values())
     second = run_study(spec, tmp_path, n_workers=1, progress=False)
     assert second["run"] == 0 and second["reused"] == 9
+
+
+def _chaos_rows():
+    base = {"seeds": 1, "loaded": True, "flow_slips": 300, "lyapunov_dt0_err": 2e-6}
+    return pd.DataFrame(
+        [
+            {**base, "model": "sakaguchi", "N": 49, "beta": 1.0, "lyapunov_dt0": -1e-6}
+            | {"verdict": "stable chaos", "verdict_text": "stable chaos: text"},
+            {**base, "model": "two-blocks", "N": 2, "beta": float("nan"), "lyapunov_dt0": 0.026}
+            | {"verdict": "chaotic", "verdict_text": "chaotic: text"},
+        ]
+    )
+
+
+def test_the_chaos_study_reports_the_lifetimes_verdicts(tmp_path):
+    from stickslip import io
+    from stickslip.experiments.studies import chaos
+
+    spec = study("chaos", "quick")
+    points_dir = spec.runs_dir(tmp_path) / "points"
+    alone = chaos.conclusions(spec, chaos.load(spec, _chaos_rows(), points_dir))
+    assert alone["lifetimes"]["found"] is False
+    assert any("stickslip study lifetimes" in s for s in alone["statements"])
+    # the lifetimes study's page in the same folder: its verdicts and bounds, its figures
+    table = _table(np.random.default_rng(1))
+    found = lifetimes.conclusions(None, table)
+    page = tmp_path / "lifetimes"
+    page.mkdir()
+    table.to_parquet(page / "table.parquet")
+    io.write_json(page / "study.json", {"meta": {"mode": "quick"}, "findings": found})
+    loaded = chaos.load(spec, _chaos_rows(), points_dir)
+    out = chaos.conclusions(spec, loaded)
+    told = out["lifetimes"]
+    assert told["found"] is True and told["mode"] == "quick"
+    assert sum(len(v) for v in told["verdicts"].values()) == len(found["verdicts"]) == 8
+    by_beta = {f["beta"]: f["T_399_low95"] for f in found["fits"]}
+    assert {b["beta"]: b["T_399_low95"] for b in told["bounds_399"]} == by_beta
+    # the bound is the lesser of the two laws' one-sided 95 % bounds, by hand
+    for f in found["fits"]:
+        low = min(f[k]["log10_T_at"] - 1.6449 * f[k]["log10_T_at_err"] for k in ("exponential", "power"))
+        assert f["T_399_low95"] == pytest.approx(10.0**low)
+    assert any(s.startswith("Extrapolated from the chain's lifetimes") for s in out["statements"])
+    assert out["verdicts"] == {"stable chaos": ["beta = 1 (N = 49)"], "chaotic": ["two blocks (N = 2)"]}
+    names = [name for name, *_ in chaos.figures(spec, loaded, tmp_path / "chaos")]
+    assert names == ["lifetimes_survival", "lifetimes_lifetime_vs_N"]

@@ -330,9 +330,74 @@ def thresholds(table: pd.DataFrame) -> tuple[list[dict[str, Any]], list[dict[str
     return out, fits
 
 
+#: Where the lifetimes study's page lies beside this study's (the same output folder).
+LIFETIMES = "lifetimes"
+
+
+def load(spec: Study, table: pd.DataFrame, points_dir: Path) -> pd.DataFrame:
+    """The table of finished points, with the findings of ``stickslip study lifetimes`` run into
+    the same output folder (its ``study.json``, issue 51) in ``table.attrs['lifetimes']``:
+    ``mode``, ``page``, ``table`` (its table.parquet) and ``findings``; nothing where it was not
+    run there."""
+    from stickslip import io
+
+    out = Path(points_dir).parent.parent.parent  # OUT/runs/<name>-<key>/points
+    page = out / LIFETIMES
+    table = table.copy()
+    if (page / "study.json").is_file() and (page / "table.parquet").is_file():
+        record = io.read_json(page / "study.json")
+        table.attrs["lifetimes"] = {
+            "mode": record["meta"]["mode"],
+            "page": str(page / "index.html"),
+            "table": str(page / "table.parquet"),
+            "findings": record["findings"],
+        }
+    return table
+
+
+def lifetime_findings(lives: dict[str, Any] | None) -> tuple[dict[str, Any], list[str]]:
+    """What the chaos study reports of the lifetimes study (:func:`load`): its revised verdicts
+    (:func:`stickslip.analysis.chaos_verdict.chaos_verdict`) by model, the paper chain's lower
+    bound of <T> at N = 399 per beta, and statements; or, where it was not run into the same
+    folder, how to run it."""
+    if not lives:
+        how = (
+            "The lifetimes of the irregular motion against N, the small-N exponents and the revised verdicts "
+            "(periodic, chaotic, stable chaos) are those of `stickslip study lifetimes` "
+            "(docs/studies/lifetimes.md); run it with the same --out DIR and this study again to report them here."
+        )
+        return {"found": False, "how": how}, [how]
+    found = lives["findings"]
+    by: dict[str, list[str]] = {}
+    for v in found.get("verdicts", []):
+        name = PRESETS[v["model"]].label or v["model"]
+        where = f"{name}, N = {v['N']}" + (f", beta = {v['beta']:g}" if v.get("beta") is not None else "")
+        by.setdefault(v["verdict"], []).append(where)
+    bounds = [
+        {"beta": f["beta"], "T_399_low95": f["T_399_low95"], "Ns": f["Ns"]}
+        for f in found.get("fits", [])
+        if is_paper(f["model"]) and "T_399_low95" in f
+    ]
+    lines = [
+        f"Lifetimes (stickslip study lifetimes --{lives['mode']}, {lives['page']}): "
+        + "; ".join(f"{k} at {', '.join(names)}" for k, names in by.items())
+        + "."
+    ]
+    if bounds:
+        lines.append(
+            "Extrapolated from the chain's lifetimes at small N to the paper's N = 399, if ln <T> grows as N or as "
+            "ln N: "
+            + "; ".join(f"beta = {b['beta']:g}: <T> > {b['T_399_low95']:.3g}" for b in bounds)
+            + " time units, with 95 % confidence (the lesser of the two laws' bounds)."
+        )
+    return {"found": True, "mode": lives["mode"], "page": lives["page"], "verdicts": by, "bounds_399": bounds}, lines
+
+
 def conclusions(spec: Study | None, table: pd.DataFrame) -> dict[str, Any]:
-    """Statements, verdicts, delta* and its fits of a chaos study's rows (module docstring)."""
+    """Statements, verdicts, delta* and its fits of a chaos study's rows (module docstring), and
+    the lifetimes study's verdicts where it ran into the same folder (:func:`lifetime_findings`)."""
     out: dict[str, Any] = {"statements": [], "verdicts": {}, "points": []}
+    out["lifetimes"], lines = lifetime_findings(table.attrs.get("lifetimes"))
     say = out["statements"].append
     rows = table.assign(_chain=table["model"].map(is_paper))
     rows = rows.sort_values(["_chain", "N", "beta"], ascending=[False, True, True])
@@ -384,6 +449,8 @@ def conclusions(spec: Study | None, table: pd.DataFrame) -> dict[str, Any]:
             f"delta* ({kind}) against N = {', '.join(map(str, Ns))}, slope of log10 delta* on log10 N "
             f"with its standard error: {'; '.join(parts)}."
         )
+    for line in lines:
+        say(line)
     return out
 
 
@@ -397,8 +464,9 @@ def figures(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[tuple[str,
     from stickslip import io
     from stickslip.plotting import chaos as pc
 
+    lives = lifetime_figures(table.attrs.get("lifetimes"), page_dir)
     if "point_dir" not in table.columns:
-        return []
+        return lives
     points_dir = spec.runs_dir(Path(page_dir).parent) / "points"
     found = []
     for r in sorted(table.itertuples(), key=lambda r: (0, r.N, r.beta) if is_paper(r.model) else (1, 0, 0.0)):
@@ -441,7 +509,23 @@ def figures(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[tuple[str,
             "line of log10 delta* on log10 N for each beta (dashed, slope in the legend)."
         )
         out.append(("threshold", pc.threshold_figure(points, fits), caption))
-    return out
+    return out + lives
+
+
+def lifetime_figures(lives: dict[str, Any] | None, page_dir: Path) -> list[tuple[str, Any, str]]:
+    """The lifetimes study's figures (survival curves, <T> against N, the exponent against N),
+    drawn again from its table (:func:`load`) as ``lifetimes_*``; none where it was not run."""
+    import pandas as pd
+
+    from stickslip.experiments.studies import lifetimes
+
+    if not lives:
+        return []
+    table = pd.read_parquet(lives["table"])
+    note = f" (from stickslip study lifetimes --{lives['mode']}, {lives['page']})"
+    return [
+        (f"lifetimes_{name}", fig, caption + note) for name, fig, caption in lifetimes.figures(None, table, page_dir)
+    ]
 
 
 #: The wall time of each mode (``stickslip study --help``, the README).
@@ -475,6 +559,7 @@ DESIGN = Design(
     check=check_point,
     findings=conclusions,
     figures=figures,
+    load=load,
     columns=(
         *"model N beta verdict verdict_text lyapunov_dt0 lyapunov_dt0_err flow_slips window".split(),
         *(column for kind in KINDS for column in threshold_columns(kind)),
