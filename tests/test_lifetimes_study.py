@@ -133,6 +133,7 @@ def test_tiny_lifetimes_study_end_to_end(tmp_path):
 
 def _chaos_rows():
     base = {"seeds": 1, "loaded": True, "flow_slips": 300, "lyapunov_dt0_err": 2e-6}
+    base |= {"threshold_below": 1e-4, "threshold_low": 1e-3}
     return pd.DataFrame(
         [
             {**base, "model": "sakaguchi", "N": 49, "beta": 1.0, "lyapunov_dt0": -1e-6}
@@ -172,5 +173,10 @@ def test_the_chaos_study_reports_the_lifetimes_verdicts(tmp_path):
         assert f["T_399_low95"] == pytest.approx(10.0**low)
     assert any(s.startswith("Extrapolated from the chain's lifetimes") for s in out["statements"])
     assert out["verdicts"] == {"stable chaos": ["beta = 1 (N = 49)"], "chaotic": ["two blocks (N = 2)"]}
+    # its own points judged again with the lifetimes' growth at the same beta (b = 0.3 planted)
+    revised = {(v["model"], v["N"]): v for v in told["revised_verdicts"]}
+    assert revised[("sakaguchi", 49)]["verdict"] == "stable chaos"
+    assert "b = 0.29" in revised[("sakaguchi", 49)]["verdict_text"]
+    assert revised[("two-blocks", 2)]["verdict"] == "chaotic"
     names = [name for name, *_ in chaos.figures(spec, loaded, tmp_path / "chaos")]
     assert names == ["lifetimes_survival", "lifetimes_lifetime_vs_N"]

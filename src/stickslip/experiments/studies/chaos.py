@@ -355,11 +355,36 @@ def load(spec: Study, table: pd.DataFrame, points_dir: Path) -> pd.DataFrame:
     return table
 
 
-def lifetime_findings(lives: dict[str, Any] | None) -> tuple[dict[str, Any], list[str]]:
+def revised_verdicts(table: pd.DataFrame, fits: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """The revised verdict (:func:`stickslip.analysis.chaos_verdict.chaos_verdict`) of each of this
+    study's points: its flow exponent at dt -> 0 and the bracket of its threshold, with the growth
+    of lifetimes with N that the lifetimes study measured for the same model and beta at small N
+    (``fits``: the slope b of ln <T> on N); no lifetimes of its own at these N."""
+    from stickslip.analysis.chaos_verdict import chaos_verdict
+
+    growth = {(f["model"], f["beta"]): f["exponential"] for f in fits if "exponential" in f}
+    out = []
+    for _, r in table.iterrows():
+        beta = _value(r.get("beta"))
+        g = growth.get((r["model"], beta))
+        v = chaos_verdict(
+            lyapunov=_value(r.get("lyapunov_dt0")),
+            lyapunov_err=_value(r.get("lyapunov_dt0_err")),
+            threshold=(_value(r.get("threshold_below")), _value(r.get("threshold_low"))),
+            growth=(g["slope"], g["slope_err"]) if g else None,
+        )
+        out.append({"model": r["model"], "N": int(r["N"]), "beta": beta, **v.to_dict()})
+    return out
+
+
+def lifetime_findings(
+    lives: dict[str, Any] | None, table: pd.DataFrame | None = None
+) -> tuple[dict[str, Any], list[str]]:
     """What the chaos study reports of the lifetimes study (:func:`load`): its revised verdicts
     (:func:`stickslip.analysis.chaos_verdict.chaos_verdict`) by model, the paper chain's lower
-    bound of <T> at N = 399 per beta, and statements; or, where it was not run into the same
-    folder, how to run it."""
+    bound of <T> at N = 399 per beta, the revised verdicts of this study's own points
+    (:func:`revised_verdicts`, where ``table`` is given) and statements; or, where it was not run
+    into the same folder, how to run it."""
     if not lives:
         how = (
             "The lifetimes of the irregular motion against N, the small-N exponents and the revised verdicts "
@@ -390,14 +415,26 @@ def lifetime_findings(lives: dict[str, Any] | None) -> tuple[dict[str, Any], lis
             + "; ".join(f"beta = {b['beta']:g}: <T> > {b['T_399_low95']:.3g}" for b in bounds)
             + " time units, with 95 % confidence (the lesser of the two laws' bounds)."
         )
-    return {"found": True, "mode": lives["mode"], "page": lives["page"], "verdicts": by, "bounds_399": bounds}, lines
+    mine = revised_verdicts(table, found.get("fits", [])) if table is not None and len(table) else []
+    if mine:
+        own: dict[str, list[str]] = {}
+        for v in mine:
+            own.setdefault(v["verdict"], []).append(PRESETS[v["model"]].point_label(v["beta"], v["N"]))
+        lines.append(
+            "Revised verdicts of this study's points (their exponent and threshold, with the growth of lifetimes "
+            "with N measured at small N for the same beta): "
+            + "; ".join(f"{k} at {', '.join(names)}" for k, names in own.items())
+            + "."
+        )
+    summary = {"found": True, "mode": lives["mode"], "page": lives["page"], "verdicts": by, "bounds_399": bounds}
+    return {**summary, "revised_verdicts": mine}, lines
 
 
 def conclusions(spec: Study | None, table: pd.DataFrame) -> dict[str, Any]:
     """Statements, verdicts, delta* and its fits of a chaos study's rows (module docstring), and
     the lifetimes study's verdicts where it ran into the same folder (:func:`lifetime_findings`)."""
     out: dict[str, Any] = {"statements": [], "verdicts": {}, "points": []}
-    out["lifetimes"], lines = lifetime_findings(table.attrs.get("lifetimes"))
+    out["lifetimes"], lines = lifetime_findings(table.attrs.get("lifetimes"), table)
     say = out["statements"].append
     rows = table.assign(_chain=table["model"].map(is_paper))
     rows = rows.sort_values(["_chain", "N", "beta"], ascending=[False, True, True])
