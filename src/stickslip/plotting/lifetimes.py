@@ -85,7 +85,15 @@ def lifetime_figure(points: list[dict[str, Any]], fits: list[dict[str, Any]]) ->
                 label=beta,
             )
         if bound:
-            ax.plot([p["N"] for p in bound], [p["mean_T_low95"] for p in bound], "^", color=colour, ms=5, mfc="none")
+            ax.plot(
+                [p["N"] for p in bound],
+                [p["mean_T_low95"] for p in bound],
+                "^",
+                color=colour,
+                ms=5,
+                mfc="none",
+                label=None if seen else f"{beta} (lower bounds)",
+            )
         fit = next((f for f in fits if name(f) == beta and "exponential" in f), None)
         if fit is not None:
             n = np.linspace(min(fit["Ns"]), max(fit["Ns"]), 50)  # over the N fitted only

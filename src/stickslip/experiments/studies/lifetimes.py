@@ -430,14 +430,17 @@ def figures(spec: Study | None, table: pd.DataFrame, page_dir: Path) -> list[tup
     from stickslip.analysis.survival import kaplan_meier
     from stickslip.plotting import lifetimes as pl
 
+    def first(p: dict[str, Any]) -> bool:  # the paper's chain first, then the relatives
+        return not is_paper(p["model"])
+
     curves = []
-    for model, beta, N, g in _groups(_split(table)[0]):
+    for model, beta, N, g in sorted(_groups(_split(table)[0]), key=lambda k: not is_paper(k[0])):
         km = kaplan_meier(g["lifetime"].to_numpy(float), g["ended"].to_numpy(bool))
         curves.append({"panel": label(model, beta), "N": N, "km": km})
     found = conclusions(spec, table)
     out = []
     if curves:
-        series = [{**p, "series": label(p["model"], p["beta"])} for p in found["points"]]
+        series = [{**p, "series": label(p["model"], p["beta"])} for p in sorted(found["points"], key=first)]
         lines = [{**f, "series": label(f["model"], f["beta"])} for f in found["fits"]]
         out += [
             (
@@ -456,7 +459,7 @@ def figures(spec: Study | None, table: pd.DataFrame, page_dir: Path) -> list[tup
             ),
         ]
     if found["exponents"]:
-        rows = [{**e, "panel": PRESETS[e["model"]].label or e["model"]} for e in found["exponents"]]
+        rows = [{**e, "panel": PRESETS[e["model"]].label or e["model"]} for e in sorted(found["exponents"], key=first)]
         out.append(
             (
                 "exponent_vs_N",
