@@ -488,8 +488,8 @@ def tables(findings: dict[str, Any]) -> list[tuple[str, list[str], list[dict[str
 
 
 COST = {
-    "quick": "about 15 minutes on two cores (estimated from the chain's 11 minutes and timed relatives)",
-    "full": "about two hours on two cores (estimated)",
+    "quick": "about 10 minutes on two free cores (estimated; 18 minutes measured in parts on a loaded machine)",
+    "full": "about two hours on two free cores (estimated)",
 }
 
 
