@@ -582,7 +582,9 @@ def describe() -> str:
         f"); --full {full.note.split(': ', 1)[1]} ({len(full.points)} points, {COST['full']})."
         " Outputs in DIR/chaos/: table.parquet and table.csv (one row per point: "
         "verdict, exponent, delta* per kind), decorrelation.csv, decorrelation, flow_ladder and "
-        "threshold (PNG, PDF), study.json, index.html."
+        "threshold (PNG, PDF), study.json, index.html; where `stickslip study lifetimes` ran into the same "
+        "DIR, its verdicts, the lower bounds of <T> at N = 399, the revised verdicts of this study's points "
+        "and the lifetimes' figures (survival curves, <T> against N, exponent against N)."
     )
 
 
