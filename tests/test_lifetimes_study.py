@@ -180,3 +180,33 @@ def test_the_chaos_study_reports_the_lifetimes_verdicts(tmp_path):
     assert revised[("two-blocks", 2)]["verdict"] == "chaotic"
     names = [name for name, *_ in chaos.figures(spec, loaded, tmp_path / "chaos")]
     assert names == ["lifetimes_survival", "lifetimes_lifetime_vs_N"]
+
+
+def test_a_rest_start_is_the_presets_draw_by_hand():
+    # docs/model.md, Carlson-Langer: x_i(0) = -A u_i, u_i = default_rng(seed).random(N), every block stuck
+    params = point_params("chain", {"model": "carlson-langer", "N": 8})
+    state = lifetimes.start_state(params, "rest", 0.01, 4)
+    assert np.array_equal(state.x[1:-1], -0.01 * np.random.default_rng(4).random(8))
+    assert not state.v[1:-1].any()
+
+
+def test_the_relatives_points_are_checked():
+    base = {"model": "carlson-langer", "N": 8, "seed": 0, "budget": 1e3, **_RULE}
+    lifetimes.check_point({**base, "start": "rest"})
+    # the plate loads every block at once: no L_ss / V, so a loaded start needs its load_t
+    with pytest.raises(ParameterError, match="load_t"):
+        lifetimes.check_point({**base, "start": "loaded"})
+    lifetimes.check_point({**base, "start": "loaded", "load_t": 2e3})
+    with pytest.raises(ParameterError, match="measure"):
+        lifetimes.check_point({**base, "start": "rest", "measure": "spectrum"})
+    exp = {"model": "two-blocks", "N": 2, "measure": "exponent", "transient": 100.0, "flow_t": 200.0}
+    with pytest.raises(ParameterError, match="deltas"):
+        lifetimes.check_point({**exp, "events": 10, "windows": 1, "deltas": []})
+
+
+def test_two_blocks_outlast_a_short_budget():
+    # two blocks are chaotic: over 2e3 time units (some 70 slips) a rest start does not settle
+    cfg = {"model": "two-blocks", "N": 2, "start": "rest", "seed": 1, "budget": 2e3, **_RULE, "perturbation": 0.01}
+    row = lifetimes.lifetime_point(cfg, point_params("chain", cfg))
+    assert row["end"] == "censored" and not row["ended"] and row["lifetime"] == pytest.approx(2e3)
+    assert row["slips"] > 30
