@@ -491,7 +491,7 @@ def tables(findings: dict[str, Any]) -> list[tuple[str, list[str], list[dict[str
 
 
 COST = {
-    "quick": "about 10 minutes on two free cores (estimated; 18 minutes measured in parts on a loaded machine)",
+    "quick": "about 10 minutes on two free cores (estimated; 20 minutes measured in parts on a loaded machine)",
     "full": "about two hours on two free cores (estimated)",
 }
 
