@@ -109,13 +109,104 @@ def test_bad_points_are_refused():
 def test_tiny_lifetimes_study_end_to_end(tmp_path):
     spec = study("lifetimes", "tiny")
     first = run_study(spec, tmp_path, n_workers=1, progress=False)
-    assert first["failed"] == 0 and first["run"] == len(spec.points) == 6
-    rows = first["rows"]
+    # the chain's six starts, one start of two blocks, the exponents of the chain and of two blocks
+    assert first["failed"] == 0 and first["run"] == len(spec.points) == 9
+    rows = [r for r in first["rows"] if r.get("measure") != "exponent"]
+    assert len(rows) == 7
     assert all(r["end"] in ("periodic", "steady", "censored") for r in rows)
     assert all((r["end"] != "censored") == r["ended"] for r in rows)
-    for name in ("survival", "lifetime_vs_N"):
+    for name in ("survival", "lifetime_vs_N", "exponent_vs_N"):
         assert (tmp_path / "lifetimes" / f"{name}.png").is_file()
-    points = first["findings"]["points"]
-    assert sorted((p["beta"], p["N"]) for p in points) == [(1.0, 3), (1.0, 5)]
+    found = first["findings"]
+    assert sorted((p["model"], p["beta"], p["N"]) for p in found["points"]) == [
+        ("sakaguchi", 1.0, 3),
+        ("sakaguchi", 1.0, 5),
+        ("two-blocks", None, 2),
+    ]
+    assert sorted((e["model"], e["N"]) for e in found["exponents"]) == [("sakaguchi", 3), ("two-blocks", 2)]
+    verdicts = {(v["model"], v["N"]): v["verdict"] for v in found["verdicts"]}
+    assert set(verdicts) == {("sakaguchi", 3), ("sakaguchi", 5), ("two-blocks", 2)}
+    assert all(v in ("periodic", "steady", "chaotic", "stable chaos", "undetermined") for v in verdicts.values())
     second = run_study(spec, tmp_path, n_workers=1, progress=False)
-    assert second["run"] == 0 and second["reused"] == 6
+    assert second["run"] == 0 and second["reused"] == 9
+
+
+def _chaos_rows():
+    base = {"seeds": 1, "loaded": True, "flow_slips": 300, "lyapunov_dt0_err": 2e-6}
+    base |= {"threshold_below": 1e-4, "threshold_low": 1e-3}
+    return pd.DataFrame(
+        [
+            {**base, "model": "sakaguchi", "N": 49, "beta": 1.0, "lyapunov_dt0": -1e-6}
+            | {"verdict": "stable chaos", "verdict_text": "stable chaos: text"},
+            {**base, "model": "two-blocks", "N": 2, "beta": float("nan"), "lyapunov_dt0": 0.026}
+            | {"verdict": "chaotic", "verdict_text": "chaotic: text"},
+        ]
+    )
+
+
+def test_the_chaos_study_reports_the_lifetimes_verdicts(tmp_path):
+    from stickslip import io
+    from stickslip.experiments.studies import chaos
+
+    spec = study("chaos", "quick")
+    points_dir = spec.runs_dir(tmp_path) / "points"
+    alone = chaos.conclusions(spec, chaos.load(spec, _chaos_rows(), points_dir))
+    assert alone["lifetimes"]["found"] is False
+    assert any("stickslip study lifetimes" in s for s in alone["statements"])
+    # the lifetimes study's page in the same folder: its verdicts and bounds, its figures
+    table = _table(np.random.default_rng(1))
+    found = lifetimes.conclusions(None, table)
+    page = tmp_path / "lifetimes"
+    page.mkdir()
+    table.to_parquet(page / "table.parquet")
+    io.write_json(page / "study.json", {"meta": {"mode": "quick"}, "findings": found})
+    loaded = chaos.load(spec, _chaos_rows(), points_dir)
+    out = chaos.conclusions(spec, loaded)
+    told = out["lifetimes"]
+    assert told["found"] is True and told["mode"] == "quick"
+    assert sum(len(v) for v in told["verdicts"].values()) == len(found["verdicts"]) == 8
+    by_beta = {f["beta"]: f["T_399_low95"] for f in found["fits"]}
+    assert {b["beta"]: b["T_399_low95"] for b in told["bounds_399"]} == by_beta
+    # the bound is the lesser of the two laws' one-sided 95 % bounds, by hand
+    for f in found["fits"]:
+        low = min(f[k]["log10_T_at"] - 1.6449 * f[k]["log10_T_at_err"] for k in ("exponential", "power"))
+        assert f["T_399_low95"] == pytest.approx(10.0**low)
+    assert any(s.startswith("Extrapolated from the chain's lifetimes") for s in out["statements"])
+    assert out["verdicts"] == {"stable chaos": ["beta = 1 (N = 49)"], "chaotic": ["two blocks (N = 2)"]}
+    # its own points judged again with the lifetimes' growth at the same beta (b = 0.3 planted)
+    revised = {(v["model"], v["N"]): v for v in told["revised_verdicts"]}
+    assert revised[("sakaguchi", 49)]["verdict"] == "stable chaos"
+    assert "b = 0.29" in revised[("sakaguchi", 49)]["verdict_text"]
+    assert revised[("two-blocks", 2)]["verdict"] == "chaotic"
+    names = [name for name, *_ in chaos.figures(spec, loaded, tmp_path / "chaos")]
+    assert names == ["lifetimes_survival", "lifetimes_lifetime_vs_N"]
+
+
+def test_a_rest_start_is_the_presets_draw_by_hand():
+    # docs/model.md, Carlson-Langer: x_i(0) = -A u_i, u_i = default_rng(seed).random(N), every block stuck
+    params = point_params("chain", {"model": "carlson-langer", "N": 8})
+    state = lifetimes.start_state(params, "rest", 0.01, 4)
+    assert np.array_equal(state.x, -0.01 * np.random.default_rng(4).random(8))
+    assert not state.v.any()
+
+
+def test_the_relatives_points_are_checked():
+    base = {"model": "carlson-langer", "N": 8, "seed": 0, "budget": 1e3, **_RULE}
+    lifetimes.check_point({**base, "start": "rest"})
+    # the plate loads every block at once: no L_ss / V, so a loaded start needs its load_t
+    with pytest.raises(ParameterError, match="load_t"):
+        lifetimes.check_point({**base, "start": "loaded"})
+    lifetimes.check_point({**base, "start": "loaded", "load_t": 2e3})
+    with pytest.raises(ParameterError, match="measure"):
+        lifetimes.check_point({**base, "start": "rest", "measure": "spectrum"})
+    exp = {"model": "two-blocks", "N": 2, "measure": "exponent", "transient": 100.0, "flow_t": 200.0}
+    with pytest.raises(ParameterError, match="deltas"):
+        lifetimes.check_point({**exp, "events": 10, "windows": 1, "deltas": []})
+
+
+def test_two_blocks_outlast_a_short_budget():
+    # two blocks are chaotic: over 2e3 time units (some 70 slips) a rest start does not settle
+    cfg = {"model": "two-blocks", "N": 2, "start": "rest", "seed": 1, "budget": 2e3, **_RULE, "perturbation": 0.01}
+    row = lifetimes.lifetime_point(cfg, point_params("chain", cfg))
+    assert row["end"] == "censored" and not row["ended"] and row["lifetime"] == pytest.approx(2e3)
+    assert row["slips"] > 30

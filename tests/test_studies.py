@@ -486,7 +486,7 @@ def test_bad_study_input_is_one_line_and_exit_2(tmp_path):
         ("phase-diagram", ["(alpha, beta)", "35 cells", "70 runs", "phase_alpha_beta"]),
         ("exponents", ["slip-size exponent tau", "N = 199", "6 runs", "tau_beta"]),
         ("chaos", ["delta*", "N = 49, 99, 199", "11 points", "decorrelation.csv"]),
-        ("lifetimes", ["Kaplan-Meier", "N = 3, 5, 7, 9, 11, 13", "192 points", "lifetime_vs_N"]),
+        ("lifetimes", ["Kaplan-Meier", "N = 3, 5, 7, 9, 11, 13", "279 points", "exponent_vs_N", "two blocks"]),
         # the paper's own two, which `stickslip reproduce` gathers into its report
         ("figs1-4", ["eq. (1)", "13 values of V", "seconds in every mode", "fig1 to fig4"]),
         ("figs5-8", ["Fig. 5b", "N = 99 chains", "12 runs", "13 values of beta", "fig5a"]),

@@ -39,6 +39,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from stickslip.experiments.studies import Design, Study, finite, short
+from stickslip.experiments.studies.chaos_lifetimes import lifetime_figures, lifetime_findings, load
 from stickslip.models.presets import PRESETS, is_paper
 
 if TYPE_CHECKING:  # loaded where used, so that listing the studies loads no heavy module
@@ -331,8 +332,10 @@ def thresholds(table: pd.DataFrame) -> tuple[list[dict[str, Any]], list[dict[str
 
 
 def conclusions(spec: Study | None, table: pd.DataFrame) -> dict[str, Any]:
-    """Statements, verdicts, delta* and its fits of a chaos study's rows (module docstring)."""
+    """Statements, verdicts, delta* and its fits of a chaos study's rows (module docstring), and
+    the lifetimes study's verdicts where it ran into the same folder (:func:`lifetime_findings`)."""
     out: dict[str, Any] = {"statements": [], "verdicts": {}, "points": []}
+    out["lifetimes"], lines = lifetime_findings(table.attrs.get("lifetimes"), table)
     say = out["statements"].append
     rows = table.assign(_chain=table["model"].map(is_paper))
     rows = rows.sort_values(["_chain", "N", "beta"], ascending=[False, True, True])
@@ -384,6 +387,8 @@ def conclusions(spec: Study | None, table: pd.DataFrame) -> dict[str, Any]:
             f"delta* ({kind}) against N = {', '.join(map(str, Ns))}, slope of log10 delta* on log10 N "
             f"with its standard error: {'; '.join(parts)}."
         )
+    for line in lines:
+        say(line)
     return out
 
 
@@ -397,8 +402,9 @@ def figures(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[tuple[str,
     from stickslip import io
     from stickslip.plotting import chaos as pc
 
+    lives = lifetime_figures(table.attrs.get("lifetimes"), page_dir)
     if "point_dir" not in table.columns:
-        return []
+        return lives
     points_dir = spec.runs_dir(Path(page_dir).parent) / "points"
     found = []
     for r in sorted(table.itertuples(), key=lambda r: (0, r.N, r.beta) if is_paper(r.model) else (1, 0, 0.0)):
@@ -441,7 +447,7 @@ def figures(spec: Study, table: pd.DataFrame, page_dir: Path) -> list[tuple[str,
             "line of log10 delta* on log10 N for each beta (dashed, slope in the legend)."
         )
         out.append(("threshold", pc.threshold_figure(points, fits), caption))
-    return out
+    return out + lives
 
 
 #: The wall time of each mode (``stickslip study --help``, the README).
@@ -461,7 +467,9 @@ def describe() -> str:
         f"); --full {full.note.split(': ', 1)[1]} ({len(full.points)} points, {COST['full']})."
         " Outputs in DIR/chaos/: table.parquet and table.csv (one row per point: "
         "verdict, exponent, delta* per kind), decorrelation.csv, decorrelation, flow_ladder and "
-        "threshold (PNG, PDF), study.json, index.html."
+        "threshold (PNG, PDF), study.json, index.html; where `stickslip study lifetimes` ran into the same "
+        "DIR, its verdicts, the lower bounds of <T> at N = 399, the revised verdicts of this study's points "
+        "and the lifetimes' figures (survival curves, <T> against N, exponent against N)."
     )
 
 
@@ -475,6 +483,7 @@ DESIGN = Design(
     check=check_point,
     findings=conclusions,
     figures=figures,
+    load=load,
     columns=(
         *"model N beta verdict verdict_text lyapunov_dt0 lyapunov_dt0_err flow_slips window".split(),
         *(column for kind in KINDS for column in threshold_columns(kind)),
