@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from stickslip.lab import LoadHistory
@@ -81,14 +81,18 @@ def test_bad_steps_refused():
 
 @settings(max_examples=60, deadline=None)
 @given(st.lists(st.tuples(st.floats(0.0, 1e3), st.floats(1e-3, 1e3)), min_size=1, max_size=12))
+@example([(2.225073858507203e-309, 0.25)])  # a subnormal displacement: found in a test run
 def test_any_steps_are_continuous_and_their_slope_is_the_velocity(segments):
     v, d = zip(*segments, strict=True)
     h = LoadHistory.steps(v, d)
     assert h.breakpoints.size == len(v) + 1
     # V_i from the summed positions and times: exact up to their rounding, (n + 2) eps of each
-    # (a short step after long ones keeps fewer digits).
+    # (a short step after long ones keeps fewer digits), and below the normal numbers (a velocity
+    # of 2e-309) to the subnormals' absolute spacing.
     p, t, dt = np.abs(h.positions), h.times, np.diff(h.times)
-    bound = (len(v) + 2) * np.finfo(float).eps * (p[:-1] + p[1:] + np.abs(v) * (t[:-1] + t[1:])) / dt
+    finfo = np.finfo(float)
+    relative = finfo.eps * (p[:-1] + p[1:] + np.abs(v) * (t[:-1] + t[1:]))
+    bound = (len(v) + 2) * (relative + finfo.smallest_subnormal) / dt
     assert np.all(np.abs(h.velocities - np.asarray(v)) <= bound)
     mid = 0.5 * (h.times[:-1] + h.times[1:])
     np.testing.assert_array_equal(h.velocity(mid), h.velocities)
