@@ -23,6 +23,7 @@ from stickslip.cli._common import (
     run_option_spelling,
     run_options_from_args,
 )
+from stickslip.cli.lattice import add_lattice_options, run_lattice_command, wants_lattice
 from stickslip.models.params import MAX_PERTURBATION, check_number, steps_for
 
 
@@ -37,6 +38,7 @@ def register(sub) -> None:
     add_model_options(
         p, helps={"N": "number of blocks N (default the preset's: 399 for the paper's chain; 49 without --t-end)"}
     )
+    add_lattice_options(p)
     _add_run_options(p)
     _add_from_option(p)
     p.add_argument("--resume", metavar="DIR", help="continue the run in DIR from its checkpoint")
@@ -205,6 +207,8 @@ _FIXED_BY_CHECKPOINT = ("from_dir", "start", "perturbation", "seed", *run_option
 
 def run_chain_command(args: argparse.Namespace) -> Result:
     """Handler of `stickslip chain`."""
+    if wants_lattice(args):
+        return run_lattice_command(args)
     progress = not args.no_progress
     periodic = _periodic_hook(args)
     if args.resume is not None:

@@ -1,0 +1,116 @@
+"""`stickslip chain --lattice square --shape RxC [--edges ...]`: a model on a lattice
+(docs/lattice.md), on the lattice reference integrator."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from stickslip.cli._common import CommandError, Result, float_arg
+
+#: Options of `stickslip chain` that do not yet go with a lattice, as the command spells them.
+_NOT_YET = {
+    "from_dir": "--from",
+    "resume": "--resume",
+    "sample_interval": "--sample-interval",
+    "average_from": "--average-from",
+    "snapshot": "--snapshot",
+    "profile_window": "--profile-window",
+    "profile_min_blocks": "--profile-min-blocks",
+    "until_steady": "--until-steady",
+    "checkpoint_interval": "--checkpoint-interval",
+    "keep_checkpoint": "--keep-checkpoint",
+    "until_periodic": "--until-periodic",
+}
+
+
+def add_lattice_options(p: argparse.ArgumentParser) -> None:
+    """``--lattice``, ``--shape``, ``--edges`` and ``--snapshot-every`` of `stickslip chain`."""
+    from stickslip.models.lattice import EDGE_KINDS, LATTICES, SIDES
+
+    g = p.add_argument_group("lattice (docs/lattice.md)")
+    g.add_argument("--lattice", choices=LATTICES, default=None, help="chain (default: eq. 4's line) or square")
+    g.add_argument("--shape", default=None, metavar="RxC", help="rows x cols of the square, e.g. 64x64")
+    g.add_argument(
+        "--edges",
+        default=None,
+        metavar="EDGES",
+        help=f"the square's sides ({', '.join(SIDES)}): one kind for all, or SIDE=KIND,... with kinds "
+        f"{', '.join(EDGE_KINDS)} (default: the ends piece's kind; an edge drive pulls the left side)",
+    )
+    g.add_argument(
+        "--snapshot-every",
+        dest="lattice_snapshot_every",
+        type=float_arg("snapshot-every", "> 0"),
+        default=None,
+        metavar="T",
+        help="with --lattice square: snapshots of x, v, theta and stopped over (row, col) every T, in state.nc",
+    )
+
+
+def wants_lattice(args: argparse.Namespace) -> bool:
+    """Whether the command line asks for a lattice other than the chain."""
+    if getattr(args, "lattice", None) in (None, "chain"):
+        for option, value in (("--shape", getattr(args, "shape", None)), ("--edges", getattr(args, "edges", None))):
+            if value is not None:
+                raise CommandError(f"{option} goes with --lattice square")
+        if getattr(args, "lattice_snapshot_every", None) is not None:
+            raise CommandError("--snapshot-every goes with --lattice square (the chain has --snapshot)")
+        return False
+    return True
+
+
+def run_lattice_command(args: argparse.Namespace) -> Result:
+    """`stickslip chain --lattice square`: run the model on the square, print its summary."""
+    from stickslip.cli._common import chain_params_from_args
+    from stickslip.models.lattice.params import on_lattice
+    from stickslip.run.lattice import run_lattice
+
+    for name, option in _NOT_YET.items():
+        if getattr(args, name, None) not in (None, False):
+            raise CommandError(f"{option} is not yet available with --lattice {args.lattice}")
+    if args.integrator not in (None, "dense", "exact"):
+        raise CommandError(f"--integrator {args.integrator}: a lattice runs on exact or dense")
+    if args.shape is None:
+        raise CommandError("--lattice square needs --shape ROWSxCOLS (e.g. 64x64)")
+    if getattr(args, "param_N", None) is not None:
+        raise CommandError("--N goes with the chain; the square's size is --shape")
+    params = on_lattice(chain_params_from_args(args), args.lattice, args.shape, args.edges)
+    t_end = 1000.0 if args.t_end is None else args.t_end
+    start = args.start or ("rest" if params.drive_piece.leaf_spring else "paper")
+    if start == "paper" and (args.perturbation is not None or args.seed is not None):
+        raise CommandError("--perturbation and --seed go with --start steady or --start rest")
+    amplitude = args.perturbation if args.perturbation is not None else (0.01 if start == "rest" else 0.0)
+    run = run_lattice(
+        params,
+        t_end,
+        start=start,
+        perturbation=amplitude,
+        seed=args.seed or 0,
+        snapshot_every=args.lattice_snapshot_every,
+        integrator=args.integrator or "exact",
+    )
+    out = Path(args.out) if args.out else None
+    if out is not None:
+        run.write(out)
+    ev = run.events
+    summary = dict(run.summary)
+    summary.update(
+        {
+            "start": start,
+            "largest_area": int(ev["area"].max()) if len(ev) else 0,
+            "largest_moment": float(ev["moment"].max()) if len(ev) else 0.0,
+            "out": str(out) if out else None,
+        }
+    )
+    pieces = ", ".join(f"{k} {v}" for k, v in params.pieces.items() if k != "ends")
+    text = [
+        f"{summary['lattice']}: {params.model} ({pieces})",
+        f"t_end {summary['t_end']:g} ({summary['steps']} steps), start {start}: {summary['events']} events, "
+        f"largest area {summary['largest_area']} blocks, largest moment {summary['largest_moment']:.4g}",
+        f"moving at the end: {summary['moving_at_end']} of {params.lattice.n_blocks}; "
+        f"state sha256 {summary['state_sha256'][:16]}...",
+    ]
+    if out is not None:
+        text.append(f"written: {out}/run.json, events.csv, state.nc")
+    return Result(summary, "\n".join(text))
