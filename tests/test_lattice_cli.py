@@ -47,7 +47,7 @@ def test_command_runs_and_writes(tmp_path, capsys):
     out = tmp_path / "run"
     code, stdout, _ = run_cli(
         capsys, "chain", "--model", "carlson-langer", "--lattice", "square", "--shape", "4x5",
-        "--t-end", "20", "--snapshot-every", "10", "--out", str(out), "--json",
+        "--t-end", "20", "--snapshot-every", "10", "--sample-interval", "5", "--out", str(out), "--json",
     )  # fmt: skip
     assert code == 0
     summary = json.loads(stdout)
@@ -62,6 +62,14 @@ def test_command_runs_and_writes(tmp_path, capsys):
     assert ds["snapshot_x"].dims == ("time", "row", "col")
     np.testing.assert_array_equal(ds["time"].values, [0.0, 10.0, 20.0])
     np.testing.assert_array_equal(ds["snapshot_x"].values[-1], ds["x"].values)
+    # the samples at the snapshots' times, from the snapshots: the plate at nu t less x, v, moving
+    samples = pd.read_csv(out / "samples.csv").set_index("t")
+    assert list(samples.index) == [0.0, 5.0, 10.0, 15.0, 20.0]
+    for i, t in enumerate(ds["time"].values):
+        x, v = ds["snapshot_x"].values[i], ds["snapshot_v"].values[i]
+        assert samples.loc[t, "mean_slip_deficit"] == pytest.approx(np.mean(0.01 * t - x), rel=1e-12, abs=1e-15)
+        assert samples.loc[t, "mean_v"] == pytest.approx(np.mean(v), rel=1e-12, abs=1e-15)
+        assert samples.loc[t, "moving"] == int((~ds["snapshot_stopped"].values[i]).sum())
     ds.close()
 
 

@@ -12,7 +12,6 @@ from stickslip.cli._common import CommandError, Result, float_arg
 _NOT_YET = {
     "from_dir": "--from",
     "resume": "--resume",
-    "sample_interval": "--sample-interval",
     "average_from": "--average-from",
     "snapshot": "--snapshot",
     "profile_window": "--profile-window",
@@ -89,6 +88,7 @@ def run_lattice_command(args: argparse.Namespace) -> Result:
         seed=args.seed or 0,
         snapshot_every=args.lattice_snapshot_every,
         integrator=args.integrator or "exact",
+        sample_every=args.sample_interval,
     )
     out = Path(args.out) if args.out else None
     if out is not None:
@@ -112,5 +112,7 @@ def run_lattice_command(args: argparse.Namespace) -> Result:
         f"state sha256 {summary['state_sha256'][:16]}...",
     ]
     if out is not None:
-        text.append(f"written: {out}/run.json, events.csv, state.nc")
+        text.append(
+            f"written: {out}/run.json, events.csv, state.nc" + (", samples.csv" if run.samples is not None else "")
+        )
     return Result(summary, "\n".join(text))

@@ -135,6 +135,9 @@ class LatticeRun:
     state: LatticeState
     snapshots: xr.Dataset | None
     summary: dict[str, Any] = field(default_factory=dict)
+    #: samples every ``sample_every``: t, the mean slip deficit (the load point V t less x, over
+    #: the blocks), the mean velocity and the number of moving blocks; None unless asked for
+    samples: pd.DataFrame | None = None
 
     def final(self) -> xr.Dataset:
         """The final state as fields over (row, col)."""
@@ -150,6 +153,8 @@ class LatticeRun:
         out.mkdir(parents=True, exist_ok=True)
         io.write_json(out / "run.json", {"params": self.params.to_dict(), "summary": self.summary})
         io.write_csv(out / "events.csv", self.events)
+        if self.samples is not None:
+            io.write_csv(out / "samples.csv", self.samples)
         ds = self.final()
         if self.snapshots is not None:
             ds = ds.merge(self.snapshots.rename({k: f"snapshot_{k}" for k in self.snapshots.data_vars}))
@@ -252,6 +257,7 @@ def run_lattice(
     perturbation: float = 0.0,
     seed: int = 0,
     snapshot_every: float | None = None,
+    sample_every: float | None = None,
     integrator: str = "exact",
 ) -> LatticeRun:
     """Integrate the model ``p`` on its lattice to ``t_end`` (docs/lattice.md): with the
@@ -270,6 +276,8 @@ def run_lattice(
         The size A and the seed of the draws of ``steady`` and ``rest``.
     snapshot_every : float, optional
         Time between snapshots of x, v, theta and stopped over (row, col), from t = 0.
+    sample_every : float, optional
+        Time between samples of the declared reductions (:attr:`LatticeRun.samples`).
     integrator : {'exact', 'dense'}
         ``exact``: the active-set path (:mod:`stickslip.kernels.lattice_sparse`) where the model's
         stopped blocks keep every bit (a drive on every block, a friction without theta), the
@@ -291,23 +299,18 @@ def run_lattice(
         s = LatticeState(**{k: np.array(getattr(start, k)) for k in start.__dataclass_fields__})
     else:
         s = initial_state(p, start, amplitude=perturbation, seed=seed)
-    every = 0
-    if snapshot_every is not None:
-        every = max(1, int(round(check_number("snapshot_every", snapshot_every, low=0.0, low_open=True) / p.dt)))
+    every = _every(p, snapshot_every, "snapshot_every")
+    every_sample = _every(p, sample_every, "sample_every")
     size = p.lattice.size
     scratch = [np.zeros(size) for _ in range(6)]
     ev_int = np.zeros((EVENT_ROWS, 9), dtype=np.int64)
     ev_moment = np.zeros(EVENT_ROWS)
     sparse = _sparse_args(p) if integrator == "exact" and sparse_path(p) else None
     call = _kernel(p, _args(p, s, scratch, ev_int, ev_moment, n_end), sparse)
-    rows, moments, snaps, times = [], [], [], []
+    rows, moments, snaps, times, samples = [], [], [], [], []
     while True:
-        target = n_end
-        if every:
-            if s.step % every == 0 and (not times or times[-1] != s.step):
-                snaps.append(s.fields(p.lattice))
-                times.append(s.step)
-            target = min(n_end, (s.step // every + 1) * every)
+        _record(p, s, every, snaps, times, every_sample, samples)
+        target = min(n_end, _next(s.step, every), _next(s.step, every_sample))
         status = call(_args(p, s, scratch, ev_int, ev_moment, target))
         k = int(s.ist[layout.EV_COUNT])
         rows.append(ev_int[:k].copy())
@@ -317,14 +320,13 @@ def run_lattice(
             raise NonFiniteState(f"the run became non-finite at step {s.step} (flat index {s.ist[layout.BAD_BLOCK]})")
         if status == layout.DONE and s.step >= n_end:
             break
-    if every and s.step % every == 0 and times[-1] != s.step:
-        snaps.append(s.fields(p.lattice))
-        times.append(s.step)
+    _record(p, s, every, snaps, times, every_sample, samples)
     events = _event_table(p, np.concatenate(rows), np.concatenate(moments))
     snapshots = None
     if snaps:
         stacked = {k: np.stack([f[k] for f in snaps]) for k in snaps[0]}
         snapshots = _dataset(stacked, p, time=np.asarray(times) * p.dt)
+    sample_table = pd.DataFrame(samples, columns=["t", "mean_slip_deficit", "mean_v", "moving"]) if samples else None
     summary = {
         "integrator": "dense" if sparse is None else "exact",
         "steps_computed": int(s.ist[layout.STEPS_COMPUTED]),
@@ -336,4 +338,28 @@ def run_lattice(
         "moving_at_end": int(s.ist[layout.N_MOVING]),
         "state_sha256": s.sha256(p.lattice),
     }
-    return LatticeRun(p, events, s, snapshots, summary)
+    return LatticeRun(p, events, s, snapshots, summary, sample_table)
+
+
+def _every(p: LatticeParams, interval: float | None, name: str) -> int:
+    """An output interval in steps (0: none)."""
+    if interval is None:
+        return 0
+    return max(1, int(round(check_number(name, interval, low=0.0, low_open=True) / p.dt)))
+
+
+def _next(step: int, every: int) -> int:
+    """The next multiple of ``every`` after ``step`` (a huge number for no output)."""
+    return (step // every + 1) * every if every else np.iinfo(np.int64).max
+
+
+def _record(p: LatticeParams, s: LatticeState, every: int, snaps, times, every_sample: int, samples) -> None:
+    """The snapshot and the sample due at the state's step, once each."""
+    n = s.step
+    if every and n % every == 0 and (not times or times[-1] != n):
+        snaps.append(s.fields(p.lattice))
+        times.append(n)
+    if every_sample and n % every_sample == 0 and (not samples or samples[-1][0] != n * p.dt):
+        f = s.fields(p.lattice)
+        load = p.drive_piece.kernel_velocity(p.chain) * (n * p.dt)
+        samples.append((n * p.dt, float(np.mean(load - f["x"])), float(np.mean(f["v"])), int(s.ist[layout.N_MOVING])))
