@@ -104,3 +104,20 @@ def test_exact_equals_dense_on_drawn_lattices(draw):
     edges = ",".join(f"{side}={kind}" for side, kind in kinds.items())
     p = chain_params("carlson-langer", lattice="square", shape=(rows, cols), edges=edges)
     _same(p, float(rng.uniform(20.0, 120.0)), "rest", float(rng.uniform(0.005, 0.05)))
+
+
+def test_exact_continues_an_event_in_progress():
+    """A state handed over in the middle of an event (from either path) continues as dense does:
+    the event's moved blocks are recovered from their first moves."""
+    from stickslip.kernels import layout
+
+    p = chain_params("carlson-langer", lattice="square", shape=(6, 6), edges="periodic")
+    for t in (40.0, 45.0, 50.0, 55.0, 60.0, 65.0, 70.0):
+        prep = run_lattice(p, t, start="rest", perturbation=0.01, integrator="exact")
+        if prep.state.ist[layout.EV_ACTIVE] == 1:
+            break
+    assert prep.state.ist[layout.EV_ACTIVE] == 1
+    dense = run_lattice(p, t + 30.0, start=prep.state, integrator="dense")
+    exact = run_lattice(p, t + 30.0, start=prep.state, integrator="exact")
+    assert exact.summary["state_sha256"] == dense.summary["state_sha256"]
+    assert exact.events.equals(dense.events) and len(exact.events) > 0

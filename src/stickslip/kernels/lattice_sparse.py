@@ -245,13 +245,20 @@ def run_lattice_sparse(a, sp, drive, friction, threshold, lattice):
     cap_ev = a.ev_int.shape[0]
     nb = np.zeros(4, dtype=np.int64)
     if book[B_FRESH] == 1:
+        # Every block a candidate; the moved blocks of an event in progress (a state handed over
+        # from another run) from their first moves.
         nc = 0
+        m = 0
         for r in range(R):
             row = base + r * W
             for k in range(row, row + C):
                 cand[nc] = k
                 nc += 1
+                if a.first_step[k] >= 0:
+                    sp.moved[m] = k
+                    m += 1
         book[B_N_CAND] = nc
+        book[B_MOVED] = m
         book[B_FRESH] = 0
     while True:
         n = ist[STEP]
