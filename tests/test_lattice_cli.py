@@ -92,3 +92,24 @@ def test_command_refusals_are_one_line(argv, names, capsys):
 
     assert main(["chain", *argv, "--t-end", "1"]) == 2
     one_line_error(capsys, *names)
+
+
+def test_bench_compares_dense_and_exact_on_the_square(capsys):
+    code, stdout, _ = run_cli(
+        capsys, "bench", "--model", "carlson-langer", "--lattice", "square", "--shape", "6x6",
+        "--t-prepare", "5", "--t-end", "10", "--json",
+    )  # fmt: skip
+    assert code == 0
+    result = json.loads(stdout)
+    assert result["identical"] is True and result["exact_integrator"] == "exact"
+    assert result["t_prepare"] == 5.0 and result["t_timed"] == 10.0
+    assert result["exact_block_updates"] < result["dense_block_updates"] == 36 * 2000
+
+
+def test_bench_refusals_are_one_line(capsys):
+    from stickslip.cli import main
+
+    assert main(["bench", "--t-prepare", "5"]) == 2
+    one_line_error(capsys, "--t-prepare", "--lattice square")
+    assert main(["bench", "--lattice", "square", "--shape", "4x4", "--profile"]) == 2
+    one_line_error(capsys, "--profile")

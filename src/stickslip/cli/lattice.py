@@ -23,8 +23,9 @@ _NOT_YET = {
 }
 
 
-def add_lattice_options(p: argparse.ArgumentParser) -> None:
-    """``--lattice``, ``--shape``, ``--edges`` and ``--snapshot-every`` of `stickslip chain`."""
+def add_lattice_options(p: argparse.ArgumentParser, *, bench: bool = False) -> None:
+    """``--lattice``, ``--shape``, ``--edges`` and ``--snapshot-every`` of `stickslip chain`
+    (``--t-prepare`` in its place for `stickslip bench`)."""
     from stickslip.models.lattice import EDGE_KINDS, LATTICES, SIDES
 
     g = p.add_argument_group("lattice (docs/lattice.md)")
@@ -37,6 +38,15 @@ def add_lattice_options(p: argparse.ArgumentParser) -> None:
         help=f"the square's sides ({', '.join(SIDES)}): one kind for all, or SIDE=KIND,... with kinds "
         f"{', '.join(EDGE_KINDS)} (default: the ends piece's kind; an edge drive pulls the left side)",
     )
+    if bench:
+        g.add_argument(
+            "--t-prepare",
+            type=float_arg("t-prepare", ">= 0"),
+            default=None,
+            metavar="T",
+            help="with --lattice square: run exact from rest to T first, then time both over --t-end",
+        )
+        return
     g.add_argument(
         "--snapshot-every",
         dest="lattice_snapshot_every",
@@ -53,6 +63,8 @@ def wants_lattice(args: argparse.Namespace) -> bool:
         for option, value in (("--shape", getattr(args, "shape", None)), ("--edges", getattr(args, "edges", None))):
             if value is not None:
                 raise CommandError(f"{option} goes with --lattice square")
+        if getattr(args, "t_prepare", None) is not None:
+            raise CommandError("--t-prepare goes with --lattice square")
         if getattr(args, "lattice_snapshot_every", None) is not None:
             raise CommandError("--snapshot-every goes with --lattice square (the chain has --snapshot)")
         return False
@@ -116,3 +128,32 @@ def run_lattice_command(args: argparse.Namespace) -> Result:
             f"written: {out}/run.json, events.csv, state.nc" + (", samples.csv" if run.samples is not None else "")
         )
     return Result(summary, "\n".join(text))
+
+
+def run_lattice_bench_command(args: argparse.Namespace) -> Result:
+    """`stickslip bench --lattice square --shape RxC`: dense against exact on the square, from the
+    model's state at --t-prepare (default 0), timed over --t-end (default 100)."""
+    from stickslip.cli._common import chain_params_from_args
+    from stickslip.models.lattice.params import on_lattice
+    from stickslip.run.lattice import bench_lattice
+
+    for name, option in (("profile", "--profile"), ("workload", "--workload"), ("switches", "--switches")):
+        if getattr(args, name, None) not in (None, False, "default", "grid"):
+            raise CommandError(f"{option} is not yet available with --lattice {args.lattice}")
+    if args.shape is None:
+        raise CommandError("--lattice square needs --shape ROWSxCOLS (e.g. 64x64)")
+    if getattr(args, "param_N", None) is not None:
+        raise CommandError("--N goes with the chain; the square's size is --shape")
+    params = on_lattice(chain_params_from_args(args), args.lattice, args.shape, args.edges)
+    t_prepare = 0.0 if args.t_prepare is None else args.t_prepare
+    result = bench_lattice(
+        params, 100.0 if args.t_end is None else args.t_end, t_prepare=t_prepare, repeat=args.repeat or 1
+    )
+    text = (
+        f"{result['lattice']}, {result['model']}: from t = {result['t_prepare']:g} over {result['t_timed']:g}: "
+        f"dense {result['dense_seconds']:.3g} s, exact {result['exact_seconds']:.3g} s "
+        f"({result['speedup']:.2f}x; exact path {result['exact_integrator']}), identical {result['identical']}; "
+        f"block updates {result['exact_block_updates']:.3g} against {result['dense_block_updates']:.3g}, "
+        f"{result['events']} events"
+    )
+    return Result(result, text)

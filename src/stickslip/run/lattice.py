@@ -363,3 +363,40 @@ def _record(p: LatticeParams, s: LatticeState, every: int, snaps, times, every_s
         f = s.fields(p.lattice)
         load = p.drive_piece.kernel_velocity(p.chain) * (n * p.dt)
         samples.append((n * p.dt, float(np.mean(load - f["x"])), float(np.mean(f["v"])), int(s.ist[layout.N_MOVING])))
+
+
+def bench_lattice(p: LatticeParams, t_timed: float, *, t_prepare: float = 0.0, repeat: int = 1) -> dict[str, Any]:
+    """Dense against exact on one workload, in one process (docs/lattice.md, "Speed"): the model
+    run by exact from ``rest`` (Carlson-Langer's start, A = 0.01) to ``t_prepare``, then continued
+    for ``t_timed`` by each integrator, alternated ``repeat`` times, the fastest kept; whether
+    their states and events are identical, and the work each did."""
+    import time
+
+    repeat = int(check_number("repeat", repeat, low=1, integer=True))
+    prep = run_lattice(p, t_prepare, start="rest", perturbation=0.01, integrator="exact")
+    t_end = prep.summary["t_end"] + check_number("t-end", t_timed, low=0.0, low_open=True)
+    best: dict[str, float] = {}
+    runs: dict[str, LatticeRun] = {}
+    for _ in range(repeat):
+        for integrator in ("dense", "exact"):
+            t0 = time.perf_counter()
+            runs[integrator] = run_lattice(p, t_end, start=prep.state, integrator=integrator)
+            best[integrator] = min(best.get(integrator, np.inf), time.perf_counter() - t0)
+    dense, exact = runs["dense"], runs["exact"]
+    before = prep.summary["block_updates"]
+    return {
+        "lattice": p.lattice.describe(),
+        "model": p.model,
+        "t_prepare": prep.summary["t_end"],
+        "t_timed": t_end - prep.summary["t_end"],
+        "dense_seconds": best["dense"],
+        "exact_seconds": best["exact"],
+        "speedup": best["dense"] / best["exact"],
+        "identical": dense.summary["state_sha256"] == exact.summary["state_sha256"]
+        and dense.events.equals(exact.events),
+        "exact_integrator": exact.summary["integrator"],
+        "events": len(exact.events),
+        "dense_block_updates": dense.summary["block_updates"] - before,
+        "exact_block_updates": exact.summary["block_updates"] - before,
+        "state_sha256": exact.summary["state_sha256"],
+    }
