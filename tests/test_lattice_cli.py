@@ -23,6 +23,9 @@ def test_chain_params_on_a_square():
     assert p.lattice.shape == (4, 6) and p.lattice.edges == ("free", "free", "periodic", "periodic")
     assert p.N == 24 and p.K == 100.0
     assert p.to_dict()["shape"] == "4x6" and "N" not in p.to_dict()
+    import pickle
+
+    assert pickle.loads(pickle.dumps(p)) == p
     chain = chain_params(lattice="chain", shape=9)
     assert isinstance(chain, ChainParams) and chain.N == 9
 

@@ -21,7 +21,8 @@ class LatticeParams:
     lattice: Any
 
     def __getattr__(self, name: str) -> Any:
-        if name.startswith("__"):
+        # Only after construction (not for the fields themselves, which unpickling looks up first).
+        if name.startswith("__") or name in ("chain", "lattice"):
             raise AttributeError(name)
         return getattr(self.chain, name)
 
