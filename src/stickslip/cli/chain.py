@@ -23,6 +23,7 @@ from stickslip.cli._common import (
     run_option_spelling,
     run_options_from_args,
 )
+from stickslip.cli.lattice import add_lattice_options, run_lattice_bench_command, run_lattice_command, wants_lattice
 from stickslip.models.params import MAX_PERTURBATION, check_number, steps_for
 
 
@@ -37,6 +38,7 @@ def register(sub) -> None:
     add_model_options(
         p, helps={"N": "number of blocks N (default the preset's: 399 for the paper's chain; 49 without --t-end)"}
     )
+    add_lattice_options(p)
     _add_run_options(p)
     _add_from_option(p)
     p.add_argument("--resume", metavar="DIR", help="continue the run in DIR from its checkpoint")
@@ -62,6 +64,7 @@ def register(sub) -> None:
         description="Run the same chain workload with the dense and the exact integrator and compare.",
     )
     add_model_options(b)
+    add_lattice_options(b, bench=True)
     b.add_argument(
         "--t-end",
         type=float_arg("t-end"),
@@ -205,6 +208,8 @@ _FIXED_BY_CHECKPOINT = ("from_dir", "start", "perturbation", "seed", *run_option
 
 def run_chain_command(args: argparse.Namespace) -> Result:
     """Handler of `stickslip chain`."""
+    if wants_lattice(args):
+        return run_lattice_command(args)
     progress = not args.no_progress
     periodic = _periodic_hook(args)
     if args.resume is not None:
@@ -481,6 +486,8 @@ def run_bench_command(args: argparse.Namespace) -> Result:
     """Handler of `stickslip bench`: the same workload with dense and exact, one process."""
     from stickslip.run import bench
 
+    if wants_lattice(args):
+        return run_lattice_bench_command(args)
     if args.repeat is None:
         # A short timing is the noisier one: the partly stuck workload's exact run takes about 0.25 s.
         args.repeat = 3 if args.workload in ("partly-stuck", "disordered") else 1

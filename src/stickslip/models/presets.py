@@ -23,7 +23,9 @@ def preset(name: str) -> Preset:
     return PRESETS[name]
 
 
-def chain_params(model: str = "sakaguchi", **overrides: Any):
+def chain_params(
+    model: str = "sakaguchi", *, lattice: str | None = None, shape: Any = None, edges: Any = None, **overrides: Any
+):
     """Validated parameters of preset ``model`` with ``overrides`` (pieces or parameters).
 
     For the Carlson-Langer family ``l`` and ``nu`` are accepted in the model's own symbols
@@ -36,14 +38,20 @@ def chain_params(model: str = "sakaguchi", **overrides: Any):
     model : str
         A preset (``stickslip models`` lists them): ``sakaguchi`` (the paper's chain of eq. 4,
         the default), ``carlson-langer``, ``train``, ``batista-carlson``, ``two-blocks``.
+    lattice, shape, edges : optional
+        The lattice the blocks sit on (docs/lattice.md): ``"chain"`` (eq. 4's line, ``shape`` its
+        N) or ``"square"`` with ``shape`` (rows, cols) or ``"RxC"`` and ``edges`` per side
+        (:func:`stickslip.models.lattice.edges.parse_edges`; default: the ends piece's kind, the
+        left side pulled by an edge drive).
     **overrides
         Pieces (``drive``, ``friction``, ``threshold``, ``ends``) or parameters (``N``,
         ``beta``, ...) that replace the preset's.
 
     Returns
     -------
-    ChainParams
-        Every parameter checked; a bad one raises ParameterError naming it and its range.
+    ChainParams or LatticeParams
+        Every parameter checked; a bad one raises ParameterError naming it and its range. On the
+        square, a :class:`~stickslip.models.lattice.params.LatticeParams`.
 
     Examples
     --------
@@ -57,9 +65,26 @@ def chain_params(model: str = "sakaguchi", **overrides: Any):
     ...
     stickslip.models.params.ParameterError: beta is not a parameter of this model (carlson-langer: ...
     """
+    from stickslip.models.params import ParameterError
+
+    if lattice is None and (shape is not None or edges is not None):
+        raise ParameterError("shape and edges go with lattice (lattice='square', shape=(rows, cols))")
+    if lattice not in (None, "chain"):
+        if shape is None:
+            raise ParameterError(f"lattice {lattice} needs shape (rows, cols), e.g. shape=(64, 64)")
+        if "N" in overrides:
+            raise ParameterError("N goes with the chain; the square's size is shape (rows, cols)")
+    elif shape is not None:
+        overrides = {**overrides, "N": shape}
     params = build_chain_params(model, **overrides)
     refuse_unread(params, overrides)
-    return params
+    if lattice in (None, "chain"):
+        if edges is not None:
+            raise ParameterError("edges go with lattice square (the chain's ends are the ends piece)")
+        return params
+    from stickslip.models.lattice.params import on_lattice
+
+    return on_lattice(params, lattice, shape, edges)
 
 
 def build_chain_params(model: str = "sakaguchi", **overrides: Any):

@@ -200,8 +200,10 @@ def build(mode: str) -> Study:
 
 
 def label(model: str, beta: float | None) -> str:
-    """How the study names a model and beta: ``eq. (4), beta = 1``, ``train model, beta = 0.5``,
-    ``two blocks`` (the relatives whose friction reads no beta)."""
+    """The name the study gives a model at a beta, in its tables, figures and page.
+
+    For example ``eq. (4), beta = 1``, ``train model, beta = 0.5``, or ``two blocks`` alone (the
+    relatives whose friction reads no beta)."""
     name = PRESETS[model].label or model
     return f"{name}, beta = {beta:g}" if beta is not None else name
 

@@ -6,6 +6,8 @@ through :func:`stickslip.kernels.laws.call`:
 
 * ``force(xl, xc, xr, K, p, dp)``: the spring force on a block between xl and xr with the drive
   at p = V t (in the drive's own frame, p = 0), in the drive's own order of operations;
+* ``force_lap(lap, xc, K, p, dp)``: the same force with the lattice's Laplacian of x ``lap`` in
+  place of the neighbours (:mod:`stickslip.models.lattice`), in ``force``'s order of operations;
 * ``leaf(dp)``: the stiffness of the spring joining every block to the drive (0 when it pulls
   block 1 only), which the start-step searches and rounding bounds read;
 * ``left(p, ghost)``: x_0, the ghost cell left of block 1: the pulling point p, or the ends'

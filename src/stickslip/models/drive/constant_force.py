@@ -33,6 +33,14 @@ def force(xl, xc, xr, K, p, dp):
 
 
 @njit(cache=True, inline="always")
+def force_lap(lap, xc, K, p, dp):
+    """K times the Laplacian of x plus the constant force F.
+    ``lap`` is the lattice's Laplacian of x at the block (:mod:`stickslip.models.lattice`);
+    :func:`force` in the same order of operations, so the chain's bits stay."""
+    return K * lap + dp.F
+
+
+@njit(cache=True, inline="always")
 def leaf(dp):
     """No spring to the drive."""
     return 0.0

@@ -42,6 +42,14 @@ def force(xl, xc, xr, K, p, dp):
 
 
 @njit(cache=True, inline="always")
+def force_lap(lap, xc, K, p, dp):
+    """K times the Laplacian of x (eq. 4); an edge block reads the load point in its ghost cell.
+    ``lap`` is the lattice's Laplacian of x at the block (:mod:`stickslip.models.lattice`);
+    :func:`force` in the same order of operations, so the chain's bits stay."""
+    return K * lap
+
+
+@njit(cache=True, inline="always")
 def leaf(dp):
     """No spring to the drive but block 1's."""
     return 0.0

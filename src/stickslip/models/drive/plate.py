@@ -16,6 +16,14 @@ def force(xl, xc, xr, K, p, dp):
 
 
 @njit(cache=True, inline="always")
+def force_lap(lap, xc, K, p, dp):
+    """K times the Laplacian of x plus Kp (V t - x_i), the plate at p = V t.
+    ``lap`` is the lattice's Laplacian of x at the block (:mod:`stickslip.models.lattice`);
+    :func:`force` in the same order of operations, so the chain's bits stay."""
+    return K * lap + dp.Kp * (p - xc)
+
+
+@njit(cache=True, inline="always")
 def leaf(dp):
     """Kp."""
     return dp.Kp

@@ -7,7 +7,9 @@ A law's module defines
 * ``accel(f, v, th, lp)``, the force f on a moving block less the law's friction, and
   ``rate(thl, th, thr, v, lp)``, the state variable's rate (0 for a law without one): compiled
   functions that every integrator calls (dense, exact, sparse, located switches; the contract is
-  in :mod:`stickslip.kernels.laws`);
+  in :mod:`stickslip.kernels.laws`), and ``rate_lap(lap, th, v, lp)``, the same rate with the
+  lattice's Laplacian of theta ``lap`` in place of the neighbours (:mod:`stickslip.models.lattice`,
+  :mod:`stickslip.kernels.lattice`), in ``rate``'s order of operations;
 * ``PIECE``, a :class:`~stickslip.models.piece.Piece` carrying its name, meaning, parameters and
   their checks, steady sliding, start value of theta, linearisation and figure label.
 

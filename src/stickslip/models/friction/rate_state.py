@@ -70,6 +70,13 @@ def rate(thl, th, thr, v, lp):
     return 1.0 - v * th / lp.Dc
 
 
+@njit(cache=True, inline="always")
+def rate_lap(lap, th, v, lp):
+    """:func:`rate`, which reads no neighbour: the law has no diffusion of theta (``lap`` unread;
+    :mod:`stickslip.models.lattice`)."""
+    return rate(th, th, th, v, lp)
+
+
 def psi(p: Any, theta: float) -> float:
     """psi / a with psi = mu0 + b ln(v0 theta / D_c): the exponent of the regularised law."""
     return (p.mu0 + p.rs_b * math.log(p.v0 * theta / p.Dc)) / p.rs_a

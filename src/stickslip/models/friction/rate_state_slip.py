@@ -48,6 +48,13 @@ def rate(thl, th, thr, v, lp):
     return g
 
 
+@njit(cache=True, inline="always")
+def rate_lap(lap, th, v, lp):
+    """:func:`rate`, which reads no neighbour: the law has no diffusion of theta (``lap`` unread;
+    :mod:`stickslip.models.lattice`)."""
+    return rate(th, th, th, v, lp)
+
+
 PIECE = Piece(
     "friction",
     "rate-state-slip",

@@ -28,6 +28,13 @@ def rate(thl, th, thr, v, lp):
     return th * (1.0 - th) - lp.alpha * th * v + lp.D * ((thl - th) - (th - thr))
 
 
+@njit(cache=True, inline="always")
+def rate_lap(lap, th, v, lp):
+    """eq. (4)'s dtheta/dt with the lattice's Laplacian of theta ``lap`` (:mod:`stickslip.models.lattice`):
+    theta (1 - theta) - alpha theta v + D lap, :func:`rate` in the same order of operations."""
+    return th * (1.0 - th) - lp.alpha * th * v + lp.D * lap
+
+
 def _steady(p: Any) -> tuple[float, float]:
     """theta_0 = 1 - alpha V and c = theta_0 + beta V (sections 2, 3)."""
     theta0 = 1.0 - p.alpha * p.V

@@ -26,6 +26,13 @@ def rate(thl, th, thr, v, lp):
     return 0.0
 
 
+@njit(cache=True, inline="always")
+def rate_lap(lap, th, v, lp):
+    """:func:`rate`, which reads no neighbour: the law has no diffusion of theta (``lap`` unread;
+    :mod:`stickslip.models.lattice`)."""
+    return rate(th, th, th, v, lp)
+
+
 def _slope(p: Any) -> float:
     """phi'(V) of the train model's F0 + beta v: beta."""
     return float(p.beta)

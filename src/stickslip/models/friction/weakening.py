@@ -30,6 +30,13 @@ def rate(thl, th, thr, v, lp):
     return 0.0
 
 
+@njit(cache=True, inline="always")
+def rate_lap(lap, th, v, lp):
+    """:func:`rate`, which reads no neighbour: the law has no diffusion of theta (``lap`` unread;
+    :mod:`stickslip.models.lattice`)."""
+    return rate(th, th, th, v, lp)
+
+
 def weakening_g(p: Any) -> float:
     """g = (1 + 2 alpha V / (1 - sigma))^-2 of CL's velocity weakening; -phi'(V) = 2 alpha g."""
     return float((1.0 + 2.0 * p.alpha * p.V / (1.0 - p.sigma)) ** -2)
