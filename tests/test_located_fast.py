@@ -106,8 +106,9 @@ CASES = {
 
 
 #: The default run's cases (each case compiles both forms for its composition, about a minute on
-#: two cores); the others run with the slow tests.
-DEFAULT_CASES = ("eq4-beta0.5", "fixed-ends", "carlson-langer-disordered")
+#: two cores); the others run with the slow tests (a disordered located chain is also in the
+#: default run through tests/test_disorder_analysis.py).
+DEFAULT_CASES = ("eq4-beta0.5", "fixed-ends")
 
 
 @pytest.mark.parametrize("name", [n if n in DEFAULT_CASES else pytest.param(n, marks=pytest.mark.slow) for n in CASES])
@@ -123,7 +124,7 @@ def test_fast_equals_dense_bit_for_bit(name):
         assert work["stepped"] + work["switch_steps"] < round(t / params.dt) and work["jumps"] > 0, work
 
 
-@pytest.mark.parametrize("name", ["eq4-beta0.5", "carlson-langer", "rate-state"])
+@pytest.mark.parametrize("name", ["eq4-beta0.5", pytest.param("carlson-langer", marks=pytest.mark.slow), "rate-state"])
 def test_calls_that_end_inside_events_and_a_full_event_buffer(name):
     params, t_load, t, _ = CASES[name]
     start = _loaded(params, t_load)

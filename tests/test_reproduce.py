@@ -346,6 +346,7 @@ def test_help_lists_the_modes(capsys):
     )
 
 
+@pytest.mark.slow  # the default run compares plot and catalog in tests/test_catalog.py
 def test_plot_reproduce_and_catalog_give_the_same_tau_on_the_same_run(tiny_run, tmp_path, capsys):
     """One stationary window (analysis.stats.chain_runs.stationary_from) and one fit for all three."""
     out, _ = tiny_run

@@ -145,6 +145,7 @@ def cluster():
     lc.close()
 
 
+@pytest.mark.slow  # its parts run by default: points, findings, the ramp's stop
 def test_tiny_disorder_study_end_to_end(tmp_path, cluster):
     spec = study("disorder", "tiny")
     first = run_study(spec, tmp_path, scheduler=cluster, progress=False)
