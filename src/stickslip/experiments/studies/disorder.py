@@ -383,7 +383,8 @@ def _tables(found: dict[str, Any]) -> list[tuple[str, list[str], list[dict[str, 
 
 
 COST = {
-    "quick": "about 90 s on two free cores with the kernels compiled (measured; 28 minutes before the ramp runs stopped at depinning, on a loaded machine)",
+    "quick": "about 90 s on two free cores with the kernels compiled (measured; 28 minutes before the ramp "
+    "runs stopped at depinning, on a loaded machine)",
     "full": "about 11 minutes on two free cores with the kernels compiled (measured)",
 }
 
