@@ -83,12 +83,15 @@ def disorder_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     raise ValueError(f"part must be a, b or c (got {part!r})")
 
 
-def _run_from_rest(point: dict[str, Any], point_dir: Path, t_end: float, hooks=()):
+def _run_from_rest(point: dict[str, Any], point_dir: Path, t_end: float, *, stop_at_depinning: bool = False):
     """The point's chain from rest at x_i = 0 (every block stuck, springs unstretched), sampled
-    with the count of moving blocks (``n_samples`` samples to ``t_end``, default 400)."""
+    with the count of moving blocks (``n_samples`` samples to ``t_end``, default 400); with
+    ``stop_at_depinning``, ended by :func:`depinned_stop` at the sampling steps."""
     from stickslip.experiments.sweep import run_chain_point
 
     params = _params(point)
+    interval = _sample_interval(point, params, t_end)
+    hooks = (depinned_stop(int(round(interval / params.dt))),) if stop_at_depinning else ()
     run = run_chain_point(
         params,
         t_end,
@@ -96,9 +99,9 @@ def _run_from_rest(point: dict[str, Any], point_dir: Path, t_end: float, hooks=(
         start="rest",
         perturbation=0.0,
         seed=0,
-        sample_interval=_sample_interval(point, params, t_end),
+        sample_interval=interval,
         sample_moving=True,
-        hooks=tuple(hooks),
+        hooks=hooks,
     )
     return params, run
 
@@ -140,9 +143,7 @@ def ramp_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
     F_c where every block first moves, and the run's costs. The run ends at F_c
     (:func:`depinned_stop`) or at ``t_end``; ``t_stop`` and ``F_end`` say where."""
     t_end = float(point["t_end"])
-    p = _params(point)
-    every = int(round(_sample_interval(point, p, t_end) / p.dt))  # the run's sampling steps
-    params, run = _run_from_rest(point, point_dir, t_end, hooks=[depinned_stop(every)])
+    params, run = _run_from_rest(point, point_dir, t_end, stop_at_depinning=True)
     samples = run.samples
     F_start, r = float(point["F_start"]), float(point["r"])
     F_c = depinning_force(samples["t"].values, samples["n_moving"].values, params.N, F_start, r)
