@@ -399,6 +399,7 @@ OUT_FILES: dict[str, frozenset[str]] = {
     "lab step": frozenset({"step.nc", "step.json"}) | _figures("step"),
     "lab shs": frozenset({"shs.nc", "shs.json"}) | _figures("shs"),
     "lab fit": frozenset({"fit.nc", "fit.json", "posterior.nc"}) | _figures("fit", "posterior"),
+    "lab invert": frozenset({"invert.nc", "invert.json"}) | _figures("invert"),
     "sweep": frozenset({"summary.parquet", "summary.csv"}),
     "reproduce": frozenset({"runs", *PAPER, "report.json", "report.html", MANIFEST}),
 }

@@ -1,11 +1,13 @@
-"""`stickslip lab step|shs|fit|bench`: the rock-friction laboratory's protocols (:mod:`stickslip.lab`).
+"""`stickslip lab step|shs|fit|invert|bench`: the rock-friction laboratory's protocols (:mod:`stickslip.lab`).
 
 ``lab step`` runs the quasi-static spring-slider through steps of the load-point velocity and
 reports each step's peak and new steady state; ``lab shs`` runs a slide-hold-slide test and
 reports the peak friction against hold time and the healing rate d(Delta mu)/d log10 t_hold;
 ``lab fit DATA.csv ...`` fits rate-and-state parameters to records, with standard errors and
-correlations; ``lab bench`` measures the quasi-static solver against a plain-Python odeint model
-and the CPU time of a four-parameter fit. The friction parameters are the lab's (docs/lab.md):
+correlations; ``lab invert DATA.csv`` fits the inertial spring-slider to the periods, stress
+drops and peak slip rates of a stick-slip record or a table of its cycles; ``lab bench``
+measures the quasi-static solver against a plain-Python odeint model and the CPU time of a
+four-parameter fit. The friction parameters are the lab's (docs/lab.md):
 each of --a, --b, --Dc, --mu0, --V0, --k is required, none has a default.
 """
 
@@ -78,7 +80,7 @@ def _out_options(p: argparse.ArgumentParser, stem: str) -> None:
 
 
 def register(sub) -> None:
-    """Add ``lab`` with ``step``, ``shs``, ``fit`` and ``bench`` to the parser."""
+    """Add ``lab`` with ``step``, ``shs``, ``fit``, ``invert`` and ``bench`` to the parser."""
     lab = sub.add_parser(
         "lab",
         help="the rock-friction laboratory: velocity steps, slide-hold-slide, fits (quasi-static spring-slider)",
@@ -132,6 +134,43 @@ def register(sub) -> None:
     f.add_argument("--velocity", default=None, help="load-point velocity column")
     _out_options(f, "fit")
     f.set_defaults(handler=run_fit)
+
+    v = ls.add_parser(
+        "invert",
+        help="fit the inertial spring-slider to stick-slip cycles: periods, stress drops, peak slip rates",
+        description="Least-squares inversion of a stick-slip record (or a table of its cycles) with the inertial "
+        "spring-slider (the chain's single block with a mass, docs/lab.md); the friction options give the "
+        "starting values and the fixed parameters. A fit costs some 60 runs of the model: 10-30 s of CPU "
+        "for a record of 400 time units sampled every 0.1 at dt = 2.5e-3.",
+    )  # fmt: skip
+    v.add_argument("data", metavar="DATA.csv",
+                   help="a record (columns time, mu or friction, load_point or velocity) or, with --cycles, "
+                        "a table of cycles (columns period, stress_drop, peak_slip_rate, peak_friction)")  # fmt: skip
+    _add_law_options(v, k_help="stiffness k in friction per unit displacement (> 0; fitted if in --free)")
+    v.add_argument("--M", type=float_arg("M"), default=None, help="mass per unit normal stress (> 0; required)")
+    v.add_argument("--dt", type=float_arg("dt"), default=None, help="the integrator's step (default M / 4)")
+    v.add_argument("--free", type=_words, default=["a", "b", "Dc"],
+                   help="parameters fitted: a, b, Dc, mu0, k, M (default a,b,Dc)")  # fmt: skip
+    v.add_argument("--observables", type=_words, default=None,
+                   help="observables compared: period, stress_drop, peak_slip_rate, peak_friction "
+                        "(default all four, or a table's columns)")  # fmt: skip
+    v.add_argument("--cycles", action="store_true", help="DATA.csv is a table of cycles, one row per cycle")
+    v.add_argument("--V", type=float_arg("V"), default=None,
+                   help="load-point velocity (with --cycles; default a record's mean in the window)")  # fmt: skip
+    v.add_argument("--window", type=_floats("window"), default=None,
+                   help="read only t0 <= t <= t1 of data and model (T0,T1; default a record's 2nd half)")  # fmt: skip
+    v.add_argument("--t-end", dest="t_end", type=float_arg("t-end"), default=None,
+                   help="with --cycles: length of the model run (default 12 observed periods)")  # fmt: skip
+    v.add_argument("--sample-interval", dest="sample_interval", type=float_arg("sample-interval"), default=None,
+                   help="with --cycles: sampling of the model run (default the observed period / 200)")  # fmt: skip
+    v.add_argument("--floor", type=float_arg("floor"), default=1e-3,
+                   help="relative floor of the observables' standard errors (default 1e-3)")  # fmt: skip
+    v.add_argument("--time", default="time", help="time column (default time)")
+    v.add_argument("--friction", default=None, help="friction column (default mu or friction)")
+    v.add_argument("--displacement", default=None, help="load-point displacement column")
+    v.add_argument("--velocity", default=None, help="load-point velocity column")
+    _out_options(v, "invert")
+    v.set_defaults(handler=run_invert)
 
     b = ls.add_parser(
         "bench",
@@ -295,6 +334,65 @@ def run_fit(args) -> Result:
             lines.append(f"  {name:>8} = {v['mean']:.6g} +- {v['std']:.2g}  [{lo:.6g}, {hi:.6g}]")
     lines += [f"wrote {p}" for p in data.get("outputs", [])]
     return Result(data=data, text="\n".join(lines))
+
+
+def _cycles_csv(path: str):
+    """A table of cycles from a CSV file (a header line, one row per cycle)."""
+    import pandas as pd
+
+    try:
+        table = pd.read_csv(path)
+    except (ValueError, OSError) as exc:
+        raise CommandError(f"DATA {path}: not a table of cycles ({str(exc).splitlines()[0]})") from None
+    if len(table) == 0:
+        raise CommandError(f"DATA {path}: no cycles")
+    return table
+
+
+def run_invert(args) -> Result:
+    """Handler of ``stickslip lab invert``."""
+    from dataclasses import replace
+
+    from stickslip.lab.inversion import invert_stick_slip
+    from stickslip.lab.records import Record
+
+    if args.M is None:
+        raise CommandError("--M is required: the mass per unit normal stress (> 0)")
+    model = replace(_model(args), form="asinh")
+    model.require_k()
+    window = _pair("--window", args.window)
+    if not Path(args.data).is_file():
+        raise CommandError(f"DATA {args.data}: no such file")
+    if args.cycles:
+        data = _cycles_csv(args.data)
+    else:
+        data = Record.from_csv(
+            args.data, time=args.time, friction=args.friction, displacement=args.displacement, velocity=args.velocity
+        )
+    own = OUT_FILES["lab invert"]
+    with owned_out_dir(args.out, own, "stickslip lab invert", overwrite=args.overwrite) as out:
+        res = invert_stick_slip(
+            data, model, args.M, args.free, observables_=args.observables, dt=args.dt, V=args.V, window=window,
+            t_end=args.t_end, sample_interval=args.sample_interval, floor=args.floor,
+        )  # fmt: skip
+        data_out = res.summary()
+        if out is not None:
+            from stickslip import io
+            from stickslip.plotting.lab import plot_stick_slip
+            from stickslip.plotting.style import save_figure
+
+            written = [io.write_dataset(out / "invert.nc", res.to_dataset())]
+            written += save_figure(plot_stick_slip(res), out / "invert")
+            written.append(io.write_json(out / "invert.json", data_out))
+            data_out["outputs"] = [str(p) for p in written]
+    lines = [f"stick-slip inversion: {len(res.cycles)} cycles, chi2 {res.chi2:.3g} ({res.dof} dof): {res.message}"]
+    for name, o in data_out["observables"].items():
+        lines.append(f"  {name:>15}: observed {o['observed']:.6g} +- {o['stderr']:.2g}, model {o['model']:.6g}")
+    for name, p in data_out["parameters"].items():
+        lines.append(f"  {name:>8} = {p['value']:.6g} +- {p['stderr']:.2g}")
+    lines.append(f"CPU {res.cpu_seconds:.3g} s, {res.evaluations} model runs")
+    lines += [f"wrote {p}" for p in data_out.get("outputs", [])]
+    return Result(data=data_out, text="\n".join(lines))
 
 
 def run_bench(args) -> Result:

@@ -1,5 +1,5 @@
 """Figures of the rock-friction laboratory (:mod:`stickslip.lab`): a velocity step, a
-slide-hold-slide test and a fit (data, model, residuals)."""
+slide-hold-slide test, a fit (data, model, residuals) and a stick-slip inversion."""
 
 from __future__ import annotations
 
@@ -158,4 +158,45 @@ def plot_posterior(post, result=None) -> Figure:
             ax.tick_params(labelsize=6)
             for label in ax.get_xticklabels():
                 label.set_rotation(30)
+    return fig
+
+
+def plot_stick_slip(result) -> Figure:
+    """A stick-slip inversion (:func:`stickslip.lab.inversion.invert_stick_slip`): the data's and the
+    fitted model's friction over the window read (a record's samples as dots), and each observable
+    observed (with two standard errors) against the model's, relative to the observed mean.
+
+    Parameters
+    ----------
+    result : StickSlipResult
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fig, (ax, axo) = new_figure(1, 2, width=7.5, height=2.8, gridspec_kw={"width_ratios": [2.2, 1]})
+    s = result.series
+    t0, t1 = s["window"]
+    if "data_t" in s:
+        m = (s["data_t"] >= t0) & (s["data_t"] <= t1)
+        ax.plot(s["data_t"][m], s["data_mu"][m], ".", ms=2, color=SIM, alpha=0.5, label="data")
+    ax.plot(s["t"], s["mu"], color="k", lw=1.0, label="model")
+    ax.set_xlabel("time")
+    ax.set_ylabel(r"friction $k\,(p - x)$")
+    ax.legend(fontsize=8, loc="lower left")
+    text = "\n".join(
+        f"{n} = {v:.4g} ± {e:.2g}" for n, v, e in zip(result.names, result.values, result.errors, strict=True)
+    )
+    ax.text(0.99, 0.02, text, transform=ax.transAxes, ha="right", va="bottom", fontsize=7)
+    y = np.arange(len(result.observables))
+    scale = np.where(result.observed != 0.0, np.abs(result.observed), 1.0)
+    axo.errorbar(
+        np.zeros(y.size), y, xerr=2.0 * result.stderr / scale, fmt="o", color=SIM, ms=4, label="observed ± 2 s.e."
+    )
+    axo.plot((result.predicted - result.observed) / scale, y, "x", color=THEORY, ms=6, label="model")
+    axo.set_yticks(y, [o.replace("_", " ") for o in result.observables], fontsize=7)
+    axo.axvline(0.0, color="0.7", lw=0.8)
+    axo.set_xlabel("relative to the observed mean")
+    axo.legend(fontsize=7, loc="best")
+    axo.set_title(rf"$\chi^2$ = {result.chi2:.3g} ({result.dof} dof)", fontsize=8)
     return fig
