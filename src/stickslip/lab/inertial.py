@@ -20,7 +20,7 @@ from stickslip.lab.history import LoadHistory
 from stickslip.lab.laws import RateState, friction_of
 from stickslip.models.params import ParameterError, check_number
 
-__all__ = ["FRICTION", "critical_stiffness_inertial", "sample"]
+__all__ = ["FRICTION", "check_route", "critical_stiffness_inertial", "sample"]
 
 #: The chain's friction piece of each evolution law the inertial route has.
 FRICTION = {"aging": "rate-state", "slip": "rate-state-slip"}
@@ -45,6 +45,25 @@ def critical_stiffness_inertial(model: RateState, M: float, V: float) -> float:
     return (b - a) / dc * (1.0 + M * V * V / (a * dc))
 
 
+def check_route(model: RateState) -> float:
+    """The model's k, where the inertial route has the model: one state variable with the aging or
+    the slip law, a finite k, no radiation damping.
+
+    Raises
+    ------
+    ParameterError
+        Anything else, in one line.
+    """
+    k = model.require_k()
+    if model.n_states != 1 or model.law[0] not in FRICTION:
+        raise ParameterError(
+            f"the inertial route has one state variable with the aging or the slip law (got law {','.join(model.law)})"
+        )
+    if model.eta != 0.0 or k == np.inf:
+        raise ParameterError("the inertial route has a finite k and no radiation damping (eta = 0)")
+    return k
+
+
 def chain_params_of(model: RateState, M: float, dt: float, history: LoadHistory):
     """The chain's parameters (N = 1) of the inertial spring-slider (module docstring).
 
@@ -55,13 +74,7 @@ def chain_params_of(model: RateState, M: float, dt: float, history: LoadHistory)
     """
     from stickslip.models.presets import chain_params
 
-    k = model.require_k()
-    if model.n_states != 1 or model.law[0] not in FRICTION:
-        raise ParameterError(
-            f"the inertial route has one state variable with the aging or the slip law (got law {','.join(model.law)})"
-        )
-    if model.eta != 0.0 or k == np.inf:
-        raise ParameterError("the inertial route has a finite k and no radiation damping (eta = 0)")
+    k = check_route(model)
     return chain_params(
         "sakaguchi", N=1, drive="history", history=history, friction=FRICTION[model.law[0]], threshold="none",
         rs_a=model.a, rs_b=model.b[0], Dc=model.Dc[0], v0=model.V0, mu0=model.mu0, sigma_n=1.0, K=k,

@@ -35,7 +35,7 @@ from scipy.optimize import least_squares
 
 from stickslip.lab.cycles import OBSERVABLES, cycle_table, observables
 from stickslip.lab.history import LoadHistory
-from stickslip.lab.inertial import sample
+from stickslip.lab.inertial import check_route, sample
 from stickslip.lab.laws import RateState
 from stickslip.lab.records import Record
 from stickslip.models.params import ParameterError, check_number
@@ -297,7 +297,7 @@ def invert_stick_slip(
         raise ParameterError(f"observables must be distinct names of {', '.join(OBSERVABLES)} (got {names})")
     if len(names) < len(free):
         raise ParameterError(f"{len(free)} free parameters need at least as many observables (got {len(names)})")
-    k0 = model.require_k()
+    k0 = check_route(model)
     M = check_number("M", M, low=0.0, low_open=True)
     dt = M / 4.0 if dt is None else check_number("dt", dt, low=0.0, low_open=True)
     floor = check_number("floor", floor, low=0.0)
