@@ -77,7 +77,8 @@ def test_the_neutral_oscillation_at_the_inertial_critical_stiffness_has_the_rice
     assert abs(drops[-1] / drops[0] - 1.0) < 0.05
 
 
-def test_noise_free_record_gives_back_its_parameters(noisy):
+@pytest.mark.slow  # a second fit of two parameters (20-40 s under load)
+def test_noise_free_record_gives_back_its_parameters():
     rec = synthetic_stick_slip(TRUE, M, HISTORY, sample_interval=0.2)
     res = invert_stick_slip(rec, TRUE.with_values(b=0.0105, Dc=0.9), M, ("b", "Dc"))
     np.testing.assert_allclose(res.values, [0.01, 1.0], rtol=2e-3)
@@ -105,6 +106,7 @@ def test_three_parameters_with_the_mass_within_two_standard_errors(noisy):
         assert abs(value - truth) < 2.0 * err, (name, value, err)
 
 
+@pytest.mark.slow  # a record made, then a fit (about 20 s under load)
 def test_a_table_of_cycles_is_inverted_at_its_velocity():
     rec = synthetic_stick_slip(TRUE, M, HISTORY, sample_interval=0.2)
     table = cycle_table(rec.t, rec.mu, V=1.0, k=TRUE.k, window=(200.0, 400.0))

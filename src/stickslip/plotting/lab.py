@@ -179,7 +179,7 @@ def plot_stick_slip(result) -> Figure:
     t0, t1 = s["window"]
     if "data_t" in s:
         m = (s["data_t"] >= t0) & (s["data_t"] <= t1)
-        ax.plot(s["data_t"][m], s["data_mu"][m], ".", ms=2, color=SIM, alpha=0.5, label="data")
+        ax.plot(s["data_t"][m], s["data_mu"][m], ".", ms=2, color=SIM["color"], alpha=0.5, label="data")
     ax.plot(s["t"], s["mu"], color="k", lw=1.0, label="model")
     ax.set_xlabel("time")
     ax.set_ylabel(r"friction $k\,(p - x)$")
@@ -191,9 +191,15 @@ def plot_stick_slip(result) -> Figure:
     y = np.arange(len(result.observables))
     scale = np.where(result.observed != 0.0, np.abs(result.observed), 1.0)
     axo.errorbar(
-        np.zeros(y.size), y, xerr=2.0 * result.stderr / scale, fmt="o", color=SIM, ms=4, label="observed ± 2 s.e."
+        np.zeros(y.size),
+        y,
+        xerr=2.0 * result.stderr / scale,
+        fmt="o",
+        color=SIM["color"],
+        ms=4,
+        label="observed ± 2 s.e.",
     )
-    axo.plot((result.predicted - result.observed) / scale, y, "x", color=THEORY, ms=6, label="model")
+    axo.plot((result.predicted - result.observed) / scale, y, "x", color=THEORY["color"], ms=6, label="model")
     axo.set_yticks(y, [o.replace("_", " ") for o in result.observables], fontsize=7)
     axo.axvline(0.0, color="0.7", lw=0.8)
     axo.set_xlabel("relative to the observed mean")
