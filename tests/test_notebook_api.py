@@ -33,6 +33,7 @@ DOCTEST_MODULES = (
     "stickslip.run.outputs",
     "stickslip.run.rundir",
     "stickslip.run.block",
+    "stickslip.lab.cycles",
     "stickslip.plotting",
     "stickslip.experiments.studies.transition",
     "stickslip.experiments.sweep",

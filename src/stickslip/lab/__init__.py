@@ -1,7 +1,8 @@
 """The rock-friction laboratory: load histories, the quasi-static spring-slider, fitting.
 
-A layer of its own beside :mod:`stickslip.analysis`: it imports :mod:`stickslip.models` (and
-the shared helpers), never the plotting, the reports or the command line.
+A layer of its own beside :mod:`stickslip.analysis`: it imports :mod:`stickslip.models`, the
+chain's runs (:mod:`stickslip.run`, for the inertial route) and the shared helpers, never the
+plotting, the reports or the command line.
 
 - :class:`LoadHistory`: velocity steps, holds, tables and lab records (CSV) of the load point;
 - :class:`RateState`: rate-and-state friction in the lab's conventions, any number of state
@@ -9,11 +10,15 @@ the shared helpers), never the plotting, the reports or the command line.
 - :func:`quasi_static`: the massless spring-slider k (p - x) = mu + eta v over a history;
 - :func:`critical_stiffness`: k_c of steady sliding, one or more state variables;
 - :func:`fit`: least-squares fits of records, with standard errors and correlations;
-- :mod:`stickslip.lab.protocols`: velocity steps and slide-hold-slide tests as one call.
+- :mod:`stickslip.lab.protocols`: velocity steps and slide-hold-slide tests as one call;
+- :func:`invert_stick_slip`: the inertial spring-slider (:mod:`stickslip.lab.inertial`) fitted
+  to the periods, stress drops and peak slip rates of a stick-slip record
+  (:mod:`stickslip.lab.cycles`).
 """
 
 from stickslip.lab.fitting import FitResult, fit
 from stickslip.lab.history import LoadHistory
+from stickslip.lab.inversion import StickSlipResult, invert_stick_slip
 from stickslip.lab.laws import LAWS, RateState, steady_friction, steady_theta
 from stickslip.lab.protocols import slide_hold_slide, velocity_step
 from stickslip.lab.records import Record, detrend, synthetic
@@ -26,9 +31,11 @@ __all__ = [
     "LoadHistory",
     "RateState",
     "Record",
+    "StickSlipResult",
     "critical_stiffness",
     "detrend",
     "fit",
+    "invert_stick_slip",
     "quasi_static",
     "slide_hold_slide",
     "steady_friction",
