@@ -124,14 +124,17 @@ def _write(path, rec):
 OPTS = ["--a", "0.005", "--b", "0.0105", "--Dc", "1", "--mu0", "0.6", "--V0", "1", "--k", "2.5e-3"]
 
 
-def test_cli_invert_json_and_outputs(capsys, tmp_path, noisy):
+def test_cli_invert_json_and_outputs(capsys, tmp_path):
+    # a coarse record (a sample every 0.5, a dozen per slip) keeps the fit cheap
+    rec = synthetic_stick_slip(TRUE, M, LoadHistory.steps([1.0], [330.0]), sample_interval=0.5, noise=5e-5, rng=4)
     path = tmp_path / "ss.csv"
-    _write(path, noisy)
-    argv = ["lab", "invert", str(path), *OPTS, "--M", "1e-2", "--free", "b", "--json", "--out", str(tmp_path / "o")]
-    assert main(argv) == 0
+    _write(path, rec)
+    argv = ["lab", "invert", str(path), *OPTS, "--M", "1e-2", "--free", "b", "--observables", "period,stress_drop"]
+    assert main([*argv, "--json", "--out", str(tmp_path / "o")]) == 0
     d = json.loads(capsys.readouterr().out)
     value, err = d["parameters"]["b"]["value"], d["parameters"]["b"]["stderr"]
     assert abs(value - 0.01) < 2.0 * err
+    assert d["cycles"] >= 3 and set(d["observables"]) == {"period", "stress_drop"}
     assert {"invert.nc", "invert.json", "invert.png"} <= {p.name for p in (tmp_path / "o").iterdir()}
 
 

@@ -382,6 +382,8 @@ def invert_stick_slip(
         x_scale="jac",
         diff_step=diff_step,
         max_nfev=max_evaluations,
+        ftol=1e-4,
+        xtol=1e-6,
     )
     cpu = time.process_time() - cpu0
     _, sv, vt = np.linalg.svd(sol.jac, full_matrices=False)

@@ -177,10 +177,10 @@ def plot_stick_slip(result) -> Figure:
     fig, (ax, axo) = new_figure(1, 2, width=7.5, height=2.8, gridspec_kw={"width_ratios": [2.2, 1]})
     s = result.series
     t0, t1 = s["window"]
+    ax.plot(s["t"], s["mu"], color="k", lw=0.8, label="model")
     if "data_t" in s:
         m = (s["data_t"] >= t0) & (s["data_t"] <= t1)
-        ax.plot(s["data_t"][m], s["data_mu"][m], ".", ms=2, color=SIM["color"], alpha=0.5, label="data")
-    ax.plot(s["t"], s["mu"], color="k", lw=1.0, label="model")
+        ax.plot(s["data_t"][m], s["data_mu"][m], ".", ms=3, color=SIM["color"], alpha=0.6, label="data", zorder=3)
     ax.set_xlabel("time")
     ax.set_ylabel(r"friction $k\,(p - x)$")
     ax.legend(fontsize=8, loc="lower left")
