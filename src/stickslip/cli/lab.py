@@ -140,8 +140,8 @@ def register(sub) -> None:
         help="fit the inertial spring-slider to stick-slip cycles: periods, stress drops, peak slip rates",
         description="Least-squares inversion of a stick-slip record (or a table of its cycles) with the inertial "
         "spring-slider (the chain's single block with a mass, docs/lab.md); the friction options give the "
-        "starting values and the fixed parameters. A fit costs some 60 runs of the model: 10-30 s of CPU "
-        "for a record of 400 time units sampled every 0.1 at dt = 2.5e-3.",
+        "starting values and the fixed parameters. A fit costs 10 to 30 runs of the model: 2-5 s of CPU "
+        "for a record of 400 time units sampled every 0.2 at dt = 2.5e-3.",
     )  # fmt: skip
     v.add_argument("data", metavar="DATA.csv",
                    help="a record (columns time, mu or friction, load_point or velocity) or, with --cycles, "
