@@ -107,6 +107,8 @@ def test_bench_measures_both_routes_and_they_agree(capsys):
     assert d["speed_ratio"] > 0.0 and d["fit_cpu_s"] > 0.0
     inertial = d["inertial_history"]
     assert inertial["steps"] == 276_000 and inertial["ratio"] == inertial["history_s"] / inertial["constant_s"]
+    # a fair comparison: the same steps, and the history at one V is the constant V's run bit for bit
+    assert inertial["same_steps"] and inertial["flat_same_state"]
     for name in ("a", "b", "Dc", "mu0"):
         v, e = d["fit"][name]["value"], d["fit"][name]["stderr"]
         assert abs(v - d["fit_truth"][name]) < 5.0 * e
