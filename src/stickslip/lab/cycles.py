@@ -11,7 +11,8 @@ each drop and measures, cycle by cycle (:func:`cycle_table`):
 - ``stress_drop``: the peak friction before the drop less the least friction after it, each
   extremum the vertex of a parabola fitted by least squares through the samples around it;
 - ``peak_slip_rate``: V + max(-dmu/dt) / k, the slip rate at the steepest point of the drop, since
-  dmu/dt = k (V - v) holds exactly for the spring; -dmu/dt from centred differences, its
+  dmu/dt = k (V - v) holds exactly for the spring; -dmu/dt from a Savitzky-Golay filter (a
+  quadratic over five samples; centred differences where the samples are unevenly spaced), its
   maximum again the vertex of a parabola;
 - ``peak_friction``: the peak friction before each drop.
 
