@@ -66,7 +66,8 @@ B_N_CAND = 0  # candidates of the next step, in ``cand``
 B_HEAP = 1  # triggers in the heap
 B_MOVED = 2  # blocks moved in the event in progress, in ``moved``
 B_FRESH = 3  # 1: no candidate list yet (the first call): every block is a candidate
-BOOK_SIZE = 4
+B_MOVING_UPDATES = 4  # block updates of blocks that moved (the mask set), summed over the steps
+BOOK_SIZE = 5
 
 
 class SparseArgs(NamedTuple):
@@ -75,7 +76,8 @@ class SparseArgs(NamedTuple):
 
     cand: np.ndarray  # int64: candidates of the next step
     nxt: np.ndarray  # int64 scratch: candidates being gathered
-    flag: np.ndarray  # int64 per flat index: 1 while in ``nxt``
+    act: np.ndarray  # int64 scratch: the candidates that move in the step
+    mark: np.ndarray  # int64 per flat index: the step whose candidates hold it (-1: none)
     trig: np.ndarray  # int64 per flat index: trigger step of a quiet stopped block (_NEVER: none)
     heap_t: np.ndarray  # int64 binary heap of (trigger, block)
     heap_k: np.ndarray
@@ -185,9 +187,10 @@ def _trigger(lap, xk, thr, K, V, dt, dp, n0, drive, k):
 
 
 @njit(cache=True, inline="always")
-def _add(k, nxt, flag, n):
-    if flag[k] == 0:
-        flag[k] = 1
+def _add(k, nxt, mark, n, stamp):
+    """Append block k to ``nxt`` unless its mark is already ``stamp`` (no flags to clear)."""
+    if mark[k] != stamp:
+        mark[k] = stamp
         nxt[n] = k
         n += 1
     return n
@@ -236,7 +239,8 @@ def run_lattice_sparse(a, sp, drive, friction, threshold, lattice):
     x, v, th, mov, xs = a.x, a.v, a.th, a.mov, a.xs
     vs, ths, mm, a1, b1 = a.vs, a.ths, a.mm, a.a1, a.b1
     ist, geo, par = a.ist, a.geo, a.par
-    cand, nxt, flag, trig, ht, hk, book = sp.cand, sp.nxt, sp.flag, sp.trig, sp.heap_t, sp.heap_k, sp.book
+    cand, nxt, act, mark, trig = sp.cand, sp.nxt, sp.act, sp.mark, sp.trig
+    ht, hk, book = sp.heap_t, sp.heap_k, sp.book
     R, C, W, base = geo[0], geo[1], geo[2], geo[3]
     K, V, dt = par[0], par[1], par[2]
     dp, tp, lp = a.dp, a.tp, a.law
@@ -253,6 +257,7 @@ def run_lattice_sparse(a, sp, drive, friction, threshold, lattice):
             row = base + r * W
             for k in range(row, row + C):
                 cand[nc] = k
+                mark[k] = ist[STEP]
                 nc += 1
                 if a.first_step[k] >= 0:
                     sp.moved[m] = k
@@ -268,19 +273,15 @@ def run_lattice_sparse(a, sp, drive, friction, threshold, lattice):
             return EVENTS_FULL
         nc = book[B_N_CAND]
         hs = book[B_HEAP]
-        # Due triggers join the candidates (stale heap entries are dropped).
-        for j in range(nc):
-            flag[cand[j]] = 1
+        # Due triggers join the candidates (``mark`` = n: already one; stale entries dropped).
         while hs > 0 and ht[0] <= n:
             k = hk[0]
             t = ht[0]
             hs = _pop(ht, hk, hs)
-            if trig[k] == t and flag[k] == 0:
-                flag[k] = 1
+            if trig[k] == t and mark[k] != n:
+                mark[k] = n
                 cand[nc] = k
                 nc += 1
-        for j in range(nc):
-            flag[cand[j]] = 0
         book[B_HEAP] = hs
         if nc == 0:
             # Nothing can change before the earliest trigger: jump there.
@@ -288,85 +289,76 @@ def run_lattice_sparse(a, sp, drive, friction, threshold, lattice):
             if target > n:
                 ist[STEP] = target
                 continue
+        # Stage 1. A stopped block that stays stopped ends the step as it began (x, v = 0 and
+        # theta: its rate is 0); its predictors are what dense writes, read by its neighbours.
         p1 = _pull(V, n, dt, dp, drive)
-        call(lattice, "fill", x, th, geo, p1)
+        na = 0
+        first = -1
         for j in range(nc):
             k = cand[j]
             trig[k] = _NEVER
+            call(lattice, "fill_at", x, th, geo, p1, k)
             f = call(drive, "force_lap", call(lattice, "lap", x, k, W), x[k], K, p1, at(dp, k))
-            if mov[k] != 0.0 or f > _threshold(th[k], tp, threshold, k):
-                mm[k] = 1.0
-            else:
-                mm[k] = 0.0
-            a1[k] = _accel(f, th[k], v[k], mm[k], mp, friction, k)
             b1[k] = call(friction, "rate_lap", call(lattice, "lap", th, k, W), th[k], v[k], at(lp, k))
             xs[k] = x[k] + dt * v[k]
-            vs[k] = v[k] + dt * a1[k]
             ths[k] = th[k] + dt * b1[k]
-        p2 = _pull(V, n + 1, dt, dp, drive)
-        call(lattice, "fill", xs, ths, geo, p2)
-        # Event start and first moves (dense's: the first block in flat order opens it).
-        if ist[EV_ACTIVE] == 0 and ist[N_MOVING] == 0:
-            first = -1
-            for j in range(nc):
-                k = cand[j]
-                if mm[k] != 0.0 and (first < 0 or k < first):
+            if mov[k] != 0.0 or f > _threshold(th[k], tp, threshold, k):
+                mm[k] = 1.0
+                a1[k] = _accel(f, th[k], v[k], mm[k], mp, friction, k)
+                vs[k] = v[k] + dt * a1[k]
+                act[na] = k
+                na += 1
+                if first < 0 or k < first:
                     first = k
-            if first >= 0:
-                ist[EV_ACTIVE] = 1
-                ist[EV_START_STEP] = n
-                ist[EV_START_BLOCK] = first
-                ist[EV_N_MOVED] = 0
-                book[B_MOVED] = 0
-        if ist[EV_ACTIVE] == 1:
-            for j in range(nc):
-                k = cand[j]
-                if mm[k] != 0.0 and a.first_step[k] < 0:
-                    a.first_step[k] = n
-                    a.x0ev[k] = x[k]
-                    ist[EV_N_MOVED] += 1
-                    sp.moved[book[B_MOVED]] = k
-                    book[B_MOVED] += 1
+            else:
+                mm[k] = 0.0
+        p2 = _pull(V, n + 1, dt, dp, drive)
+        # Event start (dense's: the first block in flat order opens it).
+        if ist[EV_ACTIVE] == 0 and ist[N_MOVING] == 0 and first >= 0:
+            ist[EV_ACTIVE] = 1
+            ist[EV_START_STEP] = n
+            ist[EV_START_BLOCK] = first
+            ist[EV_N_MOVED] = 0
+            book[B_MOVED] = 0
+        # Stage 2 and the corrector of the blocks that move; they and their neighbours are the
+        # next step's candidates (``mark`` = n + 1).
         n_moving = 0
         bad = 0
-        for j in range(nc):
-            k = cand[j]
+        nn = 0
+        for j in range(na):
+            k = act[j]
+            if ist[EV_ACTIVE] == 1 and a.first_step[k] < 0:
+                a.first_step[k] = n
+                a.x0ev[k] = x[k]
+                ist[EV_N_MOVED] += 1
+                sp.moved[book[B_MOVED]] = k
+                book[B_MOVED] += 1
+            call(lattice, "fill_at", xs, ths, geo, p2, k)
             f2 = call(drive, "force_lap", call(lattice, "lap", xs, k, W), xs[k], K, p2, at(dp, k))
             a2 = _accel(f2, ths[k], vs[k], mm[k], mp, friction, k)
             b2 = call(friction, "rate_lap", call(lattice, "lap", ths, k, W), ths[k], vs[k], at(lp, k))
             th[k] = th[k] + h2 * (b1[k] + b2)
-            if mm[k] != 0.0:
-                x[k] = x[k] + h2 * (v[k] + vs[k])
-                vn = v[k] + h2 * (a1[k] + a2)
-                if vn <= 0.0:
-                    v[k] = 0.0
-                    mov[k] = 0.0
-                else:
-                    v[k] = vn
-                    mov[k] = 1.0
-                    n_moving += 1
-            else:
+            x[k] = x[k] + h2 * (v[k] + vs[k])
+            vn = v[k] + h2 * (a1[k] + a2)
+            if vn <= 0.0:
                 v[k] = 0.0
                 mov[k] = 0.0
+            else:
+                v[k] = vn
+                mov[k] = 1.0
+                n_moving += 1
             if bad == 0 and not (abs(x[k]) <= _BIG and abs(v[k]) <= _BIG and abs(th[k]) <= _BIG):
                 bad = k
-        # The next step's candidates: blocks that moved in this step and their neighbours.
-        nn = 0
-        for j in range(nc):
-            k = cand[j]
-            if mm[k] != 0.0:
-                nn = _add(k, nxt, flag, nn)
-                m = call(lattice, "neighbours", k, geo, nb)
-                for q in range(m):
-                    nn = _add(nb[q], nxt, flag, nn)
-        # The others leave: predictors as dense writes them for a still block, and a trigger.
+            nn = _add(k, nxt, mark, nn, n + 1)
+            m = call(lattice, "neighbours", k, geo, nb)
+            for q in range(m):
+                nn = _add(nb[q], nxt, mark, nn, n + 1)
+        # The others leave with a trigger (their Laplacian no longer changes).
         hs = book[B_HEAP]
         for j in range(nc):
             k = cand[j]
-            if flag[k] != 0:
+            if mark[k] == n + 1:
                 continue
-            xs[k] = x[k] + dt * v[k]
-            ths[k] = th[k] + dt * 0.0
             t = _trigger(
                 call(lattice, "lap", x, k, W), x[k], _threshold(th[k], tp, threshold, k), K, V, dt, dp, n + 1, drive, k
             )
@@ -378,8 +370,8 @@ def run_lattice_sparse(a, sp, drive, friction, threshold, lattice):
         book[B_HEAP] = hs
         for j in range(nn):
             cand[j] = nxt[j]
-            flag[nxt[j]] = 0
         book[B_N_CAND] = nn
+        book[B_MOVING_UPDATES] += na
         ist[N_MOVING] = n_moving
         ist[BLOCK_UPDATES] += nc
         ist[STEPS_COMPUTED] += 1

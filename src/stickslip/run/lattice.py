@@ -206,7 +206,7 @@ def _sparse_args(p: LatticeParams):
     book[B_FRESH] = 1
     ints = lambda: np.zeros(size, dtype=np.int64)  # noqa: E731
     return SparseArgs(
-        ints(), ints(), ints(), np.full(size, _NEVER, dtype=np.int64),
+        ints(), ints(), ints(), np.full(size, -1, dtype=np.int64), np.full(size, _NEVER, dtype=np.int64),
         np.zeros(2 * size + 16, dtype=np.int64), np.zeros(2 * size + 16, dtype=np.int64), ints(), book,
     )  # fmt: skip
 
