@@ -67,7 +67,8 @@ B_HEAP = 1  # triggers in the heap
 B_MOVED = 2  # blocks moved in the event in progress, in ``moved``
 B_FRESH = 3  # 1: no candidate list yet (the first call): every block is a candidate
 B_MOVING_UPDATES = 4  # block updates of blocks that moved (the mask set), summed over the steps
-BOOK_SIZE = 5
+B_TRIGGERS = 5  # triggers computed (blocks that left the candidates)
+BOOK_SIZE = 6
 
 
 class SparseArgs(NamedTuple):
@@ -82,6 +83,7 @@ class SparseArgs(NamedTuple):
     heap_t: np.ndarray  # int64 binary heap of (trigger, block)
     heap_k: np.ndarray
     moved: np.ndarray  # int64: the event's moved blocks
+    nbr: np.ndarray  # int32 (flat index, 5): the lattice's neighbours of each block (-1: none), then 1 on the rim
     book: np.ndarray  # int64 bookkeeping (indices above)
 
 
@@ -186,14 +188,19 @@ def _trigger(lap, xk, thr, K, V, dt, dp, n0, drive, k):
     return hi
 
 
-@njit(cache=True, inline="always")
-def _add(k, nxt, mark, n, stamp):
-    """Append block k to ``nxt`` unless its mark is already ``stamp`` (no flags to clear)."""
-    if mark[k] != stamp:
-        mark[k] = stamp
-        nxt[n] = k
-        n += 1
-    return n
+@njit(cache=True)
+def _table(nbr, geo, lattice):
+    """The lattice's neighbours of every block (``neighbours``) and whether it reads a ghost cell
+    (``rim``), once: the steps then read a table instead of calling the lattice per block."""
+    R, C, W, base = geo[0], geo[1], geo[2], geo[3]
+    nb = np.zeros(4, dtype=np.int64)
+    for r in range(R):
+        row = base + r * W
+        for k in range(row, row + C):
+            m = call(lattice, "neighbours", k, geo, nb)
+            for q in range(4):
+                nbr[k, q] = nb[q] if q < m else -1
+            nbr[k, 4] = 1 if call(lattice, "rim", k, geo) else 0
 
 
 @njit(cache=True)
@@ -247,8 +254,9 @@ def run_lattice_sparse(a, sp, drive, friction, threshold, lattice):
     mp = (K, dp, tp, lp, a.mass)
     h2 = 0.5 * dt
     cap_ev = a.ev_int.shape[0]
-    nb = np.zeros(4, dtype=np.int64)
+    nbr = sp.nbr
     if book[B_FRESH] == 1:
+        _table(nbr, geo, lattice)
         # Every block a candidate; the moved blocks of an event in progress (a state handed over
         # from another run) from their first moves.
         nc = 0
@@ -283,6 +291,7 @@ def run_lattice_sparse(a, sp, drive, friction, threshold, lattice):
                 cand[nc] = k
                 nc += 1
         book[B_HEAP] = hs
+
         if nc == 0:
             # Nothing can change before the earliest trigger: jump there.
             target = a.n_end if hs == 0 else min(ht[0], a.n_end)
@@ -297,7 +306,8 @@ def run_lattice_sparse(a, sp, drive, friction, threshold, lattice):
         for j in range(nc):
             k = cand[j]
             trig[k] = _NEVER
-            call(lattice, "fill_at", x, th, geo, p1, k)
+            if nbr[k, 4] != 0:
+                call(lattice, "fill_at", x, th, geo, p1, k)
             f = call(drive, "force_lap", call(lattice, "lap", x, k, W), x[k], K, p1, at(dp, k))
             b1[k] = call(friction, "rate_lap", call(lattice, "lap", th, k, W), th[k], v[k], at(lp, k))
             xs[k] = x[k] + dt * v[k]
@@ -333,7 +343,8 @@ def run_lattice_sparse(a, sp, drive, friction, threshold, lattice):
                 ist[EV_N_MOVED] += 1
                 sp.moved[book[B_MOVED]] = k
                 book[B_MOVED] += 1
-            call(lattice, "fill_at", xs, ths, geo, p2, k)
+            if nbr[k, 4] != 0:
+                call(lattice, "fill_at", xs, ths, geo, p2, k)
             f2 = call(drive, "force_lap", call(lattice, "lap", xs, k, W), xs[k], K, p2, at(dp, k))
             a2 = _accel(f2, ths[k], vs[k], mm[k], mp, friction, k)
             b2 = call(friction, "rate_lap", call(lattice, "lap", ths, k, W), ths[k], vs[k], at(lp, k))
@@ -349,10 +360,17 @@ def run_lattice_sparse(a, sp, drive, friction, threshold, lattice):
                 n_moving += 1
             if bad == 0 and not (abs(x[k]) <= _BIG and abs(v[k]) <= _BIG and abs(th[k]) <= _BIG):
                 bad = k
-            nn = _add(k, nxt, mark, nn, n + 1)
-            m = call(lattice, "neighbours", k, geo, nb)
-            for q in range(m):
-                nn = _add(nb[q], nxt, mark, nn, n + 1)
+            # (written out: a helper taking the arrays costs two atomic reference counts a call)
+            if mark[k] != n + 1:
+                mark[k] = n + 1
+                nxt[nn] = k
+                nn += 1
+            for q in range(4):
+                kq = nbr[k, q]
+                if kq >= 0 and mark[kq] != n + 1:
+                    mark[kq] = n + 1
+                    nxt[nn] = kq
+                    nn += 1
         # The others leave with a trigger (their Laplacian no longer changes).
         hs = book[B_HEAP]
         for j in range(nc):
@@ -363,6 +381,7 @@ def run_lattice_sparse(a, sp, drive, friction, threshold, lattice):
                 call(lattice, "lap", x, k, W), x[k], _threshold(th[k], tp, threshold, k), K, V, dt, dp, n + 1, drive, k
             )
             trig[k] = t
+            book[B_TRIGGERS] += 1
             if t != _NEVER:
                 if hs >= ht.shape[0]:
                     hs = _rebuild(ht, hk, trig, geo)

@@ -207,8 +207,19 @@ def _sparse_args(p: LatticeParams):
     ints = lambda: np.zeros(size, dtype=np.int64)  # noqa: E731
     return SparseArgs(
         ints(), ints(), ints(), np.full(size, -1, dtype=np.int64), np.full(size, _NEVER, dtype=np.int64),
-        np.zeros(2 * size + 16, dtype=np.int64), np.zeros(2 * size + 16, dtype=np.int64), ints(), book,
+        np.zeros(2 * size + 16, dtype=np.int64), np.zeros(2 * size + 16, dtype=np.int64), ints(),
+        np.zeros((size, 5), dtype=np.int32), book,
     )  # fmt: skip
+
+
+def _sparse_counts(sparse) -> dict[str, int]:
+    """The active-set path's own counts of this run: block updates of blocks that moved, and
+    triggers computed (blocks that left the candidates); none for the dense path."""
+    from stickslip.kernels.lattice_sparse import B_MOVING_UPDATES, B_TRIGGERS
+
+    if sparse is None:
+        return {}
+    return {"moving_block_updates": int(sparse.book[B_MOVING_UPDATES]), "triggers": int(sparse.book[B_TRIGGERS])}
 
 
 def _args(p: LatticeParams, s: LatticeState, scratch, ev_int, ev_moment, n_end: int):
@@ -337,6 +348,7 @@ def run_lattice(
         "steps": n_end,
         "events": len(events),
         "moving_at_end": int(s.ist[layout.N_MOVING]),
+        **_sparse_counts(sparse),
         "state_sha256": s.sha256(p.lattice),
     }
     return LatticeRun(p, events, s, snapshots, summary, sample_table)

@@ -50,6 +50,12 @@ def fill_at(x, th, geo, p, k):
 
 
 @njit(cache=True, inline="always")
+def rim(k, geo):
+    """Whether block k reads a ghost cell (block 1 or N)."""
+    return k == 1 or k == geo[1]
+
+
+@njit(cache=True, inline="always")
 def neighbours(k, geo, out):
     """The blocks whose force reads block k (k - 1, k + 1; across periodic ends the other end),
     written to ``out``; returns how many."""

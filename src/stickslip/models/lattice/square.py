@@ -102,6 +102,15 @@ def fill_at(x, th, geo, p, k):
 
 
 @njit(cache=True, inline="always")
+def rim(k, geo):
+    """Whether block k reads a ghost cell (it sits on a side): those :func:`fill_at` fills."""
+    R, C, W = geo[0], geo[1], geo[2]
+    r = k // W
+    c = k - r * W
+    return r == 1 or r == R or c == 1 or c == C
+
+
+@njit(cache=True, inline="always")
 def neighbours(k, geo, out):
     """The blocks whose force reads block k through the stencil (left, right, up, down; across
     a periodic side the opposite edge's block), written to ``out``; returns how many."""
