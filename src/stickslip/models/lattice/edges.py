@@ -12,7 +12,6 @@ import re
 
 import numpy as np
 
-
 FREE, FIXED, PERIODIC, DRIVEN = 0, 1, 2, 3
 #: Edge kinds by name, and their codes in a lattice's ``geo`` vector.
 CODES = {"free": FREE, "fixed": FIXED, "periodic": PERIODIC, "driven": DRIVEN}
