@@ -10,9 +10,16 @@ with the mask 0 as long as its force stays at or below its threshold. So each st
 dense's own expressions and in its order within a block:
 
 * the candidates: the blocks that moved in the previous step, their neighbours through the stencil
-  (the lattice's ``neighbours``), and the stopped blocks whose trigger is due;
-* for every other block, its stage-1 predictors are x + dt * 0 and theta + dt * 0 (kept in the
-  scratch arrays when it leaves the candidates), which is what dense writes there.
+  (the lattice's ``neighbours``, read from a table built once), and the stopped blocks whose
+  trigger is due; the ghost cells next to a candidate on a side (the lattice's ``fill_at``), not
+  the whole ring;
+* stage 1 of every candidate; stage 2 and the corrector only of those whose mask is set: a
+  stopped block that stays stopped ends the step with dense's x, v = 0 and theta;
+* for every other block, its stage-1 predictors are x + dt * 0 and theta + dt * 0 (written when
+  it was last a candidate), which is what dense writes there.
+
+The step's cost is that of its candidates and due triggers: no loop over the lattice, no flags to
+clear (a block's ``mark`` is the step whose candidate list holds it).
 
 A stopped block that leaves the candidates gets its trigger: the first step at which its force,
 evaluated with the step's own expression (the drive's ``force_lap`` on its Laplacian, which no
