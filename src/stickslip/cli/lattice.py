@@ -169,8 +169,8 @@ def run_lattice_bench_command(args: argparse.Namespace) -> Result:
     )
     if r["exact_moving_block_updates"]:
         text += (
-            f"; {r['exact_moving_block_updates']:.3g} of moving blocks ({r['moving_fraction']:.2%} of block-steps), "
-            f"{r['exact_ns_per_moving_update']:.3g} ns of exact each"
+            f"; of exact's, {r['exact_moving_block_updates']:.3g} of blocks that moved ({r['moving_fraction']:.2%} "
+            f"of the block-steps), {r['exact_ns_per_moving_update']:.3g} ns of exact each"
         )
     text += f"\n{r['events']} events, mean area {r['event_area_mean']:.4g} blocks"
     return Result(result, text)
