@@ -136,7 +136,7 @@ def test_extent():
         ((3, 3), "top=periodic", "top and bottom must both be periodic"),
         ((3, 3), "middle=free", "side must be one of"),
         ((3, 3), "sticky", "top must be one of"),
-        ((2000, 2000), None, "at most"),
+        ((4097, 4096), None, "at most"),
     ],
 )
 def test_bad_shapes_and_edges(shape, edges, message):
@@ -153,3 +153,84 @@ def test_edges_and_drives_must_fit():
         lattice("square", (3, 3), "left=driven,right=driven", edge_drive=True)
     assert parse_shape("64x32") == (64, 32)
     assert parse_edges("top=fixed", default="periodic")["left"] == "periodic"
+
+
+@pytest.mark.parametrize("draw", range(6))
+def test_fill_at_rim_and_neighbours_are_the_stencil(draw):
+    """The active-set path's pieces of a lattice against the whole ring and the stencil: fill_at
+    writes, next to each block, what fill writes there; rim says whether the block reads a
+    ghost cell; neighbours are the blocks whose 5-point stencil reads it."""
+    rng = np.random.default_rng(draw)
+    rows, cols = (int(n) for n in rng.integers(1, 6, 2))
+    kinds = {}
+    for a, b in (("top", "bottom"), ("left", "right")):
+        if rng.random() < 0.4:
+            kinds[a] = kinds[b] = "periodic"
+        else:
+            kinds[a], kinds[b] = rng.choice(["free", "fixed"], 2)
+    lat = lattice("square", (rows, cols), ",".join(f"{s}={k}" for s, k in kinds.items()))
+    geo = lat.geometry()
+    x, th = rng.normal(size=lat.size), rng.normal(size=lat.size)
+    ref_x, ref_th = x.copy(), th.copy()
+    square.fill.py_func(ref_x, ref_th, geo, 0.25)
+    is_block = np.zeros(lat.size, dtype=bool)
+    is_block[lat.blocks()] = True
+    W = lat.width
+    out = np.zeros(4, dtype=np.int64)
+    for k in lat.blocks():
+        stencil = (k - 1, k + 1, k - W, k + W)
+        ghosts = [j for j in stencil if not is_block[j]]
+        ax, at = x.copy(), th.copy()
+        square.fill_at.py_func(ax, at, geo, 0.25, k)
+        changed = set(np.flatnonzero((ax != x) | (at != th)))
+        assert changed <= set(ghosts)
+        for j in ghosts:
+            assert ax[j] == ref_x[j] and at[j] == ref_th[j]
+        assert square.rim.py_func(k, geo) == bool(ghosts)
+        # who reads k: each block whose stencil (ghosts mapped through a periodic side) holds k
+        readers = set()
+        for q in lat.blocks():
+            for j in (q - 1, q + 1, q - W, q + W):
+                if j == k or (not is_block[j] and _periodic_image(lat, q, j) == k):
+                    readers.add(int(q))
+        readers.discard(int(k))
+        m = square.neighbours.py_func(k, geo, out)
+        assert set(out[:m].tolist()) - {int(k)} == readers
+
+
+def _periodic_image(lat, q, j):
+    """The block a ghost cell j beside block q stands for across a periodic side (None else)."""
+    W, R, C = lat.width, lat.rows, lat.cols
+    r, c = divmod(int(q), W)
+    top, bottom, left, right = lat.edges
+    if j == q - 1 and c == 1 and left == "periodic":
+        return q + C - 1
+    if j == q + 1 and c == C and right == "periodic":
+        return q - C + 1
+    if j == q - W and r == 1 and top == "periodic":
+        return q + (R - 1) * W
+    if j == q + W and r == R and bottom == "periodic":
+        return q - (R - 1) * W
+    return None
+
+
+def test_a_million_blocks_and_more_fit_their_memory():
+    """1024 x 1024 (beyond a chain's largest N) is accepted, N is the lattice's, and the arrays a
+    run holds are the footprint counted by hand: state, scratch and the active-set path's."""
+    from stickslip.models.lattice.edges import MAX_LATTICE_BLOCKS
+    from stickslip.models.presets import chain_params
+    from stickslip.run.lattice import _sparse_args, initial_state
+
+    big = chain_params("carlson-langer", lattice="square", shape="1024x1024")
+    assert big.N == 1024 * 1024 and big.lattice.size == 1026 * 1026
+    # state 6 x 8, scratch 6 x 8, active set 6 x 8 + heap 2 x 2 x 8 + table 5 x 4 bytes per cell
+    assert big.footprint() == 1026 * 1026 * 196 < 2 * 10**9
+    assert MAX_LATTICE_BLOCKS == 4096 * 4096
+    p = chain_params("carlson-langer", lattice="square", shape=(5, 7))
+    s = initial_state(p, "rest", amplitude=0.01)
+    held = sum(getattr(s, f).nbytes for f in ("xg", "vg", "thg", "mov", "first_step", "x0ev"))
+    held += 6 * np.zeros(p.lattice.size).nbytes  # run_lattice's scratch
+    sp = _sparse_args(p)
+    held += sum(a.nbytes for a in sp)
+    # the heap's 16 spare entries of two int64 and the bookkeeping vector besides
+    assert held - p.footprint() == 2 * 16 * 8 + sp.book.nbytes

@@ -100,13 +100,22 @@ def test_command_refusals_are_one_line(argv, names, capsys):
 def test_bench_compares_dense_and_exact_on_the_square(capsys):
     code, stdout, _ = run_cli(
         capsys, "bench", "--model", "carlson-langer", "--lattice", "square", "--shape", "6x6",
-        "--t-prepare", "5", "--t-end", "10", "--json",
+        "--t-prepare", "0", "--t-end", "10", "--json",
     )  # fmt: skip
     assert code == 0
     result = json.loads(stdout)
     assert result["identical"] is True and result["exact_integrator"] == "exact"
-    assert result["t_prepare"] == 5.0 and result["t_timed"] == 10.0
+    assert result["t_prepare"] == 0.0 and result["t_timed"] == 10.0
     assert result["exact_block_updates"] < result["dense_block_updates"] == 36 * 2000
+    # the slow-loading workload's V unless given; the work of the moving blocks within the exact path's
+    assert result["V"] == 0.001 and result["blocks"] == 36 and result["steps"] == 2000
+    assert 0 < result["exact_moving_block_updates"] <= result["exact_block_updates"]
+    assert result["moving_fraction"] == result["exact_moving_block_updates"] / (36 * 2000)
+    code, stdout, _ = run_cli(
+        capsys, "bench", "--model", "carlson-langer", "--lattice", "square", "--shape", "4x4",
+        "--nu", "0.02", "--t-prepare", "5", "--t-end", "2", "--repeat", "1", "--json",
+    )  # fmt: skip
+    assert code == 0 and json.loads(stdout)["V"] == 0.02 and json.loads(stdout)["identical"] is True
 
 
 def test_bench_refusals_are_one_line(capsys):

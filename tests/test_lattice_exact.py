@@ -121,3 +121,13 @@ def test_exact_continues_an_event_in_progress():
     exact = run_lattice(p, t + 30.0, start=prep.state, integrator="exact")
     assert exact.summary["state_sha256"] == dense.summary["state_sha256"]
     assert exact.events.equals(dense.events) and len(exact.events) > 0
+
+
+def test_exact_equals_dense_under_slow_loading():
+    """The bench's regime (nu = 0.001, docs/lattice.md "Speed"): long stick phases, during which
+    the exact path jumps from trigger to trigger, and events of a few blocks between them."""
+    p = chain_params("carlson-langer", lattice="square", shape=(8, 8), nu=0.001)
+    dense, exact = _same(p, 1500.0, "rest", 0.01)
+    assert len(dense.events) > 10
+    assert exact.summary["steps_computed"] < dense.summary["steps_computed"] == dense.summary["steps"]
+    assert exact.summary["moving_block_updates"] <= exact.summary["block_updates"]

@@ -44,7 +44,8 @@ def add_lattice_options(p: argparse.ArgumentParser, *, bench: bool = False) -> N
             type=float_arg("t-prepare", ">= 0"),
             default=None,
             metavar="T",
-            help="with --lattice square: run exact from rest to T first, then time both over --t-end",
+            help="with --lattice square: run exact from rest to T first, then time both over --t-end "
+            "(default: two loading times 2 / V for a plate drive, at V = 0.001 unless given; else 0)",
         )
         return
     g.add_argument(
@@ -132,10 +133,13 @@ def run_lattice_command(args: argparse.Namespace) -> Result:
 
 def run_lattice_bench_command(args: argparse.Namespace) -> Result:
     """`stickslip bench --lattice square --shape RxC`: dense against exact on the square, from the
-    model's state at --t-prepare (default 0), timed over --t-end (default 100)."""
+    model's state at --t-prepare, timed over --t-end. A model pulled by a leaf spring
+    (Carlson-Langer) runs the slow-loading workload :data:`~stickslip.run.lattice.SLOW_LOADING`
+    (V = 0.001 unless --V or --nu is given; --t-prepare 2 / V, --t-end 20); another from t = 0
+    over 100."""
     from stickslip.cli._common import chain_params_from_args
     from stickslip.models.lattice.params import on_lattice
-    from stickslip.run.lattice import bench_lattice
+    from stickslip.run.lattice import SLOW_LOADING, bench_lattice
 
     for name, option in (("profile", "--profile"), ("workload", "--workload"), ("switches", "--switches")):
         if getattr(args, name, None) not in (None, False, "default", "grid"):
@@ -144,16 +148,29 @@ def run_lattice_bench_command(args: argparse.Namespace) -> Result:
         raise CommandError("--lattice square needs --shape ROWSxCOLS (e.g. 64x64)")
     if getattr(args, "param_N", None) is not None:
         raise CommandError("--N goes with the chain; the square's size is --shape")
-    params = on_lattice(chain_params_from_args(args), args.lattice, args.shape, args.edges)
-    t_prepare = 0.0 if args.t_prepare is None else args.t_prepare
-    result = bench_lattice(
-        params, 100.0 if args.t_end is None else args.t_end, t_prepare=t_prepare, repeat=args.repeat or 1
-    )
+    chain = chain_params_from_args(args)
+    slow = chain.drive_piece.leaf_spring
+    if slow and getattr(args, "param_V", None) is None and getattr(args, "param_nu", None) is None:
+        chain = chain_params_from_args(args, V=SLOW_LOADING["V"])
+    params = on_lattice(chain, args.lattice, args.shape, args.edges)
+    if args.t_prepare is not None:
+        t_prepare = args.t_prepare
+    else:
+        t_prepare = SLOW_LOADING["loading_times"] / params.V if slow and params.V > 0 else 0.0
+    t_timed = args.t_end if args.t_end is not None else (SLOW_LOADING["t_timed"] if slow else 100.0)
+    result = bench_lattice(params, t_timed, t_prepare=t_prepare, repeat=args.repeat or (3 if slow else 1))
+    r = result
     text = (
-        f"{result['lattice']}, {result['model']}: from t = {result['t_prepare']:g} over {result['t_timed']:g}: "
-        f"dense {result['dense_seconds']:.3g} s, exact {result['exact_seconds']:.3g} s "
-        f"({result['speedup']:.2f}x; exact path {result['exact_integrator']}), identical {result['identical']}; "
-        f"block updates {result['exact_block_updates']:.3g} against {result['dense_block_updates']:.3g}, "
-        f"{result['events']} events"
+        f"{r['lattice']}, {r['model']} (V = {r['V']:g}): from t = {r['t_prepare']:g} over {r['t_timed']:g}: "
+        f"dense {r['dense_seconds']:.3g} s, exact {r['exact_seconds']:.3g} s ({r['speedup']:.1f}x; processor "
+        f"time {r['cpu_speedup']:.1f}x; exact path {r['exact_integrator']}), identical {r['identical']}\n"
+        f"block updates {r['exact_block_updates']:.3g} against {r['dense_block_updates']:.3g}, "
+        f"{r['exact_ns_per_block_update']:.3g} ns each against {r['dense_ns_per_block_update']:.3g}"
     )
+    if r["exact_moving_block_updates"]:
+        text += (
+            f"; of exact's, {r['exact_moving_block_updates']:.3g} of blocks that moved ({r['moving_fraction']:.2%} "
+            f"of the block-steps), {r['exact_ns_per_moving_update']:.3g} ns of exact each"
+        )
+    text += f"\n{r['events']} events, mean area {r['event_area_mean']:.4g} blocks"
     return Result(result, text)

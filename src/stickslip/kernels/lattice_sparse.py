@@ -10,9 +10,16 @@ with the mask 0 as long as its force stays at or below its threshold. So each st
 dense's own expressions and in its order within a block:
 
 * the candidates: the blocks that moved in the previous step, their neighbours through the stencil
-  (the lattice's ``neighbours``), and the stopped blocks whose trigger is due;
-* for every other block, its stage-1 predictors are x + dt * 0 and theta + dt * 0 (kept in the
-  scratch arrays when it leaves the candidates), which is what dense writes there.
+  (the lattice's ``neighbours``, read from a table built once), and the stopped blocks whose
+  trigger is due; the ghost cells next to a candidate on a side (the lattice's ``fill_at``), not
+  the whole ring;
+* stage 1 of every candidate; stage 2 and the corrector only of those whose mask is set: a
+  stopped block that stays stopped ends the step with dense's x, v = 0 and theta;
+* for every other block, its stage-1 predictors are x + dt * 0 and theta + dt * 0 (written when
+  it was last a candidate), which is what dense writes there.
+
+The step's cost is that of its candidates and due triggers: no loop over the lattice, no flags to
+clear (a block's ``mark`` is the step whose candidate list holds it).
 
 A stopped block that leaves the candidates gets its trigger: the first step at which its force,
 evaluated with the step's own expression (the drive's ``force_lap`` on its Laplacian, which no
@@ -66,7 +73,9 @@ B_N_CAND = 0  # candidates of the next step, in ``cand``
 B_HEAP = 1  # triggers in the heap
 B_MOVED = 2  # blocks moved in the event in progress, in ``moved``
 B_FRESH = 3  # 1: no candidate list yet (the first call): every block is a candidate
-BOOK_SIZE = 4
+B_MOVING_UPDATES = 4  # block updates of blocks that moved (the mask set), summed over the steps
+B_TRIGGERS = 5  # triggers computed (blocks that left the candidates)
+BOOK_SIZE = 6
 
 
 class SparseArgs(NamedTuple):
@@ -75,11 +84,13 @@ class SparseArgs(NamedTuple):
 
     cand: np.ndarray  # int64: candidates of the next step
     nxt: np.ndarray  # int64 scratch: candidates being gathered
-    flag: np.ndarray  # int64 per flat index: 1 while in ``nxt``
+    act: np.ndarray  # int64 scratch: the candidates that move in the step
+    mark: np.ndarray  # int64 per flat index: the step whose candidates hold it (-1: none)
     trig: np.ndarray  # int64 per flat index: trigger step of a quiet stopped block (_NEVER: none)
     heap_t: np.ndarray  # int64 binary heap of (trigger, block)
     heap_k: np.ndarray
     moved: np.ndarray  # int64: the event's moved blocks
+    nbr: np.ndarray  # int32 (flat index, 5): the lattice's neighbours of each block (-1: none), then 1 on the rim
     book: np.ndarray  # int64 bookkeeping (indices above)
 
 
@@ -184,13 +195,19 @@ def _trigger(lap, xk, thr, K, V, dt, dp, n0, drive, k):
     return hi
 
 
-@njit(cache=True, inline="always")
-def _add(k, nxt, flag, n):
-    if flag[k] == 0:
-        flag[k] = 1
-        nxt[n] = k
-        n += 1
-    return n
+@njit(cache=True)
+def _table(nbr, geo, lattice):
+    """The lattice's neighbours of every block (``neighbours``) and whether it reads a ghost cell
+    (``rim``), once: the steps then read a table instead of calling the lattice per block."""
+    R, C, W, base = geo[0], geo[1], geo[2], geo[3]
+    nb = np.zeros(4, dtype=np.int64)
+    for r in range(R):
+        row = base + r * W
+        for k in range(row, row + C):
+            m = call(lattice, "neighbours", k, geo, nb)
+            for q in range(4):
+                nbr[k, q] = nb[q] if q < m else -1
+            nbr[k, 4] = 1 if call(lattice, "rim", k, geo) else 0
 
 
 @njit(cache=True)
@@ -236,15 +253,17 @@ def run_lattice_sparse(a, sp, drive, friction, threshold, lattice):
     x, v, th, mov, xs = a.x, a.v, a.th, a.mov, a.xs
     vs, ths, mm, a1, b1 = a.vs, a.ths, a.mm, a.a1, a.b1
     ist, geo, par = a.ist, a.geo, a.par
-    cand, nxt, flag, trig, ht, hk, book = sp.cand, sp.nxt, sp.flag, sp.trig, sp.heap_t, sp.heap_k, sp.book
+    cand, nxt, act, mark, trig = sp.cand, sp.nxt, sp.act, sp.mark, sp.trig
+    ht, hk, book = sp.heap_t, sp.heap_k, sp.book
     R, C, W, base = geo[0], geo[1], geo[2], geo[3]
     K, V, dt = par[0], par[1], par[2]
     dp, tp, lp = a.dp, a.tp, a.law
     mp = (K, dp, tp, lp, a.mass)
     h2 = 0.5 * dt
     cap_ev = a.ev_int.shape[0]
-    nb = np.zeros(4, dtype=np.int64)
+    nbr = sp.nbr
     if book[B_FRESH] == 1:
+        _table(nbr, geo, lattice)
         # Every block a candidate; the moved blocks of an event in progress (a state handed over
         # from another run) from their first moves.
         nc = 0
@@ -253,6 +272,7 @@ def run_lattice_sparse(a, sp, drive, friction, threshold, lattice):
             row = base + r * W
             for k in range(row, row + C):
                 cand[nc] = k
+                mark[k] = ist[STEP]
                 nc += 1
                 if a.first_step[k] >= 0:
                     sp.moved[m] = k
@@ -268,109 +288,107 @@ def run_lattice_sparse(a, sp, drive, friction, threshold, lattice):
             return EVENTS_FULL
         nc = book[B_N_CAND]
         hs = book[B_HEAP]
-        # Due triggers join the candidates (stale heap entries are dropped).
-        for j in range(nc):
-            flag[cand[j]] = 1
+        # Due triggers join the candidates (``mark`` = n: already one; stale entries dropped).
         while hs > 0 and ht[0] <= n:
             k = hk[0]
             t = ht[0]
             hs = _pop(ht, hk, hs)
-            if trig[k] == t and flag[k] == 0:
-                flag[k] = 1
+            if trig[k] == t and mark[k] != n:
+                mark[k] = n
                 cand[nc] = k
                 nc += 1
-        for j in range(nc):
-            flag[cand[j]] = 0
         book[B_HEAP] = hs
+
         if nc == 0:
             # Nothing can change before the earliest trigger: jump there.
             target = a.n_end if hs == 0 else min(ht[0], a.n_end)
             if target > n:
                 ist[STEP] = target
                 continue
+        # Stage 1. A stopped block that stays stopped ends the step as it began (x, v = 0 and
+        # theta: its rate is 0); its predictors are what dense writes, read by its neighbours.
         p1 = _pull(V, n, dt, dp, drive)
-        call(lattice, "fill", x, th, geo, p1)
+        na = 0
+        first = -1
         for j in range(nc):
             k = cand[j]
             trig[k] = _NEVER
+            if nbr[k, 4] != 0:
+                call(lattice, "fill_at", x, th, geo, p1, k)
             f = call(drive, "force_lap", call(lattice, "lap", x, k, W), x[k], K, p1, at(dp, k))
-            if mov[k] != 0.0 or f > _threshold(th[k], tp, threshold, k):
-                mm[k] = 1.0
-            else:
-                mm[k] = 0.0
-            a1[k] = _accel(f, th[k], v[k], mm[k], mp, friction, k)
             b1[k] = call(friction, "rate_lap", call(lattice, "lap", th, k, W), th[k], v[k], at(lp, k))
             xs[k] = x[k] + dt * v[k]
-            vs[k] = v[k] + dt * a1[k]
             ths[k] = th[k] + dt * b1[k]
-        p2 = _pull(V, n + 1, dt, dp, drive)
-        call(lattice, "fill", xs, ths, geo, p2)
-        # Event start and first moves (dense's: the first block in flat order opens it).
-        if ist[EV_ACTIVE] == 0 and ist[N_MOVING] == 0:
-            first = -1
-            for j in range(nc):
-                k = cand[j]
-                if mm[k] != 0.0 and (first < 0 or k < first):
+            if mov[k] != 0.0 or f > _threshold(th[k], tp, threshold, k):
+                mm[k] = 1.0
+                a1[k] = _accel(f, th[k], v[k], mm[k], mp, friction, k)
+                vs[k] = v[k] + dt * a1[k]
+                act[na] = k
+                na += 1
+                if first < 0 or k < first:
                     first = k
-            if first >= 0:
-                ist[EV_ACTIVE] = 1
-                ist[EV_START_STEP] = n
-                ist[EV_START_BLOCK] = first
-                ist[EV_N_MOVED] = 0
-                book[B_MOVED] = 0
-        if ist[EV_ACTIVE] == 1:
-            for j in range(nc):
-                k = cand[j]
-                if mm[k] != 0.0 and a.first_step[k] < 0:
-                    a.first_step[k] = n
-                    a.x0ev[k] = x[k]
-                    ist[EV_N_MOVED] += 1
-                    sp.moved[book[B_MOVED]] = k
-                    book[B_MOVED] += 1
+            else:
+                mm[k] = 0.0
+        p2 = _pull(V, n + 1, dt, dp, drive)
+        # Event start (dense's: the first block in flat order opens it).
+        if ist[EV_ACTIVE] == 0 and ist[N_MOVING] == 0 and first >= 0:
+            ist[EV_ACTIVE] = 1
+            ist[EV_START_STEP] = n
+            ist[EV_START_BLOCK] = first
+            ist[EV_N_MOVED] = 0
+            book[B_MOVED] = 0
+        # Stage 2 and the corrector of the blocks that move; they and their neighbours are the
+        # next step's candidates (``mark`` = n + 1).
         n_moving = 0
         bad = 0
-        for j in range(nc):
-            k = cand[j]
+        nn = 0
+        for j in range(na):
+            k = act[j]
+            if ist[EV_ACTIVE] == 1 and a.first_step[k] < 0:
+                a.first_step[k] = n
+                a.x0ev[k] = x[k]
+                ist[EV_N_MOVED] += 1
+                sp.moved[book[B_MOVED]] = k
+                book[B_MOVED] += 1
+            if nbr[k, 4] != 0:
+                call(lattice, "fill_at", xs, ths, geo, p2, k)
             f2 = call(drive, "force_lap", call(lattice, "lap", xs, k, W), xs[k], K, p2, at(dp, k))
             a2 = _accel(f2, ths[k], vs[k], mm[k], mp, friction, k)
             b2 = call(friction, "rate_lap", call(lattice, "lap", ths, k, W), ths[k], vs[k], at(lp, k))
             th[k] = th[k] + h2 * (b1[k] + b2)
-            if mm[k] != 0.0:
-                x[k] = x[k] + h2 * (v[k] + vs[k])
-                vn = v[k] + h2 * (a1[k] + a2)
-                if vn <= 0.0:
-                    v[k] = 0.0
-                    mov[k] = 0.0
-                else:
-                    v[k] = vn
-                    mov[k] = 1.0
-                    n_moving += 1
-            else:
+            x[k] = x[k] + h2 * (v[k] + vs[k])
+            vn = v[k] + h2 * (a1[k] + a2)
+            if vn <= 0.0:
                 v[k] = 0.0
                 mov[k] = 0.0
+            else:
+                v[k] = vn
+                mov[k] = 1.0
+                n_moving += 1
             if bad == 0 and not (abs(x[k]) <= _BIG and abs(v[k]) <= _BIG and abs(th[k]) <= _BIG):
                 bad = k
-        # The next step's candidates: blocks that moved in this step and their neighbours.
-        nn = 0
-        for j in range(nc):
-            k = cand[j]
-            if mm[k] != 0.0:
-                nn = _add(k, nxt, flag, nn)
-                m = call(lattice, "neighbours", k, geo, nb)
-                for q in range(m):
-                    nn = _add(nb[q], nxt, flag, nn)
-        # The others leave: predictors as dense writes them for a still block, and a trigger.
+            # (written out: a helper taking the arrays costs two atomic reference counts a call)
+            if mark[k] != n + 1:
+                mark[k] = n + 1
+                nxt[nn] = k
+                nn += 1
+            for q in range(4):
+                kq = nbr[k, q]
+                if kq >= 0 and mark[kq] != n + 1:
+                    mark[kq] = n + 1
+                    nxt[nn] = kq
+                    nn += 1
+        # The others leave with a trigger (their Laplacian no longer changes).
         hs = book[B_HEAP]
         for j in range(nc):
             k = cand[j]
-            if flag[k] != 0:
+            if mark[k] == n + 1:
                 continue
-            xs[k] = x[k] + dt * v[k]
-            ths[k] = th[k] + dt * 0.0
             t = _trigger(
                 call(lattice, "lap", x, k, W), x[k], _threshold(th[k], tp, threshold, k), K, V, dt, dp, n + 1, drive, k
             )
             trig[k] = t
+            book[B_TRIGGERS] += 1
             if t != _NEVER:
                 if hs >= ht.shape[0]:
                     hs = _rebuild(ht, hk, trig, geo)
@@ -378,8 +396,8 @@ def run_lattice_sparse(a, sp, drive, friction, threshold, lattice):
         book[B_HEAP] = hs
         for j in range(nn):
             cand[j] = nxt[j]
-            flag[nxt[j]] = 0
         book[B_N_CAND] = nn
+        book[B_MOVING_UPDATES] += na
         ist[N_MOVING] = n_moving
         ist[BLOCK_UPDATES] += nc
         ist[STEPS_COMPUTED] += 1

@@ -206,9 +206,20 @@ def _sparse_args(p: LatticeParams):
     book[B_FRESH] = 1
     ints = lambda: np.zeros(size, dtype=np.int64)  # noqa: E731
     return SparseArgs(
-        ints(), ints(), ints(), np.full(size, _NEVER, dtype=np.int64),
-        np.zeros(2 * size + 16, dtype=np.int64), np.zeros(2 * size + 16, dtype=np.int64), ints(), book,
+        ints(), ints(), ints(), np.full(size, -1, dtype=np.int64), np.full(size, _NEVER, dtype=np.int64),
+        np.zeros(2 * size + 16, dtype=np.int64), np.zeros(2 * size + 16, dtype=np.int64), ints(),
+        np.zeros((size, 5), dtype=np.int32), book,
     )  # fmt: skip
+
+
+def _sparse_counts(sparse) -> dict[str, int]:
+    """The active-set path's own counts of this run: block updates of blocks that moved, and
+    triggers computed (blocks that left the candidates); none for the dense path."""
+    from stickslip.kernels.lattice_sparse import B_MOVING_UPDATES, B_TRIGGERS
+
+    if sparse is None:
+        return {}
+    return {"moving_block_updates": int(sparse.book[B_MOVING_UPDATES]), "triggers": int(sparse.book[B_TRIGGERS])}
 
 
 def _args(p: LatticeParams, s: LatticeState, scratch, ev_int, ev_moment, n_end: int):
@@ -337,6 +348,7 @@ def run_lattice(
         "steps": n_end,
         "events": len(events),
         "moving_at_end": int(s.ist[layout.N_MOVING]),
+        **_sparse_counts(sparse),
         "state_sha256": s.sha256(p.lattice),
     }
     return LatticeRun(p, events, s, snapshots, summary, sample_table)
@@ -366,38 +378,69 @@ def _record(p: LatticeParams, s: LatticeState, every: int, snaps, times, every_s
         samples.append((n * p.dt, float(np.mean(load - f["x"])), float(np.mean(f["v"])), int(s.ist[layout.N_MOVING])))
 
 
+#: The lattice bench's workload for a model whose drive pulls every block by a leaf spring
+#: (Carlson-Langer, Burridge-Knopoff; docs/lattice.md, "Speed"): slow loading, V = 0.001 unless
+#: given, prepared over two loading times 2 / V from rest, then timed over 20 time units.
+SLOW_LOADING = {"V": 1e-3, "loading_times": 2.0, "t_timed": 20.0}
+
+
 def bench_lattice(p: LatticeParams, t_timed: float, *, t_prepare: float = 0.0, repeat: int = 1) -> dict[str, Any]:
     """Dense against exact on one workload, in one process (docs/lattice.md, "Speed"): the model
     run by exact from ``rest`` (Carlson-Langer's start, A = 0.01) to ``t_prepare``, then continued
-    for ``t_timed`` by each integrator, alternated ``repeat`` times, the fastest kept; whether
-    their states and events are identical, and the work each did."""
+    for ``t_timed`` by each integrator (both compiled first), alternated ``repeat`` times, the
+    fastest kept (wall-clock and processor seconds); whether their states and events are
+    identical, the work each did and its cost per block update, the exact path's block updates
+    per update of a block that moved, and the events' mean area (the cost per event against
+    its size, at any L)."""
     import time
 
     repeat = int(check_number("repeat", repeat, low=1, integer=True))
     prep = run_lattice(p, t_prepare, start="rest", perturbation=0.01, integrator="exact")
-    t_end = prep.summary["t_end"] + check_number("t-end", t_timed, low=0.0, low_open=True)
+    t0_end = prep.summary["t_end"]
+    t_end = t0_end + check_number("t-end", t_timed, low=0.0, low_open=True)
+    for integrator in ("dense", "exact"):  # compile both outside the timings
+        run_lattice(p, t0_end + 2 * p.dt, start=prep.state, integrator=integrator)
     best: dict[str, float] = {}
+    cpu: dict[str, float] = {}
     runs: dict[str, LatticeRun] = {}
     for _ in range(repeat):
         for integrator in ("dense", "exact"):
-            t0 = time.perf_counter()
+            t0, c0 = time.perf_counter(), time.process_time()
             runs[integrator] = run_lattice(p, t_end, start=prep.state, integrator=integrator)
             best[integrator] = min(best.get(integrator, np.inf), time.perf_counter() - t0)
+            cpu[integrator] = min(cpu.get(integrator, np.inf), time.process_time() - c0)
     dense, exact = runs["dense"], runs["exact"]
     before = prep.summary["block_updates"]
+    du = dense.summary["block_updates"] - before
+    eu = exact.summary["block_updates"] - before
+    moving = exact.summary.get("moving_block_updates")
+    steps = exact.summary["steps"] - prep.summary["steps"]
+    ev = exact.events
     return {
         "lattice": p.lattice.describe(),
         "model": p.model,
-        "t_prepare": prep.summary["t_end"],
-        "t_timed": t_end - prep.summary["t_end"],
+        "V": p.V,
+        "blocks": p.lattice.n_blocks,
+        "t_prepare": t0_end,
+        "t_timed": t_end - t0_end,
+        "steps": steps,
         "dense_seconds": best["dense"],
         "exact_seconds": best["exact"],
         "speedup": best["dense"] / best["exact"],
-        "identical": dense.summary["state_sha256"] == exact.summary["state_sha256"]
-        and dense.events.equals(exact.events),
+        "dense_cpu_seconds": cpu["dense"],
+        "exact_cpu_seconds": cpu["exact"],
+        "cpu_speedup": cpu["dense"] / cpu["exact"],
+        "identical": dense.summary["state_sha256"] == exact.summary["state_sha256"] and dense.events.equals(ev),
         "exact_integrator": exact.summary["integrator"],
-        "events": len(exact.events),
-        "dense_block_updates": dense.summary["block_updates"] - before,
-        "exact_block_updates": exact.summary["block_updates"] - before,
+        "events": len(ev),
+        "event_area_mean": float(ev["area"].mean()) if len(ev) else 0.0,
+        "dense_block_updates": du,
+        "exact_block_updates": eu,
+        "dense_ns_per_block_update": 1e9 * cpu["dense"] / max(du, 1),
+        "exact_ns_per_block_update": 1e9 * cpu["exact"] / max(eu, 1),
+        "exact_moving_block_updates": moving,
+        "exact_updates_per_moving_update": eu / moving if moving else None,
+        "exact_ns_per_moving_update": 1e9 * cpu["exact"] / moving if moving else None,
+        "moving_fraction": moving / (p.lattice.n_blocks * steps) if moving and steps else None,
         "state_sha256": exact.summary["state_sha256"],
     }

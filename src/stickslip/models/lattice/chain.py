@@ -38,6 +38,24 @@ def fill(x, th, geo, p):
 
 
 @njit(cache=True, inline="always")
+def fill_at(x, th, geo, p, k):
+    """Set the ghost cell next to block k (at an end) as :func:`fill` does (the active-set path)."""
+    N = geo[1]
+    if k == 1:
+        x[0] = ghost_x(geo[6], x[1], x[N], p)
+        th[0] = ghost_th(geo[6], th[1], th[N])
+    if k == N:
+        x[N + 1] = ghost_x(geo[7], x[N], x[1], p)
+        th[N + 1] = ghost_th(geo[7], th[N], th[1])
+
+
+@njit(cache=True, inline="always")
+def rim(k, geo):
+    """Whether block k reads a ghost cell (block 1 or N)."""
+    return k == 1 or k == geo[1]
+
+
+@njit(cache=True, inline="always")
 def neighbours(k, geo, out):
     """The blocks whose force reads block k (k - 1, k + 1; across periodic ends the other end),
     written to ``out``; returns how many."""

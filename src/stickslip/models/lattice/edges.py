@@ -12,16 +12,21 @@ import re
 
 import numpy as np
 
-from stickslip.models.params import MAX_BLOCKS
-
 FREE, FIXED, PERIODIC, DRIVEN = 0, 1, 2, 3
 #: Edge kinds by name, and their codes in a lattice's ``geo`` vector.
 CODES = {"free": FREE, "fixed": FIXED, "periodic": PERIODIC, "driven": DRIVEN}
 EDGE_KINDS = tuple(CODES)
 #: The sides of the square, in the order of its ``geo`` vector (top is row 1, left is column 1).
 SIDES = ("top", "bottom", "left", "right")
-#: The largest lattice (blocks): a chain's largest N (:data:`stickslip.models.params.MAX_BLOCKS`).
-MAX_LATTICE_BLOCKS = MAX_BLOCKS
+#: Bytes per cell of the padded layout that a run on a lattice holds (docs/lattice.md, "Memory"):
+#: the state (x, v, theta, the moving mask, the first moves and x there: 6 x 8), the Heun scratch
+#: (6 x 8) and the active-set path's own arrays (candidates, next, moving, marks, triggers, moved
+#: blocks: 6 x 8; the heap of 2 size entries of two int64: 32; the neighbour table of 5 int32: 20).
+BYTES_PER_CELL = 6 * 8 + 6 * 8 + 6 * 8 + 32 + 20
+#: The largest lattice (blocks), 4096 x 4096: its arrays take BYTES_PER_CELL x the padded cells,
+#: about 3.3 GB, and every flat index fits the neighbour table's int32. A chain's largest N
+#: (:data:`stickslip.models.params.MAX_BLOCKS`) is the chain kernels' and does not bound a lattice.
+MAX_LATTICE_BLOCKS = 4096 * 4096
 
 
 class LatticeError(ValueError):

@@ -7,18 +7,32 @@ from dataclasses import dataclass
 from typing import Any
 
 from stickslip.models.lattice import LATTICES, LatticeError, lattice
-from stickslip.models.params import ChainParams, ParameterError
+from stickslip.models.params import MAX_BLOCKS, ChainParams, ParameterError
 
 
 @dataclass(frozen=True)
 class LatticeParams:
     """The model ``chain`` (pieces and parameters, eq. (4) and its relatives) on ``lattice``
     (:mod:`stickslip.models.lattice`): every parameter of the model is the chain's, read at each
-    block; the chain's N is the lattice's number of blocks. Attributes of the model are read
+    block; the chain's N is the lattice's number of blocks (up to a chain's largest; ``N`` here is
+    always the lattice's). Attributes of the model are read
     through (``p.K``, ``p.drive_piece``)."""
 
     chain: ChainParams
     lattice: Any
+
+    @property
+    def N(self) -> int:
+        """The number of blocks, the lattice's (the chain's N stops at a chain's largest)."""
+        return self.lattice.n_blocks
+
+    def footprint(self) -> int:
+        """Bytes of the arrays a run on the lattice holds, state, scratch and the active-set
+        path's bookkeeping (:data:`~stickslip.models.lattice.edges.BYTES_PER_CELL` per cell of
+        the padded layout); snapshots and the event table come on top."""
+        from stickslip.models.lattice.edges import BYTES_PER_CELL
+
+        return BYTES_PER_CELL * self.lattice.size
 
     def __getattr__(self, name: str) -> Any:
         # Only after construction (not for the fields themselves, which unpickling looks up first).
@@ -65,6 +79,10 @@ def on_lattice(chain: ChainParams, name: str, shape: Any = None, edges: Any = No
         lat = lattice(name, chain.N if shape is None else shape, edges, edge_drive=edge_drive, ends=chain.ends)
     except LatticeError as exc:
         raise ParameterError(str(exc)) from None
-    if lat.n_blocks != chain.N:
-        chain = chain.replace(N=lat.n_blocks)
+    # The chain's N is the lattice's number of blocks up to a chain's largest (ChainParams' bound,
+    # the chain kernels'); nothing on a lattice reads it (p.N is the lattice's, per-block values
+    # are refused above).
+    n = min(lat.n_blocks, MAX_BLOCKS)
+    if n != chain.N:
+        chain = chain.replace(N=n)
     return LatticeParams(chain, lat)
