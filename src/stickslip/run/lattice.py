@@ -139,6 +139,38 @@ class LatticeRun:
     #: samples every ``sample_every``: t, the mean slip deficit (the load point V t less x, over
     #: the blocks), the mean velocity and the number of moving blocks; None unless asked for
     samples: pd.DataFrame | None = None
+    #: the slip field and the first-move step of each block over (event, row, col) of the events
+    #: asked for (``slip_maps`` of :func:`run_lattice`); None unless asked for
+    event_fields: xr.Dataset | None = None
+
+    def __repr__(self) -> str:
+        return (
+            f"LatticeRun({self.params.lattice.describe()}, {self.params.model}, "
+            f"t_end={self.summary.get('t_end')}, events={len(self.events)})"
+        )
+
+    @property
+    def plot(self):
+        """This run's figures (:class:`stickslip.plotting.lattice.LatticePlots`), lent to it by
+        :mod:`stickslip.accessors`: ``run.plot.snapshot()``, ``.event()``, ``.rupture()``."""
+        from stickslip import accessors
+
+        return accessors.accessor("lattice_plot", self)
+
+    def plot_snapshot(self, t: float | None = None, *, fields=("x", "v", "stopped")):
+        """x, v and stopped over (row, col) as images, at the end or at the snapshot nearest ``t``:
+        :func:`stickslip.plotting.lattice.snapshot_images`; returns the Figure."""
+        return self.plot.snapshot(t, fields=fields)
+
+    def plot_event(self, event: int | None = None):
+        """The slip map of a recorded event (the largest by default) with its rupture front's
+        contours: :func:`stickslip.plotting.lattice.slip_map`; returns the Figure."""
+        return self.plot.event(event)
+
+    def plot_rupture(self, event: int | None = None, *, frames: int = 6):
+        """The rupture front of a recorded event as a sequence of ``frames`` images:
+        :func:`stickslip.plotting.lattice.rupture_frames`; returns the Figure."""
+        return self.plot.rupture(event, frames=frames)
 
     def final(self) -> xr.Dataset:
         """The final state as fields over (row, col)."""
@@ -147,7 +179,8 @@ class LatticeRun:
 
     def write(self, out: str | Path) -> Path:
         """Write run.json (parameters, summary), events.csv and state.nc (the final state over
-        (row, col) and the snapshots over (time, row, col)) into the directory ``out``."""
+        (row, col) and the snapshots over (time, row, col)) into the directory ``out``, and
+        event_fields.nc where events' fields were recorded."""
         from stickslip import io
 
         out = Path(out)
@@ -160,6 +193,8 @@ class LatticeRun:
         if self.snapshots is not None:
             ds = ds.merge(self.snapshots.rename({k: f"snapshot_{k}" for k in self.snapshots.data_vars}))
         io.write_dataset(out / "state.nc", ds)
+        if self.event_fields is not None:
+            io.write_dataset(out / "event_fields.nc", self.event_fields)
         return out
 
 
