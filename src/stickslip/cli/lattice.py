@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from stickslip.cli._common import CommandError, Result, float_arg
+from stickslip.cli._common import CommandError, Result, float_arg, int_arg
 
 #: Options of `stickslip chain` that do not yet go with a lattice, as the command spells them.
 _NOT_YET = {
@@ -55,6 +55,20 @@ def add_lattice_options(p: argparse.ArgumentParser, *, bench: bool = False) -> N
         metavar="T",
         help="with --lattice square: snapshots of x, v, theta and stopped over (row, col) every T, in state.nc",
     )
+    g.add_argument(
+        "--slip-maps",
+        type=int_arg("slip-maps", "in [0, 256]"),
+        default=None,
+        metavar="K",
+        help="with --lattice square: the slip field and first-move steps of the K largest events, in event_fields.nc",
+    )
+    g.add_argument(
+        "--slip-min-area",
+        type=int_arg("slip-min-area", ">= 1"),
+        default=None,
+        metavar="A",
+        help="with --slip-maps: only events of at least A blocks",
+    )
 
 
 def wants_lattice(args: argparse.Namespace) -> bool:
@@ -67,6 +81,9 @@ def wants_lattice(args: argparse.Namespace) -> bool:
             raise CommandError("--t-prepare goes with --lattice square")
         if getattr(args, "lattice_snapshot_every", None) is not None:
             raise CommandError("--snapshot-every goes with --lattice square (the chain has --snapshot)")
+        for option, name in (("--slip-maps", "slip_maps"), ("--slip-min-area", "slip_min_area")):
+            if getattr(args, name, None) is not None:
+                raise CommandError(f"{option} goes with --lattice square")
         return False
     return True
 
@@ -101,6 +118,8 @@ def run_lattice_command(args: argparse.Namespace) -> Result:
         snapshot_every=args.lattice_snapshot_every,
         integrator=args.integrator or "exact",
         sample_every=args.sample_interval,
+        slip_maps=args.slip_maps or 0,
+        slip_min_area=args.slip_min_area or 1,
     )
     out = Path(args.out) if args.out else None
     if out is not None:
@@ -125,7 +144,9 @@ def run_lattice_command(args: argparse.Namespace) -> Result:
     ]
     if out is not None:
         text.append(
-            f"written: {out}/run.json, events.csv, state.nc" + (", samples.csv" if run.samples is not None else "")
+            f"written: {out}/run.json, events.csv, state.nc"
+            + (", samples.csv" if run.samples is not None else "")
+            + (", event_fields.nc" if run.event_fields is not None else "")
         )
     return Result(summary, "\n".join(text))
 
