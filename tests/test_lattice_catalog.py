@@ -93,3 +93,12 @@ def test_catalog_command_on_a_lattice_run_directory(tmp_path, capsys):
     table = pd.read_csv(out / "catalog" / "catalog.csv")
     np.testing.assert_allclose(table["magnitude"], (2.0 / 3.0) * np.log10(window["moment"]), rtol=1e-14)
     assert (out / "catalog" / "frequency_magnitude.png").is_file()
+
+
+def test_examples_in_the_docstrings_run():
+    import doctest
+
+    import stickslip.analysis.stats.lattice_catalog as module
+
+    result = doctest.testmod(module, optionflags=doctest.ELLIPSIS, verbose=False)
+    assert result.attempted > 0 and result.failed == 0, result

@@ -421,6 +421,37 @@ def _replay(p: LatticeParams, pre: LatticeState, step_end: int) -> tuple[Lattice
     return s, first, float(ev_moment[0])
 
 
+class LatticeStepper:
+    """Advance lattice states of one model to given steps with no outputs kept: the loop of
+    :func:`run_lattice` without its tables, for methods that restart short runs many times
+    (:mod:`stickslip.analysis.dynamics.lyapunov_lattice`). It runs the dense reference, which
+    gives the bits of either integrator and keeps no bookkeeping of its own between calls, so
+    any number of states (a reference and its twins) share one stepper."""
+
+    def __init__(self, p: LatticeParams):
+        self.p = p
+        self.scratch = [np.zeros(p.lattice.size) for _ in range(6)]
+        self.ev_int = np.zeros((EVENT_ROWS, 9), dtype=np.int64)
+        self.ev_moment = np.zeros(EVENT_ROWS)
+        self._call = None
+
+    def advance(self, s: LatticeState, step: int) -> tuple[LatticeState, int]:
+        """Advance ``s`` in place to ``step``; returns it and the slip events completed."""
+        events0 = int(s.ist[layout.N_EVENTS])
+        while True:
+            args = _args(self.p, s, self.scratch, self.ev_int, self.ev_moment, step)
+            if self._call is None:
+                self._call = _kernel(self.p, args, None)
+            status = self._call(args)
+            s.ist[layout.EV_COUNT] = 0
+            if status == layout.NONFINITE:
+                raise NonFiniteState(
+                    f"the run became non-finite at step {s.step} (flat index {s.ist[layout.BAD_BLOCK]})"
+                )
+            if status == layout.DONE:
+                return s, int(s.ist[layout.N_EVENTS]) - events0
+
+
 def _every(p: LatticeParams, interval: float | None, name: str) -> int:
     """An output interval in steps (0: none)."""
     if interval is None:
