@@ -135,3 +135,17 @@ def test_slip_maps_go_with_a_lattice(capsys):
 
     assert main(["chain", "--N", "5", "--t-end", "1", "--slip-maps", "2"]) == 2
     one_line_error(capsys, "--slip-maps", "--lattice square")
+
+
+@pytest.mark.parametrize(
+    ("argv", "names"),
+    [
+        (["--slip-maps", "999"], ["--slip-maps", "256"]),
+        (["--slip-maps", "2", "--slip-min-area", "0"], ["--slip-min-area"]),
+    ],
+)
+def test_slip_map_options_out_of_range(capsys, argv, names):
+    from stickslip.cli import main
+
+    assert main(["chain", "--lattice", "square", "--shape", "3x3", "--t-end", "1", *argv]) == 2
+    one_line_error(capsys, *names)

@@ -103,6 +103,12 @@ def run_lattice_command(args: argparse.Namespace) -> Result:
         raise CommandError("--lattice square needs --shape ROWSxCOLS (e.g. 64x64)")
     if getattr(args, "param_N", None) is not None:
         raise CommandError("--N goes with the chain; the square's size is --shape")
+    from stickslip.run.lattice_fields import MAX_SLIP_MAPS
+
+    if args.slip_maps is not None and not 0 <= args.slip_maps <= MAX_SLIP_MAPS:
+        raise CommandError(f"--slip-maps must be in [0, {MAX_SLIP_MAPS}] (got {args.slip_maps})")
+    if args.slip_min_area is not None and (args.slip_min_area < 1 or not args.slip_maps):
+        raise CommandError(f"--slip-min-area must be >= 1 and goes with --slip-maps (got {args.slip_min_area})")
     params = on_lattice(chain_params_from_args(args), args.lattice, args.shape, args.edges)
     t_end = 1000.0 if args.t_end is None else args.t_end
     start = args.start or ("rest" if params.drive_piece.leaf_spring else "paper")

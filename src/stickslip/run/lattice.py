@@ -354,8 +354,6 @@ def run_lattice(
     scratch = [np.zeros(size) for _ in range(6)]
     ev_int = np.zeros((EVENT_ROWS, 9), dtype=np.int64)
     ev_moment = np.zeros(EVENT_ROWS)
-    sparse = _sparse_args(p) if integrator == "exact" and sparse_path(p) else None
-    call = _kernel(p, _args(p, s, scratch, ev_int, ev_moment, n_end), sparse)
     from stickslip.run.lattice_fields import EventFields
 
     maps = EventFields(p, slip_maps, slip_min_area)  # checked whether asked for or not
@@ -363,6 +361,8 @@ def run_lattice(
         ev_int, ev_moment = ev_int[:1], ev_moment[:1]  # the kernel returns after each event
     else:
         maps = None
+    sparse = _sparse_args(p) if integrator == "exact" and sparse_path(p) else None
+    call = _kernel(p, _args(p, s, scratch, ev_int, ev_moment, n_end), sparse)
     rows, moments, snaps, times, samples = [], [], [], [], []
     while True:
         _record(p, s, every, snaps, times, every_sample, samples)
