@@ -80,6 +80,7 @@ def snapshot_images(run, t: float | None = None, *, fields=("x", "v", "stopped")
         data = np.asarray(state[name], dtype=float)
         im = ax.imshow(data, cmap=_CMAPS[name], extent=_extent((rows, cols)), interpolation="nearest")
         fig.colorbar(im, ax=ax, shrink=0.8)
+        ax.grid(False)
         ax.set_title(_LABELS[name], fontsize=9)
         ax.set_xlabel("column")
         ax.set_ylabel("row")
@@ -129,6 +130,7 @@ def slip_map(run, event: int | None = None) -> Figure:
     fig, ax = new_figure(1, 1, width=5.0, height=max(2.0, 4.2 * min(rows / cols, 1.5)))
     im = ax.imshow(slip, cmap="viridis", extent=_extent((rows, cols)), interpolation="nearest")
     fig.colorbar(im, ax=ax, shrink=0.8, label="slip")
+    ax.grid(False)
     moved = first >= 0
     if moved.sum() > 3 and len(np.unique(first[moved])) > 2:
         t_front = np.where(moved, (first - int(f["step_start"])) * dt, np.nan)
@@ -193,6 +195,7 @@ def rupture_frames(run, event: int | None = None, *, frames: int = 6) -> Figure:
         ax.set_title(f"t - t0 = {times[k]:.3g}", fontsize=8)
         ax.set_xticks([])
         ax.set_yticks([])
+        ax.grid(False)
     fig.colorbar(im, ax=axes.ravel().tolist(), shrink=0.8, label="time of first move")
     fig.suptitle(f"{_title(run)}: rupture front of event {int(f['event'])}", fontsize=9)
     return fig
