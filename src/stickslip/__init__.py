@@ -49,6 +49,7 @@ __all__ = ["BlockParams", "ChainParams", "ParameterError", "__version__", *_LAZY
 from stickslip import accessors as _accessors  # noqa: E402
 
 _accessors.register("plot", "stickslip.plotting.run:RunPlots")
+_accessors.register("lattice_plot", "stickslip.plotting.lattice:LatticePlots")
 
 
 __getattr__, __dir__ = lazy_names(__name__, _LAZY)

@@ -30,7 +30,9 @@ def register(sub) -> None:
         "tau, the power law against lognormal, exponential, stretched exponential and exponential cut-off "
         "(Vuong) with a KS-bootstrap goodness of fit, the inter-event times with renewal fits, and the moment "
         "rate of the largest slips where the run kept profiles. Tables, figures (PNG and PDF), catalog.json "
-        "and a page index.html go to RUN_DIR/catalog (or --out DIR). See docs/statistics.md.",
+        "and a page index.html go to RUN_DIR/catalog (or --out DIR). See docs/statistics.md. On a lattice run "
+        "directory (`stickslip chain --lattice square ... --out`): magnitudes M = (2/3) log10 moment, the b-value, "
+        "tau of the moments and the recurrence, from the events of the run's second half (docs/lattice.md).",
     )
     p.add_argument("run_dir", metavar="RUN_DIR", help="a chain run directory (run.json, state.nc, events.parquet)")
     p.add_argument("--out", metavar="DIR", default=None, help="where the catalogue goes (default RUN_DIR/catalog)")
@@ -71,8 +73,52 @@ def run_catalog_command(args: argparse.Namespace) -> Result:
             f"--out {out} is the run directory itself; the catalogue goes into a folder of its own "
             "(default RUN_DIR/catalog)"
         )
+    from stickslip.run.lattice_dir import is_lattice_run_dir
+
+    if is_lattice_run_dir(run_dir):
+        return _lattice_catalog(args, run_dir, out)
     with reading_run_dir(run_dir):  # a run writing into it (chain --resume) and the catalogue exclude each other
         return _catalog(args, run_dir, out)
+
+
+def _lattice_catalog(args: argparse.Namespace, run_dir: Path, out: Path) -> Result:
+    """The catalogue of a lattice run directory into ``out``: catalog.csv, catalog.json and the
+    frequency-magnitude figure (docs/lattice.md, "The catalogue")."""
+    from stickslip import io
+    from stickslip.analysis.stats.lattice_catalog import lattice_catalog_analysis
+    from stickslip.plotting.catalog import frequency_magnitude_figure
+    from stickslip.plotting.style import save_figure
+    from stickslip.report.catalog_page import CATALOG_FILES
+
+    cat = lattice_catalog_analysis(run_dir, dm=args.dm, bootstrap=args.bootstrap, seed=args.seed)
+    formats = ("png", "pdf")
+    with owned_out_dir(out, CATALOG_FILES, "stickslip catalog", overwrite=args.overwrite) as out:
+        with staged_writes(out, CATALOG_FILES.__contains__) as stage:
+            io.write_csv(stage / "catalog.csv", cat.table)
+            io.write_json(stage / "catalog.json", cat.summary)
+            fig = frequency_magnitude_figure(cat)
+            figures = [p.name for p in save_figure(fig, stage / "frequency_magnitude", formats=formats)] if fig else []
+    s = cat.summary
+    fm = s["frequency_magnitude"]
+    bv = fm.get("b_value")
+    lines = [f"{s['lattice']}: {s['n_events']} events at t >= {s['window']['t_from']:g} ({s['n_positive']} with M)"]
+    lines.append(
+        f"- b = {bv['b']:.3f} ± {bv['b_err_shi_bolt']:.3f} above Mc = {bv['mc']:.3g} ({bv['n']} events)"
+        if bv
+        else f"- {fm.get('reason', 'no b-value')}"
+    )
+    if "tau" in s["moments"]:
+        lines.append(f"- tau of the moments {s['moments']['tau']:.3f}: b = (3/2)(tau - 1) = {fm['b_from_tau']:.3f}")
+    else:
+        lines.append(f"- moments: {s['moments']['reason']}")
+    lines.append(f"written to {out}: catalog.csv, catalog.json" + (", " + ", ".join(figures) if figures else ""))
+    data = {
+        "out": str(out),
+        "run_dir": str(run_dir),
+        **s,
+        "outputs": [str(out / n) for n in ["catalog.csv", "catalog.json", *figures]],
+    }
+    return Result(data, "\n".join(lines))
 
 
 def _catalog(args: argparse.Namespace, run_dir: Path, out: Path) -> Result:

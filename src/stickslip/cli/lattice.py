@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from stickslip.cli._common import CommandError, Result, float_arg
+from stickslip.cli._common import CommandError, Result, float_arg, int_arg
 
 #: Options of `stickslip chain` that do not yet go with a lattice, as the command spells them.
 _NOT_YET = {
@@ -56,6 +56,20 @@ def add_lattice_options(p: argparse.ArgumentParser, *, bench: bool = False) -> N
         metavar="T",
         help="with --lattice square: snapshots of x, v, theta and stopped over (row, col) every T, in state.nc",
     )
+    g.add_argument(
+        "--slip-maps",
+        type=int_arg("slip-maps", "in [0, 256]"),
+        default=None,
+        metavar="K",
+        help="with --lattice square: the slip field and first-move steps of the K largest events, in event_fields.nc",
+    )
+    g.add_argument(
+        "--slip-min-area",
+        type=int_arg("slip-min-area", ">= 1"),
+        default=None,
+        metavar="A",
+        help="with --slip-maps: only events of at least A blocks",
+    )
 
 
 def wants_lattice(args: argparse.Namespace) -> bool:
@@ -68,6 +82,9 @@ def wants_lattice(args: argparse.Namespace) -> bool:
             raise CommandError("--t-prepare goes with --lattice square")
         if getattr(args, "lattice_snapshot_every", None) is not None:
             raise CommandError("--snapshot-every goes with --lattice square (the chain has --snapshot)")
+        for option, name in (("--slip-maps", "slip_maps"), ("--slip-min-area", "slip_min_area")):
+            if getattr(args, name, None) is not None:
+                raise CommandError(f"{option} goes with --lattice square")
         return False
     return True
 
@@ -87,6 +104,12 @@ def run_lattice_command(args: argparse.Namespace) -> Result:
         raise CommandError("--lattice square needs --shape ROWSxCOLS (e.g. 64x64)")
     if getattr(args, "param_N", None) is not None:
         raise CommandError("--N goes with the chain; the square's size is --shape")
+    from stickslip.run.lattice_fields import MAX_SLIP_MAPS
+
+    if args.slip_maps is not None and not 0 <= args.slip_maps <= MAX_SLIP_MAPS:
+        raise CommandError(f"--slip-maps must be in [0, {MAX_SLIP_MAPS}] (got {args.slip_maps})")
+    if args.slip_min_area is not None and (args.slip_min_area < 1 or not args.slip_maps):
+        raise CommandError(f"--slip-min-area must be >= 1 and goes with --slip-maps (got {args.slip_min_area})")
     params = on_lattice(chain_params_from_args(args), args.lattice, args.shape, args.edges)
     t_end = 1000.0 if args.t_end is None else args.t_end
     start = args.start or ("rest" if params.drive_piece.leaf_spring else "paper")
@@ -102,6 +125,8 @@ def run_lattice_command(args: argparse.Namespace) -> Result:
         snapshot_every=args.lattice_snapshot_every,
         integrator=args.integrator or "exact",
         sample_every=args.sample_interval,
+        slip_maps=args.slip_maps or 0,
+        slip_min_area=args.slip_min_area or 1,
     )
     out = Path(args.out) if args.out else None
     if out is not None:
@@ -126,7 +151,9 @@ def run_lattice_command(args: argparse.Namespace) -> Result:
     ]
     if out is not None:
         text.append(
-            f"written: {out}/run.json, events.csv, state.nc" + (", samples.csv" if run.samples is not None else "")
+            f"written: {out}/run.json, events.csv, state.nc"
+            + (", samples.csv" if run.samples is not None else "")
+            + (", event_fields.nc" if run.event_fields is not None else "")
         )
     return Result(summary, "\n".join(text))
 

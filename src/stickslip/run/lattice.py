@@ -60,6 +60,10 @@ class LatticeState:
     def step(self) -> int:
         return int(self.ist[layout.STEP])
 
+    def copy(self) -> LatticeState:
+        """A copy of every array."""
+        return LatticeState(**{k: np.array(getattr(self, k)) for k in self.__dataclass_fields__})
+
     def sha256(self, lat) -> str:
         """SHA-256 of x, v, theta (float64 little-endian, the blocks in row-major order) then
         stopped (1 byte each): on the chain lattice, :meth:`stickslip.run.state.ChainState.sha256`."""
@@ -139,6 +143,38 @@ class LatticeRun:
     #: samples every ``sample_every``: t, the mean slip deficit (the load point V t less x, over
     #: the blocks), the mean velocity and the number of moving blocks; None unless asked for
     samples: pd.DataFrame | None = None
+    #: the slip field and the first-move step of each block over (event, row, col) of the events
+    #: asked for (``slip_maps`` of :func:`run_lattice`); None unless asked for
+    event_fields: xr.Dataset | None = None
+
+    def __repr__(self) -> str:
+        return (
+            f"LatticeRun({self.params.lattice.describe()}, {self.params.model}, "
+            f"t_end={self.summary.get('t_end')}, events={len(self.events)})"
+        )
+
+    @property
+    def plot(self):
+        """This run's figures (:class:`stickslip.plotting.lattice.LatticePlots`), lent to it by
+        :mod:`stickslip.accessors`: ``run.plot.snapshot()``, ``.event()``, ``.rupture()``."""
+        from stickslip import accessors
+
+        return accessors.accessor("lattice_plot", self)
+
+    def plot_snapshot(self, t: float | None = None, *, fields=("x", "v", "stopped")):
+        """x, v and stopped over (row, col) as images, at the end or at the snapshot nearest ``t``:
+        :func:`stickslip.plotting.lattice.snapshot_images`; returns the Figure."""
+        return self.plot.snapshot(t, fields=fields)
+
+    def plot_event(self, event: int | None = None):
+        """The slip map of a recorded event (the largest by default) with its rupture front's
+        contours: :func:`stickslip.plotting.lattice.slip_map`; returns the Figure."""
+        return self.plot.event(event)
+
+    def plot_rupture(self, event: int | None = None, *, frames: int = 6):
+        """The rupture front of a recorded event as a sequence of ``frames`` images:
+        :func:`stickslip.plotting.lattice.rupture_frames`; returns the Figure."""
+        return self.plot.rupture(event, frames=frames)
 
     def final(self) -> xr.Dataset:
         """The final state as fields over (row, col)."""
@@ -147,7 +183,8 @@ class LatticeRun:
 
     def write(self, out: str | Path) -> Path:
         """Write run.json (parameters, summary), events.csv and state.nc (the final state over
-        (row, col) and the snapshots over (time, row, col)) into the directory ``out``."""
+        (row, col) and the snapshots over (time, row, col)) into the directory ``out``, and
+        event_fields.nc where events' fields were recorded."""
         from stickslip import io
 
         out = Path(out)
@@ -160,6 +197,8 @@ class LatticeRun:
         if self.snapshots is not None:
             ds = ds.merge(self.snapshots.rename({k: f"snapshot_{k}" for k in self.snapshots.data_vars}))
         io.write_dataset(out / "state.nc", ds)
+        if self.event_fields is not None:
+            io.write_dataset(out / "event_fields.nc", self.event_fields)
         return out
 
 
@@ -271,6 +310,8 @@ def run_lattice(
     snapshot_every: float | None = None,
     sample_every: float | None = None,
     integrator: str = "exact",
+    slip_maps: int = 0,
+    slip_min_area: int = 1,
 ) -> LatticeRun:
     """Integrate the model ``p`` on its lattice to ``t_end`` (docs/lattice.md): with the
     active-set exact path where it applies, else with the reference integrator
@@ -294,6 +335,13 @@ def run_lattice(
         ``exact``: the active-set path (:mod:`stickslip.kernels.lattice_sparse`) where the model's
         stopped blocks keep every bit (a drive on every block, a friction without theta), the
         dense reference otherwise; ``dense``: the reference. Both give the same bits.
+    slip_maps : int
+        Record the slip field and each block's first-move step of the ``slip_maps`` largest
+        events by moment (:attr:`LatticeRun.event_fields`, :mod:`stickslip.run.lattice_fields`;
+        at most :data:`~stickslip.run.lattice_fields.MAX_SLIP_MAPS`). 0 (the default) records none
+        and leaves the run as it is; with it the kernel returns after every event.
+    slip_min_area : int
+        Only events of at least this area (blocks) are recorded.
 
     Returns
     -------
@@ -308,7 +356,7 @@ def run_lattice(
     if isinstance(start, LatticeState):
         if start.xg.shape != (p.lattice.size,):
             raise ParameterError(f"start holds {start.xg.size} cells, the lattice's layout {p.lattice.size}")
-        s = LatticeState(**{k: np.array(getattr(start, k)) for k in start.__dataclass_fields__})
+        s = start.copy()
     else:
         s = initial_state(p, start, amplitude=perturbation, seed=seed)
     every = _every(p, snapshot_every, "snapshot_every")
@@ -317,16 +365,26 @@ def run_lattice(
     scratch = [np.zeros(size) for _ in range(6)]
     ev_int = np.zeros((EVENT_ROWS, 9), dtype=np.int64)
     ev_moment = np.zeros(EVENT_ROWS)
+    from stickslip.run.lattice_fields import EventFields
+
+    maps = EventFields(p, slip_maps, slip_min_area)  # checked whether asked for or not
+    if maps.largest:
+        ev_int, ev_moment = ev_int[:1], ev_moment[:1]  # the kernel returns after each event
+    else:
+        maps = None
     sparse = _sparse_args(p) if integrator == "exact" and sparse_path(p) else None
     call = _kernel(p, _args(p, s, scratch, ev_int, ev_moment, n_end), sparse)
     rows, moments, snaps, times, samples = [], [], [], [], []
     while True:
         _record(p, s, every, snaps, times, every_sample, samples)
         target = min(n_end, _next(s.step, every), _next(s.step, every_sample))
+        pre = s.copy() if maps is not None else None
         status = call(_args(p, s, scratch, ev_int, ev_moment, target))
         k = int(s.ist[layout.EV_COUNT])
         rows.append(ev_int[:k].copy())
         moments.append(ev_moment[:k].copy())
+        if maps is not None and k:
+            maps.offer(pre, ev_int[0], float(ev_moment[0]))
         s.ist[layout.EV_COUNT] = 0
         if status == layout.NONFINITE:
             raise NonFiniteState(f"the run became non-finite at step {s.step} (flat index {s.ist[layout.BAD_BLOCK]})")
@@ -351,7 +409,59 @@ def run_lattice(
         **_sparse_counts(sparse),
         "state_sha256": s.sha256(p.lattice),
     }
-    return LatticeRun(p, events, s, snapshots, summary, sample_table)
+    fields = maps.dataset(_replay) if maps is not None else None
+    return LatticeRun(p, events, s, snapshots, summary, sample_table, fields)
+
+
+def _replay(p: LatticeParams, pre: LatticeState, step_end: int) -> tuple[LatticeState, np.ndarray, float]:
+    """The event that closes in step ``step_end``, run again by the dense reference from ``pre``
+    (a state before its end, whatever the integrator that made it: both give the same bits):
+    (the state after it, each block's first-move step in it (-1: none), its moment)."""
+    s = pre.copy()
+    scratch = [np.zeros(p.lattice.size) for _ in range(6)]
+    ev_int, ev_moment = np.zeros((1, 9), dtype=np.int64), np.zeros(1)
+    call = _kernel(p, _args(p, s, scratch, ev_int, ev_moment, step_end), None)
+    call(_args(p, s, scratch, ev_int, ev_moment, step_end))
+    first = s.first_step.copy()  # reset by the event's end, so read before its last step
+    s.x0ev[first < 0] = np.nan
+    call(_args(p, s, scratch, ev_int, ev_moment, step_end + 1))
+    from stickslip.kernels.lattice import L_END_STEP
+
+    if int(s.ist[layout.EV_COUNT]) != 1 or int(ev_int[0, L_END_STEP]) != step_end:
+        raise RuntimeError(f"the replay of the event ending at step {step_end} did not end there")
+    first[(first < 0) & ~np.isnan(s.x0ev)] = step_end  # blocks whose first move was the last step
+    return s, first, float(ev_moment[0])
+
+
+class LatticeStepper:
+    """Advance lattice states of one model to given steps with no outputs kept: the loop of
+    :func:`run_lattice` without its tables, for methods that restart short runs many times
+    (:mod:`stickslip.analysis.dynamics.lyapunov_lattice`). It runs the dense reference, which
+    gives the bits of either integrator and keeps no bookkeeping of its own between calls, so
+    any number of states (a reference and its twins) share one stepper."""
+
+    def __init__(self, p: LatticeParams):
+        self.p = p
+        self.scratch = [np.zeros(p.lattice.size) for _ in range(6)]
+        self.ev_int = np.zeros((EVENT_ROWS, 9), dtype=np.int64)
+        self.ev_moment = np.zeros(EVENT_ROWS)
+        self._call = None
+
+    def advance(self, s: LatticeState, step: int) -> tuple[LatticeState, int]:
+        """Advance ``s`` in place to ``step``; returns it and the slip events completed."""
+        events0 = int(s.ist[layout.N_EVENTS])
+        while True:
+            args = _args(self.p, s, self.scratch, self.ev_int, self.ev_moment, step)
+            if self._call is None:
+                self._call = _kernel(self.p, args, None)
+            status = self._call(args)
+            s.ist[layout.EV_COUNT] = 0
+            if status == layout.NONFINITE:
+                raise NonFiniteState(
+                    f"the run became non-finite at step {s.step} (flat index {s.ist[layout.BAD_BLOCK]})"
+                )
+            if status == layout.DONE:
+                return s, int(s.ist[layout.N_EVENTS]) - events0
 
 
 def _every(p: LatticeParams, interval: float | None, name: str) -> int:

@@ -27,7 +27,9 @@ RUN_ID_FILE = ".run_id"
 #: Where ``stickslip plot`` draws a run's figures by default (RUN_DIR/figures), and their names
 #: (:func:`stickslip.plotting.run.run_figures`): the run owns that folder while it holds only these.
 PLOT_FOLDER = "figures"
-PLOT_FILE = re.compile(r"(length|snapshot_final|snapshot_t[^/]*|sizes|fronts)\.(png|pdf|svg)")
+PLOT_FILE = re.compile(
+    r"(length|snapshot_final|snapshot_t[^/]*|sizes|fronts|slip_map_e\d+|rupture_e\d+)\.(png|pdf|svg)"
+)
 #: Where ``stickslip catalog`` writes a run's catalogue by default (RUN_DIR/catalog), its figures
 #: and every file it may write there: the run owns that folder while it holds only these.
 CATALOG_FOLDER = "catalog"

@@ -33,7 +33,6 @@ perturbation's energy that every block has whatever its neighbours do).
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -43,6 +42,7 @@ import numpy as np
 import pandas as pd
 
 from stickslip.analysis.dynamics.benettin import METHOD, LyapunovResult, check_run, two_trajectory_exponent
+from stickslip.models.lattice import norm
 from stickslip.models.params import ChainParams, ParameterError, steps_for
 from stickslip.run.driver import ChainState, Stepper, run_chain
 from stickslip.run.errors import short_runs_expected
@@ -53,26 +53,18 @@ NORM = "Euclidean norm of (sqrt(K) e_i, v_i, theta_i), e_i = x_{i-1} - x_i, x_0 
 
 
 def separation(ref: ChainState, twin: ChainState, params: ChainParams) -> np.ndarray:
-    """The separation twin - ref in the coordinates y = (sqrt(K) e, v, theta) (length 3N).
+    """The separation twin - ref in the coordinates y = (sqrt(K) e, v, theta) (length 3N), the
+    lattice's norm (:func:`stickslip.models.lattice.norm.coordinates`).
 
     e_i = x_{i-1} - x_i with the same pulling point for both, so de_i = dx_{i-1} - dx_i, dx_0 = 0.
     With the plate drive y = (sqrt(Kp) dx, v, theta) (module docstring).
     """
-    dx = twin.x - ref.x
-    if params.drive_piece.leaf_spring:
-        return np.concatenate((math.sqrt(params.Kp) * dx, twin.v - ref.v, twin.theta - ref.theta))
-    de = np.concatenate(([0.0], dx[:-1])) - dx
-    dv = twin.v - ref.v
-    dth = twin.theta - ref.theta
-    return np.concatenate((math.sqrt(params.K) * de, dv, dth))
+    return norm.coordinates(norm.lattice_of(params), twin.x - ref.x, twin.v - ref.v, twin.theta - ref.theta, params)
 
 
 def _project(dy: np.ndarray, stopped: np.ndarray) -> np.ndarray:
     """Drop the velocity components of blocks stuck in the reference (the constraint v = 0)."""
-    N = stopped.shape[0]
-    out = dy.copy()
-    out[N : 2 * N][stopped] = 0.0
-    return out
+    return norm.on_branch(dy, stopped)
 
 
 ENGINES = ("lean", "run_chain")
@@ -142,14 +134,11 @@ def twin_state(ref: ChainState, direction: np.ndarray, d0: float, params: ChainP
     u = _project(direction, b["stopped"])
     if not params.friction_piece.has_state:
         u[2 * N :] = 0.0  # no state variable: theta is not a coordinate of these models
-    norm = float(np.linalg.norm(u))
-    if not norm > 0.0:
+    size = float(np.linalg.norm(u))
+    if not size > 0.0:
         raise ValueError("the separation vanished on the reference's branch; cannot renormalise")
-    u = u * (d0 / norm)
-    if params.drive_piece.leaf_spring:
-        x = b["x"] + u[:N] / math.sqrt(params.Kp)
-    else:
-        x = b["x"] - np.cumsum(u[:N] / math.sqrt(params.K))
+    u = u * (d0 / size)
+    x = b["x"] + norm.displacement(norm.lattice_of(params), u[:N], params)
     v = np.where(b["stopped"], 0.0, b["v"] + u[N : 2 * N])
     th = b["theta"] + u[2 * N :]
     return _with_step(ChainState.from_blocks(x, v, th, b["stopped"]), ref.step)

@@ -41,6 +41,7 @@ from typing import Any
 import numpy as np
 
 from stickslip.analysis.dynamics.benettin import LyapunovResult, check_run, two_trajectory_exponent
+from stickslip.models.lattice import norm
 from stickslip.models.params import ChainParams, ParameterError, check_number, steps_for
 from stickslip.run.located import LocatedState, LocatedStepper, rates, start_state
 from stickslip.run.state import ChainState
@@ -58,16 +59,14 @@ FlowLyapunovResult = LyapunovResult
 
 
 def separation(ref: LocatedState, twin: LocatedState, params: ChainParams) -> np.ndarray:
-    """twin - ref in y coordinates (module docstring), length 3N."""
+    """twin - ref in y coordinates (module docstring), length 3N: the lattice's norm
+    (:func:`stickslip.models.lattice.norm.coordinates`)."""
     du = twin.u[1:-1] - ref.u[1:-1]
     dv = twin.v[1:-1] - ref.v[1:-1]
     dth = twin.th[1:-1] - ref.th[1:-1]
     if not params.friction_piece.has_state:
         dth = np.zeros_like(dth)
-    if params.drive_piece.leaf_spring:
-        return np.concatenate((math.sqrt(params.Kp) * du, dv, dth))
-    de = np.concatenate(([0.0], du[:-1])) - du
-    return np.concatenate((math.sqrt(params.K) * de, dv, dth))
+    return norm.coordinates(norm.lattice_of(params), du, dv, dth, params)
 
 
 def flow_direction(state: LocatedState, params: ChainParams) -> np.ndarray:
@@ -75,20 +74,12 @@ def flow_direction(state: LocatedState, params: ChainParams) -> np.ndarray:
     N = state.N
     du, dv, dth = rates(state, params)
     fth = dth[1:-1] if params.friction_piece.has_state else np.zeros(N)
-    if params.drive_piece.leaf_spring:
-        return np.concatenate((math.sqrt(params.Kp) * du[1:-1], dv[1:-1], fth))
-    fe = np.concatenate(([0.0], du[1:-2])) - du[1:-1]
-    return np.concatenate((math.sqrt(params.K) * fe, dv[1:-1], fth))
+    return norm.coordinates(norm.lattice_of(params), du[1:-1], dv[1:-1], fth, params)
 
 
 def _on_branch(dy: np.ndarray, stopped: np.ndarray, params: ChainParams) -> np.ndarray:
     """No velocity on the reference's stuck blocks; no theta without a state variable."""
-    N = stopped.shape[0]
-    out = dy.copy()
-    out[N : 2 * N][stopped] = 0.0
-    if not params.friction_piece.has_state:
-        out[2 * N :] = 0.0
-    return out
+    return norm.on_branch(dy, stopped, params.friction_piece.has_state)
 
 
 def twin_state(ref: LocatedState, direction: np.ndarray, d0: float, params: ChainParams) -> LocatedState:
@@ -99,14 +90,11 @@ def twin_state(ref: LocatedState, direction: np.ndarray, d0: float, params: Chai
     stopped = ref.stopped
     N = ref.N
     u = _on_branch(direction, stopped, params)
-    norm = float(np.linalg.norm(u))
-    if not norm > 0.0:
+    size = float(np.linalg.norm(u))
+    if not size > 0.0:
         raise ValueError("the separation vanished on the reference's branch; cannot renormalise")
-    u = u * (d0 / norm)
-    if params.drive_piece.leaf_spring:
-        du = u[:N] / math.sqrt(params.Kp)
-    else:
-        du = -np.cumsum(u[:N] / math.sqrt(params.K))
+    u = u * (d0 / size)
+    du = norm.displacement(norm.lattice_of(params), u[:N], params)
     twin = ref.copy()
     twin.u[1:-1] += du
     twin.v[1:-1] = np.where(stopped, 0.0, np.maximum(ref.v[1:-1] + u[N : 2 * N], 0.0))

@@ -157,6 +157,16 @@ class Chain:
         """4 sin^2(k/2) over the chain's modes (:func:`~stickslip.models.lattice.edges.eigenvalues_1d`)."""
         return eigenvalues_1d(self.N, self.left, self.right)
 
+    def strain(self, dx: np.ndarray) -> np.ndarray:
+        """The springs' extensions e_i = dx_{i-1} - dx_i of a displacement dx of the blocks
+        (1..N), dx_0 = 0 at the pulling point (eq. (4)'s end drive): the position part of the
+        norm of :mod:`stickslip.models.lattice.norm`."""
+        return np.concatenate(([0.0], dx[:-1])) - dx
+
+    def unstrain(self, e: np.ndarray) -> np.ndarray:
+        """The displacement whose :meth:`strain` is ``e``: dx_i = -(e_1 + ... + e_i)."""
+        return -np.cumsum(e)
+
     def describe(self) -> str:
         return f"chain of {self.N} (left {self.left}, right {self.right})"
 

@@ -259,6 +259,32 @@ class Square:
         ly = eigenvalues_1d(self.rows, top, bottom)
         return np.sort((ly[:, None] + lx[None, :]).ravel())
 
+    def _toward_driven(self, a: np.ndarray) -> np.ndarray:
+        """The (rows, cols) field ``a`` turned so that the driven side (the left if none) is at
+        the left of each row (a view; :meth:`_from_driven` turns it back)."""
+        side = next((s for s, kind in zip(SIDES, self.edges, strict=True) if kind == "driven"), "left")
+        return {"left": a, "right": a[:, ::-1], "top": a.T, "bottom": a[::-1].T}[side]
+
+    def _from_driven(self, a: np.ndarray) -> np.ndarray:
+        side = next((s for s, kind in zip(SIDES, self.edges, strict=True) if kind == "driven"), "left")
+        return {"left": a, "right": a[:, ::-1], "top": a.T, "bottom": a.T[::-1]}[side]
+
+    def strain(self, dx: np.ndarray) -> np.ndarray:
+        """The extensions of the springs along each line from the driven side (the left if no
+        side is driven) of a displacement dx of the blocks (flat, row-major): every such line is
+        the chain's, e_i = dx_{i-1} - dx_i with dx_0 = 0 at the pulling point
+        (:meth:`stickslip.models.lattice.chain.Chain.strain`), so a square of one row gives the
+        chain's bits. The position part of the norm of :mod:`stickslip.models.lattice.norm`."""
+        g = self._toward_driven(np.asarray(dx).reshape(self.shape))
+        e = np.concatenate((np.zeros((g.shape[0], 1)), g[:, :-1]), axis=1) - g
+        return np.ascontiguousarray(self._from_driven(e)).ravel()
+
+    def unstrain(self, e: np.ndarray) -> np.ndarray:
+        """The displacement (flat, row-major) whose :meth:`strain` is ``e``: along each line from
+        the driven side, dx_i = -(e_1 + ... + e_i)."""
+        g = self._toward_driven(np.asarray(e).reshape(self.shape))
+        return np.ascontiguousarray(self._from_driven(-np.cumsum(g, axis=1))).ravel()
+
     def describe(self) -> str:
         sides = ", ".join(f"{s} {e}" for s, e in zip(SIDES, self.edges, strict=True))
         return f"square {self.rows}x{self.cols} ({sides})"
