@@ -71,10 +71,36 @@ def wants_lattice(args: argparse.Namespace) -> bool:
     return True
 
 
+def lattice_params_from_args(args: argparse.Namespace):
+    """The model of the command line on ``--lattice square --shape RxC --edges ...``: the chain's
+    options (pieces, parameters, per-block values and ``--disorder-seed``, ``--history``) for
+    N = rows cols blocks, a per-block ``file:`` table of rows x cols read row by row
+    (docs/lattice.md)."""
+    import dataclasses
+
+    from stickslip.cli._common import chain_params_from_args
+    from stickslip.models.lattice import parse_shape
+    from stickslip.models.lattice.params import on_lattice, row_major
+    from stickslip.models.params import ChainParams
+    from stickslip.models.presets import on_square
+
+    if args.shape is None:
+        raise CommandError(f"--lattice {args.lattice} needs --shape ROWSxCOLS (e.g. 64x64)")
+    if getattr(args, "param_N", None) is not None:
+        raise CommandError("--N goes with the chain; the square's size is --shape")
+    N = on_square({}, args.shape)["N"]  # a bad shape: ParameterError, one line
+    shape = parse_shape(args.shape)
+    given = argparse.Namespace(**vars(args))
+    for f in dataclasses.fields(ChainParams):
+        value = getattr(given, f"param_{f.name}", None)
+        if value is not None:
+            setattr(given, f"param_{f.name}", row_major(f"--{f.name}", value, shape))
+    given.param_N = N
+    return on_lattice(chain_params_from_args(given), args.lattice, args.shape, args.edges)
+
+
 def run_lattice_command(args: argparse.Namespace) -> Result:
     """`stickslip chain --lattice square`: run the model on the square, print its summary."""
-    from stickslip.cli._common import chain_params_from_args
-    from stickslip.models.lattice.params import on_lattice
     from stickslip.run.lattice import run_lattice
 
     for name, option in _NOT_YET.items():
@@ -82,11 +108,7 @@ def run_lattice_command(args: argparse.Namespace) -> Result:
             raise CommandError(f"{option} is not yet available with --lattice {args.lattice}")
     if args.integrator not in (None, "dense", "exact"):
         raise CommandError(f"--integrator {args.integrator}: a lattice runs on exact or dense")
-    if args.shape is None:
-        raise CommandError("--lattice square needs --shape ROWSxCOLS (e.g. 64x64)")
-    if getattr(args, "param_N", None) is not None:
-        raise CommandError("--N goes with the chain; the square's size is --shape")
-    params = on_lattice(chain_params_from_args(args), args.lattice, args.shape, args.edges)
+    params = lattice_params_from_args(args)
     t_end = 1000.0 if args.t_end is None else args.t_end
     start = args.start or ("rest" if params.drive_piece.leaf_spring else "paper")
     if start == "paper" and (args.perturbation is not None or args.seed is not None):
@@ -133,18 +155,12 @@ def run_lattice_command(args: argparse.Namespace) -> Result:
 def run_lattice_bench_command(args: argparse.Namespace) -> Result:
     """`stickslip bench --lattice square --shape RxC`: dense against exact on the square, from the
     model's state at --t-prepare (default 0), timed over --t-end (default 100)."""
-    from stickslip.cli._common import chain_params_from_args
-    from stickslip.models.lattice.params import on_lattice
     from stickslip.run.lattice import bench_lattice
 
     for name, option in (("profile", "--profile"), ("workload", "--workload"), ("switches", "--switches")):
         if getattr(args, name, None) not in (None, False, "default", "grid"):
             raise CommandError(f"{option} is not yet available with --lattice {args.lattice}")
-    if args.shape is None:
-        raise CommandError("--lattice square needs --shape ROWSxCOLS (e.g. 64x64)")
-    if getattr(args, "param_N", None) is not None:
-        raise CommandError("--N goes with the chain; the square's size is --shape")
-    params = on_lattice(chain_params_from_args(args), args.lattice, args.shape, args.edges)
+    params = lattice_params_from_args(args)
     t_prepare = 0.0 if args.t_prepare is None else args.t_prepare
     result = bench_lattice(
         params, 100.0 if args.t_end is None else args.t_end, t_prepare=t_prepare, repeat=args.repeat or 1
