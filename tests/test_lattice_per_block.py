@@ -30,9 +30,9 @@ def _grid(p, name):
     return np.full(p.lattice.shape, float(value)) if values is None else np.reshape(values, p.lattice.shape)
 
 
-def _rates(p, g, x, v, th, m, kinds, t):
-    """(f, dv/dt, dtheta/dt) of docs/model.md at every block, each parameter read at its block."""
-    load = p.V * t
+def _rates(p, g, x, v, th, m, kinds, load):
+    """(f, dv/dt, dtheta/dt) of docs/model.md at every block, each parameter read at its block,
+    the drive's load point at ``load``."""
     f = p.K * _laplacian(_padded(x, kinds, load, False))
     if p.drive == "plate":
         f = f + g["Kp"] * (load - x)
@@ -46,16 +46,18 @@ def _rates(p, g, x, v, th, m, kinds, t):
     return f, a, b
 
 
-def _oracle(p, kinds, x, v, th, mov, n_steps):
-    """Heun with the start and stop rules, every block with its own parameters; the event count."""
+def _oracle(p, kinds, x, v, th, mov, n_steps, pull=None):
+    """Heun with the start and stop rules, every block with its own parameters; the event count.
+    The load point at step n is ``pull(n)``, V t_n by default."""
+    pull = pull or (lambda n: p.V * (n * p.dt))
     g = {k: _grid(p, k) for k in ("Fs", "beta", "alpha", "D", "M", "Kp", "sigma") if hasattr(p.chain, k)}
     dt, n_events, n_moving, active = p.dt, 0, int(mov.sum()), False
     for n in range(n_steps):
-        f, _, _ = _rates(p, g, x, v, th, mov, kinds, n * dt)
+        f, _, _ = _rates(p, g, x, v, th, mov, kinds, pull(n))
         m = np.where((mov != 0.0) | (f > g["Fs"]), 1.0, 0.0)
-        _, a1, b1 = _rates(p, g, x, v, th, m, kinds, n * dt)
+        _, a1, b1 = _rates(p, g, x, v, th, m, kinds, pull(n))
         xs, vs, ths = x + dt * v, v + dt * a1, th + dt * b1
-        _, a2, b2 = _rates(p, g, xs, vs, ths, m, kinds, (n + 1) * dt)
+        _, a2, b2 = _rates(p, g, xs, vs, ths, m, kinds, pull(n + 1))
         active = active or (n_moving == 0 and bool(m.any()))
         th = th + 0.5 * dt * (b1 + b2)
         xn = np.where(m != 0.0, x + 0.5 * dt * (v + vs), x)

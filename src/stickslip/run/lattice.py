@@ -94,7 +94,12 @@ def steady_fields(p: LatticeParams) -> dict[str, np.ndarray]:
     edges = lat.edges if lat.name == "square" else (lat.left, lat.right)
     if "fixed" in edges:
         raise ParameterError("start steady: a fixed edge has no steady sliding (the wall stays behind the load)")
-    if p.drive_piece.applied is not None or p.drive_piece.pull_velocity is not None or p.friction_piece.steady is None:
+    if (
+        p.drive_piece.applied is not None
+        or p.drive_piece.pull_velocity is not None
+        or not p.drive_piece.steady_sliding
+        or p.friction_piece.steady is None
+    ):
         raise ParameterError(
             f"start steady needs a drive at the velocity V and a law with steady sliding (got {p.drive}, {p.friction})"
         )
@@ -138,7 +143,8 @@ class LatticeRun:
     state: LatticeState
     snapshots: xr.Dataset | None
     summary: dict[str, Any] = field(default_factory=dict)
-    #: samples every ``sample_every``: t, the mean slip deficit (the load point V t less x, over
+    #: samples every ``sample_every``: t, the mean slip deficit (the load point V t, or a load
+    #: history's p(t), less x, over
     #: the blocks), the mean velocity and the number of moving blocks; None unless asked for
     samples: pd.DataFrame | None = None
 
@@ -369,8 +375,17 @@ def _record(p: LatticeParams, s: LatticeState, every: int, snaps, times, every_s
         times.append(n)
     if every_sample and n % every_sample == 0 and (not samples or samples[-1][0] != n * p.dt):
         f = s.fields(p.lattice)
-        load = p.drive_piece.kernel_velocity(p.chain) * (n * p.dt)
+        load = load_point(p, n)
         samples.append((n * p.dt, float(np.mean(load - f["x"])), float(np.mean(f["v"])), int(s.ist[layout.N_MOVING])))
+
+
+def load_point(p: LatticeParams, n: int) -> float:
+    """The drive's load point at step n as the kernels compute it
+    (:func:`stickslip.kernels.laws.pull_point`): V t_n, or a load history's p(t_n)."""
+    from stickslip.kernels.laws import pull_point
+
+    dp = p.kernel_params(p.drive_piece)
+    return float(pull_point(p.drive_piece.kernel_velocity(p.chain), n, p.dt, dp, p.drive_piece.module))
 
 
 def bench_lattice(p: LatticeParams, t_timed: float, *, t_prepare: float = 0.0, repeat: int = 1) -> dict[str, Any]:
