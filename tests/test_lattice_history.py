@@ -20,8 +20,8 @@ from stickslip.run.lattice import LatticeState, initial_state, run_lattice
 from stickslip.run.state import initial_state as chain_start
 from test_lattice_per_block import _oracle
 
-# a slide, a hold at V = 0, a faster slide
 SIDES = ("top", "bottom", "left", "right")
+# a slide, a hold at V = 0, a faster slide
 STEPS = LoadHistory.steps([0.2, 0.0, 0.4], [3.0, 2.0, 5.0])
 
 
