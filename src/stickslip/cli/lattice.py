@@ -23,9 +23,10 @@ _NOT_YET = {
 }
 
 
-def add_lattice_options(p: argparse.ArgumentParser, *, bench: bool = False) -> None:
+def add_lattice_options(p: argparse.ArgumentParser, *, bench: bool = False, run: bool = True):
     """``--lattice``, ``--shape``, ``--edges`` and ``--snapshot-every`` of `stickslip chain`
-    (``--t-prepare`` in its place for `stickslip bench`)."""
+    (``--t-prepare`` in its place for `stickslip bench`; neither where ``run`` is false: the
+    other commands that take a model). Returns the option group."""
     from stickslip.models.lattice import EDGE_KINDS, LATTICES, SIDES
 
     g = p.add_argument_group("lattice (docs/lattice.md)")
@@ -38,6 +39,8 @@ def add_lattice_options(p: argparse.ArgumentParser, *, bench: bool = False) -> N
         help=f"the square's sides ({', '.join(SIDES)}): one kind for all, or SIDE=KIND,... with kinds "
         f"{', '.join(EDGE_KINDS)} (default: the ends piece's kind; an edge drive pulls the left side)",
     )
+    if not run:
+        return g
     if bench:
         g.add_argument(
             "--t-prepare",
@@ -46,7 +49,7 @@ def add_lattice_options(p: argparse.ArgumentParser, *, bench: bool = False) -> N
             metavar="T",
             help="with --lattice square: run exact from rest to T first, then time both over --t-end",
         )
-        return
+        return g
     g.add_argument(
         "--snapshot-every",
         dest="lattice_snapshot_every",
@@ -55,6 +58,14 @@ def add_lattice_options(p: argparse.ArgumentParser, *, bench: bool = False) -> N
         metavar="T",
         help="with --lattice square: snapshots of x, v, theta and stopped over (row, col) every T, in state.nc",
     )
+    return g
+
+
+def refuse_lattice(args: argparse.Namespace, command: str) -> None:
+    """The one-line refusal of a command that does not yet run on a lattice: ``--lattice square``
+    (and ``--shape``, ``--edges`` without it, as :func:`wants_lattice` refuses them)."""
+    if wants_lattice(args):
+        raise CommandError(f"--lattice {args.lattice} is not yet available with stickslip {command} (docs/lattice.md)")
 
 
 def wants_lattice(args: argparse.Namespace) -> bool:
@@ -173,3 +184,47 @@ def run_lattice_bench_command(args: argparse.Namespace) -> Result:
         f"{result['events']} events"
     )
     return Result(result, text)
+
+
+def run_stability_lattice(args: argparse.Namespace) -> Result:
+    """`stickslip stability chain --lattice square --shape RxC`: steady sliding on the square
+    against its normal modes (eq. 5 with the lattice's Laplacian eigenvalues; docs/lattice.md,
+    "Steady sliding and its stability")."""
+    from stickslip.analysis.dynamics.lattice_stability import lattice_critical_beta, lattice_stability
+    from stickslip.run.lattice import steady_fields
+
+    for name in ("Fs", "dt"):
+        if getattr(args, f"param_{name}", None) is not None:
+            raise CommandError(f"--{name} is not read by the linear stability of steady sliding")
+    if args.out is not None:
+        raise CommandError(f"--out is not yet available with stickslip stability chain --lattice {args.lattice}")
+    p = lattice_params_from_args(args)
+    if p.per_block():
+        raise CommandError(
+            f"stickslip stability chain --lattice {args.lattice}: per-block parameters "
+            f"({', '.join(p.per_block())}) are not yet covered (one number each)"
+        )
+    if not p.friction_piece.eq5:
+        raise CommandError(
+            f"stickslip stability chain --lattice {args.lattice}: friction {p.friction} is not yet covered "
+            "(eq. 5's law, friction state)"
+        )
+    steady_fields(p)  # a ParameterError of one line where there is no steady sliding (a fixed side)
+    s = lattice_stability(p)
+    data = {
+        "params": {k: v for k, v in p.to_dict().items() if k in ("K", "D", "V", "beta", "alpha", "shape", "edges")},
+        "lattice": p.lattice.describe(),
+        **s,
+        "q_min": float(p.lattice.eigenvalues()[p.lattice.eigenvalues() > 1e-12].min()),
+        "critical_beta_lattice": lattice_critical_beta(p),
+    }
+    text = "\n".join(
+        [
+            f"{data['lattice']}: K = {p.K:g}, D = {p.D:g}, V = {p.V:g}, alpha = {p.alpha:g}, beta = {p.beta:g}",
+            f"largest growth rate {s['max_growth_rate']:.6g} (mode q = {s['q_at_max']:.4g}): "
+            f"{'unstable' if s['unstable'] else 'stable'}",
+            f"critical beta of this lattice {data['critical_beta_lattice']:.6g} (long waves: {s['critical_beta']:g}; "
+            f"smallest q {data['q_min']:.4g})",
+        ]
+    )
+    return Result(data, text)
