@@ -119,13 +119,15 @@ def test_per_block_square_step_equals_the_plain_numpy_equations(preset, override
 
 
 def test_active_set_path_keeps_the_references_bits_with_disorder():
-    """Carlson-Langer with drawn thresholds and plate springs: exact (active set) equals dense."""
+    """Carlson-Langer with drawn thresholds, plate springs and masses: exact (active set) equals
+    dense."""
     p = chain_params(
         "carlson-langer",
         lattice="square",
         shape=(4, 5),
         Fs=Quenched("uniform", 0.8, 1.2, seed=3),
         Kp=Quenched("uniform", 0.8, 1.2, seed=3),
+        M=Quenched("uniform", 0.5, 1.5, seed=3),
     )
     dense = run_lattice(p, 100.0, start="rest", perturbation=0.01, seed=2, integrator="dense")
     exact = run_lattice(p, 100.0, start="rest", perturbation=0.01, seed=2, integrator="exact")

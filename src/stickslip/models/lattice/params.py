@@ -110,7 +110,10 @@ def row_major(name: str, value: Any, shape: tuple[int, int]) -> Any:
             return PerBlock(row_major(name, table, shape), value)
         return value
     if isinstance(value, (list, tuple, np.ndarray)):
-        arr = np.asarray(value, dtype=np.float64)
+        try:
+            arr = np.asarray(value, dtype=np.float64)
+        except (TypeError, ValueError):
+            return value  # ChainParams names the parameter in its refusal
         if arr.ndim == 2:
             if arr.shape != tuple(shape):
                 raise ParameterError(
