@@ -189,7 +189,7 @@ def test_refusals():
         on_lattice(chain_params(), "square", "3by3")
     with pytest.raises(ParameterError, match="both be periodic"):
         on_lattice(chain_params("carlson-langer"), "square", (3, 3), "top=free")
-    with pytest.raises(ParameterError, match="per-block parameters"):
-        on_lattice(chain_params(N=9, Fs=np.linspace(3, 4, 9)), "square", (3, 3))
+    with pytest.raises(ParameterError, match="K must be one number"):
+        on_lattice(chain_params(N=9, K=np.linspace(3, 4, 9)), "square", (3, 3))
     with pytest.raises(ParameterError, match="run_lattice needs"):
         run_lattice(chain_params(N=9), 1.0)

@@ -412,7 +412,12 @@ def _inherit_per_block(params, args):
         return params
     from stickslip import io
     from stickslip.models.params import ChainParams
+    from stickslip.run.rundir import LatticeRunDir, refuse_lattice_run
 
+    try:
+        refuse_lattice_run(args.from_dir, "--from")
+    except LatticeRunDir as exc:
+        raise CommandError(f"--from: {exc}") from None
     try:
         before = ChainParams(**io.read_json(Path(args.from_dir) / "run.json")["params"])
     except (OSError, ValueError, KeyError, TypeError) as exc:

@@ -23,9 +23,10 @@ _NOT_YET = {
 }
 
 
-def add_lattice_options(p: argparse.ArgumentParser, *, bench: bool = False) -> None:
+def add_lattice_options(p: argparse.ArgumentParser, *, bench: bool = False, run: bool = True):
     """``--lattice``, ``--shape``, ``--edges`` and ``--snapshot-every`` of `stickslip chain`
-    (``--t-prepare`` in its place for `stickslip bench`)."""
+    (``--t-prepare`` in its place for `stickslip bench`; neither where ``run`` is false: the
+    other commands that take a model). Returns the option group."""
     from stickslip.models.lattice import EDGE_KINDS, LATTICES, SIDES
 
     g = p.add_argument_group("lattice (docs/lattice.md)")
@@ -38,6 +39,8 @@ def add_lattice_options(p: argparse.ArgumentParser, *, bench: bool = False) -> N
         help=f"the square's sides ({', '.join(SIDES)}): one kind for all, or SIDE=KIND,... with kinds "
         f"{', '.join(EDGE_KINDS)} (default: the ends piece's kind; an edge drive pulls the left side)",
     )
+    if not run:
+        return g
     if bench:
         g.add_argument(
             "--t-prepare",
@@ -47,7 +50,7 @@ def add_lattice_options(p: argparse.ArgumentParser, *, bench: bool = False) -> N
             help="with --lattice square: run exact from rest to T first, then time both over --t-end "
             "(default: two loading times 2 / V for a plate drive, at V = 0.001 unless given; else 0)",
         )
-        return
+        return g
     g.add_argument(
         "--snapshot-every",
         dest="lattice_snapshot_every",
@@ -70,6 +73,14 @@ def add_lattice_options(p: argparse.ArgumentParser, *, bench: bool = False) -> N
         metavar="A",
         help="with --slip-maps: only events of at least A blocks",
     )
+    return g
+
+
+def refuse_lattice(args: argparse.Namespace, command: str) -> None:
+    """The one-line refusal of a command that does not yet run on a lattice: ``--lattice square``
+    (and ``--shape``, ``--edges`` without it, as :func:`wants_lattice` refuses them)."""
+    if wants_lattice(args):
+        raise CommandError(f"--lattice {args.lattice} is not yet available with stickslip {command} (docs/lattice.md)")
 
 
 def wants_lattice(args: argparse.Namespace) -> bool:
@@ -89,10 +100,37 @@ def wants_lattice(args: argparse.Namespace) -> bool:
     return True
 
 
+def lattice_params_from_args(args: argparse.Namespace, **overrides):
+    """The model of the command line on ``--lattice square --shape RxC --edges ...``: the chain's
+    options (pieces, parameters, per-block values and ``--disorder-seed``, ``--history``) for
+    N = rows cols blocks, a per-block ``file:`` table of rows x cols read row by row
+    (docs/lattice.md); ``overrides`` are the command's own defaults, as for
+    :func:`~stickslip.cli._common.chain_params_from_args`."""
+    import dataclasses
+
+    from stickslip.cli._common import chain_params_from_args
+    from stickslip.models.lattice import parse_shape
+    from stickslip.models.lattice.params import on_lattice, row_major
+    from stickslip.models.params import ChainParams
+    from stickslip.models.presets import on_square
+
+    if args.shape is None:
+        raise CommandError(f"--lattice {args.lattice} needs --shape ROWSxCOLS (e.g. 64x64)")
+    if getattr(args, "param_N", None) is not None:
+        raise CommandError("--N goes with the chain; the square's size is --shape")
+    N = on_square({}, args.shape)["N"]  # a bad shape: ParameterError, one line
+    shape = parse_shape(args.shape)
+    given = argparse.Namespace(**vars(args))
+    for f in dataclasses.fields(ChainParams):
+        value = getattr(given, f"param_{f.name}", None)
+        if value is not None:
+            setattr(given, f"param_{f.name}", row_major(f"--{f.name}", value, shape))
+    given.param_N = N
+    return on_lattice(chain_params_from_args(given, **overrides), args.lattice, args.shape, args.edges)
+
+
 def run_lattice_command(args: argparse.Namespace) -> Result:
     """`stickslip chain --lattice square`: run the model on the square, print its summary."""
-    from stickslip.cli._common import chain_params_from_args
-    from stickslip.models.lattice.params import on_lattice
     from stickslip.run.lattice import run_lattice
 
     for name, option in _NOT_YET.items():
@@ -100,17 +138,13 @@ def run_lattice_command(args: argparse.Namespace) -> Result:
             raise CommandError(f"{option} is not yet available with --lattice {args.lattice}")
     if args.integrator not in (None, "dense", "exact"):
         raise CommandError(f"--integrator {args.integrator}: a lattice runs on exact or dense")
-    if args.shape is None:
-        raise CommandError("--lattice square needs --shape ROWSxCOLS (e.g. 64x64)")
-    if getattr(args, "param_N", None) is not None:
-        raise CommandError("--N goes with the chain; the square's size is --shape")
     from stickslip.run.lattice_fields import MAX_SLIP_MAPS
 
     if args.slip_maps is not None and not 0 <= args.slip_maps <= MAX_SLIP_MAPS:
         raise CommandError(f"--slip-maps must be in [0, {MAX_SLIP_MAPS}] (got {args.slip_maps})")
     if args.slip_min_area is not None and (args.slip_min_area < 1 or not args.slip_maps):
         raise CommandError(f"--slip-min-area must be >= 1 and goes with --slip-maps (got {args.slip_min_area})")
-    params = on_lattice(chain_params_from_args(args), args.lattice, args.shape, args.edges)
+    params = lattice_params_from_args(args)
     t_end = 1000.0 if args.t_end is None else args.t_end
     start = args.start or ("rest" if params.drive_piece.leaf_spring else "paper")
     if start == "paper" and (args.perturbation is not None or args.seed is not None):
@@ -164,22 +198,15 @@ def run_lattice_bench_command(args: argparse.Namespace) -> Result:
     (Carlson-Langer) runs the slow-loading workload :data:`~stickslip.run.lattice.SLOW_LOADING`
     (V = 0.001 unless --V or --nu is given; --t-prepare 2 / V, --t-end 20); another from t = 0
     over 100."""
-    from stickslip.cli._common import chain_params_from_args
-    from stickslip.models.lattice.params import on_lattice
     from stickslip.run.lattice import SLOW_LOADING, bench_lattice
 
     for name, option in (("profile", "--profile"), ("workload", "--workload"), ("switches", "--switches")):
         if getattr(args, name, None) not in (None, False, "default", "grid"):
             raise CommandError(f"{option} is not yet available with --lattice {args.lattice}")
-    if args.shape is None:
-        raise CommandError("--lattice square needs --shape ROWSxCOLS (e.g. 64x64)")
-    if getattr(args, "param_N", None) is not None:
-        raise CommandError("--N goes with the chain; the square's size is --shape")
-    chain = chain_params_from_args(args)
-    slow = chain.drive_piece.leaf_spring
+    params = lattice_params_from_args(args)
+    slow = params.drive_piece.leaf_spring
     if slow and getattr(args, "param_V", None) is None and getattr(args, "param_nu", None) is None:
-        chain = chain_params_from_args(args, V=SLOW_LOADING["V"])
-    params = on_lattice(chain, args.lattice, args.shape, args.edges)
+        params = lattice_params_from_args(args, V=SLOW_LOADING["V"])
     if args.t_prepare is not None:
         t_prepare = args.t_prepare
     else:
@@ -201,3 +228,47 @@ def run_lattice_bench_command(args: argparse.Namespace) -> Result:
         )
     text += f"\n{r['events']} events, mean area {r['event_area_mean']:.4g} blocks"
     return Result(result, text)
+
+
+def run_stability_lattice(args: argparse.Namespace) -> Result:
+    """`stickslip stability chain --lattice square --shape RxC`: steady sliding on the square
+    against its normal modes (eq. 5 with the lattice's Laplacian eigenvalues; docs/lattice.md,
+    "Steady sliding and its stability")."""
+    from stickslip.analysis.dynamics.lattice_stability import lattice_critical_beta, lattice_stability
+    from stickslip.run.lattice import steady_fields
+
+    for name in ("Fs", "dt"):
+        if getattr(args, f"param_{name}", None) is not None:
+            raise CommandError(f"--{name} is not read by the linear stability of steady sliding")
+    if args.out is not None:
+        raise CommandError(f"--out is not yet available with stickslip stability chain --lattice {args.lattice}")
+    p = lattice_params_from_args(args)
+    if p.per_block():
+        raise CommandError(
+            f"stickslip stability chain --lattice {args.lattice}: per-block parameters "
+            f"({', '.join(p.per_block())}) are not yet covered (one number each)"
+        )
+    if not p.friction_piece.eq5:
+        raise CommandError(
+            f"stickslip stability chain --lattice {args.lattice}: friction {p.friction} is not yet covered "
+            "(eq. 5's law, friction state)"
+        )
+    steady_fields(p)  # a ParameterError of one line where there is no steady sliding (a fixed side)
+    s = lattice_stability(p)
+    data = {
+        "params": {k: v for k, v in p.to_dict().items() if k in ("K", "D", "V", "beta", "alpha", "shape", "edges")},
+        "lattice": p.lattice.describe(),
+        **s,
+        "q_min": float(p.lattice.eigenvalues()[p.lattice.eigenvalues() > 1e-12].min()),
+        "critical_beta_lattice": lattice_critical_beta(p),
+    }
+    text = "\n".join(
+        [
+            f"{data['lattice']}: K = {p.K:g}, D = {p.D:g}, V = {p.V:g}, alpha = {p.alpha:g}, beta = {p.beta:g}",
+            f"largest growth rate {s['max_growth_rate']:.6g} (mode q = {s['q_at_max']:.4g}): "
+            f"{'unstable' if s['unstable'] else 'stable'}",
+            f"critical beta of this lattice {data['critical_beta_lattice']:.6g} (long waves: {s['critical_beta']:g}; "
+            f"smallest q {data['q_min']:.4g})",
+        ]
+    )
+    return Result(data, text)

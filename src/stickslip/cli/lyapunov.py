@@ -38,6 +38,9 @@ def register(sub) -> None:
         ),
     )
     add_model_options(p)
+    from stickslip.cli.lattice import add_lattice_options
+
+    add_lattice_options(p, run=False)
     p.add_argument(
         "--start",
         choices=("paper", "steady", "rest"),
@@ -202,8 +205,10 @@ def run_lyapunov_command(args: argparse.Namespace) -> Result:
     """Handler of `stickslip lyapunov`."""
     from stickslip.analysis.dynamics import lyapunov as ly
     from stickslip.analysis.dynamics.benettin import check_run
+    from stickslip.cli.lattice import refuse_lattice
     from stickslip.models.presets import PRESETS
 
+    refuse_lattice(args, "lyapunov")
     params = chain_params_from_args(args)
     preset = PRESETS[params.model]
     if args.start is None:

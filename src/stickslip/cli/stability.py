@@ -96,6 +96,9 @@ def register(sub) -> None:
         ),
     )
     add_model_options(c)
+    from stickslip.cli.lattice import add_lattice_options
+
+    add_lattice_options(c, run=False)
     c.add_argument("--out", default=None, metavar="DIR",
                    help="write fig4.png, fig4.nc and stability_chain.json to DIR (the relatives: "
                         "mode_growth.png, mode_growth.nc, stability_chain.json)")  # fmt: skip
@@ -245,7 +248,10 @@ def run_stability_chain(args: argparse.Namespace) -> Result:
     """Handler of ``stickslip stability chain``: Fourier modes of eq. (5), Fig. 4; the relatives
     without state variable mode by mode (:func:`run_stability_modes`)."""
     from stickslip.analysis.dynamics import stability as st
+    from stickslip.cli.lattice import run_stability_lattice, wants_lattice
 
+    if wants_lattice(args):
+        return run_stability_lattice(args)
     for name in ("Fs", "dt"):
         if getattr(args, f"param_{name}", None) is not None:
             raise CommandError(f"--{name} is not read by the linear stability of steady sliding")

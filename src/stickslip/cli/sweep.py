@@ -90,6 +90,9 @@ def register(sub) -> None:
     )
     parser.add_argument("--t-end", type=str, required=True, metavar="T", help="run length of every point")
     parser.add_argument("--out", required=True, metavar="DIR", help="output directory of the sweep")
+    from stickslip.cli.lattice import add_lattice_options
+
+    add_lattice_options(parser, run=False)
     add_dask_options(parser)
     add_overwrite_option(parser)
     add_json_option(parser)
@@ -198,8 +201,10 @@ def _check_options(model: str, params, settings: dict[str, Any]) -> None:
 
 def run(args: argparse.Namespace) -> Result:
     """Handler of ``stickslip sweep``."""
+    from stickslip.cli.lattice import refuse_lattice
     from stickslip.experiments.sweep import STOP_WAIT_SECONDS, block_task, chain_task, run_sweep
 
+    refuse_lattice(args, f"sweep {args.model}")
     points, common = parse_grid(args.model, args.grid, args.fixed, args.t_end)
     _, workers = dask_options(args)
     own = _sweep_files(args.out)

@@ -93,10 +93,13 @@ def kernel_params(module: str, reads: tuple[str, ...]) -> type:
     return namedtuple("Params", reads, module=module)
 
 
-def _kernel_value(value: Any) -> Any:
-    """A parameter as the kernels read it: a float, or a per-block one padded like x."""
+def _kernel_value(value: Any, pad: Callable[[Any], Any] | None = None) -> Any:
+    """A parameter as the kernels read it: a float, or a per-block one padded like x (the chain's
+    layout, or ``pad(values)``: a lattice's, :meth:`~stickslip.models.lattice.params.LatticeParams.kernel_params`)."""
     padded = getattr(value, "padded", None)
-    return padded() if padded is not None else float(value)
+    if padded is None:
+        return float(value)
+    return padded() if pad is None else pad(value.values)
 
 
 @dataclass(frozen=True)
@@ -223,15 +226,16 @@ class Piece:
     #: equations read t there (the other ends leave them autonomous in that frame)
     wall: bool = False
 
-    def kernel_params(self, p: Any) -> tuple:
+    def kernel_params(self, p: Any, pad: Callable[[Any], Any] | None = None) -> tuple:
         """The parameters of ``p`` the piece's compiled functions read, as the ``Params`` named
         tuple of its module, in the order of :attr:`reads`: floats, and a per-block parameter
         (:class:`~stickslip.models.disorder.PerBlock`) as a float64 array of N + 2 with block i
-        at index i, which the kernels read at each block (:func:`stickslip.kernels.laws.at`)."""
+        at index i, which the kernels read at each block (:func:`stickslip.kernels.laws.at`);
+        ``pad`` puts the N values into another layout (a lattice's padded flat arrays)."""
         if self.pack is not None:
             return self.pack(p)
         params = importlib.import_module(self.module).Params
-        return params(*(_kernel_value(getattr(p, name)) for name in self.reads))
+        return params(*(_kernel_value(getattr(p, name), pad) for name in self.reads))
 
     def kernel_velocity(self, p: Any) -> float:
         """The drive's V as the kernels read it (their pull point p = V t_n): :attr:`pull_velocity`

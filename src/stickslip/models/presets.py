@@ -45,7 +45,9 @@ def chain_params(
         left side pulled by an edge drive).
     **overrides
         Pieces (``drive``, ``friction``, ``threshold``, ``ends``) or parameters (``N``,
-        ``beta``, ...) that replace the preset's.
+        ``beta``, ...) that replace the preset's. A parameter may differ from block to block
+        (docs/model.md, "Per-block parameters"); on the square, an array over (rows, cols) or of
+        rows cols values in row-major order, or a drawn :class:`~stickslip.models.disorder.Quenched`.
 
     Returns
     -------
@@ -76,8 +78,11 @@ def chain_params(
             raise ParameterError("N goes with the chain; the square's size is shape (rows, cols)")
     elif shape is not None:
         overrides = {**overrides, "N": shape}
+    given = overrides
+    if lattice not in (None, "chain"):
+        overrides = on_square(overrides, shape)
     params = build_chain_params(model, **overrides)
-    refuse_unread(params, overrides)
+    refuse_unread(params, given)
     if lattice in (None, "chain"):
         if edges is not None:
             raise ParameterError("edges go with lattice square (the chain's ends are the ends piece)")
@@ -85,6 +90,23 @@ def chain_params(
     from stickslip.models.lattice.params import on_lattice
 
     return on_lattice(params, lattice, shape, edges)
+
+
+def on_square(overrides: dict[str, Any], shape: Any) -> dict[str, Any]:
+    """``overrides`` for a model on the square of ``shape``: N = rows cols, and each per-block
+    value given over (rows, cols) in row-major order
+    (:func:`~stickslip.models.lattice.params.row_major`); a bad shape raises ParameterError."""
+    from stickslip.models.lattice import LatticeError, parse_shape
+    from stickslip.models.lattice.params import row_major
+    from stickslip.models.params import ParameterError
+
+    try:
+        rows, cols = parse_shape(shape)
+    except LatticeError as exc:
+        raise ParameterError(str(exc)) from None
+    out = {k: row_major(k, v, (rows, cols)) for k, v in overrides.items()}
+    out["N"] = rows * cols
+    return out
 
 
 def build_chain_params(model: str = "sakaguchi", **overrides: Any):

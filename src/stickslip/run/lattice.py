@@ -92,11 +92,18 @@ def steady_fields(p: LatticeParams) -> dict[str, np.ndarray]:
     from scipy.sparse import identity
     from scipy.sparse.linalg import spsolve
 
+    if p.per_block():
+        raise ParameterError("start steady with per-block parameters is not yet available on a lattice")
     lat = p.lattice
     edges = lat.edges if lat.name == "square" else (lat.left, lat.right)
     if "fixed" in edges:
         raise ParameterError("start steady: a fixed edge has no steady sliding (the wall stays behind the load)")
-    if p.drive_piece.applied is not None or p.drive_piece.pull_velocity is not None or p.friction_piece.steady is None:
+    if (
+        p.drive_piece.applied is not None
+        or p.drive_piece.pull_velocity is not None
+        or not p.drive_piece.steady_sliding
+        or p.friction_piece.steady is None
+    ):
         raise ParameterError(
             f"start steady needs a drive at the velocity V and a law with steady sliding (got {p.drive}, {p.friction})"
         )
@@ -140,7 +147,8 @@ class LatticeRun:
     state: LatticeState
     snapshots: xr.Dataset | None
     summary: dict[str, Any] = field(default_factory=dict)
-    #: samples every ``sample_every``: t, the mean slip deficit (the load point V t less x, over
+    #: samples every ``sample_every``: t, the mean slip deficit (the load point V t, or a load
+    #: history's p(t), less x, over
     #: the blocks), the mean velocity and the number of moving blocks; None unless asked for
     samples: pd.DataFrame | None = None
     #: the slip field and the first-move step of each block over (event, row, col) of the events
@@ -182,9 +190,9 @@ class LatticeRun:
         return _dataset(f, self.params)
 
     def write(self, out: str | Path) -> Path:
-        """Write run.json (parameters, summary), events.csv and state.nc (the final state over
-        (row, col) and the snapshots over (time, row, col)) into the directory ``out``, and
-        event_fields.nc where events' fields were recorded."""
+        """Write run.json (parameters, summary), events.csv and state.nc (the final state and the
+        per-block parameters over (row, col), the snapshots over (time, row, col)) into the
+        directory ``out``, and event_fields.nc where events' fields were recorded."""
         from stickslip import io
 
         out = Path(out)
@@ -194,6 +202,10 @@ class LatticeRun:
         if self.samples is not None:
             io.write_csv(out / "samples.csv", self.samples)
         ds = self.final()
+        for name, pb in self.params.per_block().items():
+            # the per-block parameters over (row, col), as the chain's state.nc holds them over block
+            ds[f"param_{name}"] = (("row", "col"), np.reshape(pb.values, self.params.lattice.shape))
+            ds[f"param_{name}"].attrs.update({"spec": pb.spec_text, "sha256": pb.sha256})
         if self.snapshots is not None:
             ds = ds.merge(self.snapshots.rename({k: f"snapshot_{k}" for k in self.snapshots.data_vars}))
         io.write_dataset(out / "state.nc", ds)
@@ -263,11 +275,11 @@ def _sparse_counts(sparse) -> dict[str, int]:
 
 def _args(p: LatticeParams, s: LatticeState, scratch, ev_int, ev_moment, n_end: int):
     from stickslip.kernels.lattice import LatticeArgs
-    from stickslip.run.loop import _par, chain_extras
+    from stickslip.run.loop import _par
 
-    _, mass = chain_extras(p.chain)
-    tp, lp = p.threshold_piece.kernel_params(p.chain), p.friction_piece.kernel_params(p.chain)
-    dp = p.drive_piece.kernel_params(p.chain)
+    mass = p.kernel_mass()
+    tp, lp = p.kernel_params(p.threshold_piece), p.kernel_params(p.friction_piece)
+    dp = p.kernel_params(p.drive_piece)
     geo = p.lattice.geometry()
     return LatticeArgs(
         s.xg, s.vg, s.thg, s.mov, *scratch, s.first_step, s.x0ev, geo, s.ist, _par(p.chain), dp, tp, lp, mass,
@@ -484,7 +496,7 @@ def _record(p: LatticeParams, s: LatticeState, every: int, snaps, times, every_s
         times.append(n)
     if every_sample and n % every_sample == 0 and (not samples or samples[-1][0] != n * p.dt):
         f = s.fields(p.lattice)
-        load = p.drive_piece.kernel_velocity(p.chain) * (n * p.dt)
+        load = load_point(p, n)
         samples.append((n * p.dt, float(np.mean(load - f["x"])), float(np.mean(f["v"])), int(s.ist[layout.N_MOVING])))
 
 
@@ -492,6 +504,15 @@ def _record(p: LatticeParams, s: LatticeState, every: int, snaps, times, every_s
 #: (Carlson-Langer, Burridge-Knopoff; docs/lattice.md, "Speed"): slow loading, V = 0.001 unless
 #: given, prepared over two loading times 2 / V from rest, then timed over 20 time units.
 SLOW_LOADING = {"V": 1e-3, "loading_times": 2.0, "t_timed": 20.0}
+
+
+def load_point(p: LatticeParams, n: int) -> float:
+    """The drive's load point at step n as the kernels compute it
+    (:func:`stickslip.kernels.laws.pull_point`): V t_n, or a load history's p(t_n)."""
+    from stickslip.kernels.laws import pull_point
+
+    dp = p.kernel_params(p.drive_piece)
+    return float(pull_point(p.drive_piece.kernel_velocity(p.chain), n, p.dt, dp, p.drive_piece.module))
 
 
 def bench_lattice(p: LatticeParams, t_timed: float, *, t_prepare: float = 0.0, repeat: int = 1) -> dict[str, Any]:

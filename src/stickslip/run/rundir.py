@@ -66,6 +66,36 @@ class RunDirMissing(RunDirDamaged, FileNotFoundError):
         return str(self.args[0])
 
 
+class LatticeRunDir(RunDirDamaged):
+    """A run directory that holds a run on a lattice (docs/lattice.md), which the chain's readers
+    (:func:`load_run`, the catalogue, the period, the plots, ``--from``) do not yet take."""
+
+
+def lattice_run(run_dir: str | Path) -> str | None:
+    """The lattice and shape of the run in ``run_dir`` (``"square 4x5"``), None for a chain run or
+    a folder without a readable run.json."""
+    import json
+
+    try:
+        params = json.loads((Path(run_dir) / "run.json").read_text()).get("params", {})
+    except (OSError, ValueError, AttributeError):
+        return None
+    if not isinstance(params, dict) or params.get("lattice") in (None, "chain"):
+        return None
+    return f"{params['lattice']} {params.get('shape', '')}".strip()
+
+
+def refuse_lattice_run(run_dir: str | Path, what: str) -> None:
+    """Raise :class:`LatticeRunDir` in one line where ``run_dir`` holds a run on a lattice, which
+    ``what`` does not yet read."""
+    lat = lattice_run(run_dir)
+    if lat is not None:
+        raise LatticeRunDir(
+            f"{run_dir} holds a run on lattice {lat}: {what} does not yet read lattice runs "
+            "(their events.csv and state.nc are read with pandas and xarray; docs/lattice.md)"
+        )
+
+
 def _read(path: Path, reader):
     """``reader(path)``, any failure of it a :class:`RunDirDamaged` naming the file."""
     try:
@@ -108,6 +138,7 @@ def load_run(run_dir: str | Path) -> ChainRun:
         raise RunDirDamaged(f"{run_dir} is not a directory (a run directory holds run.json, state.nc, ...)")
     if not run_dir.exists():
         raise RunDirMissing(f"{run_dir}: no such run directory", run_dir)
+    refuse_lattice_run(run_dir, "the chain's readers (load_run, period, plot, --from)")
     try:
         return _load_run(run_dir)
     except RunDirDamaged:

@@ -109,11 +109,15 @@ def load_catalog_run(run_dir: str | Path):
     ParameterError
         In one line, where the folder holds no whole run.
     """
-    from stickslip.run.rundir import RunDirDamaged, load_run
+    from stickslip.run.rundir import RunDirDamaged, load_run, refuse_lattice_run
 
     run_dir = Path(run_dir)
     if not run_dir.is_dir():
         raise ParameterError(f"{run_dir} is not a directory (a catalogue is read from a chain run directory)")
+    try:
+        refuse_lattice_run(run_dir, "the catalogue")
+    except RunDirDamaged as exc:
+        raise ParameterError(str(exc)) from None
     if not (run_dir / "run.json").is_file() or not (run_dir / "events.parquet").is_file():
         raise ParameterError(
             f"{run_dir} is not a chain run directory (no run.json or events.parquet; "

@@ -6,6 +6,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
+
+from stickslip.models.disorder import PerBlock
 from stickslip.models.lattice import LATTICES, LatticeError, lattice
 from stickslip.models.params import MAX_BLOCKS, ChainParams, ParameterError
 
@@ -48,6 +51,26 @@ class LatticeParams:
         pc = self.chain.drive_piece
         return float(importlib.import_module(pc.module).leaf(pc.kernel_params(self.chain)))
 
+    def pad(self, values) -> np.ndarray:
+        """The N values of a per-block parameter (row-major over the lattice's blocks) in the
+        lattice's padded flat layout, 0 at the ghost cells: what the lattice kernels read at each
+        block (:func:`stickslip.kernels.laws.at`)."""
+        return self.lattice.padded(np.reshape(np.asarray(values, dtype=np.float64), self.lattice.shape))
+
+    def kernel_params(self, piece) -> tuple:
+        """The parameters of ``piece`` (the drive, friction or threshold piece) as the lattice
+        kernels read them: :meth:`~stickslip.models.piece.Piece.kernel_params` with each per-block
+        parameter in the lattice's layout (:meth:`pad`)."""
+        return piece.kernel_params(self.chain, pad=self.pad)
+
+    def kernel_mass(self) -> Any:
+        """The masses as the lattice kernels read them: None for unit masses, a float M, or the
+        M_i in the lattice's layout (:meth:`pad`)."""
+        M = self.chain.M
+        if isinstance(M, PerBlock):
+            return self.pad(M.values)
+        return None if M == 1.0 else float(M)
+
     def to_dict(self) -> dict[str, Any]:
         """The model's parameters with the lattice's name, shape and edges (N left out)."""
         d = {k: v for k, v in self.chain.to_dict().items() if k != "N"}
@@ -63,16 +86,17 @@ class LatticeParams:
 
 def on_lattice(chain: ChainParams, name: str, shape: Any = None, edges: Any = None) -> LatticeParams:
     """``chain``'s model on the lattice ``name`` of ``shape`` with ``edges``; the chain's N becomes
-    the lattice's number of blocks. Refused with a one-line :class:`ParameterError`: a bad shape
-    or edges, per-block parameters (not yet on lattices), edges that do not fit the drive."""
+    the lattice's number of blocks (a drawn per-block parameter is drawn again for them, with its
+    seed; an array must already hold them, row-major). Refused with a one-line
+    :class:`ParameterError`: a bad shape or edges, edges that do not fit the drive, springs K
+    that differ from block to block (per bond in two dimensions: not yet there)."""
     if name not in LATTICES:
         raise ParameterError(f"lattice must be one of {', '.join(LATTICES)} (got {name!r})")
-    if chain.per_block():
-        names = ", ".join(chain.per_block())
-        raise ParameterError(f"per-block parameters ({names}) are not yet available on lattice {name}")
-    if chain.drive_piece.pack is not None:
+    K = chain.K
+    if isinstance(K, PerBlock) and bool((K.values != K.values[0]).any()):
         raise ParameterError(
-            f"drive {chain.drive} is not yet available on a lattice (drive end, plate, constant-force)"
+            f"K must be one number on lattice {name} (springs that differ from bond to bond are not yet "
+            f"available on a lattice; got {K.spec_text})"
         )
     edge_drive = not chain.drive_piece.leaf_spring
     try:
@@ -86,3 +110,33 @@ def on_lattice(chain: ChainParams, name: str, shape: Any = None, edges: Any = No
     if n != chain.N:
         chain = chain.replace(N=n)
     return LatticeParams(chain, lat)
+
+
+def row_major(name: str, value: Any, shape: tuple[int, int]) -> Any:
+    """A per-block value given over the square's (rows, cols) (an array, or ``file:PATH`` of a
+    table of rows x cols) as the N = rows cols values in row-major order that
+    :class:`~stickslip.models.params.ChainParams` reads; anything else as it is. A 2-d array of
+    another shape raises a one-line :class:`ParameterError` naming ``name``."""
+    if isinstance(value, str) and value.startswith("file:"):
+        from stickslip.models.disorder import DisorderError, _load
+
+        try:
+            table = _load(value[len("file:") :])
+        except DisorderError as exc:
+            raise ParameterError(f"{name}: {exc}") from None
+        if table.ndim == 2:
+            return PerBlock(row_major(name, table, shape), value)
+        return value
+    if isinstance(value, (list, tuple, np.ndarray)):
+        try:
+            arr = np.asarray(value, dtype=np.float64)
+        except (TypeError, ValueError):
+            return value  # ChainParams names the parameter in its refusal
+        if arr.ndim == 2:
+            if arr.shape != tuple(shape):
+                raise ParameterError(
+                    f"{name} must be {shape[0]}x{shape[1]} values over (row, col), or {shape[0] * shape[1]} "
+                    f"in row-major order (got {arr.shape[0]}x{arr.shape[1]})"
+                )
+            return arr.ravel()
+    return value
