@@ -97,7 +97,7 @@ def lattice_run_dir(tmp_path_factory):
 
 @pytest.mark.parametrize(
     "argv",
-    [["catalog", "RUN"], ["period", "RUN"], ["plot", "RUN"], ["chain", "--from", "RUN", "--t-end", "1"]],
+    [["period", "RUN"], ["chain", "--from", "RUN", "--t-end", "1"]],
 )
 def test_run_readers_refuse_a_lattice_run(argv, lattice_run_dir, capsys):
     from stickslip.cli import main
