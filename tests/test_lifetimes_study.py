@@ -115,6 +115,9 @@ def test_tiny_lifetimes_study_end_to_end(tmp_path):
     assert len(rows) == 7
     assert all(r["end"] in ("periodic", "steady", "censored") for r in rows)
     assert all((r["end"] != "censored") == r["ended"] for r in rows)
+    # each point's cost, its worker's own CPU time beside its wall time (the cost of --full is
+    # estimated from these on a shared machine)
+    assert all(0.0 < r["point_cpu_seconds"] for r in first["rows"])
     for name in ("survival", "lifetime_vs_N", "exponent_vs_N"):
         assert (tmp_path / "lifetimes" / f"{name}.png").is_file()
     found = first["findings"]
