@@ -213,3 +213,22 @@ def test_two_blocks_outlast_a_short_budget():
     row = lifetimes.lifetime_point(cfg, point_params("chain", cfg))
     assert row["end"] == "censored" and not row["ended"] and row["lifetime"] == pytest.approx(2e3)
     assert row["slips"] > 30
+
+
+def test_a_point_with_a_single_lifetime_is_drawn_without_an_error_bar():
+    # a point of one start that ended has <T> but no error (per_point gives None): the figure of
+    # <T> against N drew nothing and raised before
+    from stickslip.plotting.lifetimes import lifetime_figure
+
+    table = pd.DataFrame(
+        [
+            {"status": "ok", "model": "sakaguchi", "N": N, "beta": 1.0, "lifetime": T, "ended": True}
+            | {"end": "periodic", "period_slips": 10, "budget": 1e6, "slips": 100, "t_reached": T}
+            for N, T in ((3, 2e4), (5, 3e4), (5, 3.5e4))
+        ]
+    )
+    points = lifetimes.per_point(table)
+    assert [p["mean_T_err"] is None for p in points] == [True, False]
+    fig = lifetime_figure([{**p, "series": "eq. (4)"} for p in points], [])
+    (bars,) = [c for c in fig.axes[0].containers]
+    assert len(bars.lines[0].get_xdata()) == 2
