@@ -115,6 +115,9 @@ def test_tiny_lifetimes_study_end_to_end(tmp_path):
     assert len(rows) == 7
     assert all(r["end"] in ("periodic", "steady", "censored") for r in rows)
     assert all((r["end"] != "censored") == r["ended"] for r in rows)
+    # each point's cost, its worker's own CPU time beside its wall time (the cost of --full is
+    # estimated from these on a shared machine)
+    assert all(0.0 < r["point_cpu_seconds"] for r in first["rows"])
     for name in ("survival", "lifetime_vs_N", "exponent_vs_N"):
         assert (tmp_path / "lifetimes" / f"{name}.png").is_file()
     found = first["findings"]
@@ -210,3 +213,22 @@ def test_two_blocks_outlast_a_short_budget():
     row = lifetimes.lifetime_point(cfg, point_params("chain", cfg))
     assert row["end"] == "censored" and not row["ended"] and row["lifetime"] == pytest.approx(2e3)
     assert row["slips"] > 30
+
+
+def test_a_point_with_a_single_lifetime_is_drawn_without_an_error_bar():
+    # a point of one start that ended has <T> but no error (per_point gives None): the figure of
+    # <T> against N drew nothing and raised before
+    from stickslip.plotting.lifetimes import lifetime_figure
+
+    table = pd.DataFrame(
+        [
+            {"status": "ok", "model": "sakaguchi", "N": N, "beta": 1.0, "lifetime": T, "ended": True}
+            | {"end": "periodic", "period_slips": 10, "budget": 1e6, "slips": 100, "t_reached": T}
+            for N, T in ((3, 2e4), (5, 3e4), (5, 3.5e4))
+        ]
+    )
+    points = lifetimes.per_point(table)
+    assert [p["mean_T_err"] is None for p in points] == [True, False]
+    fig = lifetime_figure([{**p, "series": "eq. (4)"} for p in points], [])
+    (bars,) = [c for c in fig.axes[0].containers]
+    assert len(bars.lines[0].get_xdata()) == 2

@@ -59,9 +59,9 @@ def survival_figure(curves: list[dict[str, Any]]) -> Figure:
 
 def lifetime_figure(points: list[dict[str, Any]], fits: list[dict[str, Any]]) -> Figure:
     """<T> against N per series: ``points`` with ``series`` (a model and beta; ``beta = ...`` when
-    absent), ``N``, ``mean_T``, ``mean_T_err`` (None where none ended) and ``mean_T_low95``;
-    ``fits`` with the same ``series`` and, where fitted, ``exponential`` and ``power`` line fits of
-    ln <T> (intercept, slope)."""
+    absent), ``N``, ``mean_T``, ``mean_T_err`` (None where none ended, or a single lifetime) and
+    ``mean_T_low95``; ``fits`` with the same ``series`` and, where fitted, ``exponential`` and
+    ``power`` line fits of ln <T> (intercept, slope)."""
 
     def name(p: dict[str, Any]) -> str:
         return p.get("series") or f"beta = {p['beta']:g}"
@@ -77,7 +77,8 @@ def lifetime_figure(points: list[dict[str, Any]], fits: list[dict[str, Any]]) ->
             ax.errorbar(
                 [p["N"] for p in seen],
                 [p["mean_T"] for p in seen],
-                yerr=[p["mean_T_err"] for p in seen],
+                # no error where a single lifetime ended (NaN: matplotlib refuses None)
+                yerr=[float("nan") if p["mean_T_err"] is None else p["mean_T_err"] for p in seen],
                 fmt="o",
                 color=colour,
                 ms=4,
