@@ -50,7 +50,7 @@ __all__ = [
 ]
 
 #: The studies, each the module of its name (``-`` read as ``_``) in this package.
-STUDIES = ("transition", "phase-diagram", "exponents", "chaos", "lifetimes", "disorder")
+STUDIES = ("transition", "phase-diagram", "exponents", "chaos", "lifetimes", "disorder", "lattice")
 #: The studies of ``stickslip reproduce`` (the paper's figures and stated numbers), in report order.
 PAPER = ("figs1-4", "figs5-8")
 #: The record, at the top of a study's output folder, of every page file its studies wrote.
