@@ -196,3 +196,18 @@ def test_the_study_has_its_own_help(capsys):
     text = " ".join(capsys.readouterr().out.split())
     for words in ("usage: stickslip study lattice", "up and down ladders", "L = 256", "magnitudes", "index.html"):
         assert words in text, words
+
+
+def test_log_binned_density_integrates_to_one_and_the_figures_draw():
+    """p(S) on log bins times the bins' widths sums to 1 (every size falls in a bin); the
+    size and magnitude figures have a panel per part."""
+    from stickslip.plotting.lattice_study import log_binned_density, magnitudes_figure, sizes_figure
+
+    S = np.random.default_rng(0).lognormal(0.0, 2.0, 500)
+    x, p = log_binned_density(S, bins_per_decade=4)
+    edges = 10.0 ** np.arange(np.floor(np.log10(S.min())), np.ceil(np.log10(S.max())) + 0.25, 0.25)
+    widths = np.diff(edges)[np.histogram(S, edges)[0] > 0]
+    assert np.sum(p * widths) == pytest.approx(1.0, rel=1e-9)
+    runs = [{"L": 8, "S": S, "t": 100.0}]
+    assert len(sizes_figure(runs, runs).axes) == 2
+    assert len(magnitudes_figure({"sizes": runs, "chain": runs, "cl": runs}).axes) == 3

@@ -89,11 +89,14 @@ def magnitudes_figure(sizes: dict[str, list[dict[str, Any]]]) -> Figure:
     panels = [p for p in ("sizes", "chain", "cl") if sizes.get(p)]
     fig, axes = new_figure(1, max(1, len(panels)), width=3.2, height=3.4)
     axes = np.atleast_1d(axes)
+    Ls = sorted({s["L"] for p in panels for s in sizes[p]})  # one colour per L in every panel
     for ax, part in zip(axes, panels, strict=False):
-        for k, s in enumerate(sizes[part]):
+        for s in sizes[part]:
             M = np.sort(magnitude(s["S"][s["S"] > 0]))[::-1]
             if M.size:
-                ax.semilogy(M, np.arange(1, M.size + 1) / s["t"], "-", color=f"C{k}", label=f"L = {s['L']}")
+                rate = np.arange(1, M.size + 1) / s["t"]
+                ax.step(M, rate, where="post", color=f"C{Ls.index(s['L'])}", label=f"L = {s['L']}")
+                ax.set_yscale("log")
         ax.set_xlabel("M = (2/3) log10 S")
         ax.set_title(titles[part])
         ax.legend(fontsize=7)
