@@ -185,6 +185,7 @@ def test_findings_on_a_synthetic_table():
     assert edge["up_m_at_lo"] == 0.2
     assert 0.5 < edge["linear_threshold"] < 1.0  # below alpha by about 7.6 q_min at these parameters
     assert any("stick-slips up to beta = 1" in s for s in found["statements"])
+    assert "one loading time at L = 256 costs about 463 core-hours" in found["statements"][-1]
 
 
 def test_the_study_has_its_own_help(capsys):

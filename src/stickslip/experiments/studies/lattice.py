@@ -236,6 +236,13 @@ def findings(spec: Study, table: pd.DataFrame) -> dict[str, Any]:
         if part == "sizes" and c and finite(f["tau"]) and finite(c["tau"]):
             z = (f["tau"] - c["tau"]) / math.hypot(f["tau_err"], c["tau_err"])
             say.append(f"L = {L}: tau on the square minus the chain's = {f['tau'] - c['tau']:+.3f} ({z:+.1f} sigma)")
+    square_L = [int(L) for L in _rows(table, "sizes")["L"]] + [e["L"] for e in edges]
+    if square_L and max(square_L) < 256:
+        say.append(
+            f"eq. (4) on the square stops at L = {max(square_L)} here: it runs on the dense integrator, and one "
+            f"loading time at L = 256 costs about {_load_hours(256):.0f} core-hours (L = 128: "
+            f"{_load_hours(128):.0f}), beyond any run of this study; L = 256 is the chain's and Carlson-Langer's only"
+        )
     return {"statements": say, "edges": edges, "rungs": rungs, "fits": fits}
 
 
