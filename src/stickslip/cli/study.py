@@ -42,8 +42,8 @@ def register(sub) -> None:
 
     p = sub.add_parser(
         "study",
-        help="run a study the paper leaves open (transition, phase-diagram, exponents, chaos, lifetimes, disorder) "
-        "or one of "
+        help="run a study the paper leaves open (transition, phase-diagram, exponents, chaos, lifetimes, disorder, "
+        "lattice) or one of "
         "the paper's own (figs1-4, figs5-8); writes a page",
         description=(
             "Run every point of a study on Dask (reusing finished points), then write its table "

@@ -12,7 +12,9 @@ N grows (``transition``), the final state and m over (alpha, beta) and (D, beta)
 (``phase-diagram``), the slip-size exponent tau (``exponents``), whether the chain is chaotic
 at the onset (``chaos``), how long its irregular motion lasts against N (``lifetimes``), and the
 chain with random thresholds: the transition, avalanches under a force ramp beside qEW,
-depinning under a constant force (``disorder``). :data:`PAPER` are the paper's own figures and
+depinning under a constant force (``disorder``), and eq. (4) on the square lattice: its
+transition against beta, its slip sizes and magnitudes beside the chain's, Carlson-Langer's on
+the square (``lattice``). :data:`PAPER` are the paper's own figures and
 stated numbers, each with one page: the single block of section 2 and the Fourier modes of Fig. 4
 (``figs1-4``) and the chain runs of section 3 (``figs5-8``); ``stickslip reproduce`` gathers them
 into one report
@@ -50,7 +52,7 @@ __all__ = [
 ]
 
 #: The studies, each the module of its name (``-`` read as ``_``) in this package.
-STUDIES = ("transition", "phase-diagram", "exponents", "chaos", "lifetimes", "disorder")
+STUDIES = ("transition", "phase-diagram", "exponents", "chaos", "lifetimes", "disorder", "lattice")
 #: The studies of ``stickslip reproduce`` (the paper's figures and stated numbers), in report order.
 PAPER = ("figs1-4", "figs5-8")
 #: The record, at the top of a study's output folder, of every page file its studies wrote.
