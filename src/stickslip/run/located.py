@@ -36,7 +36,8 @@ EVENT_COLUMNS = ["t_start", "t_end", "size", "start_block", "n_blocks"]
 class LocatedState:
     """State of the located integrator at the grid step ``step`` (t = step dt).
 
-    u = x - V t (positions relative to the drive), v, th, mov (1.0 moving, 0.0 stuck), with ghost
+    u = x - V t (positions relative to the drive; u = x for a load history, :func:`frame_velocity`),
+    v, th, mov (1.0 moving, 0.0 stuck), with ghost
     cells 0 and N + 1 as in the kernels; ist, evf, moved: the event bookkeeping of
     :mod:`stickslip.kernels.located`.
     """
@@ -314,7 +315,9 @@ def run_located(
     Heun and located switches (:mod:`stickslip.kernels.located`), from ``start``.
 
     Second order in dt up to and across switches; the events carry located start and end times.
-    ``form``: "fast" or "dense" (:data:`FORMS`), the same bits.
+    ``form``: "fast" or "dense" (:data:`FORMS`), the same bits. A load history (drive history,
+    :mod:`stickslip.models.drive.history`) is read at the located times, in the lab's frame, and
+    runs dense.
     """
     state = start_state(params, start, perturbation=perturbation, seed=seed)
     n_end = steps_for(t_end, params.dt, "t_end")
