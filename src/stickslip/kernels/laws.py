@@ -314,3 +314,25 @@ def _right_of_first(x, N, ends):
     if N > 1:
         return x[2]
     return call(ends, "ghost", x[1], x[1], 0.0)
+
+
+def load_point(t, dp, drive):
+    """The load point in the located integrator's frame at any time t (:mod:`stickslip.kernels.located`):
+    the drive's own ``load(t, dp)`` where it has one (a load history, whose frame is the lab's,
+    :mod:`stickslip.models.drive.history`), else 0 (the drive's own frame, u = x - V t)."""
+    mod = importlib.import_module(drive)
+    if hasattr(mod, "load"):
+        return mod.load(t, dp)
+    return 0.0
+
+
+@overload(load_point, prefer_literal=True)
+def _load_point(t, dp, drive):
+    mod = _module(drive)
+    if mod is None:
+        return None
+    if hasattr(mod, "load"):
+        fn = mod.load
+        return lambda t, dp, drive: fn(t, dp)
+    # Every constant-velocity drive: the constant 0.0 of today's ghost cell, so its bits stay.
+    return lambda t, dp, drive: 0.0

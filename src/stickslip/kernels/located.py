@@ -22,7 +22,8 @@ t_n = n dt. Positions are held relative to the drive, u_i = x_i - V t: the frame
 equations are autonomous (except for fixed ends), and in which a stuck block's coordinate stays
 of order one however long the run, so no precision is lost as V t grows.
 
-Pieces as the other integrators take them (:mod:`stickslip.kernels.layout`): drive end (u_0 = 0)
+Pieces as the other integrators take them (:mod:`stickslip.kernels.layout`): drive end (u_0 = 0),
+history (u_0 = p(t) in the lab's frame, V = 0 in ``par``: :func:`stickslip.kernels.laws.load_point`)
 or plate (f_i gains Kp (0 - u_i), the plate at u = 0); any friction law, through its module's
 compiled functions (:mod:`stickslip.kernels.laws`: the force less the friction, the state
 variable's rate, on stuck blocks too); threshold constant (Fs) or state (theta_i); ends free,
@@ -47,7 +48,7 @@ import numpy as np
 from numba import njit
 
 from stickslip.kernels.laws import _force as _spring_force
-from stickslip.kernels.laws import _threshold, at, call, has, law_accel, law_rate
+from stickslip.kernels.laws import _threshold, at, call, has, law_accel, law_rate, load_point
 from stickslip.kernels.layout import P_DT, P_K, P_V
 
 # Integer state vector.
@@ -64,9 +65,10 @@ SWITCHES_PER_BLOCK = 8
 
 
 @njit(cache=True, inline="always")
-def _ghosts(u, th, N, t, V, drive, ends):
-    """Ghost cells 0 and N + 1 of u = x - V t and theta (docs/model.md, the ends)."""
-    u[0] = call(drive, "left", 0.0, call(ends, "ghost", u[1], u[N], -V * t))
+def _ghosts(u, th, N, t, V, dp, drive, ends):
+    """Ghost cells 0 and N + 1 of u = x - V t and theta (docs/model.md, the ends); the load point
+    at u = 0, or at p(t) for a load history (V = 0: the lab's frame, :func:`laws.load_point`)."""
+    u[0] = call(drive, "left", load_point(t, dp, drive), call(ends, "ghost", u[1], u[N], -V * t))
     u[N + 1] = call(ends, "ghost", u[N], u[1], -V * t)
     th[0] = call(ends, "ghost", th[1], th[N], th[1])
     th[N + 1] = call(ends, "ghost", th[N], th[1], th[N])
@@ -90,7 +92,7 @@ def _rates(u, v, th, mov, N, t, par, lp, dp, drive, friction, ends, du, dv, dth)
     """Right-hand side at time t: du = v - V, dv = the law's f - friction while moving, dtheta of
     the law on every block."""
     V = par[P_V]
-    _ghosts(u, th, N, t, V, drive, ends)
+    _ghosts(u, th, N, t, V, dp, drive, ends)
     for i in range(1, N + 1):
         du[i] = v[i] - V
         if mov[i] != 0.0:
@@ -114,7 +116,7 @@ def _heun(h, t, u, v, th, mov, N, par, lp, dp, drive, friction, ends, sc):
         ou[i] = u[i] + 0.5 * h * (k1u[i] + k2u[i])
         ov[i] = v[i] + 0.5 * h * (k1v[i] + k2v[i])
         oth[i] = th[i] + 0.5 * h * (k1th[i] + k2th[i])
-    _ghosts(ou, oth, N, t + h, par[P_V], drive, ends)
+    _ghosts(ou, oth, N, t + h, par[P_V], dp, drive, ends)
 
 
 @njit(cache=True, _nrt=False)
@@ -200,7 +202,7 @@ def _heun_near(i, h, t, u, v, th, mov, N, par, lp, dp, drive, friction, ends, sc
     if has(ends, "ring"):
         _predict_u(1, h, u, v, th, V, sc)
         _predict_u(N, h, u, v, th, V, sc)
-    _ghosts(pu, pth, N, t + h, V, drive, ends)
+    _ghosts(pu, pth, N, t + h, V, dp, drive, ends)
     if mov[i] != 0.0:
         k2v[i] = law_accel(friction, _force(pu, i, par, dp, drive), pv[i], pth[i], at(lp, i))
     else:
@@ -208,7 +210,7 @@ def _heun_near(i, h, t, u, v, th, mov, N, par, lp, dp, drive, friction, ends, sc
     k2th[i] = law_rate(friction, pth[i - 1], pth[i], pth[i + 1], pv[i], at(lp, i))
     ov[i] = v[i] + 0.5 * h * (k1v[i] + k2v[i])
     oth[i] = th[i] + 0.5 * h * (k1th[i] + k2th[i])
-    _ghosts(ou, oth, N, t + h, V, drive, ends)
+    _ghosts(ou, oth, N, t + h, V, dp, drive, ends)
 
 
 @njit(cache=True, _nrt=False)
@@ -224,7 +226,7 @@ def _locate(i, stop, h, t, u, v, th, mov, N, par, lp, tp, dp, drive, friction, t
     if stop:
         fa = v[i]
     else:
-        _ghosts(u, th, N, t, par[P_V], drive, ends)
+        _ghosts(u, th, N, t, par[P_V], dp, drive, ends)
         fa = -_gap(u, th, i, par, tp, dp, drive, threshold)
     a = 0.0
     b = h
@@ -282,7 +284,7 @@ def _steps(
         while True:
             t = n * dt + s
             # Switches due now: a stuck block above its threshold, a moving one below v = 0.
-            _ghosts(u, th, N, t, par[P_V], drive, ends)
+            _ghosts(u, th, N, t, par[P_V], dp, drive, ends)
             for i in range(1, N + 1):
                 if mov[i] == 0.0:
                     if _gap(u, th, i, par, tp, dp, drive, threshold) > 0.0:

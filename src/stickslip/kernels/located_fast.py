@@ -222,7 +222,7 @@ def advance_fast(
                 b1 = eh + 1 if eh < N else N
                 for j in range(a1, b1 + 1):
                     _catch(j, n, u, us, sd, se, c)
-            _ghosts(u, th, N, t, V, drive, ends)
+            _ghosts(u, th, N, t, V, dp, drive, ends)
             if fresh and el <= eh:
                 dense = _fires(el, eh, u, th, v, v, mov, K, dp, tp, drive, threshold, False)
         if not dense:
@@ -239,7 +239,7 @@ def advance_fast(
                         _stage1_theta_only(v, th, pth, k1th, sl, min(sr, a1 - 1), mp, h, friction)
                     if sr > b1:
                         _stage1_theta_only(v, th, pth, k1th, max(sl, b1 + 1), sr, mp, h, friction)
-            _ghosts(pu, pth, N, t + h, V, drive, ends)
+            _ghosts(pu, pth, N, t + h, V, dp, drive, ends)
             # Stage 2 on E, o* of u on its two neighbours, the tests of the step's end.
             if el <= eh:
                 _stage2_near(el, eh, u, v, th, mov, sc, h, V, K, dp, lp, drive, friction)
@@ -247,7 +247,7 @@ def advance_fast(
                     if i < el or i > eh:
                         k2u[i] = pv[i] - V
                         ou[i] = u[i] + 0.5 * h * (k1u[i] + k2u[i])
-                _ghosts(ou, oth, N, t + h, V, drive, ends)
+                _ghosts(ou, oth, N, t + h, V, dp, drive, ends)
                 dense = _fires(el, eh, ou, oth, v, ov, mov, K, dp, tp, drive, threshold, True)
         if dense:
             # A switch step: the dense form's own step, every block.

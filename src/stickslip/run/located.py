@@ -13,6 +13,7 @@ default (:mod:`stickslip.kernels.located_fast`, docs/performance.md), bit for bi
 
 from __future__ import annotations
 
+import importlib
 from dataclasses import dataclass
 
 import numpy as np
@@ -35,7 +36,8 @@ EVENT_COLUMNS = ["t_start", "t_end", "size", "start_block", "n_blocks"]
 class LocatedState:
     """State of the located integrator at the grid step ``step`` (t = step dt).
 
-    u = x - V t (positions relative to the drive), v, th, mov (1.0 moving, 0.0 stuck), with ghost
+    u = x - V t (positions relative to the drive; u = x for a load history, :func:`frame_velocity`),
+    v, th, mov (1.0 moving, 0.0 stuck), with ghost
     cells 0 and N + 1 as in the kernels; ist, evf, moved: the event bookkeeping of
     :mod:`stickslip.kernels.located`.
     """
@@ -104,18 +106,21 @@ class LocatedState:
         """
         b = state.blocks()
         t = state.step * (params.dt if dt is None else dt)
-        u = b["x"] - params.V * t
+        u = b["x"] - frame_velocity(params) * t
         if restart_clock:
             if params.ends_piece.wall:
                 raise ParameterError("restart_clock needs ends that do not read t (fixed ends do)")
+            if is_history(params):
+                raise ParameterError("restart_clock needs a drive that does not read t (a load history does)")
             return cls.from_blocks(u, b["v"], b["theta"], b["stopped"], 0, 0.0)
         return cls.from_blocks(u, b["v"], b["theta"], b["stopped"], state.step, t)
 
     def blocks(self, params: ChainParams) -> dict[str, np.ndarray]:
-        """Per-block copies: x = u + V t, u, v, theta and stopped, block i at index i - 1."""
+        """Per-block copies: x = u + V t (V the frame's, :func:`frame_velocity`), u, v, theta and
+        stopped, block i at index i - 1."""
         t = self.step * params.dt
         return {
-            "x": self.u[1:-1] + params.V * t,
+            "x": self.u[1:-1] + frame_velocity(params) * t,
             "u": self.u[1:-1].copy(),
             "v": self.v[1:-1].copy(),
             "theta": self.th[1:-1].copy(),
@@ -126,13 +131,26 @@ class LocatedState:
         return LocatedState(**{k: getattr(self, k).copy() for k in ("u", "v", "th", "mov", "moved", "ist", "evf")})
 
 
+def is_history(p: ChainParams) -> bool:
+    """Whether the drive moves its load point along a history p(t) (its module has ``load``,
+    :mod:`stickslip.models.drive.history`) rather than at the constant V."""
+    return hasattr(importlib.import_module(p.drive_piece.module), "load")
+
+
+def frame_velocity(p: ChainParams) -> float:
+    """The velocity of the located integrator's frame, u = x - V t: the drive's V (the frame in
+    which the equations are autonomous), or 0 for a load history, whose load point p(t) the
+    kernels read in the lab's frame (:func:`stickslip.kernels.laws.load_point`)."""
+    return 0.0 if is_history(p) else p.V
+
+
 def parameter_vector(p: ChainParams) -> np.ndarray:
-    """The kernel's parameter vector, laid out as the engine's (:mod:`stickslip.kernels.layout`);
-    the threshold's and the friction law's parameters go separately
-    (:meth:`~stickslip.models.piece.Piece.kernel_params`)."""
+    """The kernel's parameter vector, laid out as the engine's (:mod:`stickslip.kernels.layout`),
+    with the frame's velocity (:func:`frame_velocity`) as V; the threshold's and the friction
+    law's parameters go separately (:meth:`~stickslip.models.piece.Piece.kernel_params`)."""
     par = np.zeros(layout.PAR_SIZE)
     par[layout.P_K] = p.K if isinstance(p.K, float) else float(p.K.values[0])
-    par[layout.P_V], par[layout.P_DT] = p.V, p.dt
+    par[layout.P_V], par[layout.P_DT] = frame_velocity(p), p.dt
     return par
 
 
@@ -181,9 +199,9 @@ class LocatedStepper:
         if not params.drive_piece.located:
             raise ParameterError(f"drive {params.drive} does not run on the located integrator (use the grid's)")
         self.form = form
-        # A wall's ghost cells move with t in the drive's frame: the dense form, which the fast
-        # form skips no work of there.
-        self.fast = form == "fast" and not params.ends_piece.wall
+        # A wall's ghost cells move with t in the drive's frame, and a load history's load point
+        # moves with t in the lab's: the dense form, which the fast form skips no work of there.
+        self.fast = form == "fast" and not params.ends_piece.wall and not is_history(params)
         self.params = params
         self.par = parameter_vector(params)
         self.lp = params.friction_piece.kernel_params(params)
@@ -297,7 +315,9 @@ def run_located(
     Heun and located switches (:mod:`stickslip.kernels.located`), from ``start``.
 
     Second order in dt up to and across switches; the events carry located start and end times.
-    ``form``: "fast" or "dense" (:data:`FORMS`), the same bits.
+    ``form``: "fast" or "dense" (:data:`FORMS`), the same bits. A load history (drive history,
+    :mod:`stickslip.models.drive.history`) is read at the located times, in the lab's frame, and
+    runs dense.
     """
     state = start_state(params, start, perturbation=perturbation, seed=seed)
     n_end = steps_for(t_end, params.dt, "t_end")

@@ -19,7 +19,9 @@ integrator (:func:`monotone`, :attr:`~stickslip.models.piece.Piece.monotone`). O
 from t_0 = 0, p_0 = 0, p(t_n) = V_0 (n dt) is the end drive's V * (n dt) bit for bit while
 n dt < t_1 and V_0 rounds to V.
 
-Not on the located integrator (its frame u = x - V t needs a constant V). No steady sliding.
+On the located integrator (:mod:`stickslip.kernels.located`) the load point is read at the
+located times inside a step too (:func:`load`), and positions are held in the lab's frame
+(u = x, the frame velocity 0; :func:`stickslip.run.located.frame_velocity`). No steady sliding.
 """
 
 from __future__ import annotations
@@ -62,13 +64,13 @@ def left(p, ghost):
 
 
 @njit(cache=True, inline="always")
-def pull(n, dt, dp):
-    """The load point p(t_n), t_n = n dt (module docstring): linear on the interval of t_n,
-    clamped to the interval's end position, held before the first and after the last breakpoint."""
+def load(t, dp):
+    """The load point p(t) at any time t (the located integrator reads it inside a step): linear
+    on the interval of t, clamped to the interval's end position, held before the first and after
+    the last breakpoint."""
     tb = dp.table[0]
     pb = dp.table[1]
     vb = dp.table[2]
-    t = np.float64(n) * dt
     m = tb.shape[0] - 1
     if t >= tb[m]:
         return pb[m]
@@ -79,6 +81,12 @@ def pull(n, dt, dp):
     if vb[k] >= 0.0:
         return min(q, pb[k + 1])
     return max(q, pb[k + 1])
+
+
+@njit(cache=True, inline="always")
+def pull(n, dt, dp):
+    """The load point p(t_n), t_n = n dt (module docstring): :func:`load` at t_n."""
+    return load(np.float64(n) * dt, dp)
 
 
 def pull_py(n: int, dt: float, table: np.ndarray) -> float:
@@ -147,6 +155,5 @@ PIECE = Piece(
     pack=lambda p: Params(table(p.history)),
     monotone=lambda p: monotone(p.history),
     steady_sliding=False,
-    located=False,
     module=__name__,
 )
