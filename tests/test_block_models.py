@@ -1,8 +1,8 @@
 """The single block as a model of the family: the paper's and the Batista-Carlson reading.
 
-The chain engine at N = 1 (end drive, state friction, free end) is eq. (1) with M = sigma = 1,
-written as a different kernel (tests/test_models_exact.py holds it to plain Python): the
-single-block kernel must give the same trajectory bit for bit, with either threshold.
+The single block runs on the chain's reference kernel at N = 1 (end drive, state friction, free
+end); the chain's driver, on its fast exact kernel (tests/test_models_exact.py holds it to plain
+Python), must give the same trajectory bit for bit, with either threshold.
 """
 
 from __future__ import annotations

@@ -73,8 +73,11 @@ def test_friction_laws_are_their_modules(name):
     assert pieces.code("friction", name) == LAW_MODULES[name] == law.module
     p = ChainParams(friction=name, **({"sigma": 0.01} if name == "weakening" else {}))
     lp = law.kernel_params(p)
-    # the named tuple the compiled functions read: the law's parameters, by name, in its order
-    assert lp._fields == law.reads and all(getattr(lp, k) == getattr(p, k) for k in law.reads)
+    # the named tuple the compiled functions read: the law's parameters, by name, in its order,
+    # then its optional ones (eq. (1)'s sigma of the state law), unset for a chain
+    n = len(law.reads)
+    assert lp._fields[:n] == law.reads and all(getattr(lp, k) == getattr(p, k) for k in law.reads)
+    assert lp._fields[n:] == (("sigma",) if name == "state" else ()) and lp[n:] == (None,) * len(lp._fields[n:])
 
 
 def test_params_hand_out_their_pieces():

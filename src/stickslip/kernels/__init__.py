@@ -1,5 +1,5 @@
-"""Numba kernels: the single block (:mod:`~stickslip.kernels.block`) and the chain, whose kernels
-show their parts: :mod:`~stickslip.kernels.layout` (arrays, pieces' codes, status codes),
+"""Numba kernels of the chain (the single block of eq. (1) is its N = 1), whose kernels show their
+parts: :mod:`~stickslip.kernels.layout` (arrays, pieces' codes, status codes),
 :mod:`~stickslip.kernels.laws` (the step's expressions), :mod:`~stickslip.kernels.events`
 (outputs and events), :mod:`~stickslip.kernels.triggers` (the drive's starts),
 :mod:`~stickslip.kernels.dense` (the reference), :mod:`~stickslip.kernels.stages` and

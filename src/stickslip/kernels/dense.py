@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from numba import njit
 
-from stickslip.kernels.events import _end_event, _overflow, _service, _start_and_first_moves
+from stickslip.kernels.events import _end_event, _overflow, _service, _start_and_first_moves, _trace
 from stickslip.kernels.laws import _accel, _dtheta, _force, _pull, _set_ghosts, _threshold
 from stickslip.kernels.layout import (
     _BIG,
@@ -37,7 +37,10 @@ def run_dense(args, drive, friction, threshold, ends):
     are codes (:mod:`stickslip.kernels.layout`), compile-time constants. Advances the state
     arrays to step ``n_end`` or until an output buffer is full; returns a status code. The step is in
     :mod:`stickslip.kernels.laws`, the events in :mod:`stickslip.kernels.events`. ``trig`` is
-    scratch of :func:`stickslip.kernels.exact.run_exact`, unused here.
+    scratch of :func:`stickslip.kernels.exact.run_exact`, unused here. Where ``args.trace`` is a
+    :class:`~stickslip.kernels.layout.Trace` (the single block, eq. 1, as the chain's N = 1) it
+    records the state every few steps and the range of v over every step; None compiles to
+    nothing.
     """
     x, v, th, mov, xs = args.x, args.v, args.th, args.mov, args.xs
     vs, ths, mm, a1, b1 = args.vs, args.ths, args.mm, args.a1, args.b1
@@ -103,6 +106,7 @@ def run_dense(args, drive, friction, threshold, ends):
         ist[BLOCK_UPDATES] += N
         ist[STEPS_COMPUTED] += 1
         ist[STEP] = n + 1
+        _trace(args.trace, n + 1, x, v, th, mov, N)
         if bad > 0:
             ist[BAD_BLOCK] = bad
             return NONFINITE

@@ -10,7 +10,8 @@ when one could overflow, and the driver empties them and calls again.
 
 from __future__ import annotations
 
-from numba import njit
+from numba import njit, types
+from numba.extending import overload
 
 from stickslip.kernels.layout import (
     ALL_MOVING,
@@ -172,3 +173,39 @@ def _end_event(n, args):
             ist[P_COUNT] = ist[EV_P_FIRST]  # too small to keep: drop its rows
     ist[EV_ACTIVE] = 0
     ist[N_EVENTS] = eid + 1
+
+
+def _trace(trace, n, x, v, th, mov, N):
+    """After step n (the arrays hold t_n): the range of v over blocks 1..N, and their state when n
+    is the step due (:class:`~stickslip.kernels.layout.Trace`); nothing where ``trace`` is None, as
+    for every chain."""
+
+
+@overload(_trace, inline="always")
+def _trace_impl(trace, n, x, v, th, mov, N):
+    if isinstance(trace, types.NoneType):
+        return lambda trace, n, x, v, th, mov, N: None
+
+    def record(trace, n, x, v, th, mov, N):
+        vr = trace.v_range
+        for i in range(1, N + 1):
+            vi = v[i]
+            if vi < vr[0]:
+                vr[0] = vi
+            if vi > vr[1]:
+                vr[1] = vi
+        # count[1]: the next step to record (a comparison each step rather than a division)
+        c = trace.count
+        if n == c[1]:
+            c[1] = n + trace.every
+            k = c[0]
+            if k < trace.step.shape[0]:
+                for i in range(1, N + 1):
+                    trace.x[k, i - 1] = x[i]
+                    trace.v[k, i - 1] = v[i]
+                    trace.th[k, i - 1] = th[i]
+                    trace.mov[k, i - 1] = mov[i]
+                trace.step[k] = n
+                c[0] = k + 1
+
+    return record

@@ -128,6 +128,23 @@ class ChainArgs(NamedTuple):
     profile_every: int  # 0: no profiles
     profile_min_blocks: int
     stop_all_moving: int  # 1: return ALL_MOVING after a sample at which every block moves
+    trace: object = None  # None, or a Trace: every block's state at every few steps (the reference only)
+
+
+class Trace(NamedTuple):
+    """Every block's state after each ``every``-th step (from ``count[1]`` on), and the range of v over every
+    step (the single block's series, Figs. 1-2): written by the reference kernel
+    (:func:`stickslip.kernels.dense.run_dense`, :func:`stickslip.kernels.events._trace`) where
+    ``ChainArgs.trace`` is one; None (every chain) compiles to nothing."""
+
+    every: int  # record the state after steps every, 2 every, ...
+    x: np.ndarray  # float64 (rows, N): x_1..x_N at the recorded steps
+    v: np.ndarray
+    th: np.ndarray
+    mov: np.ndarray  # 1.0 moving, 0.0 stopped
+    step: np.ndarray  # int64 (rows): the recorded steps
+    count: np.ndarray  # int64 (2): rows filled (a full buffer is left as it is) and the next step due
+    v_range: np.ndarray  # float64 (2): least and greatest v_i over the blocks and every step so far
 
 
 _BIG = np.float64(1.7976931348623157e308)

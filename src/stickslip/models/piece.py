@@ -86,11 +86,15 @@ def njit(**options: Any) -> Callable[[Callable], Any]:
     return mark
 
 
-def kernel_params(module: str, reads: tuple[str, ...]) -> type:
+def kernel_params(module: str, reads: tuple[str, ...], optional: tuple[str, ...] = ()) -> type:
     """The named tuple of the parameters a piece's compiled functions read, in the order of
     ``reads``: the one declaration the driver packs from and the compiled code reads by name
-    (``lp.beta``). Defined as ``Params`` in the piece's own module (numba's cache finds it there)."""
-    return namedtuple("Params", reads, module=module)
+    (``lp.beta``). Defined as ``Params`` in the piece's own module (numba's cache finds it there).
+
+    ``optional`` fields follow, None unless a caller sets them (eq. (1)'s sigma, which only the
+    single block sets): a kernel is compiled for None or a float, so a None field costs nothing
+    and leaves every expression as it was."""
+    return namedtuple("Params", reads + optional, defaults=(None,) * len(optional), module=module)
 
 
 def _kernel_value(value: Any, pad: Callable[[Any], Any] | None = None) -> Any:

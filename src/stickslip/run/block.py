@@ -1,7 +1,11 @@
 """The single block and spring of section 2: runs of eq. (1) and their slips.
 
-A run starts at t = 0 from a :class:`BlockState` and advances eq. (1) with the compiled Heun
-step of :mod:`stickslip.kernels.block` (start and stop rules of docs/model.md). It returns a
+A run starts at t = 0 from a :class:`BlockState` and advances eq. (1) as the chain of eq. (4) at
+N = 1 (docs/model.md): the chain's reference kernel :func:`stickslip.kernels.dense.run_dense`
+with the drive ``end`` (the pulling point V t and the spring K), the block's friction and threshold
+pieces (with eq. (1)'s sigma), its mass M and free ends, so the block, the chain and every law
+share one Heun step and one pair of start and stop rules. The chain's events are the slips; the
+kernel's trace keeps the series. It returns a
 :class:`BlockRun`: the time series as an xarray Dataset, the table of slips as a pandas
 DataFrame, the final state and a few statistics gathered over every step. The period sweep of
 Fig. 3 is :func:`stickslip.analysis.dynamics.slip_limit.period_sweep`.
@@ -17,15 +21,13 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from stickslip.kernels.block import heun_block
-from stickslip.kernels.entry import specialise_call
+from stickslip.kernels import layout
+from stickslip.kernels.dense import run_dense
+from stickslip.kernels.entry import specialise
 from stickslip.models.params import BlockParams, ParameterError, check_number, steps_for
+from stickslip.models.pieces import piece
 
 INTEGRATOR = "heun (explicit trapezoid, fixed dt) with the start/stop rules of docs/model.md"
-
-#: The positions of the friction law and the threshold among heun_block's arguments (compiled
-#: as literals).
-LAW_ARG = frozenset({8, 10})
 
 SLIP_COLUMNS = ("t_c", "t_e", "duration", "slip", "force_at_stop", "period")
 
@@ -178,64 +180,183 @@ def simulate_block(
     initial = BlockState() if initial is None else initial
     every = int(check_number("every", every, low=1, integer=True))
     steps = steps_for(t_end, params.dt, "t_end")
-    n_out = n_samples(steps, every)
-
-    out_t = np.empty(n_out)
-    out_x = np.empty(n_out)
-    out_v = np.empty(n_out)
-    out_theta = np.empty(n_out)
-    out_stopped = np.empty(n_out, dtype=np.bool_)
-
-    # A slip takes at least one step; start with room for one per 1000 steps and run again
-    # with exact room in the rare case (fast chatter) that this is not enough.
-    capacity = max(16, steps // 1000)
-    while True:
-        slip_start = np.empty(capacity, dtype=np.int64)
-        slip_end = np.empty(capacity, dtype=np.int64)
-        slip_x_start = np.empty(capacity)
-        slip_x_end = np.empty(capacity)
-        law, thr = params.friction_piece, params.threshold_piece
-        args = (
-            initial.x, initial.v, initial.theta, initial.stopped, steps, every,
-            params.K, params.V, law.module, law.kernel_params(params), thr.module, thr.kernel_params(params),
-            params.M, params.sigma, params.dt,
-            out_t, out_x, out_v, out_theta, out_stopped,
-            slip_start, slip_end, slip_x_start, slip_x_end,
-        )  # fmt: skip
-        (x, v, theta, stopped, n_slips, n_starts, n_stops, v_min, v_max) = specialise_call(heun_block, args, LAW_ARG)
-        if n_slips <= capacity:
-            break
-        capacity = n_slips
+    chain = _Chain1(params, initial, steps, every)
+    chain.run()
+    x, v, theta, stopped = chain.state()
     if not (np.isfinite(x) and np.isfinite(v) and np.isfinite(theta)):
-        _blow_up(params, out_t, out_x, out_v, out_theta, steps)
-
-    series = _series(params, out_t, out_x, out_v, out_theta, out_stopped, every)
-    slips = _slip_table(params, slip_start[:n_slips], slip_end[:n_slips], slip_x_start[:n_slips], slip_x_end[:n_slips])
-    final = BlockState(x=x, v=v, theta=theta, stopped=bool(stopped))
+        _blow_up(params, chain.bad_step())
+    t, xs, vs, ths, stops = chain.series(steps)
+    series = _series(params, t, xs, vs, ths, stops, every)
+    n_c, n_e, x_c, x_e = chain.slips()
+    slips = _slip_table(params, n_c, n_e, x_c, x_e)
+    v_min, v_max = chain.trace.v_range
     return BlockRun(
         params=params,
         series=series,
         slips=slips,
-        final=final,
+        final=BlockState(x=x, v=v, theta=theta, stopped=stopped),
         steps=steps,
         every=every,
         v_min=float(v_min),
         v_max=float(v_max),
-        n_stops=int(n_stops),
-        n_starts=int(n_starts),
+        n_stops=chain.n_stops(),
+        n_starts=chain.n_starts(),
         initial=initial,
     )
 
 
-def _blow_up(p: BlockParams, t, x, v, theta, steps: int) -> None:
-    """Raise NonFiniteBlock naming the first stored time with a non-finite state."""
+def chain_pieces(p: BlockParams) -> tuple[str, str, str, str]:
+    """eq. (1) as the chain of eq. (4) at N = 1: what the chain's kernels are compiled for (drive,
+    friction, threshold, ends; :func:`stickslip.models.pieces.code`). The pulling point V t is
+    joined to the block by the spring K (drive ``end``), no spring beyond it (ends ``free``), and
+    the block's friction and threshold are the chain's pieces."""
+    from stickslip.models.pieces import code
+
+    return (code("drive", "end"), p.friction_piece.module, p.threshold_piece.module, code("ends", "free"))
+
+
+def _sigma(kernel_params: tuple, sigma: float) -> tuple:
+    """A piece's kernel parameters with eq. (1)'s sigma where the piece reads one (its optional
+    field: sigma theta + beta v, and the threshold sigma theta)."""
+    return kernel_params._replace(sigma=float(sigma)) if "sigma" in kernel_params._fields else kernel_params
+
+
+class _Chain1:
+    """The arrays of one run of the chain's reference kernel at N = 1 for eq. (1)
+    (:func:`stickslip.kernels.dense.run_dense`, its ``trace`` keeping the series): its events are
+    the slips, their first and last profile rows the block's position at t_c and t_e."""
+
+    def __init__(self, p: BlockParams, s: BlockState, steps: int, every: int):
+        self.p, self.initial, self.steps = p, s, steps
+        # A slip takes at least one step: room for one per 1000 steps, emptied when full.
+        cap = max(16, steps // 1000)
+        ist = np.zeros(layout.IST_SIZE, dtype=np.int64)
+        ist[layout.N_MOVING] = 0 if s.stopped else 1
+        ist[layout.NEXT_SAMPLE] = layout._NEVER
+        ist[layout.NEXT_PROFILE] = layout._NEVER
+        self.ist = ist
+        rows = steps // every
+        self.trace = layout.Trace(
+            np.int64(every),
+            np.empty((rows, 1)),
+            np.empty((rows, 1)),
+            np.empty((rows, 1)),
+            np.empty((rows, 1)),
+            np.empty(rows, dtype=np.int64),
+            np.array([0, every], dtype=np.int64),
+            np.array([s.v, s.v]),
+        )
+        state = [np.array([0.0, value, 0.0]) for value in (s.x, s.v, s.theta, 0.0 if s.stopped else 1.0)]
+        law, thr = p.friction_piece, p.threshold_piece
+        self.args = layout.ChainArgs(
+            *state,
+            *(np.zeros(3) for _ in range(6)),
+            np.zeros(3, dtype=np.int64),
+            np.full(3, -1, dtype=np.int64),
+            np.zeros(3),
+            ist,
+            np.array([p.K, p.V, p.dt]),
+            piece("drive", "end").kernel_params(p),
+            _sigma(thr.kernel_params(p), p.sigma),
+            _sigma(law.kernel_params(p), p.sigma),
+            None,
+            float(p.M),  # a / M, as eq. (1) reads it (a / 1.0 is a): one kernel for every M
+            np.zeros((cap, layout.EV_INT_COLS), dtype=np.int64),
+            np.zeros(cap),
+            np.zeros((cap + 1, 3), dtype=np.int64),
+            np.zeros(1),
+            np.zeros(1, dtype=np.int64),
+            np.zeros(1, dtype=np.int64),
+            np.zeros((2 * cap + 2, 1)),
+            np.zeros((2 * cap + 2, 2), dtype=np.int64),
+            np.int64(steps),
+            np.int64(1),
+            np.int64(1) << np.int64(62),  # profile rows at an event's start and end only
+            np.int64(1),
+            np.int64(0),
+            self.trace,
+        )
+        self.pieces = chain_pieces(p)
+        self.events: list[np.ndarray] = []
+        self.rows: list[tuple[np.ndarray, np.ndarray]] = []
+
+    def run(self) -> None:
+        """Run the kernel to the last step, emptying the event and profile buffers when full."""
+        entry_point = specialise(run_dense, self.args, self.pieces)
+        while True:
+            status = entry_point(self.args, *self.pieces)
+            if status in (layout.EVENTS_FULL, layout.FIRST_MOVES_FULL, layout.PROFILES_FULL):
+                self._drain()
+                continue
+            if status not in (layout.DONE, layout.NONFINITE):
+                raise RuntimeError(f"unexpected status {status} of the chain kernel")
+            self._drain()
+            return
+
+    def _drain(self) -> None:
+        a, ist = self.args, self.ist
+        self.events.append(a.ev_int[: ist[layout.EV_COUNT]].copy())
+        p = ist[layout.P_COUNT]
+        self.rows.append((a.prof_x[:p, 0].copy(), a.prof_meta[:p, 0].copy()))
+        ist[layout.EV_COUNT] = ist[layout.FM_COUNT] = ist[layout.P_COUNT] = 0
+
+    def state(self) -> tuple[float, float, float, bool]:
+        a = self.args
+        return float(a.x[1]), float(a.v[1]), float(a.th[1]), bool(a.mov[1] == 0.0)
+
+    def bad_step(self) -> int:
+        """The step after which the state was found non-finite."""
+        return int(self.ist[layout.STEP])
+
+    def series(self, steps: int):
+        """t, x, v, theta and the stop flag at step 0, every ``every``-th step and the last."""
+        tr = self.trace
+        k = int(tr.count[0])
+        x0 = self.initial
+        last = [] if k and tr.step[k - 1] == steps or not steps else [steps]
+        n = np.concatenate([[0], tr.step[:k], last]).astype(np.int64)
+        xf, vf, thf, stf = self.state()
+
+        def column(values, first, final):
+            return np.concatenate([[first], values[:k, 0], [final] if last else []])
+
+        mov = column(tr.mov, 0.0 if x0.stopped else 1.0, 0.0 if stf else 1.0)
+        t = n * self.p.dt
+        return (t, column(tr.x, x0.x, xf), column(tr.v, x0.v, vf), column(tr.th, x0.theta, thf), mov == 0.0)
+
+    def slips(self):
+        """Start and end step of each complete slip (the chain's events; t_e = (end + 1) dt) and the
+        block's position then (the event's first and last profile rows)."""
+        ev = np.concatenate(self.events) if self.events else np.zeros((0, layout.EV_INT_COLS), dtype=np.int64)
+        x = np.concatenate([r[0] for r in self.rows]) if self.rows else np.zeros(0)
+        eid = np.concatenate([r[1] for r in self.rows]) if self.rows else np.zeros(0, dtype=np.int64)
+        first = {}
+        last = {}
+        for j, e in enumerate(eid.tolist()):
+            first.setdefault(e, x[j])
+            last[e] = x[j]
+        ids = ev[:, layout.E_ID].tolist()
+        x_c = np.array([first[e] for e in ids], dtype=float)
+        x_e = np.array([last[e] for e in ids], dtype=float)
+        return ev[:, layout.E_START_STEP], ev[:, layout.E_END_STEP] + 1, x_c, x_e
+
+    def n_starts(self) -> int:
+        """Starts: every event opened (each start of the block's slips)."""
+        return int(self.ist[layout.N_EVENTS] + self.ist[layout.EV_ACTIVE])
+
+    def n_stops(self) -> int:
+        """Stops: each complete event, and the end of a slip under way at step 0."""
+        first = not self.initial.stopped and (self.state()[3] or self.n_starts() > 0)
+        return int(self.ist[layout.N_EVENTS]) + int(first)
+
+
+def _blow_up(p: BlockParams, step: int) -> None:
+    """Raise NonFiniteBlock naming the time at which the state was found non-finite."""
     from stickslip.run.errors import NonFiniteBlock
 
-    bad = ~(np.isfinite(x) & np.isfinite(v) & np.isfinite(theta))
-    when = f"t = {float(t[np.argmax(bad)]):.6g}" if bad.any() else f"t <= {steps * p.dt:.6g}"
     raise NonFiniteBlock(
-        f"the block's state became non-finite by {when} (blow-up; a smaller dt may help, "
-        f"dt = {p.dt:g}, K/M = {p.K / p.M:g})"
+        f"the block's state became non-finite by t = {step * p.dt:.6g} (blow-up; a smaller dt may "
+        f"help, dt = {p.dt:g}, K/M = {p.K / p.M:g})"
     )
 
 

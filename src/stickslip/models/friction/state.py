@@ -1,4 +1,5 @@
-"""eq. (4)'s friction: theta_i + beta v_i while moving, with the state law of eq. (4).
+"""eq. (4)'s friction: theta_i + beta v_i while moving, with the state law of eq. (4); the single
+block's sigma theta + beta v of eq. (1) with its optional parameter sigma.
 
 dtheta_i/dt = theta_i (1 - theta_i) - alpha theta_i v_i + D (theta_{i+1} - 2 theta_i + theta_{i-1}).
 Its compiled functions :func:`accel` and :func:`rate` are what every integrator evaluates
@@ -12,13 +13,25 @@ from typing import Any
 from stickslip.models.piece import Linearisation, Piece, kernel_params, njit
 
 READS = ("beta", "alpha", "D")
-Params = kernel_params(__name__, READS)
+#: ``sigma``: eq. (1)'s scale of the state term, sigma theta + beta v; None (eq. 4) reads theta.
+Params = kernel_params(__name__, READS, optional=("sigma",))
+
+
+@njit(cache=True)
+def scaled(sigma, th):
+    """sigma theta (eq. 1), or theta itself where sigma is None (eq. 4): chosen when compiled, so
+    the chain's expression is untouched. Not inlined by numba, so that it can prune the branch
+    on its argument's type; LLVM inlines it."""
+    if sigma is None:
+        return th
+    return sigma * th
 
 
 @njit(cache=True, inline="always")
 def accel(f, v, th, lp):
-    """f - theta - beta v: the force on a moving block less eq. (4)'s friction theta + beta v."""
-    return f - th - lp.beta * v
+    """f - sigma theta - beta v: the force on a moving block less the friction sigma theta + beta v
+    of eq. (1) (eq. 4: sigma None, theta + beta v)."""
+    return f - scaled(lp.sigma, th) - lp.beta * v
 
 
 @njit(cache=True, inline="always")

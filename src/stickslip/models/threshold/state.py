@@ -3,16 +3,18 @@ Batista-Carlson, docs/model.md)."""
 
 from __future__ import annotations
 
+from stickslip.models.friction import state as law
 from stickslip.models.piece import Piece, kernel_params, njit
 
 READS: tuple[str, ...] = ()
-Params = kernel_params(__name__, READS)
+#: ``sigma``: the single block's threshold sigma theta (eq. 1); None (the chain) reads theta_i.
+Params = kernel_params(__name__, READS, optional=("sigma",))
 
 
 @njit(cache=True, inline="always")
 def value(th, tp):
-    """theta_i: the threshold moves with the state variable."""
-    return th
+    """theta_i (sigma theta for the single block): the threshold moves with the state variable."""
+    return law.scaled(tp.sigma, th)
 
 
 PIECE = Piece(
