@@ -104,8 +104,13 @@ def on_square(overrides: dict[str, Any], shape: Any) -> dict[str, Any]:
         rows, cols = parse_shape(shape)
     except LatticeError as exc:
         raise ParameterError(str(exc)) from None
+    from stickslip.models.params import MAX_BLOCKS
+
     out = {k: row_major(k, v, (rows, cols)) for k, v in overrides.items()}
-    out["N"] = rows * cols
+    # The wrapped chain's N is the lattice's count up to a chain's largest (on_lattice's rule);
+    # per-block values need every block, so they bound the square to a chain's largest.
+    per_block = any(not isinstance(v, (int, float, str, type(None))) for v in out.values())
+    out["N"] = rows * cols if per_block else min(rows * cols, MAX_BLOCKS)
     return out
 
 

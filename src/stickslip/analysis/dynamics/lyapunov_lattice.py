@@ -38,7 +38,13 @@ class LatticeEngine:
     """The lattice's map for :func:`~stickslip.analysis.dynamics.benettin.two_trajectory_exponent`:
     states are :class:`~stickslip.run.lattice.LatticeState`, separations in the lattice's norm,
     twins on the reference's branch; no neutral direction removed and no waiting (the grid's
-    map, as :class:`stickslip.analysis.dynamics.lyapunov.GridEngine`)."""
+    map, as :class:`stickslip.analysis.dynamics.lyapunov.GridEngine`).
+
+    Parameters
+    ----------
+    params : LatticeParams
+        The model on its lattice; both trajectories run its dense integrator.
+    """
 
     method = METHOD
     norm = NORM
@@ -126,6 +132,31 @@ def lattice_lyapunov(
     (``default_rng(direction_seed)``); both advance by ``interval``, the distance is measured and
     the twin put back d0 away along the separation. Counted and averaged as in
     :func:`stickslip.analysis.dynamics.lyapunov.largest_lyapunov` (its parameters are these).
+
+    Parameters
+    ----------
+    params : LatticeParams
+        The model on its lattice.
+    t_end : float
+        The reference's last time.
+    interval : float
+        Time between two renormalisations.
+    d0 : float
+        The twin's distance after each renormalisation, in the lattice's norm.
+    transient : float
+        The reference's time alone before the twin is placed.
+    align : float, optional
+        Time the twin first runs without counting (as ``largest_lyapunov``'s).
+    start : str or LatticeState
+        The reference's start (:func:`stickslip.run.lattice.initial_state`), or a state.
+    perturbation : float
+        The start's perturbation amplitude.
+    seed : int
+        The start's seed.
+    direction_seed : int
+        The seed of the twin's first direction.
+    segments : int
+        Segments of the error estimate.
 
     Returns
     -------

@@ -121,7 +121,20 @@ def lattice_catalog(events: pd.DataFrame, n_blocks: int, *, t_from: float = 0.0)
 class LatticeCatalog:
     """A lattice run's catalogue (:func:`lattice_catalog`), the numbers read from it
     (``summary``, JSON-able), the power-law fit of the moments (``size_fit``, or None) and the
-    inter-event times (``intervals``)."""
+    inter-event times (``intervals``).
+
+    Attributes
+    ----------
+    table : pandas.DataFrame
+        One row per event (:func:`lattice_catalog`): times, moment, magnitude M = (2/3) log10
+        moment, area, epicentre and extent.
+    summary : dict
+        The numbers read from it (b-value, tau, recurrence), JSON-able.
+    size_fit : object or None
+        The power-law fit of the moments, None with too few events.
+    intervals : numpy.ndarray
+        The inter-event times.
+    """
 
     table: pd.DataFrame
     summary: dict[str, Any]

@@ -27,10 +27,12 @@ import io as _io
 import json
 import math
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 __all__ = [
     "lattice_task",
@@ -112,6 +114,8 @@ def _save(path: Path, state, events: pd.DataFrame, samples: pd.DataFrame, extra:
 
 
 def _load(path: Path):
+    import pandas as pd
+
     from stickslip.run.lattice import LatticeState
 
     with np.load(path) as z:
@@ -147,6 +151,8 @@ def run_segments(
         The final :class:`~stickslip.run.lattice.LatticeState`, the events and the samples
         (t, mean_slip_deficit, mean_v, moving), each sample once.
     """
+    import pandas as pd  # here, not above: the study's registry is read by `stickslip --help`
+
     from stickslip.run.errors import Interrupted
     from stickslip.run.lattice import run_lattice
 
