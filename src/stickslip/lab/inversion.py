@@ -6,7 +6,7 @@ time, friction, load history) or a table of its cycles (one row per cycle: ``per
 ``stress_drop``, ``peak_slip_rate``, ``peak_friction``, any of them). Their observables
 (:mod:`stickslip.lab.cycles`) are averaged over the cycles, each mean with its standard error s_j
 (the scatter between cycles over the square root of their number) widened by a floor
-``floor`` |mean_j| (``floor`` times the stress drop for the peak friction, a level) that
+``floor`` ``|mean_j|`` (``floor`` times the stress drop for the peak friction, a level) that
 stands for the model's own error. The forward model is the inertial
 spring-slider (:mod:`stickslip.lab.inertial`: the chain's single block with a mass M, no static
 threshold), run over the record's load history (or at the table's V for ``t_end``) and sampled at

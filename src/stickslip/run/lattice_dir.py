@@ -1,4 +1,4 @@
-"""Lattice run directories (docs/lattice.md, "Outputs"): what ``stickslip chain --lattice ...
+"""Lattice run directories (docs/lattice.md, "Outputs"): what ``stickslip chain --lattice square
 --out DIR`` and :meth:`stickslip.run.lattice.LatticeRun.write` leave, read back as a
 :class:`~stickslip.run.lattice.LatticeRun` for ``stickslip catalog`` and ``stickslip plot``."""
 

@@ -7,7 +7,7 @@ springs, so the separation of two states is measured in y = (sqrt(K) e, v, theta
 springs' extensions along each line from the pulled side (:meth:`Chain.strain
 <stickslip.models.lattice.chain.Chain.strain>`, :meth:`Square.strain
 <stickslip.models.lattice.square.Square.strain>`; the pulling point is the same for both states),
-with the Euclidean norm: with unit mass |(sqrt(K) de, dv)|^2 / 2 is the energy of the
+with the Euclidean norm: with unit mass ``|(sqrt(K) de, dv)|^2 / 2`` is the energy of the
 perturbation along those lines. With a drive that holds every block by its own leaf spring Kp
 (the plate), positions relative to the plate are the displacements themselves and y =
 (sqrt(Kp) dx, v, theta). Every array here is over the blocks in the lattice's order (row-major),
@@ -69,7 +69,7 @@ def on_branch(dy: np.ndarray, stopped: np.ndarray, has_state: bool = True) -> np
 
 
 def distance(lat, a: tuple, b: tuple, params: Any) -> float:
-    """The distance |y(b) - y(a)| of two states given as (x, v, theta) over the blocks of the
+    """The distance ``|y(b) - y(a)|`` of two states given as (x, v, theta) over the blocks of the
     padded layout (flat arrays of the lattice's ``size``, ghost cells included and not read).
 
     Examples
