@@ -269,6 +269,35 @@ class Problem:
         return np.concatenate(res)
 
 
+def standard_errors(jac: np.ndarray, scale: np.ndarray, s2: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+    """Standard errors and correlations of least-squares parameters from the covariance
+    s2 (J^T J)^-1 at the solution (the pseudo-inverse of J, as scipy's curve_fit).
+
+    Parameters
+    ----------
+    jac : array (n, p)
+        The Jacobian of the residuals in the scaled parameters.
+    scale : array (p,)
+        The parameters' scales (value = scaled value * scale).
+    s2 : float
+        The residual variance (1 where the residuals are already divided by their errors).
+
+    Returns
+    -------
+    tuple of arrays
+        The standard errors (p,) and the correlation matrix (p, p).
+    """
+    _, sv, vt = np.linalg.svd(jac, full_matrices=False)
+    thresh = np.finfo(float).eps * max(jac.shape) * sv[0]
+    sv = sv[sv > thresh]
+    vt = vt[: sv.size]
+    cov = (vt.T / sv**2) @ vt * s2 * np.outer(scale, scale)
+    err = np.sqrt(np.diag(cov))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        corr = cov / np.outer(err, err)
+    return err, corr
+
+
 def fit(
     records: Record | Sequence[Record],
     model: RateState,
@@ -342,16 +371,7 @@ def fit(
     values = sol.x * scale
     dof = n - len(slots)
     s2 = 2.0 * sol.cost / dof
-    # Covariance from the pseudo-inverse of J (scipy's curve_fit does the same).
-    _, sv, vt = np.linalg.svd(sol.jac, full_matrices=False)
-    thresh = np.finfo(float).eps * max(sol.jac.shape) * sv[0]
-    sv = sv[sv > thresh]
-    vt = vt[: sv.size]
-    cov_x = (vt.T / sv**2) @ vt * s2
-    cov = cov_x * np.outer(scale, scale)
-    err = np.sqrt(np.diag(cov))
-    with np.errstate(invalid="ignore", divide="ignore"):
-        corr = cov / np.outer(err, err)
+    err, corr = standard_errors(sol.jac, scale, s2)
     fitted = models_at(sol.x)
     preds = [
         model_friction(m, rec, trend=tr, rtol=rtol, method=method) for (m, tr), rec in zip(fitted, records, strict=True)

@@ -34,6 +34,7 @@ import xarray as xr
 from scipy.optimize import least_squares
 
 from stickslip.lab.cycles import OBSERVABLES, cycle_table, observables
+from stickslip.lab.fitting import standard_errors
 from stickslip.lab.history import LoadHistory
 from stickslip.lab.inertial import check_route, sample
 from stickslip.lab.laws import RateState
@@ -386,12 +387,7 @@ def invert_stick_slip(
         xtol=1e-6,
     )
     cpu = time.process_time() - cpu0
-    _, sv, vt = np.linalg.svd(sol.jac, full_matrices=False)
-    keep = sv > np.finfo(float).eps * max(sol.jac.shape) * sv[0]
-    cov = (vt[keep].T / sv[keep] ** 2) @ vt[keep] * np.outer(scale, scale)
-    err = np.sqrt(np.diag(cov))
-    with np.errstate(invalid="ignore", divide="ignore"):
-        corr = cov / np.outer(err, err)
+    err, corr = standard_errors(sol.jac, scale)
     mod, m_ = at(sol.x)
     series, model_cycles, pred = predicted(mod, m_)
     obs, se = observed_at(mod.k)
