@@ -21,6 +21,7 @@ import xarray as xr
 from stickslip.kernels import layout
 from stickslip.models.lattice import module_of
 from stickslip.models.lattice.params import LatticeParams
+from stickslip.models.lattice.samples import SAMPLES, sample
 from stickslip.models.params import MAX_PERTURBATION, ParameterError, check_number, steps_for
 from stickslip.run.errors import NonFiniteState
 
@@ -147,9 +148,9 @@ class LatticeRun:
     state: LatticeState
     snapshots: xr.Dataset | None
     summary: dict[str, Any] = field(default_factory=dict)
-    #: samples every ``sample_every``: t, the mean slip deficit (the load point V t, or a load
-    #: history's p(t), less x, over
-    #: the blocks), the mean velocity and the number of moving blocks; None unless asked for
+    #: samples every ``sample_every``: t and the declared reductions of
+    #: :data:`~stickslip.models.lattice.samples.SAMPLES` (the mean slip deficit, the mean velocity,
+    #: the number of moving blocks, the mean stress); None unless asked for
     samples: pd.DataFrame | None = None
     #: the slip field and the first-move step of each block over (event, row, col) of the events
     #: asked for (``slip_maps`` of :func:`run_lattice`); None unless asked for
@@ -408,7 +409,7 @@ def run_lattice(
     if snaps:
         stacked = {k: np.stack([f[k] for f in snaps]) for k in snaps[0]}
         snapshots = _dataset(stacked, p, time=np.asarray(times) * p.dt)
-    sample_table = pd.DataFrame(samples, columns=["t", "mean_slip_deficit", "mean_v", "moving"]) if samples else None
+    sample_table = pd.DataFrame(samples, columns=["t", *(r.name for r in SAMPLES)]) if samples else None
     summary = {
         "integrator": "dense" if sparse is None else "exact",
         "steps_computed": int(s.ist[layout.STEPS_COMPUTED]),
@@ -495,24 +496,13 @@ def _record(p: LatticeParams, s: LatticeState, every: int, snaps, times, every_s
         snaps.append(s.fields(p.lattice))
         times.append(n)
     if every_sample and n % every_sample == 0 and (not samples or samples[-1][0] != n * p.dt):
-        f = s.fields(p.lattice)
-        load = load_point(p, n)
-        samples.append((n * p.dt, float(np.mean(load - f["x"])), float(np.mean(f["v"])), int(s.ist[layout.N_MOVING])))
+        samples.append(sample(p, s, n))
 
 
 #: The lattice bench's workload for a model whose drive pulls every block by a leaf spring
 #: (Carlson-Langer, Burridge-Knopoff; docs/lattice.md, "Speed"): slow loading, V = 0.001 unless
 #: given, prepared over two loading times 2 / V from rest, then timed over 20 time units.
 SLOW_LOADING = {"V": 1e-3, "loading_times": 2.0, "t_timed": 20.0}
-
-
-def load_point(p: LatticeParams, n: int) -> float:
-    """The drive's load point at step n as the kernels compute it
-    (:func:`stickslip.kernels.laws.pull_point`): V t_n, or a load history's p(t_n)."""
-    from stickslip.kernels.laws import pull_point
-
-    dp = p.kernel_params(p.drive_piece)
-    return float(pull_point(p.drive_piece.kernel_velocity(p.chain), n, p.dt, dp, p.drive_piece.module))
 
 
 def bench_lattice(p: LatticeParams, t_timed: float, *, t_prepare: float = 0.0, repeat: int = 1) -> dict[str, Any]:
