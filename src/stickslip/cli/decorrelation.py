@@ -118,8 +118,13 @@ def run(params, args: argparse.Namespace) -> Result:
         from stickslip.run.loaded import check_cache_folder
 
         check_cache_folder(args.state_cache, "--state-cache")
-    source = LocatedSequences(params) if located else GridSequences(params)
-    start, loading = _start(params, args, located)
+    from stickslip.models.lattice.params import LatticeParams
+
+    if isinstance(params, LatticeParams):
+        source, start, loading = _lattice_start(params, args)
+    else:
+        source = LocatedSequences(params) if located else GridSequences(params)
+        start, loading = _start(params, args, located)
     say = None
     if not args.no_progress and sys.stderr.isatty():
 
@@ -157,6 +162,17 @@ def run(params, args: argparse.Namespace) -> Result:
         verdict = "loaded" if loading["loaded"] else "NOT loaded"
         lines.append(f"transient {args.transient:g}: {reach}; {verdict} ({loading['loaded_rule']})")
     return Result(data, "\n".join(lines))
+
+
+def _lattice_start(params, args):
+    """A lattice's slip sequences (:class:`stickslip.analysis.dynamics.lyapunov_lattice.LatticeSequences`)
+    and the state at ``--transient`` from ``--start``; no loading check."""
+    from stickslip.analysis.dynamics.lyapunov_lattice import LatticeSequences
+    from stickslip.run.lattice import LatticeStepper, initial_state
+
+    ref = initial_state(params, args.start, amplitude=args.perturbation, seed=args.seed)
+    ref, _ = LatticeStepper(params).advance(ref, steps_for(args.transient, params.dt, "transient"))
+    return LatticeSequences(params), ref, None
 
 
 def _start(params, args, located: bool):

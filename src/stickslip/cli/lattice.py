@@ -83,6 +83,29 @@ def refuse_lattice(args: argparse.Namespace, command: str) -> None:
         raise CommandError(f"--lattice {args.lattice} is not yet available with stickslip {command} (docs/lattice.md)")
 
 
+def refuse_on_lattice(args: argparse.Namespace) -> None:
+    """The one-line refusal of what `stickslip lyapunov --lattice square` does not yet do: the
+    exponent of the flow and its modes (``--switches located``), the tables against d0 or beta,
+    the lifetimes, the chain's centred frame, a shared transient's cache and a twin that differs
+    in a parameter."""
+    perturb = getattr(args, "perturb", None)
+    for option, given in (
+        ("--switches located", args.switches == "located"),
+        ("--convergence", args.convergence),
+        ("--betas", args.betas is not None),
+        ("--lifetimes", args.lifetimes is not None),
+        ("--finite-size", args.finite_size),
+        ("--fronts", args.fronts),
+        ("--frame centred", args.frame == "centred"),
+        ("--state-cache", getattr(args, "state_cache", None) is not None),
+        (f"--perturb {perturb}", perturb not in (None, "state")),
+    ):
+        if given:
+            raise CommandError(
+                f"{option} is not yet available with stickslip lyapunov --lattice {args.lattice} (docs/lattice.md)"
+            )
+
+
 def wants_lattice(args: argparse.Namespace) -> bool:
     """Whether the command line asks for a lattice other than the chain."""
     if getattr(args, "lattice", None) in (None, "chain"):

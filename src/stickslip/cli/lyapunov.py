@@ -6,6 +6,8 @@ tabulates the exponent against d0, the renormalisation interval and the run leng
 measures the exponent of the flow instead (:mod:`stickslip.analysis.dynamics.lyapunov_flow`): located
 switches, the time-shift direction removed, at dt, dt/2, dt/4 and extrapolated to dt -> 0.
 ``--decorrelation`` compares slip sequences of perturbed twins (:mod:`stickslip.cli.decorrelation`).
+``--lattice square --shape RxC`` measures the exponent and the decorrelation of the model on the
+square (:mod:`stickslip.analysis.dynamics.lyapunov_lattice`; docs/lattice.md).
 """
 
 from __future__ import annotations
@@ -91,6 +93,13 @@ def register(sub) -> None:
         "--segments", type=int, default=10, metavar="M", help="independent segments for the error bar (default 10)"
     )
     p.add_argument("--direction-seed", type=int, default=0, help="seed of the twin's first direction (default 0)")
+    p.add_argument(
+        "--frame",
+        choices=("centred", "absolute"),
+        default=None,
+        help="the grid's twin runs in a frame moved back along the drive (centred, the chain's default) or "
+        "beside the reference itself (absolute, the only one on a lattice); docs/lyapunov.md",
+    )
     p.add_argument(
         "--convergence",
         action="store_true",
@@ -205,11 +214,13 @@ def run_lyapunov_command(args: argparse.Namespace) -> Result:
     """Handler of `stickslip lyapunov`."""
     from stickslip.analysis.dynamics import lyapunov as ly
     from stickslip.analysis.dynamics.benettin import check_run
-    from stickslip.cli.lattice import refuse_lattice
+    from stickslip.cli.lattice import lattice_params_from_args, refuse_on_lattice, wants_lattice
     from stickslip.models.presets import PRESETS
 
-    refuse_lattice(args, "lyapunov")
-    params = chain_params_from_args(args)
+    lattice = wants_lattice(args)
+    if lattice:
+        refuse_on_lattice(args)
+    params = lattice_params_from_args(args) if lattice else chain_params_from_args(args)
     preset = PRESETS[params.model]
     if args.start is None:
         args.start = preset.start
@@ -254,6 +265,11 @@ def run_lyapunov_command(args: argparse.Namespace) -> Result:
     for flag, given in (("--finite-size", args.finite_size), ("--fronts", args.fronts)):
         if given:
             raise CommandError(f"{flag} goes with --switches located")
+    if lattice:
+        from stickslip.analysis.dynamics.lyapunov_lattice import lattice_lyapunov
+
+        return _exponent(lattice_lyapunov(params, args.t_end, **kw), args)
+    kw["frame"] = args.frame or "centred"
     if args.convergence:
         table = ly.lyapunov_convergence(params, args.t_end, **kw)
         data = {
@@ -293,7 +309,11 @@ def run_lyapunov_command(args: argparse.Namespace) -> Result:
             data["outputs"] = [str(p) for p in written]
             text += f"\nplot written to {', '.join(data['outputs'])}"
         return Result(data, text)
-    res = ly.largest_lyapunov(params, args.t_end, progress=not args.no_progress, **kw)
+    return _exponent(ly.largest_lyapunov(params, args.t_end, progress=not args.no_progress, **kw), args)
+
+
+def _exponent(res, args) -> Result:
+    """The result of one exponent (the chain's or a lattice's), a warning where the twin merged."""
     data = res.to_dict()
     if data["merges"]:
         import sys
@@ -437,6 +457,10 @@ def _refuse_ignored(args) -> None:
     for option, name, mode, on in _MODE_OPTIONS:
         if getattr(args, name) is not None and not on(args):
             raise CommandError(f"{option} goes with {mode}")
+    if args.frame is not None and (args.switches == "located" or args.decorrelation or args.lifetimes is not None):
+        raise CommandError(
+            "--frame goes with the grid's exponent (--switches grid, without --decorrelation or --lifetimes)"
+        )
     if args.lifetimes is None:
         return
     for option, given in (

@@ -313,6 +313,13 @@ def _event_table(p: LatticeParams, ev_int: np.ndarray, moment: np.ndarray) -> pd
     )
 
 
+def epicentre_index(events: pd.DataFrame, lat) -> np.ndarray:
+    """The epicentres of a lattice's event table as row-major indices over its blocks, 0-based:
+    (epicentre_row - 1) cols + epicentre_col - 1 (the chain lattice's block i - 1)."""
+    cols = lat.shape[1]
+    return ((np.asarray(events["epicentre_row"]) - 1) * cols + np.asarray(events["epicentre_col"]) - 1).astype(np.int64)
+
+
 def run_lattice(
     p: LatticeParams,
     t_end: float,

@@ -11,6 +11,11 @@ flags and the separation no velocity on the reference's stuck blocks, as in
 :mod:`stickslip.analysis.dynamics.lyapunov`. The twin runs beside the reference in its own
 frame (the chain's ``frame='absolute'``): on a square of one row, and on the chain lattice, the
 exponent is the chain's ``largest_lyapunov(..., frame='absolute')`` bit for bit.
+
+:class:`LatticeSequences` gives the lattice's slip sequences to the decorrelation of
+:func:`stickslip.analysis.dynamics.decorrelation.sequence_decorrelation`: a slip is its
+epicentre (the flat row-major index of the first block to move), its area and its moment, in the
+places of the chain's start block, number of blocks and size.
 """
 
 from __future__ import annotations
@@ -26,7 +31,7 @@ from stickslip.models.lattice.params import LatticeParams
 from stickslip.models.params import ParameterError, steps_for
 from stickslip.run.lattice import LatticeState, LatticeStepper, initial_state
 
-__all__ = ["NORM", "LatticeEngine", "lattice_lyapunov"]
+__all__ = ["NORM", "LatticeEngine", "LatticeSequences", "lattice_lyapunov"]
 
 NORM = (
     "Euclidean norm of (sqrt(K) e, v, theta), e the springs' extensions along each line from the pulled side "
@@ -196,3 +201,49 @@ def lattice_lyapunov(
         extra={"frame": "absolute", "lattice": params.lattice.describe()},
         wall0=wall0,
     )
+
+
+class LatticeSequences:
+    """Slip sequences of a model on a lattice for
+    :func:`~stickslip.analysis.dynamics.decorrelation.sequence_decorrelation` (the map of
+    :func:`stickslip.run.lattice.run_lattice`): each slip a row of t_start, moment, epicentre
+    (row-major index over the blocks, 0-based) and area, the chain's size, start block and blocks
+    moved. The twin is :meth:`LatticeEngine.twin`, the reference's state moved by delta in the
+    lattice's norm on its branch; the clock runs on (a twin differs in its state only).
+
+    Parameters
+    ----------
+    params : LatticeParams
+        The model on its lattice.
+    """
+
+    switches = "grid"
+
+    def __init__(self, params: LatticeParams):
+        self.params = params
+        self.engine = LatticeEngine(params)
+
+    def prepare(self, state: LatticeState) -> LatticeState:
+        """A copy of the start state (the drive's clock is kept)."""
+        return state.copy()
+
+    def twin(self, params: LatticeParams, state: LatticeState, direction: np.ndarray, delta: float) -> LatticeState:
+        """``state`` moved by delta along ``direction`` (y of the lattice's norm), theta kept in the
+        law's range."""
+        out = self.engine.twin(state, direction, delta)
+        bounds = params.friction_piece.theta_range
+        if bounds is not None:  # a stuck block's theta at the end of its range stays in it
+            np.clip(out.thg, bounds[0], bounds[1], out=out.thg)
+        return out
+
+    def run(self, params: LatticeParams, state: LatticeState, step: int) -> tuple[LatticeState, np.ndarray]:
+        """``state`` run to ``step``; its slips completed on the way as rows of t_start, moment,
+        epicentre (row-major, 0-based) and area."""
+        from stickslip.run.lattice import epicentre_index, run_lattice
+
+        run = run_lattice(params, step * params.dt, start=state)
+        ev = run.events
+        if not len(ev):
+            return run.state, np.zeros((0, 4))
+        epicentre = epicentre_index(ev, params.lattice)
+        return run.state, np.column_stack((ev["t_start"], ev["moment"], epicentre, ev["area"])).astype(float)
