@@ -2,8 +2,8 @@
 chain` (docs/lattice.md, "Commands"): `stability chain` analyses steady sliding on the square,
 checked against eq. (5) written out here; `sweep` refuses a lattice in one line, `lyapunov` what
 it does not yet do on one (tests/test_lyapunov_lattice_cli.py),
-exit 2, and so do the readers of run directories (catalog, period, plot, --from) given a lattice
-run."""
+exit 2, and so does ``chain --from`` given a lattice run (`period` reads one:
+tests/test_period_lattice.py)."""
 
 from __future__ import annotations
 
@@ -101,7 +101,7 @@ def lattice_run_dir(tmp_path_factory):
 
 @pytest.mark.parametrize(
     "argv",
-    [["period", "RUN"], ["chain", "--from", "RUN", "--t-end", "1"]],
+    [["chain", "--from", "RUN", "--t-end", "1"]],
 )
 def test_run_readers_refuse_a_lattice_run(argv, lattice_run_dir, capsys):
     from stickslip.cli import main

@@ -138,7 +138,7 @@ def load_run(run_dir: str | Path) -> ChainRun:
         raise RunDirDamaged(f"{run_dir} is not a directory (a run directory holds run.json, state.nc, ...)")
     if not run_dir.exists():
         raise RunDirMissing(f"{run_dir}: no such run directory", run_dir)
-    refuse_lattice_run(run_dir, "the chain's readers (load_run, period, plot, --from)")
+    refuse_lattice_run(run_dir, "the chain's readers (load_run, --from)")
     try:
         return _load_run(run_dir)
     except RunDirDamaged:

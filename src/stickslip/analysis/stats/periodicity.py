@@ -43,6 +43,7 @@ from stickslip.run.loop import Hook, Loop
 __all__ = [
     "Periodicity",
     "find_period",
+    "lattice_periodicity",
     "periodicity",
     "PeriodicStop",
     "RTOL",
@@ -55,22 +56,31 @@ __all__ = [
 _PROBE = 8
 
 
-def rule_text(rtol: float, max_period: int, repeats: int) -> str:
+#: The names of a slip's three columns in the rule's words: the chain's event table's.
+CHAIN_COLUMNS = ("start_block", "n_blocks", "S")
+#: A lattice's slip (:func:`lattice_periodicity`): its epicentre, area and moment.
+LATTICE_COLUMNS = ("epicentre", "area", "moment")
+
+
+def rule_text(rtol: float, max_period: int, repeats: int, columns: tuple[str, str, str] = CHAIN_COLUMNS) -> str:
     """The matching rule in words (module docstring), for a result's ``rule``.
 
     Parameters
     ----------
     rtol, max_period, repeats
         The rule's tolerance on S, longest period searched and periods in the stretch.
+    columns
+        The names of the slip's block, count and size (:data:`CHAIN_COLUMNS`, :data:`LATTICE_COLUMNS`).
 
     Returns
     -------
     str
         One sentence.
     """
+    block, count, S = columns
     return (
-        f"slip i matches slip i + p when start_block and n_blocks are equal and |S_i - S_(i+p)| <= "
-        f"{rtol:g} max(|S_i|, |S_(i+p)|); periodic with period p from slip s when every slip from s on "
+        f"slip i matches slip i + p when {block} and {count} are equal and |{S}_i - {S}_(i+p)| <= "
+        f"{rtol:g} max(|{S}_i|, |{S}_(i+p)|); periodic with period p from slip s when every slip from s on "
         f"matches the one p later over a stretch of at least max({repeats} p, p + P) slips to the end, "
         f"P = min({max_period}, slips // {repeats}) the longest period searched; the smallest such p, "
         "the earliest such s"
@@ -166,6 +176,7 @@ def find_period(
     rtol: float = RTOL,
     max_period: int = MAX_PERIOD,
     repeats: int = REPEATS,
+    columns: tuple[str, str, str] = CHAIN_COLUMNS,
 ) -> Periodicity:
     """The smallest period of a slip sequence and the slip from which it repeats (module docstring).
 
@@ -182,6 +193,8 @@ def find_period(
         Longest period searched (default :data:`MAX_PERIOD`; no more than n // repeats is searched).
     repeats : int
         Periods the periodic stretch must hold, >= 2 (default :data:`REPEATS`).
+    columns : tuple of str
+        What the three columns are called in the rule's words (:func:`rule_text`).
 
     Returns
     -------
@@ -231,7 +244,7 @@ def find_period(
         if matches(probe, n - p, p).all() and (probe == lo or matches(lo, probe, p).all()):
             period = p
             break
-    rule = rule_text(rtol, max_period, repeats)
+    rule = rule_text(rtol, max_period, repeats, columns)
     common = dict(n_slips=n, t_last=None if t is None or n == 0 else float(t[-1]), rtol=float(rtol))
     common.update(max_period=int(max_period), repeats=int(repeats), longest_period_searched=longest, rule=rule)
     if period is None:
@@ -277,6 +290,35 @@ def periodicity(events: Any, **rule: Any) -> Periodicity:
     (16, 156)
     """
     return find_period(events["start_block"], events["n_blocks"], events["S"], events["t_start"], **rule)
+
+
+def lattice_periodicity(events: Any, lattice: Any, **rule: Any) -> Periodicity:
+    """:func:`find_period` of a lattice run's events (docs/lattice.md): a slip is its epicentre
+    (the row-major index of its first block, :func:`stickslip.run.lattice.epicentre_index`), its
+    area and its moment, in the places of the chain's start block, number of blocks and size S.
+
+    Parameters
+    ----------
+    events : pandas.DataFrame
+        A :class:`~stickslip.run.lattice.LatticeRun`'s ``events`` (or a run directory's
+        events.csv read back): ``epicentre_row``, ``epicentre_col``, ``area``, ``moment``,
+        ``t_start``, one row per slip in order.
+    lattice : Chain or Square
+        The run's lattice (``run.params.lattice``).
+    **rule
+        ``rtol`` (on the moment), ``max_period``, ``repeats`` (:func:`find_period`).
+
+    Returns
+    -------
+    Periodicity
+        Its rule names the epicentre, the area and the moment.
+    """
+    from stickslip.run.lattice import epicentre_index
+
+    return find_period(
+        epicentre_index(events, lattice), events["area"], events["moment"], events["t_start"], **rule,
+        columns=LATTICE_COLUMNS,
+    )  # fmt: skip
 
 
 class PeriodicStop(Hook):
