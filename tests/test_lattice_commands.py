@@ -1,6 +1,6 @@
 """``--lattice``, ``--shape`` and ``--edges`` on the commands that take a model besides `stickslip
 chain` (docs/lattice.md, "Commands"): `stability chain` analyses steady sliding on the square,
-checked against eq. (5) written out here; `lyapunov` and `sweep` refuse a lattice in one line,
+checked against eq. (5) written out here; `lyapunov` refuses a lattice in one line,
 exit 2, and so do the readers of run directories (catalog, period, plot, --from) given a lattice
 run."""
 
@@ -67,10 +67,6 @@ def test_stability_of_a_row_is_the_chains_first_mode(capsys):
     [
         (["lyapunov", "--lattice", "square", "--shape", "4x4"], ["--lattice square", "lyapunov"]),
         (["lyapunov", "--shape", "4x4"], ["--shape", "--lattice square"]),
-        (
-            ["sweep", "chain", "--grid", "beta=1,2", "--t-end", "1", "--out", "OUT", "--lattice", "square"],
-            ["--lattice square", "sweep chain"],
-        ),
         (["stability", "chain", "--lattice", "square", "--shape", "4x4", "--out", "OUT"], ["--out", "--lattice"]),
         (["stability", "chain", "--lattice", "square"], ["--shape"]),
         (["stability", "chain", "--lattice", "square", "--shape", "4x0"], ["shape"]),
