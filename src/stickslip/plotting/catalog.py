@@ -45,6 +45,17 @@ def magnitude_label(definition: str | None) -> str:
     (``summary["frequency_magnitude"]["definition"]``): "M = (2/3) log10 S" on a chain,
     "M = (2/3) log10 moment" on a lattice, the size each catalogue's magnitude is read from.
 
+    Parameters
+    ----------
+    definition : str or None
+        The catalogue's definition of M.
+
+    Returns
+    -------
+    str
+        The label in matplotlib's mathtext: a one-letter size in italics, a word upright; another
+        definition as written.
+
     Examples
     --------
     >>> print(magnitude_label("M = (2/3) log10 S"))

@@ -261,7 +261,14 @@ def rung_order(
 
 
 def steady_deficit(p) -> float:
-    """d_ss: the mean of V t - x over the blocks in steady sliding (:func:`steady_fields` at t = 0)."""
+    """d_ss: the mean of V t - x over the blocks in steady sliding (:func:`steady_fields` at t = 0),
+    the lattice's L_ss of the order parameter (:func:`rung_order`).
+
+    Raises
+    ------
+    ParameterError
+        Where the model has no steady sliding on its lattice (:func:`steady_fields`).
+    """
     from stickslip.run.lattice import steady_fields
 
     return float(-np.mean(steady_fields(p)["x"]))
