@@ -72,6 +72,21 @@ def test_b_value_of_a_synthetic_gutenberg_richter_catalogue():
     assert cat.summary["n_events"] == 4000 and cat.summary["N"] == 16
 
 
+def test_the_frequency_magnitude_figure_says_what_the_magnitude_is_read_from():
+    """The x label is the catalogue's own: the moment on a lattice, S on the chain (the label it
+    has always had), from each catalogue's definition of its magnitude."""
+    from stickslip.analysis.stats.catalog import _frequency_magnitude
+    from stickslip.plotting.catalog import frequency_magnitude_figure
+
+    cat = lattice_catalog_analysis(_gr_run(1.0, 400), t_from=0.0, bootstrap=0)
+    label = frequency_magnitude_figure(cat).axes[0].get_xlabel()
+    assert label == r"magnitude $M = \frac{2}{3}\log_{10} \mathrm{moment}$"
+    M = cat.table["magnitude"].to_numpy()
+    chain_fm = _frequency_magnitude(M, cat.table["moment"].to_numpy(), None, dm=0.1, bootstrap=0, seed=0)
+    chain = SimpleNamespace(table=cat.table, summary={**cat.summary, "frequency_magnitude": chain_fm})
+    assert frequency_magnitude_figure(chain).axes[0].get_xlabel() == r"magnitude $M = \frac{2}{3}\log_{10} S$"
+
+
 def test_too_few_events_is_refused():
     with pytest.raises(ParameterError, match="at least 50"):
         lattice_catalog_analysis(_gr_run(1.0, 40), t_from=0.0)

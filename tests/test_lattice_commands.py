@@ -1,9 +1,8 @@
 """``--lattice``, ``--shape`` and ``--edges`` on the commands that take a model besides `stickslip
 chain` (docs/lattice.md, "Commands"): `stability chain` analyses steady sliding on the square,
-checked against eq. (5) written out here; `sweep` refuses a lattice in one line, `lyapunov` what
-it does not yet do on one (tests/test_lyapunov_lattice_cli.py),
-exit 2, and so does ``chain --from`` given a lattice run (`period` reads one:
-tests/test_period_lattice.py)."""
+checked against eq. (5) written out here; `lyapunov` refuses what it does not yet do on one
+(tests/test_lyapunov_lattice_cli.py), exit 2, and so does ``chain --from`` given a lattice run
+(`period` reads one: tests/test_period_lattice.py; `sweep` runs one: tests/test_sweep_lattice.py)."""
 
 from __future__ import annotations
 
@@ -71,10 +70,6 @@ def test_stability_of_a_row_is_the_chains_first_mode(capsys):
             ["--lattice square", "lyapunov"],
         ),
         (["lyapunov", "--shape", "4x4"], ["--shape", "--lattice square"]),
-        (
-            ["sweep", "chain", "--grid", "beta=1,2", "--t-end", "1", "--out", "OUT", "--lattice", "square"],
-            ["--lattice square", "sweep chain"],
-        ),
         (["stability", "chain", "--lattice", "square", "--shape", "4x4", "--out", "OUT"], ["--out", "--lattice"]),
         (["stability", "chain", "--lattice", "square"], ["--shape"]),
         (["stability", "chain", "--lattice", "square", "--shape", "4x0"], ["shape"]),

@@ -220,3 +220,21 @@ def test_command_line_refusals(argv, names, tmp_path, capsys):
 
     assert main(["chain", "--lattice", "square", *argv, "--t-end", "1"]) == 2
     one_line_error(capsys, *names)
+
+
+def test_the_leaf_spring_of_a_per_block_kp_is_its_values_over_the_square():
+    """LatticeParams.leaf(): Kp as given over (row, col) where it differs from block to block, the
+    number where it does not, 0 for the edge drive; the stability analysis, which takes one
+    number per parameter, refuses per-block Kp in one line."""
+    from stickslip.analysis.dynamics.lattice_stability import lattice_stability
+
+    Kp = np.linspace(0.9, 1.1, 20).reshape(4, 5)
+    p = chain_params("carlson-langer", lattice="square", shape=(4, 5), Kp=Kp)
+    np.testing.assert_array_equal(p.leaf(), Kp)
+    drawn = chain_params("carlson-langer", lattice="square", shape=(3, 4), Kp=Quenched("uniform", 0.5, 1.5, seed=7))
+    np.testing.assert_array_equal(drawn.leaf(), np.reshape(drawn.Kp.values, (3, 4)))  # the draw, row by row
+    one = chain_params("carlson-langer", lattice="square", shape=(4, 5), Kp=1.25)
+    assert type(one.leaf()) is float and one.leaf() == 1.25
+    assert chain_params(lattice="square", shape=(4, 5)).leaf() == 0.0
+    with pytest.raises(ParameterError, match="per block: Kp"):
+        lattice_stability(chain_params(lattice="square", shape=(4, 5), drive="plate", Kp=Kp))

@@ -22,13 +22,13 @@ from stickslip.experiments.studies.lattice import (
 )
 from stickslip.experiments.studies.lattice_points import (
     CHECKPOINT,
-    _steady_deficit,
     ladder_task,
     lattice_params,
     loading_time,
     run_segments,
     rung_order,
     sizes_task,
+    steady_deficit,
 )
 from stickslip.run.errors import Interrupted
 from stickslip.run.lattice import run_lattice
@@ -41,7 +41,7 @@ def test_the_steady_deficit_is_the_chains_profile_in_every_row():
     p = lattice_params({"L": L}, beta)
     c = 1.0 - p.alpha * p.V + beta * p.V
     lag = np.cumsum([c / p.K * (L - i + 1) for i in range(1, L + 1)])  # V t - x_i at every t
-    assert _steady_deficit(p) == pytest.approx(lag.mean(), rel=1e-10)
+    assert steady_deficit(p) == pytest.approx(lag.mean(), rel=1e-10)
 
 
 def test_loading_time_is_the_chains():

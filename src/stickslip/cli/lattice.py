@@ -154,7 +154,7 @@ def lattice_params_from_args(args: argparse.Namespace, **overrides):
 
 def run_lattice_command(args: argparse.Namespace) -> Result:
     """`stickslip chain --lattice square`: run the model on the square, print its summary."""
-    from stickslip.run.lattice import run_lattice
+    from stickslip.run.lattice import run_lattice, start_defaults
 
     for name, option in _NOT_YET.items():
         if getattr(args, name, None) not in (None, False):
@@ -169,10 +169,9 @@ def run_lattice_command(args: argparse.Namespace) -> Result:
         raise CommandError(f"--slip-min-area must be >= 1 and goes with --slip-maps (got {args.slip_min_area})")
     params = lattice_params_from_args(args)
     t_end = 1000.0 if args.t_end is None else args.t_end
-    start = args.start or ("rest" if params.drive_piece.leaf_spring else "paper")
+    start, amplitude = start_defaults(params, args.start, args.perturbation)
     if start == "paper" and (args.perturbation is not None or args.seed is not None):
         raise CommandError("--perturbation and --seed go with --start steady or --start rest")
-    amplitude = args.perturbation if args.perturbation is not None else (0.01 if start == "rest" else 0.0)
     run = run_lattice(
         params,
         t_end,

@@ -1,6 +1,7 @@
 """`stickslip sweep`: run the chain (eq. 4) or the single block (eq. 1) over a grid of parameters.
 
     stickslip sweep chain --grid beta=0.8,0.9,1.0 --grid N=99,199 --set K=10 --t-end 1e5 --out DIR
+    stickslip sweep chain --lattice square --shape 16x16 --grid beta=0.6,1.2 --t-end 1e4 --out DIR
 
 Every combination of the ``--grid`` values is one point, run as an independent Dask task (a
 local cluster, one worker per core, unless ``--scheduler ADDRESS``). ``--set NAME=VALUE`` fixes
@@ -43,8 +44,19 @@ _OPTIONS: dict[str, dict[str, type]] = {
         "profile_min_blocks": int,
     },
     "block": {"t_end": float, "every": int},
+    # the chain on --lattice square (stickslip.experiments.sweep_lattice)
+    "lattice": {
+        "t_end": float,
+        "integrator": str,
+        "start": str,
+        "perturbation": float,
+        "seed": int,
+        "sample_interval": float,
+        "average_from": float,
+        "shape": str,
+    },
 }
-_PARAMS: dict[str, type] = {"chain": ChainParams, "block": BlockParams}
+_PARAMS: dict[str, type] = {"chain": ChainParams, "block": BlockParams, "lattice": ChainParams}
 # Lower ends of the numeric run options (their upper ends depend on dt: RunOptions.validated).
 _OPTION_RANGES: dict[str, dict[str, Any]] = {
     "sample_interval": {"low": 0.0, "low_open": True},
@@ -52,6 +64,8 @@ _OPTION_RANGES: dict[str, dict[str, Any]] = {
     "profile_window": {"low": 0.0, "low_open": True},
     "profile_min_blocks": {"low": 0},
     "every": {"low": 1},
+    "perturbation": {"low": 0.0},
+    "seed": {"low": 0},
 }
 
 
@@ -64,7 +78,8 @@ def register(sub) -> None:
             "Run the chain (eq. 4) or the single block (eq. 1) at every point of a parameter "
             "grid, each point an independent task on a Dask cluster. One directory per point "
             "under --out, a summary table (summary.parquet, summary.csv); finished points are "
-            "skipped when the command is run again; a failed point is reported and the others go on."
+            "skipped when the command is run again; a failed point is reported and the others go on. "
+            "With --lattice square --shape RxC the chain's model runs on the square (docs/lattice.md)."
         ),
         epilog=(
             "example: stickslip sweep chain --grid beta=0.2,0.6,1.0,1.2 --set N=49 "
@@ -119,6 +134,11 @@ def _value(model: str, name: str, text: str) -> Any:
 
 
 def _check_name(model: str, name: str) -> None:
+    if model == "lattice":
+        from stickslip.experiments.sweep_lattice import NOT_ON_LATTICE
+
+        if name in NOT_ON_LATTICE:
+            raise CommandError(f"{name} does not go with --lattice square ({NOT_ON_LATTICE[name]})")
     allowed = [f.name for f in dataclasses.fields(_PARAMS[model])] + list(_OPTIONS[model])
     if name not in allowed:
         raise CommandError(f"unknown parameter {name!r} for {model} (allowed: {', '.join(allowed)})")
@@ -133,12 +153,13 @@ def _split_assignment(text: str, option: str) -> tuple[str, str]:
 
 
 def parse_grid(
-    model: str, grid: list[str], fixed: list[str], t_end: str
+    model: str, grid: list[str], fixed: list[str], t_end: str, lattice: dict[str, Any] | None = None
 ) -> tuple[list[dict[str, Any]], dict[str, Any]]:
     """The points (one dict per combination of ``--grid`` values) and the settings common to all.
 
-    Every point is validated by building its parameter dataclass, so a bad value is reported
-    before anything is written.
+    ``model`` ``lattice`` is the chain on the lattice ``lattice`` (its name, and shape and edges
+    where given), which goes into the common settings. Every point is validated by building its
+    parameter dataclass, so a bad value is reported before anything is written.
     """
     axes: dict[str, list[Any]] = {}
     for text in grid:
@@ -153,7 +174,10 @@ def parse_grid(
         if len(set(map(repr, converted))) != len(converted):
             raise CommandError(f"--grid {name}: repeated value in {values!r}")
         axes[name] = converted
-    common: dict[str, Any] = {}
+    common: dict[str, Any] = dict(lattice or {})
+    clash = sorted(set(axes) & set(common))  # --shape and --grid shape=...
+    if clash:
+        raise CommandError(f"{clash[0]} is given more than once (--{clash[0]}/--grid)")
     for text in fixed:
         name, value = _split_assignment(text, "--set")
         _check_name(model, name)
@@ -170,6 +194,14 @@ def parse_grid(
     points = [dict(zip(names, combo, strict=False)) for combo in itertools.product(*axes.values())] if names else [{}]
     from stickslip.experiments.sweep_points import point_params
 
+    if model == "lattice":
+        from stickslip.experiments.sweep_lattice import lattice_run_args
+
+        if "shape" not in common and "shape" not in axes:
+            raise CommandError(f"--lattice {common['lattice']} needs --shape ROWSxCOLS (e.g. 64x64)")
+        for point in points:
+            lattice_run_args({**common, **point})  # raises ParameterError
+        return points, common
     for point in points:
         settings = {**common, **point}
         params = point_params(model, settings)  # raises ParameterError
@@ -201,15 +233,24 @@ def _check_options(model: str, params, settings: dict[str, Any]) -> None:
 
 def run(args: argparse.Namespace) -> Result:
     """Handler of ``stickslip sweep``."""
-    from stickslip.cli.lattice import refuse_lattice
+    from stickslip.cli.lattice import wants_lattice
     from stickslip.experiments.sweep import STOP_WAIT_SECONDS, block_task, chain_task, run_sweep
 
-    refuse_lattice(args, f"sweep {args.model}")
-    points, common = parse_grid(args.model, args.grid, args.fixed, args.t_end)
+    kind, lattice = args.model, None
+    if wants_lattice(args):
+        if args.model != "chain":
+            raise CommandError(f"--lattice {args.lattice} goes with stickslip sweep chain, not sweep {args.model}")
+        kind = "lattice"
+        lattice = {"lattice": args.lattice, "shape": args.shape, "edges": args.edges}
+        lattice = {k: v for k, v in lattice.items() if v is not None}
+    points, common = parse_grid(kind, args.grid, args.fixed, args.t_end, lattice)
     _, workers = dask_options(args)
     own = _sweep_files(args.out)
-    # Not a model piece: the user's choice of system (chain or single block) picks the task.
-    task = chain_task if args.model == "chain" else block_task
+    # Not a model piece: the user's choice of system (chain, chain on a lattice or single block) picks the task.
+    if kind == "lattice":
+        from stickslip.experiments.sweep_lattice import lattice_run_task as task
+    else:
+        task = chain_task if args.model == "chain" else block_task
     with owned_out_dir(args.out, own, "stickslip sweep", overwrite=args.overwrite) as out:
         try:
             with sigterm_as_interrupt():
@@ -222,12 +263,15 @@ def run(args: argparse.Namespace) -> Result:
                     n_workers=workers,
                     dashboard=args.dashboard,
                     progress=not args.no_progress,
-                    stop_wait=STOP_WAIT_SECONDS if task is chain_task else 0.0,  # block points keep no checkpoint
+                    stop_wait=0.0 if task is block_task else STOP_WAIT_SECONDS,  # block points keep no checkpoint
                 )
         except KeyboardInterrupt:
-            return interrupted(
-                "sweep", out, f"finished points in {out} are kept, chain runs continue from their checkpoints"
+            runs = (
+                "lattice runs continue from their last checkpoint"
+                if kind == "lattice"
+                else "chain runs continue from their checkpoints"
             )
+            return interrupted("sweep", out, f"finished points in {out} are kept, {runs}")
         except OSError as exc:  # e.g. no scheduler at the given address
             if is_disk_full(exc):
                 raise

@@ -7,6 +7,7 @@ matplotlib Figure, or None when the catalogue has nothing to draw (the caller sa
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 from matplotlib.figure import Figure
@@ -15,7 +16,14 @@ from stickslip.analysis.stats import magnitudes as mg
 from stickslip.analysis.stats.recurrence import renewal_pdf
 from stickslip.plotting.style import PAPER, SIM, THEORY, new_figure
 
-__all__ = ["frequency_magnitude_figure", "ccdf_figure", "recurrence_figure", "moment_rate_figure", "catalog_figures"]
+__all__ = [
+    "magnitude_label",
+    "frequency_magnitude_figure",
+    "ccdf_figure",
+    "recurrence_figure",
+    "moment_rate_figure",
+    "catalog_figures",
+]
 
 _CANDIDATE_STYLE = {
     "power_law": {"color": "C3", "ls": "--"},
@@ -32,9 +40,42 @@ def _title(catalog) -> str:
     return f"{s['model']}, N = {s['N']}, slips at t >= {s['window']['t_from']:g}"
 
 
+def magnitude_label(definition: str | None) -> str:
+    """The axis label of a magnitude from the catalogue's definition of it
+    (``summary["frequency_magnitude"]["definition"]``): "M = (2/3) log10 S" on a chain,
+    "M = (2/3) log10 moment" on a lattice, the size each catalogue's magnitude is read from.
+
+    Parameters
+    ----------
+    definition : str or None
+        The catalogue's definition of M.
+
+    Returns
+    -------
+    str
+        The label in matplotlib's mathtext: a one-letter size in italics, a word upright; another
+        definition as written.
+
+    Examples
+    --------
+    >>> print(magnitude_label("M = (2/3) log10 S"))
+    magnitude $M = \\frac{2}{3}\\log_{10} S$
+    >>> print(magnitude_label("M = (2/3) log10 moment"))
+    magnitude $M = \\frac{2}{3}\\log_{10} \\mathrm{moment}$
+    """
+    match = re.fullmatch(r"M = \(2/3\) log10 (\w+)", definition or "")
+    if match is None:  # another definition: as written
+        return f"magnitude {definition}" if definition else "magnitude $M$"
+    size = match.group(1)
+    symbol = size if len(size) == 1 else f"\\mathrm{{{size}}}"  # a symbol in italics, a word upright
+    return f"magnitude $M = \\frac{{2}}{{3}}\\log_{{10}} {symbol}$"
+
+
 def frequency_magnitude_figure(catalog) -> Figure | None:
-    """Frequency-magnitude distribution: N(>= M) and the count per bin of M = (2/3) log10 S, with the
-    Aki-Utsu Gutenberg-Richter line from the completeness magnitude and the doubly truncated fit."""
+    """Frequency-magnitude distribution: N(>= M) and the count per bin of M = (2/3) log10 S (of the
+    moment on a lattice: the x label is the catalogue's own definition, :func:`magnitude_label`),
+    with the Aki-Utsu Gutenberg-Richter line from the completeness magnitude and the doubly
+    truncated fit."""
     fm = catalog.summary["frequency_magnitude"]
     M = catalog.table["magnitude"].to_numpy(dtype=float)
     M = M[np.isfinite(M)]
@@ -73,7 +114,7 @@ def frequency_magnitude_figure(catalog) -> Figure | None:
             **PAPER,
             label=f"doubly truncated GR: $b = {gr['b']:.3f}$ ($\\tau = {gr['tau']:.3f}$)",
         )
-    ax.set_xlabel("magnitude $M = \\frac{2}{3}\\log_{10} S$")
+    ax.set_xlabel(magnitude_label(fm.get("definition")))
     ax.set_ylabel("number of slips")
     ax.legend(loc="lower left", fontsize=8)
     ax.set_title(f"frequency-magnitude: {_title(catalog)}", loc="left", fontsize=9, wrap=True)

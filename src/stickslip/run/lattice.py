@@ -137,6 +137,16 @@ def initial_state(p: LatticeParams, start: str = "paper", *, amplitude: float = 
     raise ParameterError(f"start must be one of {', '.join(STARTS)} (got {start!r})")
 
 
+def start_defaults(p: LatticeParams, start: str | None = None, perturbation: float | None = None) -> tuple[str, float]:
+    """The start of a run of ``p`` where none is given, and its size A (:func:`initial_state`):
+    ``rest`` for a drive with a leaf spring (Carlson-Langer's, A = 0.01), else the paper's
+    (section 3, never perturbed); a ``rest`` start with no A given gets 0.01, another 0."""
+    start = start or ("rest" if p.drive_piece.leaf_spring else "paper")
+    if perturbation is None:
+        perturbation = 0.01 if start == "rest" else 0.0
+    return start, perturbation
+
+
 @dataclass
 class LatticeRun:
     """A run on a lattice: ``events`` (one row per slip event: steps and times, epicentre row and

@@ -17,6 +17,18 @@ from typing import Any
 import numpy as np
 
 
+def _leaf(p: Any) -> float:
+    """The plate's leaf spring Kp (0 for an edge drive); the modes of eq. (5) take one number
+    per parameter, so per-block values are refused in one line."""
+    if p.per_block():
+        from stickslip.models.params import ParameterError
+
+        raise ParameterError(
+            f"the linear stability on a lattice takes one number per parameter (per block: {', '.join(p.per_block())})"
+        )
+    return p.leaf()
+
+
 def lattice_mode_matrix(p: Any, q: np.ndarray | float) -> np.ndarray:
     """eq. (5)'s matrix for a mode of Laplacian eigenvalue -q, shape (..., 3, 3).
 
@@ -29,7 +41,7 @@ def lattice_mode_matrix(p: Any, q: np.ndarray | float) -> np.ndarray:
         raise ValueError(f"friction {p.friction} has no state variable: its modes are not eq. (5)'s")
     lin = lin(p.chain)
     q = np.asarray(q, dtype=float)
-    kp = p.leaf()
+    kp = _leaf(p)
     A = np.zeros(q.shape + (3, 3))
     A[..., 0, 1] = 1.0
     A[..., 1, 0] = -(p.K * q + kp)
@@ -44,7 +56,7 @@ def lattice_growth_rates(p: Any) -> np.ndarray:
     """The largest real part of eq. (5)'s eigenvalues for each normal mode of the lattice (in the
     order of its eigenvalues q), leaving out a rigid translation (q = 0 without a leaf spring)."""
     q = p.lattice.eigenvalues()
-    if p.leaf() == 0.0:
+    if _leaf(p) == 0.0:
         q = q[q > 1e-12]
     return np.linalg.eigvals(lattice_mode_matrix(p, q)).real.max(axis=-1)
 
@@ -54,7 +66,7 @@ def lattice_stability(p: Any) -> dict[str, float | bool]:
     growth rate and the eigenvalue q of its mode, whether it is unstable, and the long-wave
     threshold beta_c = alpha (0 on the melted branch alpha V >= 1) that it is compared with."""
     q = p.lattice.eigenvalues()
-    if p.leaf() == 0.0:
+    if _leaf(p) == 0.0:
         q = q[q > 1e-12]
     rates = lattice_growth_rates(p)
     i = int(np.argmax(rates))

@@ -41,6 +41,8 @@ __all__ = [
     "loading_time",
     "run_segments",
     "rung_order",
+    "steady_deficit",
+    "at_steady",
     "ladder_task",
     "sizes_task",
     "chain_sizes_task",
@@ -52,6 +54,8 @@ __all__ = [
 CHECKPOINT = "lattice-checkpoint.npz"
 #: The rungs of a ladder finished so far, in its folder.
 RUNGS = "rungs.json"
+#: The samples' columns (:attr:`stickslip.run.lattice.LatticeRun.samples`), none yet.
+_NO_SAMPLES = {"t": [], "mean_slip_deficit": [], "mean_v": [], "moving": []}
 
 
 def loading_time(L: int, K: float = 10.0, V: float = 0.001) -> float:
@@ -138,12 +142,14 @@ def run_segments(
     segments: int = 8,
     key: Any = None,
     stop=None,
+    integrator: str = "exact",
 ):
     """:func:`stickslip.run.lattice.run_lattice` to ``t_end`` (an absolute time) in ``segments``
     equal parts, each continued from the state the last one ended with (the same steps, events
     and samples as one run), with a checkpoint in ``point_dir`` after each; a checkpoint of the
     same ``key`` is continued. ``stop()`` true between segments raises
-    :class:`~stickslip.run.errors.Interrupted` (the sweep was interrupted).
+    :class:`~stickslip.run.errors.Interrupted` (the sweep was interrupted). ``integrator``:
+    :func:`~stickslip.run.lattice.run_lattice`'s (both give the same bits).
 
     Returns
     -------
@@ -171,11 +177,21 @@ def run_segments(
         if stop is not None and stop():
             raise Interrupted(path if path.exists() else None, t0 if isinstance(state, str) else state.step * p.dt)
         target = t0 + (t_end - t0) * (k + 1) / segments
-        run = run_lattice(p, target, start=state, perturbation=perturbation, seed=seed, sample_every=sample_every)
+        run = run_lattice(
+            p,
+            target,
+            start=state,
+            perturbation=perturbation,
+            seed=seed,
+            sample_every=sample_every,
+            integrator=integrator,
+        )
         state = run.state
         events = run.events if events is None else pd.concat([events, run.events], ignore_index=True)
-        new = run.samples
-        if samples is not None and len(samples):
+        new = run.samples  # None where no sample falls in the segment (an interval longer than it)
+        if new is None:
+            new = samples if samples is not None else pd.DataFrame(_NO_SAMPLES).astype({"moving": np.int64})
+        elif samples is not None and len(samples):
             new = new[new["t"] > samples["t"].iloc[-1]]
             new = pd.concat([samples, new], ignore_index=True)
         samples = new
@@ -187,11 +203,19 @@ def run_segments(
 # Ladders: the order parameter per rung
 
 
-def rung_order(samples: pd.DataFrame, d_ss: float, n_blocks: int, t0: float, t_end: float, steady: bool):
+def rung_order(
+    samples: pd.DataFrame,
+    d_ss: float,
+    n_blocks: int,
+    t0: float,
+    t_end: float,
+    steady: bool,
+    average_from: float | None = None,
+):
     """The order parameter of one rung, the lattice's analogue of the chain's m = 1 - <L>/L_ss
     (:mod:`stickslip.analysis.stats.order`): m = 1 - <d>/d_ss, d the mean slip deficit (the load
     point V t less x, over the blocks) and d_ss its value in steady sliding, averaged over the
-    rung's second half with its batch-means error; the fraction of samples with a block stuck
+    rung's second half (or from ``average_from``) with its batch-means error; the fraction of samples with a block stuck
     there; and the final state (:func:`~stickslip.analysis.stats.order.classify_final_state` on
     the rung's last two quarters, ``steady`` where every block slides at V at the end).
 
@@ -207,6 +231,14 @@ def rung_order(samples: pd.DataFrame, d_ss: float, n_blocks: int, t0: float, t_e
         The rung's start and end.
     steady : bool
         Whether the rung ended in steady sliding.
+    average_from : float, optional
+        The start of the average (default the middle of the rung), an absolute time.
+
+    Returns
+    -------
+    dict
+        ``order_parameter``, ``order_parameter_err``, ``err_reliable``, ``stuck_fraction``,
+        ``final_state``, ``final_reason``.
     """
     from stickslip.analysis.stats.order import classify_final_state, mean_with_error, quarter_stats
 
@@ -214,7 +246,7 @@ def rung_order(samples: pd.DataFrame, d_ss: float, n_blocks: int, t0: float, t_e
     t = s["t"].to_numpy(dtype=float) - t0
     m = 1.0 - s["mean_slip_deficit"].to_numpy(dtype=float) / d_ss
     stuck = (s["moving"].to_numpy() < n_blocks).astype(float)
-    late = t >= 0.5 * (t_end - t0) - 1e-9
+    late = t >= (0.5 * (t_end - t0) if average_from is None else average_from - t0) - 1e-9
     est = mean_with_error(m[late])
     q = quarter_stats(t, m, stuck, t_end - t0)
     state, reason = classify_final_state(reached_steady=steady, **q)
@@ -228,14 +260,22 @@ def rung_order(samples: pd.DataFrame, d_ss: float, n_blocks: int, t0: float, t_e
     }
 
 
-def _steady_deficit(p) -> float:
-    """d_ss: the mean of V t - x over the blocks in steady sliding (:func:`steady_fields` at t = 0)."""
+def steady_deficit(p) -> float:
+    """d_ss: the mean of V t - x over the blocks in steady sliding (:func:`steady_fields` at t = 0),
+    the lattice's L_ss of the order parameter (:func:`rung_order`).
+
+    Raises
+    ------
+    ParameterError
+        Where the model has no steady sliding on its lattice (:func:`steady_fields`).
+    """
     from stickslip.run.lattice import steady_fields
 
     return float(-np.mean(steady_fields(p)["x"]))
 
 
-def _at_steady(p, state) -> bool:
+def at_steady(p, state) -> bool:
+    """Whether every block of ``state`` slides at V (within 1e-6): the run ended in steady sliding."""
     f = state.fields(p.lattice)
     return bool(not f["stopped"].any() and np.max(np.abs(f["v"] - p.V)) < 1e-6)
 
@@ -279,7 +319,7 @@ def ladder_task(point: dict[str, Any], point_dir: Path) -> dict[str, Any]:
             key=key,
             stop=stop_requested(point_dir),
         )
-        order = rung_order(samples, _steady_deficit(p), p.lattice.n_blocks, t0, t0 + rung_t, _at_steady(p, state))
+        order = rung_order(samples, steady_deficit(p), p.lattice.n_blocks, t0, t0 + rung_t, at_steady(p, state))
         late = events[events["t_start"] >= t0 + 0.5 * rung_t]
         all_rows = int(np.count_nonzero((late["row_min"] <= 1) & (late["row_max"] >= L)))
         rungs.append(

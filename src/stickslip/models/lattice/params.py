@@ -43,13 +43,17 @@ class LatticeParams:
             raise AttributeError(name)
         return getattr(self.chain, name)
 
-    def leaf(self) -> float:
+    def leaf(self) -> float | np.ndarray:
         """The stiffness of the spring joining every block to the drive: the drive's ``leaf``
-        (a plate's Kp; 0 for an edge drive and a force)."""
+        (a plate's Kp; 0 for an edge drive and a force), a float, or the values over (row, col)
+        where it differs from block to block (a per-block Kp)."""
         import importlib
 
         pc = self.chain.drive_piece
-        return float(importlib.import_module(pc.module).leaf(pc.kernel_params(self.chain)))
+        leaf = importlib.import_module(pc.module).leaf
+        # the plain-Python form of the drive's compiled function: read once, nothing to compile
+        value = getattr(leaf, "py_func", leaf)(self.kernel_params(pc))
+        return float(value) if np.ndim(value) == 0 else self.lattice.grid(np.asarray(value, dtype=np.float64))
 
     def pad(self, values) -> np.ndarray:
         """The N values of a per-block parameter (row-major over the lattice's blocks) in the
