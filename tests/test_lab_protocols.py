@@ -140,3 +140,27 @@ def test_velocity_step_with_damping_and_two_state_variables():
     assert st["mu_before"] == pytest.approx(0.6 + 1e-4, abs=1e-12)  # the spring carries mu + eta V
     assert st["mu_end"] == pytest.approx(st["mu_ss_closed_form"], abs=1e-9)
     assert st["a_minus_b_from_run"] == pytest.approx(0.008 - 0.010, rel=1e-6)
+
+
+def test_cli_fit_posterior_writes_the_corner_figure(capsys, tmp_path):
+    """`lab fit --posterior`: emcee's samples about the known truth, the corner figure and the
+    posterior's NetCDF beside the fit's."""
+    pytest.importorskip("emcee")
+    true = RateState(**LAB, k=1e-3)
+    h = LoadHistory.steps([1.0, 10.0], [20.0, 80.0])
+    rec = synthetic(true, h, n=200, noise=2e-4, rng=11)
+    path = tmp_path / "noisy.csv"
+    rows = [f"{float(t)!r},{float(m)!r},{float(p)!r}" for t, m, p in zip(rec.t, rec.mu, h.position(rec.t), strict=True)]
+    path.write_text("time,mu,load_point\n" + "\n".join(rows) + "\n")
+    # a and b free from 20% and 10% off; D_c, mu0 and k at their true values
+    start = ["--a", "0.006", "--b", "0.009", "--Dc", "10", "--mu0", "0.6", "--V0", "1", "--k", "1e-3"]
+    out = tmp_path / "fit"
+    d = _json(capsys, "lab", "fit", str(path), *start, "--free", "a,b", "--posterior", "200", "--out", str(out))
+    post = d["posterior"]["parameters"]
+    for name, truth in (("a", 0.005), ("b", 0.01)):
+        # the CSV carries no weights: the errors are the residuals' scatter, the noise 2e-4
+        assert abs(post[name]["mean"] - truth) < 5.0 * post[name]["std"]
+        lo, hi = post[name]["interval_95"]
+        assert lo < post[name]["mean"] < hi
+        assert 0.5 < post[name]["std"] / d["parameters"][name]["stderr"] < 2.0
+    assert {"fit.json", "fit.nc", "fit.png", "posterior.nc", "posterior.png"} <= {p.name for p in out.iterdir()}
