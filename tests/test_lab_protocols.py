@@ -164,3 +164,23 @@ def test_cli_fit_posterior_writes_the_corner_figure(capsys, tmp_path):
         assert lo < post[name]["mean"] < hi
         assert 0.5 < post[name]["std"] / d["parameters"][name]["stderr"] < 2.0
     assert {"fit.json", "fit.nc", "fit.png", "posterior.nc", "posterior.png"} <= {p.name for p in out.iterdir()}
+
+
+def test_cli_a_run_that_fails_writes_nothing(capsys, tmp_path):
+    """The slip law runs away after a step 1 -> 10 at k = 2 k_c: one line, exit 2, no --out left."""
+    out = tmp_path / "step"
+    assert main(["lab", "step", *OPTS, "--law", "slip", "--V", "1,10", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "the slip rate runs away" in err and err.count("\n") == 1
+    assert not out.exists()
+    # bad input found before the run leaves nothing either
+    assert main(["lab", "shs", *OPTS, "--V", "0", "--out", str(out)]) == 2
+    assert "V must be > 0" in capsys.readouterr().err and not out.exists()
+
+
+def test_cli_shs_writes_its_figure_and_data(capsys, tmp_path):
+    d = _json(capsys, "lab", "shs", *OPTS[:-2], "--k", "1e-2", "--holds", "10,100", "--out", str(tmp_path / "shs"))
+    assert {"shs.json", "shs.nc", "shs.png", "shs.pdf"} <= {p.name for p in (tmp_path / "shs").iterdir()}
+    # two holds give the rate as the difference quotient of their healing
+    rate = (d["holds"][1]["delta_mu"] - d["holds"][0]["delta_mu"]) / 1.0
+    assert d["healing_rate"] == pytest.approx(rate, rel=1e-12)
