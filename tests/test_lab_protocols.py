@@ -82,6 +82,8 @@ def test_cli_fit_of_a_csv_record(capsys, tmp_path):
         (["lab", "step", "--a", "0.005", "--b", "0.01", "--mu0", "0.6", "--V0", "1", "--k", "1e-3"], "Dc is required"),
         (["lab", "step", *OPTS[:-2]], "k is required"),
         (["lab", "step", *OPTS, "--V", "1,-10"], "V must be > 0"),
+        (["lab", "step", *OPTS, "--V", "-1,10"], "V must be > 0"),
+        (["lab", "step", *OPTS[2:], "--a", "-5e-3"], "a must be > 0"),
         (["lab", "shs", *OPTS, "--holds", "0,10"], "hold must be > 0"),
         (["lab", "step", *OPTS, "--law", "dieterich"], "law must be one of"),
         (["lab", "fit", "missing.csv", *OPTS], "no such file"),
