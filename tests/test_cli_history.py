@@ -43,6 +43,8 @@ def test_a_csv_record_is_the_same_table(capsys, tmp_path):
         (["--history", "1:20,x:3"], ["--history", "V:T"]),
         (["--history", "1:20:3"], ["--history", "each step is V:T"]),
         (["--history", "1:0"], ["--history", "durations must be > 0"]),
+        # a value that starts with a minus is the value, named by its own check
+        (["--history", "-1:20"], ["--history", "velocities must be >= 0"]),
         (["--history", "missing.csv"], ["--history", "no such file"]),
         (["--drive", "plate", "--history", "1:10"], ["--history is not a parameter"]),
         (["--drive", "history"], ["--drive history needs --history"]),

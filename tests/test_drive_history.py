@@ -4,7 +4,8 @@ history p(t), read by the kernels through the drive's compiled ``pull`` at step 
 Known answers: the integrators agree bit for bit (exact = dense); a plain-Python Heun step of
 the single block of eq. (4) with the history's load point gives the kernel's trajectory bit for
 bit; the kernel's load point agrees with the history's linear interpolation (numpy's); a history
-at one constant velocity gives the end drive's bits; a history that moves back runs dense.
+at one constant velocity gives the end drive's bits; a history that moves back says so (a
+DenseStepsWarning) and runs dense.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ from stickslip.models.drive import history as hist
 from stickslip.models.params import ParameterError
 from stickslip.models.presets import chain_params
 from stickslip.run.driver import run_chain
+from stickslip.run.errors import DenseStepsWarning
 
 #: velocity steps up and down and a hold at V = 0 (eq. 4's units: V = 0.001 is the paper's)
 STEPS = LoadHistory.steps([0.001, 0.01, 0.0, 0.002], [500.0, 300.0, 400.0, 1000.0])
@@ -105,7 +107,8 @@ def test_a_history_that_moves_back_runs_dense():
     assert not hist.monotone(back)
     p = _params(3, back)
     a = run_chain(p, 1500.0, integrator="dense")
-    b = run_chain(p, 1500.0, integrator="exact")
+    with pytest.warns(DenseStepsWarning, match="moves back.*dense"):
+        b = run_chain(p, 1500.0, integrator="exact")
     assert a.state.sha256() == b.state.sha256()
 
 

@@ -23,29 +23,39 @@ def test_exact_record_recovers_the_parameters():
 
 
 def _coverage(n_records, seed):
+    """The share of two-standard-error intervals that cover the truth, the fits' scatter over their
+    mean standard error, and the fits' correlation matrix less the mean of the reported ones in
+    units of a sample correlation's standard error, (1 - r^2) / sqrt(n)."""
     rng = np.random.default_rng(seed)
-    est, err = [], []
+    est, err, corr = [], [], []
     for _ in range(n_records):
         res = fit(synthetic(TRUE, STEP, n=300, noise=2e-4, rng=rng), START, FREE)
         est.append(res.values)
         err.append(res.errors)
+        corr.append(res.correlation)
     est, err = np.array(est), np.array(err)
     covered = np.abs(est - TRUTH) <= 2.0 * err
-    return covered.mean(), est.std(axis=0, ddof=1) / err.mean(axis=0)
+    r = np.mean(corr, axis=0)
+    off = ~np.eye(len(FREE), dtype=bool)
+    z = (np.corrcoef(est.T) - r)[off] / ((1.0 - r[off] ** 2) / np.sqrt(n_records))
+    return covered.mean(), est.std(axis=0, ddof=1) / err.mean(axis=0), z
 
 
 def test_two_standard_error_intervals_cover_the_truth_20_records():
-    covered, ratio = _coverage(20, 2024)
+    covered, ratio, corr = _coverage(20, 2024)
     # 80 intervals of 95.4 %: fewer than 70 covered would happen by chance once in ~1000 runs
     assert covered >= 70 / 80
     assert np.all((ratio > 0.55) & (ratio < 1.6))
+    # the reported correlations (a and b: 0.8) are those of the fits' scatter
+    assert np.all(np.abs(corr) < 3.5)
 
 
 @pytest.mark.slow
 def test_two_standard_error_intervals_cover_the_truth_200_records():
-    covered, ratio = _coverage(200, 7)
+    covered, ratio, corr = _coverage(200, 7)
     assert 0.92 <= covered <= 0.985
     assert np.all((ratio > 0.8) & (ratio < 1.25))
+    assert np.all(np.abs(corr) < 3.5)
 
 
 def test_several_records_with_shared_parameters_and_own_mu0():

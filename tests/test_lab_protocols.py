@@ -82,6 +82,8 @@ def test_cli_fit_of_a_csv_record(capsys, tmp_path):
         (["lab", "step", "--a", "0.005", "--b", "0.01", "--mu0", "0.6", "--V0", "1", "--k", "1e-3"], "Dc is required"),
         (["lab", "step", *OPTS[:-2]], "k is required"),
         (["lab", "step", *OPTS, "--V", "1,-10"], "V must be > 0"),
+        (["lab", "step", *OPTS, "--V", "-1,10"], "V must be > 0"),
+        (["lab", "step", *OPTS[2:], "--a", "-5e-3"], "a must be > 0"),
         (["lab", "shs", *OPTS, "--holds", "0,10"], "hold must be > 0"),
         (["lab", "step", *OPTS, "--law", "dieterich"], "law must be one of"),
         (["lab", "fit", "missing.csv", *OPTS], "no such file"),
@@ -140,3 +142,47 @@ def test_velocity_step_with_damping_and_two_state_variables():
     assert st["mu_before"] == pytest.approx(0.6 + 1e-4, abs=1e-12)  # the spring carries mu + eta V
     assert st["mu_end"] == pytest.approx(st["mu_ss_closed_form"], abs=1e-9)
     assert st["a_minus_b_from_run"] == pytest.approx(0.008 - 0.010, rel=1e-6)
+
+
+def test_cli_fit_posterior_writes_the_corner_figure(capsys, tmp_path):
+    """`lab fit --posterior`: emcee's samples about the known truth, the corner figure and the
+    posterior's NetCDF beside the fit's."""
+    pytest.importorskip("emcee")
+    true = RateState(**LAB, k=1e-3)
+    h = LoadHistory.steps([1.0, 10.0], [20.0, 80.0])
+    rec = synthetic(true, h, n=200, noise=2e-4, rng=11)
+    path = tmp_path / "noisy.csv"
+    rows = [f"{float(t)!r},{float(m)!r},{float(p)!r}" for t, m, p in zip(rec.t, rec.mu, h.position(rec.t), strict=True)]
+    path.write_text("time,mu,load_point\n" + "\n".join(rows) + "\n")
+    # a and b free from 20% and 10% off; D_c, mu0 and k at their true values
+    start = ["--a", "0.006", "--b", "0.009", "--Dc", "10", "--mu0", "0.6", "--V0", "1", "--k", "1e-3"]
+    out = tmp_path / "fit"
+    d = _json(capsys, "lab", "fit", str(path), *start, "--free", "a,b", "--posterior", "200", "--out", str(out))
+    post = d["posterior"]["parameters"]
+    for name, truth in (("a", 0.005), ("b", 0.01)):
+        # the CSV carries no weights: the errors are the residuals' scatter, the noise 2e-4
+        assert abs(post[name]["mean"] - truth) < 5.0 * post[name]["std"]
+        lo, hi = post[name]["interval_95"]
+        assert lo < post[name]["mean"] < hi
+        assert 0.5 < post[name]["std"] / d["parameters"][name]["stderr"] < 2.0
+    assert {"fit.json", "fit.nc", "fit.png", "posterior.nc", "posterior.png"} <= {p.name for p in out.iterdir()}
+
+
+def test_cli_a_run_that_fails_writes_nothing(capsys, tmp_path):
+    """The slip law runs away after a step 1 -> 10 at k = 2 k_c: one line, exit 2, no --out left."""
+    out = tmp_path / "step"
+    assert main(["lab", "step", *OPTS, "--law", "slip", "--V", "1,10", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "the slip rate runs away" in err and err.count("\n") == 1
+    assert not out.exists()
+    # bad input found before the run leaves nothing either
+    assert main(["lab", "shs", *OPTS, "--V", "0", "--out", str(out)]) == 2
+    assert "V must be > 0" in capsys.readouterr().err and not out.exists()
+
+
+def test_cli_shs_writes_its_figure_and_data(capsys, tmp_path):
+    d = _json(capsys, "lab", "shs", *OPTS[:-2], "--k", "1e-2", "--holds", "10,100", "--out", str(tmp_path / "shs"))
+    assert {"shs.json", "shs.nc", "shs.png", "shs.pdf"} <= {p.name for p in (tmp_path / "shs").iterdir()}
+    # two holds give the rate as the difference quotient of their healing
+    rate = (d["holds"][1]["delta_mu"] - d["holds"][0]["delta_mu"]) / 1.0
+    assert d["healing_rate"] == pytest.approx(rate, rel=1e-12)

@@ -9,6 +9,7 @@ Bad input gives one line on stderr naming the parameter and exit status 2.
 from __future__ import annotations
 
 import argparse
+import re
 import sys
 import warnings
 
@@ -21,7 +22,15 @@ __all__ = ["main", "build_parser", "Result", "CommandError"]
 
 class _Parser(argparse.ArgumentParser):
     """An ArgumentParser whose errors are argparse's usage line and one line of error (with a
-    "did you mean" for a misspelt choice or option), exit status 2."""
+    "did you mean" for a misspelt choice or option), exit status 2. A word that starts with a minus
+    and a digit is a value (``--history -1:20``, ``--V -1,10``, ``--rs-a -1e-3``), so that the
+    value's own check names what is wrong with it."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        # argparse takes only plain numbers such as -1 or -.5 for values; no option here starts
+        # with a digit, so every such word is one.
+        self._negative_number_matcher = re.compile(r"^-\.?\d")
 
     def error(self, message: str):  # type: ignore[override]
         self.print_usage(sys.stderr)
@@ -32,7 +41,6 @@ class _Parser(argparse.ArgumentParser):
 def _did_you_mean(parser: argparse.ArgumentParser, message: str) -> str:
     """``; did you mean 'chain'?`` for an invalid choice or an unrecognised option close to a valid one."""
     import difflib
-    import re
 
     choice = re.search(r"invalid choice: '([^']*)' \(choose from (.*)\)$", message)
     if choice:

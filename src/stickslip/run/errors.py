@@ -35,6 +35,12 @@ class ShortRunWarning(UserWarning):
     """A chain run with the end drive ends, or averages from, before the chain has loaded."""
 
 
+class DenseStepsWarning(UserWarning):
+    """An exact run whose load history moves back (drive ``history`` given positions that
+    decrease) takes the dense integrator's plain steps: the exact path's start searches need a
+    force that never decreases (:func:`stickslip.models.drive.history.monotone`)."""
+
+
 @contextlib.contextmanager
 def short_runs_expected():
     """Leave :class:`ShortRunWarning` out inside the block (or the decorated function): for runs

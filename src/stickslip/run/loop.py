@@ -20,6 +20,7 @@ from __future__ import annotations
 import bisect
 import numbers
 import time
+import warnings
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -28,7 +29,7 @@ import numpy as np
 from stickslip.kernels import dense, entry, exact, layout, plate
 from stickslip.models.params import ChainParams
 from stickslip.models.pieces import stopped_blocks_still
-from stickslip.run.errors import HookError, Interrupted, NonFiniteState
+from stickslip.run.errors import DenseStepsWarning, HookError, Interrupted, NonFiniteState
 from stickslip.run.state import ChainState, line_aligned, steady_deviation
 
 NEVER = np.iinfo(np.int64).max  # a hook that needs no stop
@@ -84,6 +85,12 @@ class _Kernel:
         monotone = params.drive_piece.monotone
         if name == "exact" and monotone is not None and not monotone(params):
             # The start searches of the fast paths need a load point that never moves back.
+            warnings.warn(
+                "the load point moves back: the exact integrator's start search needs one that never "
+                "does, so this run takes the dense integrator's plain steps (the same bits as dense)",
+                DenseStepsWarning,
+                stacklevel=2,
+            )
             name = "dense"
         if name == "exact" and stopped_blocks_still(params.drive_piece, params.friction_piece):
             name = "sparse"
