@@ -7,7 +7,8 @@ object with ``times`` (increasing breakpoints t_0 < ... < t_m) and ``positions``
 a ``LoadHistory`` or a pair of arrays. The kernels receive it as one table (``Params.table``, a
 3 x (m + 1) array: the breakpoints, the positions and the velocities V_k = (p_k+1 - p_k) /
 (t_k+1 - t_k) of the intervals), which :func:`stickslip.kernels.laws.at` leaves whole (it gathers
-1-D fields only), and read the load point at step n with :func:`pull`:
+1-D fields only), and read the load point at step n with :func:`pull` (the chain's step loops with
+:func:`pull_from`, once a step, on the table as its address, :func:`kernel_view`):
 
     p(t_n) = min(p_k + V_k (t_n - t_k), p_k+1)   on [t_k, t_k+1), with t_n = n dt,
 
