@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from numba import njit
 
 from stickslip.lab import LoadHistory
 from stickslip.models.drive import history as hist
@@ -48,6 +49,41 @@ def test_load_point_is_the_histories_interpolation():
     dense = np.array([hist.pull(int(k), dt, hist.Params(tb)) for k in range(159_000, 161_000)])
     assert (np.diff(dense) >= 0.0).all()
     assert [hist.pull_py(int(k), dt, tb) for k in n] == got.tolist()
+
+
+def _plain_load(t, tb):
+    """p(t) from the table, written plainly: the interval by a scan, linear, clamped, held outside."""
+    times, positions, slopes = (list(map(float, row)) for row in tb)
+    m = len(times) - 1
+    if t >= times[m]:
+        return positions[m], None
+    if t < times[0]:
+        return positions[0], None
+    k = max(i for i in range(m) if times[i] <= t)
+    q = positions[k] + slopes[k] * (t - times[k])
+    return (min(q, positions[k + 1]) if slopes[k] >= 0.0 else max(q, positions[k + 1])), k
+
+
+@njit
+def _viewed(t, dp, k):
+    # the table as the chain's kernels carry it (its address and columns)
+    return hist.load_from(t, hist.kernel_view(dp), k)
+
+
+def test_the_load_point_from_any_interval_guess_is_the_plain_interpolation():
+    # Twelve intervals with steps up, holds and a step back; the kernels look the interval up from
+    # the last step's (any guess must give the same interval and the same number).
+    rng = np.random.default_rng(3)
+    tb = hist.table((np.cumsum(rng.uniform(0.1, 2.0, 13)), np.r_[0.0, np.cumsum(rng.choice([0.0, 0.5, -0.2], 12))]))
+    m = tb.shape[1] - 1
+    ts = np.r_[rng.uniform(tb[0, 0] - 1.0, tb[0, -1] + 1.0, 150), tb[0], np.nextafter(tb[0], -np.inf)]
+    dp = hist.Params(tb)
+    for t in ts:
+        want, k_want = _plain_load(float(t), tb)
+        for guess in (-1, 0, m - 1, int(rng.integers(0, m))):
+            for p, k in (hist.load_from(float(t), dp, guess), _viewed(float(t), dp, guess)):
+                assert p == want
+                assert k == (guess if k_want is None else k_want)
 
 
 def _oracle(N1_params, history, steps):

@@ -8,7 +8,7 @@ from __future__ import annotations
 from numba import njit
 
 from stickslip.kernels.events import _end_event, _overflow, _service, _start_and_first_moves, _trace
-from stickslip.kernels.laws import _accel, _dtheta, _force, _pull, _set_ghosts, _threshold
+from stickslip.kernels.laws import NO_CARRY, _accel, _dtheta, _force, _set_ghosts, _threshold, drive_view, pull_carried
 from stickslip.kernels.layout import (
     _BIG,
     BAD_BLOCK,
@@ -48,10 +48,11 @@ def run_dense(args, drive, friction, threshold, ends):
     first_step, x0ev, prof_meta = args.first_step, args.x0ev, args.prof_meta
     n_end, profile_every = args.n_end, args.profile_every
     N = x.shape[0] - 2
-    mp, V, dt = _unpack(par, args.dp, args.tp, args.law, args.kb, args.mass)
+    mp, V, dt = _unpack(par, drive_view(args.dp, drive), args.tp, args.law, args.kb, args.mass)
     K, dp, tp = mp[0], mp[1], mp[2]
     h2 = 0.5 * dt
     cap_ev, cap_fm, cap_p = ev_int.shape[0], fm.shape[0], prof_x.shape[0]
+    carry = NO_CARRY  # a load history's last step read (laws.pull_carried)
     while True:
         n = ist[STEP]
         # Outputs due, the end, buffers that could overflow. Written out here rather than in a
@@ -64,7 +65,7 @@ def run_dense(args, drive, friction, threshold, ends):
             return DONE
         if ist[EV_COUNT] >= cap_ev or ist[FM_COUNT] + N > cap_fm or (profile_every > 0 and ist[P_COUNT] + 2 > cap_p):
             return _overflow(ist, N, cap_ev, cap_fm)
-        p1 = _pull(V, n, dt, dp, drive)
+        p1, carry = pull_carried(V, n, dt, dp, drive, carry)
         _set_ghosts(x, th, N, p1, drive, ends)
         for i in range(1, N + 1):
             f = _force(x[i - 1], x[i], x[i + 1], K, dp, p1, drive, i)
@@ -77,7 +78,7 @@ def run_dense(args, drive, friction, threshold, ends):
             xs[i] = x[i] + dt * v[i]
             vs[i] = v[i] + dt * a1[i]
             ths[i] = th[i] + dt * b1[i]
-        p2 = _pull(V, n + 1, dt, dp, drive)
+        p2, carry = pull_carried(V, n + 1, dt, dp, drive, carry)
         _set_ghosts(xs, ths, N, p2, drive, ends)
         _start_and_first_moves(n, 1, N, x, mm, first_step, x0ev, ist, prof_x, prof_meta, N, profile_every)
         n_moving = 0

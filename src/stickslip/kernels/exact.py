@@ -52,7 +52,17 @@ from numba import njit
 
 from stickslip.kernels import lanes
 from stickslip.kernels.events import _end_event, _overflow, _service, _start_and_first_moves
-from stickslip.kernels.laws import _force, _pull, _right_of_first, _set_ghosts, _threshold, has
+from stickslip.kernels.laws import (
+    NO_CARRY,
+    _force,
+    _right_of_first,
+    _set_ghosts,
+    _threshold,
+    drive_view,
+    has,
+    pull_carried,
+    pull_peek,
+)
 from stickslip.kernels.layout import (
     _NEVER,
     ACT_HI,
@@ -112,6 +122,7 @@ def _slide_steps(args, ra0, rb0, hi, mp, V, dt, drive, friction, threshold, ends
     fh = rb0 + 1
     h1 = hi + 1
     rp = _run_padded(ra0, rb0, N)
+    carry = NO_CARRY  # a load history's last step read (laws.pull_carried)
     while True:
         n = ist[STEP]
         if (
@@ -123,7 +134,7 @@ def _slide_steps(args, ra0, rb0, hi, mp, V, dt, drive, friction, threshold, ends
             or (profile_every > 0 and ist[P_COUNT] + 2 > cap_p)
         ):
             return ra0, rb0, _NEVER
-        p1 = _pull(V, n, dt, dp, drive)
+        p1, carry = pull_carried(V, n, dt, dp, drive, carry)
         _set_ghosts(x, th, N, p1, drive, ends)
         if not every and _force(x[fh - 1], x[fh], x[fh + 1], K, dp, p1, drive, fh) > _threshold(
             th[fh], tp, threshold, fh
@@ -132,7 +143,7 @@ def _slide_steps(args, ra0, rb0, hi, mp, V, dt, drive, friction, threshold, ends
         _stage1_run(x, v, th, xs, vs, ths, a1, b1, ra0, rp, p1, mp, dt, drive, friction)
         if not every:
             _stage1_theta(x, v, th, xs, vs, ths, mm, b1, fh, h1, mp, dt, friction)
-        p2 = _pull(V, n + 1, dt, dp, drive)
+        p2, carry = pull_carried(V, n + 1, dt, dp, drive, carry)
         _set_ghosts(xs, ths, N, p2, drive, ends)
         c_hi = rb0
         if has(friction, "has_state") and not every:
@@ -189,7 +200,7 @@ def run_exact(args, drive, friction, threshold, ends):
     prof_x, n_end, profile_every = args.prof_x, args.n_end, args.profile_every
     first_step, x0ev, prof_meta = args.first_step, args.x0ev, args.prof_meta
     N = x.shape[0] - 2
-    mp, V, dt = _unpack(par, args.dp, args.tp, args.law, args.kb, args.mass)
+    mp, V, dt = _unpack(par, drive_view(args.dp, drive), args.tp, args.law, args.kb, args.mass)
     K, dp, tp = mp[0], mp[1], mp[2]
     h2 = 0.5 * dt
     cap_ev, cap_fm, cap_p = ev_int.shape[0], fm.shape[0], prof_x.shape[0]
@@ -200,6 +211,7 @@ def run_exact(args, drive, friction, threshold, ends):
     if has(drive, "leaf_spring"):
         _set_ghosts(x, th, N, 0.0, drive, ends)
         t_next = leaf_triggers(x, th, mov, mm, trig, 1, N, True, ist[STEP], n_end, mp, V, dt, drive, threshold)
+    carry = NO_CARRY  # a load history's last step read (laws.pull_carried)
     while True:
         # The run's bounds, fixed over the inner loop of steps: the compiler then checks the
         # run stages' arrays for overlap once per run rather than once per step (measured).
@@ -235,9 +247,10 @@ def run_exact(args, drive, friction, threshold, ends):
             mh = ist[MECH_HI]
             if not has(drive, "leaf_spring"):
                 x2 = _right_of_first(x, N, ends)
-                if mov[1] != 0.0 or _force(_pull(V, n, dt, dp, drive), x[1], x2, K, dp, 0.0, drive, 1) > _threshold(
-                    th[1], tp, threshold, 1
-                ):
+                # Block 1's load point is read only while it is stopped (the `or` short-circuits).
+                if mov[1] != 0.0 or _force(
+                    pull_peek(V, n, dt, dp, drive, carry), x[1], x2, K, dp, 0.0, drive, 1
+                ) > _threshold(th[1], tp, threshold, 1):
                     lo = 1
                     if hi < 1:
                         hi = 1
@@ -287,7 +300,7 @@ def run_exact(args, drive, friction, threshold, ends):
                     t_next = t
                 continue
 
-            p1 = _pull(V, n, dt, dp, drive)
+            p1, carry = pull_carried(V, n, dt, dp, drive, carry)
             _set_ghosts(x, th, N, p1, drive, ends)
             l1 = lo - 1 if lo > 1 else 1
             h1 = hi + 1 if hi < N else N
@@ -365,7 +378,7 @@ def run_exact(args, drive, friction, threshold, ends):
                             _stage1_theta_only(v, th, ths, b1, b_ + 1, h1, mp, dt, friction)
             elif has(friction, "has_state"):
                 _stage1_theta_only(v, th, ths, b1, l1, h1, mp, dt, friction)
-            p2 = _pull(V, n + 1, dt, dp, drive)
+            p2, carry = pull_carried(V, n + 1, dt, dp, drive, carry)
             _set_ghosts(xs, ths, N, p2, drive, ends)
             # Only a block that starts in this step can move for the first time in an event.
             if (ist[EV_ACTIVE] == 1 and starts) or (ist[N_MOVING] == 0 and first <= last):

@@ -298,6 +298,86 @@ def _pull(V, n, dt, dp, drive):
     return pull_point(V, n, dt, dp, drive)
 
 
+def drive_view(dp, drive):
+    """The drive's parameters as a kernel's step loop carries them: the drive's own
+    ``kernel_view(dp)`` where it has one (a load history's table as an address, so that the loop
+    counts no references to an array: :func:`stickslip.models.drive.history.kernel_view`), else
+    ``dp`` itself (compiled away)."""
+    mod = importlib.import_module(drive)
+    return mod.kernel_view(dp) if hasattr(mod, "kernel_view") else dp
+
+
+@overload(drive_view, prefer_literal=True)
+def _drive_view(dp, drive):
+    mod = _module(drive)
+    if mod is None:
+        return None
+    if hasattr(mod, "kernel_view"):
+        fn = mod.kernel_view
+        return lambda dp, drive: fn(dp)
+    return lambda dp, drive: dp
+
+
+#: The carry of :func:`pull_carried` before a kernel's first step: no step read, no interval.
+NO_CARRY = (np.int64(-1), 0.0, np.int64(-1))
+
+
+def pull_carried(V, n, dt, dp, drive, carry):
+    """(the load point at step n as :func:`_pull` gives it, the carry): for a load history, the
+    value of the step the carry holds if it is n (a step's end is the next step's start), else the
+    drive's ``pull_from`` from the carry's interval, O(1) as the steps go forward; the carry is
+    (step, value, interval), :data:`NO_CARRY` at first. For the drives at a constant velocity V *
+    (n dt) and the carry as it was (compiled away): today's code."""
+    mod = importlib.import_module(drive)
+    if hasattr(mod, "pull_from"):
+        if n == carry[0]:
+            return carry[1], carry
+        p, k = mod.pull_from(n, dt, dp, carry[2])
+        return p, (n, p, k)
+    return V * (np.float64(n) * dt), carry
+
+
+@overload(pull_carried, prefer_literal=True)
+def _pull_carried(V, n, dt, dp, drive, carry):
+    mod = _module(drive)
+    if mod is None:
+        return None
+    if hasattr(mod, "pull_from"):
+        fn = mod.pull_from
+
+        def carried(V, n, dt, dp, drive, carry):
+            if n == carry[0]:
+                return carry[1], carry
+            p, k = fn(n, dt, dp, carry[2])
+            return p, (np.int64(n), p, k)
+
+        return carried
+    return lambda V, n, dt, dp, drive, carry: (V * (np.float64(n) * dt), carry)
+
+
+def pull_peek(V, n, dt, dp, drive, carry):
+    """The load point at step n as :func:`pull_carried` gives it, the carry left as it is (a read
+    outside the step's own two)."""
+    return pull_carried(V, n, dt, dp, drive, carry)[0]
+
+
+@overload(pull_peek, prefer_literal=True)
+def _pull_peek(V, n, dt, dp, drive, carry):
+    mod = _module(drive)
+    if mod is None:
+        return None
+    if hasattr(mod, "pull_from"):
+        fn = mod.pull_from
+
+        def peek(V, n, dt, dp, drive, carry):
+            if n == carry[0]:
+                return carry[1]
+            return fn(n, dt, dp, carry[2])[0]
+
+        return peek
+    return lambda V, n, dt, dp, drive, carry: V * (np.float64(n) * dt)
+
+
 @njit(cache=True, inline="always")
 def _set_ghosts(x, th, N, p, drive, ends):
     """Ghost cells 0 and N + 1 from the drive and the ends' ``ghost`` (a wall at x = 0; theta

@@ -7,7 +7,8 @@ object with ``times`` (increasing breakpoints t_0 < ... < t_m) and ``positions``
 a ``LoadHistory`` or a pair of arrays. The kernels receive it as one table (``Params.table``, a
 3 x (m + 1) array: the breakpoints, the positions and the velocities V_k = (p_k+1 - p_k) /
 (t_k+1 - t_k) of the intervals), which :func:`stickslip.kernels.laws.at` leaves whole (it gathers
-1-D fields only), and read the load point at step n with :func:`pull`:
+1-D fields only), and read the load point at step n with :func:`pull` (the chain's step loops with
+:func:`pull_from`, once a step, on the table as its address, :func:`kernel_view`):
 
     p(t_n) = min(p_k + V_k (t_n - t_k), p_k+1)   on [t_k, t_k+1), with t_n = n dt,
 
@@ -29,12 +30,75 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from llvmlite import ir
+from numba import types
+from numba.extending import intrinsic, overload
 
 from stickslip.models.piece import Piece, kernel_params, njit
 
 READS = ("history",)
 #: The kernels' parameters: the table of breakpoints, positions and velocities (3 x (m + 1)).
 Params = kernel_params(__name__, ("table",))
+
+
+@intrinsic
+def _read(typingctx, address, i):
+    """The float64 at ``address`` + 8 i (the table's memory, which the caller keeps alive)."""
+    if not (isinstance(address, types.Integer) and isinstance(i, types.Integer)):
+        return None
+
+    def codegen(context, builder, signature, args):
+        ptr = builder.inttoptr(args[0], ir.DoubleType().as_pointer())
+        return builder.load(builder.gep(ptr, [args[1]]))
+
+    return types.float64(address, i), codegen
+
+
+def entry(table, r, k):
+    """Row r, column k of the table: of the array, or of its in-kernel form (address, columns),
+    :func:`kernel_view`."""
+    return table[r, k] if hasattr(table, "shape") else None
+
+
+@overload(entry, inline="always")
+def _entry(table, r, k):
+    if isinstance(table, types.Array):
+        return lambda table, r, k: table[r, k]
+    if isinstance(table, types.BaseTuple):
+        return lambda table, r, k: _read(table[0], r * table[1] + k)
+    return None
+
+
+def columns(table):
+    """The number of breakpoints m + 1 (the table's columns), of either form (:func:`entry`)."""
+    return table.shape[1]
+
+
+@overload(columns, inline="always")
+def _columns(table):
+    if isinstance(table, types.Array):
+        return lambda table: table.shape[1]
+    if isinstance(table, types.BaseTuple):
+        return lambda table: table[1]
+    return None
+
+
+def kernel_view(dp):
+    """The parameters as the chain's kernels carry them (:func:`stickslip.kernels.laws.drive_view`):
+    the table as (the address of its C-contiguous data, its columns), read by :func:`entry`. The
+    same numbers; what changes is that the step loops hold no array of the drive's, so they count
+    no references to it (as an array, each inlined stage that reads it adds a pair of atomic
+    reference counts a step, more than the lookup costs). The kernel's argument keeps the array
+    alive; a table of any other layout stays an array."""
+    return dp
+
+
+@overload(kernel_view, inline="always")
+def _kernel_view(dp):
+    table = dp.types[0] if isinstance(dp, types.BaseNamedTuple) else None
+    if isinstance(table, types.Array) and table.ndim == 2 and table.layout == "C" and table.dtype == types.float64:
+        return lambda dp: Params((dp.table.ctypes.data, np.int64(dp.table.shape[1])))
+    return lambda dp: dp
 
 
 @njit(cache=True, inline="always")
@@ -64,29 +128,74 @@ def left(p, ghost):
 
 
 @njit(cache=True, inline="always")
+def _interval(t, table, k):
+    """The interval of t, the k with t_k <= t < t_k+1, for t_0 <= t < t_m (``np.searchsorted(t_b,
+    t, side="right") - 1``, the same k): from a guess k (0 <= k < m), the last step's interval,
+    checked first, then the next; a bisection over the rest (or over all of them with no guess, k
+    < 0, or a guess past t). Reads the table's rows in place (a row as an array of its own costs a
+    reference count in the kernels that count them)."""
+    m = columns(table) - 1
+    lo = 0
+    if k >= 0 and t >= entry(table, 0, k):
+        if t < entry(table, 0, k + 1):
+            return k
+        if t < entry(table, 0, k + 2):  # k + 1 < m here, since t_k+1 <= t < t_m
+            return k + 1
+        lo = k + 2
+    hi = m  # t_lo <= t < t_hi
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if entry(table, 0, mid) <= t:
+            lo = mid
+        else:
+            hi = mid
+    return lo
+
+
+@njit(cache=True, inline="always")
+def _at(t, table, k):
+    """p(t) on the interval k: linear, clamped to the interval's end position."""
+    q = entry(table, 1, k) + entry(table, 2, k) * (t - entry(table, 0, k))
+    if entry(table, 2, k) >= 0.0:
+        return min(q, entry(table, 1, k + 1))
+    return max(q, entry(table, 1, k + 1))
+
+
+@njit(cache=True, inline="always")
+def load_from(t, dp, k):
+    """The load point p(t) at any time t and the interval k of t, from the interval k of an earlier
+    time (:func:`_interval`; k < 0 for none): one or two comparisons when the times go forward,
+    as a run's steps do. The same value as :func:`load`; k is left as it is outside the breakpoints."""
+    table = dp.table
+    m = columns(table) - 1
+    if t >= entry(table, 0, m):
+        return entry(table, 1, m), k
+    if t < entry(table, 0, 0):
+        return entry(table, 1, 0), k
+    k = _interval(t, table, k)
+    return _at(t, table, k), k
+
+
+@njit(cache=True, inline="always")
 def load(t, dp):
     """The load point p(t) at any time t (the located integrator reads it inside a step): linear
     on the interval of t, clamped to the interval's end position, held before the first and after
     the last breakpoint."""
-    tb = dp.table[0]
-    pb = dp.table[1]
-    vb = dp.table[2]
-    m = tb.shape[0] - 1
-    if t >= tb[m]:
-        return pb[m]
-    if t < tb[0]:
-        return pb[0]
-    k = np.searchsorted(tb, t, side="right") - 1
-    q = pb[k] + vb[k] * (t - tb[k])
-    if vb[k] >= 0.0:
-        return min(q, pb[k + 1])
-    return max(q, pb[k + 1])
+    return load_from(t, dp, -1)[0]
 
 
 @njit(cache=True, inline="always")
 def pull(n, dt, dp):
     """The load point p(t_n), t_n = n dt (module docstring): :func:`load` at t_n."""
     return load(np.float64(n) * dt, dp)
+
+
+@njit(cache=True, inline="always")
+def pull_from(n, dt, dp, k):
+    """:func:`pull` and the interval of t_n, from the interval k of an earlier step
+    (:func:`load_from`): what the kernels' step loops read, once a step
+    (:func:`stickslip.kernels.laws.pull_carried`)."""
+    return load_from(np.float64(n) * dt, dp, k)
 
 
 def pull_py(n: int, dt: float, table: np.ndarray) -> float:
