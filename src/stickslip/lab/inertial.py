@@ -1,10 +1,10 @@
 """The inertial spring-slider of the laboratory, sampled: the chain's single block with a mass.
 
-M dv/dt = k (p(t) - x) - mu(v, theta),  dtheta/dt = 1 - v theta / D_c (aging; or the slip law),
+M dv/dt = k (p(t) - x) - mu(v, theta),  dtheta/dt = 1 - v theta / D_c (aging; or the slip or PRZ law),
 
 with mu the regularised (asinh) rate-and-state law and no static threshold (docs/lab.md, "The
 inertial route"): the chain of eq. (4) at N = 1, drive ``history``, friction ``rate-state`` (or
-``rate-state-slip``), threshold ``none``, sigma_n = 1 so that its K is the lab's k and its M is
+``rate-state-slip``, ``rate-state-prz``), threshold ``none``, sigma_n = 1 so that its K is the lab's k and its M is
 the mass per unit normal stress. The run is the chain's own (:class:`stickslip.run.driver.Stepper`,
 the exact integrator at a fixed step dt); this module only starts it and reads x and v at the
 sample times, where the spring's friction is k (p(t) - x). Below the critical stiffness
@@ -17,19 +17,19 @@ from __future__ import annotations
 import numpy as np
 
 from stickslip.lab.history import LoadHistory
-from stickslip.lab.laws import RateState, friction_of
+from stickslip.lab.laws import RateState, friction_of, steady_theta
 from stickslip.models.params import ParameterError, check_number
 
 __all__ = ["FRICTION", "check_route", "critical_stiffness_inertial", "sample"]
 
 #: The chain's friction piece of each evolution law the inertial route has.
-FRICTION = {"aging": "rate-state", "slip": "rate-state-slip"}
+FRICTION = {"aging": "rate-state", "slip": "rate-state-slip", "prz": "rate-state-prz"}
 
 
 def critical_stiffness_inertial(model: RateState, M: float, V: float) -> float:
     """k_c = (b - a) / D_c (1 + M V^2 / (a D_c)) of the inertial spring-slider with one state
-    variable (aging or slip law, which linearise alike; Rice and Ruina 1983, eq. (23) with the
-    mass per unit normal stress M).
+    variable (aging, slip or PRZ law, which linearise alike; Rice and Ruina 1983, eq. (23) with
+    the mass per unit normal stress M).
 
     Parameters
     ----------
@@ -46,8 +46,8 @@ def critical_stiffness_inertial(model: RateState, M: float, V: float) -> float:
 
 
 def check_route(model: RateState) -> float:
-    """The model's k, where the inertial route has the model: one state variable with the aging or
-    the slip law, a finite k, no radiation damping.
+    """The model's k, where the inertial route has the model: one state variable with the aging, the
+    slip or the PRZ law, a finite k, no radiation damping.
 
     Raises
     ------
@@ -57,7 +57,7 @@ def check_route(model: RateState) -> float:
     k = model.require_k()
     if model.n_states != 1 or model.law[0] not in FRICTION:
         raise ParameterError(
-            f"the inertial route has one state variable with the aging or the slip law (got law {','.join(model.law)})"
+            f"the inertial route has one state variable with the aging, slip or prz law (got law {','.join(model.law)})"
         )
     if model.eta != 0.0 or k == np.inf:
         raise ParameterError("the inertial route has a finite k and no radiation damping (eta = 0)")
@@ -70,7 +70,7 @@ def chain_params_of(model: RateState, M: float, dt: float, history: LoadHistory)
     Raises
     ------
     ParameterError
-        More than one state variable, a law other than aging or slip, damping eta, no k.
+        More than one state variable, a law other than aging, slip or prz, damping eta, no k.
     """
     from stickslip.models.presets import chain_params
 
@@ -95,14 +95,16 @@ def sample(
     """Run the inertial spring-slider over ``history`` and read it at the times ``t``.
 
     The block starts at the history's first time t_0 in steady sliding at the load point's first
-    velocity V_1 (theta = D_c / V_1, the spring at mu_ss(V_1)), but with the slip rate
+    velocity V_1 (theta = s D_c / V_1, s = 2 for the PRZ law and 1 otherwise; the spring at
+    mu_ss(V_1)), but with the slip rate
     ``v_init``, default (1 + ``kick``) V_1: the kick starts the cycles where steady sliding is
     unstable.
 
     Parameters
     ----------
     model : RateState
-        a, b, D_c, mu0, V0 and k (one state variable; aging or slip law; read in the asinh form).
+        a, b, D_c, mu0, V0 and k (one state variable; aging, slip or PRZ law; read in the asinh
+        form).
     M : float
         Mass per unit normal stress (> 0).
     history : LoadHistory
@@ -146,8 +148,10 @@ def sample(
     if V1 <= 0.0:
         raise ParameterError("the inertial route starts in steady sliding: the history must start at V > 0")
     v0 = (1.0 + kick) * V1 if v_init is None else check_number("v_init", v_init, low=0.0, low_open=True)
-    lab = RateState(a=model.a, b=model.b, Dc=model.Dc, mu0=model.mu0, V0=model.V0, k=model.k, form="asinh")
-    theta = model.Dc[0] / V1
+    lab = RateState(
+        a=model.a, b=model.b, Dc=model.Dc, mu0=model.mu0, V0=model.V0, k=model.k, law=model.law, form="asinh"
+    )
+    theta = float(steady_theta(lab, V1)[0])
     p0 = float(history.positions[0])
     x0 = p0 - friction_of(lab, V1, np.array([theta])) / p.K
     state = ChainState.from_blocks([x0], [v0], [theta], [False])

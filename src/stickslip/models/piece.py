@@ -217,6 +217,9 @@ class Piece:
     label: str = ""
     #: friction: extra numbers the stability report shows for this law (closed forms to compare)
     stability_extras: Callable[[Any], dict[str, float]] | None = None
+    #: friction: a regularised rate-and-state law, which holds no force at v = 0 (mu(0, theta) = 0),
+    #: so that it runs without a static threshold (threshold ``none``)
+    rate_and_state: bool = False
     #: friction and drive: the compiled functions the run stages call (``accel``, ``rate``;
     #: ``force``) use only + - * / on their arguments and float parameters, so they run on 8
     #: blocks at once (:mod:`stickslip.kernels.lanes`)

@@ -12,7 +12,8 @@ drive      ``end``: a pulling point x_0 = V t joined to block 1 (eq. 4);
 friction   ``state``: theta_i + beta v_i, theta from eq. (4);
            ``weakening``: phi(v) = (1 - sigma) / (1 + 2 alpha max(v, 0) / (1 - sigma)) (CL);
            ``strengthening``: F0 + beta v, no state variable (train model);
-           ``rate-state``: Dieterich-Ruina with the aging law; ``slip``: with Ruina's slip law;
+           ``rate-state``: Dieterich-Ruina with the aging law; ``rate-state-slip``: with Ruina's
+           slip law; ``rate-state-prz``: with the Perrin-Rice-Zheng law;
            one module each in :mod:`stickslip.models.friction`, listed in :data:`FRICTIONS`
 threshold  ``constant``: Fs; ``state``: theta_i (the paper's reading of Batista-Carlson);
            ``none``: no static threshold, for rate-and-state (a block starts when f_i > 0)
@@ -55,6 +56,7 @@ FRICTIONS = (
     "strengthening",
     "rate_state",
     "rate_state_slip",
+    "rate_state_prz",
 )
 
 #: The drives, one module each in :mod:`stickslip.models.drive`.
@@ -96,11 +98,15 @@ def code(kind: str, name: str) -> str:
     return piece(kind, name).module
 
 
+#: The frictions that run without a static threshold (threshold none): the regularised
+#: rate-and-state laws, which hold no force at v = 0 (:attr:`Piece.rate_and_state`).
+RATE_AND_STATE = tuple(p.name for p in PIECES["friction"] if p.rate_and_state)
+
 #: The rules of composition (docs/model.md), as ``stickslip models`` states them.
 RULES = (
     "ends periodic needs a drive that acts on every block (plate, constant-force, force-ramp)",
     "threshold state needs friction state",
-    "threshold none needs a rate-and-state friction (rate-state, rate-state-slip)",
+    f"threshold none needs a rate-and-state friction ({', '.join(RATE_AND_STATE)})",
 )
 
 
@@ -115,9 +121,9 @@ def check_composition(drive: str, friction: str, threshold: str, ends: str) -> N
         )
     if threshold == "state" and friction != "state":
         raise CompositionError(f"threshold state needs friction state (friction {friction} has no theta)")
-    if threshold == "none" and not friction.startswith("rate-state"):
+    if threshold == "none" and not piece("friction", friction).rate_and_state:
         raise CompositionError(
-            f"threshold none needs a rate-and-state friction (rate-state, rate-state-slip; got friction {friction})"
+            f"threshold none needs a rate-and-state friction ({', '.join(RATE_AND_STATE)}; got friction {friction})"
         )
 
 

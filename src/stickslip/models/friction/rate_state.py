@@ -169,6 +169,7 @@ PIECE = Piece(
     ),
     check=check_v,
     has_state=True,
+    rate_and_state=True,
     theta0=lambda p: p.Dc / p.V,
     theta_range=(0.0, float("inf"), True),  # ln(v0 theta / D_c) needs theta > 0
     steady=steady_sliding,

@@ -63,6 +63,7 @@ PIECE = Piece(
     READS,
     check=aging.check_v,
     has_state=True,
+    rate_and_state=True,
     theta0=lambda p: p.Dc / p.V,
     theta_range=aging.PIECE.theta_range,
     steady=aging.steady_sliding,
