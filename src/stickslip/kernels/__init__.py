@@ -2,8 +2,9 @@
 parts: :mod:`~stickslip.kernels.layout` (arrays, pieces' codes, status codes),
 :mod:`~stickslip.kernels.laws` (the step's expressions), :mod:`~stickslip.kernels.events`
 (outputs and events), :mod:`~stickslip.kernels.triggers` (the drive's starts),
-:mod:`~stickslip.kernels.dense` (the reference), :mod:`~stickslip.kernels.stages` and
-:mod:`~stickslip.kernels.exact` (the fast interval path), :mod:`~stickslip.kernels.plate` (the
+:mod:`~stickslip.kernels.dense` (the reference), :mod:`~stickslip.kernels.active` (which blocks
+get which stage in a step, and the rules the fast paths share), :mod:`~stickslip.kernels.stages`
+and :mod:`~stickslip.kernels.exact` (the fast interval path), :mod:`~stickslip.kernels.plate` (the
 fast sparse path of the plate drive), :mod:`~stickslip.kernels.located` (Heun with switches
 located inside the step, the flow's reference) with its fast form
 :mod:`~stickslip.kernels.located_fast` and :mod:`~stickslip.kernels.located_lazy` (the same

@@ -5,7 +5,10 @@ It skips only work whose result is known: one step of block i reads blocks i-2..
 reads the neighbours' predictors, which read theirs), so a block none of whose neighbours out
 to two places changed in the last step cannot change now, except through the start rule. The
 blocks to update form the changed set dilated by two (kept as one bounding interval, which is
-conservative; on a periodic chain an interval that would wrap becomes the whole chain).
+conservative; on a periodic chain an interval that would wrap becomes the whole chain). These
+are the rules of :mod:`stickslip.kernels.active`, which names the intervals below and holds the
+interval's bookkeeping (the widening, the pauses, the plate's due starts) for this kernel and
+:func:`_slide_steps`.
 
 Which stopped blocks can start:
 
@@ -51,6 +54,15 @@ from __future__ import annotations
 from numba import njit
 
 from stickslip.kernels import lanes
+from stickslip.kernels.active import (
+    CHANGE_REACH,
+    MOVE_REACH,
+    dilate,
+    due_plate_starts,
+    due_step,
+    may_overflow,
+    outputs_due,
+)
 from stickslip.kernels.events import _end_event, _overflow, _service, _start_and_first_moves
 from stickslip.kernels.laws import (
     NO_CARRY,
@@ -126,12 +138,9 @@ def _slide_steps(args, ra0, rb0, hi, mp, V, dt, drive, friction, threshold, ends
     while True:
         n = ist[STEP]
         if (
-            n == ist[NEXT_SAMPLE]
-            or (profile_every > 0 and ist[EV_ACTIVE] == 1 and n == ist[NEXT_PROFILE])
+            outputs_due(n, ist[NEXT_SAMPLE], ist[NEXT_PROFILE], profile_every, ist[EV_ACTIVE] == 1)
             or n >= n_end
-            or ist[EV_COUNT] >= cap_ev
-            or ist[FM_COUNT] + N > cap_fm
-            or (profile_every > 0 and ist[P_COUNT] + 2 > cap_p)
+            or may_overflow(ist[EV_COUNT], ist[FM_COUNT], ist[P_COUNT], N, cap_ev, cap_fm, cap_p, profile_every)
         ):
             return ra0, rb0, _NEVER
         p1, carry = pull_carried(V, n, dt, dp, drive, carry)
@@ -156,7 +165,7 @@ def _slide_steps(args, ra0, rb0, hi, mp, V, dt, drive, friction, threshold, ends
         ist[STEP] = n + 1
         # The next step's candidates, as run_exact's: the changes dilated by two (block 1 is the
         # lowest), and the movers and their neighbours.
-        c_hi = c_hi + 2 if c_hi < N - 2 else N
+        _, c_hi = dilate(1, c_hi, CHANGE_REACH, N, False)
         a_hi = c_hi if c_hi > fh or every else fh
         ist[ACT_LO], ist[ACT_HI] = 1, a_hi
         ist[MECH_LO], ist[MECH_HI] = 1, N if every else fh
@@ -225,19 +234,16 @@ def run_exact(args, drive, friction, threshold, ends):
             if ra != ra0 or rb != rb0:
                 break
             n = ist[STEP]
-            # Outputs due, the end, buffers that could overflow. Written out here rather than in a
-            # helper: as a function this costs several times a short step (measured).
-            if n == ist[NEXT_SAMPLE] or (profile_every > 0 and ist[EV_ACTIVE] == 1 and n == ist[NEXT_PROFILE]):
+            # Outputs due, the end, buffers that could overflow. The helpers take numbers, not
+            # arrays: a helper taking ``args`` or an array, even inlined, counts references to
+            # them at every step, which costs several times a short step (measured).
+            if outputs_due(n, ist[NEXT_SAMPLE], ist[NEXT_PROFILE], profile_every, ist[EV_ACTIVE] == 1):
                 st = _service(n, args)
                 if st != DONE:
                     return st
             if n >= n_end:
                 return DONE
-            if (
-                ist[EV_COUNT] >= cap_ev
-                or ist[FM_COUNT] + N > cap_fm
-                or (profile_every > 0 and ist[P_COUNT] + 2 > cap_p)
-            ):
+            if may_overflow(ist[EV_COUNT], ist[FM_COUNT], ist[P_COUNT], N, cap_ev, cap_fm, cap_p, profile_every):
                 return _overflow(ist, N, cap_ev, cap_fm)
             lo = ist[ACT_LO]
             hi = ist[ACT_HI]
@@ -258,13 +264,7 @@ def run_exact(args, drive, friction, threshold, ends):
                     if mh < 1:
                         mh = 1
             elif n >= t_next:
-                t_next = _NEVER
-                for i in range(1, N + 1):
-                    if mov[i] == 0.0:
-                        if trig[i] <= n:
-                            ml, mh = _merge(ml, mh, i, i)
-                        elif trig[i] < t_next:
-                            t_next = trig[i]
+                ml, mh, t_next = due_plate_starts(mov, trig, n, ml, mh)
                 lo, hi = _merge(lo, hi, ml, mh)
             if has(threshold, "has_state"):
                 # A changing state variable moves the threshold itself.
@@ -275,11 +275,7 @@ def run_exact(args, drive, friction, threshold, ends):
                 hi = N
             if lo > hi:
                 # Nothing can change before the drive starts a block: jump, but stop at due outputs.
-                target = n_end
-                if ist[NEXT_SAMPLE] < target:
-                    target = ist[NEXT_SAMPLE]
-                if profile_every > 0 and ist[EV_ACTIVE] == 1 and ist[NEXT_PROFILE] < target:
-                    target = ist[NEXT_PROFILE]
+                target = due_step(n_end, ist[NEXT_SAMPLE], ist[NEXT_PROFILE], profile_every, ist[EV_ACTIVE] == 1)
                 if not has(drive, "leaf_spring"):
                     ist[STEP] = pull_trigger(
                         x, N, V, dt, K, _threshold(th[1], tp, threshold, 1), n + 1, target, dp, drive, ends
@@ -438,12 +434,7 @@ def run_exact(args, drive, friction, threshold, ends):
             # through the springs that takes a neighbour's move, and only moving blocks change x.
             # So: this step's movers +- 1 (and, as above, the drive's starts and changing thetas).
             if first <= last:
-                if has(ends, "ring") and (first == 1 or last == N):
-                    ist[MECH_LO] = 1
-                    ist[MECH_HI] = N
-                else:
-                    ist[MECH_LO] = first - 1 if first > 1 else 1
-                    ist[MECH_HI] = last + 1 if last < N else N
+                ist[MECH_LO], ist[MECH_HI] = dilate(first, last, MOVE_REACH, N, has(ends, "ring"))
             else:
                 ist[MECH_LO] = 1
                 ist[MECH_HI] = 0
@@ -467,12 +458,7 @@ def run_exact(args, drive, friction, threshold, ends):
             # Next step's candidates: changes dilated by two, and every block that may move (a
             # start rule that fires is an event's move even when it changes no bit).
             if c_lo <= c_hi:
-                if has(ends, "ring") and (c_lo <= 2 or c_hi >= N - 1):
-                    c_lo = 1
-                    c_hi = N
-                else:
-                    c_lo = c_lo - 2 if c_lo > 2 else 1
-                    c_hi = c_hi + 2 if c_hi < N - 2 else N
+                c_lo, c_hi = dilate(c_lo, c_hi, CHANGE_REACH, N, has(ends, "ring"))
             ist[ACT_LO], ist[ACT_HI] = _merge(c_lo, c_hi, ist[MECH_LO], ist[MECH_HI])
             if has(drive, "leaf_spring"):
                 # Stopped blocks whose force or threshold changed: their first start step anew.

@@ -19,7 +19,8 @@ dense's own expressions and in its order within a block:
   it was last a candidate), which is what dense writes there.
 
 The step's cost is that of its candidates and due triggers: no loop over the lattice, no flags to
-clear (a block's ``mark`` is the step whose candidate list holds it).
+clear (a block's ``mark`` is the step whose candidate list holds it). These are the rules of
+:mod:`stickslip.kernels.active`, with the candidates as a list gathered anew each step.
 
 A stopped block that leaves the candidates gets its trigger: the first step at which its force,
 evaluated with the step's own expression (the drive's ``force_lap`` on its Laplacian, which no

@@ -17,6 +17,11 @@ so a mover's stage 2 reads its stopped neighbours' predictors without recomputin
 which it was a candidate and no neighbour moved); a block due in the next step goes on the
 queue, the others are found when the step reaches the smallest of their ``trig``.
 
+These lists are the active set of :mod:`stickslip.kernels.active` (which blocks get which stage),
+kept from step to step while no block starts or stops. The pause for outputs, the end and the
+buffers is written out rather than taken from there: with those helpers this kernel measured
+about 10% slower (docs/performance.md, "One active set, three forms").
+
 A step costs little more than its moving blocks (most steps move one to a few of them):
 
 1. the start rule of the stopped candidates: a first pass only asks whether any fires (it
