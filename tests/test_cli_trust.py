@@ -221,6 +221,7 @@ def test_crafted_checkpoint_refused(craft, tmp_path, capsys):
     assert err.count("\n") == 1 and "checkpoint" in err, err
 
 
+@pytest.mark.slow
 def test_second_writer_refused_while_first_runs(tmp_path):
     out = tmp_path / "run"
     first = subprocess.Popen(

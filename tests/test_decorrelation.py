@@ -59,6 +59,7 @@ def test_periodic_block_never_decorrelates():
         assert row["events"] == res.reference_events
 
 
+@pytest.mark.slow
 def test_identical_runs_never_decorrelate():
     params = chain_params("two-blocks")
     state = _after(params, "rest", 0.01, 500.0)

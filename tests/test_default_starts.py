@@ -62,6 +62,7 @@ def test_the_slip_law_from_the_papers_start_is_refused_with_what_to_do():
     assert "--start steady" in str(info.value) and "dt below 0.0011" in str(info.value)
 
 
+@pytest.mark.slow
 def test_the_refusal_foresees_what_the_engine_does(monkeypatch):
     """Without the check, the run dies at step 1 as the refusal says it would."""
     monkeypatch.setattr(state_mod, "first_step_problem", lambda state, p: None)

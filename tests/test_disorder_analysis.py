@@ -5,6 +5,7 @@ uniform chain, with the same exactness checks."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from stickslip import ChainParams, Quenched
 from stickslip.analysis.dynamics.decorrelation import event_decorrelation
@@ -25,6 +26,7 @@ def test_lyapunov_reference_is_the_run_and_both_engines_agree():
     assert lean.lyapunov == public.lyapunov and lean.events == public.events > 0
 
 
+@pytest.mark.slow
 def test_located_decorrelation_of_a_disordered_pair_of_blocks():
     """Two blocks with thresholds 0.9 and 1.1 (located switches): the run against itself never
     decorrelates, and a tiny kick does within the window, as for the uniform pair."""

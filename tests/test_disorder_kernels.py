@@ -149,6 +149,7 @@ def test_uniform_values_given_as_arrays_give_the_scalar_chain_bits():
         assert_same_run(a[integrator], b[integrator])
 
 
+@pytest.mark.slow
 def test_unit_masses_given_as_an_array_divide_by_one():
     """M_i = 1 divides by 1, which changes no bit: the chain of unit masses."""
     p = _params("end-state-constant-free", 10, seed=1)

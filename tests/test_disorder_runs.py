@@ -97,6 +97,7 @@ def test_bench_disordered_reports_both_chains_in_one_run(monkeypatch, capsys):
     assert out["disordered"]["exact_block_updates"] == long.summary["block_updates"]
 
 
+@pytest.mark.slow
 def test_a_chain_without_a_closed_form_steady_state_runs_and_says_so():
     """Per-block alpha gives each block its own theta_0 = 1 - alpha_i V, which the diffusion D = 5
     couples: no closed-form steady sliding, so the run's L_steady is NaN, not an error."""

@@ -26,7 +26,7 @@ def _rest(p, seed=1):
 @pytest.mark.parametrize(
     "over, t_end",
     [
-        ({"drive": "constant-force", "friction": "strengthening", "F": 3.2}, 200.0),
+        pytest.param({"drive": "constant-force", "friction": "strengthening", "F": 3.2}, 200.0, marks=pytest.mark.slow),
         ({"drive": "constant-force", "friction": "state", "F": 3.1, "D": 1.0, "beta": 0.5}, 200.0),
         ({"drive": "force-ramp", "friction": "strengthening", "F_start": 2.0, "r": 0.01}, 300.0),
         ({"drive": "force-ramp", "friction": "state", "F_start": 2.5, "r": 0.01, "D": 1.0}, 200.0),

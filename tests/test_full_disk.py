@@ -81,7 +81,17 @@ WRITES = [
 ]
 
 
-@pytest.mark.parametrize("command, name", WRITES, ids=[f"{c.split(' --')[0]}:{n}" for c, n in WRITES])
+def _writes():
+    """One file of each command in the default run, the others with -m slow (each a fresh run)."""
+    seen = set()
+    for command, name in WRITES:
+        first = command not in seen
+        seen.add(command)
+        marks = () if first else pytest.mark.slow
+        yield pytest.param(command, name, id=f"{command.split(' --')[0]}:{name}", marks=marks)
+
+
+@pytest.mark.parametrize("command, name", list(_writes()))
 def test_full_disk_is_one_line_and_exit_1(command, name, full_at, small_run, tmp_path, capsys):
     out = tmp_path / "out"
     argv = shlex.split(command.format(out=out, run=small_run))
@@ -131,7 +141,10 @@ CONTINUED = [
 ]
 
 
-@pytest.mark.parametrize("name, argv, n_points", CONTINUED, ids=[c[0] for c in CONTINUED])
+@pytest.mark.parametrize(
+    "name, argv, n_points",
+    [pytest.param(*c, id=c[0], marks=() if k == 0 else pytest.mark.slow) for k, c in enumerate(CONTINUED)],
+)
 def test_sweep_and_study_after_a_full_disk_continue(name, argv, n_points, full_at, tmp_path, monkeypatch, capsys):
     argv = [*argv, "--workers", "1", "--no-progress", "--json", "--out", str(tmp_path / "out")]
     full_at(name)

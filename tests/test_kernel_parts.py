@@ -29,7 +29,7 @@ print(*(len(k.signatures) for k in (exact.run_exact, plate.run_sparse, dense.run
     [
         # run_exact, run_sparse, run_dense, the plate's start steps (triggers._plate_triggers)
         ("sakaguchi", "1 0 0 0"),
-        ("carlson-langer", "0 1 0 0"),
+        pytest.param("carlson-langer", "0 1 0 0", marks=pytest.mark.slow),
     ],
 )
 def test_a_run_compiles_only_what_its_model_uses(model, compiled, tmp_path):

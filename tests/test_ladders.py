@@ -348,6 +348,7 @@ def test_up_ladder_agrees_with_paper_start_runs_at_n49(tmp_path):
         assert abs(c["z"]) < 3.0, c
 
 
+@pytest.mark.slow
 def test_chain_from_the_final_state_of_another_run(tmp_path):
     """`stickslip chain --from DIR` starts from a run directory's final state and goes on in time:
     run to 2000 then --from to 4000 ends where one run to 4000 from the same state does."""

@@ -560,6 +560,7 @@ def test_the_pieces_choose_lanes_or_loop():
     assert "llvm.masked.load" not in _stub_ir(RATE_STATE, mp_rs)
 
 
+@pytest.mark.slow
 def test_rate_state_chain_exact_equals_dense():
     """A law without lanes runs its loops in the exact integrator: same bits as the dense one."""
     p = ChainParams(N=5, K=5.0, friction="rate-state")

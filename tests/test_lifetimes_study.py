@@ -106,6 +106,7 @@ def test_bad_points_are_refused():
         lifetimes.check_point({**base, "start": "paper", "budget": -1.0})
 
 
+@pytest.mark.slow
 def test_tiny_lifetimes_study_end_to_end(tmp_path):
     spec = study("lifetimes", "tiny")
     first = run_study(spec, tmp_path, n_workers=1, progress=False)

@@ -76,8 +76,8 @@ def _plain_heun(x, v, th, p, n_steps):
     "params",
     [
         chain_params("sakaguchi", N=3, V=0.5),
-        chain_params("carlson-langer", N=4, V=0.5),
-        chain_params("train", N=3, V=0.5),
+        pytest.param(chain_params("carlson-langer", N=4, V=0.5), marks=pytest.mark.slow),
+        pytest.param(chain_params("train", N=3, V=0.5), marks=pytest.mark.slow),
     ],
     ids=["sakaguchi", "carlson-langer", "train"],
 )
@@ -136,7 +136,9 @@ ORDER_CASES = {
 }
 
 
-@pytest.mark.parametrize("name", list(ORDER_CASES))
+@pytest.mark.parametrize(
+    "name", [pytest.param(n, marks=pytest.mark.slow) if n == "batista-carlson" else n for n in ORDER_CASES]
+)
 def test_second_order_against_a_run_at_dt_over_16(name):
     params, t_end, start, amplitude, dts = ORDER_CASES[name]
     ref = run_located(params.replace(dt=dts[0] / 16), t_end, start=start, perturbation=amplitude)

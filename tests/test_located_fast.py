@@ -142,7 +142,7 @@ def test_calls_that_end_inside_events_and_a_full_event_buffer(name):
     assert np.array_equal(out["fast"][1], ev)
 
 
-@pytest.mark.parametrize("form", FORMS)
+@pytest.mark.parametrize("form", [pytest.param("fast", marks=pytest.mark.slow), "dense"])
 def test_switches_that_repeat_at_one_time_are_refused_not_looped(form):
     """Thresholds below the friction at v = 0+ (Fs_i < 1 - sigma): blocks 11 and 16 of this chain
     start, decelerate at once and stop, each restarting the other's step at a time 1e-123 later;

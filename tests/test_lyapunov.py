@@ -143,6 +143,7 @@ def test_sliding_block_ten_times_the_defaults():
     assert abs(res.lyapunov - exact) <= abs(heun - exact) + 3 * res.lyapunov_err
 
 
+@pytest.mark.slow
 def test_twin_runs_in_a_frame_moved_back_along_the_drive():
     from stickslip.analysis.dynamics.lyapunov import GridEngine
 

@@ -243,6 +243,7 @@ def test_parameters_and_composition():
     assert "rs_a" not in ChainParams().to_dict() and "rs_a" in _params().to_dict()
 
 
+@pytest.mark.slow
 def test_located_switches_run_the_law():
     """The located integrator's right-hand side is the law's, checked against the plain formulas
     above (friction sigma_n mu(|v|, theta); the aging law on stuck blocks too)."""

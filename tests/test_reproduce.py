@@ -117,7 +117,13 @@ def test_an_experiment_is_computed_once_and_reused(tmp_path):
     assert run_study(spec, tmp_path, n_workers=1, progress=False)["reused"] == 1
 
 
-@pytest.mark.parametrize("damage", ["summary edited", "file changed", "file deleted", "no checksums"])
+@pytest.mark.parametrize(
+    "damage",
+    [
+        "summary edited",
+        *(pytest.param(d, marks=pytest.mark.slow) for d in ("file changed", "file deleted", "no checksums")),
+    ],
+)
 def test_a_damaged_result_is_run_again(tmp_path, damage):
     spec, point = _one("slip-limit")
     run_study(spec, tmp_path, n_workers=1, progress=False)
@@ -247,6 +253,7 @@ def test_every_figure_is_drawn_with_png_pdf_and_data(tiny_run):
     assert html.count("data:image/png;base64,") == len(report["figures"])
 
 
+@pytest.mark.slow
 def test_second_call_reuses_every_result_and_only_redraws(tiny_run, monkeypatch):
     out, _ = tiny_run
 
@@ -287,6 +294,7 @@ def test_each_study_of_the_paper_has_its_page(tiny_run):
         assert "stickslip reproduce --tiny --out DIR" in page and "The paper&#39;s stated numbers" in page
 
 
+@pytest.mark.slow
 def test_a_failed_chain_run_is_named_and_run_again(tiny_run, tmp_path):
     import shutil
 

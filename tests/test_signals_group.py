@@ -76,7 +76,9 @@ def reference():
     return run_chain(ChainParams(N=399), T_END, integrator="exact").summary["state_sha256"]
 
 
-@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT], ids=["SIGTERM", "SIGINT"])
+@pytest.mark.parametrize(
+    "sig", [signal.SIGTERM, pytest.param(signal.SIGINT, marks=pytest.mark.slow)], ids=["SIGTERM", "SIGINT"]
+)
 def test_signal_to_the_process_group_of_a_sweep(sig, tmp_path, reference):
     out = tmp_path / "sweep"
     argv = [*SWEEP, "--out", str(out)]

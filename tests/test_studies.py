@@ -274,6 +274,7 @@ def _delta_star_by_hand(rows, seed):
     return min(hits) if hits else None
 
 
+@pytest.mark.slow
 def test_tiny_chaos_study_end_to_end(tmp_path, cluster):
     from stickslip import io
     from stickslip.analysis.dynamics.decorrelation import VERDICTS
@@ -526,6 +527,7 @@ def test_sizes_summary_fits_the_events_after_the_transient_only():
     assert few["n_events"] == 5 and math.isnan(few["tau"]) and few["error_note"].startswith("only 5 events")
 
 
+@pytest.mark.slow
 def test_tiny_exponents_study_draws_the_family_beside_fig8(tmp_path, cluster):
     """Carlson-Langer's slip sizes beside eq. (4) at beta = 0.2 (Fig. 8), drawn from the points'
     own runs: each panel's fit is its point's row (the same events after the same transient)."""

@@ -97,6 +97,7 @@ def test_foreign_files_refused_before_the_first_point(
     assert {p: p.read_bytes() for p in out.rglob("*") if p.is_file()} == before, "nothing written, nothing removed"
 
 
+@pytest.mark.slow
 def test_overwrite_removes_only_the_studys_own_files(tmp_path, finished, capsys):
     out = tmp_path / "out"
     shutil.copytree(finished, out)
@@ -209,7 +210,13 @@ DAMAGES = [
 ]
 
 
-@pytest.mark.parametrize("what, damage, why", DAMAGES, ids=[d[0] for d in DAMAGES])
+_DEFAULT_DAMAGES = {"summary missing", "state.nc truncated", "summary edited"}  # the rest: -m slow
+
+
+@pytest.mark.parametrize(
+    "what, damage, why",
+    [pytest.param(*d, id=d[0], marks=() if d[0] in _DEFAULT_DAMAGES else pytest.mark.slow) for d in DAMAGES],
+)
 def test_damaged_cached_point_runs_again(what, damage, why, tmp_path, finished):
     out = tmp_path / "out"
     shutil.copytree(finished, out)
