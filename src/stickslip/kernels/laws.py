@@ -313,6 +313,8 @@ def _drive_view(dp, drive):
     if mod is None:
         return None
     if hasattr(mod, "kernel_view"):
+        if hasattr(mod, "NUMBA_EXTENSIONS"):  # kernel_view's compiled form (stickslip.models.piece)
+            importlib.import_module(mod.NUMBA_EXTENSIONS)
         fn = mod.kernel_view
         return lambda dp, drive: fn(dp)
     return lambda dp, drive: dp

@@ -55,6 +55,9 @@ def _compile_module(module: types.ModuleType) -> dict[str, Any]:
 
         import stickslip.kernels  # noqa: F401  (the cache directory, before numba decorates)
 
+        if "NUMBA_EXTENSIONS" in namespace:  # a piece's own numba extensions (overloads), first
+            importlib.import_module(namespace["NUMBA_EXTENSIONS"])
+
         for name, waiting in pending.items():
             namespace[name] = numba_njit(**waiting.options)(waiting.fn)
     return namespace

@@ -30,28 +30,15 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from llvmlite import ir
-from numba import types
-from numba.extending import intrinsic, overload
 
 from stickslip.models.piece import Piece, kernel_params, njit
 
 READS = ("history",)
+#: Where :func:`entry`, :func:`columns` and :func:`kernel_view` get their compiled forms, imported
+#: when the piece's functions are compiled (numba is not loaded by importing the piece).
+NUMBA_EXTENSIONS = "stickslip.models.drive.history_numba"
 #: The kernels' parameters: the table of breakpoints, positions and velocities (3 x (m + 1)).
 Params = kernel_params(__name__, ("table",))
-
-
-@intrinsic
-def _read(typingctx, address, i):
-    """The float64 at ``address`` + 8 i (the table's memory, which the caller keeps alive)."""
-    if not (isinstance(address, types.Integer) and isinstance(i, types.Integer)):
-        return None
-
-    def codegen(context, builder, signature, args):
-        ptr = builder.inttoptr(args[0], ir.DoubleType().as_pointer())
-        return builder.load(builder.gep(ptr, [args[1]]))
-
-    return types.float64(address, i), codegen
 
 
 def entry(table, r, k):
@@ -60,27 +47,9 @@ def entry(table, r, k):
     return table[r, k] if hasattr(table, "shape") else None
 
 
-@overload(entry, inline="always")
-def _entry(table, r, k):
-    if isinstance(table, types.Array):
-        return lambda table, r, k: table[r, k]
-    if isinstance(table, types.BaseTuple):
-        return lambda table, r, k: _read(table[0], r * table[1] + k)
-    return None
-
-
 def columns(table):
     """The number of breakpoints m + 1 (the table's columns), of either form (:func:`entry`)."""
     return table.shape[1]
-
-
-@overload(columns, inline="always")
-def _columns(table):
-    if isinstance(table, types.Array):
-        return lambda table: table.shape[1]
-    if isinstance(table, types.BaseTuple):
-        return lambda table: table[1]
-    return None
 
 
 def kernel_view(dp):
@@ -91,14 +60,6 @@ def kernel_view(dp):
     reference counts a step, more than the lookup costs). The kernel's argument keeps the array
     alive; a table of any other layout stays an array."""
     return dp
-
-
-@overload(kernel_view, inline="always")
-def _kernel_view(dp):
-    table = dp.types[0] if isinstance(dp, types.BaseNamedTuple) else None
-    if isinstance(table, types.Array) and table.ndim == 2 and table.layout == "C" and table.dtype == types.float64:
-        return lambda dp: Params((dp.table.ctypes.data, np.int64(dp.table.shape[1])))
-    return lambda dp: dp
 
 
 @njit(cache=True, inline="always")
