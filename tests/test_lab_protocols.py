@@ -53,7 +53,7 @@ def test_cli_step_shs_and_outputs(capsys, tmp_path):
     d = _json(capsys, "lab", "step", *OPTS, "--V", "1,10", "--out", str(tmp_path / "step"))
     assert d["steps"][0]["mu_ss_closed_form"] == pytest.approx(0.6 - 0.005 * math.log(10.0), abs=1e-12)
     assert sorted(p.name for p in (tmp_path / "step").iterdir() if not p.name.startswith(".")) == [
-        "step.json", "step.nc", "step.pdf", "step.png",
+        "index.html", "step.json", "step.nc", "step.pdf", "step.png",
     ]  # fmt: skip
     d = _json(capsys, "lab", "shs", *OPTS[:-2], "--k", "1e-2", "--V", "10", "--holds", "10,100,1000")
     assert len(d["holds"]) == 3 and d["healing_rate"] > 0.0
@@ -74,6 +74,10 @@ def test_cli_fit_of_a_csv_record(capsys, tmp_path):
     assert d["parameters"]["a"]["value"] == pytest.approx(0.005, rel=2e-3)
     assert d["parameters"]["Dc"]["value"] == pytest.approx(10.0, rel=2e-3)
     assert (tmp_path / "fit" / "fit.nc").is_file() and (tmp_path / "fit" / "fit.png").is_file()
+    page = (tmp_path / "fit" / "index.html").read_text(encoding="utf-8")
+    for name in ("a", "b", "Dc"):  # the page's parameter table: value and standard error
+        p = d["parameters"][name]
+        assert f"<td>{name}</td><td>{p['value']:.4g}</td><td>{p['stderr']:.4g}</td>" in page
 
 
 @pytest.mark.parametrize(

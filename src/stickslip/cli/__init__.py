@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import re
+import shlex
 import sys
 import warnings
 
@@ -128,6 +129,7 @@ def main(argv: list[str] | None = None) -> int:
     args, extra = parser.parse_known_args(argv)
     if extra:  # refused by the command's own parser: its usage line, and its options to suggest from
         parser.commands[args.command].error(f"unrecognized arguments: {' '.join(extra)}")
+    args.command_line = "stickslip " + shlex.join(argv)  # quoted on the pages a command writes
     sub_command = getattr(args, "stability_command", None) or getattr(args, "lab_command", None)
     name = " ".join(v for v in (args.command, sub_command) if v)
     try:

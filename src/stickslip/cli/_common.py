@@ -396,10 +396,10 @@ OUT_FILES: dict[str, frozenset[str]] = {
     "stability chain": frozenset({"fig4.nc", "mode_growth.nc", "stability_chain.json"})
     | _figures("fig4", "mode_growth"),
     "hysteresis": frozenset({"hysteresis.nc", "hysteresis.json"}) | _figures("hysteresis"),
-    "lab step": frozenset({"step.nc", "step.json"}) | _figures("step"),
-    "lab shs": frozenset({"shs.nc", "shs.json"}) | _figures("shs"),
-    "lab fit": frozenset({"fit.nc", "fit.json", "posterior.nc"}) | _figures("fit", "posterior"),
-    "lab invert": frozenset({"invert.nc", "invert.json"}) | _figures("invert"),
+    "lab step": frozenset({"step.nc", "step.json", "index.html"}) | _figures("step"),
+    "lab shs": frozenset({"shs.nc", "shs.json", "index.html"}) | _figures("shs"),
+    "lab fit": frozenset({"fit.nc", "fit.json", "posterior.nc", "index.html"}) | _figures("fit", "posterior"),
+    "lab invert": frozenset({"invert.nc", "invert.json", "index.html"}) | _figures("invert"),
     "sweep": frozenset({"summary.parquet", "summary.csv"}),
     "reproduce": frozenset({"runs", *PAPER, "report.json", "report.html", MANIFEST}),
 }

@@ -74,7 +74,8 @@ def _model(args):
 
 def _out_options(p: argparse.ArgumentParser, stem: str) -> None:
     p.add_argument("--out", default=None, metavar="DIR",
-                   help=f"write {stem}.nc, {stem}.json and the figure {stem}.png/.pdf to DIR")  # fmt: skip
+                   help=f"write {stem}.nc, {stem}.json, the figure {stem}.png/.pdf and the page "
+                        "index.html to DIR")  # fmt: skip
     add_overwrite_option(p)
     add_json_option(p)
 
@@ -209,6 +210,16 @@ def _write(out: Path, stem: str, ds, data: dict, fig) -> list[str]:
     return [str(p) for p in written]
 
 
+def _page(args, out: Path, protocol: str, data: dict, lines: list[str], figures: list[str]) -> None:
+    """The run's page, ``out/index.html``, listed last in ``data["outputs"]``."""
+    from stickslip.report.lab_page import PAGE, write_lab_page
+
+    outputs = [*data["outputs"], str(out / PAGE)]
+    command = getattr(args, "command_line", f"stickslip lab {protocol}")
+    write_lab_page(out, protocol, data, command=command, statements=lines, figures=figures, outputs=outputs)
+    data["outputs"] = outputs
+
+
 def _netcdf_safe(ds):
     """Attributes NetCDF can hold: lists of numbers stay, anything else as text."""
     ds = ds.copy()
@@ -229,10 +240,17 @@ def run_step(args) -> Result:
         ds, data = _integration(
             velocity_step, model, args.V, displacement=args.displacement, rtol=args.rtol, method=args.method
         )
+        lines = _step_lines(data)
         if out is not None:
             from stickslip.plotting.lab import plot_step
 
             data["outputs"] = _write(out, "step", ds, data, plot_step(ds, data))
+            _page(args, out, "step", data, lines, ["step"])
+    lines += [f"wrote {p}" for p in data.get("outputs", [])]
+    return Result(data=data, text="\n".join(lines))
+
+
+def _step_lines(data: dict) -> list[str]:
     lines = [f"velocity steps {', '.join(f'{v:g}' for v in data['velocities'])}; k_c = {data['k_c']:.6g}"]
     for st in data["steps"]:
         lines.append(
@@ -240,8 +258,7 @@ def run_step(args) -> Result:
             f"peak {st['mu_peak']:.6f}, end {st['mu_end']:.6f} (mu_ss {st['mu_ss_closed_form']:.6f}); "
             f"a - b from the run {st['a_minus_b_from_run']:.5g}"
         )
-    lines += [f"wrote {p}" for p in data.get("outputs", [])]
-    return Result(data=data, text="\n".join(lines))
+    return lines
 
 
 def run_shs(args) -> Result:
@@ -255,10 +272,18 @@ def run_shs(args) -> Result:
         ds, data = _integration(
             slide_hold_slide, model, args.V, args.holds, slide=args.slide, rtol=args.rtol, method=args.method
         )
+        lines = _shs_lines(data)
         if out is not None:
             from stickslip.plotting.lab import plot_shs
 
             data["outputs"] = _write(out, "shs", ds, data, plot_shs(ds, data))
+            page_lines = [lines[0], *lines[len(data["holds"]) + 2 :]]  # the holds are the page's table
+            _page(args, out, "shs", data, page_lines, ["shs"])
+    lines += [f"wrote {p}" for p in data.get("outputs", [])]
+    return Result(data=data, text="\n".join(lines))
+
+
+def _shs_lines(data: dict) -> list[str]:
     lines = [f"slide-hold-slide at V = {data['V']:g}", "   t_hold     mu_peak    Delta mu   relaxation"]
     for r in data["holds"]:
         lines.append(f"{r['t_hold']:9.4g}  {r['mu_peak']:.6f}  {r['delta_mu']:.6f}  {r['relaxation']:.6f}")
@@ -274,8 +299,7 @@ def run_shs(args) -> Result:
                 else ""
             )
         )
-    lines += [f"wrote {p}" for p in data.get("outputs", [])]
-    return Result(data=data, text="\n".join(lines))
+    return lines
 
 
 def run_fit(args) -> Result:
@@ -323,7 +347,14 @@ def run_fit(args) -> Result:
                 written += save_figure(plot_posterior(post, res), out / "posterior")
             written.append(io.write_json(out / "fit.json", data))
             data["outputs"] = [str(p) for p in written]
-    lines = [f"fit of {len(records)} record(s), {res.n} samples, rms residual {res.rms:.3g}: {res.message}"]
+            figures = ["fit"] if post is None else ["fit", "posterior"]
+            _page(args, out, "fit", data, _fit_lines(res, data, len(records)), figures)
+    lines = _fit_lines(res, data, len(records)) + [f"wrote {p}" for p in data.get("outputs", [])]
+    return Result(data=data, text="\n".join(lines))
+
+
+def _fit_lines(res, data: dict, n_records: int) -> list[str]:
+    lines = [f"fit of {n_records} record(s), {res.n} samples, rms residual {res.rms:.3g}: {res.message}"]
     for name, v in data["parameters"].items():
         lines.append(f"  {name:>8} = {v['value']:.6g} +- {v['stderr']:.2g}")
     lines.append(f"CPU {res.cpu_seconds:.3g} s, {res.evaluations} model evaluations")
@@ -332,8 +363,7 @@ def run_fit(args) -> Result:
         for name, v in data["posterior"]["parameters"].items():
             lo, hi = v["interval_95"]
             lines.append(f"  {name:>8} = {v['mean']:.6g} +- {v['std']:.2g}  [{lo:.6g}, {hi:.6g}]")
-    lines += [f"wrote {p}" for p in data.get("outputs", [])]
-    return Result(data=data, text="\n".join(lines))
+    return lines
 
 
 def _cycles_csv(path: str):
@@ -385,14 +415,19 @@ def run_invert(args) -> Result:
             written += save_figure(plot_stick_slip(res), out / "invert")
             written.append(io.write_json(out / "invert.json", data_out))
             data_out["outputs"] = [str(p) for p in written]
+            _page(args, out, "invert", data_out, _invert_lines(res, data_out), ["invert"])
+    lines = _invert_lines(res, data_out) + [f"wrote {p}" for p in data_out.get("outputs", [])]
+    return Result(data=data_out, text="\n".join(lines))
+
+
+def _invert_lines(res, data: dict) -> list[str]:
     lines = [f"stick-slip inversion: {len(res.cycles)} cycles, chi2 {res.chi2:.3g} ({res.dof} dof): {res.message}"]
-    for name, o in data_out["observables"].items():
+    for name, o in data["observables"].items():
         lines.append(f"  {name:>15}: observed {o['observed']:.6g} +- {o['stderr']:.2g}, model {o['model']:.6g}")
-    for name, p in data_out["parameters"].items():
+    for name, p in data["parameters"].items():
         lines.append(f"  {name:>8} = {p['value']:.6g} +- {p['stderr']:.2g}")
     lines.append(f"CPU {res.cpu_seconds:.3g} s, {res.evaluations} model runs")
-    lines += [f"wrote {p}" for p in data_out.get("outputs", [])]
-    return Result(data=data_out, text="\n".join(lines))
+    return lines
 
 
 def run_bench(args) -> Result:
