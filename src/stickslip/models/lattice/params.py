@@ -43,6 +43,20 @@ class LatticeParams:
             raise AttributeError(name)
         return getattr(self.chain, name)
 
+    def replace(self, **changes: Any) -> LatticeParams:
+        """The same lattice with some of the model's fields changed (validated again, as
+        :meth:`ChainParams.replace <stickslip.models.params._Validated.replace>` does, and against
+        the lattice as :func:`on_lattice` does); N is the lattice's, so it is refused here."""
+        if "N" in changes:
+            raise ParameterError("N of a model on a lattice is its shape's: give the lattice a new shape instead")
+        chain = self.chain.replace(**changes)
+        if chain.drive_piece is self.chain.drive_piece and chain.ends == self.chain.ends and "K" not in changes:
+            return LatticeParams(chain, self.lattice)
+        return on_lattice(chain, self.lattice.name, self.lattice.shape, self._edges())
+
+    def _edges(self) -> dict[str, str] | None:
+        return self.to_dict().get("edges")
+
     def leaf(self) -> float | np.ndarray:
         """The stiffness of the spring joining every block to the drive: the drive's ``leaf``
         (a plate's Kp; 0 for an edge drive and a force), a float, or the values over (row, col)
