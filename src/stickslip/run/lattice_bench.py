@@ -164,6 +164,7 @@ def one_size(
         "ns_per_block_update": 1e9 * net / updates if updates > 0 else None,
         "ns_per_area": 1e9 * net / area if area else None,
         "block_updates_per_event": updates / n if n else None,
+        "triggers_per_event": (run.summary["triggers"] - one.summary["triggers"]) / n if n else None,
         "block_updates_per_area": float(w["block_updates"].sum() / w["area"].sum()) if len(w) else None,
         "work_exponent_on_area": _slope(w["area"], w["block_updates"]),
         "area_bins": area_bins(w).to_dict(orient="records"),
