@@ -4,6 +4,8 @@ No timing is asserted."""
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
@@ -118,3 +120,13 @@ def test_the_command_refuses_in_one_line(argv, says, capsys):
     assert main(["bench", *argv]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and says in err, err
+
+
+def test_the_command_prints_the_table_and_its_json(capsys):
+    argv = ["bench", "--model", "carlson-langer", "--lattice", "square", "--workload", "events", "--sizes", "8,6"]
+    assert main([*argv, "--repeat", "1", "--json"]) == 0
+    r = json.loads(capsys.readouterr().out)
+    assert [s["L"] for s in r["sizes"]] == [6, 8]
+    assert r["V64"] == 1e-6 and r["loading_times"] == lb.EVENTS["loading_times"]
+    assert all(s["events"] > 0 and s["block_updates"] > 0 for s in r["sizes"])
+    assert set(r["exponents"]) >= {"block_updates_per_event_on_area", "seconds_per_event_on_L"}
