@@ -86,12 +86,14 @@ def register(sub) -> None:
     )
     b.add_argument(
         "--workload",
-        choices=("default", "partly-stuck", "disordered"),
+        choices=("default", "partly-stuck", "disordered", "events"),
         default="default",
         help="partly-stuck: the paper's chain loading at beta = 1.3 with part of its blocks stuck "
         "(N, beta and t-end as given, else 199, 1.3 and 1e4 after a prepared 4e5); disordered: the "
         "chain with per-block values (as given, else Fs uniform(2.5, 3.5) and beta 10%% normal) "
-        "against the same chain with their means, time per block update (N 199, t-end 2e4)",
+        "against the same chain with their means, time per block update (N 199, t-end 2e4); events "
+        "(with --lattice square): the exact path's cost per slip event against its area on L x L "
+        "squares of --sizes, under a plate slow enough to keep the events apart",
     )
     b.add_argument(
         "--profile", action="store_true", help="instead: where the exact integrator spends its time on this workload"
@@ -493,6 +495,8 @@ def run_bench_command(args: argparse.Namespace) -> Result:
 
     if wants_lattice(args):
         return run_lattice_bench_command(args)
+    if args.workload == "events" or args.sizes is not None:
+        raise CommandError("--workload events and --sizes go with --lattice square")
     if args.repeat is None:
         # A short timing is the noisier one: the partly stuck workload's exact run takes about 0.25 s.
         args.repeat = 3 if args.workload in ("partly-stuck", "disordered") else 1

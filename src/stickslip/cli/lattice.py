@@ -50,6 +50,12 @@ def add_lattice_options(p: argparse.ArgumentParser, *, bench: bool = False, run:
             help="with --lattice square: run exact from rest to T first, then time both over --t-end "
             "(default: two loading times 2 / V for a plate drive, at V = 0.001 unless given; else 0)",
         )
+        g.add_argument(
+            "--sizes",
+            default=None,
+            metavar="L,L,...",
+            help="with --workload events: the sizes L of the L x L squares (default 64,128,256)",
+        )
         return g
     g.add_argument(
         "--snapshot-every",
@@ -222,6 +228,10 @@ def run_lattice_bench_command(args: argparse.Namespace) -> Result:
     over 100."""
     from stickslip.run.lattice import SLOW_LOADING, bench_lattice
 
+    if args.workload == "events":
+        return _event_cost(args)
+    if args.sizes is not None:
+        raise CommandError("--sizes goes with --workload events")
     for name, option in (("profile", "--profile"), ("workload", "--workload"), ("switches", "--switches")):
         if getattr(args, name, None) not in (None, False, "default", "grid"):
             raise CommandError(f"{option} is not yet available with --lattice {args.lattice}")
@@ -250,6 +260,39 @@ def run_lattice_bench_command(args: argparse.Namespace) -> Result:
         )
     text += f"\n{r['events']} events, mean area {r['event_area_mean']:.4g} blocks"
     return Result(result, text)
+
+
+def _event_cost(args: argparse.Namespace) -> Result:
+    """`stickslip bench --lattice square --workload events`: the exact path's cost per slip event
+    against its area on L x L squares (:func:`stickslip.run.lattice_bench.event_cost`); the model's
+    V (--V, --nu) is the plate's at L = 64, unless given :data:`~stickslip.run.lattice_bench.EVENTS`'s."""
+    import sys
+
+    from stickslip.run.lattice_bench import EVENTS, event_cost, format_event_cost
+
+    for name, option in (("shape", "--shape"), ("t_prepare", "--t-prepare"), ("t_end", "--t-end")):
+        if getattr(args, name, None) is not None:
+            raise CommandError(f"{option} is not read by --workload events (it sets its own; --sizes sets L)")
+    for name, option in (("profile", "--profile"), ("switches", "--switches"), ("start", "--start")):
+        if getattr(args, name, None) not in (None, False, "grid"):
+            raise CommandError(f"{option} is not available with --workload events")
+    try:
+        sizes = [int(text) for text in (args.sizes or ",".join(map(str, EVENTS["sizes"]))).split(",")]
+    except ValueError:
+        raise CommandError(f"--sizes must be sizes L in [4, 4096] separated by commas (got {args.sizes!r})") from None
+    if not sizes or not all(4 <= L <= 4096 for L in sizes):
+        raise CommandError(f"--sizes must be sizes L in [4, 4096] separated by commas (got {args.sizes!r})")
+    given_v = getattr(args, "param_V", None) is not None or getattr(args, "param_nu", None) is not None
+    args = argparse.Namespace(**{**vars(args), "shape": f"{sizes[0]}x{sizes[0]}"})
+    params = lattice_params_from_args(args)
+    v64 = params.V if given_v else EVENTS["V64"]
+
+    def say(line: str) -> None:
+        sys.stderr.write(f"stickslip bench: {line}\n")
+        sys.stderr.flush()
+
+    result = event_cost(params, sizes, v64=v64, repeat=args.repeat or EVENTS["repeat"], say=say)
+    return Result(result, format_event_cost(result))
 
 
 def run_stability_lattice(args: argparse.Namespace) -> Result:

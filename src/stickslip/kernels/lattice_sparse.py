@@ -25,7 +25,8 @@ clear (a block's ``mark`` is the step whose candidate list holds it). These are 
 A stopped block that leaves the candidates gets its trigger: the first step at which its force,
 evaluated with the step's own expression (the drive's ``force_lap`` on its Laplacian, which no
 longer changes, and the load point p(t_m)), exceeds its threshold: non-decreasing in m for a load
-point that never moves back, so an exponential then binary search finds it exactly. Triggers wait
+point that never moves back, so the chain's start-step search
+(:func:`stickslip.kernels.triggers.first_start`) finds it exactly. Triggers wait
 in a heap; when no block is a candidate the run jumps to the earliest. An event's epicentre is the
 smallest flat index among the blocks that start it (dense's row-major order), and its extent sums
 the moved blocks' slips in that order too.
@@ -68,6 +69,7 @@ from stickslip.kernels.layout import (
     STEP,
     STEPS_COMPUTED,
 )
+from stickslip.kernels.triggers import HORIZON, first_start
 
 # Indices of the sparse path's own int64 bookkeeping ``book``.
 B_N_CAND = 0  # candidates of the next step, in ``cand``
@@ -145,55 +147,22 @@ def _rebuild(ht, hk, trig, geo):
 
 
 @njit(cache=True, inline="always")
-def _fires(lap, xk, thr, K, V, dt, dp, m, drive, k):
-    return call(drive, "force_lap", lap, xk, K, _pull(V, m, dt, dp, drive), at(dp, k)) > thr
+def force_at(fa, m, drive):
+    """The force on block k at step m, the step's own expression (the drive's ``force_lap`` on
+    its Laplacian ``lap``), ``fa`` = (lap, x_k, K, V, dt, the drive's parameters, k)."""
+    lap, xk, K, V, dt, dp, k = fa
+    return call(drive, "force_lap", lap, xk, K, _pull(V, m, dt, dp, drive), at(dp, k))
 
 
 @njit(cache=True)
 def _trigger(lap, xk, thr, K, V, dt, dp, n0, drive, k):
     """First step m >= n0 at which a stopped block of Laplacian ``lap`` starts (its force, the
-    step's own expression, exceeds ``thr``), else _NEVER. The force is non-decreasing in m; a
-    first guess from its rate per step (the leaf spring's Kp V dt) is bracketed by galloping
-    from it, then bisected, so the answer is exact whatever the guess."""
-    if _fires(lap, xk, thr, K, V, dt, dp, n0, drive, k):
-        return n0
-    lo = n0  # does not fire
-    hi = _NEVER  # fires (none found yet)
+    step's own expression, exceeds ``thr``), else _NEVER: the chain's start-step search
+    (:func:`stickslip.kernels.triggers.first_start`) on the lattice's force, up to its horizon
+    (a trigger outlives the kernel's call, so the run's end does not bound it)."""
     rate = call(drive, "leaf", at(dp, k)) * V * dt
-    if rate > 0.0:
-        f0 = call(drive, "force_lap", lap, xk, K, _pull(V, n0, dt, dp, drive), at(dp, k))
-        guess = (thr - f0) / rate
-        if guess < 1e17:
-            g = n0 + 1 + np.int64(guess)
-            if _fires(lap, xk, thr, K, V, dt, dp, g, drive, k):
-                hi = g
-                step = np.int64(1)
-                while hi - step > lo:
-                    if not _fires(lap, xk, thr, K, V, dt, dp, hi - step, drive, k):
-                        lo = hi - step
-                        break
-                    hi -= step
-                    step *= 2
-            else:
-                lo = g
-    if hi == _NEVER:
-        step = np.int64(1)
-        while True:
-            probe = lo + step
-            if probe > np.int64(1) << np.int64(61):
-                return _NEVER
-            if _fires(lap, xk, thr, K, V, dt, dp, probe, drive, k):
-                hi = probe
-                break
-            lo = probe
-            step *= 2
-    while hi - lo > 1:
-        mid = lo + (hi - lo) // 2
-        if _fires(lap, xk, thr, K, V, dt, dp, mid, drive, k):
-            hi = mid
-        else:
-            lo = mid
-    return hi
+    t = first_start("stickslip.kernels.lattice_sparse", (lap, xk, K, V, dt, dp, k), drive, thr, rate, n0, HORIZON + 1)
+    return _NEVER if t == HORIZON + 1 else t
 
 
 @njit(cache=True)

@@ -12,7 +12,8 @@ seen from the drive), for the fast integrators' jumps over steps in which nothin
   comparing the step with these numbers.
 
 Each answer is exact: a bisection on the very expression the step evaluates, not a solved
-inequality.
+inequality. The plate's search is :func:`first_start`, which the lattice's active-set path
+(:mod:`stickslip.kernels.lattice_sparse`) shares with its own expression for the force.
 """
 
 from __future__ import annotations
@@ -47,51 +48,79 @@ def _first_trigger(x, N, V, dt, K, thr, n_lo, n_hi, dp, drive, ends):
     return lo
 
 
-@njit(cache=True, inline="always")
-def _plate_fires(xl, xc, xr, thr, K, dp, V, dt, m, drive, i):
-    return _force(xl, xc, xr, K, dp, _pull(V, m, dt, dp, drive), drive, i) > thr
+#: The latest step :func:`first_start` looks at where the caller has no end of its own (the
+#: lattice's triggers outlive a call of its kernel): a trigger later than this is ``_NEVER``.
+HORIZON = np.int64(1) << np.int64(61)
 
 
 @njit(cache=True)
-def _plate_trigger(xl, xc, xr, thr, K, dp, V, dt, n0, n_cap, drive, i):
-    """Plate drive: first step m in [n0, n_cap) at which a stopped block with neighbours xl, xr
-    starts (f > thr), else n_cap.
+def first_start(form, fa, drive, thr, rate, n0, n_cap):
+    """The start-step search of every exact path (docs/model.md, the start rule): the first step
+    m in [n0, n_cap) at which a stopped block starts, ``force_at(fa, m, drive) > thr``, else
+    n_cap; ``force_at`` is the step's own expression for the block's force at step m (the
+    chain's from its two neighbours, the lattice's from its Laplacian), the function of that name
+    in the module ``form`` (a literal import path, resolved when the kernel is compiled, as the
+    pieces' functions are), ``fa`` its operands.
 
-    The force, evaluated with the step's own expression, is non-decreasing in m for V, Kp >= 0;
-    a first guess from its rate Kp V dt is refined by bisection, so the answer is exact.
+    That force is non-decreasing in m (the load point never moves back, every rounding is
+    monotone), so the first firing step is found exactly: a guess from its rate per step
+    ``rate`` (the leaf spring's Kp V dt) is bracketed by galloping from it (one step either way
+    when the guess is right, as it nearly always is), then bisected.
     """
     if n0 >= n_cap:
         return n_cap
-    if _plate_fires(xl, xc, xr, thr, K, dp, V, dt, n0, drive, i):
+    f0 = call(form, "force_at", fa, n0, drive)
+    if f0 > thr:
         return n0
-    if not _plate_fires(xl, xc, xr, thr, K, dp, V, dt, n_cap - 1, drive, i):
+    if not call(form, "force_at", fa, n_cap - 1, drive) > thr:
         return n_cap
     lo = n0  # does not fire
     hi = n_cap - 1  # fires
-    f0 = _force(xl, xc, xr, K, dp, _pull(V, n0, dt, dp, drive), drive, i)
-    rate = call(drive, "leaf", at(dp, i)) * V * dt
     if rate > 0.0:
         guess = (thr - f0) / rate
         if guess < np.float64(hi - lo):
             g = lo + 1 + np.int64(guess)
             if g < hi:
-                if _plate_fires(xl, xc, xr, thr, K, dp, V, dt, g, drive, i):
+                step = np.int64(1)
+                if call(form, "force_at", fa, g, drive) > thr:
                     hi = g
-                    if not _plate_fires(xl, xc, xr, thr, K, dp, V, dt, g - 1, drive, i):
-                        return g
-                    hi = g - 1
+                    while hi - step > lo:
+                        if not call(form, "force_at", fa, hi - step, drive) > thr:
+                            lo = hi - step
+                            break
+                        hi -= step
+                        step *= 2
                 else:
                     lo = g
-                    if _plate_fires(xl, xc, xr, thr, K, dp, V, dt, g + 1, drive, i):
-                        return g + 1
-                    lo = g + 1
+                    while lo + step < hi:
+                        if call(form, "force_at", fa, lo + step, drive) > thr:
+                            hi = lo + step
+                            break
+                        lo += step
+                        step *= 2
     while hi - lo > 1:
         mid = lo + (hi - lo) // 2
-        if _plate_fires(xl, xc, xr, thr, K, dp, V, dt, mid, drive, i):
+        if call(form, "force_at", fa, mid, drive) > thr:
             hi = mid
         else:
             lo = mid
     return hi
+
+
+@njit(cache=True, inline="always")
+def force_at(fa, m, drive):
+    """The chain's force on block i at step m, the step's own expression (eq. 4 with the drive's
+    term), ``fa`` = (x_{i-1}, x_i, x_{i+1}, K, the drive's parameters, V, dt, i)."""
+    xl, xc, xr, K, dp, V, dt, i = fa
+    return _force(xl, xc, xr, K, dp, _pull(V, m, dt, dp, drive), drive, i)
+
+
+@njit(cache=True)
+def _plate_trigger(xl, xc, xr, thr, K, dp, V, dt, n0, n_cap, drive, i):
+    """Plate drive: first step m in [n0, n_cap) at which a stopped block with neighbours xl, xr
+    starts (f > thr), else n_cap: :func:`first_start` on the chain's force."""
+    rate = call(drive, "leaf", at(dp, i)) * V * dt
+    return first_start("stickslip.kernels.triggers", (xl, xc, xr, K, dp, V, dt, i), drive, thr, rate, n0, n_cap)
 
 
 @njit(cache=True)
