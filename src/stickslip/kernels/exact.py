@@ -331,26 +331,9 @@ def run_exact(args, drive, friction, threshold, ends):
                     last = rb0
                     if fl < ra0:
                         f_, l_, starts = _stage1(
-                            x,
-                            v,
-                            th,
-                            mov,
-                            xs,
-                            vs,
-                            ths,
-                            mm,
-                            a1,
-                            b1,
-                            fl,
-                            ra0 - 1,
-                            p1,
-                            q1,
-                            mp,
-                            dt,
-                            drive,
-                            friction,
+                            x, v, th, mov, xs, vs, ths, mm, a1, b1, fl, ra0 - 1, p1, q1, mp, dt, drive, friction,
                             threshold,
-                        )
+                        )  # fmt: skip
                         if f_ <= l_:
                             first = f_
                     # Over whole groups of 8 blocks, with no masked or scalar rest: the up to 7
@@ -374,26 +357,9 @@ def run_exact(args, drive, friction, threshold, ends):
                         fh = rb0
                     elif rb0 < fh:
                         f_, l_, s_ = _stage1(
-                            x,
-                            v,
-                            th,
-                            mov,
-                            xs,
-                            vs,
-                            ths,
-                            mm,
-                            a1,
-                            b1,
-                            rb0 + 1,
-                            fh,
-                            p1,
-                            q1,
-                            mp,
-                            dt,
-                            drive,
-                            friction,
+                            x, v, th, mov, xs, vs, ths, mm, a1, b1, rb0 + 1, fh, p1, q1, mp, dt, drive, friction,
                             threshold,
-                        )
+                        )  # fmt: skip
                         starts |= s_
                         if f_ <= l_:
                             last = l_
