@@ -6,11 +6,12 @@ Nagata law),
 with mu the regularised (asinh) rate-and-state law and no static threshold (docs/lab.md, "The
 inertial route"): the chain of eq. (4) at N = 1, drive ``history``, friction ``rate-state`` (or
 ``rate-state-slip``, ``rate-state-prz``, ``rate-state-nagata``), threshold ``none``, sigma_n = 1 so
-that its K is the lab's k and its M is the mass per unit normal stress. The run is the chain's own (:class:`stickslip.run.driver.Stepper`,
-the exact integrator at a fixed step dt); this module only starts it and reads x and v at the
-sample times, where the spring's friction is k (p(t) - x). Below the critical stiffness
-k_c = (b - a) / D_c (1 + M V^2 / (a D_c)) (Rice and Ruina 1983) steady sliding is unstable and the
-block settles into stick-slip cycles, whose observables :mod:`stickslip.lab.cycles` measures.
+that its K is the lab's k and its M is the mass per unit normal stress. The run is the chain's
+own (:class:`stickslip.run.driver.Stepper`, the exact integrator at a fixed step dt); this module
+only starts it and reads x and v at the sample times, where the spring's friction is
+k (p(t) - x). Below the critical stiffness k_c = (b - a) / D_c (1 + M V^2 / (a D_c)) (Rice and
+Ruina 1983) steady sliding is unstable and the block settles into stick-slip cycles, whose
+observables :mod:`stickslip.lab.cycles` measures.
 """
 
 from __future__ import annotations
