@@ -166,11 +166,13 @@ def test_with_c_zero_it_is_the_aging_law_bit_for_bit():
 
 def test_dense_and_exact_bit_for_bit_and_steady_sliding_stays():
     # a chain past a group of eight lanes (the exact path's run stages), in stick-slip with stuck
-    # blocks; the plate drive; a load history with a hold and threshold none
+    # blocks; the plate drive; springs per bond; a load history with a hold and threshold none
     hist = LoadHistory.steps([1e-3, 0.0, 3e-3], [100.0, 50.0, 150.0])
     cases = [
         (ChainParams(N=12, K=5.0, friction=LAW, dt=0.002), 400.0),
         (ChainParams(N=9, K=5.0, friction=LAW, dt=0.002, drive="plate", Kp=0.3, rs_c=0.7), 300.0),
+        # springs per bond and masses per block (the stress rate reads K_i and K_i+1)
+        (ChainParams(N=6, K=np.linspace(4.0, 6.0, 6), M=np.linspace(0.8, 1.2, 6), friction=LAW, dt=0.002), 300.0),
         (chain_params("sakaguchi", N=10, K=5.0, friction=LAW, dt=0.002, drive="history", history=hist,
                       threshold="none", V=3e-3), 300.0),
     ]  # fmt: skip
