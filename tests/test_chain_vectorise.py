@@ -61,19 +61,20 @@ def _example_args(name: str) -> tuple:
     name = name.removesuffix("_loop").removesuffix("_lanes")
     a = [np.linspace(0.5, 1.5, 12) for _ in range(10)]
     lo, hi = 1, 10
-    dt, p = 0.005, 0.0
+    dt, p, q = 0.005, 0.0, 0.0
     # The paper's model: K, the end drive, the threshold's Fs, eq. (4)'s law (beta, alpha, D), unit masses;
     # pieces as literals (their modules' paths).
     mp = (10.0, end_drive.Params(), constant_threshold.Params(3.0), state_law.Params(1.0, 1.0, 5.0), None)
     end, state, constant = end_drive.__name__, state_law.__name__, constant_threshold.__name__
     return {
-        "_stage1": (*a, lo, hi, p, mp, dt, end, state, constant),
-        "_stage2": (*a, lo, hi, p, mp, 0.5 * dt, end, state),
-        "_stage1_theta": (*a[:8], lo, hi, mp, dt, state),
-        "_stage1_theta_only": (*a[:4], lo, hi, mp, dt, state),
-        "_stage2_theta": (*a[:4], lo, hi, mp, 0.5 * dt, state),
-        "_stage1_run": (*a[:8], lo, hi, p, mp, dt, end, state),
-        "_stage2_run": (*a[:8], lo, hi, p, mp, 0.5 * dt, end, state),
+        # q: the drive's velocity, read by a law with a context only (0.0 in the engine otherwise)
+        "_stage1": (*a, lo, hi, p, q, mp, dt, end, state, constant),
+        "_stage2": (*a, lo, hi, p, q, mp, 0.5 * dt, end, state),
+        "_stage1_theta": (*a[:8], lo, hi, q, mp, dt, end, state),
+        "_stage1_theta_only": (*a[:4], lo, hi, q, mp, dt, end, state),
+        "_stage2_theta": (*a[:5], lo, hi, q, mp, 0.5 * dt, end, state),
+        "_stage1_run": (*a[:8], lo, hi, p, q, mp, dt, end, state),
+        "_stage2_run": (*a[:8], lo, hi, p, q, mp, 0.5 * dt, end, state),
     }[name]
 
 

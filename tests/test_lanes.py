@@ -255,11 +255,11 @@ _GUARD_SCRIPT = textwrap.dedent(
 
     @numba.njit
     def run(x, v, th, xs, vs, ths, mm, a1, b1, lo, hi):
-        stages._stage1_run_lanes(x, v, th, xs, vs, ths, a1, b1, lo, hi, 0.0, mp, 0.005, END, STATE)
-        s = stages._stage2_run_lanes(x, v, th, xs, vs, ths, a1, b1, lo, hi, 0.0, mp, 0.0025, END, STATE)
-        stages._stage1_theta_lanes(x, v, th, xs, vs, ths, mm, b1, lo, hi, mp, 0.005, STATE)
-        stages._stage1_theta_only_lanes(v, th, ths, b1, lo, hi, mp, 0.005, STATE)
-        c = stages._stage2_theta_lanes(th, ths, v, b1, lo, hi, mp, 0.0025, STATE)
+        stages._stage1_run_lanes(x, v, th, xs, vs, ths, a1, b1, lo, hi, 0.0, 0.0, mp, 0.005, END, STATE)
+        s = stages._stage2_run_lanes(x, v, th, xs, vs, ths, a1, b1, lo, hi, 0.0, 0.0, mp, 0.0025, END, STATE)
+        stages._stage1_theta_lanes(x, v, th, xs, vs, ths, mm, b1, lo, hi, 0.0, mp, 0.005, END, STATE)
+        stages._stage1_theta_only_lanes(v, th, ths, b1, lo, hi, 0.0, mp, 0.005, END, STATE)
+        c = stages._stage2_theta_lanes(th, ths, v, vs, b1, lo, hi, 0.0, mp, 0.0025, END, STATE)
         return s, c
 
     N = 21
@@ -417,24 +417,32 @@ PAIRS = {
 
 
 def _wrapper(fn, n_arrays, with_drive, drive, friction):
-    """An njit function calling the stage ``fn`` with the pieces as literals."""
+    """An njit function calling the stage ``fn`` with the pieces as literals (and the drive's
+    velocity q = 0.0, which only a law with a context reads: the engine passes 0.0 to the others)."""
     if with_drive:
 
         @numba.njit
         def call(a, lo, hi, p, mp, dt):
-            return fn(a[0], a[1], a[2], a[3], a[4], a[5], a[6], a[7], lo, hi, p, mp, dt, drive, friction)
+            return fn(a[0], a[1], a[2], a[3], a[4], a[5], a[6], a[7], lo, hi, p, 0.0, mp, dt, drive, friction)
 
     elif n_arrays == 8:
 
         @numba.njit
         def call(a, lo, hi, p, mp, dt):
-            return fn(a[0], a[1], a[2], a[3], a[4], a[5], a[6], a[7], lo, hi, mp, dt, friction)
+            return fn(a[0], a[1], a[2], a[3], a[4], a[5], a[6], a[7], lo, hi, 0.0, mp, dt, drive, friction)
+
+    elif "stage2_theta" in fn.py_func.__name__:
+        # th, ths, v, vs (unread without a context: v in its place), b1
+
+        @numba.njit
+        def call(a, lo, hi, p, mp, dt):
+            return fn(a[0], a[1], a[2], a[2], a[3], lo, hi, 0.0, mp, dt, drive, friction)
 
     else:
 
         @numba.njit
         def call(a, lo, hi, p, mp, dt):
-            return fn(a[0], a[1], a[2], a[3], lo, hi, mp, dt, friction)
+            return fn(a[0], a[1], a[2], a[3], lo, hi, 0.0, mp, dt, drive, friction)
 
     return call
 
@@ -538,7 +546,7 @@ def test_stage_as_lanes_equals_its_loop_bit_for_bit(name, pieces):
 def _stub_ir(friction: str, mp) -> str:
     @numba.njit
     def call(th, ths, v, b1, lo, hi, mp, h2):
-        return stages._stage2_theta(th, ths, v, b1, lo, hi, mp, h2, friction)
+        return stages._stage2_theta(th, ths, v, v, b1, lo, hi, 0.0, mp, h2, END, friction)
 
     a = np.linspace(0.1, 0.9, 20)
     call(a, a.copy(), a.copy(), a.copy(), 1, 18, mp, 0.0025)

@@ -8,7 +8,18 @@ from __future__ import annotations
 from numba import njit
 
 from stickslip.kernels.events import _end_event, _overflow, _service, _start_and_first_moves, _trace
-from stickslip.kernels.laws import NO_CARRY, _accel, _dtheta, _force, _set_ghosts, _threshold, drive_view, pull_carried
+from stickslip.kernels.laws import (
+    NO_CARRY,
+    _accel,
+    _dtheta_in,
+    _force,
+    _set_ghosts,
+    _threshold,
+    drive_view,
+    load_rate,
+    pull_carried,
+    set_velocity_ghosts,
+)
 from stickslip.kernels.layout import (
     _BIG,
     BAD_BLOCK,
@@ -66,7 +77,9 @@ def run_dense(args, drive, friction, threshold, ends):
         if ist[EV_COUNT] >= cap_ev or ist[FM_COUNT] + N > cap_fm or (profile_every > 0 and ist[P_COUNT] + 2 > cap_p):
             return _overflow(ist, N, cap_ev, cap_fm)
         p1, carry = pull_carried(V, n, dt, dp, drive, carry)
+        q1 = load_rate(V, n, dt, dp, drive, carry, friction)  # 0.0 unless the law reads the stress rate
         _set_ghosts(x, th, N, p1, drive, ends)
+        set_velocity_ghosts(v, N, q1, drive, ends, friction)
         for i in range(1, N + 1):
             f = _force(x[i - 1], x[i], x[i + 1], K, dp, p1, drive, i)
             if mov[i] != 0.0 or f > _threshold(th[i], tp, threshold, i):
@@ -74,19 +87,21 @@ def run_dense(args, drive, friction, threshold, ends):
             else:
                 mm[i] = 0.0
             a1[i] = _accel(f, th[i], v[i], mm[i], mp, friction, i)
-            b1[i] = _dtheta(th[i - 1], th[i], th[i + 1], v[i], mp, friction, i)
+            b1[i] = _dtheta_in(th[i - 1], th[i], th[i + 1], v[i], v, q1, mp, drive, friction, i)
             xs[i] = x[i] + dt * v[i]
             vs[i] = v[i] + dt * a1[i]
             ths[i] = th[i] + dt * b1[i]
         p2, carry = pull_carried(V, n + 1, dt, dp, drive, carry)
+        q2 = load_rate(V, n + 1, dt, dp, drive, carry, friction)
         _set_ghosts(xs, ths, N, p2, drive, ends)
+        set_velocity_ghosts(vs, N, q2, drive, ends, friction)
         _start_and_first_moves(n, 1, N, x, mm, first_step, x0ev, ist, prof_x, prof_meta, N, profile_every)
         n_moving = 0
         bad = 0
         for i in range(1, N + 1):
             f2 = _force(xs[i - 1], xs[i], xs[i + 1], K, dp, p2, drive, i)
             a2 = _accel(f2, ths[i], vs[i], mm[i], mp, friction, i)
-            b2 = _dtheta(ths[i - 1], ths[i], ths[i + 1], vs[i], mp, friction, i)
+            b2 = _dtheta_in(ths[i - 1], ths[i], ths[i + 1], vs[i], vs, q2, mp, drive, friction, i)
             th[i] = th[i] + h2 * (b1[i] + b2)
             if mm[i] != 0.0:
                 x[i] = x[i] + h2 * (v[i] + vs[i])

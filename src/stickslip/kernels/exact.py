@@ -72,8 +72,10 @@ from stickslip.kernels.laws import (
     _threshold,
     drive_view,
     has,
+    load_rate,
     pull_carried,
     pull_peek,
+    set_velocity_ghosts,
 )
 from stickslip.kernels.layout import (
     _NEVER,
@@ -144,21 +146,25 @@ def _slide_steps(args, ra0, rb0, hi, mp, V, dt, drive, friction, threshold, ends
         ):
             return ra0, rb0, _NEVER
         p1, carry = pull_carried(V, n, dt, dp, drive, carry)
+        q1 = load_rate(V, n, dt, dp, drive, carry, friction)  # 0.0 unless the law reads the stress rate
         _set_ghosts(x, th, N, p1, drive, ends)
+        set_velocity_ghosts(v, N, q1, drive, ends, friction)
         if not every and _force(x[fh - 1], x[fh], x[fh + 1], K, dp, p1, drive, fh) > _threshold(
             th[fh], tp, threshold, fh
         ):
             return ra0, rb0, _NEVER  # block rb0+1 starts: run_exact's general step
-        _stage1_run(x, v, th, xs, vs, ths, a1, b1, ra0, rp, p1, mp, dt, drive, friction)
+        _stage1_run(x, v, th, xs, vs, ths, a1, b1, ra0, rp, p1, q1, mp, dt, drive, friction)
         if not every:
-            _stage1_theta(x, v, th, xs, vs, ths, mm, b1, fh, h1, mp, dt, friction)
+            _stage1_theta(x, v, th, xs, vs, ths, mm, b1, fh, h1, q1, mp, dt, drive, friction)
         p2, carry = pull_carried(V, n + 1, dt, dp, drive, carry)
+        q2 = load_rate(V, n + 1, dt, dp, drive, carry, friction)
         _set_ghosts(xs, ths, N, p2, drive, ends)
+        set_velocity_ghosts(vs, N, q2, drive, ends, friction)
         c_hi = rb0
         if has(friction, "has_state") and not every:
-            _, t_hi = _stage2_theta(th, ths, v, b1, fh, hi, mp, h2, friction)
+            _, t_hi = _stage2_theta(th, ths, v, vs, b1, fh, hi, q2, mp, h2, drive, friction)
             c_hi = t_hi if t_hi > rb0 else rb0
-        stops = _stage2_run(x, v, th, xs, vs, ths, a1, b1, ra0, rb0, p2, mp, h2, drive, friction)
+        stops = _stage2_run(x, v, th, xs, vs, ths, a1, b1, ra0, rb0, p2, q2, mp, h2, drive, friction)
         ist[FULL_UPDATES] += rb0
         ist[BLOCK_UPDATES] += hi
         ist[STEPS_COMPUTED] += 1
@@ -266,6 +272,12 @@ def run_exact(args, drive, friction, threshold, ends):
             elif n >= t_next:
                 ml, mh, t_next = due_plate_starts(mov, trig, n, ml, mh)
                 lo, hi = _merge(lo, hi, ml, mh)
+            if has(friction, "context"):
+                # The law reads the drive's velocity, which a load history changes at its
+                # breakpoints: block 1's state variable is updated at every step.
+                lo = 1
+                if hi < 1:
+                    hi = 1
             if has(threshold, "has_state"):
                 # A changing state variable moves the threshold itself.
                 ml, mh = _merge(ml, mh, lo, hi)
@@ -297,7 +309,9 @@ def run_exact(args, drive, friction, threshold, ends):
                 continue
 
             p1, carry = pull_carried(V, n, dt, dp, drive, carry)
+            q1 = load_rate(V, n, dt, dp, drive, carry, friction)  # 0.0 unless the law reads the stress rate
             _set_ghosts(x, th, N, p1, drive, ends)
+            set_velocity_ghosts(v, N, q1, drive, ends, friction)
             l1 = lo - 1 if lo > 1 else 1
             h1 = hi + 1 if hi < N else N
             # Stage 1: full over [ml, mh] within [l1, h1], state variable alone elsewhere.
@@ -317,15 +331,16 @@ def run_exact(args, drive, friction, threshold, ends):
                     last = rb0
                     if fl < ra0:
                         f_, l_, starts = _stage1(
-                            x, v, th, mov, xs, vs, ths, mm, a1, b1, fl, ra0 - 1, p1, mp, dt, drive, friction, threshold
-                        )
+                            x, v, th, mov, xs, vs, ths, mm, a1, b1, fl, ra0 - 1, p1, q1, mp, dt, drive, friction,
+                            threshold,
+                        )  # fmt: skip
                         if f_ <= l_:
                             first = f_
                     # Over whole groups of 8 blocks, with no masked or scalar rest: the up to 7
                     # blocks past the run get a moving block's values, which the stages below
                     # overwrite wherever stage 2 and the bookkeeping read them (measured: 2%).
                     rp = _run_padded(ra0, rb0, N)
-                    _stage1_run(x, v, th, xs, vs, ths, a1, b1, ra0, rp, p1, mp, dt, drive, friction)
+                    _stage1_run(x, v, th, xs, vs, ths, a1, b1, ra0, rp, p1, q1, mp, dt, drive, friction)
                     if not mm_run:
                         for i in range(ra0, rb0 + 1):
                             mm[i] = 1.0
@@ -342,40 +357,46 @@ def run_exact(args, drive, friction, threshold, ends):
                         fh = rb0
                     elif rb0 < fh:
                         f_, l_, s_ = _stage1(
-                            x, v, th, mov, xs, vs, ths, mm, a1, b1, rb0 + 1, fh, p1, mp, dt, drive, friction, threshold
-                        )
+                            x, v, th, mov, xs, vs, ths, mm, a1, b1, rb0 + 1, fh, p1, q1, mp, dt, drive, friction,
+                            threshold,
+                        )  # fmt: skip
                         starts |= s_
                         if f_ <= l_:
                             last = l_
                 else:
                     first, last, starts = _stage1(
-                        x, v, th, mov, xs, vs, ths, mm, a1, b1, fl, fh, p1, mp, dt, drive, friction, threshold
+                        x, v, th, mov, xs, vs, ths, mm, a1, b1, fl, fh, p1, q1, mp, dt, drive, friction, threshold
                     )
                 # Blocks that stay stopped: stage 2 reads the predictors and the mask only next to
                 # [fl, fh] (the neighbours of its movers), so farther blocks need their theta alone
                 # (on a ring, blocks 1 and N are neighbours: all of them).
-                if has(friction, "lanes"):
+                if has(friction, "lanes") or has(friction, "context"):
                     # As lanes one pass is cheaper than two, and the full stopped stage 1 is exact
-                    # for every one of these blocks (see stages._stage1_theta_loop).
+                    # for every one of these blocks (see stages._stage1_theta_loop). A law that
+                    # reads the stress rate reads every neighbour's predicted velocity in stage 2.
                     if l1 < fl:
-                        _stage1_theta(x, v, th, xs, vs, ths, mm, b1, l1, fl - 1, mp, dt, friction)
+                        _stage1_theta(x, v, th, xs, vs, ths, mm, b1, l1, fl - 1, q1, mp, dt, drive, friction)
                     if fh < h1:
-                        _stage1_theta(x, v, th, xs, vs, ths, mm, b1, fh + 1, h1, mp, dt, friction)
+                        _stage1_theta(x, v, th, xs, vs, ths, mm, b1, fh + 1, h1, q1, mp, dt, drive, friction)
                 else:
                     if l1 < fl:
                         a_ = l1 if has(ends, "ring") else fl - 1
                         if l1 < a_:
-                            _stage1_theta_only(v, th, ths, b1, l1, a_ - 1, mp, dt, friction)
-                        _stage1_theta(x, v, th, xs, vs, ths, mm, b1, a_, fl - 1, mp, dt, friction)
+                            _stage1_theta_only(v, th, ths, b1, l1, a_ - 1, q1, mp, dt, drive, friction)
+                        _stage1_theta(x, v, th, xs, vs, ths, mm, b1, a_, fl - 1, q1, mp, dt, drive, friction)
                     if fh < h1:
                         b_ = h1 if has(ends, "ring") else fh + 1
-                        _stage1_theta(x, v, th, xs, vs, ths, mm, b1, fh + 1, b_, mp, dt, friction)
+                        _stage1_theta(x, v, th, xs, vs, ths, mm, b1, fh + 1, b_, q1, mp, dt, drive, friction)
                         if b_ < h1:
-                            _stage1_theta_only(v, th, ths, b1, b_ + 1, h1, mp, dt, friction)
+                            _stage1_theta_only(v, th, ths, b1, b_ + 1, h1, q1, mp, dt, drive, friction)
+            elif has(friction, "context"):
+                _stage1_theta(x, v, th, xs, vs, ths, mm, b1, l1, h1, q1, mp, dt, drive, friction)
             elif has(friction, "has_state"):
-                _stage1_theta_only(v, th, ths, b1, l1, h1, mp, dt, friction)
+                _stage1_theta_only(v, th, ths, b1, l1, h1, q1, mp, dt, drive, friction)
             p2, carry = pull_carried(V, n + 1, dt, dp, drive, carry)
+            q2 = load_rate(V, n + 1, dt, dp, drive, carry, friction)
             _set_ghosts(xs, ths, N, p2, drive, ends)
+            set_velocity_ghosts(vs, N, q2, drive, ends, friction)
             # Only a block that starts in this step can move for the first time in an event.
             if (ist[EV_ACTIVE] == 1 and starts) or (ist[N_MOVING] == 0 and first <= last):
                 _start_and_first_moves(
@@ -396,18 +417,18 @@ def run_exact(args, drive, friction, threshold, ends):
                     # nothing the full stages write, and its short chain of dependent operations
                     # then overlaps their loops instead of holding up the bookkeeping (measured).
                     if lo < sl:
-                        c_lo, c_hi = _stage2_theta(th, ths, v, b1, lo, sl - 1, mp, h2, friction)
+                        c_lo, c_hi = _stage2_theta(th, ths, v, vs, b1, lo, sl - 1, q2, mp, h2, drive, friction)
                     if sh < hi:
-                        t_lo, t_hi = _stage2_theta(th, ths, v, b1, sh + 1, hi, mp, h2, friction)
+                        t_lo, t_hi = _stage2_theta(th, ths, v, vs, b1, sh + 1, hi, q2, mp, h2, drive, friction)
                         c_lo, c_hi = _merge(c_lo, c_hi, t_lo, t_hi)
                 whole = run_in
                 if run_in:
                     if sl < ra0:
                         t_lo, t_hi, moved_before, moved_after = _stage2(
-                            x, v, th, mov, xs, vs, ths, mm, a1, b1, sl, ra0 - 1, p2, mp, h2, drive, friction
+                            x, v, th, mov, xs, vs, ths, mm, a1, b1, sl, ra0 - 1, p2, q2, mp, h2, drive, friction
                         )
                         c_lo, c_hi = _merge(c_lo, c_hi, t_lo, t_hi)
-                    stops_run = _stage2_run(x, v, th, xs, vs, ths, a1, b1, ra0, rb0, p2, mp, h2, drive, friction)
+                    stops_run = _stage2_run(x, v, th, xs, vs, ths, a1, b1, ra0, rb0, p2, q2, mp, h2, drive, friction)
                     # Every block of the run moved: count it as changed.
                     c_lo, c_hi = _merge(c_lo, c_hi, ra0, rb0)
                     moved_before += rb0 - ra0 + 1
@@ -417,19 +438,19 @@ def run_exact(args, drive, friction, threshold, ends):
                         moved_after += rb0 - ra0 + 1
                     if rb0 < sh:
                         t_lo, t_hi, mb, ma = _stage2(
-                            x, v, th, mov, xs, vs, ths, mm, a1, b1, rb0 + 1, sh, p2, mp, h2, drive, friction
+                            x, v, th, mov, xs, vs, ths, mm, a1, b1, rb0 + 1, sh, p2, q2, mp, h2, drive, friction
                         )
                         c_lo, c_hi = _merge(c_lo, c_hi, t_lo, t_hi)
                         moved_before += mb
                         moved_after += ma
                 else:
                     t_lo, t_hi, moved_before, moved_after = _stage2(
-                        x, v, th, mov, xs, vs, ths, mm, a1, b1, sl, sh, p2, mp, h2, drive, friction
+                        x, v, th, mov, xs, vs, ths, mm, a1, b1, sl, sh, p2, q2, mp, h2, drive, friction
                     )
                     c_lo, c_hi = _merge(c_lo, c_hi, t_lo, t_hi)
                 ist[FULL_UPDATES] += sh - sl + 1
             elif has(friction, "has_state"):
-                c_lo, c_hi = _stage2_theta(th, ths, v, b1, lo, hi, mp, h2, friction)
+                c_lo, c_hi = _stage2_theta(th, ths, v, vs, b1, lo, hi, q2, mp, h2, drive, friction)
             # Next step's movers: a stopped block starts only if its force or threshold changed;
             # through the springs that takes a neighbour's move, and only moving blocks change x.
             # So: this step's movers +- 1 (and, as above, the drive's starts and changing thetas).

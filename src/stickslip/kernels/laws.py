@@ -29,7 +29,15 @@ the law's parameters as the module's ``Params`` named tuple (``lp``). :func:`law
 * ``rate(thl, th, thr, v, lp)``: dtheta/dt of the block between thl and thr, moving or stopped
   (0.0 for a law without a state variable);
 * ``PIECE.has_state``, read as ``has(friction, "has_state")``: whether the law has a state
-  variable (otherwise the kernels skip theta).
+  variable (otherwise the kernels skip theta);
+* ``PIECE.context``: what ``rate`` reads besides the block's own values, ``("stress_rate",)``
+  for a law that reads the rate of the elastic force on the block (the Nagata law): its ``rate``
+  is then ``rate(thl, th, thr, v, lp, ctx)`` with ``ctx`` a :class:`RateContext`, which
+  :func:`_dtheta_in` builds from the velocities, their ghost cells (:func:`set_velocity_ghosts`)
+  and the drive's velocity (:func:`load_rate`) and the drive's ``force_rate``. For every other
+  law these compile to nothing and :func:`_dtheta_in` is :func:`_dtheta`: a compile-time
+  specialisation, so their kernels are as before. The dense and exact chain integrators build
+  it; the located integrator and the lattices do not, and refuse such a law before compiling.
 
 So a new law needs no edit here or in any integrator.
 """
@@ -37,6 +45,7 @@ So a new law needs no edit here or in any integrator.
 from __future__ import annotations
 
 import importlib
+from collections import namedtuple
 
 import numpy as np
 from numba import njit, types
@@ -83,6 +92,8 @@ def _law_rate(friction, thl, th, thr, v, lp):
     law = _module(friction)
     if law is None:
         return None
+    if law.PIECE.context:
+        raise TypeError(f"{law.__name__}.rate reads {law.PIECE.context}: a kernel calls it through _dtheta_in")
     fn = law.rate
 
     def impl(friction, thl, th, thr, v, lp):
@@ -260,6 +271,112 @@ def _dtheta(thl, th, thr, v, mp, friction, i):
     """dtheta/dt of the law (its ``rate``) at block i, for moving and stopped blocks alike; 0 for
     laws without a state variable."""
     return law_rate(friction, thl, th, thr, v, at(mp[3], i))
+
+
+#: What the kernels pass a law whose ``PIECE.context`` asks for it, as ``rate``'s last argument:
+#: ``stress_rate``, the rate of the elastic force on the block (:func:`_dtheta_in`).
+RateContext = namedtuple("RateContext", ["stress_rate"])
+
+
+def reads_context(friction) -> bool | None:
+    """Whether the law ``friction`` (a literal module path) reads a :class:`RateContext`; None
+    while it is not a literal."""
+    law = _module(friction)
+    return None if law is None else bool(law.PIECE.context)
+
+
+def _springs_rate(vl, vc, vr, K, dp, q, drive, i):
+    """d/dt of :func:`_springs` at the velocities vl, vc, vr and the drive's velocity q: the
+    drive's ``force_rate``, with one K or K per bond as :func:`_springs` reads them."""
+
+
+@overload(_springs_rate, prefer_literal=True)
+def _springs_rate_impl(vl, vc, vr, K, dp, q, drive, i):
+    if isinstance(K, types.Float):
+        return lambda vl, vc, vr, K, dp, q, drive, i: call(drive, "force_rate", vl, vc, vr, K, q, dp)
+    if not _is_array(K) or not isinstance(i, types.Integer):
+        return None
+    one = np.uint64(1) if not i.signed else 1
+
+    def bonds(vl, vc, vr, K, dp, q, drive, i):
+        return (K[i] * (vl - vc) - K[i + one] * (vc - vr)) + call(drive, "force_rate", vl, vc, vr, 0.0, q, dp)
+
+    return bonds
+
+
+def _dtheta_in(thl, th, thr, v, vel, q, mp, drive, friction, i):
+    """dtheta/dt of the law at block i (its ``rate``) with the context it reads: for a law whose
+    ``PIECE.context`` is empty, :func:`_dtheta` on the block's velocity v, and ``vel`` and ``q``
+    unread (the code of :func:`_dtheta`, so those laws keep their bits and instructions); for a
+    law that reads the stress rate, the rate of the elastic force on block i,
+
+        K (vel_{i-1} - 2 vel_i + vel_{i+1}) [+ Kp (q - vel_i) with the plate, + r with a ramp],
+
+    the drive's ``force_rate`` at the velocities ``vel`` (v or the predictor vs, ghost cells from
+    :func:`set_velocity_ghosts`) and the drive's velocity q (:func:`load_rate`), passed as a
+    :class:`RateContext`. ``i`` is a block index (signed or not; no lanes)."""
+
+
+@overload(_dtheta_in, prefer_literal=True)
+def _dtheta_in_impl(thl, th, thr, v, vel, q, mp, drive, friction, i):
+    ctx = reads_context(friction)
+    if ctx is None:
+        return None
+    if not ctx:
+        return lambda thl, th, thr, v, vel, q, mp, drive, friction, i: _dtheta(thl, th, thr, v, mp, friction, i)
+    if not isinstance(i, types.Integer):
+        return None
+    fn = _module(friction).rate
+    one = np.uint64(1) if not i.signed else 1
+
+    def with_context(thl, th, thr, v, vel, q, mp, drive, friction, i):
+        sr = _springs_rate(vel[i - one], vel[i], vel[i + one], mp[0], at(mp[1], i), q, drive, i)
+        return fn(thl, th, thr, v, at(mp[3], i), RateContext(sr))
+
+    return with_context
+
+
+def load_rate(V, n, dt, dp, drive, carry, friction):
+    """The drive's velocity at step n, where the law ``friction`` reads the stress rate: the
+    drive's ``pull_rate_from`` where it has one (a load history's dp/dt, from the carry's interval,
+    :func:`pull_carried`), else the kernels' V; 0.0 for every other law (compiled away)."""
+    return 0.0
+
+
+@overload(load_rate, prefer_literal=True)
+def _load_rate(V, n, dt, dp, drive, carry, friction):
+    ctx, mod = reads_context(friction), _module(drive)
+    if ctx is None or mod is None:
+        return None
+    if not ctx:
+        return lambda V, n, dt, dp, drive, carry, friction: 0.0
+    if hasattr(mod, "pull_rate_from"):
+        if hasattr(mod, "NUMBA_EXTENSIONS"):
+            importlib.import_module(mod.NUMBA_EXTENSIONS)
+        fn = mod.pull_rate_from
+        return lambda V, n, dt, dp, drive, carry, friction: fn(n, dt, dp, carry[2])
+    return lambda V, n, dt, dp, drive, carry, friction: V
+
+
+def set_velocity_ghosts(v, N, q, drive, ends, friction):
+    """Ghost cells 0 and N + 1 of the velocities ``v`` (v or its predictor) as :func:`_set_ghosts`
+    sets x's, at the drive's velocity q and a wall at rest, where the law ``friction`` reads the
+    stress rate (:func:`_dtheta_in`); nothing for every other law (compiled away)."""
+
+
+@overload(set_velocity_ghosts, prefer_literal=True)
+def _set_velocity_ghosts(v, N, q, drive, ends, friction):
+    ctx = reads_context(friction)
+    if ctx is None:
+        return None
+    if not ctx:
+        return lambda v, N, q, drive, ends, friction: None
+
+    def ghosts(v, N, q, drive, ends, friction):
+        v[0] = call(drive, "left", q, call(ends, "ghost", v[1], v[N], 0.0))
+        v[N + 1] = call(ends, "ghost", v[N], v[1], 0.0)
+
+    return ghosts
 
 
 @njit(cache=True, inline="always")

@@ -233,12 +233,12 @@ def advance_fast(
                 sl = tl - 1 if tl > 1 else 1
                 sr = tr + 1 if tr < N else N
                 if a1 > b1:
-                    _stage1_theta_only(v, th, pth, k1th, sl, sr, mp, h, friction)
+                    _stage1_theta_only(v, th, pth, k1th, sl, sr, 0.0, mp, h, drive, friction)
                 else:
                     if sl < a1:
-                        _stage1_theta_only(v, th, pth, k1th, sl, min(sr, a1 - 1), mp, h, friction)
+                        _stage1_theta_only(v, th, pth, k1th, sl, min(sr, a1 - 1), 0.0, mp, h, drive, friction)
                     if sr > b1:
-                        _stage1_theta_only(v, th, pth, k1th, max(sl, b1 + 1), sr, mp, h, friction)
+                        _stage1_theta_only(v, th, pth, k1th, max(sl, b1 + 1), sr, 0.0, mp, h, drive, friction)
             _ghosts(pu, pth, N, t + h, V, dp, drive, ends)
             # Stage 2 on E, o* of u on its two neighbours, the tests of the step's end.
             if el <= eh:
@@ -301,14 +301,14 @@ def advance_fast(
         cl, ch = el, eh  # changed blocks (E counted whole)
         if tl <= tr:
             if el > eh:
-                cl, ch = _stage2_theta(th, pth, v, k1th, tl, tr, mp, h2, friction)
+                cl, ch = _stage2_theta(th, pth, v, v, k1th, tl, tr, 0.0, mp, h2, drive, friction)
             else:
                 if tl < el:
-                    a, b = _stage2_theta(th, pth, v, k1th, tl, min(tr, el - 1), mp, h2, friction)
+                    a, b = _stage2_theta(th, pth, v, v, k1th, tl, min(tr, el - 1), 0.0, mp, h2, drive, friction)
                     if a <= b:
                         cl = min(cl, a)
                 if tr > eh:
-                    a, b = _stage2_theta(th, pth, v, k1th, max(tl, eh + 1), tr, mp, h2, friction)
+                    a, b = _stage2_theta(th, pth, v, v, k1th, max(tl, eh + 1), tr, 0.0, mp, h2, drive, friction)
                     if a <= b:
                         ch = max(ch, b)
         # After a full step the tests at the next step's start are those just made, except for

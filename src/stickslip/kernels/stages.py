@@ -24,6 +24,12 @@ stopped blocks' state-variable stages take 8 blocks at a time instead
 pieces' functions on the 8 lanes and stores the results, the last group under a mask, with no
 overlap checks and no scalar remainder (``*_lanes``; the loops are ``*_loop``). Which of the two a
 kernel runs is resolved when it is compiled (numba's ``overload`` on the pieces' literals).
+
+The loops take the state variable's rate through :func:`stickslip.kernels.laws._dtheta_in`, with
+the velocities (v in stage 1, the predictor vs in stage 2) and the drive's velocity ``q``: for a law
+that reads the stress rate (``PIECE.context``) it builds the rate of the elastic force on the block
+from them, and for every other law it is :func:`~stickslip.kernels.laws._dtheta`, ``q`` and the
+arrays unread (0.0 and compiled away), so those laws' loops are as before. Such a law runs the loops.
 """
 
 from __future__ import annotations
@@ -33,11 +39,11 @@ from numba import njit
 from numba.extending import overload
 
 from stickslip.kernels import lanes
-from stickslip.kernels.laws import _accel, _dtheta, _force, _threshold, piece_attr
+from stickslip.kernels.laws import _accel, _dtheta, _dtheta_in, _force, _threshold, piece_attr, reads_context
 
 
 @njit(cache=True, _nrt=False, inline="always")
-def _stage1(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, p, mp, dt, drive, friction, threshold):
+def _stage1(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, p, q, mp, dt, drive, friction, threshold):
     """Start rule, stage-1 derivatives and predictor for blocks lo..hi (branch-free).
 
     Returns the first and the last block that move in this step (lo > hi if none) and
@@ -60,7 +66,7 @@ def _stage1(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, p, mp, dt, drive, fr
         last = max(last, k if m != 0.0 else -1)
         starts |= m != mo
         a = _accel(f, th[i], v[i], m, mp, friction, i)
-        b = _dtheta(th[i - one], th[i], th[i + one], v[i], mp, friction, i)
+        b = _dtheta_in(th[i - one], th[i], th[i + one], v[i], v, q, mp, drive, friction, i)
         a1[i] = a
         b1[i] = b
         xs[i] = x[i] + dt * v[i]
@@ -70,7 +76,7 @@ def _stage1(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, p, mp, dt, drive, fr
 
 
 @njit(cache=True, _nrt=False, inline="always")
-def _stage1_theta_loop(x, v, th, xs, vs, ths, mm, b1, lo, hi, mp, dt, friction):
+def _stage1_theta_loop(x, v, th, xs, vs, ths, mm, b1, lo, hi, q, mp, dt, drive, friction):
     """Stage 1 for blocks lo..hi known to stay stopped in this step (mid-step mask 0).
 
     For such a block v = 0 and the acceleration is 0 * (...), so the full stage gives
@@ -78,7 +84,7 @@ def _stage1_theta_loop(x, v, th, xs, vs, ths, mm, b1, lo, hi, mp, dt, friction):
     """
     one = np.uint64(1)
     for i in range(np.uint64(lo), np.uint64(hi) + one):
-        b = _dtheta(th[i - one], th[i], th[i + one], v[i], mp, friction, i)
+        b = _dtheta_in(th[i - one], th[i], th[i + one], v[i], v, q, mp, drive, friction, i)
         b1[i] = b
         xs[i] = x[i] + dt * v[i]
         vs[i] = v[i]
@@ -87,7 +93,7 @@ def _stage1_theta_loop(x, v, th, xs, vs, ths, mm, b1, lo, hi, mp, dt, friction):
 
 
 @njit(cache=True, _nrt=False)
-def _stage1_theta_only_loop(v, th, ths, b1, lo, hi, mp, dt, friction):
+def _stage1_theta_only_loop(v, th, ths, b1, lo, hi, q, mp, dt, drive, friction):
     """Stage 1 for stopped blocks lo..hi whose predictors of x and v and mask nothing reads: in a
     step in which no block moves, or not next to a block that may move (stage 2 reads those of
     its movers' neighbours only).
@@ -97,13 +103,13 @@ def _stage1_theta_only_loop(v, th, ths, b1, lo, hi, mp, dt, friction):
     """
     one = np.uint64(1)
     for i in range(np.uint64(lo), np.uint64(hi) + one):
-        b = _dtheta(th[i - one], th[i], th[i + one], v[i], mp, friction, i)
+        b = _dtheta_in(th[i - one], th[i], th[i + one], v[i], v, q, mp, drive, friction, i)
         b1[i] = b
         ths[i] = th[i] + dt * b
 
 
 @njit(cache=True, _nrt=False, inline="always")
-def _stage2_theta_loop(th, ths, v, b1, lo, hi, mp, h2, friction):
+def _stage2_theta_loop(th, ths, v, vs, b1, lo, hi, q, mp, h2, drive, friction):
     """Stage 2 and corrector of the state variable alone, for blocks lo..hi that stay stopped.
 
     Their x, v and stopped flag provably keep every bit (see _stage1_theta_loop), and their
@@ -117,7 +123,7 @@ def _stage2_theta_loop(th, ths, v, b1, lo, hi, mp, h2, friction):
     c_hi = -1
     for k in range(n):
         i = u0 + np.uint64(k)
-        b2 = _dtheta(ths[i - one], ths[i], ths[i + one], v[i], mp, friction, i)
+        b2 = _dtheta_in(ths[i - one], ths[i], ths[i + one], v[i], vs, q, mp, drive, friction, i)
         tho = th[i]
         thn = tho + h2 * (b1[i] + b2)
         th[i] = thn
@@ -128,7 +134,7 @@ def _stage2_theta_loop(th, ths, v, b1, lo, hi, mp, h2, friction):
 
 
 @njit(cache=True, _nrt=False, inline="always")
-def _stage2(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, p, mp, h2, drive, friction):
+def _stage2(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, p, q, mp, h2, drive, friction):
     """Stage 2, corrector and stop rule for blocks lo..hi (branch-free).
 
     Returns the first and last block that changed (lo > hi if none) and the number of
@@ -147,7 +153,7 @@ def _stage2(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, p, mp, h2, drive, fr
         m = mm[i]
         f2 = _force(xs[i - one], xs[i], xs[i + one], K, dp, p, drive, i)
         a2 = _accel(f2, ths[i], vs[i], m, mp, friction, i)
-        b2 = _dtheta(ths[i - one], ths[i], ths[i + one], vs[i], mp, friction, i)
+        b2 = _dtheta_in(ths[i - one], ths[i], ths[i + one], vs[i], vs, q, mp, drive, friction, i)
         xo = x[i]
         vo = v[i]
         tho = th[i]
@@ -171,7 +177,7 @@ def _stage2(x, v, th, mov, xs, vs, ths, mm, a1, b1, lo, hi, p, mp, h2, drive, fr
 
 
 @njit(cache=True, _nrt=False, inline="always")
-def _stage1_run_loop(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, dt, drive, friction):
+def _stage1_run_loop(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, q, mp, dt, drive, friction):
     """Stage 1 for blocks lo..hi that all move at t_n (a run of sliding blocks).
 
     A moving block moves in this step whatever its force (start rule), so the mask is 1 and
@@ -189,7 +195,7 @@ def _stage1_run_loop(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, dt, drive, fr
         ti = th[i]
         f = _force(x[i - one], xi, x[i + one], K, dp, p, drive, i)
         a = _accel(f, ti, vi, 1.0, mp, friction, i)
-        b = _dtheta(th[i - one], ti, th[i + one], vi, mp, friction, i)
+        b = _dtheta_in(th[i - one], ti, th[i + one], vi, v, q, mp, drive, friction, i)
         xs[i] = xi + dt * vi
         vs[i] = vi + dt * a
         ths[i] = ti + dt * b
@@ -198,7 +204,7 @@ def _stage1_run_loop(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, dt, drive, fr
 
 
 @njit(cache=True, _nrt=False, inline="always")
-def _stage2_run_loop(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, h2, drive, friction):
+def _stage2_run_loop(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, q, mp, h2, drive, friction):
     """Stage 2, corrector and stop rule for a run lo..hi of blocks moving in this step.
 
     The moving flags are not written and the changes not tracked (the caller counts the run as
@@ -216,7 +222,7 @@ def _stage2_run_loop(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, h2, drive, fr
         tsi = ths[i]
         f2 = _force(xs[i - one], xs[i], xs[i + one], K, dp, p, drive, i)
         a2 = _accel(f2, tsi, vsi, 1.0, mp, friction, i)
-        b2 = _dtheta(ths[i - one], tsi, ths[i + one], vsi, mp, friction, i)
+        b2 = _dtheta_in(ths[i - one], tsi, ths[i + one], vsi, vs, q, mp, drive, friction, i)
         xn = x[i] + h2 * (vi + vsi)
         vn = vi + h2 * (a1[i] + a2)
         thn = th[i] + h2 * (b1[i] + b2)
@@ -269,7 +275,7 @@ def _stage2_group(x, v, th, xs, vs, ths, a1, b1, i, n, p, mp, h2, drive, frictio
 
 
 @njit(cache=True, _nrt=False, inline="always")
-def _stage1_run_lanes(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, dt, drive, friction):
+def _stage1_run_lanes(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, q, mp, dt, drive, friction):
     """:func:`_stage1_run_loop` in groups of 8 blocks, the last group masked."""
     X, V, T = x.ctypes.data, v.ctypes.data, th.ctypes.data
     XS, VS, TS, A1, B1 = xs.ctypes.data, vs.ctypes.data, ths.ctypes.data, a1.ctypes.data, b1.ctypes.data
@@ -284,7 +290,7 @@ def _stage1_run_lanes(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, dt, drive, f
 
 
 @njit(cache=True, _nrt=False, inline="always")
-def _stage2_run_lanes(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, h2, drive, friction):
+def _stage2_run_lanes(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, q, mp, h2, drive, friction):
     """:func:`_stage2_run_loop` in groups of 8 blocks, the last group masked."""
     X, V, T = x.ctypes.data, v.ctypes.data, th.ctypes.data
     XS, VS, TS, A1, B1 = xs.ctypes.data, vs.ctypes.data, ths.ctypes.data, a1.ctypes.data, b1.ctypes.data
@@ -333,13 +339,13 @@ def _theta1_lanes(x, v, th, xs, vs, ths, mm, b1, lo, hi, mp, dt, friction, full)
 
 
 @njit(cache=True, _nrt=False, inline="always")
-def _stage1_theta_lanes(x, v, th, xs, vs, ths, mm, b1, lo, hi, mp, dt, friction):
+def _stage1_theta_lanes(x, v, th, xs, vs, ths, mm, b1, lo, hi, q, mp, dt, drive, friction):
     """:func:`_stage1_theta_loop` as lanes."""
     _theta1_lanes(x, v, th, xs, vs, ths, mm, b1, lo, hi, mp, dt, friction, True)
 
 
 @njit(cache=True, _nrt=False)
-def _stage1_theta_only_lanes(v, th, ths, b1, lo, hi, mp, dt, friction):
+def _stage1_theta_only_lanes(v, th, ths, b1, lo, hi, q, mp, dt, drive, friction):
     """:func:`_stage1_theta_only_loop` as lanes."""
     # Without ``full`` the arrays in the places of x, xs, vs and mm are not touched.
     _theta1_lanes(v, v, th, ths, ths, ths, b1, b1, lo, hi, mp, dt, friction, False)
@@ -370,7 +376,7 @@ def _theta2_changes(T, TS, V, B1, i, n, mp, h2, friction, c_lo, c_hi):
 
 
 @njit(cache=True, _nrt=False, inline="always")
-def _stage2_theta_lanes(th, ths, v, b1, lo, hi, mp, h2, friction):
+def _stage2_theta_lanes(th, ths, v, vs, b1, lo, hi, q, mp, h2, drive, friction):
     """:func:`_stage2_theta_loop` as lanes."""
     T, TS, V, B1 = th.ctypes.data, ths.ctypes.data, v.ctypes.data, b1.ctypes.data
     w = np.uint64(lanes.WIDTH)
@@ -393,57 +399,59 @@ def _choose(by_lanes, by_loop, *pieces):
     flags = [piece_attr(piece, "lanes") for piece in pieces]
     if None in flags:
         return None
-    return (by_lanes if all(flags) else by_loop).py_func
+    # A law that reads a context (the stress rate) takes the loops: the lanes pass it none.
+    context = reads_context(pieces[-1])
+    return (by_lanes if all(flags) and not context else by_loop).py_func
 
 
-def _stage1_run(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, dt, drive, friction):
+def _stage1_run(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, q, mp, dt, drive, friction):
     """Stage 1 for blocks lo..hi that all move at t_n (a run of sliding blocks):
     :func:`_stage1_run_lanes` where the drive and the law run as lanes, else
     :func:`_stage1_run_loop` (resolved when the kernel is compiled)."""
 
 
-def _stage2_run(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, h2, drive, friction):
+def _stage2_run(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, q, mp, h2, drive, friction):
     """Stage 2, corrector and stop rule for a run lo..hi (:func:`_stage2_run_lanes` or
     :func:`_stage2_run_loop`). Returns whether some block stopped (v is stored as computed)."""
 
 
-def _stage1_theta(x, v, th, xs, vs, ths, mm, b1, lo, hi, mp, dt, friction):
+def _stage1_theta(x, v, th, xs, vs, ths, mm, b1, lo, hi, q, mp, dt, drive, friction):
     """Stage 1 for blocks lo..hi known to stay stopped (:func:`_stage1_theta_loop`, as lanes
     where the law allows)."""
 
 
-def _stage1_theta_only(v, th, ths, b1, lo, hi, mp, dt, friction):
+def _stage1_theta_only(v, th, ths, b1, lo, hi, q, mp, dt, drive, friction):
     """The state variable's stage 1 alone for stopped blocks lo..hi
     (:func:`_stage1_theta_only_loop`, as lanes where the law allows)."""
 
 
-def _stage2_theta(th, ths, v, b1, lo, hi, mp, h2, friction):
+def _stage2_theta(th, ths, v, vs, b1, lo, hi, q, mp, h2, drive, friction):
     """Stage 2 of the state variable alone for stopped blocks lo..hi; the first and last block
     whose state variable changed (:func:`_stage2_theta_loop`, as lanes where the law allows)."""
 
 
 @overload(_stage1_run, prefer_literal=True)
-def _stage1_run_choice(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, dt, drive, friction):
+def _stage1_run_choice(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, q, mp, dt, drive, friction):
     return _choose(_stage1_run_lanes, _stage1_run_loop, drive, friction)
 
 
 @overload(_stage2_run, prefer_literal=True)
-def _stage2_run_choice(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, mp, h2, drive, friction):
+def _stage2_run_choice(x, v, th, xs, vs, ths, a1, b1, lo, hi, p, q, mp, h2, drive, friction):
     return _choose(_stage2_run_lanes, _stage2_run_loop, drive, friction)
 
 
 @overload(_stage1_theta, prefer_literal=True)
-def _stage1_theta_choice(x, v, th, xs, vs, ths, mm, b1, lo, hi, mp, dt, friction):
+def _stage1_theta_choice(x, v, th, xs, vs, ths, mm, b1, lo, hi, q, mp, dt, drive, friction):
     return _choose(_stage1_theta_lanes, _stage1_theta_loop, friction)
 
 
 @overload(_stage1_theta_only, prefer_literal=True)
-def _stage1_theta_only_choice(v, th, ths, b1, lo, hi, mp, dt, friction):
+def _stage1_theta_only_choice(v, th, ths, b1, lo, hi, q, mp, dt, drive, friction):
     return _choose(_stage1_theta_only_lanes, _stage1_theta_only_loop, friction)
 
 
 @overload(_stage2_theta, prefer_literal=True)
-def _stage2_theta_choice(th, ths, v, b1, lo, hi, mp, h2, friction):
+def _stage2_theta_choice(th, ths, v, vs, b1, lo, hi, q, mp, h2, drive, friction):
     return _choose(_stage2_theta_lanes, _stage2_theta_loop, friction)
 
 

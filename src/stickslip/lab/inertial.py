@@ -1,15 +1,17 @@
 """The inertial spring-slider of the laboratory, sampled: the chain's single block with a mass.
 
-M dv/dt = k (p(t) - x) - mu(v, theta),  dtheta/dt = 1 - v theta / D_c (aging; or the slip or PRZ law),
+M dv/dt = k (p(t) - x) - mu(v, theta),  dtheta/dt = 1 - v theta / D_c (aging; or the slip, PRZ or
+Nagata law),
 
 with mu the regularised (asinh) rate-and-state law and no static threshold (docs/lab.md, "The
 inertial route"): the chain of eq. (4) at N = 1, drive ``history``, friction ``rate-state`` (or
-``rate-state-slip``, ``rate-state-prz``), threshold ``none``, sigma_n = 1 so that its K is the lab's k and its M is
-the mass per unit normal stress. The run is the chain's own (:class:`stickslip.run.driver.Stepper`,
-the exact integrator at a fixed step dt); this module only starts it and reads x and v at the
-sample times, where the spring's friction is k (p(t) - x). Below the critical stiffness
-k_c = (b - a) / D_c (1 + M V^2 / (a D_c)) (Rice and Ruina 1983) steady sliding is unstable and the
-block settles into stick-slip cycles, whose observables :mod:`stickslip.lab.cycles` measures.
+``rate-state-slip``, ``rate-state-prz``, ``rate-state-nagata``), threshold ``none``, sigma_n = 1 so
+that its K is the lab's k and its M is the mass per unit normal stress. The run is the chain's
+own (:class:`stickslip.run.driver.Stepper`, the exact integrator at a fixed step dt); this module
+only starts it and reads x and v at the sample times, where the spring's friction is
+k (p(t) - x). Below the critical stiffness k_c = (b - a) / D_c (1 + M V^2 / (a D_c)) (Rice and
+Ruina 1983) steady sliding is unstable and the block settles into stick-slip cycles, whose
+observables :mod:`stickslip.lab.cycles` measures.
 """
 
 from __future__ import annotations
@@ -23,13 +25,15 @@ from stickslip.models.params import ParameterError, check_number
 __all__ = ["FRICTION", "check_route", "critical_stiffness_inertial", "sample"]
 
 #: The chain's friction piece of each evolution law the inertial route has.
-FRICTION = {"aging": "rate-state", "slip": "rate-state-slip", "prz": "rate-state-prz"}
+FRICTION = {"aging": "rate-state", "slip": "rate-state-slip", "prz": "rate-state-prz", "nagata": "rate-state-nagata"}
 
 
 def critical_stiffness_inertial(model: RateState, M: float, V: float) -> float:
     """k_c = (b - a) / D_c (1 + M V^2 / (a D_c)) of the inertial spring-slider with one state
     variable (aging, slip or PRZ law, which linearise alike; Rice and Ruina 1983, eq. (23) with
-    the mass per unit normal stress M).
+    the mass per unit normal stress M); with Nagata's law
+    k_c = (b - a) (a D_c + M V^2) / (D_c (a D_c (1 + c) + c M V^2)) (docs/models/rate-state.md,
+    "The Nagata law"), the same at c = 0.
 
     Parameters
     ----------
@@ -42,12 +46,15 @@ def critical_stiffness_inertial(model: RateState, M: float, V: float) -> float:
     float
     """
     a, b, dc = model.a, model.b[0], model.Dc[0]
+    if model.law[0] == "nagata" and model.c[0] != 0.0:
+        c, mv2 = model.c[0], M * V * V
+        return (b - a) * (a * dc + mv2) / (dc * (a * dc * (1.0 + c) + c * mv2))
     return (b - a) / dc * (1.0 + M * V * V / (a * dc))
 
 
 def check_route(model: RateState) -> float:
     """The model's k, where the inertial route has the model: one state variable with the aging, the
-    slip or the PRZ law, a finite k, no radiation damping.
+    slip, the PRZ or the Nagata law, a finite k, no radiation damping.
 
     Raises
     ------
@@ -57,7 +64,8 @@ def check_route(model: RateState) -> float:
     k = model.require_k()
     if model.n_states != 1 or model.law[0] not in FRICTION:
         raise ParameterError(
-            f"the inertial route has one state variable with the aging, slip or prz law (got law {','.join(model.law)})"
+            "the inertial route has one state variable with the aging, slip, prz or nagata law "
+            f"(got law {','.join(model.law)})"
         )
     if model.eta != 0.0 or k == np.inf:
         raise ParameterError("the inertial route has a finite k and no radiation damping (eta = 0)")
@@ -70,15 +78,17 @@ def chain_params_of(model: RateState, M: float, dt: float, history: LoadHistory)
     Raises
     ------
     ParameterError
-        More than one state variable, a law other than aging, slip or prz, damping eta, no k.
+        More than one state variable, a law other than aging, slip, prz or nagata, damping eta, no k.
     """
     from stickslip.models.presets import chain_params
 
     k = check_route(model)
+    # Nagata's c (the chain's rs_c) where the law has it; the other laws do not read it.
+    c = {"rs_c": float(model.c[0])} if model.law[0] == "nagata" else {}
     return chain_params(
         "sakaguchi", N=1, drive="history", history=history, friction=FRICTION[model.law[0]], threshold="none",
         rs_a=model.a, rs_b=model.b[0], Dc=model.Dc[0], v0=model.V0, mu0=model.mu0, sigma_n=1.0, K=k,
-        M=float(M), dt=float(dt), V=max(float(np.max(history.velocities)), 1e-300),
+        M=float(M), dt=float(dt), V=max(float(np.max(history.velocities)), 1e-300), **c,
     )  # fmt: skip
 
 
@@ -103,7 +113,7 @@ def sample(
     Parameters
     ----------
     model : RateState
-        a, b, D_c, mu0, V0 and k (one state variable; aging, slip or PRZ law; read in the asinh
+        a, b, D_c, mu0, V0 and k (one state variable; aging, slip, PRZ or Nagata law; read in the asinh
         form).
     M : float
         Mass per unit normal stress (> 0).

@@ -236,7 +236,7 @@ def invert_stick_slip(
         :data:`~stickslip.lab.cycles.OBSERVABLES`).
     model : RateState
         Starting values of the free parameters and values of the fixed ones: a, b, D_c, mu0, V0,
-        k (one state variable, aging, slip or PRZ law; the inertial route reads the asinh form).
+        k (one state variable, aging, slip, PRZ or Nagata law; the inertial route reads the asinh form).
     M : float
         Mass per unit normal stress (starting value where ``M`` is free).
     free : sequence of str

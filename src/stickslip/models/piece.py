@@ -223,6 +223,12 @@ class Piece:
     #: friction: a regularised rate-and-state law, which holds no force at v = 0 (mu(0, theta) = 0),
     #: so that it runs without a static threshold (threshold ``none``)
     rate_and_state: bool = False
+    #: friction: what its ``rate`` reads besides its block's own state and velocity, which the
+    #: kernels build as a :class:`stickslip.kernels.laws.RateContext` and pass as its last argument,
+    #: ``rate(thl, th, thr, v, lp, ctx)``: ``("stress_rate",)``, the rate of the elastic force on
+    #: the block. Empty for every other law, whose kernels build nothing (a compile-time choice);
+    #: the located integrator and the lattices refuse such a law
+    context: tuple[str, ...] = ()
     #: friction and drive: the compiled functions the run stages call (``accel``, ``rate``;
     #: ``force``) use only + - * / on their arguments and float parameters, so they run on 8
     #: blocks at once (:mod:`stickslip.kernels.lanes`)

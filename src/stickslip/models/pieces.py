@@ -14,6 +14,7 @@ friction   ``state``: theta_i + beta v_i, theta from eq. (4);
            ``strengthening``: F0 + beta v, no state variable (train model);
            ``rate-state``: Dieterich-Ruina with the aging law; ``rate-state-slip``: with Ruina's
            slip law; ``rate-state-prz``: with the Perrin-Rice-Zheng law;
+           ``rate-state-nagata``: with the Nagata law (reads the stress rate);
            one module each in :mod:`stickslip.models.friction`, listed in :data:`FRICTIONS`
 threshold  ``constant``: Fs; ``state``: theta_i (the paper's reading of Batista-Carlson);
            ``none``: no static threshold, for rate-and-state (a block starts when f_i > 0)
@@ -57,6 +58,7 @@ FRICTIONS = (
     "rate_state",
     "rate_state_slip",
     "rate_state_prz",
+    "rate_state_nagata",
 )
 
 #: The drives, one module each in :mod:`stickslip.models.drive`.
@@ -125,6 +127,19 @@ def check_composition(drive: str, friction: str, threshold: str, ends: str) -> N
         raise CompositionError(
             f"threshold none needs a rate-and-state friction ({', '.join(RATE_AND_STATE)}; got friction {friction})"
         )
+
+
+def context_refusal(friction: str, what: str) -> str | None:
+    """The one-line refusal of a friction law whose rate reads a context (the stress rate of the
+    Nagata law, :attr:`Piece.context`) by ``what``, whose kernels do not build it (the located
+    integrator, the lattices); None for every other law."""
+    ctx = piece("friction", friction).context
+    if not ctx:
+        return None
+    return (
+        f"friction {friction} reads the {', '.join(c.replace('_', ' ') for c in ctx)}, which {what} "
+        "does not build (the chain's grid integrators, dense and exact, do)"
+    )
 
 
 def stopped_blocks_still(drive: Piece, friction: Piece) -> bool:

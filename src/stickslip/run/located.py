@@ -24,6 +24,7 @@ from stickslip.kernels import located as L
 from stickslip.kernels import located_fast as LF
 from stickslip.kernels.entry import specialise_call, specialised
 from stickslip.models.params import ChainParams, ParameterError, steps_for
+from stickslip.models.pieces import context_refusal
 from stickslip.run.state import ChainState, initial_state
 from stickslip.run.validate import check_start_state
 
@@ -198,6 +199,9 @@ class LocatedStepper:
         refuse_bonds_and_masses(params, "the located integrator")
         if not params.drive_piece.located:
             raise ParameterError(f"drive {params.drive} does not run on the located integrator (use the grid's)")
+        message = context_refusal(params.friction, "the located integrator")
+        if message:
+            raise ParameterError(message)
         self.form = form
         # A wall's ghost cells move with t in the drive's frame, and a load history's load point
         # moves with t in the lab's: the dense form, which the fast form skips no work of there.

@@ -264,6 +264,7 @@ def first_step_problem(state: ChainState, p: ChainParams) -> str | None:
     below 0, where ln theta is not defined.
     """
     import importlib
+    import types
 
     law = p.friction_piece
     if not law.has_state:
@@ -272,12 +273,15 @@ def first_step_problem(state: ChainState, p: ChainParams) -> str | None:
     rate, accel = module.rate.py_func, module.accel.py_func
     lp = law.kernel_params(p)
     low = law.theta_range[0] if law.theta_range is not None else -math.inf
+    # A law that reads the stress rate (PIECE.context) is read here without it: the check looks
+    # at its own terms in theta and v.
+    ctx = (types.SimpleNamespace(**dict.fromkeys(law.context, 0.0)),) if law.context else ()
 
     def rate_at(i: int, th_i: float) -> float:
         """dtheta/dt of block i at theta th_i, NaN where the law is not finite there."""
         try:
             lpi = type(lp)(*(f[i] if np.ndim(f) == 1 else f for f in lp))  # per-block values at block i
-            r = float(rate(th[i - 1], th_i, th[i + 1], v[i], lpi))
+            r = float(rate(th[i - 1], th_i, th[i + 1], v[i], lpi, *ctx))
             force = float(accel(0.0, v[i], th_i, lpi))
         except (ValueError, ZeroDivisionError, OverflowError):  # math.log of a negative theta
             return math.nan

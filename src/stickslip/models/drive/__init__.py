@@ -8,6 +8,9 @@ through :func:`stickslip.kernels.laws.call`:
   at p = V t (in the drive's own frame, p = 0), in the drive's own order of operations;
 * ``force_lap(lap, xc, K, p, dp)``: the same force with the lattice's Laplacian of x ``lap`` in
   place of the neighbours (:mod:`stickslip.models.lattice`), in ``force``'s order of operations;
+* ``force_rate(vl, vc, vr, K, q, dp)``: d/dt of ``force`` at the velocities vl, vc, vr with the
+  drive's velocity q (the stress rate a law with ``PIECE.context`` reads; ghost cells from ``left``
+  and the ends' ``ghost`` at the velocities, :func:`stickslip.kernels.laws.set_velocity_ghosts`);
 * ``leaf(dp)``: the stiffness of the spring joining every block to the drive (0 when it pulls
   block 1 only), which the start-step searches and rounding bounds read;
 * ``left(p, ghost)``: x_0, the ghost cell left of block 1: the pulling point p, or the ends'

@@ -33,6 +33,12 @@ def force(xl, xc, xr, K, p, dp):
 
 
 @njit(cache=True, inline="always")
+def force_rate(vl, vc, vr, K, q, dp):
+    """d/dt of :func:`force`: K (v_{i+1} - 2 v_i + v_{i-1}) (F is constant)."""
+    return K * ((vl - vc) - (vc - vr))
+
+
+@njit(cache=True, inline="always")
 def force_lap(lap, xc, K, p, dp):
     """K times the Laplacian of x plus the constant force F.
     ``lap`` is the lattice's Laplacian of x at the block (:mod:`stickslip.models.lattice`);

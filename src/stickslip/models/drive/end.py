@@ -15,6 +15,14 @@ def force(xl, xc, xr, K, p, dp):
 
 
 @njit(cache=True, inline="always")
+def force_rate(vl, vc, vr, K, q, dp):
+    """d/dt of :func:`force`: K (v_{i+1} - 2 v_i + v_{i-1}), block 1 reading the pulling point's
+    velocity q in its ghost cell (the stress rate a law with ``PIECE.context`` reads,
+    :mod:`stickslip.kernels.laws`)."""
+    return K * ((vl - vc) - (vc - vr))
+
+
+@njit(cache=True, inline="always")
 def force_lap(lap, xc, K, p, dp):
     """K times the Laplacian of x (eq. 4); an edge block reads the pulling point in its ghost cell.
     ``lap`` is the lattice's Laplacian of x at the block (:mod:`stickslip.models.lattice`);

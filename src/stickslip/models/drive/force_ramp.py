@@ -34,6 +34,13 @@ def force(xl, xc, xr, K, p, dp):
 
 
 @njit(cache=True, inline="always")
+def force_rate(vl, vc, vr, K, q, dp):
+    """d/dt of :func:`force`: K (v_{i+1} - 2 v_i + v_{i-1}) + r, with q = r the pull point's
+    velocity."""
+    return K * ((vl - vc) - (vc - vr)) + q
+
+
+@njit(cache=True, inline="always")
 def force_lap(lap, xc, K, p, dp):
     """K times the Laplacian of x plus F_start + r t_n, the pull point p = r t_n.
     ``lap`` is the lattice's Laplacian of x at the block (:mod:`stickslip.models.lattice`);

@@ -69,6 +69,13 @@ def force(xl, xc, xr, K, p, dp):
 
 
 @njit(cache=True, inline="always")
+def force_rate(vl, vc, vr, K, q, dp):
+    """d/dt of :func:`force`: K (v_{i+1} - 2 v_i + v_{i-1}), block 1 reading the load point's
+    velocity q = dp/dt (:func:`pull_rate_from`) in its ghost cell."""
+    return K * ((vl - vc) - (vc - vr))
+
+
+@njit(cache=True, inline="always")
 def force_lap(lap, xc, K, p, dp):
     """K times the Laplacian of x (eq. 4); an edge block reads the load point in its ghost cell.
     ``lap`` is the lattice's Laplacian of x at the block (:mod:`stickslip.models.lattice`);
@@ -157,6 +164,21 @@ def pull_from(n, dt, dp, k):
     (:func:`load_from`): what the kernels' step loops read, once a step
     (:func:`stickslip.kernels.laws.pull_carried`)."""
     return load_from(np.float64(n) * dt, dp, k)
+
+
+@njit(cache=True, inline="always")
+def pull_rate_from(n, dt, dp, k):
+    """The load point's velocity dp/dt at t_n = n dt: V_k of the interval of t_n (the right
+    derivative at a breakpoint, the interval the steps read p(t_n) on), 0 before t_0 and from t_m
+    on; k the interval of an earlier step (:func:`load_from`). What a law that reads the stress
+    rate gets as the load point's velocity (:func:`stickslip.kernels.laws.load_rate`)."""
+    t = np.float64(n) * dt
+    table = dp.table
+    m = columns(table) - 1
+    q = 0.0
+    if entry(table, 0, 0) <= t and t < entry(table, 0, m):
+        q = entry(table, 2, _interval(t, table, k))
+    return q
 
 
 def pull_py(n: int, dt: float, table: np.ndarray) -> float:

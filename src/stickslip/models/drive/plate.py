@@ -16,6 +16,13 @@ def force(xl, xc, xr, K, p, dp):
 
 
 @njit(cache=True, inline="always")
+def force_rate(vl, vc, vr, K, q, dp):
+    """d/dt of :func:`force`: K (v_{i+1} - 2 v_i + v_{i-1}) + Kp (q - v_i), q = V the plate's
+    velocity."""
+    return K * ((vl - vc) - (vc - vr)) + dp.Kp * (q - vc)
+
+
+@njit(cache=True, inline="always")
 def force_lap(lap, xc, K, p, dp):
     """K times the Laplacian of x plus Kp (V t - x_i), the plate at p = V t.
     ``lap`` is the lattice's Laplacian of x at the block (:mod:`stickslip.models.lattice`);

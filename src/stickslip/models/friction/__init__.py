@@ -10,6 +10,9 @@ A law's module defines
   in :mod:`stickslip.kernels.laws`), and ``rate_lap(lap, th, v, lp)``, the same rate with the
   lattice's Laplacian of theta ``lap`` in place of the neighbours (:mod:`stickslip.models.lattice`,
   :mod:`stickslip.kernels.lattice`), in ``rate``'s order of operations;
+* for a law whose rate reads the stress rate (the Nagata law), ``rate(thl, th, thr, v, lp, ctx)``
+  with ``ctx.stress_rate`` the rate of the elastic force on the block, and ``PIECE.context =
+  ("stress_rate",)``: only its kernels build the context (:func:`stickslip.kernels.laws._dtheta_in`);
 * ``PIECE``, a :class:`~stickslip.models.piece.Piece` carrying its name, meaning, parameters and
   their checks, steady sliding, start value of theta, linearisation and figure label.
 

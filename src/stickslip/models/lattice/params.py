@@ -11,6 +11,7 @@ import numpy as np
 from stickslip.models.disorder import PerBlock
 from stickslip.models.lattice import LATTICES, LatticeError, lattice
 from stickslip.models.params import MAX_BLOCKS, ChainParams, ParameterError
+from stickslip.models.pieces import context_refusal
 
 
 @dataclass(frozen=True)
@@ -110,6 +111,9 @@ def on_lattice(chain: ChainParams, name: str, shape: Any = None, edges: Any = No
     that differ from block to block (per bond in two dimensions: not yet there)."""
     if name not in LATTICES:
         raise ParameterError(f"lattice must be one of {', '.join(LATTICES)} (got {name!r})")
+    message = context_refusal(chain.friction, f"lattice {name}")
+    if message:
+        raise ParameterError(message)
     K = chain.K
     if isinstance(K, PerBlock) and bool((K.values != K.values[0]).any()):
         raise ParameterError(
