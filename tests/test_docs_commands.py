@@ -46,6 +46,7 @@ def _commands(page: Path) -> list[tuple[int, list[str]]]:
 _MEASURED_SLOW = (
     "chain --N 49 --Fs uniform(2.5, 3.5) --t-end 5e5",
     "chain --N 49 --beta normal(1, 0.1)",
+    "chain --N 49 --Fs asperities(3, 6, p=0.1)",
     "chain --model sakaguchi --friction strengthening --F0 1 --N 49 --t-end 5e5",
     "chain --drive constant-force --friction strengthening",
     "chain --drive force-ramp --friction strengthening",
