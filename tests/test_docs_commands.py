@@ -53,6 +53,7 @@ _MEASURED_SLOW = (
     "chain --drive plate --friction state --ends periodic",
     "chain --model carlson-langer --t-end 2e4",
     "chain --model carlson-langer --l 10",
+    "chain --model train --json",
     "chain --model carlson-langer --ends free --N 50 --t-end 2e4",
     "chain --model batista-carlson",
     "chain --model carlson-langer --friction strengthening --F0 0.5 --beta 1 --lattice square",

@@ -34,10 +34,11 @@ ALL = [
 ]
 VALID = ALL
 # Every choice of every piece, the presets' compositions (compiled ahead by `stickslip compile`)
-# and the interactions the fast path treats apart (the ring without the plate, the plate with a
-# state threshold): compiled in the default run. The compositions besides the presets' are the
-# ones the default run's other tests use (fixed ends: tests/test_located_fast.py; the force
-# drives: tests/test_force_drives.py), so that each is compiled once; the rest run with -m slow.
+# and the interaction the fast path treats apart (the interval path of the plate, with theta and
+# a state threshold, on the ring; the force drives take the plate's paths): compiled in the
+# default run. The compositions besides the presets' are those the default run's other tests use
+# (the force drives: tests/test_force_drives.py), so that each is compiled once; the rest of the
+# 44 run with -m slow.
 COVER = [
     ("end", "state", "constant", "free"),
     ("end", "state", "state", "free"),
@@ -47,7 +48,6 @@ COVER = [
     ("end", "state", "constant", "fixed"),
     ("plate", "state", "state", "periodic"),
     ("constant-force", "strengthening", "constant", "free"),
-    ("constant-force", "state", "state", "periodic"),
     ("force-ramp", "strengthening", "constant", "free"),
 ]
 
