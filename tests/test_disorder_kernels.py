@@ -136,13 +136,19 @@ def test_heterogeneous_chain_matches_plain_python(case):
     assert len(ref.events) >= 1 or any(ref.moving)
 
 
-def test_uniform_values_given_as_arrays_give_the_scalar_chain_bits():
-    """Every parameter as an array of equal values (read at each block) gives the scalar chain's
-    bits; equal springs keep the uniform expression."""
+# Every parameter of eq. (4) as an array (with -m slow), and the springs with the thresholds and
+# the friction's beta, the per-block parameters of tests/test_disorder_runs.py (one composition
+# compiled for both in the default run).
+@pytest.mark.parametrize(
+    "names", [("K", "Fs", "beta"), pytest.param(("K", "beta", "alpha", "D", "Fs"), marks=pytest.mark.slow)]
+)
+def test_uniform_values_given_as_arrays_give_the_scalar_chain_bits(names):
+    """Parameters as arrays of equal values (read at each block) give the scalar chain's bits;
+    equal springs keep the uniform expression."""
     N = 12
     scalar = ChainParams(N=N, **LIVELY)
-    arrays = ChainParams(N=N, **{**LIVELY, **{k: np.full(N, LIVELY[k]) for k in ("K", "beta", "alpha", "D", "Fs")}})
-    assert set(arrays.per_block()) == {"K", "beta", "alpha", "D", "Fs"}
+    arrays = ChainParams(N=N, **{**LIVELY, **{k: np.full(N, LIVELY[k]) for k in names}})
+    assert set(arrays.per_block()) == set(names)
     start = _start(scalar, seed=4)
     a, b = _runs(scalar, start, 3000), _runs(arrays, start, 3000)
     for integrator in ("dense", "exact"):

@@ -33,12 +33,11 @@ ALL = [
     if not (e == "periodic" and d == "end") and not (t == "state" and f != "state") and t != "none"
 ]
 VALID = ALL
-# Every choice of every piece, the presets' compositions (compiled ahead by `stickslip compile`)
-# and the interaction the fast path treats apart (the interval path of the plate, with theta and
-# a state threshold, on the ring; the force drives take the plate's paths): compiled in the
-# default run. The compositions besides the presets' are those the default run's other tests use
-# (the force drives: tests/test_force_drives.py), so that each is compiled once; the rest of the
-# 44 run with -m slow.
+# Every choice of every piece, in the presets' compositions (compiled ahead by `stickslip compile`)
+# and three more: fixed ends, and the force drives as tests/test_force_drives.py runs them (each
+# compiled once in the default run). The rest of the 44, among them the interactions the fast
+# path treats apart (the plate's interval path with theta and a state threshold on the ring, the
+# force drives with theta), run with -m slow.
 COVER = [
     ("end", "state", "constant", "free"),
     ("end", "state", "state", "free"),
@@ -46,7 +45,6 @@ COVER = [
     ("plate", "weakening", "constant", "periodic"),
     ("plate", "weakening", "constant", "free"),
     ("end", "state", "constant", "fixed"),
-    ("plate", "state", "state", "periodic"),
     ("constant-force", "strengthening", "constant", "free"),
     ("force-ramp", "strengthening", "constant", "free"),
 ]
@@ -258,7 +256,7 @@ def test_run_directory_records_the_model_everywhere(tmp_path):
 DEFAULT_ELSEWHERE = {
     ("drive", "history"): ("test_drive_history", "test_exact_equals_dense_with_a_history"),
     ("friction", "rate-state"): ("test_rate_state", "test_dense_and_exact_agree_bit_for_bit_on_a_chain"),
-    ("friction", "rate-state-slip"): ("test_slip_law", "test_dense_and_exact_identical_and_located_switches_run"),
+    ("friction", "rate-state-slip"): ("test_slip_law", "test_dense_and_exact_identical"),
     ("friction", "rate-state-prz"): ("test_prz_law", "test_dense_and_exact_bit_for_bit_and_steady_sliding_stays"),
     ("lattice", "square"): ("test_lattice_exact", "test_exact_equals_dense_across_calls_and_on_the_chain"),
     ("threshold", "none"): (
