@@ -10,8 +10,9 @@ fast form are pinned too, and the paper's beta = 1 run to t = 2e7 (``567924f9...
 docs/performance.md) is the slow test at the end.
 
 The default run pins the rows whose composition is a preset's (the kernels ``stickslip compile``
-has compiled ahead); the rows of the other compositions are pinned by the slow run
-(``pytest -m slow``), each composition compiled for them alone.
+has compiled ahead), the bench workload and the located floor; the rows of the other
+compositions are pinned by the slow run (``pytest -m slow``), so that the default run compiles
+none of their kernels for these rows.
 """
 
 from __future__ import annotations
