@@ -33,6 +33,13 @@ CASES = {
     "plate-state-state-free": (("plate", "state", "state", "free"), ("K", "M", "Kp", "beta", "alpha", "D")),
 }
 FAST = ("end-state-constant-free", "plate-weakening-constant-periodic")
+#: The default run's case (every kind of per-block parameter: springs per bond, masses, the law's
+#: and the threshold's); the others, among them the plate's sparse path, run with -m slow.
+DEFAULT = ("end-state-constant-free",)
+
+
+def _cases(names):
+    return [c if c in DEFAULT else pytest.param(c, marks=pytest.mark.slow) for c in names]
 
 
 def _spread(name, value, rng, N, width=0.3):
@@ -116,7 +123,7 @@ def _runs(p, start, steps):
     return runs
 
 
-@pytest.mark.parametrize("case", [pytest.param(c, marks=() if c in FAST else pytest.mark.slow) for c in CASES])
+@pytest.mark.parametrize("case", _cases(CASES))
 def test_heterogeneous_chain_matches_plain_python(case):
     p = _params(case, 9, seed=5)
     assert set(p.per_block()) == set(CASES[case][1])
@@ -136,13 +143,19 @@ def test_heterogeneous_chain_matches_plain_python(case):
     assert len(ref.events) >= 1 or any(ref.moving)
 
 
-def test_uniform_values_given_as_arrays_give_the_scalar_chain_bits():
-    """Every parameter as an array of equal values (read at each block) gives the scalar chain's
-    bits; equal springs keep the uniform expression."""
+# Every parameter of eq. (4) as an array (with -m slow), and the springs with the thresholds and
+# the friction's beta, the per-block parameters of tests/test_disorder_runs.py (one composition
+# compiled for both in the default run).
+@pytest.mark.parametrize(
+    "names", [("K", "Fs", "beta"), pytest.param(("K", "beta", "alpha", "D", "Fs"), marks=pytest.mark.slow)]
+)
+def test_uniform_values_given_as_arrays_give_the_scalar_chain_bits(names):
+    """Parameters as arrays of equal values (read at each block) give the scalar chain's bits;
+    equal springs keep the uniform expression."""
     N = 12
     scalar = ChainParams(N=N, **LIVELY)
-    arrays = ChainParams(N=N, **{**LIVELY, **{k: np.full(N, LIVELY[k]) for k in ("K", "beta", "alpha", "D", "Fs")}})
-    assert set(arrays.per_block()) == {"K", "beta", "alpha", "D", "Fs"}
+    arrays = ChainParams(N=N, **{**LIVELY, **{k: np.full(N, LIVELY[k]) for k in names}})
+    assert set(arrays.per_block()) == set(names)
     start = _start(scalar, seed=4)
     a, b = _runs(scalar, start, 3000), _runs(arrays, start, 3000)
     for integrator in ("dense", "exact"):
@@ -171,8 +184,9 @@ DISTS = st.sampled_from(
 )
 
 
+@pytest.mark.parametrize("case", _cases(FAST))
 @settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(case=st.sampled_from(FAST), dist=DISTS, seed=st.integers(0, 2**16), N=st.integers(8, 20))
+@given(dist=DISTS, seed=st.integers(0, 2**16), N=st.integers(8, 20))
 def test_drawn_disorder_dense_equals_exact(case, dist, seed, N):
     """dense = exact bit for bit over distributions, seeds and models (each parameter the
     composition reads scaled by a drawn factor)."""

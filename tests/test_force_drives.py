@@ -23,14 +23,28 @@ def _rest(p, seed=1):
     return ChainState.rest(p, amplitude=0.05, seed=seed)
 
 
+# The default run takes the compositions the rest of it compiles (tests/test_models_exact.py's
+# COVER, whose force drive with theta is there); the others compile for -m slow alone.
 @pytest.mark.parametrize(
     "over, t_end",
     [
-        pytest.param({"drive": "constant-force", "friction": "strengthening", "F": 3.2}, 200.0, marks=pytest.mark.slow),
-        ({"drive": "constant-force", "friction": "state", "F": 3.1, "D": 1.0, "beta": 0.5}, 200.0),
+        ({"drive": "constant-force", "friction": "strengthening", "F": 3.2}, 200.0),
+        pytest.param(
+            {"drive": "constant-force", "friction": "state", "F": 3.1, "D": 1.0, "beta": 0.5},
+            200.0,
+            marks=pytest.mark.slow,
+        ),
         ({"drive": "force-ramp", "friction": "strengthening", "F_start": 2.0, "r": 0.01}, 300.0),
-        ({"drive": "force-ramp", "friction": "state", "F_start": 2.5, "r": 0.01, "D": 1.0}, 200.0),
-        ({"drive": "force-ramp", "friction": "weakening", "ends": "periodic", "F_start": 2.5, "r": 0.02}, 200.0),
+        pytest.param(
+            {"drive": "force-ramp", "friction": "state", "F_start": 2.5, "r": 0.01, "D": 1.0},
+            200.0,
+            marks=pytest.mark.slow,
+        ),
+        pytest.param(
+            {"drive": "force-ramp", "friction": "weakening", "ends": "periodic", "F_start": 2.5, "r": 0.02},
+            200.0,
+            marks=pytest.mark.slow,
+        ),
     ],
 )
 def test_dense_equals_exact(over, t_end):

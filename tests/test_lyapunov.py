@@ -343,6 +343,7 @@ def test_plate_drive_separation_round_trip():
     assert d == pytest.approx(1e-6, rel=1e-6)
 
 
+@pytest.mark.slow  # the plate with the strengthening law: a composition no other default test compiles
 def test_plate_drive_steady_sliding_decays_at_minus_beta_over_two():
     # A block on the plate with friction F0 + beta v slides steadily at v = V; a perturbation
     # obeys lambda^2 + beta lambda + Kp = 0: Re lambda = -beta / 2 for beta^2 < 4 Kp (closed form).

@@ -194,6 +194,7 @@ def test_dense_and_exact_bit_for_bit_and_steady_sliding_stays():
     assert q.K * (q.V * t_end - b["x"][0]) == pytest.approx(q.sigma_n * mu_ss, rel=1e-9)
 
 
+@pytest.mark.slow  # the PRZ law on the load history with threshold none: a composition of its own
 def test_inertial_spring_slider_tends_to_the_lab_quasi_static_prz_solution():
     """A velocity step 1 -> 3 (lab units: um, s) on the spring-slider with threshold none: the
     spring's friction k (p - x) of the inertial route (mass M per unit normal stress) against the

@@ -119,11 +119,15 @@ def test_one_kernel_step_against_the_plain_step(integrator):
     assert b["theta"][1] == 3.0  # the stuck block keeps its state
 
 
-def test_dense_and_exact_identical_and_located_switches_run():
+def test_dense_and_exact_identical():
     p = ChainParams(N=5, K=5.0, friction=LAW)
     runs = [run_chain(p, 400.0, integrator=i, start="steady", perturbation=1e-4) for i in ("dense", "exact")]
     assert runs[0].summary["state_sha256"] == runs[1].summary["state_sha256"]
     assert len(runs[0].events) > 0
+
+
+@pytest.mark.slow  # the located kernels of this law alone (the aging law's run by default: test_rate_state.py)
+def test_located_switches_run():
     # with no switch on the way, located switches and the grid integrate the same equations
     spring_slider = _params(V=0.01, K=10.0)
     located = run_located(spring_slider, 300.0, start="steady", perturbation=1e-3)
