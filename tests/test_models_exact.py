@@ -258,6 +258,7 @@ DEFAULT_ELSEWHERE = {
     ("friction", "rate-state"): ("test_rate_state", "test_dense_and_exact_agree_bit_for_bit_on_a_chain"),
     ("friction", "rate-state-slip"): ("test_slip_law", "test_dense_and_exact_identical"),
     ("friction", "rate-state-prz"): ("test_prz_law", "test_dense_and_exact_bit_for_bit_and_steady_sliding_stays"),
+    ("friction", "rate-state-nagata"): ("test_nagata_law", "test_dense_and_exact_bit_for_bit_and_steady_sliding_stays"),
     ("lattice", "square"): ("test_lattice_exact", "test_exact_equals_dense_across_calls_and_on_the_chain"),
     ("threshold", "none"): (
         "test_threshold_none",

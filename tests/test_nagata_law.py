@@ -130,7 +130,7 @@ def test_the_kernels_law_against_the_equations():
         assert rate_state_nagata.rate(0.0, th, 0.0, v, lq, _ctx(fdot)) == rate_state.rate(0.0, th, 0.0, v, la)
 
 
-@pytest.mark.parametrize("drive", ["end", "plate"])
+@pytest.mark.parametrize("drive", ["end", pytest.param("plate", marks=pytest.mark.slow)])
 def test_kernel_steps_against_the_plain_heun_step(drive):
     p = _params(N=4, K=12.0, Fs=2.9, rs_c=1.5, drive=drive, Kp=0.5 if drive == "plate" else 1.0)
     x = [-0.30, -0.46, -0.70, -0.93]
@@ -164,23 +164,18 @@ def test_with_c_zero_it_is_the_aging_law_bit_for_bit():
     assert aging.events.equals(nagata.events)
 
 
-def test_dense_and_exact_bit_for_bit_and_steady_sliding_stays():
-    # a chain past a group of eight lanes (the exact path's run stages), in stick-slip with stuck
-    # blocks; the plate drive; springs per bond; a load history with a hold and threshold none
-    hist = LoadHistory.steps([1e-3, 0.0, 3e-3], [100.0, 50.0, 150.0])
-    cases = [
-        (ChainParams(N=12, K=5.0, friction=LAW, dt=0.002), 400.0),
-        (ChainParams(N=9, K=5.0, friction=LAW, dt=0.002, drive="plate", Kp=0.3, rs_c=0.7), 300.0),
-        # springs per bond and masses per block (the stress rate reads K_i and K_i+1)
-        (ChainParams(N=6, K=np.linspace(4.0, 6.0, 6), M=np.linspace(0.8, 1.2, 6), friction=LAW, dt=0.002), 300.0),
-        (chain_params("sakaguchi", N=10, K=5.0, friction=LAW, dt=0.002, drive="history", history=hist,
-                      threshold="none", V=3e-3), 300.0),
-    ]  # fmt: skip
+def _dense_is_exact(cases):
     for p, t_end in cases:
         start = {} if p.drive == "history" else {"start": "steady", "perturbation": 0.05}
         runs = [run_chain(p, t_end, integrator=i, sample_interval=1.0, **start) for i in ("dense", "exact")]
         assert len(runs[0].events) > 0
         assert_same_run(runs[0], runs[1])
+
+
+def test_dense_and_exact_bit_for_bit_and_steady_sliding_stays():
+    # a chain past a group of eight lanes (the exact path's run stages), in stick-slip with stuck
+    # blocks (the other drives and forms: the slow test below)
+    _dense_is_exact([(ChainParams(N=12, K=5.0, friction=LAW, dt=0.002), 400.0)])
     # steady sliding of the spring-slider above its critical stiffness: theta stays D_c / V, v
     # stays V, and the spring holds sigma_n mu_ss = sigma_n (mu0 + (a - b) ln(V / v0))
     q = _params(V=0.004, dt=0.001)
@@ -191,6 +186,20 @@ def test_dense_and_exact_bit_for_bit_and_steady_sliding_stays():
     assert b["v"][0] == pytest.approx(q.V, rel=1e-10)
     mu_ss = q.mu0 + (q.rs_a - q.rs_b) * math.log(q.V / q.v0)
     assert q.K * (q.V * t_end - b["x"][0]) == pytest.approx(q.sigma_n * mu_ss, rel=1e-9)
+
+
+@pytest.mark.slow  # three more compositions to compile; the default run has the end drive's above
+def test_dense_and_exact_bit_for_bit_with_the_plate_springs_per_bond_and_a_history():
+    # the plate drive; springs per bond; a load history with a hold and threshold none
+    hist = LoadHistory.steps([1e-3, 0.0, 3e-3], [100.0, 50.0, 150.0])
+    cases = [
+        (ChainParams(N=9, K=5.0, friction=LAW, dt=0.002, drive="plate", Kp=0.3, rs_c=0.7), 300.0),
+        # springs per bond and masses per block (the stress rate reads K_i and K_i+1)
+        (ChainParams(N=6, K=np.linspace(4.0, 6.0, 6), M=np.linspace(0.8, 1.2, 6), friction=LAW, dt=0.002), 300.0),
+        (chain_params("sakaguchi", N=10, K=5.0, friction=LAW, dt=0.002, drive="history", history=hist,
+                      threshold="none", V=3e-3), 300.0),
+    ]  # fmt: skip
+    _dense_is_exact(cases)
 
 
 def test_critical_stiffness_from_the_characteristic_cubic():
@@ -212,6 +221,7 @@ def test_critical_stiffness_from_the_characteristic_cubic():
     )
 
 
+@pytest.mark.slow  # as the PRZ law's: its own compositions (threshold none, the lab's units)
 def test_inertial_spring_slider_tends_to_the_lab_quasi_static_nagata_solution():
     """A velocity step 1 -> 3 (lab units: um, s) on the spring-slider with threshold none: the
     spring's friction k (p - x) of the inertial route (mass M per unit normal stress) against the
