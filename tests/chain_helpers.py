@@ -86,6 +86,28 @@ def assert_same_run(a, b, *, state: bool = True) -> None:
 # Plain-Python Heun step of eq. (4), written from docs/model.md and the kernel module's docstring.
 
 
+#: A partly stuck state of four blocks at step N_START (block 2 stuck, the others moving, theta
+#: from 0.05 to 40): the start of the rate-and-state laws' kernel-step tests against their plain
+#: Heun steps.
+PARTLY_STUCK_BLOCKS = (
+    [-0.30, -0.46, -0.70, -0.93],
+    [0.002, 0.0, 0.03, 1e-9],
+    [0.8, 3.0, 0.05, 40.0],
+    [True, False, True, True],
+)
+N_START = 20_000
+
+
+def partly_stuck_start():
+    """:data:`PARTLY_STUCK_BLOCKS` as the engine's state held at t_n, n = :data:`N_START`."""
+    from stickslip.run.driver import ChainState
+
+    x, v, th, moving = PARTLY_STUCK_BLOCKS
+    start = ChainState.from_blocks(np.array(x), np.array(v), np.array(th), ~np.array(moving))
+    start.ist[0] = N_START  # the state held is at t_n
+    return start
+
+
 def heun_step(x, v, th, moving, n, p):
     """One Heun step of the chain from t_n = n dt; lists of blocks 1..N at index 0..N-1.
 

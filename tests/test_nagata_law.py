@@ -19,7 +19,7 @@ import math
 import numpy as np
 import pytest
 
-from chain_helpers import assert_same_run, run_cli
+from chain_helpers import N_START, PARTLY_STUCK_BLOCKS, assert_same_run, partly_stuck_start, run_cli
 from stickslip.kernels.laws import RateContext
 from stickslip.lab import LoadHistory, RateState, quasi_static
 from stickslip.lab.inertial import critical_stiffness_inertial, sample
@@ -27,7 +27,7 @@ from stickslip.models import pieces
 from stickslip.models.friction import rate_state, rate_state_nagata
 from stickslip.models.params import ChainParams, ParameterError
 from stickslip.models.presets import chain_params
-from stickslip.run.driver import ChainState, run_chain
+from stickslip.run.driver import run_chain
 
 LAW = "rate-state-nagata"
 
@@ -133,13 +133,9 @@ def test_the_kernels_law_against_the_equations():
 @pytest.mark.parametrize("drive", ["end", pytest.param("plate", marks=pytest.mark.slow)])
 def test_kernel_steps_against_the_plain_heun_step(drive):
     p = _params(N=4, K=12.0, Fs=2.9, rs_c=1.5, drive=drive, Kp=0.5 if drive == "plate" else 1.0)
-    x = [-0.30, -0.46, -0.70, -0.93]
-    v = [0.002, 0.0, 0.03, 1e-9]
-    th = [0.8, 3.0, 0.05, 40.0]
-    moving = [True, False, True, True]
-    n = 20_000
-    start = ChainState.from_blocks(np.array(x), np.array(v), np.array(th), ~np.array(moving))
-    start.ist[0] = n  # the state held is at t_n
+    x, v, th, moving = PARTLY_STUCK_BLOCKS
+    n = N_START
+    start = partly_stuck_start()
     ref = (x, v, th, moving)
     for steps in (1, 2, 3):
         ref = _heun(*ref, n + steps - 1, p)

@@ -16,7 +16,7 @@ import math
 import numpy as np
 import pytest
 
-from chain_helpers import assert_same_run, run_cli
+from chain_helpers import N_START, PARTLY_STUCK_BLOCKS, assert_same_run, partly_stuck_start, run_cli
 from stickslip.analysis.dynamics import stability as st
 from stickslip.models.friction.rate_state import mu_lp
 from stickslip.models.params import ChainParams, ParameterError
@@ -164,13 +164,9 @@ def _plain_step(x, v, th, moving, n, p, g=_aging):
 def steps_against_the_plain_step(p, integrator, g=_aging):
     """One and three kernel steps from a partly stuck state of four blocks against
     :func:`_plain_step` with the state law ``g``; returns the blocks after three steps."""
-    x = [-0.30, -0.46, -0.70, -0.93]
-    v = [0.002, 0.0, 0.03, 1e-9]
-    th = [0.8, 3.0, 0.05, 40.0]
-    moving = [True, False, True, True]
-    n = 20_000
-    start = ChainState.from_blocks(np.array(x), np.array(v), np.array(th), ~np.array(moving))
-    start.ist[0] = n  # the state held is at t_n
+    x, v, th, moving = PARTLY_STUCK_BLOCKS
+    n = N_START
+    start = partly_stuck_start()
     for steps in (1, 3):
         ref = (x, v, th, moving)
         for k in range(steps):
