@@ -335,6 +335,7 @@ def run_fit(args) -> Result:
 
             post = posterior(res, steps=args.posterior, rng=args.seed)
             data["posterior"] = post.summary()
+        lines = _fit_lines(res, data, len(records))
         if out is not None:
             from stickslip import io
             from stickslip.plotting.lab import plot_fit, plot_posterior
@@ -348,8 +349,8 @@ def run_fit(args) -> Result:
             written.append(io.write_json(out / "fit.json", data))
             data["outputs"] = [str(p) for p in written]
             figures = ["fit"] if post is None else ["fit", "posterior"]
-            _page(args, out, "fit", data, _fit_lines(res, data, len(records)), figures)
-    lines = _fit_lines(res, data, len(records)) + [f"wrote {p}" for p in data.get("outputs", [])]
+            _page(args, out, "fit", data, lines, figures)
+    lines += [f"wrote {p}" for p in data.get("outputs", [])]
     return Result(data=data, text="\n".join(lines))
 
 
@@ -406,6 +407,7 @@ def run_invert(args) -> Result:
             t_end=args.t_end, sample_interval=args.sample_interval, floor=args.floor,
         )  # fmt: skip
         data_out = res.summary()
+        lines = _invert_lines(res, data_out)
         if out is not None:
             from stickslip import io
             from stickslip.plotting.lab import plot_stick_slip
@@ -415,8 +417,8 @@ def run_invert(args) -> Result:
             written += save_figure(plot_stick_slip(res), out / "invert")
             written.append(io.write_json(out / "invert.json", data_out))
             data_out["outputs"] = [str(p) for p in written]
-            _page(args, out, "invert", data_out, _invert_lines(res, data_out), ["invert"])
-    lines = _invert_lines(res, data_out) + [f"wrote {p}" for p in data_out.get("outputs", [])]
+            _page(args, out, "invert", data_out, lines, ["invert"])
+    lines += [f"wrote {p}" for p in data_out.get("outputs", [])]
     return Result(data=data_out, text="\n".join(lines))
 
 
