@@ -186,3 +186,19 @@ def test_a_resumed_run_reads_the_slips_of_its_checkpoint(tmp_path):
     whole = periodicity(stickslip.run_chain(params, 1e6, progress=False).events)
     assert (hook.result.period_slips, hook.result.settled_from_slip) == (16, whole.settled_from_slip)
     assert run.summary["t_reached"] < 1e6
+
+
+@pytest.mark.slow
+def test_a_small_chain_settles_on_an_orbit_longer_than_500_slips():
+    """N = 7, beta = 0.5 from a perturbed paper start: the orbit reached has 2474 slips (8e5 time
+    units), which a detector capped at 500 slips records as never settling."""
+    from stickslip.experiments.studies.lifetimes_points import lifetime_point
+    from stickslip.experiments.sweep_points import point_params
+
+    cfg = {"model": "sakaguchi", "N": 7, "beta": 0.5, "start": "paper", "seed": 0, "budget": 4e6}
+    cfg |= {"perturbation": 0.05, "until_steady": 1e-6, "rtol": 1e-6, "repeats": 3}
+    capped = lifetime_point(cfg | {"max_period": 500}, point_params("chain", cfg))
+    found = lifetime_point(cfg | {"max_period": 100_000}, point_params("chain", cfg))
+    assert capped["end"] == "censored" and capped["lifetime"] == 4e6
+    assert (found["end"], found["period_slips"], found["settled_from_slip"]) == ("periodic", 2474, 1344)
+    assert found["lifetime"] < 5e5

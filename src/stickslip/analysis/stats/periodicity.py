@@ -234,16 +234,27 @@ def find_period(
         near = np.abs(size[a] - size[b]) <= rtol * np.maximum(np.abs(size[a]), np.abs(size[b]))
         return (sb[a] == sb[b]) & (nb[a] == nb[b]) & near
 
+    # every p's probe at once (one numpy pass over P x _PROBE pairs), then the full stretch of the
+    # candidates in order: the same p, and the same comparisons counted, as trying p = 1, 2, ... in turn
+    ps = np.arange(1, longest + 1)
+    need = np.maximum(repeats * ps, ps + longest)
+    ps, need = ps[need <= n], need[need <= n]  # need grows with p: a prefix
+    lo = n - need
+    probe = np.maximum(lo, n - ps - _PROBE)
+    i = n - ps[:, None] - np.arange(1, _PROBE + 1)[None, :]  # slip i against slip i + p, the last ones
+    inside = i >= probe[:, None]
+    i = np.where(inside, i, 0)
+    j = i + ps[:, None]
+    near = np.abs(size[i] - size[j]) <= rtol * np.maximum(np.abs(size[i]), np.abs(size[j]))
+    probe_ok = ((sb[i] == sb[j]) & (nb[i] == nb[j]) & near | ~inside).all(axis=1)
+    probed = (n - ps) - probe  # pairs each p's probe compares
     period = None
-    for p in range(1, longest + 1):
-        need = max(repeats * p, p + longest)
-        if need > n:
-            break
-        lo = n - need
-        probe = max(lo, n - p - _PROBE)
-        if matches(probe, n - p, p).all() and (probe == lo or matches(lo, probe, p).all()):
+    for k in np.flatnonzero(probe_ok):
+        p = int(ps[k])
+        if probe[k] == lo[k] or matches(int(lo[k]), int(probe[k]), p).all():
             period = p
             break
+    count[0] += int(probed[: (ps.size if period is None else period)].sum())
     rule = rule_text(rtol, max_period, repeats, columns)
     common = dict(n_slips=n, t_last=None if t is None or n == 0 else float(t[-1]), rtol=float(rtol))
     common.update(max_period=int(max_period), repeats=int(repeats), longest_period_searched=longest, rule=rule)
