@@ -162,7 +162,7 @@ PRESETS: dict[str, Preset] = {
         {"amplitude": 0.01, "seed": 0},
         equations="as carlson-langer with N = 2 and free ends (x_0 = x_1, x_3 = x_2)",
         source=(
-            "M. de Sousa Vieira, \"Chaos in a homogeneous model for earthquakes\", cond-mat/9312072 "
+            'M. de Sousa Vieira, "Chaos in a homogeneous model for earthquakes", cond-mat/9312072 '
             "(Phys. Lett. A 198, 407 (1995)); "
             "H. Sakaguchi and S. Morita, arXiv:1309.4583 (2013)"
         ),
