@@ -1,6 +1,7 @@
-"""docs/studies/lifetimes.md, "What `--full` costs", states the numbers of the measured slice kept
-beside it (``docs/studies/lifetimes-full-slice.json``): the starts it saw censored, the cost per
-time unit re-derived from its rows, and the estimate's sums and minutes."""
+"""docs/studies/lifetimes.md states what `--full` found: the findings kept beside it
+(``lifetimes-full.json``) are those the study draws from the rows kept beside it
+(``lifetimes-full-table.parquet``), and the page's tables, fits, bounds and cost are those
+findings' numbers."""
 
 from __future__ import annotations
 
@@ -8,57 +9,94 @@ import json
 import re
 from pathlib import Path
 
+import pandas as pd
 import pytest
 
 from stickslip.experiments.studies import lifetimes
 
 STUDIES = Path(__file__).resolve().parent.parent / "docs" / "studies"
-SLICE = json.loads((STUDIES / "lifetimes-full-slice.json").read_text())
+FULL = json.loads((STUDIES / "lifetimes-full.json").read_text())
+TABLE = pd.read_parquet(STUDIES / "lifetimes-full-table.parquet")
 PAGE = (STUDIES / "lifetimes.md").read_text()
-SECTION = re.search(r"^### What `--full` costs\n(.*?)(?=^## )", PAGE, re.S | re.M).group(1)
+FOUND = re.search(r"^## What `--full` found\n(.*?)(?=^## )", PAGE, re.S | re.M).group(1)
+ANSWER = re.search(r"^## The answer, in short\n(.*?)(?=^## )", PAGE, re.S | re.M).group(1)
 
 
-def _text() -> str:
-    return " ".join(SECTION.split())
+def _flat(text: str) -> str:
+    return " ".join(text.split())
 
 
-def test_the_slice_is_of_full_and_its_censored_starts_are_those_the_page_names():
-    full = lifetimes.build("full")
-    keys = {(p["model"], p["N"], p.get("beta")) for p in full.points}
-    rows = [r for r in SLICE["slice"] if r["measure"] == "lifetime"]
-    assert len(SLICE["slice"]) == 31 and all((r["model"], r["N"], r["beta"]) in keys for r in rows)
-    censored = {(r["N"], r["beta"]) for r in rows if r["model"] == "sakaguchi" and r["end"] == "censored"}
-    stated = {(N, 0.9) for N in (15, 17, 19, 21)} | {(17, 1.0), (19, 1.0), (17, 1.1)}
-    stated |= {(N, 0.5) for N in (5, 13, 21)}
-    assert censored == stated
-    assert all(r["lifetime"] == 4e6 for r in rows if r["model"] == "sakaguchi" and r["end"] == "censored")
-    settled = [r["lifetime"] for r in rows if r["model"] == "sakaguchi" and r["end"] == "periodic"]
-    assert min(settled) == pytest.approx(8.6e4, rel=0.01) and max(settled) == pytest.approx(3.0e5, rel=0.01)
+def _same(a, b) -> bool:
+    """Equal structures, numbers to 1e-9 relative (NaN equal to NaN)."""
+    if isinstance(a, dict) and isinstance(b, dict):
+        return a.keys() == b.keys() and all(_same(a[k], b[k]) for k in a)
+    if isinstance(a, list | tuple) and isinstance(b, list | tuple):
+        return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b, strict=True))
+    if isinstance(a, float) or isinstance(b, float):
+        return b == pytest.approx(a, rel=1e-9, nan_ok=True)
+    return a == b
 
 
-def test_the_cost_per_time_unit_is_the_line_through_zero_of_the_rows():
-    rows = [r for r in SLICE["slice"] if r["measure"] == "lifetime" and r["model"] == "sakaguchi"]
-    t = [r["t_reached"] for r in rows]
-    c = [r["point_cpu_seconds"] for r in rows]
-    rate = sum(a * b for a, b in zip(t, c, strict=True)) / sum(a * a for a in t) * 1e6
-    assert len(rows) == 15 and rate == pytest.approx(SLICE["rates_cpu_seconds_per_1e6"]["eq. (4)"], abs=0.01)
-    assert f"{rate:.1f} s per 1e6 time units" in _text()
+def test_the_kept_findings_are_those_of_the_kept_rows():
+    assert FULL["meta"]["mode"] == "full" and FULL["meta"]["failed"] == 0
+    assert len(TABLE) == FULL["meta"]["points"] == len(lifetimes.build("full").points)
+    again = json.loads(json.dumps(lifetimes.conclusions(None, TABLE)))
+    for key in ("points", "exponents", "verdicts", "fits", "statements"):
+        assert _same(again[key], FULL["findings"][key]), key
 
 
-def test_the_page_states_the_estimate():
-    est = SLICE["estimate"]
-    text = _text()
-    central, upper = est["total_cpu_seconds"]["central"], est["total_cpu_seconds"]["upper"]
-    assert f"{round(central, -2):.0f} s of CPU time" in text and f"{round(upper, -2):.0f} s" in text
-    assert f"{round(central / 120)} minutes on two workers" in text.replace("or ", "")
-    assert f"{round(upper / 120)} minutes" in text
-    shares = {k: v["central"] / central for k, v in est["parts_cpu_seconds"].items()}
-    exps = sum(v for k, v in shares.items() if k.startswith("exp"))
-    assert f"{100 * exps:.0f} %" in text
-    assert f"{100 * shares['life sakaguchi beta=0.5']:.0f} %" in text
-    cal = SLICE["calibration"]
-    factor = cal["quick_measured_cpu_seconds_free_cores"] / cal["quick_estimated_cpu_seconds"]
-    assert f"a factor of {factor:.2f}" in text and cal["factor"] == round(factor, 2)
-    # about 45 minutes: the central minutes times the factor, to the nearest five
-    assert 5 * round(central / 120 * factor / 5) == 45 and "about 45 minutes on two free cores" in text
-    assert lifetimes.COST["full"].startswith("about 45 minutes on two free cores")
+def _chain_rows() -> dict[tuple[float, int], list[str]]:
+    rows = {}
+    for line in FOUND.splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if len(cells) == 7 and re.fullmatch(r"[\d.]+", cells[0]) and cells[1].isdigit():
+            rows[(float(cells[0]), int(cells[1]))] = cells
+    return rows
+
+
+def test_the_chains_table_is_the_findings():
+    rows = _chain_rows()
+    points = [p for p in FULL["findings"]["points"] if p["model"] == "sakaguchi"]
+    assert len(rows) == len(points) == 40
+    for p in points:
+        cells = rows[(p["beta"], p["N"])]
+        assert int(cells[2]) == p["ended"]
+        assert cells[6] == ", ".join(map(str, p["periods"]))
+        if p["ended"]:
+            assert cells[3] == f"{p['mean_T']:.3g} +- {p['mean_T_err']:.2g}"
+        else:
+            assert cells[3] == f"> {p['mean_T_low95']:.3g} (95 %)"
+        if p["weibull_shape"] is not None:
+            assert cells[4] == f"{p['weibull_shape']:.2f}"
+
+
+def test_the_fits_and_the_bounds_at_n_399_are_stated():
+    text, answer = _flat(FOUND), _flat(ANSWER)
+    for f in FULL["findings"]["fits"]:
+        if f["model"] != "sakaguchi" or "exponential" not in f:
+            continue
+        e, pw = f["exponential"], f["power"]
+        assert f"{e['slope']:.3g} +- {e['slope_err']:.2g}" in text
+        assert f"{pw['slope']:.3g} +- {pw['slope_err']:.2g}" in text
+        assert f"{e['chi2']:.3g} / {pw['chi2']:.3g} ({e['dof']})" in text
+        assert f"| {f['T_399_low95']:.3g} |" in text
+        # the answer's table rounds the same bound to two digits
+        assert f"| {f['beta']:g} | {f['T_399_low95']:.1e} |".replace("e+0", "e") in answer
+
+
+def test_the_exponents_are_stated_in_units_of_1e_4():
+    text = _flat(FOUND)
+    for e in FULL["findings"]["exponents"]:
+        if e["model"] == "sakaguchi":
+            assert f"{e['lyapunov'] * 1e4:+.2f} +- {e['lyapunov_err'] * 1e4:.2f}" in text
+
+
+def test_the_cost_is_the_measured_one():
+    meta = FULL["meta"]
+    section = _flat(re.search(r"^### What `--full` costs\n(.*?)(?=^## )", PAGE, re.S | re.M).group(1))
+    assert f"{meta['points']} points run, 0 failed, **{meta['wall_seconds']:.0f} s" in section
+    cpu = TABLE["point_cpu_seconds"].sum()
+    assert f"sums to {cpu:.0f} s" in section
+    # two free cores: the points' CPU time over two, and a few minutes more for compiling
+    assert f"some {cpu / 120:.0f} minutes of point work" in section and "**about 40 minutes**" in section
+    assert lifetimes.COST["full"].startswith("about 40 minutes on two free cores")

@@ -496,7 +496,8 @@ def tables(findings: dict[str, Any]) -> list[tuple[str, list[str], list[dict[str
 
 COST = {
     "quick": "about 5 minutes on two free cores (measured: 294 s)",
-    "full": "about 45 minutes on two free cores (estimated from a measured slice)",
+    "full": "about 40 minutes on two free cores (measured: 4317 s of CPU over its points; 61 minutes of wall "
+    "time beside a test run on the same two cores)",
 }
 
 
