@@ -210,8 +210,9 @@ DAMAGES = [
 ]
 
 
-# the rest: -m slow (each point run again, 20-30 s measured)
-_DEFAULT_DAMAGES = {"summary missing"}
+# each damaged point is run again (20-30 s, measured): -m slow; tests/test_rung_cache.py checks a
+# damaged rung in the default run
+_DEFAULT_DAMAGES: set[str] = set()
 
 
 @pytest.mark.parametrize(
