@@ -97,6 +97,7 @@ def test_a_fit_that_cannot_be_made_says_why(catalog):
         assert spanning["fits"] == [] and "a fit needs at least 10" in spanning["reason"]
 
 
+@pytest.mark.slow  # a run of its own for its catalogue (13 s, measured)
 def test_without_profiles_the_moment_rate_says_why(tmp_path, capsys):
     run = tmp_path / "run"
     assert main(["chain", "--N", "10", "--t-end", "4e4", "--out", str(run), "--no-progress"]) == 0
@@ -108,6 +109,7 @@ def test_without_profiles_the_moment_rate_says_why(tmp_path, capsys):
     assert "--profile-window" in skipped["moment_rate"]
 
 
+@pytest.mark.slow  # a second catalogue and a plot of the run (25 s, measured)
 def test_plot_and_catalog_give_the_same_tau(run_dir, catalog, tmp_path, capsys):
     _, data = catalog
     plot = _json(capsys, ["plot", str(run_dir), "--out", str(tmp_path / "fig")])

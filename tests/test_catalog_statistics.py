@@ -173,6 +173,7 @@ def test_vuong_closed_form_and_the_verdicts():
     assert verdicts["exponential"] == "exponential"
 
 
+@pytest.mark.slow  # a bootstrap of the KS statistic (about 11 s, measured)
 def test_ks_bootstrap_accepts_a_power_law_and_rejects_a_lognormal():
     S = _truncated_power_law(4, 2000, 1.5, 1.0, 1e4)
     assert mc.power_law_gof(S, 1e4, sims=40, seed=1)["p"] > 0.1

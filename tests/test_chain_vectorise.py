@@ -92,6 +92,7 @@ def _vector_ops(ir: str) -> list[tuple[str, int]]:
     return [(op, int(w)) for op, w in re.findall(r"= (fadd|fsub|fmul) <(\d+) x double>", ir)]
 
 
+@pytest.mark.slow  # the kernels compiled afresh for their IR (about 85 s, measured)
 @pytest.mark.parametrize("name", STAGES + ("run_exact",))
 def test_block_loops_use_vector_arithmetic_on_doubles(irs, name):
     ops = _vector_ops(irs[name])
@@ -103,6 +104,7 @@ def test_block_loops_use_vector_arithmetic_on_doubles(irs, name):
     assert sum(1 for op, _ in ops if op == "fmul") >= 4
 
 
+@pytest.mark.slow  # the kernels compiled afresh for their IR (about 85 s, measured)
 @pytest.mark.parametrize("name", ("_stage1", "_stage2", "run_exact"))
 def test_start_and_stop_rules_are_vector_selects(irs, name):
     ir = irs[name]
@@ -110,6 +112,7 @@ def test_start_and_stop_rules_are_vector_selects(irs, name):
     assert re.search(r"select <\d+ x i1>", ir)
 
 
+@pytest.mark.slow  # the kernels compiled afresh for their IR (about 85 s, measured)
 @pytest.mark.parametrize("name", LANES)
 def test_lanes_are_arithmetic_on_eight_doubles_with_masked_loads_and_stores(irs, name):
     ir = irs[name]
@@ -124,6 +127,7 @@ def test_lanes_are_arithmetic_on_eight_doubles_with_masked_loads_and_stores(irs,
     assert re.search(r"call void @llvm\.masked\.store\.v8f64", ir)
 
 
+@pytest.mark.slow  # the kernels compiled afresh for their IR (about 85 s, measured)
 @pytest.mark.parametrize("name", STAGES + LANES + ("run_exact", "run_dense"))
 def test_no_fast_math_flags(irs, name):
     ir = irs[name]

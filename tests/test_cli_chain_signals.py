@@ -71,6 +71,7 @@ def _assert_outputs_match(out_dir, reference, sha):
     assert_bits_equal(ds["t"].values, reference.samples["t"].values, "sample times")
 
 
+@pytest.mark.slow  # a chain killed and resumed in subprocesses (about 25 s, measured)
 @pytest.mark.parametrize("delay", [0.37, pytest.param(0.0, marks=pytest.mark.slow),
                                    pytest.param(0.8, marks=pytest.mark.slow)])  # fmt: skip
 def test_sigkill_then_resume_from_the_command_line(tmp_path, reference, delay):
@@ -88,7 +89,9 @@ def test_sigkill_then_resume_from_the_command_line(tmp_path, reference, delay):
     _assert_outputs_match(out_dir, reference, data["state_sha256"])
 
 
-@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT], ids=["SIGTERM", "SIGINT"])
+@pytest.mark.parametrize(
+    "sig", [pytest.param(signal.SIGTERM, marks=pytest.mark.slow), signal.SIGINT], ids=["SIGTERM", "SIGINT"]
+)  # SIGTERM repeats SIGINT's path (14 s, measured)
 def test_sigterm_sigint_write_a_checkpoint_and_exit_130(tmp_path, reference, sig):
     out_dir = tmp_path / "run"
     status, out, err = _launch_and_signal(out_dir, sig, delay=0.25 if sig == signal.SIGTERM else 0.6)
@@ -116,6 +119,7 @@ FAMILY = [
 ]
 
 
+@pytest.mark.slow  # a run per model killed and resumed (20-25 s each, measured)
 @pytest.mark.parametrize("model, t_end", FAMILY)
 def test_sigkill_then_resume_every_model(tmp_path, model, t_end):
     from stickslip.models.presets import PRESETS, chain_params

@@ -18,6 +18,7 @@ def _python(history, t_end):
     return run_chain(chain_params(N=5, drive="history", history=history), t_end, progress=False)
 
 
+@pytest.mark.slow  # steps run twice, by the command and in Python (about 90 s, measured)
 def test_steps_on_the_command_line_are_the_pythons_history(capsys):
     status, out, _ = run_cli(capsys, "chain", "--history", "1:20,0:10,2:20", "--N", "5", "--t-end", "50", "--json")
     assert status == 0

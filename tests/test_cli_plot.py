@@ -36,6 +36,7 @@ def run_dir(tmp_path_factory):
     return out
 
 
+@pytest.mark.slow  # every figure drawn (about 50 s, measured)
 def test_plot_draws_every_supported_figure(run_dir, capsys):
     capsys.readouterr()
     assert main(["plot", str(run_dir), "--json"]) == 0

@@ -60,6 +60,7 @@ def test_hysteresis_default(capsys):
     assert d["sweep"]["dV"] <= 0.005
 
 
+@pytest.mark.slow  # every output of the stability commands (about 18 s, measured)
 def test_outputs_written(capsys, tmp_path):
     d = run_json(capsys, "stability", "block", "--beta", "0.08", "--V", "0.2", "--out", str(tmp_path / "b"))
     assert (tmp_path / "b" / "stability_map.png").stat().st_size > 0

@@ -342,6 +342,7 @@ def test_overwrite_removes_only_this_packages_files(tmp_path, capsys):
     assert not (run / ".lock").exists() and not (run / ".lock.json").exists()
 
 
+@pytest.mark.slow  # a sweep run twice (about 12 s, measured)
 def test_sweep_reuses_its_own_folder_and_refuses_others(tmp_path, capsys):
     out = tmp_path / "sweep"
     argv = [

@@ -68,6 +68,7 @@ def test_identical_runs_never_decorrelate():
     assert row["decorrelated"] is False and row["events"] == res.reference_events > 40
 
 
+@pytest.mark.slow  # the located engine on two blocks, compiled here first (about 80 s, measured)
 def test_two_blocks_decorrelate_later_for_smaller_delta():
     params = chain_params("two-blocks")
     state = _after(params, "rest", 0.01, 500.0)
@@ -327,6 +328,7 @@ def test_cli_decorrelation_grid_rows_and_seeds(capsys):
     assert main(["lyapunov", "--N", "1", "--events", "10"]) == 2
 
 
+@pytest.mark.slow  # a thousand slips of N = 99 and four twins (15 s, measured)
 def test_a_thousand_slips_of_the_chain_in_minutes():
     """The chain of eq. (4), N = 99, beta = 0.5: 1000 slips of the reference and four twins on
     the engine's map (how long it takes is for the benchmarks to say)."""

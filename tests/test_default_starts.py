@@ -70,6 +70,7 @@ def test_the_refusal_foresees_what_the_engine_does(monkeypatch):
         run_chain(chain_params(N=1, friction="rate-state-slip", K=20), 10.0)
 
 
+@pytest.mark.slow  # every remedy's run (about 80 s, measured)
 def test_both_remedies_run():
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

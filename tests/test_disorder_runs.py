@@ -34,6 +34,7 @@ def full():
     return run
 
 
+@pytest.mark.slow  # Fs and beta per block compile a composition of their own (about 70 s, measured)
 def test_run_json_and_state_nc_carry_the_spec_the_hash_and_the_arrays(tmp_path, full):
     full.save(tmp_path / "r")
     meta = json.loads((tmp_path / "r" / "run.json").read_text())
@@ -51,6 +52,7 @@ def test_run_json_and_state_nc_carry_the_spec_the_hash_and_the_arrays(tmp_path, 
     assert loaded.events.equals(full.events)
 
 
+@pytest.mark.slow  # Fs and beta per block compile a composition of their own (about 70 s, measured)
 def test_resume_continues_the_same_medium_to_the_same_bits(tmp_path, full):
     run_chain(P, 700.0, out_dir=tmp_path, sample_interval=10.0, keep_checkpoint=True)
     run = resume_chain(tmp_path, t_end=T, expect_params=P)
@@ -60,6 +62,7 @@ def test_resume_continues_the_same_medium_to_the_same_bits(tmp_path, full):
         resume_chain(tmp_path, t_end=T + 100.0, expect_params=other)
 
 
+@pytest.mark.slow  # Fs and beta per block compile a composition of their own (about 70 s, measured)
 def test_a_checkpoint_whose_arrays_do_not_match_their_hash_is_refused(tmp_path):
     run_chain(P, 300.0, out_dir=tmp_path, keep_checkpoint=True)
     path = C.Checkpointer(tmp_path).state_path
@@ -70,6 +73,7 @@ def test_a_checkpoint_whose_arrays_do_not_match_their_hash_is_refused(tmp_path):
         resume_chain(tmp_path, t_end=400.0)
 
 
+@pytest.mark.slow  # Fs and beta per block compile a composition of their own (about 70 s, measured)
 def test_from_continues_the_medium_of_the_run_it_names(tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     argv = 'chain --N 6 --V 0.01 --Fs "uniform(2.5, 3.5)" --beta "normal(1, 0.1)" --disorder-seed 3 --t-end 300 --out a'
@@ -81,6 +85,7 @@ def test_from_continues_the_medium_of_the_run_it_names(tmp_path, monkeypatch, ca
     assert b.params.Fs == P.Fs and b.params.beta == P.beta
 
 
+@pytest.mark.slow  # Fs and beta per block compile a composition of their own (about 70 s, measured)
 def test_bench_disordered_reports_both_chains_in_one_run(monkeypatch, capsys):
     main(shlex.split("bench --workload disordered --N 6 --V 0.01 --t-end 200 --json"))
     out = json.loads(capsys.readouterr().out)

@@ -59,6 +59,16 @@ _MEASURED_SLOW = (
     "chain --model carlson-langer --friction strengthening --F0 0.5 --beta 1 --lattice square",
     "lab shs",
     "block --out fig-block --fig3",
+    # a single block on each rate-and-state law (each composition compiled here first; the laws'
+    # default-run tests are in tests/test_rate_state.py, test_prz_law.py, test_nagata_law.py)
+    "chain --friction rate-state --N 1 --K 20 --t-end 2000",
+    "chain --friction rate-state-prz --N 1 --K 20 --start steady",
+    "chain --friction rate-state-nagata --N 1 --K 20 --start steady",
+    "lab step --a 0.005 --b 0.01 --Dc 10",
+    # the square's first runs (tests/test_lattice_exact.py runs the square by default)
+    "chain --lattice square --shape 16x32",
+    "chain --model carlson-langer --lattice square --shape 16x16",
+    "chain --lattice square --shape 4x8 --history",
 )
 
 

@@ -44,11 +44,22 @@ def _double_sigint(out, gap, to_group):
 
 
 # (second Ctrl-C this long after the first, to the driver alone or to the whole group); before,
-# a second one while the driver stopped its points took 11 s and left ladders/stop-requested
+# a second one while the driver stopped its points took 11 s and left ladders/stop-requested.
+# The other gaps repeat the 0.4 s case, each a whole study in a subprocess (minutes on a loaded
+# 2-core machine): -m slow.
 CASES = [(0.05, False), (0.4, False), (1.0, False), (0.4, True)]
+SLOW_GAPS = {(0.05, False), (1.0, False)}
 
 
-@pytest.mark.parametrize("gap, to_group", CASES, ids=[f"{g:g}s-{'group' if t else 'driver'}" for g, t in CASES])
+@pytest.mark.parametrize(
+    "gap, to_group",
+    [
+        pytest.param(
+            g, t, id=f"{g:g}s-{'group' if t else 'driver'}", marks=pytest.mark.slow if (g, t) in SLOW_GAPS else ()
+        )
+        for g, t in CASES
+    ],
+)
 def test_a_second_ctrl_c_stops_at_once(gap, to_group, tmp_path):
     out = tmp_path / "studies"
     status, stdout, stderr = _double_sigint(out, gap, to_group)

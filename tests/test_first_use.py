@@ -74,6 +74,7 @@ def test_heartbeat_is_silent_on_a_terminal():
     assert out.getvalue() == ""
 
 
+@pytest.mark.slow  # a long chain off a terminal (13 s, measured)
 def test_a_long_chain_off_a_terminal_beats(monkeypatch, capsys):
     monkeypatch.setattr(heartbeat, "INTERVAL", 0.05)
     assert main(["chain", "--N", "49", "--t-end", "2e6", "--json"]) == 0

@@ -121,6 +121,7 @@ def test_a_sharply_peaked_renewal_fit_has_its_errors(seed):
     assert fit["errors"]["scale"] == pytest.approx(1.053 * scale / (c * math.sqrt(n)), rel=0.1)
 
 
+@pytest.mark.slow  # a run and its catalogue (about 20 s, measured)
 def test_catalog_of_a_two_blocks_run_reports_fits_or_their_reasons(tmp_path, capsys):
     """`stickslip catalog` on a two-blocks run crashed in the goodness of fit (OverflowError) and,
     with --gof-sims 0, reported tau = -77.4 and b = 8.69."""

@@ -81,13 +81,18 @@ WRITES = [
 ]
 
 
+#: Commands whose run is a sweep or a study (10 s or more, measured): all their files with -m slow.
+SLOW_WRITERS = {"study transition", "sweep block"}
+
+
 def _writes():
-    """One file of each command in the default run, the others with -m slow (each a fresh run)."""
+    """One file of each command but a sweep and a study in the default run, the others with -m slow
+    (each a fresh run)."""
     seen = set()
     for command, name in WRITES:
         first = command not in seen
         seen.add(command)
-        marks = () if first else pytest.mark.slow
+        marks = () if first and command.split(" --")[0] not in SLOW_WRITERS else pytest.mark.slow
         yield pytest.param(command, name, id=f"{command.split(' --')[0]}:{name}", marks=marks)
 
 
@@ -186,7 +191,12 @@ REAL = [
 ]
 
 
-@pytest.mark.parametrize("command", REAL, ids=[c.split(" --")[0] for c in REAL])
+# the chain by default; the other commands each write through the small file system (10-20 s
+# each, measured): -m slow
+@pytest.mark.parametrize(
+    "command",
+    [pytest.param(c, id=c.split(" --")[0], marks=() if k == 0 else pytest.mark.slow) for k, c in enumerate(REAL)],
+)
 def test_real_24k_file_system(command, tiny_fs):
     out = tiny_fs / "o"
     proc = subprocess.run(

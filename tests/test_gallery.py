@@ -12,9 +12,9 @@ import pytest
 
 GALLERY = Path(__file__).resolve().parent.parent / "docs" / "gallery"
 CELL = re.compile(r"^```\{code-cell\}[^\n]*\n(.*?)^```", re.S | re.M)
-#: Pages left to -m slow for the default run's time (about 20 s each on a busy two-core machine);
+#: Pages left to -m slow for the default run's time (10-20 s each on a busy two-core machine);
 #: the documentation build executes every page as well.
-SLOW: set[str] = {"transition", "sweep_dask", "sizes_two_models"}
+SLOW: set[str] = {"transition", "sweep_dask", "sizes_two_models", "stick_slip_inversion", "rate_state"}
 
 
 def pages() -> list:

@@ -93,6 +93,7 @@ def test_grid_holds_the_end_points():
     assert 0.345 in grid
 
 
+@pytest.mark.slow  # two finer, longer sweeps (about 15 s, measured)
 def test_V_up_converges_in_time_per_step_and_dV():
     """Finer steps and longer holds: V_up stays within 0.005 of the paper's 0.345."""
     for dV, T in ((0.001, 400.0), (0.005, 2000.0)):

@@ -7,6 +7,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 import stickslip
 from stickslip.kernels._cache import modules_digest
 
@@ -28,6 +30,7 @@ def _run(root: Path) -> str:
     return out.stdout.strip()
 
 
+@pytest.mark.slow  # a kernel compiled twice in a fresh cache (about 20 s, measured)
 def test_editing_a_called_module_recompiles_the_cached_kernel(tmp_path):
     # _first_trigger lives in triggers.py and inlines _pull from laws.py; numba's own stamp
     # covers triggers.py only and would load the kernel compiled before the edit.

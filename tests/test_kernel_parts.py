@@ -24,6 +24,7 @@ print(*(len(k.signatures) for k in (exact.run_exact, plate.run_sparse, dense.run
 """
 
 
+@pytest.mark.slow  # a fresh process with an empty cache compiles the model (about 100 s, measured)
 @pytest.mark.parametrize(
     ("model", "compiled"),
     [

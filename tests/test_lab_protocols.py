@@ -59,6 +59,7 @@ def test_cli_step_shs_and_outputs(capsys, tmp_path):
     assert len(d["holds"]) == 3 and d["healing_rate"] > 0.0
 
 
+@pytest.mark.slow  # a fit from the command line (25 s, measured)
 def test_cli_fit_of_a_csv_record(capsys, tmp_path):
     true = RateState(**LAB, k=1e-3)
     h = LoadHistory.steps([1.0, 10.0], [50.0, 100.0])

@@ -55,6 +55,7 @@ def _cf_units_of(path):
         return {name: ds[name].attrs["units"] for name in [*ds.variables] if "units" in ds[name].attrs}
 
 
+@pytest.mark.slow  # three commands run for their NetCDF files (about 14 s, measured)
 def test_every_units_string_is_cf(run_dir, tmp_path):
     """The CF conventions' own parser (cf-units) reads every units string the package writes."""
     cf_units = pytest.importorskip("cf_units")

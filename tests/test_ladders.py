@@ -260,6 +260,7 @@ def test_per_n_summary_averages_the_replicas_of_the_up_ladder():
     assert one["beta_t"] == 1.1 and one["beta_t_err"] == pytest.approx(0.01) and one["step_err"] == pytest.approx(0.001)
 
 
+@pytest.mark.slow  # a transition study or a ladder run to its end (20-45 s, measured)
 def test_tiny_transition_study_and_its_json(tmp_path):
     """The CLI end to end: rows and per-N fields in --json; a second call reuses every ladder."""
     out = tmp_path / "studies"
@@ -292,6 +293,7 @@ def test_extra_n_only_for_the_transition_study(tmp_path):
     assert not any(tmp_path.iterdir())
 
 
+@pytest.mark.slow  # a transition study or a ladder run to its end (20-45 s, measured)
 def test_the_transition_study_resumes_a_ladder_from_its_finished_rungs(tmp_path):
     """A ladder whose task was interrupted (no done.json) replays its finished rungs: the rows come
     back bit for bit and the rungs are not run again."""
@@ -334,6 +336,7 @@ def test_transition_loop_runs_the_studys_ladders_in_this_process(tmp_path):
 # --- the faster method measures the same thing --------------------------------------------------
 
 
+@pytest.mark.slow  # a transition study or a ladder run to its end (20-45 s, measured)
 def test_up_ladder_agrees_with_paper_start_runs_at_n49(tmp_path):
     """Below beta = 0.95 the up ladder's m at N = 49 agrees with runs of 4 loading times from the
     paper's start (second half) within 3 combined errors."""
@@ -372,6 +375,7 @@ def test_chain_from_the_final_state_of_another_run(tmp_path):
     assert bad.returncode == 2
 
 
+@pytest.mark.slow  # a transition study or a ladder run to its end (20-45 s, measured)
 def test_a_longer_run_of_a_rung_restarts_from_the_state_it_started_from(tmp_path):
     """write_checks on a finished tiny study: the longer run of an up-ladder rung starts from the
     state that rung started from (the hash its row records) and runs past the rung's own length."""

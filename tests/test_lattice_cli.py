@@ -97,6 +97,7 @@ def test_command_refusals_are_one_line(argv, names, capsys):
     one_line_error(capsys, *names)
 
 
+@pytest.mark.slow  # the bench on the square (about 13 s, measured)
 def test_bench_compares_dense_and_exact_on_the_square(capsys):
     code, stdout, _ = run_cli(
         capsys, "bench", "--model", "carlson-langer", "--lattice", "square", "--shape", "6x6",

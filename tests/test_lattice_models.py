@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 import pandas as pd
+import pytest
 import xarray as xr
 
 from chain_helpers import run_cli
@@ -79,6 +80,7 @@ def test_carlson_langer_under_the_plate_with_periodic_sides(capsys, tmp_path):
     assert (first["step_start"], first["epicentre_row"], first["epicentre_col"]) == (n, row, col)
 
 
+@pytest.mark.slow  # the square with the train's friction, compiled here first (23 s, measured)
 def test_burridge_knopoff_with_the_trains_friction_slides_steadily(capsys, tmp_path):
     """Plate drive and F0 + beta v (velocity strengthening) on the periodic square: steady sliding
     x = nu t - (F0 + beta nu) / Kp, v = nu is stable, so a perturbed start returns to it."""
@@ -94,6 +96,7 @@ def test_burridge_knopoff_with_the_trains_friction_slides_steadily(capsys, tmp_p
     np.testing.assert_allclose(x, nu * 60.0 - (F0 + beta * nu), rtol=0, atol=1e-9)
 
 
+@pytest.mark.slow  # the square with the train's friction, compiled here first (23 s, measured)
 def test_burridge_knopoff_with_the_trains_friction_sticks_and_slips(capsys, tmp_path):
     """The same model from rest with Fs = 1 above F0: stick-slip, each event's slip positive."""
     events, _ = _run(

@@ -118,6 +118,7 @@ def test_per_block_square_step_equals_the_plain_numpy_equations(preset, override
     assert (fin["stopped"] == (mov == 0.0)).all()
 
 
+@pytest.mark.slow  # disordered squares, each compiled here first (about 30 s, measured)
 def test_active_set_path_keeps_the_references_bits_with_disorder():
     """Carlson-Langer with drawn thresholds, plate springs and masses: exact (active set) equals
     dense."""
@@ -136,6 +137,7 @@ def test_active_set_path_keeps_the_references_bits_with_disorder():
     assert exact.events.equals(dense.events)
 
 
+@pytest.mark.slow  # disordered squares, each compiled here first (about 30 s, measured)
 def test_a_row_of_the_square_is_the_chains_per_block_run():
     """eq. (4) with thresholds and friction per block: a 1 x 12 square pulled at the left, free
     elsewhere, ends with the chain's state hash and events."""

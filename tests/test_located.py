@@ -113,6 +113,7 @@ def _closed_form_events(p: ChainParams, n: int) -> np.ndarray:
 SPRING_SLIDER = ChainParams(model="train", N=1, friction="strengthening", K=10.0, V=0.1, beta=0.0, F0=1.0, Fs=3.0)
 
 
+@pytest.mark.slow  # the located kernels compiled here first; three runs down to dt = 0.0025 (about 60 s, measured)
 def test_single_block_matches_the_closed_form_at_second_order():
     n = 10
     exact = _closed_form_events(SPRING_SLIDER, n)

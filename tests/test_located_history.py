@@ -28,6 +28,7 @@ def _history(N, history=STEPS, **kw):
     return chain_params("sakaguchi", N=N, drive="history", history=history, **kw)
 
 
+@pytest.mark.slow  # the located kernels with a history compile a composition of their own (about 60 s, measured)
 @pytest.mark.parametrize("N", [1, 5])
 def test_a_constant_velocity_history_is_the_constant_v_run(N):
     V = 0.001
@@ -55,6 +56,7 @@ def _position(t, times, positions):
     return min(positions[k] + slope * (t - times[k]), positions[k + 1])
 
 
+@pytest.mark.slow  # the located kernels with a history compile a composition of their own (about 60 s, measured)
 def test_a_start_after_a_hold_is_located_to_the_float():
     # One stuck block of eq. (4) (free ends: f = K (p(t) - x)); the load point is held at 0 until
     # t = 10.3, then moves at 0.01: the block starts where K (p(t) - x0) reaches Fs, inside a step.
@@ -85,6 +87,7 @@ def _after_zero(events):
     return events[events["t_start"] > 0.0].reset_index(drop=True)
 
 
+@pytest.mark.slow  # the located kernels with a history compile a composition of their own (about 60 s, measured)
 @pytest.mark.parametrize("N", [1, 4])
 def test_a_velocity_step_and_a_hold_converge_to_the_grid_run(N):
     # A start time moves by dx / V for a position error dx, so the grid's O(dt) errors in x show

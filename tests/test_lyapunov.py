@@ -111,6 +111,7 @@ def _heun_map_exponent(params: ChainParams) -> tuple[float, float]:
     return lam.real, math.log(abs(1 + z + z * z / 2)) / params.dt
 
 
+@pytest.mark.slow  # the exponent at the command's defaults (about 15 s, measured)
 def test_sliding_block_at_the_commands_defaults(capsys):
     """`stickslip lyapunov --N 1 --V 0.5 --json`: start paper, t_end 2e4, d0 1e-10, interval 10.
     Over an interval the separation decays by exp(-4.87), to 8e-13: below the rounding of

@@ -139,6 +139,7 @@ def test_progress_shows_only_where_someone_watches(monkeypatch):
     assert "t = 50/100" in err.getvalue() and "events=3" in err.getvalue()
 
 
+@pytest.mark.slow  # a notebook in a real kernel (about 12 s, measured)
 def test_a_notebook_shows_the_figures_and_the_progress_of_a_run(monkeypatch):
     """In a Jupyter kernel (the test extra installs one): a Figure that ends a cell is shown as an
     image though no pyplot figure came before it, and a run's bar goes to the cell's output."""

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pandas as pd
+import pytest
 
 from stickslip.plotting.chaos import decorrelation_figure, flow_ladder_figure, threshold_figure
 
@@ -98,6 +99,7 @@ def test_threshold_figure_draws_each_window_the_mean_and_the_fit():
     assert "beta = 0.5: -0.50 +- 0.30" in [t.get_text() for t in ax.get_legend().get_texts()]
 
 
+@pytest.mark.slow  # a chaos study's figures (about 15 s, measured)
 def test_study_draws_its_figures_and_the_rows_of_n_from_the_points_flow_json(tmp_path):
     from stickslip import io
     from stickslip.experiments.studies import design, study

@@ -127,6 +127,7 @@ def test_critical_stiffness_from_the_characteristic_cubic(V):
         assert (roots.real.max() > 0.0) == unstable
 
 
+@pytest.mark.slow  # two velocity steps integrated on the kernels' rate (about 14 s, measured)
 def test_velocity_step_omega_is_tanh_or_coth_of_the_slip():
     """Omega = v theta / (2 D_c) at a fixed velocity V1 from steady state at V0: d Omega/d(slip) =
     (1 - Omega^2) / (2 D_c), so Omega = tanh(s / 2 D_c + atanh(V1 / V0)) down, coth up. RK4 on

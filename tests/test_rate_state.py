@@ -260,6 +260,7 @@ def test_located_switches_run_the_law():
     assert len(run.events) >= 2 and (run.events["size"] > 0).all()
 
 
+@pytest.mark.slow  # stability and lyapunov on a rate-and-state block (about 60 s, measured)
 def test_command_line(capsys):
     status, out, _ = run_cli(capsys, "stability", "chain", "--friction", "rate-state", "--V", "0.01", "--json")
     assert status == 0

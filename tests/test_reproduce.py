@@ -101,6 +101,7 @@ def _done(out, spec, point):
     return out / "runs" / spec.dirname / "points" / figs1_4.point_name(point) / DONE_FILE
 
 
+@pytest.mark.slow  # experiments run end to end (20-40 s each, measured)
 def test_an_experiment_is_computed_once_and_reused(tmp_path):
     spec, point = _one("chain-modes")
     first = run_study(spec, tmp_path, n_workers=1, progress=False)
@@ -117,6 +118,7 @@ def test_an_experiment_is_computed_once_and_reused(tmp_path):
     assert run_study(spec, tmp_path, n_workers=1, progress=False)["reused"] == 1
 
 
+@pytest.mark.slow  # experiments run end to end (20-40 s each, measured)
 @pytest.mark.parametrize(
     "damage",
     [
@@ -151,6 +153,7 @@ def test_a_damaged_result_is_run_again(tmp_path, damage):
     assert run_study(spec, tmp_path, n_workers=1, progress=False)["reused"] == 1
 
 
+@pytest.mark.slow  # experiments run end to end (20-40 s each, measured)
 def test_a_result_of_another_spec_in_the_same_directory_is_not_reused(tmp_path):
     spec, point = _one("slip-limit")
     run_study(spec, tmp_path, n_workers=1, progress=False)
@@ -204,6 +207,7 @@ def tiny_run(tmp_path_factory):
     return out, json.loads(buf.getvalue())
 
 
+@pytest.mark.slow  # the tiny set (minutes on 2 cores); tests/test_report.py checks the report
 def test_report_has_a_row_for_every_stated_number(tiny_run):
     out, printed = tiny_run
     report = read_json(out / "report.json")
@@ -231,6 +235,7 @@ def test_report_has_a_row_for_every_stated_number(tiny_run):
         assert where in html
 
 
+@pytest.mark.slow  # the tiny set (minutes on 2 cores); tests/test_report.py checks the report
 def test_every_figure_is_drawn_with_png_pdf_and_data(tiny_run):
     out, printed = tiny_run
     report = read_json(out / "report.json")
@@ -271,6 +276,7 @@ def test_second_call_reuses_every_result_and_only_redraws(tiny_run, monkeypatch)
     assert [r["value"] for r in after["rows"]] == [r["value"] for r in before["rows"]]
 
 
+@pytest.mark.slow  # the tiny set (minutes on 2 cores); tests/test_report.py checks the report
 def test_chain_runs_of_the_tiny_set_are_on_disk_per_point(tiny_run):
     out, _ = tiny_run
     spec = figs5_8.build("tiny")
@@ -282,6 +288,7 @@ def test_chain_runs_of_the_tiny_set_are_on_disk_per_point(tiny_run):
     assert set(zip(table["N"], table["beta"], strict=True)) == {(p["N"], p["beta"]) for p in spec.points}
 
 
+@pytest.mark.slow  # the tiny set (minutes on 2 cores); tests/test_report.py checks the report
 def test_each_study_of_the_paper_has_its_page(tiny_run):
     out, _ = tiny_run
     small = {"fig1", "fig2", "fig3", "stability_map", "hysteresis", "fig4"}
@@ -376,6 +383,7 @@ def test_plot_reproduce_and_catalog_give_the_same_tau_on_the_same_run(tiny_run, 
         assert plotted["numbers"]["tau" if reading == "whole_range" else "tau_below_span"] == tau
 
 
+@pytest.mark.slow  # experiments run end to end (20-40 s each, measured)
 def test_a_study_of_the_paper_runs_alone_with_its_help(tmp_path, capsys):
     """`stickslip study figs1-4` runs the study of section 2 and Fig. 4 by itself, with the page
     `stickslip reproduce` writes for it; its --help says its grid, its cost and its outputs."""

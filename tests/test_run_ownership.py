@@ -40,6 +40,7 @@ def _tree(path):
     return sorted(str(p.relative_to(path)) for p in path.rglob("*"))
 
 
+@pytest.mark.slow  # commands raced against a held or stopped run (15-50 s each, measured)
 @pytest.mark.timeout(300)
 @pytest.mark.parametrize("command", ["catalog", "plot"])
 def test_a_reader_is_refused_while_a_run_holds_the_directory(command, run, capsys):
@@ -65,6 +66,7 @@ def test_a_reader_is_refused_while_a_run_holds_the_directory(command, run, capsy
     assert not (run / ".lock").exists()
 
 
+@pytest.mark.slow  # commands raced against a held or stopped run (15-50 s each, measured)
 @pytest.mark.timeout(300)
 def test_chain_overwrite_removes_the_replaced_runs_catalogue(run, capsys):
     assert main(["catalog", str(run), *FAST]) == 0
@@ -80,6 +82,7 @@ def test_chain_overwrite_removes_the_replaced_runs_catalogue(run, capsys):
     assert sorted(p.name for p in (run / "catalog").iterdir()) == ["notes.txt"]
 
 
+@pytest.mark.slow  # commands raced against a held or stopped run (15-50 s each, measured)
 def test_catalog_stopped_while_writing_leaves_the_folder_as_it_was(run, monkeypatch, capsys):
     """A stop (KeyboardInterrupt, as SIGINT raises) while the figures are drawn: no catalogue
     file appears; the next catalogue is whole and the staging folder is gone."""

@@ -176,6 +176,7 @@ FOREIGN = [
 ]
 
 
+@pytest.mark.slow  # these read a tiny transition study run for them (about 35 s, measured)
 @pytest.mark.parametrize("case, where", FOREIGN, ids=[c[0] for c in FOREIGN])
 def test_a_foreign_file_in_a_ladder_is_refused(case, where, transition, tmp_path, capsys):
     from stickslip.cli import main
@@ -194,6 +195,7 @@ def test_a_foreign_file_in_a_ladder_is_refused(case, where, transition, tmp_path
     assert {p: p.read_bytes() for p in out.rglob("*") if p.is_file()} == before
 
 
+@pytest.mark.slow  # these read a tiny transition study run for them (about 35 s, measured)
 def test_the_page_lists_a_rung_run_again(transition, tmp_path, capsys):
     """A damaged rung in a finished study: its ladder and the rung run again, and the page says so."""
     from stickslip.cli import main

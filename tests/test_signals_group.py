@@ -76,6 +76,7 @@ def reference():
     return run_chain(ChainParams(N=399), T_END, integrator="exact").summary["state_sha256"]
 
 
+@pytest.mark.slow  # a sweep of N = 399 chains in a process group (about 50 s, measured)
 @pytest.mark.parametrize(
     "sig", [signal.SIGTERM, pytest.param(signal.SIGINT, marks=pytest.mark.slow)], ids=["SIGTERM", "SIGINT"]
 )

@@ -153,6 +153,7 @@ def cluster():
     lc.close()
 
 
+@pytest.mark.slow  # a study on the module's cluster (about 25 s, measured)
 def test_tiny_study_end_to_end(tmp_path, cluster):
     first = run_study(_tiny(), tmp_path, scheduler=cluster, progress=False)
     assert first["failed"] == 0 and first["run"] == 2
@@ -171,6 +172,7 @@ def test_tiny_study_end_to_end(tmp_path, cluster):
     pd.testing.assert_frame_equal(_science(first["rows"]), _science(second["rows"]))
 
 
+@pytest.mark.slow  # a second study on the cluster (20 s, measured)
 def test_failed_point_is_reported_and_retried_alone(tmp_path, cluster):
     # K = 1e6 passes the checks made up front but makes Heun blow up: the run raises on its worker
     cell = {"N": 5, "alpha": 1.0, "D": 5.0, "t_end": 2000.0, "start": "paper"}
@@ -225,6 +227,7 @@ def test_existing_scheduler_gives_the_local_result(tmp_path):
                 proc.wait(timeout=30)
 
 
+@pytest.mark.slow  # a study in a subprocess (20 s or more, measured)
 def test_an_interrupted_study_stops_its_running_ladder(tmp_path):
     """SIGTERM to `stickslip study` (as a batch system's stop or `kill` sends it) while its worker
     runs a ladder of the transition study: the command ends (exit 130, one line), the ladder is
@@ -330,6 +333,7 @@ def test_tiny_chaos_study_end_to_end(tmp_path, cluster):
     assert [r["verdict_text"] for r in second["rows"]] == [r["verdict_text"] for r in rows]
 
 
+@pytest.mark.slow  # a chaos point run in a subprocess and stopped (about 100 s, measured)
 def test_an_interrupted_chaos_point_keeps_its_finished_parts(tmp_path):
     """A point whose task stopped after some parts runs only the others again, and gives the same
     row; a study's stop request stops it within a part; a part made with other settings is not

@@ -55,6 +55,7 @@ def test_depinning_force_is_the_first_sample_with_every_block_moving():
     assert math.isnan(depinning_force(t, [0, 3, 7, 7], 8, 2.0, 0.01))
 
 
+@pytest.mark.slow  # a ramp run to depinning (about 45 s, measured)
 def test_a_ramp_run_ends_where_the_chain_depins_and_loses_nothing(tmp_path):
     """A point of part b stops at the first sample with every block moving; the run to the
     ramp's end without the stop has the same event sizes and F_c (no event ends after depinning:

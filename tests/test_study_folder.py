@@ -210,7 +210,9 @@ DAMAGES = [
 ]
 
 
-_DEFAULT_DAMAGES = {"summary missing", "state.nc truncated", "summary edited"}  # the rest: -m slow
+# each damaged point is run again (20-30 s, measured): -m slow; tests/test_rung_cache.py checks a
+# damaged rung in the default run
+_DEFAULT_DAMAGES: set[str] = set()
 
 
 @pytest.mark.parametrize(
@@ -247,6 +249,7 @@ def _listening(proc) -> set[tuple[str, int]]:
     return found
 
 
+@pytest.mark.slow  # a local Dask cluster started per case (10 s each, measured)
 @pytest.mark.parametrize("dashboard", [False, True], ids=["default", "--dashboard"])
 def test_local_sweep_listens_on_loopback_only(dashboard, tmp_path, capsys):
     import psutil
@@ -281,6 +284,7 @@ def test_local_sweep_listens_on_loopback_only(dashboard, tmp_path, capsys):
 # The transition study (run by continuation in beta) owns its folder the same way
 
 
+@pytest.mark.slow  # a transition study run twice (about 40 s, measured)
 def test_transition_study_owns_its_folder(tmp_path, capsys):
     argv = ["study", "transition", "--tiny", "--workers", "1", "--no-progress", "--json"]
     out = tmp_path / "out"

@@ -177,6 +177,7 @@ def test_cli_bad_t_end_and_workers(tmp_path, capsys):
     assert not out.exists()
 
 
+@pytest.mark.slow  # a sweep of blocks from the command line (19 s, measured)
 def test_cli_block_sweep_json(tmp_path, capsys):
     out = tmp_path / "sweep"
     argv = [
@@ -209,6 +210,7 @@ def test_cli_block_sweep_json(tmp_path, capsys):
     assert json.loads(capsys.readouterr().out)["n_reused"] == 2
 
 
+@pytest.mark.slow  # a worker killed and its cluster restarted (13 s, measured)
 def test_a_point_that_kills_its_worker_is_recorded_and_the_others_finish(tmp_path):
     import dask
 
@@ -225,8 +227,10 @@ def test_a_point_that_kills_its_worker_is_recorded_and_the_others_finish(tmp_pat
     assert table.loc[["x=1", "x=3"], "value"].tolist() == [5.0, 15.0]
 
 
-# both end in the same except clause: one of them in the default run
-@pytest.mark.parametrize("signame", [pytest.param("SIGINT", marks=pytest.mark.slow), "SIGTERM"])
+# both end in the same except clause; each a sweep stopped and resumed in subprocesses (about
+# 20 s, measured): -m slow (tests/test_signals_group.py stops a sweep in the default run)
+@pytest.mark.slow
+@pytest.mark.parametrize("signame", ["SIGINT", "SIGTERM"])
 def test_an_interrupted_sweep_says_so_in_one_line_and_resumes(tmp_path, signame):
     """SIGINT or SIGTERM to the command alone (as ``timeout`` or ``kill`` send them) while its worker
     runs a chain: exit 130, one line on stderr, the directory left to the next call."""

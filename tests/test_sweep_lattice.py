@@ -37,6 +37,7 @@ def _steady_deficit_by_hand(K: float, V: float, alpha: float, beta: float, cols:
     return float(np.mean(np.cumsum([c / K * (cols - i + 1) for i in range(1, cols + 1)])))
 
 
+@pytest.mark.slow  # each point run again alone (about 13 s, measured)
 def test_each_point_measures_what_its_run_alone_gives(tmp_path, capsys):
     out = tmp_path / "sweep"
     argv = ["sweep", "chain", "--lattice", "square", "--shape", SHAPE, "--grid", "model=sakaguchi,carlson-langer",
