@@ -238,7 +238,8 @@ def find_period(
     # candidates in order: the same p, and the same comparisons counted, as trying p = 1, 2, ... in turn
     ps = np.arange(1, longest + 1)
     need = np.maximum(repeats * ps, ps + longest)
-    ps, need = ps[need <= n], need[need <= n]  # need grows with p: a prefix
+    fits = int(np.searchsorted(need, n, side="right"))  # need grows with p: the p that fit are a prefix
+    ps, need = ps[:fits], need[:fits]
     lo = n - need
     probe = np.maximum(lo, n - ps - _PROBE)
     i = n - ps[:, None] - np.arange(1, _PROBE + 1)[None, :]  # slip i against slip i + p, the last ones
