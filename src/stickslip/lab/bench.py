@@ -5,14 +5,17 @@ threshold) driven by a slide-hold-slide load history against the same run at a c
 
 The case is the field's standard velocity step: a = 0.005, b = 0.01, D_c = 10, mu0 = 0.6, V0 = 1,
 k = 1e-3, the load point stepping 1 -> 10 at t = 10, run to t = 100 with 1001 outputs, at rtol 1e-10
-in both. Each timing is the least of ``repeats`` runs after one run that compiles (wall-clock
-``perf_counter``; the fit's and the inertial route's CPU time, ``process_time``). How the
-numbers compare with the targets is in docs/lab.md and docs/performance.md.
+in both. Every timing is CPU time (``process_time``: on a shared machine wall-clock time counts the
+other processes' turns), after one run that compiles; a call of a millisecond or so is timed in
+batches long enough for the clock (:class:`timeit.Timer`'s ``autorange``), the three ways taken
+in turn in each of ``repeats`` rounds, and each keeps its least time per call. How the numbers
+compare with the targets is in docs/lab.md and docs/performance.md.
 """
 
 from __future__ import annotations
 
 import time
+import timeit
 
 import numpy as np
 
@@ -28,12 +31,15 @@ __all__ = ["bench", "inertial_history_cost"]
 CASE = dict(a=0.005, b=0.01, Dc=10.0, mu0=0.6, V0=1.0, k=1e-3)
 
 
-def _best(fn, repeats: int) -> float:
-    best = np.inf
+def _best_interleaved(fns: dict, repeats: int) -> dict:
+    """The least CPU time per call of each function, timed in turn in each of ``repeats`` rounds
+    (module docstring), so that a change of the machine's load falls on all of them alike."""
+    timers = {name: timeit.Timer(fn, timer=time.process_time) for name, fn in fns.items()}
+    number = {name: max(1, timer.autorange()[0]) for name, timer in timers.items()}
+    best = dict.fromkeys(fns, np.inf)
     for _ in range(repeats):
-        t0 = time.perf_counter()
-        fn()
-        best = min(best, time.perf_counter() - t0)
+        for name, timer in timers.items():
+            best[name] = min(best[name], timer.timeit(number[name]) / number[name])
     return best
 
 
@@ -130,9 +136,8 @@ def bench(repeats: int = 5) -> dict:
     arrays = lambda: solve(model, history, t, rtol=1e-10)
     ds = qs()
     mu_ref = ref()[0]
-    t_qs = _best(qs, repeats)
-    t_arrays = _best(arrays, repeats)
-    t_ref = _best(ref, repeats)
+    times = _best_interleaved({"qs": qs, "arrays": arrays, "ref": ref}, repeats)
+    t_qs, t_arrays, t_ref = times["qs"], times["arrays"], times["ref"]
     rec = synthetic(model, history, n=500, noise=1e-4, rng=0)
     start = model.with_values(a=0.007, b=0.007, Dc=5.0, mu0=0.59)
     fit(rec, start, ("a", "b", "Dc", "mu0"))  # compiles nothing new; warms the caches

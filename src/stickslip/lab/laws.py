@@ -33,7 +33,7 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from stickslip.lab.compiled import friction, rhs
+from stickslip.lab.compiled import friction, lab_laws, rhs
 from stickslip.models.params import ParameterError, check_number
 
 __all__ = ["LAWS", "RateState", "friction_of", "rhs", "steady_friction", "steady_theta"]
@@ -41,24 +41,25 @@ __all__ = ["LAWS", "RateState", "friction_of", "rhs", "steady_friction", "steady
 
 @dataclass(frozen=True)
 class Law:
-    """One state-evolution law: its name, code in :func:`rhs`, scale s of D_c and its equation."""
+    """One state-evolution law as the lab names it: its code in :func:`rhs` (its place among
+    :func:`~stickslip.lab.compiled.lab_laws`), its friction module (whose ``lab_rate`` :func:`rhs`
+    calls), the scale s of D_c, its equation and reference, and whether its rate reads the stress
+    rate (:class:`~stickslip.models.piece.LabLaw`)."""
 
     name: str
     code: int
+    module: str
     scale: float
     equation: str
     reference: str
+    reads_stress_rate: bool
 
 
-#: The evolution laws by name.
+#: The evolution laws by name: the friction laws that declare their lab form, each its own module
+#: (:data:`stickslip.models.pieces.FRICTIONS`).
 LAWS = {
-    law.name: law
-    for law in (
-        Law("aging", 0, 1.0, "dtheta/dt = 1 - v theta / D_c", "Dieterich 1979"),
-        Law("slip", 1, 1.0, "dtheta/dt = -(v theta / D_c) ln(v theta / D_c)", "Ruina 1983"),
-        Law("prz", 2, 2.0, "dtheta/dt = 1 - (v theta / 2 D_c)^2", "Perrin, Rice and Zheng 1995"),
-        Law("nagata", 3, 1.0, "dtheta/dt = 1 - v theta / D_c - (c / b) theta dtau/dt", "Nagata et al. 2012"),
-    )
+    p.lab.name: Law(p.lab.name, code, p.module, p.lab.scale, p.lab.equation, p.lab.reference, bool(p.context))
+    for code, p in enumerate(lab_laws())
 }
 
 #: The friction forms by name, and their code in :func:`rhs`.
@@ -165,11 +166,13 @@ class RateState:
         put("eta", check_number("eta", self.eta, low=0.0))
         if self.k is not None and not (isinstance(self.k, float | int) and self.k == math.inf):
             put("k", check_number("k", self.k, low=0.0, low_open=True))
-        if self.k == math.inf and "nagata" in law:
-            raise ParameterError("nagata's law needs a finite k (its rate reads the stress rate k (V - v))")
         for i, (name, bk) in enumerate(zip(law, self.b, strict=True)):
-            if name == "nagata" and bk == 0.0 and self.c[i] != 0.0:
-                raise ParameterError("nagata's law needs b != 0 where c != 0 (its term is (c / b) theta dtau/dt)")
+            if not LAWS[name].reads_stress_rate:
+                continue
+            if self.k == math.inf:
+                raise ParameterError(f"{name}'s law needs a finite k (its rate reads the stress rate k (V - v))")
+            if bk == 0.0 and self.c[i] != 0.0:
+                raise ParameterError(f"{name}'s law needs b != 0 where c != 0 (its term is (c / b) theta dtau/dt)")
 
     @property
     def n_states(self) -> int:
@@ -207,14 +210,13 @@ class RateState:
 
     def arrays(self):
         """The arguments of :func:`rhs` after ``t, y, out, vlp``."""
-        m = self.n_states
         codes = np.array([LAWS[n].code for n in self.law], dtype=np.int64)
         scale = np.array([LAWS[n].scale for n in self.law])
         b = np.array(self.b, dtype=float)
         cb = np.array([c / bk if c != 0.0 else 0.0 for c, bk in zip(self.c, self.b, strict=True)])
         return (
             self.a, self.mu0, self.V0, 0.0 if self.k is None else self.k, self.eta, FORMS[self.form],
-            b, np.array(self.Dc, dtype=float) * scale, cb, codes[:m],
+            b, np.array(self.Dc, dtype=float) * scale, cb, codes,
         )  # fmt: skip
 
     def summary(self) -> dict:

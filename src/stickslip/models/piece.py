@@ -158,6 +158,21 @@ class Linearisation:
 
 
 @dataclass(frozen=True)
+class LabLaw:
+    """A friction law's state evolution as the rock-friction lab writes it (:mod:`stickslip.lab.laws`):
+    its name there, the scale s of D_c in x = v theta / (s D_c) (so that x = 1 in steady sliding),
+    its equation and its reference. The law's module holds the compiled rate
+    ``lab_rate(x, th, cb, dtau)``: dtheta/dt from x, theta, c / b and the stress rate dtau/dt (the
+    last two read by the Nagata law only), which the lab's quasi-static right-hand side calls
+    (:mod:`stickslip.lab.compiled`)."""
+
+    name: str
+    scale: float
+    equation: str
+    reference: str
+
+
+@dataclass(frozen=True)
 class Piece:
     """One choice for one piece: its name, what it means, and the parameters it reads.
 
@@ -238,6 +253,9 @@ class Piece:
     steady_sliding: bool = True
     #: ends: the chain closes into a ring (x_0 = x_N, x_{N+1} = x_1)
     ring: bool = False
+    #: friction: its state law as the lab's quasi-static spring-slider runs it (module's
+    #: ``lab_rate``); None for a law the lab does not offer
+    lab: LabLaw | None = None
     #: ends: a spring to a wall at x = 0, which moves at -V in the frame of the drive, so the
     #: equations read t there (the other ends leave them autonomous in that frame)
     wall: bool = False

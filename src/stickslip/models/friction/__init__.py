@@ -13,6 +13,10 @@ A law's module defines
 * for a law whose rate reads the stress rate (the Nagata law), ``rate(thl, th, thr, v, lp, ctx)``
   with ``ctx.stress_rate`` the rate of the elastic force on the block, and ``PIECE.context =
   ("stress_rate",)``: only its kernels build the context (:func:`stickslip.kernels.laws._dtheta_in`);
+* for a law the rock-friction lab offers, ``lab_rate(x, th, cb, dtau)``, its dtheta/dt as the
+  lab's quasi-static spring-slider evaluates it (:mod:`stickslip.lab.compiled`), and
+  ``PIECE.lab``, its :class:`~stickslip.models.piece.LabLaw` (the name :data:`stickslip.lab.LAWS`
+  lists it under);
 * ``PIECE``, a :class:`~stickslip.models.piece.Piece` carrying its name, meaning, parameters and
   their checks, steady sliding, start value of theta, linearisation and figure label.
 

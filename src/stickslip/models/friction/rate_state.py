@@ -28,7 +28,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from stickslip.models.piece import Linearisation, Param, Piece, kernel_params, njit
+from stickslip.models.piece import LabLaw, Linearisation, Param, Piece, kernel_params, njit
 
 READS = ("rs_a", "rs_b", "Dc", "v0", "mu0", "sigma_n")
 Params = kernel_params(__name__, READS)
@@ -75,6 +75,13 @@ def rate_lap(lap, th, v, lp):
     """:func:`rate`, which reads no neighbour: the law has no diffusion of theta (``lap`` unread;
     :mod:`stickslip.models.lattice`)."""
     return rate(th, th, th, v, lp)
+
+
+@njit(cache=True, inline="always")
+def lab_rate(x, th, cb, dtau):
+    """The aging law as the lab writes it, dtheta/dt = 1 - x with x = v theta / D_c
+    (:class:`~stickslip.models.piece.LabLaw`; ``cb``, ``dtau`` unread)."""
+    return 1.0 - x
 
 
 def psi(p: Any, theta: float) -> float:
@@ -175,6 +182,7 @@ PIECE = Piece(
     steady=steady_sliding,
     linear=linearised,
     module=__name__,
+    lab=LabLaw("aging", 1.0, "dtheta/dt = 1 - v theta / D_c", "Dieterich 1979"),
     stability_extras=extras,
     label=r"$\sigma_n\,[\mu_0 + a \ln(v/v_0) + b \ln(v_0\theta/D_c)]$",
 )

@@ -35,7 +35,7 @@ from __future__ import annotations
 from typing import Any
 
 from stickslip.models.friction import rate_state as aging
-from stickslip.models.piece import Param, Piece, kernel_params, njit
+from stickslip.models.piece import LabLaw, Param, Piece, kernel_params, njit
 
 READS = (*aging.READS, "rs_c")
 Params = kernel_params(__name__, READS)
@@ -58,6 +58,14 @@ def rate(thl, th, thr, v, lp, ctx):
     if lp.rs_c != 0.0:
         w = lp.rs_c / lp.rs_b * th * ctx.stress_rate / lp.sigma_n
     return (1.0 - v * th / lp.Dc) - w
+
+
+@njit(cache=True, inline="always")
+def lab_rate(x, th, cb, dtau):
+    """The Nagata law as the lab writes it, dtheta/dt = 1 - x - (c / b) theta dtau/dt with
+    x = v theta / D_c, ``cb`` = c / b and ``dtau`` the rate of the spring's friction k (V - v)
+    (:class:`~stickslip.models.piece.LabLaw`)."""
+    return 1.0 - x - cb * th * dtau
 
 
 def steady_sliding(p: Any) -> tuple[float, float]:
@@ -136,6 +144,7 @@ PIECE = Piece(
     steady=steady_sliding,
     linear=linearised,
     module=__name__,
+    lab=LabLaw("nagata", 1.0, "dtheta/dt = 1 - v theta / D_c - (c / b) theta dtau/dt", "Nagata et al. 2012"),
     stability_extras=extras,
     label=r"$\sigma_n\,[\mu_0 + a \ln(v/v_0) + b \ln(v_0\theta/D_c)]$, Nagata law",
 )

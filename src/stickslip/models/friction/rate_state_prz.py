@@ -33,7 +33,7 @@ import math
 from typing import Any
 
 from stickslip.models.friction import rate_state as aging
-from stickslip.models.piece import Linearisation, Piece, kernel_params, njit
+from stickslip.models.piece import LabLaw, Linearisation, Piece, kernel_params, njit
 
 READS = aging.READS
 Params = kernel_params(__name__, READS)
@@ -59,6 +59,13 @@ def rate_lap(lap, th, v, lp):
     """:func:`rate`, which reads no neighbour: the law has no diffusion of theta (``lap`` unread;
     :mod:`stickslip.models.lattice`)."""
     return rate(th, th, th, v, lp)
+
+
+@njit(cache=True, inline="always")
+def lab_rate(x, th, cb, dtau):
+    """The PRZ law as the lab writes it, dtheta/dt = 1 - x^2 with x = v theta / (2 D_c)
+    (:class:`~stickslip.models.piece.LabLaw`, scale 2; ``cb``, ``dtau`` unread)."""
+    return 1.0 - x * x
 
 
 def steady_sliding(p: Any) -> tuple[float, float]:
@@ -108,6 +115,7 @@ PIECE = Piece(
     steady=steady_sliding,
     linear=linearised,
     module=__name__,
+    lab=LabLaw("prz", 2.0, "dtheta/dt = 1 - (v theta / 2 D_c)^2", "Perrin, Rice and Zheng 1995"),
     stability_extras=aging.extras,
     label=r"$\sigma_n\,[\mu_0 + a \ln(v/v_0) + b \ln(v_0\theta/2D_c)]$, PRZ law",
 )

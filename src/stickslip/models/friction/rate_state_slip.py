@@ -25,7 +25,7 @@ from __future__ import annotations
 import math
 
 from stickslip.models.friction import rate_state as aging
-from stickslip.models.piece import Piece, kernel_params, njit
+from stickslip.models.piece import LabLaw, Piece, kernel_params, njit
 
 READS = aging.READS
 Params = kernel_params(__name__, READS)
@@ -55,6 +55,16 @@ def rate_lap(lap, th, v, lp):
     return rate(th, th, th, v, lp)
 
 
+@njit(cache=True, inline="always")
+def lab_rate(x, th, cb, dtau):
+    """Ruina's slip law as the lab writes it, dtheta/dt = -x ln x with x = v theta / D_c, 0 at x = 0
+    (:class:`~stickslip.models.piece.LabLaw`; ``cb``, ``dtau`` unread)."""
+    g = 0.0
+    if x > 0.0:
+        g = -x * math.log(x)
+    return g
+
+
 PIECE = Piece(
     "friction",
     "rate-state-slip",
@@ -69,6 +79,7 @@ PIECE = Piece(
     steady=aging.steady_sliding,
     linear=aging.linearised,
     module=__name__,
+    lab=LabLaw("slip", 1.0, "dtheta/dt = -(v theta / D_c) ln(v theta / D_c)", "Ruina 1983"),
     stability_extras=aging.extras,
     label=r"$\sigma_n\,[\mu_0 + a \ln(v/v_0) + b \ln(v_0\theta/D_c)]$, slip law",
 )
