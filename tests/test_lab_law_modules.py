@@ -71,3 +71,26 @@ def test_two_state_variables_each_follow_their_own_law():
     x1, x2 = v * 7.0 / 10.0, v * 30.0 / 50.0
     assert out[1] == pytest.approx(1.0 - x1 * x1, rel=1e-12)
     assert out[2] == pytest.approx(-x2 * math.log(x2), rel=1e-12)
+
+
+def test_the_lab_is_cached_where_an_edit_to_a_law_compiles_it_afresh(tmp_path):
+    """The lab's compiled functions call the laws' modules, so they are cached in the directory
+    named by the digest of the kernels and the model modules (``stickslip.kernels._cache``), not
+    beside ``lab/compiled.py`` (where numba would stamp them with that file alone)."""
+    import os
+    import subprocess
+    import sys
+
+    from stickslip.kernels import _cache
+
+    code = (
+        "from stickslip.lab import RateState\n"
+        "from stickslip.lab.laws import friction_of\n"
+        "print(friction_of(RateState(a=0.005, b=0.01, Dc=10.0, mu0=0.6, V0=1.0), 2.0, 5.0))\n"
+    )
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
+    assert float(out.stdout) == pytest.approx(0.6 + 0.005 * math.log(2.0) + 0.01 * math.log(0.5), rel=1e-12)
+    digest_dir = tmp_path / f"stickslip-{_cache.DIGEST[:20]}"
+    cached = [p.name for p in digest_dir.rglob("compiled.friction-*.nbi")]
+    assert cached, sorted(p.name for p in tmp_path.rglob("*"))[:20]

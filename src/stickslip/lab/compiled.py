@@ -21,20 +21,23 @@ import numpy as np
 from numba import njit
 from numba.extending import overload
 
+import stickslip.kernels  # noqa: F401  (the digest's cache directory, set before numba decorates below)
 
-@njit(cache=True)
-def psi_of(th, mu0, V0, b, sdc):
-    """psi = mu0 + sum_k b_k ln(V0 theta_k / (s_k D_c,k)) (``sdc`` holds s_k D_c,k)."""
+
+@njit(cache=True, inline="always")
+def psi_of(th, first, mu0, V0, b, sdc):
+    """psi = mu0 + sum_k b_k ln(V0 theta_k / (s_k D_c,k)) with theta_k = th[first + k] (``sdc``
+    holds s_k D_c,k): the state read in place, from the right-hand side's y or a theta array."""
     psi = mu0
-    for i in range(th.size):
-        psi += b[i] * math.log(V0 * th[i] / sdc[i])
+    for i in range(b.size):
+        psi += b[i] * math.log(V0 * th[first + i] / sdc[i])
     return psi
 
 
 @njit(cache=True)
 def friction(v, th, a, mu0, V0, form, b, sdc):
     """mu(v, theta) in the log form (form 0) or the asinh form (form 1) (:mod:`stickslip.lab.laws`)."""
-    psi = psi_of(th, mu0, V0, b, sdc)
+    psi = psi_of(th, 0, mu0, V0, b, sdc)
     if form == 0:
         return psi + a * math.log(v / V0)
     return a * math.asinh(v / (2.0 * V0) * math.exp(psi / a))
@@ -144,9 +147,7 @@ def rhs(t, y, out, vlp, a, mu0, V0, k, eta, form, b, sdc, cb, codes):
         v = vlp
         dtau = 0.0
     else:
-        psi = mu0
-        for i in range(b.size):
-            psi += b[i] * math.log(V0 * y[i + 1] / sdc[i])
+        psi = psi_of(y, 1, mu0, V0, b, sdc)
         v = slip_rate(y[0], psi, a, V0, eta, form)
         dtau = k * (vlp - v)
     out[0] = dtau
