@@ -458,3 +458,21 @@ def record_lock_tries(monkeypatch) -> list:
 
     monkeypatch.setattr(filelock.FileLock, "acquire", spy)
     return tries
+
+
+def same_findings(a, b, *, none_is_nan: bool = False) -> bool:
+    """Equal structures, numbers to 1e-9 relative, NaN equal to NaN (and to None where
+    ``none_is_nan``, as a study's JSON writes NaN): a study's findings derived again against the
+    ones kept beside its page."""
+    import pytest
+
+    nan = lambda x: isinstance(x, float) and math.isnan(x)
+    if none_is_nan and (a is None or b is None or nan(a) or nan(b)):
+        return (a is None or nan(a)) and (b is None or nan(b))
+    if isinstance(a, dict) and isinstance(b, dict):
+        return a.keys() == b.keys() and all(same_findings(a[k], b[k], none_is_nan=none_is_nan) for k in a)
+    if isinstance(a, list | tuple) and isinstance(b, list | tuple):
+        return len(a) == len(b) and all(same_findings(x, y, none_is_nan=none_is_nan) for x, y in zip(a, b, strict=True))
+    if isinstance(a, float) or isinstance(b, float):
+        return b == pytest.approx(a, rel=1e-9, nan_ok=True)
+    return a == b

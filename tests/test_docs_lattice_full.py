@@ -10,8 +10,8 @@ import re
 from pathlib import Path
 
 import pandas as pd
-import pytest
 
+from chain_helpers import same_findings
 from stickslip.experiments.studies import lattice, study
 
 STUDIES = Path(__file__).resolve().parent.parent / "docs" / "studies"
@@ -19,21 +19,6 @@ FULL = json.loads((STUDIES / "lattice-full.json").read_text())
 TABLE = pd.read_parquet(STUDIES / "lattice-full-table.parquet")
 PAGE = (STUDIES / "lattice.md").read_text()
 FOUND = re.search(r"^## What `--full` found\n(.*?)(?=^## )", PAGE, re.S | re.M).group(1)
-
-
-def _same(a, b) -> bool:
-    """Equal structures, numbers to 1e-9 relative (NaN equal to NaN and to None, as the study's
-    JSON writes it)."""
-    nan = lambda x: x is None or (isinstance(x, float) and math.isnan(x))
-    if nan(a) or nan(b):
-        return nan(a) and nan(b)
-    if isinstance(a, dict) and isinstance(b, dict):
-        return a.keys() == b.keys() and all(_same(a[k], b[k]) for k in a)
-    if isinstance(a, list | tuple) and isinstance(b, list | tuple):
-        return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b, strict=True))
-    if isinstance(a, float) or isinstance(b, float):
-        return b == pytest.approx(a, rel=1e-9, nan_ok=True)
-    return a == b
 
 
 def _rows(ncells: int) -> list[list[str]]:
@@ -62,7 +47,7 @@ def test_the_kept_findings_are_those_of_the_kept_rows():
     assert len(TABLE) == FULL["points"] == len(study("lattice", "full").points)
     again = json.loads(json.dumps(lattice.findings(study("lattice", "full"), TABLE)))
     for key in ("statements", "edges", "rungs", "fits"):
-        assert _same(again[key], FULL["findings"][key]), key
+        assert same_findings(again[key], FULL["findings"][key], none_is_nan=True), key
 
 
 def test_the_pages_edges_table_is_the_findings():

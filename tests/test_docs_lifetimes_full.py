@@ -10,8 +10,8 @@ import re
 from pathlib import Path
 
 import pandas as pd
-import pytest
 
+from chain_helpers import same_findings
 from stickslip.experiments.studies import lifetimes
 
 STUDIES = Path(__file__).resolve().parent.parent / "docs" / "studies"
@@ -26,23 +26,12 @@ def _flat(text: str) -> str:
     return " ".join(text.split())
 
 
-def _same(a, b) -> bool:
-    """Equal structures, numbers to 1e-9 relative (NaN equal to NaN)."""
-    if isinstance(a, dict) and isinstance(b, dict):
-        return a.keys() == b.keys() and all(_same(a[k], b[k]) for k in a)
-    if isinstance(a, list | tuple) and isinstance(b, list | tuple):
-        return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b, strict=True))
-    if isinstance(a, float) or isinstance(b, float):
-        return b == pytest.approx(a, rel=1e-9, nan_ok=True)
-    return a == b
-
-
 def test_the_kept_findings_are_those_of_the_kept_rows():
     assert FULL["meta"]["mode"] == "full" and FULL["meta"]["failed"] == 0
     assert len(TABLE) == FULL["meta"]["points"] == len(lifetimes.build("full").points)
     again = json.loads(json.dumps(lifetimes.conclusions(None, TABLE)))
     for key in ("points", "exponents", "verdicts", "fits", "statements"):
-        assert _same(again[key], FULL["findings"][key]), key
+        assert same_findings(again[key], FULL["findings"][key]), key
 
 
 def _chain_rows() -> dict[tuple[float, int], list[str]]:
