@@ -57,7 +57,7 @@ def test_rhs_evaluates_each_laws_own_module_and_its_written_form(law):
         # the module's own function, called from Python, gives the compiled result to the bit
         assert out[1] == importlib.import_module(LAWS[law].module).lab_rate.py_func(x, th, cb, dtau)
         py = np.empty(2)
-        law_rates(args[-1], v, y, args[7], args[8], dtau, py)
+        law_rates(args[9], v, y, 1, args[7], args[8], dtau, py)
         assert py[1] == out[1]
 
 

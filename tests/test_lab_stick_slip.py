@@ -151,7 +151,7 @@ def test_cli_invert_json_and_outputs(capsys, tmp_path):
         (["--M", "1e-2", "--observables", "period,size"], "observables must be distinct names"),
         (["--M", "1e-2", "--window", "5,1"], "--window must be two times"),
         (["--M", "1e-2", "--cycles", "--free", "Dc"], "needs the load-point velocity V"),
-        (["--M", "1e-2", "--law", "aging,slip", "--b", "0.01,0.002", "--Dc", "1,10"], "one state variable"),
+        (["--M", "1e-2", "--free", "a,b2"], "b2: the model has 1 state variable"),
     ],
 )
 def test_cli_invert_bad_input_one_line_exit_2(capsys, tmp_path, extra, message):

@@ -34,6 +34,8 @@ DOCTEST_MODULES = (
     "stickslip.run.rundir",
     "stickslip.run.block",
     "stickslip.lab.cycles",
+    "stickslip.lab.spring_slider",
+    "stickslip.lab.inertial_ode",
     "stickslip.plotting",
     "stickslip.experiments.studies.transition",
     "stickslip.experiments.sweep",

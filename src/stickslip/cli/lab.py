@@ -72,6 +72,12 @@ def _model(args):
     )  # fmt: skip
 
 
+def _mass_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--M", type=float_arg("M"), default=0.0,
+                   help="mass per unit normal stress: 0 (default) for the quasi-static spring-slider, > 0 for the "
+                        "inertial one (any number of state variables; docs/lab.md)")  # fmt: skip
+
+
 def _out_options(p: argparse.ArgumentParser, stem: str) -> None:
     p.add_argument("--out", default=None, metavar="DIR",
                    help=f"write {stem}.nc, {stem}.json, the figure {stem}.png/.pdf and the page "
@@ -93,12 +99,13 @@ def register(sub) -> None:
     s = ls.add_parser(
         "step",
         help="velocity steps of the load point",
-        description="The quasi-static spring-slider through steps of the load-point velocity.",
+        description="The spring-slider (quasi-static, or inertial with --M) through steps of the load-point velocity.",
     )
     _add_law_options(s, k_help="stiffness k in friction per unit displacement (> 0)")
     s.add_argument("--V", type=_floats("V"), default=[1.0, 10.0], help="load-point velocities in turn (default 1,10)")
     s.add_argument("--displacement", type=float_arg("displacement"), default=None,
                    help="load-point displacement at each velocity (default 20 D_c)")  # fmt: skip
+    _mass_option(s)
     _out_options(s, "step")
     s.set_defaults(handler=run_step)
 
@@ -110,6 +117,7 @@ def register(sub) -> None:
                    help="hold times (default 1,3,10,30,100,300,1000)")  # fmt: skip
     h.add_argument("--slide", type=float_arg("slide"), default=None,
                    help="load-point displacement of each slide (default 20 D_c)")  # fmt: skip
+    _mass_option(h)
     _out_options(h, "shs")
     h.set_defaults(handler=run_shs)
 
@@ -238,7 +246,7 @@ def run_step(args) -> Result:
     own = OUT_FILES["lab step"]
     with owned_out_dir(args.out, own, "stickslip lab step", overwrite=args.overwrite) as out:
         ds, data = _integration(
-            velocity_step, model, args.V, displacement=args.displacement, rtol=args.rtol, method=args.method
+            velocity_step, model, args.V, displacement=args.displacement, rtol=args.rtol, method=args.method, M=args.M
         )
         lines = _step_lines(data)
         if out is not None:
@@ -251,7 +259,8 @@ def run_step(args) -> Result:
 
 
 def _step_lines(data: dict) -> list[str]:
-    lines = [f"velocity steps {', '.join(f'{v:g}' for v in data['velocities'])}; k_c = {data['k_c']:.6g}"]
+    mass = f"; inertial, M = {data['M']:g}" if data.get("M") else ""
+    lines = [f"velocity steps {', '.join(f'{v:g}' for v in data['velocities'])}; k_c = {data['k_c']:.6g}{mass}"]
     for st in data["steps"]:
         lines.append(
             f"V {st['V_before']:g} -> {st['V_after']:g} at t = {st['t']:g}: mu {st['mu_before']:.6f}, "
@@ -270,7 +279,7 @@ def run_shs(args) -> Result:
     own = OUT_FILES["lab shs"]
     with owned_out_dir(args.out, own, "stickslip lab shs", overwrite=args.overwrite) as out:
         ds, data = _integration(
-            slide_hold_slide, model, args.V, args.holds, slide=args.slide, rtol=args.rtol, method=args.method
+            slide_hold_slide, model, args.V, args.holds, slide=args.slide, rtol=args.rtol, method=args.method, M=args.M
         )
         lines = _shs_lines(data)
         if out is not None:
@@ -284,7 +293,8 @@ def run_shs(args) -> Result:
 
 
 def _shs_lines(data: dict) -> list[str]:
-    lines = [f"slide-hold-slide at V = {data['V']:g}", "   t_hold     mu_peak    Delta mu   relaxation"]
+    mass = f"; inertial, M = {data['M']:g}" if data.get("M") else ""
+    lines = [f"slide-hold-slide at V = {data['V']:g}{mass}", "   t_hold     mu_peak    Delta mu   relaxation"]
     for r in data["holds"]:
         lines.append(f"{r['t_hold']:9.4g}  {r['mu_peak']:.6f}  {r['delta_mu']:.6f}  {r['relaxation']:.6f}")
     if data["healing_rate"] is not None:

@@ -8,6 +8,7 @@ plotting, the reports or the command line.
 - :class:`RateState`: rate-and-state friction in the lab's conventions, any number of state
   variables, each with its own law (aging, slip, PRZ, Nagata), log or asinh form;
 - :func:`quasi_static`: the massless spring-slider k (p - x) = mu + eta v over a history;
+- :func:`inertial_slider`: the spring-slider with a mass M, any number of state variables, adaptive;
 - :func:`critical_stiffness`: k_c of steady sliding, one or more state variables;
 - :func:`fit`: least-squares fits of records, with standard errors and correlations;
 - :mod:`stickslip.lab.protocols`: velocity steps and slide-hold-slide tests as one call;
@@ -18,6 +19,7 @@ plotting, the reports or the command line.
 
 from stickslip.lab.fitting import FitResult, fit
 from stickslip.lab.history import LoadHistory
+from stickslip.lab.inertial_ode import inertial_slider
 from stickslip.lab.inversion import StickSlipResult, invert_stick_slip
 from stickslip.lab.laws import LAWS, RateState, steady_friction, steady_theta
 from stickslip.lab.protocols import slide_hold_slide, velocity_step
@@ -35,6 +37,7 @@ __all__ = [
     "critical_stiffness",
     "detrend",
     "fit",
+    "inertial_slider",
     "invert_stick_slip",
     "quasi_static",
     "slide_hold_slide",

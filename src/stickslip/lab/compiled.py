@@ -84,16 +84,17 @@ def lab_laws() -> tuple:
     return tuple(p for p in PIECES["friction"] if p.lab is not None)
 
 
-def law_rates(codes, v, y, sdc, cb, dtau, out):
-    """out[k + 1] = dtheta_k/dt of each state variable theta_k = y[k + 1]: the ``lab_rate(x_k,
-    theta_k, c_k / b_k, dtau/dt)`` of the law of code ``codes[k]`` (:func:`lab_laws`),
-    x_k = v theta_k / (s_k D_c,k) with ``sdc`` holding s_k D_c,k (:mod:`stickslip.lab.laws`)."""
+def law_rates(codes, v, y, first, sdc, cb, dtau, out):
+    """out[first + k] = dtheta_k/dt of each state variable theta_k = y[first + k]: the
+    ``lab_rate(x_k, theta_k, c_k / b_k, dtau/dt)`` of the law of code ``codes[k]``
+    (:func:`lab_laws`), x_k = v theta_k / (s_k D_c,k) with ``sdc`` holding s_k D_c,k
+    (:mod:`stickslip.lab.laws`)."""
     import importlib
 
     laws = lab_laws()
     for i in range(codes.size):
         rate = importlib.import_module(laws[codes[i]].module).lab_rate
-        out[i + 1] = rate(v * y[i + 1] / sdc[i], y[i + 1], cb[i], dtau)
+        out[first + i] = rate(v * y[first + i] / sdc[i], y[first + i], cb[i], dtau)
 
 
 def _pick_from(rates, j):
@@ -117,32 +118,62 @@ def _pick_from(rates, j):
 
 
 @overload(law_rates)
-def _law_rates(codes, v, y, sdc, cb, dtau, out):
+def _law_rates(codes, v, y, first, sdc, cb, dtau, out):
     import importlib
 
     pick = _pick_from(tuple(importlib.import_module(p.module).lab_rate for p in lab_laws()), 0)
 
-    def impl(codes, v, y, sdc, cb, dtau, out):
+    def impl(codes, v, y, first, sdc, cb, dtau, out):
         for i in range(codes.size):
-            th = y[i + 1]
-            out[i + 1] = pick(codes[i], v * th / sdc[i], th, cb[i], dtau)
+            th = y[first + i]
+            out[first + i] = pick(codes[i], v * th / sdc[i], th, cb[i], dtau)
 
     return impl
+
+
+_LN2 = math.log(2.0)
+
+
+@njit(cache=True, inline="always")
+def mu_at(v, psi, a, V0, form):
+    """mu(v, theta) of the state's psi at any slip rate v: psi + a ln(v / V0) (log form, v > 0) or
+    a asinh(v / (2 V0) exp(psi / a)) (asinh form, odd in v), the latter through ln z for
+    z = |v| / (2 V0) exp(psi / a) > e^20, where asinh z = ln 2z to round-off and exp could overflow."""
+    if form == 0:
+        return psi + a * math.log(v / V0)
+    s = 0.5 * abs(v) / V0
+    if s == 0.0:
+        return 0.0
+    lz = math.log(s) + psi / a
+    mu = a * (lz + _LN2) if lz > 20.0 else a * math.asinh(math.exp(lz))
+    return mu if v > 0.0 else -mu
 
 
 # Inlined where the integrator calls it: a call passes six arrays, and the calls cost as much as
 # the equations (the velocity step's integration 250 -> 140 us with 3 outputs).
 @njit(cache=True, inline="always")
-def rhs(t, y, out, vlp, a, mu0, V0, k, eta, form, b, sdc, cb, codes):
-    """The quasi-static spring-slider k (p(t) - x) = tau = mu(v, theta) + eta v
-    (:mod:`stickslip.lab.spring_slider`) as d/dt of y = (tau, theta_1 .. theta_m):
+def rhs(t, y, out, vlp, a, mu0, V0, k, eta, form, b, sdc, cb, codes, M):
+    """The spring-slider as d/dt of its state y, with V(t) = ``vlp`` the load point's velocity on
+    this interval of the history. Quasi-static (M = 0; :mod:`stickslip.lab.spring_slider`),
+    k (p(t) - x) = tau = mu(v, theta) + eta v and y = (tau, theta_1 .. theta_m):
 
         dtau/dt = k (V(t) - v),   dtheta_k/dt by law k (:mod:`stickslip.lab.laws`),
 
-    with v from :func:`slip_rate` and V(t) = ``vlp``, the load point's velocity on this
-    interval of the history; with k = inf (a rigid machine) v = V(t) and tau is left alone.
-    Writes ``out`` and returns v.
+    with v from :func:`slip_rate`; with k = inf (a rigid machine) v = V(t) and tau is left alone.
+    Inertial (mass M > 0 per unit normal stress; :mod:`stickslip.lab.inertial_ode`),
+    y = (tau, v, theta_1 .. theta_m):
+
+        dtau/dt = k (V(t) - v),   M dv/dt = tau - mu(v, theta) - eta v   (:func:`mu_at`),
+
+    and the same laws, Nagata's reading dtau/dt. Writes ``out`` and returns v.
     """
+    if M > 0.0:
+        v = y[1]
+        dtau = k * (vlp - v)
+        out[0] = dtau
+        out[1] = (y[0] - mu_at(v, psi_of(y, 2, mu0, V0, b, sdc), a, V0, form) - eta * v) / M
+        law_rates(codes, v, y, 2, sdc, cb, dtau, out)
+        return v
     if k == np.inf:
         v = vlp
         dtau = 0.0
@@ -151,14 +182,14 @@ def rhs(t, y, out, vlp, a, mu0, V0, k, eta, form, b, sdc, cb, codes):
         v = slip_rate(y[0], psi, a, V0, eta, form)
         dtau = k * (vlp - v)
     out[0] = dtau
-    law_rates(codes, v, y, sdc, cb, dtau, out)
+    law_rates(codes, v, y, 1, sdc, cb, dtau, out)
     return v
 
 
 @njit(cache=True)
 def _initial_step(t, y, f, t_bound, vl, rtol, atol, work, fw, args):
     """scipy's select_initial_step (Hairer et al., sec. II.4) for an error of order 7."""
-    a, mu0, V0, k, eta, form, b, sdc, cb, codes = args
+    a, mu0, V0, k, eta, form, b, sdc, cb, codes, M = args
     n = y.size
     length = t_bound - t
     d0 = 0.0
@@ -173,7 +204,7 @@ def _initial_step(t, y, f, t_bound, vl, rtol, atol, work, fw, args):
     h0 = min(h0, length)
     for i in range(n):
         work[i] = y[i] + h0 * f[i]
-    rhs(t + h0, work, fw, vl, a, mu0, V0, k, eta, form, b, sdc, cb, codes)
+    rhs(t + h0, work, fw, vl, a, mu0, V0, k, eta, form, b, sdc, cb, codes, M)
     d2 = 0.0
     for i in range(n):
         sc = atol + abs(y[i]) * rtol
@@ -191,7 +222,7 @@ def _dense(K, y, y_new, f_new, t_old, h, t_out, j0, j1, Y, Vs, vl, A, C, D, work
     """Outputs t_out[j0:j1] inside the step (t_old, t_old + h) from DOP853's interpolant (scipy's
     ``_dense_output_impl`` and ``Dop853DenseOutput``): three more stages, then
     y(t_old + x h) = y_old + sum of the seven coefficient rows in Horner form in x and 1 - x."""
-    a, mu0, V0, k, eta, form, b, sdc, cb, codes = args
+    a, mu0, V0, k, eta, form, b, sdc, cb, codes, M = args
     n = y.size
     ns = 12
     for st in range(ns + 1, ns + 4):
@@ -200,7 +231,7 @@ def _dense(K, y, y_new, f_new, t_old, h, t_out, j0, j1, Y, Vs, vl, A, C, D, work
             for q in range(st):
                 acc += A[st, q] * K[q, i]
             work[i] = y[i] + h * acc
-        rhs(t_old + C[st] * h, work, K[st], vl, a, mu0, V0, k, eta, form, b, sdc, cb, codes)
+        rhs(t_old + C[st] * h, work, K[st], vl, a, mu0, V0, k, eta, form, b, sdc, cb, codes, M)
     F = np.empty((7, n))
     for i in range(n):
         dy = y_new[i] - y[i]
@@ -224,7 +255,7 @@ def _dense(K, y, y_new, f_new, t_old, h, t_out, j0, j1, Y, Vs, vl, A, C, D, work
                 else:
                     acc *= 1.0 - x
             Y[j, i] = acc + y[i]
-        Vs[j] = rhs(t_out[j], Y[j], fw, vl, a, mu0, V0, k, eta, form, b, sdc, cb, codes)
+        Vs[j] = rhs(t_out[j], Y[j], fw, vl, a, mu0, V0, k, eta, form, b, sdc, cb, codes, M)
 
 
 @njit(cache=True)
@@ -237,7 +268,7 @@ def dop853_history(y0, seg_t, seg_v, t_out, rtol, atol, max_steps, A, B, C, E3, 
     no growth right after a rejection; outputs inside a step by :func:`_dense`.
     Returns (Y, v, status, steps, evaluations).
     """
-    a, mu0, V0, k, eta, form, b, sdc, cb, codes = args
+    a, mu0, V0, k, eta, form, b, sdc, cb, codes, M = args
     n = y0.size
     ns = B.size
     nout = t_out.size
@@ -256,7 +287,7 @@ def dop853_history(y0, seg_t, seg_v, t_out, rtol, atol, max_steps, A, B, C, E3, 
     for s in range(seg_t.size - 1):
         tb = seg_t[s + 1]
         vl = seg_v[s]
-        v = rhs(t, y, f, vl, a, mu0, V0, k, eta, form, b, sdc, cb, codes)
+        v = rhs(t, y, f, vl, a, mu0, V0, k, eta, form, b, sdc, cb, codes, M)
         nfev += 1
         while j < nout and t_out[j] <= t:
             Y[j] = y
@@ -283,13 +314,13 @@ def dop853_history(y0, seg_t, seg_v, t_out, rtol, atol, max_steps, A, B, C, E3, 
                         for q in range(st):
                             acc += A[st, q] * K[q, i]
                         work[i] = y[i] + h * acc
-                    rhs(t + C[st] * h, work, K[st], vl, a, mu0, V0, k, eta, form, b, sdc, cb, codes)
+                    rhs(t + C[st] * h, work, K[st], vl, a, mu0, V0, k, eta, form, b, sdc, cb, codes, M)
                 for i in range(n):
                     acc = 0.0
                     for q in range(ns):
                         acc += B[q] * K[q, i]
                     y_new[i] = y[i] + h * acc
-                v_new = rhs(t_new, y_new, K[ns], vl, a, mu0, V0, k, eta, form, b, sdc, cb, codes)
+                v_new = rhs(t_new, y_new, K[ns], vl, a, mu0, V0, k, eta, form, b, sdc, cb, codes, M)
                 nfev += ns
                 e5 = 0.0
                 e3 = 0.0

@@ -38,18 +38,25 @@ __all__ = ["FitResult", "fit", "model_friction"]
 _LOWER = {"a": 0.0, "Dc": 0.0, "k": 0.0, "eta": 0.0}
 
 
-def _base(name: str) -> str:
-    """``Dc2`` -> ``Dc``, ``b1`` -> ``b``, ``mu0`` -> ``mu0``."""
+def base_name(name: str) -> str:
+    """The parameter a fitted name sets: ``Dc2`` -> ``Dc``, ``b1`` -> ``b``, ``mu0`` -> ``mu0``."""
     for stem in ("Dc", "b"):
         if name.startswith(stem) and name[len(stem) :].isdigit():
             return stem
     return name
 
 
-def _value(model: RateState, name: str, trend: float) -> float:
+def start_value(model: RateState, name: str, trend: float = 0.0) -> float:
+    """The model's value of a fitted name (``b2`` the second state variable's b; ``trend`` ``trend``).
+
+    Raises
+    ------
+    ParameterError
+        An unknown name, a state variable the model lacks, an infinite or missing start.
+    """
     if name == "trend":
         return trend
-    base = _base(name)
+    base = base_name(name)
     if base in ("b", "Dc"):
         idx = int(name[len(base) :] or 1) - 1
         seq = getattr(model, base)
@@ -220,15 +227,15 @@ class Problem:
                 raise ParameterError(f"per_record names {name!r}, which is not free")
         slots = []
         for name in free:
-            _value(model, name, trend)
+            start_value(model, name, trend)
             if name in per_record:
                 slots += [(f"{name}[{r}]", name, r) for r in range(len(records))]
             else:
                 slots.append((name, name, None))
-        start = np.array([_value(model, name, trend) for _, name, _ in slots])
+        start = np.array([start_value(model, name, trend) for _, name, _ in slots])
         is_trend = np.array([s[1] == "trend" for s in slots])
         self.scale = np.where(start != 0.0, np.abs(start), np.where(is_trend, 1e-4, 1e-2))
-        self.lower = np.array([_LOWER.get(_base(s[1]), -np.inf) for s in slots]) / self.scale
+        self.lower = np.array([_LOWER.get(base_name(s[1]), -np.inf) for s in slots]) / self.scale
         self.x0 = start / self.scale
         self.records, self.model, self.slots, self.trend, self.rtol = records, model, slots, trend, rtol
         self.method = method

@@ -11,7 +11,9 @@ own (:class:`stickslip.run.driver.Stepper`, the exact integrator at a fixed step
 only starts it and reads x and v at the sample times, where the spring's friction is
 k (p(t) - x). Below the critical stiffness k_c = (b - a) / D_c (1 + M V^2 / (a D_c)) (Rice and
 Ruina 1983) steady sliding is unstable and the block settles into stick-slip cycles, whose
-observables :mod:`stickslip.lab.cycles` measures.
+observables :mod:`stickslip.lab.cycles` measures. Models the chain's block has not (several
+state variables, radiation damping) are sampled from the same equations integrated adaptively,
+:func:`stickslip.lab.inertial_ode.inertial_slider`.
 """
 
 from __future__ import annotations
@@ -22,7 +24,7 @@ from stickslip.lab.history import LoadHistory
 from stickslip.lab.laws import RateState, friction_of, steady_theta
 from stickslip.models.params import ParameterError, check_number
 
-__all__ = ["FRICTION", "check_route", "critical_stiffness_inertial", "sample"]
+__all__ = ["FRICTION", "check_route", "critical_stiffness_inertial", "on_chain", "sample"]
 
 #: The chain's friction piece of each evolution law the inertial route has.
 FRICTION = {"aging": "rate-state", "slip": "rate-state-slip", "prz": "rate-state-prz", "nagata": "rate-state-nagata"}
@@ -52,23 +54,24 @@ def critical_stiffness_inertial(model: RateState, M: float, V: float) -> float:
     return (b - a) / dc * (1.0 + M * V * V / (a * dc))
 
 
+def on_chain(model: RateState) -> bool:
+    """Whether the chain's single block has the model: one state variable with a law of
+    :data:`FRICTION` and no radiation damping (the others take the adaptive route,
+    :func:`stickslip.lab.inertial_ode.inertial_slider`)."""
+    return model.n_states == 1 and model.law[0] in FRICTION and model.eta == 0.0
+
+
 def check_route(model: RateState) -> float:
-    """The model's k, where the inertial route has the model: one state variable with the aging, the
-    slip, the PRZ or the Nagata law, a finite k, no radiation damping.
+    """The model's k, where the inertial route has the model: a finite k.
 
     Raises
     ------
     ParameterError
-        Anything else, in one line.
+        No k, or k = inf, in one line.
     """
     k = model.require_k()
-    if model.n_states != 1 or model.law[0] not in FRICTION:
-        raise ParameterError(
-            "the inertial route has one state variable with the aging, slip, prz or nagata law "
-            f"(got law {','.join(model.law)})"
-        )
-    if model.eta != 0.0 or k == np.inf:
-        raise ParameterError("the inertial route has a finite k and no radiation damping (eta = 0)")
+    if k == np.inf:
+        raise ParameterError("the inertial route needs a finite k (k = inf imposes the slip rate)")
     return k
 
 
@@ -78,11 +81,17 @@ def chain_params_of(model: RateState, M: float, dt: float, history: LoadHistory)
     Raises
     ------
     ParameterError
-        More than one state variable, a law other than aging, slip, prz or nagata, damping eta, no k.
+        More than one state variable, a law other than aging, slip, prz or nagata, damping eta, no
+        finite k.
     """
     from stickslip.models.presets import chain_params
 
     k = check_route(model)
+    if not on_chain(model):
+        raise ParameterError(
+            "the chain's single block has one state variable with the aging, slip, prz or nagata law and no "
+            f"damping (got law {','.join(model.law)}, eta {model.eta:g}); inertial_slider has the rest"
+        )
     # Nagata's c (the chain's rs_c) where the law has it; the other laws do not read it.
     c = {"rs_c": float(model.c[0])} if model.law[0] == "nagata" else {}
     return chain_params(
@@ -102,7 +111,9 @@ def sample(
     v_init: float | None = None,
     kick: float = 0.5,
 ) -> dict:
-    """Run the inertial spring-slider over ``history`` and read it at the times ``t``.
+    """Run the inertial spring-slider over ``history`` and read it at the times ``t``: on the chain's
+    single block where it has the model (:func:`on_chain`), else adaptively
+    (:func:`stickslip.lab.inertial_ode.inertial_slider`, the same start, ``dt`` unread).
 
     The block starts at the history's first time t_0 in steady sliding at the load point's first
     velocity V_1 (theta = s D_c / V_1, s = 2 for the PRZ law and 1 otherwise; the spring at
@@ -113,8 +124,8 @@ def sample(
     Parameters
     ----------
     model : RateState
-        a, b, D_c, mu0, V0 and k (one state variable; aging, slip, PRZ or Nagata law; read in the asinh
-        form).
+        a, b, D_c, mu0, V0, k and eta (read in the asinh form): on the chain with one state
+        variable (aging, slip, PRZ or Nagata law) and eta = 0, adaptively otherwise.
     M : float
         Mass per unit normal stress (> 0).
     history : LoadHistory
@@ -151,16 +162,23 @@ def sample(
     steps = np.rint((t - t0) / dt).astype(np.int64)
     if np.any(np.diff(steps) <= 0):
         raise ParameterError(f"dt = {dt:g} must be smaller than the spacing of the samples ({np.min(np.diff(t)):g})")
-    # the chain's time starts at 0: the history shifted to start there
-    shifted = LoadHistory.table(history.times - t0, history.positions)
-    p = chain_params_of(model, M, dt, shifted)
     V1 = float(history.velocities[0])
     if V1 <= 0.0:
         raise ParameterError("the inertial route starts in steady sliding: the history must start at V > 0")
-    v0 = (1.0 + kick) * V1 if v_init is None else check_number("v_init", v_init, low=0.0, low_open=True)
     lab = RateState(
-        a=model.a, b=model.b, Dc=model.Dc, mu0=model.mu0, V0=model.V0, k=model.k, law=model.law, form="asinh"
-    )
+        a=model.a, b=model.b, Dc=model.Dc, mu0=model.mu0, V0=model.V0, k=model.k, law=model.law, c=model.c,
+        eta=model.eta, form="asinh",
+    )  # fmt: skip
+    if not on_chain(model):
+        from stickslip.lab.inertial_ode import inertial_slider
+
+        v_kick = 0.0 if v_init is None else check_number("v_init", v_init, low=0.0, low_open=True) / V1 - 1.0
+        ds = inertial_slider(lab, history, M, t=t, kick=kick if v_init is None else v_kick)
+        return {"t": t, "mu": ds.mu.values, "v": ds.v.values, "steps": int(ds.attrs["steps"])}
+    # the chain's time starts at 0: the history shifted to start there
+    shifted = LoadHistory.table(history.times - t0, history.positions)
+    p = chain_params_of(model, M, dt, shifted)
+    v0 = (1.0 + kick) * V1 if v_init is None else check_number("v_init", v_init, low=0.0, low_open=True)
     theta = float(steady_theta(lab, V1)[0])
     p0 = float(history.positions[0])
     x0 = p0 - friction_of(lab, V1, np.array([theta])) / p.K

@@ -1,4 +1,5 @@
-"""Integrators of the quasi-static spring-slider over a load history, restarting at its breakpoints.
+"""Integrators of the spring-slider (quasi-static, or inertial with a mass) over a load history,
+restarting at its breakpoints.
 
 Two routes over the same compiled right-hand side (:func:`stickslip.lab.laws.rhs`):
 
@@ -52,11 +53,14 @@ def stiffness_ratio(model, history, v_init: float | None = None) -> float:
     return model.k * v_max * min(model.Dc) / model.a
 
 
-def choose(method: str, model, history, v_init: float | None = None) -> str:
-    """The integrator ``auto`` stands for: ``dop853`` up to :data:`STIFF_RATIO`, ``LSODA`` above."""
+def choose(method: str, model, history, v_init: float | None = None, M: float = 0.0) -> str:
+    """The integrator ``auto`` stands for: ``dop853`` up to :data:`STIFF_RATIO`, ``LSODA`` above;
+    for the inertial spring-slider (M > 0) also ``LSODA`` through a hold, where the slip rate
+    falls and with it the block's relaxation time M v / a."""
     if method != "auto":
         return method
-    return "LSODA" if stiffness_ratio(model, history, v_init) > STIFF_RATIO else "dop853"
+    hold = M > 0.0 and bool(np.any(np.asarray(history.velocities) == 0.0))
+    return "LSODA" if hold or stiffness_ratio(model, history, v_init) > STIFF_RATIO else "dop853"
 
 
 #: Status codes of the compiled route.
@@ -72,8 +76,10 @@ class IntegrationError(RuntimeError):
     """The quasi-static integration could not go on (one line saying why and where)."""
 
 
-def integrate(model, history, y0, t_out, *, rtol=1e-10, atol=1e-12, method="dop853", max_steps=10_000_000):
-    """y = (tau, theta_1 .. theta_m) and v at the times ``t_out`` over the whole ``history``.
+def integrate(model, history, y0, t_out, *, rtol=1e-10, atol=1e-12, method="dop853", max_steps=10_000_000, M=0.0):
+    """y = (tau, theta_1 .. theta_m) and v at the times ``t_out`` over the whole ``history``
+    (quasi-static); y = (tau, v, theta_1 .. theta_m) for the inertial spring-slider of mass
+    ``M`` > 0 (:func:`stickslip.lab.compiled.rhs`).
 
     Parameters
     ----------
@@ -87,10 +93,12 @@ def integrate(model, history, y0, t_out, *, rtol=1e-10, atol=1e-12, method="dop8
         Tolerances of the error control.
     method : str
         One of :data:`METHODS` (module docstring).
+    M : float
+        Mass per unit normal stress; 0 for the quasi-static spring-slider.
 
     Returns
     -------
-    Y : array (len(t_out), m + 1), v : array, info : dict
+    Y : array (len(t_out), m + 1, or m + 2 where M > 0), v : array, info : dict
         ``info`` has the status, steps and right-hand-side evaluations.
 
     Raises
@@ -98,8 +106,8 @@ def integrate(model, history, y0, t_out, *, rtol=1e-10, atol=1e-12, method="dop8
     IntegrationError
         The integrator failed (too many steps, step size at round-off, a non-finite state).
     """
-    args = model.arrays()
-    method = choose(method, model, history)
+    args = model.arrays(M)
+    method = choose(method, model, history, M=M)
     history = history.merged()
     seg_t = np.ascontiguousarray(history.times, dtype=float)
     seg_v = np.ascontiguousarray(history.velocities, dtype=float)

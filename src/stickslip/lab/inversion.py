@@ -34,7 +34,7 @@ import xarray as xr
 from scipy.optimize import least_squares
 
 from stickslip.lab.cycles import OBSERVABLES, cycle_table, observables
-from stickslip.lab.fitting import standard_errors
+from stickslip.lab.fitting import base_name, standard_errors, start_value
 from stickslip.lab.history import LoadHistory
 from stickslip.lab.inertial import check_route, sample
 from stickslip.lab.laws import RateState
@@ -44,7 +44,7 @@ from stickslip.models.params import ParameterError, check_number
 __all__ = ["FREE", "StickSlipResult", "invert_stick_slip"]
 
 #: The parameters an inversion may fit, each with its lower bound.
-FREE = {"a": 0.0, "b": -math.inf, "Dc": 0.0, "mu0": -math.inf, "k": 0.0, "M": 0.0}
+FREE = {"a": 0.0, "b": -math.inf, "Dc": 0.0, "mu0": -math.inf, "k": 0.0, "M": 0.0, "eta": 0.0}
 
 
 @dataclass
@@ -236,11 +236,12 @@ def invert_stick_slip(
         :data:`~stickslip.lab.cycles.OBSERVABLES`).
     model : RateState
         Starting values of the free parameters and values of the fixed ones: a, b, D_c, mu0, V0,
-        k (one state variable, aging, slip, PRZ or Nagata law; the inertial route reads the asinh form).
+        k, eta (any number of state variables, each its law; the inertial route reads the asinh
+        form: :func:`stickslip.lab.inertial.sample`).
     M : float
         Mass per unit normal stress (starting value where ``M`` is free).
     free : sequence of str
-        The parameters fitted, of a, b, Dc, mu0, k, M.
+        The parameters fitted, of a, b, Dc (b2, Dc2, ... for further state variables), mu0, k, eta, M.
     observables_ : sequence of str
         The observables compared (of :data:`~stickslip.lab.cycles.OBSERVABLES`), at least as many
         as free parameters; default all four for a record, the table's columns for a table.
@@ -288,8 +289,13 @@ def invert_stick_slip(
     if not free or len(set(free)) != len(free):
         raise ParameterError(f"free must name each parameter once, at least one (got {free})")
     for name in free:
-        if name not in FREE:
-            raise ParameterError(f"cannot fit {name!r} to stick-slip cycles: choose from {', '.join(FREE)}")
+        if base_name(name) not in FREE:
+            raise ParameterError(
+                f"cannot fit {name!r} to stick-slip cycles: choose from {', '.join(FREE)} (b2, Dc2, ... for the "
+                "further state variables)"
+            )
+        if name != "M":
+            start_value(model, name)  # a state variable the model lacks, a start it cannot take
     if observables_ is None:
         present = data.columns if isinstance(data, pd.DataFrame) else OBSERVABLES
         observables_ = [o for o in OBSERVABLES if o in present]
@@ -343,10 +349,9 @@ def invert_stick_slip(
         )
         return mean, np.sqrt(np.nan_to_num(err) ** 2 + (floor * size) ** 2)
 
-    start = np.array([M if n == "M" else (model.b[0] if n == "b" else model.Dc[0] if n == "Dc" else getattr(model, n))
-                      for n in free], dtype=float)  # fmt: skip
+    start = np.array([M if n == "M" else start_value(model, n) for n in free], dtype=float)
     scale = np.where(start != 0.0, np.abs(start), 1.0)
-    lower = np.array([FREE[n] for n in free]) / scale
+    lower = np.array([FREE[base_name(n)] for n in free]) / scale
     calls = [0]
 
     def at(x):

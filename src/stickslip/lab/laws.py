@@ -208,15 +208,16 @@ class RateState:
             raise ParameterError(f"k is required by the spring-slider ({PARAM_TEXT['k']}); no default is assumed")
         return self.k
 
-    def arrays(self):
-        """The arguments of :func:`rhs` after ``t, y, out, vlp``."""
+    def arrays(self, M: float = 0.0):
+        """The arguments of :func:`rhs` after ``t, y, out, vlp``, for the quasi-static spring-slider
+        (M = 0) or the inertial one of mass M per unit normal stress."""
         codes = np.array([LAWS[n].code for n in self.law], dtype=np.int64)
         scale = np.array([LAWS[n].scale for n in self.law])
         b = np.array(self.b, dtype=float)
         cb = np.array([c / bk if c != 0.0 else 0.0 for c, bk in zip(self.c, self.b, strict=True)])
         return (
             self.a, self.mu0, self.V0, 0.0 if self.k is None else self.k, self.eta, FORMS[self.form],
-            b, np.array(self.Dc, dtype=float) * scale, cb, codes,
+            b, np.array(self.Dc, dtype=float) * scale, cb, codes, float(M),
         )  # fmt: skip
 
     def summary(self) -> dict:
@@ -267,7 +268,7 @@ def friction_of(m: RateState, v: float, theta) -> float:
     -------
     float
     """
-    a, mu0, V0, _, _, form, b, sdc, _, _ = m.arrays()
+    a, mu0, V0, _, _, form, b, sdc, *_ = m.arrays()
     return float(friction(float(v), np.asarray(theta, dtype=float).reshape(-1), a, mu0, V0, form, b, sdc))
 
 

@@ -37,6 +37,15 @@ def _grid(history: LoadHistory, n: int) -> np.ndarray:
     return np.unique(np.concatenate(parts))
 
 
+def _run(model: RateState, history: LoadHistory, t, rtol: float, method: str, M: float) -> xr.Dataset:
+    """The quasi-static spring-slider (M = 0) or the inertial one of mass M over ``history``."""
+    if M == 0.0:
+        return quasi_static(model, history, t=t, rtol=rtol, method=method)
+    from stickslip.lab.inertial_ode import inertial_slider
+
+    return inertial_slider(model, history, M, t=t, rtol=rtol, method=method)
+
+
 def _peak(ds: xr.Dataset, t0: float, t1: float, sign: float) -> tuple[float, float]:
     """The extreme of mu (sign 1: maximum, -1: minimum) over [t0, t1], refined by a parabola through
     the largest sample and its neighbours. Returns (time, mu)."""
@@ -60,6 +69,7 @@ def velocity_step(
     n: int = 400,
     rtol: float = 1e-10,
     method: str = "auto",
+    M: float = 0.0,
 ) -> tuple[xr.Dataset, dict]:
     """Steps of the load-point velocity through ``velocities`` (the first is the steady start), each
     held for a load-point ``displacement`` (default 20 times the largest D_c).
@@ -77,6 +87,9 @@ def velocity_step(
     rtol : float
     method : str
         The integrator (:func:`stickslip.lab.spring_slider.quasi_static`).
+    M : float
+        Mass per unit normal stress: 0 (default) for the quasi-static spring-slider, > 0 for the
+        inertial one (:func:`stickslip.lab.inertial_ode.inertial_slider`).
 
     Returns
     -------
@@ -98,7 +111,8 @@ def velocity_step(
         else check_number("displacement", displacement, low=0.0, low_open=True)
     )
     history = LoadHistory.steps(v, [disp / x for x in v])
-    ds = quasi_static(model, history, t=_grid(history, n), rtol=rtol, method=method)
+    M = check_number("M", M, low=0.0)
+    ds = _run(model, history, _grid(history, n), rtol, method, M)
     steps = []
     for i in range(1, len(v)):
         t0, t1 = history.times[i], history.times[i + 1]
@@ -125,6 +139,7 @@ def velocity_step(
         "velocities": v,
         "displacement_per_step": disp,
         "k_c": critical_stiffness(model, v[-1]),
+        "M": M,
         "steps": steps,
         "integrator": ds.attrs["integrator"],
         "steps_taken": ds.attrs["steps"],
@@ -141,6 +156,7 @@ def slide_hold_slide(
     n: int = 200,
     rtol: float = 1e-10,
     method: str = "auto",
+    M: float = 0.0,
 ) -> tuple[xr.Dataset, dict]:
     """A slide-hold-slide test (module docstring): slides at V of load-point displacement ``slide``
     (default 20 times the largest D_c) around holds of the given lengths.
@@ -160,6 +176,9 @@ def slide_hold_slide(
     rtol : float
     method : str
         The integrator (:func:`stickslip.lab.spring_slider.quasi_static`).
+    M : float
+        Mass per unit normal stress: 0 (default) for the quasi-static spring-slider, > 0 for the
+        inertial one (:func:`stickslip.lab.inertial_ode.inertial_slider`).
 
     Returns
     -------
@@ -179,7 +198,8 @@ def slide_hold_slide(
         raise ParameterError("slide_hold_slide needs a finite k (in a rigid machine the log form is -inf at V = 0)")
     slide = 20.0 * max(model.Dc) if slide is None else check_number("slide", slide, low=0.0, low_open=True)
     history = LoadHistory.slide_hold_slide(V, slide / V, holds)
-    ds = quasi_static(model, history, t=_grid(history, n), rtol=rtol, method=method)
+    M = check_number("M", M, low=0.0)
+    ds = _run(model, history, _grid(history, n), rtol, method, M)
     rows = []
     for i, th in enumerate(holds):
         t_hold0 = history.times[1 + 2 * i]
@@ -210,6 +230,7 @@ def slide_hold_slide(
     summary = {
         "model": model.summary(),
         "V": V,
+        "M": M,
         "slide_displacement": slide,
         "holds": rows,
         "healing_rate": rate,

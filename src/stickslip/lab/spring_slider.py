@@ -21,7 +21,7 @@ from stickslip.lab.integrate import METHODS, integrate
 from stickslip.lab.laws import RateState, friction_of, steady_theta
 from stickslip.models.params import ParameterError, check_number
 
-__all__ = ["initial_state", "quasi_static", "solve"]
+__all__ = ["dataset", "initial_state", "quasi_static", "slip_of", "solve"]
 
 
 def initial_state(
@@ -137,6 +137,13 @@ def solve(
     return {"t": t, "mu": tau, "v": v, "theta": Y[:, 1:], "y0": y0, "info": info}
 
 
+def slip_of(history: LoadHistory, t_out, tau, tau0: float, k: float):
+    """x(t) - x(0) = p(t) - p(0) - (tau - tau_0) / k from the spring's tau = k (p - x) (the load
+    point's own displacement for a rigid machine, k = inf)."""
+    dp = history.position(t_out) - float(history.position(history.times[0]))
+    return dp if k == np.inf else dp - (tau - tau0) / k
+
+
 def quasi_static(
     model: RateState,
     history: LoadHistory,
@@ -187,27 +194,38 @@ def quasi_static(
     t_out = output_times(history, t, n)
     r = solve(model, history, t_out, v_init=v_init, theta_init=theta_init, rtol=rtol, atol=atol, method=method)
     tau, v, y0, info, Y = r["mu"], r["v"], r["y0"], r["info"], r["theta"]
-    p = history.position(t_out)
-    p0 = float(history.position(history.times[0]))
-    slip = (p - p0) if k == np.inf else (p - p0) - (tau - y0[0]) / k
+    slip = slip_of(history, t_out, tau, y0[0], k)
+    return dataset(model, history, t_out, tau, v, Y, slip, info, rtol=rtol, atol=atol)
+
+
+def dataset(model: RateState, history: LoadHistory, t_out, tau, v, Y, slip, info, *, rtol, atol, M: float = 0.0):
+    """The Dataset of a spring-slider's run (:func:`quasi_static`, and the inertial one of
+    :mod:`stickslip.lab.inertial_ode`): ``mu``, ``v``, ``theta`` (with a ``state`` dimension
+    when m > 1), ``load_point``, ``V`` and ``slip`` over ``t``, the parameters as attributes
+    (and the mass M where M > 0)."""
     m = model.n_states
     theta = (("t", "state"), Y) if m > 1 else ("t", Y[:, 0])
+    coords = {"t": ("t", t_out, {"long_name": "time"})}
+    if m > 1:
+        coords["state"] = np.arange(1, m + 1)
     ds = xr.Dataset(
         {
             "mu": ("t", tau, {"long_name": "friction k (p - x)", "units": "1"}),
             "v": ("t", v, {"long_name": "slip rate"}),
             "theta": (*theta[:-1], theta[-1], {"long_name": "state variable"}),
-            "load_point": ("t", p, {"long_name": "load-point displacement p"}),
+            "load_point": ("t", history.position(t_out), {"long_name": "load-point displacement p"}),
             "V": ("t", history.velocity(t_out), {"long_name": "load-point velocity"}),
             "slip": ("t", slip, {"long_name": "slip x - x(0)"}),
         },
-        coords={"t": ("t", t_out, {"long_name": "time"})},
+        coords=coords,
     )
-    if m > 1:
-        ds = ds.assign_coords(state=np.arange(1, m + 1))
     ds.attrs.update(
         {
-            "model": "quasi-static spring-slider, k (p - x) = mu(v, theta) + eta v",
+            "model": (
+                "inertial spring-slider, M dv/dt = k (p - x) - mu(v, theta) - eta v"
+                if M > 0.0
+                else "quasi-static spring-slider, k (p - x) = mu(v, theta) + eta v"
+            ),
             "law": ",".join(model.law),
             "form": model.form,
             "a": model.a,
@@ -215,8 +233,9 @@ def quasi_static(
             "Dc": list(model.Dc) if m > 1 else model.Dc[0],
             "mu0": model.mu0,
             "V0": model.V0,
-            "k": k,
+            "k": model.k,
             "eta": model.eta,
+            **({"M": float(M)} if M > 0.0 else {}),
             "integrator": info["method"],
             "rtol": float(rtol),
             "atol": float(atol),

@@ -77,13 +77,14 @@ def critical_stiffness(model: RateState, V: float | None = None) -> float:
     return (-B + math.sqrt(disc)) / (2.0 * sig) / V
 
 
-def _jacobian(model: RateState, k: float, V: float) -> np.ndarray:
-    """The Jacobian of :func:`stickslip.lab.laws.rhs` at steady sliding, by central differences."""
+def _jacobian(model: RateState, k: float, V: float, M: float = 0.0) -> np.ndarray:
+    """The Jacobian of :func:`stickslip.lab.laws.rhs` at steady sliding, by central differences
+    (over (tau, v, theta) where the block has a mass M > 0)."""
     th = steady_theta(model, V)
-    args = list(model.arrays())
+    args = list(model.arrays(M))
     args[3] = k
     mu = friction_of(model, V, th)
-    y = np.concatenate([[mu + model.eta * V], th])
+    y = np.concatenate([[mu + model.eta * V], [V] if M > 0.0 else [], th])
     n = y.size
     J = np.empty((n, n))
     fp, fm = np.empty(n), np.empty(n)
@@ -98,9 +99,9 @@ def _jacobian(model: RateState, k: float, V: float) -> np.ndarray:
     return J
 
 
-def growth_rate(model: RateState, k: float, V: float | None = None) -> float:
+def growth_rate(model: RateState, k: float, V: float | None = None, M: float = 0.0) -> float:
     """The largest real part of the eigenvalues of the linearised spring-slider at stiffness k
-    (module docstring; > 0: steady sliding at V is unstable).
+    (module docstring; > 0: steady sliding at V is unstable), massless or of mass M.
 
     Parameters
     ----------
@@ -109,25 +110,33 @@ def growth_rate(model: RateState, k: float, V: float | None = None) -> float:
         Stiffness in friction per unit displacement.
     V : float, optional
         Sliding velocity (default V0).
+    M : float
+        Mass per unit normal stress (0: the quasi-static spring-slider).
 
     Returns
     -------
     float
     """
     V = model.V0 if V is None else V
-    return float(np.max(np.linalg.eigvals(_jacobian(model, k, V)).real))
+    return float(np.max(np.linalg.eigvals(_jacobian(model, k, V, M)).real))
 
 
-def critical_stiffness_numeric(model: RateState, V: float | None = None, *, k_max: float | None = None) -> float:
+def critical_stiffness_numeric(
+    model: RateState, V: float | None = None, *, M: float = 0.0, k_max: float | None = None
+) -> float:
     """k_c as the largest stiffness at which the linearised system has a growing mode: a scan
-    over k on a log grid up to ``k_max`` (default ``10 sum |b_k| / D_c,k``), refined by Brent's
-    method (module docstring).
+    over k on a log grid up to ``k_max`` (default ``10 sum |b_k| / D_c,k``, times
+    1 + M V^2 / (a min D_c) with a mass), refined by Brent's method (module docstring). With a
+    mass M and one state variable it is Rice and Ruina's (b - a) / D_c (1 + M V^2 / (a D_c))
+    (:func:`stickslip.lab.inertial.critical_stiffness_inertial`).
 
     Parameters
     ----------
     model : RateState
     V : float, optional
         Sliding velocity (default V0).
+    M : float
+        Mass per unit normal stress of the inertial spring-slider (0: quasi-static).
     k_max : float, optional
         Top of the scan.
 
@@ -142,10 +151,11 @@ def critical_stiffness_numeric(model: RateState, V: float | None = None, *, k_ma
     )
     if scale == 0.0:
         return 0.0
-    k_max = 10.0 * scale if k_max is None else k_max
+    M = check_number("M", M, low=0.0)
+    k_max = 10.0 * scale * (1.0 + M * V * V / (model.a * min(model.Dc))) if k_max is None else k_max
     ks = np.geomspace(k_max * 1e-8, k_max, 241)
     # A small offset keeps the neutral mode (k = k_c exactly) on the stable side.
-    g = np.array([growth_rate(model, k, V) for k in ks])
+    g = np.array([growth_rate(model, k, V, M) for k in ks])
     tol = 1e-9 * V / min(model.Dc)
     unstable = np.flatnonzero(g > tol)
     if unstable.size == 0:
@@ -153,4 +163,4 @@ def critical_stiffness_numeric(model: RateState, V: float | None = None, *, k_ma
     i = unstable[-1]
     if i == ks.size - 1:
         raise ParameterError(f"steady sliding is unstable up to k_max = {k_max:g}; give a larger k_max")
-    return float(brentq(lambda k: growth_rate(model, k, V), ks[i], ks[i + 1], xtol=1e-14 * k_max, rtol=1e-12))
+    return float(brentq(lambda k: growth_rate(model, k, V, M), ks[i], ks[i + 1], xtol=1e-14 * k_max, rtol=1e-12))
