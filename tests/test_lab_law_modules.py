@@ -94,3 +94,9 @@ def test_the_lab_is_cached_where_an_edit_to_a_law_compiles_it_afresh(tmp_path):
     digest_dir = tmp_path / f"stickslip-{_cache.DIGEST[:20]}"
     cached = [p.name for p in digest_dir.rglob("compiled.friction-*.nbi")]
     assert cached, sorted(p.name for p in tmp_path.rglob("*"))[:20]
+
+
+def test_the_command_line_names_the_registrys_laws():
+    from stickslip.cli.lab import _lab_laws
+
+    assert _lab_laws() == list(LAWS) == ["aging", "slip", "prz", "nagata"]

@@ -45,6 +45,14 @@ def _words(text: str) -> list[str]:
     return [x.strip() for x in text.split(",") if x.strip()]
 
 
+def _lab_laws() -> list[str]:
+    """The lab's names of the friction laws that declare a lab form, in the registry's order
+    (:data:`stickslip.lab.LAWS`, read from the pieces without compiling anything)."""
+    from stickslip.models.pieces import PIECES
+
+    return [p.lab.name for p in PIECES["friction"] if p.lab is not None]
+
+
 def _add_law_options(p: argparse.ArgumentParser, *, k_help: str) -> None:
     g = p.add_argument_group("friction (lab conventions, docs/lab.md; required unless marked)")
     g.add_argument("--a", type=float_arg("a"), help="direct effect a (> 0)")
@@ -54,7 +62,7 @@ def _add_law_options(p: argparse.ArgumentParser, *, k_help: str) -> None:
     g.add_argument("--V0", type=float_arg("V0"), help="reference velocity V0 (> 0)")
     g.add_argument("--k", type=float_arg("k"), help=k_help)
     g.add_argument("--law", type=_words, default=["aging"],
-                   help="evolution law of each state variable: aging, slip, prz, nagata (default aging)")  # fmt: skip
+                   help=f"evolution law of each state variable: {', '.join(_lab_laws())} (default aging)")  # fmt: skip
     g.add_argument("--c", type=_floats("c"), default=[0.0], help="Nagata's c of each state variable (default 0)")
     g.add_argument("--eta", type=float_arg("eta"), default=0.0, help="radiation damping eta (default 0)")
     g.add_argument("--form", choices=("log", "asinh"), default="log", help="friction form (default log)")
