@@ -92,6 +92,10 @@ class LoadHistory:
         p.flags.writeable = False
         object.__setattr__(self, "times", t)
         object.__setattr__(self, "positions", p)
+        v = dp / dt
+        v.flags.writeable = False
+        # Read at every integration (the integrators' tables, their choice of method): once here.
+        object.__setattr__(self, "_velocities", v)
 
     # -- building ------------------------------------------------------------------------------
 
@@ -265,8 +269,8 @@ class LoadHistory:
     def velocities(self) -> np.ndarray:
         """V_i = (p_i+1 - p_i) / (t_i+1 - t_i), the load-point velocity on each interval (exact up to
         the rounding of the summed positions and times: a short step after long ones keeps fewer
-        digits)."""
-        return np.diff(self.positions) / np.diff(self.times)
+        digits). Read-only, computed once."""
+        return self._velocities
 
     def merged(self, rtol: float = 1e-9) -> LoadHistory:
         """The same history without the breakpoints where the velocity does not change (to

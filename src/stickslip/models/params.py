@@ -52,24 +52,28 @@ def check_number(
 
     The error names ``name`` and the allowed range, e.g. ``K must be > 0 (got -1)``.
     """
-    allowed = _range_text(low, high, low_open, high_open)
-    kind = "an integer" if integer else "a finite number"
-    wanted = f"{kind} {allowed}".rstrip()
-    shown = _shown(value)
+
+    def refused(what: str) -> ParameterError:
+        # Written only when it is raised: a check that passes costs no formatting.
+        allowed = _range_text(low, high, low_open, high_open)
+        if what == "kind":
+            allowed = f"{'an integer' if integer else 'a finite number'} {allowed}".rstrip()
+        return ParameterError(f"{name} must be {allowed} (got {_shown(value)})")
+
     try:
         number = float(value)
     except (TypeError, ValueError, OverflowError):
-        raise ParameterError(f"{name} must be {wanted} (got {shown})") from None
+        raise refused("kind") from None
     if not math.isfinite(number):
-        raise ParameterError(f"{name} must be {wanted} (got {shown})")
+        raise refused("kind")
     if integer:
         if number != int(number):
-            raise ParameterError(f"{name} must be {wanted} (got {shown})")
+            raise refused("kind")
         number = int(number)
     too_low = low is not None and (number <= low if low_open else number < low)
     too_high = high is not None and (number >= high if high_open else number > high)
     if too_low or too_high:
-        raise ParameterError(f"{name} must be {allowed} (got {shown})")
+        raise refused("range")
     return number
 
 
