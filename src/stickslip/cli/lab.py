@@ -167,7 +167,7 @@ def register(sub) -> None:
     v.add_argument("--M", type=float_arg("M"), default=None, help="mass per unit normal stress (> 0; required)")
     v.add_argument("--dt", type=float_arg("dt"), default=None, help="the integrator's step (default M / 4)")
     v.add_argument("--free", type=_words, default=["a", "b", "Dc"],
-                   help="parameters fitted: a, b, Dc, mu0, k, M (default a,b,Dc)")  # fmt: skip
+                   help="parameters fitted: a, b, Dc, b2, Dc2, mu0, k, eta, M (default a,b,Dc)")  # fmt: skip
     v.add_argument("--observables", type=_words, default=None,
                    help="observables compared: period, stress_drop, peak_slip_rate, peak_friction "
                         "(default all four, or a table's columns)")  # fmt: skip
