@@ -27,7 +27,8 @@ def plot_step(ds: xr.Dataset, summary: dict | None = None) -> Figure:
     """
     fig, (ax, axv) = new_figure(2, 1, width=6.0, height=2.6, sharex=True)
     x = ds.load_point.values - float(ds.load_point[0])
-    ax.plot(x, ds.mu, **SIM, label="spring-slider")
+    mass = ds.attrs.get("M")
+    ax.plot(x, ds.mu, **SIM, label="spring-slider" + (f", M = {mass:g}" if mass else ", quasi-static"))
     if summary:
         starts = [st["t"] for st in summary["steps"]] + [float(ds.t[-1])]
         for st, t1 in zip(summary["steps"], starts[1:], strict=True):
