@@ -26,7 +26,7 @@ import numpy as np
 import xarray as xr
 
 from stickslip.lab.history import LoadHistory
-from stickslip.lab.integrate import METHODS, integrate
+from stickslip.lab.integrate import checked, integrate
 from stickslip.lab.laws import RateState
 from stickslip.lab.spring_slider import dataset, output_times, slip_of
 from stickslip.models.params import ParameterError, check_number
@@ -129,10 +129,7 @@ def inertial_slider(
     k = model.require_k()
     if k == np.inf:
         raise ParameterError("the inertial spring-slider needs a finite k (k = inf imposes the slip rate)")
-    if method not in METHODS:
-        raise ParameterError(f"method must be one of {', '.join(METHODS)} (got {method!r})")
-    rtol = check_number("rtol", rtol, low=1e-14, high=1.0)
-    atol = check_number("atol", atol, low=0.0, low_open=True)
+    rtol, atol = checked(method, rtol, atol)
     t_out = output_times(history, t, n)
     y0 = initial_state_inertial(model, history, v_init=v_init, theta_init=theta_init, kick=kick)
     Y, v, info = integrate(model, history, y0, t_out, rtol=rtol, atol=atol, method=method, M=M)

@@ -24,6 +24,7 @@ from scipy.integrate import solve_ivp
 from scipy.integrate._ivp import dop853_coefficients as _dop
 
 from stickslip.lab.compiled import dop853_history, rhs
+from stickslip.models.params import ParameterError, check_number
 
 #: The DOP853 tableau (scipy's): stages, weights, nodes and the two error estimators.
 _NS = _dop.N_STAGES
@@ -70,6 +71,19 @@ STATUS_TEXT = {
     -2: "the step size fell to round-off: the slip rate runs away (a dynamic instability the quasi-static "
     "model cannot follow; a stiffer spring or a smaller step of the load point stays quasi-static)",
 }
+
+
+def checked(method: str, rtol: float, atol: float) -> tuple[float, float]:
+    """``rtol`` and ``atol`` checked (1e-14 <= rtol <= 1, atol > 0) for a ``method`` of :data:`METHODS`.
+
+    Raises
+    ------
+    ParameterError
+        An unknown method or a tolerance out of range, in one line.
+    """
+    if method not in METHODS:
+        raise ParameterError(f"method must be one of {', '.join(METHODS)} (got {method!r})")
+    return check_number("rtol", rtol, low=1e-14, high=1.0), check_number("atol", atol, low=0.0, low_open=True)
 
 
 class IntegrationError(RuntimeError):

@@ -17,7 +17,7 @@ import numpy as np
 import xarray as xr
 
 from stickslip.lab.history import LoadHistory
-from stickslip.lab.integrate import METHODS, integrate
+from stickslip.lab.integrate import checked, integrate
 from stickslip.lab.laws import RateState, friction_of, steady_theta
 from stickslip.models.params import ParameterError, check_number
 
@@ -124,10 +124,7 @@ def solve(
         ``t``, ``mu``, ``v``, ``theta`` (t, m), ``y0`` and the integrator's ``info``.
     """
     k = model.require_k()
-    if method not in METHODS:
-        raise ParameterError(f"method must be one of {', '.join(METHODS)} (got {method!r})")
-    rtol = check_number("rtol", rtol, low=1e-14, high=1.0)
-    atol = check_number("atol", atol, low=0.0, low_open=True)
+    rtol, atol = checked(method, rtol, atol)
     y0 = initial_state(model, history, v_init=v_init, theta_init=theta_init)
     Y, v, info = integrate(model, history, y0, t, rtol=rtol, atol=atol, method=method)
     tau = Y[:, 0]
