@@ -172,3 +172,14 @@ def test_critical_stiffness_with_a_mass_is_rice_and_ruinas_and_the_runs_obey_it(
         swing = np.abs(ds.v.values - 1.0)
         late = swing[ds.t.values > 2500.0].max()
         assert (late > 10.0 * swing[0]) if grows else (late < 1e-6 * swing[0]), (factor, late)
+
+
+@pytest.mark.parametrize("method", ["LSODA", "Radau"])
+def test_the_solve_ivp_routes_count_their_steps_not_their_outputs(method):
+    model = RateState(**LAB, b=(0.006, 0.004), Dc=(5.0, 50.0), law=("aging", "slip"), k=1e-3, form="asinh")
+    history = LoadHistory.steps([1.0, 10.0, 0.0, 1.0], [10.0, 40.0, 30.0, 40.0])
+    for run in (quasi_static, lambda m, h, **kw: inertial_slider(m, h, 1e-3, **kw)):
+        few, many = (run(model, history, n=n, method=method) for n in (11, 301))
+        # the step sequence does not depend on where the outputs are read
+        assert few.attrs["steps"] == many.attrs["steps"] > 0
+        assert few.attrs["evaluations"] > few.attrs["steps"]

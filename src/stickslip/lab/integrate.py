@@ -169,12 +169,13 @@ def _solve_ivp_history(args, seg_t, seg_v, y0, t_out, rtol, atol, method):
 
         inside = (t_out >= t0) & ((t_out < t1) | ((s == seg_t.size - 2) & (t_out <= t1)))
         t_eval = np.unique(np.concatenate([t_out[inside], [t1]]))
-        sol = solve_ivp(fun, (t0, t1), y, method=method, t_eval=t_eval, rtol=rtol, atol=atol)
+        # dense_output keeps the steps' own times (sol.sol.ts); the values at t_eval are the same.
+        sol = solve_ivp(fun, (t0, t1), y, method=method, t_eval=t_eval, rtol=rtol, atol=atol, dense_output=True)
         if sol.status != 0 or not np.all(np.isfinite(sol.y)):
             raise IntegrationError(f"the integration stopped in [{t0:g}, {t1:g}]: {sol.message}")
         Y[inside] = sol.y[:, :-1].T if t_eval[-1] not in t_out[inside] else sol.y.T
         y = sol.y[:, -1].copy()
-        steps += sol.t.size
+        steps += sol.sol.ts.size - 1
         nfev += sol.nfev
     v = np.array([rhs(0.0, row, out, 0.0, *args) for row in Y])
     return Y, v, {"method": method, "steps": int(steps), "evaluations": int(nfev)}
