@@ -39,7 +39,16 @@ _LOWER = {"a": 0.0, "Dc": 0.0, "k": 0.0, "eta": 0.0}
 
 
 def base_name(name: str) -> str:
-    """The parameter a fitted name sets: ``Dc2`` -> ``Dc``, ``b1`` -> ``b``, ``mu0`` -> ``mu0``."""
+    """The parameter a fitted name sets: ``Dc2`` -> ``Dc``, ``b1`` -> ``b``, ``mu0`` -> ``mu0``.
+
+    Parameters
+    ----------
+    name : str
+
+    Returns
+    -------
+    str
+    """
     for stem in ("Dc", "b"):
         if name.startswith(stem) and name[len(stem) :].isdigit():
             return stem
@@ -48,6 +57,17 @@ def base_name(name: str) -> str:
 
 def start_value(model: RateState, name: str, trend: float = 0.0) -> float:
     """The model's value of a fitted name (``b2`` the second state variable's b; ``trend`` ``trend``).
+
+    Parameters
+    ----------
+    model : RateState
+    name : str
+    trend : float
+        The value of ``trend``.
+
+    Returns
+    -------
+    float
 
     Raises
     ------

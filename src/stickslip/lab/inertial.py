@@ -57,7 +57,16 @@ def critical_stiffness_inertial(model: RateState, M: float, V: float) -> float:
 def on_chain(model: RateState) -> bool:
     """Whether the chain's single block has the model: one state variable with a law of
     :data:`FRICTION` and no radiation damping (the others take the adaptive route,
-    :func:`stickslip.lab.inertial_ode.inertial_slider`)."""
+    :func:`stickslip.lab.inertial_ode.inertial_slider`).
+
+    Parameters
+    ----------
+    model : RateState
+
+    Returns
+    -------
+    bool
+    """
     return model.n_states == 1 and model.law[0] in FRICTION and model.eta == 0.0
 
 

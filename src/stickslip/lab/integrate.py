@@ -76,6 +76,16 @@ STATUS_TEXT = {
 def checked(method: str, rtol: float, atol: float) -> tuple[float, float]:
     """``rtol`` and ``atol`` checked (1e-14 <= rtol <= 1, atol > 0) for a ``method`` of :data:`METHODS`.
 
+    Parameters
+    ----------
+    method : str
+    rtol, atol : float
+
+    Returns
+    -------
+    tuple of float
+        (rtol, atol) as floats.
+
     Raises
     ------
     ParameterError

@@ -136,7 +136,24 @@ def solve(
 
 def slip_of(history: LoadHistory, t_out, tau, tau0: float, k: float):
     """x(t) - x(0) = p(t) - p(0) - (tau - tau_0) / k from the spring's tau = k (p - x) (the load
-    point's own displacement for a rigid machine, k = inf)."""
+    point's own displacement for a rigid machine, k = inf).
+
+    Parameters
+    ----------
+    history : LoadHistory
+    t_out : array
+        Times.
+    tau : array
+        The spring's friction at ``t_out``.
+    tau0 : float
+        The spring's friction at the history's start.
+    k : float
+        Stiffness.
+
+    Returns
+    -------
+    numpy.ndarray
+    """
     dp = history.position(t_out) - float(history.position(history.times[0]))
     return dp if k == np.inf else dp - (tau - tau0) / k
 
@@ -199,7 +216,31 @@ def dataset(model: RateState, history: LoadHistory, t_out, tau, v, Y, slip, info
     """The Dataset of a spring-slider's run (:func:`quasi_static`, and the inertial one of
     :mod:`stickslip.lab.inertial_ode`): ``mu``, ``v``, ``theta`` (with a ``state`` dimension
     when m > 1), ``load_point``, ``V`` and ``slip`` over ``t``, the parameters as attributes
-    (and the mass M where M > 0)."""
+    (and the mass M where M > 0).
+
+    Parameters
+    ----------
+    model : RateState
+    history : LoadHistory
+    t_out : array
+        Output times.
+    tau, v : array
+        The spring's friction and the slip rate at ``t_out``.
+    Y : array (len(t_out), m)
+        The state variables.
+    slip : array
+        x - x(0) (:func:`slip_of`).
+    info : dict
+        The integrator's ``method``, ``steps`` and ``evaluations``.
+    rtol, atol : float
+        The tolerances used.
+    M : float
+        The mass (0: quasi-static).
+
+    Returns
+    -------
+    xarray.Dataset
+    """
     m = model.n_states
     theta = (("t", "state"), Y) if m > 1 else ("t", Y[:, 0])
     coords = {"t": ("t", t_out, {"long_name": "time"})}
