@@ -138,7 +138,7 @@ _LN2 = math.log(2.0)
 def mu_at(v, psi, a, V0, form):
     """mu(v, theta) of the state's psi at any slip rate v: psi + a ln(v / V0) (log form, v > 0) or
     a asinh(v / (2 V0) exp(psi / a)) (asinh form, odd in v), the latter through ln z for
-    z = |v| / (2 V0) exp(psi / a) > e^20, where asinh z = ln 2z to round-off and exp could overflow."""
+    z = abs(v) / (2 V0) exp(psi / a) > e^20, where asinh z = ln 2z to round-off and exp could overflow."""
     if form == 0:
         return psi + a * math.log(v / V0)
     s = 0.5 * abs(v) / V0
