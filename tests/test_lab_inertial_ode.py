@@ -183,3 +183,16 @@ def test_the_solve_ivp_routes_count_their_steps_not_their_outputs(method):
         # the step sequence does not depend on where the outputs are read
         assert few.attrs["steps"] == many.attrs["steps"] > 0
         assert few.attrs["evaluations"] > few.attrs["steps"]
+
+
+def test_auto_crosses_a_short_hold_explicitly_and_a_long_one_with_lsoda():
+    from stickslip.lab.integrate import HOLD_BUDGET
+
+    model = RateState(**LAB, b=0.012, Dc=10.0, k=5e-3, form="asinh").with_values(a=0.01)
+    short = inertial_slider(model, LoadHistory.steps([1.0, 0.0, 1.0], [20.0, 10.0, 40.0]), 1e-3, n=71)
+    assert short.attrs["integrator"] == "dop853" and short.attrs["steps"] < HOLD_BUDGET
+    history = LoadHistory.slide_hold_slide(10.0, 20.0, [300.0])
+    t = np.linspace(0.0, history.t_end, 201)
+    long = inertial_slider(model, history, 1e-5, t=t)
+    assert long.attrs["integrator"] == "LSODA"
+    np.testing.assert_array_equal(long.mu.values, inertial_slider(model, history, 1e-5, t=t, method="LSODA").mu.values)

@@ -8,8 +8,8 @@ pulled through a spring of stiffness k by a load point at p(t) (:class:`~sticksl
 integrated over y = (tau, v, theta_1 .. theta_m) with tau = k (p - x) the spring's friction, so
 that dtau/dt = k (V(t) - v) (:func:`stickslip.lab.compiled.rhs` with M > 0). It is the
 quasi-static spring-slider of :mod:`stickslip.lab.spring_slider` with the mass put back: the same
-compiled right-hand side, laws and integrators (DOP853, or LSODA through holds and for stiff
-springs: :mod:`stickslip.lab.integrate`), so each state variable may follow its own law (aging,
+compiled right-hand side, laws and integrators (DOP853, or LSODA for stiff springs and through
+holds too long for DOP853: :mod:`stickslip.lab.integrate`), so each state variable may follow its own law (aging,
 slip, PRZ, Nagata) in the log or the asinh form, with radiation damping eta. As M -> 0 it tends to
 the quasi-static solution linearly in M.
 
@@ -101,7 +101,8 @@ def inertial_slider(
     rtol, atol : float
         Tolerances of the error control.
     method : str
-        ``auto`` (``dop853``, or ``LSODA`` through a hold or for a very stiff spring), ``dop853``,
+        ``auto`` (``dop853``; ``LSODA`` for a very stiff spring, or through a hold that ``dop853``
+        does not cross in :data:`~stickslip.lab.integrate.HOLD_BUDGET` steps), ``dop853``,
         ``LSODA``, ``Radau`` or ``BDF`` (:mod:`stickslip.lab.integrate`).
 
     Returns

@@ -14,7 +14,10 @@ Two routes over the same compiled right-hand side (:func:`stickslip.lab.laws.rhs
   explicit method needs many small steps.
 - ``auto`` (the default of the callers): ``dop853`` unless the stiffness ratio
   S = k V_max min(D_c) / a exceeds 3000, then ``LSODA`` (the threshold's measurements are in
-  docs/performance.md).
+  docs/performance.md). For the inertial spring-slider through a hold, ``dop853`` for at most
+  :data:`HOLD_BUDGET` steps, then ``LSODA`` from the start: a short hold is over in a few
+  thousand explicit steps, a long one drives the slip rate, and with it the block's relaxation
+  time M v / a, down by orders of magnitude.
 """
 
 from __future__ import annotations
@@ -54,14 +57,22 @@ def stiffness_ratio(model, history, v_init: float | None = None) -> float:
     return model.k * v_max * min(model.Dc) / model.a
 
 
+#: Steps ``auto`` gives ``dop853`` through a hold of the inertial spring-slider before it takes
+#: LSODA (about 0.1 s of the compiled integrator; module docstring).
+HOLD_BUDGET = 100_000
+
+
 def choose(method: str, model, history, v_init: float | None = None, M: float = 0.0) -> str:
-    """The integrator ``auto`` stands for: ``dop853`` up to :data:`STIFF_RATIO`, ``LSODA`` above;
-    for the inertial spring-slider (M > 0) also ``LSODA`` through a hold, where the slip rate
-    falls and with it the block's relaxation time M v / a."""
+    """The integrator ``auto`` stands for: ``dop853`` up to :data:`STIFF_RATIO`, ``LSODA`` above.
+    For the inertial spring-slider (M > 0) through a hold, where the slip rate falls and with it
+    the block's relaxation time M v / a, ``dop853`` first for at most :data:`HOLD_BUDGET` steps
+    and ``LSODA`` after it (:func:`integrate`); ``auto`` stands for that."""
     if method != "auto":
         return method
+    if stiffness_ratio(model, history, v_init) > STIFF_RATIO:
+        return "LSODA"
     hold = M > 0.0 and bool(np.any(np.asarray(history.velocities) == 0.0))
-    return "LSODA" if hold or stiffness_ratio(model, history, v_init) > STIFF_RATIO else "dop853"
+    return "auto" if hold else "dop853"
 
 
 #: Status codes of the compiled route.
@@ -137,6 +148,9 @@ def integrate(model, history, y0, t_out, *, rtol=1e-10, atol=1e-12, method="dop8
     seg_v = np.ascontiguousarray(history.velocities, dtype=float)
     t_out = np.ascontiguousarray(t_out, dtype=float)
     y0 = np.ascontiguousarray(y0, dtype=float)
+    budgeted = method == "auto"  # an inertial run through a hold (choose)
+    if budgeted:
+        method, max_steps = "dop853", min(max_steps, HOLD_BUDGET)
     if method == "dop853":
         Y, v, status, steps, nfev = dop853_history(
             y0,
@@ -156,6 +170,8 @@ def integrate(model, history, y0, t_out, *, rtol=1e-10, atol=1e-12, method="dop8
             _D,
             args,
         )
+        if status != 0 and budgeted:
+            return _solve_ivp_history(args, seg_t, seg_v, y0, t_out, rtol, atol, "LSODA")
         if status != 0:
             t_last = t_out[np.flatnonzero(np.isfinite(v))[-1]] if np.isfinite(v).any() else seg_t[0]
             raise IntegrationError(f"the integration stopped after t = {t_last:g}: {STATUS_TEXT[status]}")
