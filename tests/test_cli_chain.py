@@ -145,6 +145,7 @@ def test_bench_partly_stuck_json(capsys):
     assert data["workload"]["steps"] == 40000 and data["workload"]["N"] == 20 and data["workload"]["beta"] == 1.3
     assert 0 < data["exact_block_updates"] <= 20 * 40000
     assert data["repeat"] == 3  # the default of this workload: its exact run is short
+    assert data["exact_timings"] == 15  # five of the exact run for each of the dense one
     status, out, _ = run_cli(
         capsys, "bench", "--workload", "partly-stuck", "--N", "20", "--t-end", "200", "--repeat", "1", "--json"
     )
