@@ -174,20 +174,16 @@ def sample(
     V1 = float(history.velocities[0])
     if V1 <= 0.0:
         raise ParameterError("the inertial route starts in steady sliding: the history must start at V > 0")
-    lab = RateState(
-        a=model.a, b=model.b, Dc=model.Dc, mu0=model.mu0, V0=model.V0, k=model.k, law=model.law, c=model.c,
-        eta=model.eta, form="asinh",
-    )  # fmt: skip
+    lab = model.with_values(form="asinh")
+    v0 = (1.0 + kick) * V1 if v_init is None else check_number("v_init", v_init, low=0.0, low_open=True)
     if not on_chain(model):
         from stickslip.lab.inertial_ode import inertial_slider
 
-        v_kick = 0.0 if v_init is None else check_number("v_init", v_init, low=0.0, low_open=True) / V1 - 1.0
-        ds = inertial_slider(lab, history, M, t=t, kick=kick if v_init is None else v_kick)
+        ds = inertial_slider(lab, history, M, t=t, kick=kick if v_init is None else v0 / V1 - 1.0)
         return {"t": t, "mu": ds.mu.values, "v": ds.v.values, "steps": int(ds.attrs["steps"])}
     # the chain's time starts at 0: the history shifted to start there
     shifted = LoadHistory.table(history.times - t0, history.positions)
     p = chain_params_of(model, M, dt, shifted)
-    v0 = (1.0 + kick) * V1 if v_init is None else check_number("v_init", v_init, low=0.0, low_open=True)
     theta = float(steady_theta(lab, V1)[0])
     p0 = float(history.positions[0])
     x0 = p0 - friction_of(lab, V1, np.array([theta])) / p.K

@@ -28,7 +28,7 @@ import xarray as xr
 from stickslip.lab.history import LoadHistory
 from stickslip.lab.integrate import checked, integrate
 from stickslip.lab.laws import RateState
-from stickslip.lab.spring_slider import dataset, output_times, slip_of
+from stickslip.lab.spring_slider import dataset, initial_state, output_times, slip_of
 from stickslip.models.params import ParameterError, check_number
 
 __all__ = ["inertial_slider", "initial_state_inertial"]
@@ -60,8 +60,6 @@ def initial_state_inertial(
     ParameterError
         No positive v_init (a history that starts with a hold), a bad theta_init or kick.
     """
-    from stickslip.lab.spring_slider import initial_state
-
     kick = check_number("kick", kick, low=-1.0, low_open=True)
     y = initial_state(model, history, v_init=v_init, theta_init=theta_init)
     v = float(history.velocities[0]) if v_init is None else float(v_init)
